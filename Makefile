@@ -1,0 +1,39 @@
+# The two entry points on a fresh machine: `make demo` and `make test`.
+# Both create the virtual environment .venv and install the project into it first.
+
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+
+.PHONY: demo test lint typecheck pytest clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	touch $(STAMP)
+
+demo: $(STAMP)
+	$(BIN)/rl1c check examples/sample.rob
+
+test: lint typecheck pytest
+
+lint: $(STAMP)
+	$(BIN)/ruff check compiler vm lsp tests bench
+
+# mypy cannot follow setuptools' editable-install mapping of rl1.compiler onto
+# compiler/, so it checks a tree of symlinks with the installed names.
+typecheck: $(STAMP)
+	rm -rf .typecheck && mkdir -p .typecheck/rl1
+	ln -s ../../compiler .typecheck/rl1/compiler
+	ln -s ../../vm .typecheck/rl1/vm
+	ln -s ../../lsp .typecheck/rl1/lsp
+	MYPYPATH=.typecheck $(BIN)/mypy -p rl1.compiler -p rl1.vm -p rl1.lsp
+	MYPYPATH=.typecheck $(BIN)/mypy tests $(wildcard bench/*.py)
+
+pytest: $(STAMP)
+	$(BIN)/pytest -n 2
+
+clean:
+	rm -rf $(VENV) .typecheck .mypy_cache .pytest_cache .ruff_cache .hypothesis

@@ -1,0 +1,168 @@
+"""The built-in functions of RL/I (the paper's Tables 2 and 3) as data.
+
+One table serves every stage: the checker (arity, kinds, ranges), the code generator
+(opcodes and device features), the VMs (which reserved variables a call writes) and the
+language server (hover, completion, signature help, inlay hints). spec/language.md
+renders the same facts for people; keep the two in step.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+
+
+class Feature(Enum):
+    """Device features a program may need; the .ilc header lists those it uses."""
+
+    MOTION = 0
+    STEERING = 1
+    CAMERA = 2
+    VISION = 3
+    ULTRASONIC = 4
+    IO = 5
+    FUZZY = 6
+
+
+@dataclass(frozen=True, slots=True)
+class Param:
+    name: str
+    low: int
+    high: int
+    meaning: str
+
+    def describe(self) -> str:
+        return f"{self.name}: {self.meaning}, {self.low}..{self.high}"
+
+
+@dataclass(frozen=True, slots=True)
+class Form:
+    """One way to call a built-in. Most have a single form with `selector` None;
+    `(CAM ...)` and `(ULT ...)` have one form per selector letter."""
+
+    selector: str | None
+    params: tuple[Param, ...]
+    summary: str
+    result: str | None = None  # what the call returns, None if it returns nothing
+    writes: tuple[str, ...] = ()  # reserved variables the call sets
+
+    @property
+    def returns_value(self) -> bool:
+        return self.result is not None
+
+
+@dataclass(frozen=True, slots=True)
+class Builtin:
+    mnemonic: str
+    name: str  # the paper's expansion of the mnemonic
+    group: str  # "motion" (Table 2) or "sensing" (Table 3)
+    feature: Feature | None
+    waits: bool  # True when the call takes device time before the next statement runs
+    forms: tuple[Form, ...]
+
+    @property
+    def has_selector(self) -> bool:
+        return self.forms[0].selector is not None
+
+    def form(self, selector: str | None) -> Form | None:
+        return next((form for form in self.forms if form.selector == selector), None)
+
+
+WHEEL_SPEED = "wheel speed"
+
+
+def _one(summary: str, *params: Param, result: str | None = None,
+         writes: tuple[str, ...] = ()) -> tuple[Form, ...]:
+    return (Form(None, params, summary, result, writes),)
+
+
+BUILTINS: dict[str, Builtin] = {
+    b.mnemonic: b
+    for b in (
+        Builtin("FRE", "Free", "motion", Feature.MOTION, False,
+                _one("Free the drive axes (the wheels turn freely).")),
+        Builtin("HLD", "Hold", "motion", Feature.MOTION, False,
+                _one("Hold (lock) the drive axes.")),
+        Builtin("ORG", "Origin", "motion", Feature.STEERING, True,
+                _one("Return the steering to its origin.")),
+        Builtin("MVI", "Move mediate", "motion", Feature.MOTION, True,
+                _one("Move at the given wheel speeds for a distance; waits until done.",
+                     Param("l", -12, 12, "left " + WHEEL_SPEED),
+                     Param("r", -12, 12, "right " + WHEEL_SPEED),
+                     Param("cm", -1900, 1900, "distance in cm"))),
+        Builtin("MOV", "Move", "motion", Feature.MOTION, False,
+                _one("Start moving at the given wheel speeds; the next statement runs at once.",
+                     Param("l", -12, 12, "left " + WHEEL_SPEED),
+                     Param("r", -12, 12, "right " + WHEEL_SPEED))),
+        Builtin("STR", "Steer Right", "motion", Feature.STEERING, True,
+                _one("Turn the steering right.", Param("deg", 0, 180, "angle in degrees"))),
+        Builtin("STL", "Steer Left", "motion", Feature.STEERING, True,
+                _one("Turn the steering left.", Param("deg", 0, 180, "angle in degrees"))),
+        Builtin("STX", "Steer X", "motion", Feature.STEERING, True,
+                _one("Steer to a signed angle in 0.1 degree units (+ left, - right).",
+                     Param("tenths", -1800, 1800, "angle in 0.1 degrees"))),
+        Builtin("ROT", "Rotate", "motion", Feature.MOTION, True,
+                _one("Turn on the spot by differential wheel drive (PWS).",
+                     Param("deg", -360, 360, "angle in degrees, + left, - right"))),
+        Builtin("TRC", "Trace", "motion", Feature.MOTION, False,
+                _one("Set the line-tracing mode (what a lost line does, Table 4).",
+                     Param("mode", 0, 3, "tracing mode"))),
+        Builtin("TIM", "Time", "motion", None, True,
+                _one("Stop the program and wait, in 0.1 s units.",
+                     Param("tenths", 1, 100, "time in 0.1 s"))),
+        Builtin("KYC", "Kyori Clear", "sensing", Feature.MOTION, False,
+                _one("Clear the distance counters.")),
+        Builtin("KYO", "Kyori", "sensing", Feature.MOTION, False,
+                _one("Read the distance counters.",
+                     result="movement of the vehicle centre (cm)", writes=("u", "v"))),
+        Builtin("SCN", "Scene", "sensing", Feature.VISION, False,
+                _one("Switch the vision sensor's scene (a stored recognition set-up).",
+                     Param("scene", 0, 7, "scene number"))),
+        Builtin("IMG", "Image", "sensing", Feature.VISION, True,
+                _one("Measure with the vision sensor.",
+                     result="area of the recognised image (pixels)",
+                     writes=("w", "x", "y", "z"))),
+        Builtin("CAM", "Camera", "sensing", Feature.CAMERA, True, (
+            Form("Z", (), "Camera to its origin."),
+            Form("U", (), "Tilt the camera up."),
+            Form("D", (), "Tilt the camera down."),
+            Form("A", (Param("deg", 0, 180, "pan angle in degrees"),),
+                 "Pan the camera to an angle."),
+            Form("P", (Param("pulse", 0, 784, "pan pulse position"),),
+                 "Pan the camera to a pulse position."),
+            Form("R", (), "Read the camera's pan position.",
+                 result="pan pulse position (0..784)"),
+        )),
+        Builtin("ULT", "Ultra", "sensing", Feature.ULTRASONIC, True, tuple(
+            Form(letter, (), f"Ultrasonic range reading from sensor {letter}.",
+                 result="distance (cm)")
+            for letter in "ABCD"
+        )),
+        Builtin("LMP", "Lamp", "sensing", Feature.VISION, False,
+                _one("Switch the lighting off or on.", Param("on", 0, 1, "0 off, 1 on"))),
+        Builtin("INP", "Input", "sensing", Feature.IO, False,
+                _one("Read an input port.", Param("port", 0, 0x7D, "input port"),
+                     result="the port's data (0..255)")),
+        Builtin("OUT", "Output", "sensing", Feature.IO, False,
+                _one("Write data to an output port.", Param("port", 0, 0x7D, "output port"),
+                     Param("data", 0, 255, "data byte"))),
+        Builtin("FZO", "Fuzzy Out", "sensing", Feature.FUZZY, False,
+                _one("Write two values to the fuzzy-logic board.",
+                     Param("a", -32768, 32767, "first value"),
+                     Param("b", -32768, 32767, "second value"))),
+        Builtin("FZI", "Fuzzy In", "sensing", Feature.FUZZY, False,
+                _one("Read the fuzzy-logic board into s and t.", writes=("s", "t"))),
+    )
+}
+
+RESERVED_VARIABLES = "stuvwxyz"
+VARIABLES = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz@"
+"""The 53 variables in their index order (the .ilc variable index)."""
+
+HANDLER_LABELS = range(96, 100)
+"""`:96`-`:99`: where a lost guidance line sends the program (Table 4)."""
+
+
+def writers_of(variable: str) -> list[tuple[Builtin, Form]]:
+    """The built-in forms that set a reserved variable."""
+    return [(b, form) for b in BUILTINS.values() for form in b.forms if variable in form.writes]

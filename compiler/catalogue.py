@@ -1,0 +1,43 @@
+"""The catalogue of diagnostic codes: each code's severity, title and long explanation.
+
+Codes are stable: never reuse or renumber one. Ranges by area:
+E01xx source and syntax · E02xx/W02xx labels · E03xx/W03xx tracing handlers ·
+W04xx reserved variables · E05xx/W05xx calls and constants · W06xx control flow ·
+W07xx safety. The long explanation of CODE is explanations/CODE.md, printed by
+`rl1c explain CODE`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from .diagnostics import Severity
+
+_EXPLANATIONS = Path(__file__).with_name("explanations")
+
+
+@dataclass(frozen=True, slots=True)
+class CodeInfo:
+    code: str
+    severity: Severity
+    title: str
+
+    def explanation(self) -> str:
+        return (_EXPLANATIONS / f"{self.code}.md").read_text(encoding="utf-8")
+
+
+def _entries(*rows: tuple[str, Severity, str]) -> dict[str, CodeInfo]:
+    return {code: CodeInfo(code, severity, title) for code, severity, title in rows}
+
+
+E, W = Severity.ERROR, Severity.WARNING
+
+CODES: dict[str, CodeInfo] = _entries(
+    ("E0100", E, "source file cannot be read"),
+    ("E0101", E, "syntax error"),
+    ("E0102", E, "unexpected character"),
+    ("E0103", E, "a word that is not a variable"),
+    ("E0104", E, "label not at the start of a line"),
+    ("E0105", E, "malformed hex constant"),
+)

@@ -1,0 +1,27 @@
+"""The front end in one call: source text to AST and sorted diagnostics."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .ast import Program
+from .checker import check
+from .diagnostics import Diagnostic, sort_key
+from .parser import parse_program
+
+
+@dataclass(frozen=True, slots=True)
+class Analysis:
+    program: Program
+    diagnostics: list[Diagnostic]
+
+    @property
+    def has_errors(self) -> bool:
+        return any(diagnostic.is_error for diagnostic in self.diagnostics)
+
+
+def analyze(text: str) -> Analysis:
+    program, diagnostics = parse_program(text)
+    diagnostics.extend(check(program))
+    diagnostics.sort(key=sort_key)
+    return Analysis(program, diagnostics)

@@ -1,0 +1,277 @@
+"""The parser: RL/I text to the AST, one line at a time.
+
+Each line is parsed alone by lark's LALR parser (grammar.lark, tokens from scanner.py), so
+a syntax error on one line never hides the errors on the others, and the language server
+can re-parse only the lines an edit touches. The lark parser is built once per process
+and cached on disk between processes.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import unicodedata
+from pathlib import Path
+from typing import cast
+
+import lark
+from lark.exceptions import UnexpectedInput, UnexpectedToken
+from lark.lexer import Lexer, Token
+
+from . import ast
+from .builtins import BUILTINS
+from .diagnostics import Diagnostic, Severity
+from .scanner import ScanError, scan
+from .source import split_lines
+
+GRAMMAR = Path(__file__).with_name("grammar.lark")
+
+# What each terminal is called in "expected ..." messages.
+TERMINAL_NAMES = {
+    "VAR": "a variable", "NUMBER": "a number", "HEX": "a `$` hex constant",
+    "MNEMONIC": "a function name", "LABELREF": "a jump target `#NN`", "LABEL": "a label",
+    "EQUAL": "`=`", "INCDEC": "`++` or `--`", "QMARK": "`?`", "LPAR": "`(`", "RPAR": "`)`",
+    "PLUS": "an operator", "MINUS": "an operator", "AMP": "an operator", "BAR": "an operator",
+    "CARET": "an operator", "LESS": "`<`", "MORE": "`>`", "_SEMI": "`;`", "_COMMA": "`,`",
+    "WORD": "a word", "$END": "the end of the line",
+}
+
+
+_ParsedLine = tuple[ast.LabelDef | None, tuple[ast.Statement, ...]]
+
+
+class _ScannerLexer(Lexer):
+    """Adapts scanner.scan to lark's custom-lexer interface."""
+
+    def __init__(self, lexer_conf: object) -> None:
+        pass
+
+    def lex(self, data: str) -> object:  # type: ignore[override]
+        return scan(data)
+
+
+class _AstBuilder(lark.Transformer):  # type: ignore[type-arg]
+    """Builds AST nodes as lark reduces rules (no intermediate parse tree)."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.line_number = 1
+        self.problems: list[Diagnostic] = []
+
+    def span(self, token: Token) -> ast.Span:
+        start = int(token.start_pos or 0) + 1
+        return ast.Span(self.line_number, start, self.line_number, start + len(token))
+
+    def operand(self, item: Token | ast.Call) -> ast.Var | ast.Const | ast.Call:
+        if isinstance(item, ast.Call):
+            return item
+        if item.type == "VAR":
+            return ast.Var(self.span(item), str(item))
+        return self.constant(item)
+
+    def constant(self, token: Token) -> ast.Const:
+        text = str(token)
+        if token.type == "NUMBER":
+            return ast.Const(self.span(token), int(text), text, False)
+        digits = text[1:]
+        try:
+            value = int(digits, 16)
+        except ValueError:
+            value = -1
+        if not 0 <= value <= 0xFFFF:
+            self.problems.append(Diagnostic(
+                "E0105", Severity.ERROR,
+                f"`{text}` is not a 16-bit hex constant",
+                self.span(token),
+                help="write `$` and one to four hex digits 0-9, A-F, e.g. `$FF` or `$AA55`",
+            ))
+            value = 0
+        return ast.Const(self.span(token), value - 0x10000 if value >= 0x8000 else value,
+                         text, True)
+
+    def line(self, items: list[object]) -> _ParsedLine:
+        label = None
+        if items and isinstance(items[0], Token):
+            token = items.pop(0)
+            assert isinstance(token, Token)
+            digits = str(token)[1:]
+            number = int(digits) if len(digits) == 2 else None
+            label = ast.LabelDef(self.span(token), str(token), number)
+        return label, tuple(items)  # type: ignore[arg-type]
+
+    def assign(self, items: list[object]) -> ast.Assign:
+        target_token, _, first, *steps = items
+        assert isinstance(target_token, Token)
+        target = ast.Var(self.span(target_token), str(target_token))
+        first_operand = self.operand(first)  # type: ignore[arg-type]
+        rest = tuple(step for step in steps if isinstance(step, ast.BinaryStep))
+        end = rest[-1].span if rest else first_operand.span
+        return ast.Assign(target.span.cover(end), target, first_operand, rest)
+
+    def step(self, items: list[object]) -> ast.BinaryStep:
+        op_token, operand_item = items
+        assert isinstance(op_token, Token)
+        operand = self.operand(operand_item)  # type: ignore[arg-type]
+        op_span = self.span(op_token)
+        return ast.BinaryStep(op_span.cover(operand.span), str(op_token),  # type: ignore[arg-type]
+                              op_span, operand)
+
+    def incdec(self, items: list[Token]) -> ast.IncDec:
+        var_token, step_token = items
+        target = ast.Var(self.span(var_token), str(var_token))
+        return ast.IncDec(target.span.cover(self.span(step_token)), target,
+                          str(step_token))  # type: ignore[arg-type]
+
+    def label_ref(self, token: Token) -> ast.LabelRef:
+        digits = str(token)[1:]
+        return ast.LabelRef(self.span(token), str(token), int(digits) if len(digits) == 2 else None)
+
+    def goto(self, items: list[Token]) -> ast.Goto:
+        target = self.label_ref(items[0])
+        return ast.Goto(target.span, target)
+
+    def condjump(self, items: list[Token]) -> ast.CondJump:
+        qmark, var_token, relation, target_token = items
+        target = self.label_ref(target_token)
+        return ast.CondJump(self.span(qmark).cover(target.span),
+                            ast.Var(self.span(var_token), str(var_token)),
+                            str(relation), target)  # type: ignore[arg-type]
+
+    def call(self, items: list[Token]) -> ast.Call:
+        lpar, mnemonic, *args, rpar = items
+        builtin = BUILTINS.get(str(mnemonic).upper())
+        built: list[ast.Arg] = []
+        for index, arg in enumerate(args):
+            if index == 0 and arg.type == "VAR" and builtin is not None and builtin.has_selector:
+                built.append(ast.Selector(self.span(arg), str(arg)))
+            else:
+                built.append(self.operand(arg))  # type: ignore[arg-type]
+        return ast.Call(self.span(lpar).cover(self.span(rpar)), str(mnemonic),
+                        self.span(mnemonic), tuple(built))
+
+    def call_stmt(self, items: list[ast.Call]) -> ast.CallStmt:
+        return ast.CallStmt(items[0].span, items[0])
+
+
+def _build_lark() -> tuple[lark.Lark, _AstBuilder]:
+    builder = _AstBuilder()
+    cache = Path(tempfile.gettempdir()) / f"rl1-grammar-{lark.__version__}.cache"
+    parser = lark.Lark(
+        GRAMMAR.read_text(encoding="utf-8"),
+        start="line",
+        parser="lalr",
+        lexer=_ScannerLexer,
+        transformer=builder,
+        cache=str(cache),
+    )
+    return parser, builder
+
+
+_parser: tuple[lark.Lark, _AstBuilder] | None = None
+
+
+def _lark() -> tuple[lark.Lark, _AstBuilder]:
+    global _parser
+    if _parser is None:
+        _parser = _build_lark()
+    return _parser
+
+
+def _syntax_error(line: int, error: Exception, code: str) -> Diagnostic:
+    if isinstance(error, ScanError):
+        span = ast.Span(line, error.column + 1, line, error.column + 2)
+        return _bad_character(span, error.character)
+    assert isinstance(error, UnexpectedToken)
+    token = error.token
+    if token.type == "$END":
+        column, width = len(code.rstrip()) + 1, 1
+    else:
+        column, width = int(token.start_pos or 0) + 1, max(len(token), 1)
+    span = ast.Span(line, column, line, column + width)
+    if token.type == "WORD":
+        return _misused_word(span, str(token))
+    if token.type == "LABEL":
+        return Diagnostic(
+            "E0104", Severity.ERROR, f"the label `{token}` is not at the start of its line",
+            span, help="a label `:NN` may only start a line: move it to a line of its own",
+        )
+    expected = sorted({TERMINAL_NAMES.get(name, name) for name in error.expected})
+    found = "the end of the line" if token.type == "$END" else f"`{token}`"
+    return Diagnostic(
+        "E0101", Severity.ERROR,
+        f"expected {_either(expected)}, found {found}", span,
+        help=_syntax_help(str(token), error.expected),
+    )
+
+
+def _either(names: list[str]) -> str:
+    return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " or " + names[-1]
+
+
+def _syntax_help(found: str, expected: set[str]) -> str | None:
+    if "VAR" in expected and "NUMBER" in expected and found.startswith("-"):
+        return "there is no unary minus on a variable: write `0-V` for the negative of V"
+    if expected == {"RPAR"} or ("RPAR" in expected and "_COMMA" in expected):
+        return "close the call with `)`"
+    if "LABELREF" in expected:
+        return "a jump target is `#` and two digits, e.g. `#10`"
+    return None
+
+
+def _bad_character(span: ast.Span, character: str) -> Diagnostic:
+    ascii_form = unicodedata.normalize("NFKC", character)
+    if ascii_form != character and ascii_form.isascii() and ascii_form.strip():
+        help_text = f"this is a full-width character: type the ASCII `{ascii_form}` instead"
+    elif character == "\u3000":
+        help_text = "this is a full-width space: type an ASCII space instead"
+    else:
+        help_text = "RL/I code is ASCII; text in any script may follow `'` as a comment"
+    name = unicodedata.name(character, f"U+{ord(character):04X}")
+    return Diagnostic("E0102", Severity.ERROR,
+                      f"unexpected character `{character}` ({name})", span, help=help_text)
+
+
+def _misused_word(span: ast.Span, word: str) -> Diagnostic:
+    if word.upper() in BUILTINS:
+        return Diagnostic(
+            "E0103", Severity.ERROR,
+            f"`{word}` is a built-in function, which is called in parentheses", span,
+            help=f"write `({word.upper()} ...)`",
+        )
+    return Diagnostic(
+        "E0103", Severity.ERROR, f"`{word}` is not a variable: variable names are one letter",
+        span, help="use one of A-Z, a-z or @; built-in functions are written `(NAME ...)`",
+    )
+
+
+def parse_line(text: str, number: int) -> tuple[ast.Line, list[Diagnostic]]:
+    """Parse one line of source (no line end) as line `number`."""
+    code, quote, comment_text = text.partition("'")
+    comment = None
+    if quote:
+        start = len(code) + 1
+        comment = ast.Comment(ast.Span(number, start, number, len(text) + 1), comment_text)
+    span = ast.Span(number, 1, number, len(text) + 1)
+    if not code.strip():
+        return ast.Line(span, number, None, (), comment), []
+    parser, builder = _lark()
+    builder.line_number = number
+    builder.problems = []
+    try:
+        label, statements = cast(_ParsedLine, parser.parse(code))
+    except (ScanError, UnexpectedInput) as error:
+        return ast.Line(span, number, None, (), comment, ok=False), [
+            _syntax_error(number, error, code)
+        ]
+    return ast.Line(span, number, label, statements, comment), builder.problems
+
+
+def parse_program(text: str) -> tuple[ast.Program, list[Diagnostic]]:
+    """Parse a whole source text; the diagnostics are the syntax errors of every line."""
+    lines: list[ast.Line] = []
+    diagnostics: list[Diagnostic] = []
+    for number, line_text in enumerate(split_lines(text), start=1):
+        line, problems = parse_line(line_text, number)
+        lines.append(line)
+        diagnostics.extend(problems)
+    end = lines[-1].span if lines else ast.Span(1, 1, 1, 1)
+    return ast.Program(ast.Span(1, 1, end.end_line, end.end_column), tuple(lines)), diagnostics

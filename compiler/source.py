@@ -1,0 +1,83 @@
+"""Reading RL/I source: bytes to text, and text to lines.
+
+Source is UTF-8; legacy files whose comments are Shift-JIS (CP932) are read too. Lines end
+with LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+MAX_SOURCE_BYTES = 64 * 1024 * 1024
+_LINE_BREAK = re.compile(r"\r\n|\r|\n")
+
+
+class SourceError(Exception):
+    """A file that cannot be read as RL/I text; the message says why and what to do."""
+
+
+@dataclass(frozen=True, slots=True)
+class Source:
+    name: str
+    text: str
+    encoding: str  # "utf-8" or "cp932"
+
+    @property
+    def lines(self) -> list[str]:
+        return split_lines(self.text)
+
+
+def split_lines(text: str) -> list[str]:
+    """The lines of `text` without their line ends. A final line end does not start an
+    extra line; an empty text has no lines."""
+    lines = _LINE_BREAK.split(text)
+    if lines and lines[-1] == "":
+        lines.pop()
+    return lines
+
+
+def decode(data: bytes, name: str = "<input>") -> Source:
+    """Decode source bytes: UTF-8 (a BOM is dropped), else CP932, else refuse."""
+    if b"\x00" in data:
+        offset = data.index(b"\x00")
+        raise SourceError(
+            f"{name} looks like a binary file (a NUL byte at offset {offset}); "
+            "RL/I source is text: check that this is the .rob file you meant"
+        )
+    if data.startswith(b"\xef\xbb\xbf"):
+        data = data[3:]
+    try:
+        return Source(name, data.decode("utf-8"), "utf-8")
+    except UnicodeDecodeError as utf8_error:
+        try:
+            return Source(name, data.decode("cp932"), "cp932")
+        except UnicodeDecodeError:
+            raise SourceError(
+                f"{name} is neither UTF-8 nor Shift-JIS text (invalid byte "
+                f"0x{data[utf8_error.start]:02X} at offset {utf8_error.start}); "
+                "save it as UTF-8"
+            ) from None
+
+
+def read_source(path: str | Path) -> Source:
+    """Read and decode a source file, turning every OS failure into a SourceError."""
+    path = Path(path)
+    try:
+        if path.is_dir():
+            raise SourceError(f"{path} is a directory, not an RL/I source file")
+        size = path.stat().st_size
+        if size > MAX_SOURCE_BYTES:
+            raise SourceError(
+                f"{path} is {size} bytes; RL/I sources are limited to "
+                f"{MAX_SOURCE_BYTES // (1024 * 1024)} MiB"
+            )
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise SourceError(f"{path}: no such file") from None
+    except PermissionError:
+        raise SourceError(f"{path}: permission denied") from None
+    except OSError as error:
+        raise SourceError(f"{path}: cannot read ({error.strerror or error})") from None
+    return decode(data, str(path))

@@ -1,0 +1,1 @@
+"""RL/I language server (rl1-lsp)."""

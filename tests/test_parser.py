@@ -1,0 +1,64 @@
+"""The parser: spans, left-to-right expressions, selectors and syntax errors."""
+
+from pathlib import Path
+
+from rl1.compiler import ast
+from rl1.compiler.parser import parse_line, parse_program
+
+SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
+
+
+def test_sample_parses_without_syntax_errors() -> None:
+    program, diagnostics = parse_program(SAMPLE.read_text(encoding="utf-8"))
+    assert diagnostics == []
+    assert len(program.lines) == 43
+    labels = [line.label.number for line in program.lines if line.label]
+    assert labels == [10, 12, 13, 14, 20, 21, 22, 29, 40, 96, 99]
+
+
+def test_expression_keeps_operators_in_order_with_spans() -> None:
+    line, diagnostics = parse_line("C=a<3+b>6+C", 4)
+    assert diagnostics == []
+    (assign,) = line.statements
+    assert isinstance(assign, ast.Assign)
+    assert [step.op for step in assign.rest] == ["<", "+", ">", "+"]
+    assert assign.span == ast.Span(4, 1, 4, 12)
+    assert assign.rest[1].op_span == ast.Span(4, 6, 4, 7)
+
+
+def test_minus_after_operand_is_an_operator_and_before_digits_a_sign() -> None:
+    line, _ = parse_line("A=B--5; d=-450", 1)
+    first, second = line.statements
+    assert isinstance(first, ast.Assign) and isinstance(second, ast.Assign)
+    assert first.rest[0].op == "-"
+    assert isinstance(first.rest[0].operand, ast.Const)
+    assert first.rest[0].operand.value == -5
+    assert isinstance(second.first, ast.Const) and second.first.value == -450
+
+
+def test_camera_and_ultrasonic_selectors_are_letters_not_variables() -> None:
+    line, _ = parse_line("(CAM P c); (ULT A)", 1)
+    cam, ult = (statement.call for statement in line.statements
+                if isinstance(statement, ast.CallStmt))
+    assert cam.args == (ast.Selector(ast.Span(1, 6, 1, 7), "P"), ast.Var(ast.Span(1, 8, 1, 9), "c"))
+    assert isinstance(ult.args[0], ast.Selector)
+
+
+def test_hex_is_a_bit_pattern() -> None:
+    line, _ = parse_line("A=$FFFF", 1)
+    (assign,) = line.statements
+    assert isinstance(assign, ast.Assign) and isinstance(assign.first, ast.Const)
+    assert assign.first.value == -1
+
+
+def test_error_on_one_line_does_not_hide_the_next() -> None:
+    _, diagnostics = parse_program("A=\nB=(MOV 1\nC=1\n")
+    assert [(d.code, d.span.line) for d in diagnostics] == [("E0101", 1), ("E0101", 2)]
+
+
+def test_multi_letter_word_and_bare_mnemonic_get_specific_messages() -> None:
+    _, [word] = parse_line("AB=3", 1)
+    _, [bare] = parse_line("MOV 3,3", 1)
+    assert word.code == bare.code == "E0103"
+    assert "one letter" in word.message
+    assert bare.help == "write `(MOV ...)`"

@@ -1,0 +1,1 @@
+"""RL/I reference virtual machine, devices and simulator."""
