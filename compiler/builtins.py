@@ -55,7 +55,7 @@ class Form:
 class Builtin:
     mnemonic: str
     name: str  # the paper's expansion of the mnemonic
-    group: str  # "motion" (Table 2) or "sensing" (Table 3)
+    group: str  # "motion" (Table 2), "sensing" (Table 3) or "control" (Table 1)
     feature: Feature | None
     waits: bool  # True when the call takes device time before the next statement runs
     forms: tuple[Form, ...]
@@ -79,6 +79,8 @@ def _one(summary: str, *params: Param, result: str | None = None,
 BUILTINS: dict[str, Builtin] = {
     b.mnemonic: b
     for b in (
+        Builtin("END", "End", "control", None, False,
+                _one("End the program. Motion in effect is not stopped by this.")),
         Builtin("FRE", "Free", "motion", Feature.MOTION, False,
                 _one("Free the drive axes (the wheels turn freely).")),
         Builtin("HLD", "Hold", "motion", Feature.MOTION, False,
