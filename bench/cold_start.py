@@ -1,0 +1,45 @@
+"""Cold start: `rl1c check` on the sample as a whole process, against `python3 -c pass`
+in the same run (goal: at most 2x). Interleaves the two commands so that both see the
+same machine load, and reports medians.
+
+    .venv/bin/python bench/cold_start.py [--runs 15]
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def run_seconds(command: list[str]) -> float:
+    start = time.perf_counter()
+    subprocess.run(command, check=False, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return time.perf_counter() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=15)
+    options = parser.parse_args()
+    rl1c = str(Path(sys.executable).with_name("rl1c"))
+    check = [rl1c, "check", str(ROOT / "examples" / "sample.rob")]
+    baseline = [sys.executable, "-c", "pass"]
+    run_seconds(check)  # fills the parser cache and the OS page cache
+    checks, passes = [], []
+    for _ in range(options.runs):
+        checks.append(run_seconds(check))
+        passes.append(run_seconds(baseline))
+    check_ms, pass_ms = statistics.median(checks) * 1000, statistics.median(passes) * 1000
+    print(f"rl1c check sample.rob: {check_ms:.1f} ms (median of {options.runs})")
+    print(f"python3 -c pass      : {pass_ms:.1f} ms (median of {options.runs})")
+    print(f"ratio: {check_ms / pass_ms:.1f}x (goal <= 2x)")
+
+
+if __name__ == "__main__":
+    main()
