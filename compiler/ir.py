@@ -1,0 +1,318 @@
+"""The intermediate representation between the checked AST and the .ilc code.
+
+A program is an ordered set of basic blocks. Instructions mirror the accumulator machine
+of vm/isa.py (load, operate, store, step, call) but name variables by letter and jump to
+blocks, not addresses; every instruction carries the source line it came from. Control
+leaves a block only through its terminator: a jump, a two-way branch or the end. Nothing
+falls through implicitly; the code generator drops a jump to the block laid out next.
+
+Passes rewrite the IR in place: `Program.blocks` maps each block's id to the block, in
+layout order, and a block's instructions are a list of small frozen dataclasses, so a
+pass replaces instructions and terminators rather than mutating them. `validate` states
+the invariants every pass must keep.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+from .ast import BinaryOperator, Relation, Step
+from .builtins import BUILTINS, HANDLER_LABELS, VARIABLES
+
+BlockId = str
+"""`Lnn` for the block a source label `:nn` starts, `Bn` for the others."""
+
+
+def label_block(number: int) -> BlockId:
+    return f"L{number:02d}"
+
+
+# Operands ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class Var:
+    """A variable, by its letter (builtins.VARIABLES)."""
+
+    name: str
+
+    def __str__(self) -> str:
+        return self.name
+
+
+@dataclass(frozen=True, slots=True)
+class Imm:
+    """A 16-bit signed immediate."""
+
+    value: int
+
+    def __str__(self) -> str:
+        return str(self.value)
+
+
+@dataclass(frozen=True, slots=True)
+class Result:
+    """The result register R: the value of the last value-returning call."""
+
+    def __str__(self) -> str:
+        return "R"
+
+
+R = Result()
+
+Operand = Var | Imm | Result
+Argument = Var | Imm
+
+
+# Instructions -----------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class Load:
+    """acc = source."""
+
+    source: Operand
+    line: int
+
+    def __str__(self) -> str:
+        return f"load {self.source}"
+
+
+OPERATOR_NAMES: dict[BinaryOperator, str] = {
+    "+": "add", "-": "sub", "&": "and", "|": "or", "^": "xor", "<": "shl", ">": "shr",
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Operate:
+    """acc = acc op source."""
+
+    op: BinaryOperator
+    source: Operand
+    line: int
+
+    def __str__(self) -> str:
+        return f"{OPERATOR_NAMES[self.op]} {self.source}"
+
+
+@dataclass(frozen=True, slots=True)
+class Store:
+    """target = acc."""
+
+    target: Var
+    line: int
+
+    def __str__(self) -> str:
+        return f"store {self.target}"
+
+
+@dataclass(frozen=True, slots=True)
+class StepVar:
+    """target++ or target--, without touching acc."""
+
+    target: Var
+    step: Step
+    line: int
+
+    def __str__(self) -> str:
+        return f"{'inc' if self.step == '++' else 'dec'} {self.target}"
+
+
+@dataclass(frozen=True, slots=True)
+class Call:
+    """A built-in call other than END; one that returns a value sets R."""
+
+    mnemonic: str
+    selector: str | None
+    args: tuple[Argument, ...]
+    line: int
+
+    @property
+    def returns_value(self) -> bool:
+        form = BUILTINS[self.mnemonic].form(self.selector)
+        return form is not None and form.returns_value
+
+    def __str__(self) -> str:
+        words = [self.mnemonic, *([self.selector] if self.selector else [])]
+        text = "call " + " ".join(words)
+        return text + (" " + ", ".join(map(str, self.args)) if self.args else "")
+
+
+Instruction = Load | Operate | Store | StepVar | Call
+
+
+# Terminators ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class Jump:
+    target: BlockId
+    line: int
+
+    @property
+    def targets(self) -> tuple[BlockId, ...]:
+        return (self.target,)
+
+    def __str__(self) -> str:
+        return f"jump {self.target}"
+
+
+@dataclass(frozen=True, slots=True)
+class Branch:
+    """Go to `if_true` when `var` compares with zero as `relation` says, else `if_false`."""
+
+    var: Var
+    relation: Relation
+    if_true: BlockId
+    if_false: BlockId
+    line: int
+
+    @property
+    def targets(self) -> tuple[BlockId, ...]:
+        return (self.if_true, self.if_false)
+
+    def __str__(self) -> str:
+        return f"if {self.var}{self.relation}0 then {self.if_true} else {self.if_false}"
+
+
+@dataclass(frozen=True, slots=True)
+class End:
+    line: int
+
+    @property
+    def targets(self) -> tuple[BlockId, ...]:
+        return ()
+
+    def __str__(self) -> str:
+        return "end"
+
+
+Terminator = Jump | Branch | End
+
+
+# Blocks and programs ----------------------------------------------------------------
+
+
+@dataclass(slots=True)
+class Block:
+    id: BlockId
+    instructions: list[Instruction]
+    terminator: Terminator
+
+    @property
+    def successors(self) -> tuple[BlockId, ...]:
+        return self.terminator.targets
+
+
+@dataclass(slots=True)
+class Program:
+    """Blocks in layout order (the entry block first); `handlers` maps each handler label
+    :96-:99 the program defines to its block."""
+
+    blocks: dict[BlockId, Block]
+    entry: BlockId
+    handlers: dict[int, BlockId] = field(default_factory=dict)
+
+    def __iter__(self) -> Iterator[Block]:
+        return iter(self.blocks.values())
+
+    def successors(self, block_id: BlockId) -> tuple[BlockId, ...]:
+        return self.blocks[block_id].successors
+
+    def predecessors(self) -> dict[BlockId, list[BlockId]]:
+        """Each block's predecessors in layout order (a block that jumps to itself is
+        its own predecessor; the handler table is not an edge)."""
+        preds: dict[BlockId, list[BlockId]] = {block_id: [] for block_id in self.blocks}
+        for block in self:
+            for target in dict.fromkeys(block.successors):
+                if target in preds:
+                    preds[target].append(block.id)
+        return preds
+
+
+# Invariants -------------------------------------------------------------------------
+
+
+def validate(program: Program) -> list[str]:
+    """Every broken invariant, as a message naming the block; empty when the IR is
+    well formed. The code generator relies on all of these."""
+    problems: list[str] = []
+    if next(iter(program.blocks), None) != program.entry:
+        problems.append(f"the entry block {program.entry} is not the first block")
+    for block_id, block in program.blocks.items():
+        if block.id != block_id:
+            problems.append(f"block {block.id} is filed under the id {block_id}")
+        problems.extend(f"{block_id}: {problem}" for problem in _block_problems(block))
+        problems.extend(
+            f"{block_id}: jumps to {target}, which is not a block"
+            for target in block.successors if target not in program.blocks
+        )
+    for label, block_id in program.handlers.items():
+        if label not in HANDLER_LABELS:
+            problems.append(f"handler :{label} is not one of :96-:99")
+        if block_id not in program.blocks:
+            problems.append(f"handler :{label} names {block_id}, which is not a block")
+    return problems
+
+
+def _block_problems(block: Block) -> Iterator[str]:
+    if not isinstance(block.terminator, Jump | Branch | End):
+        yield f"ends with {block.terminator!r}, which is not a terminator"
+    result_set = False  # whether R holds a value here (only a call within the block sets it)
+    for instruction in block.instructions:
+        if not isinstance(instruction, Load | Operate | Store | StepVar | Call):
+            yield f"holds {instruction!r}, which is not an instruction"
+            continue
+        for operand in _operands(instruction):
+            if isinstance(operand, Var) and operand.name not in VARIABLES:
+                yield f"line {instruction.line}: `{operand.name}` is not a variable"
+            elif isinstance(operand, Imm) and not -0x8000 <= operand.value <= 0x7FFF:
+                yield f"line {instruction.line}: {operand.value} does not fit 16 bits"
+            elif isinstance(operand, Result) and not result_set:
+                yield f"line {instruction.line}: `{instruction}` reads R before a call sets it"
+        if isinstance(instruction, Call):
+            yield from _call_problems(instruction)
+            result_set = instruction.mnemonic in BUILTINS and instruction.returns_value
+    if isinstance(block.terminator, Branch) and block.terminator.var.name not in VARIABLES:
+        yield f"branches on `{block.terminator.var.name}`, which is not a variable"
+
+
+def _operands(instruction: Instruction) -> tuple[Operand, ...]:
+    if isinstance(instruction, Load | Operate):
+        return (instruction.source,)
+    if isinstance(instruction, Store | StepVar):
+        return (instruction.target,)
+    return instruction.args
+
+
+def _call_problems(call: Call) -> Iterator[str]:
+    builtin = BUILTINS.get(call.mnemonic)
+    form = builtin.form(call.selector) if builtin else None
+    if builtin is None or form is None or call.mnemonic == "END":
+        yield f"line {call.line}: `{call}` is not a built-in form (END is a terminator)"
+        return
+    if len(call.args) != len(form.params):
+        yield f"line {call.line}: `{call}` takes {len(form.params)} arguments"
+        return
+    for arg, param in zip(call.args, form.params, strict=True):
+        if isinstance(arg, Imm) and not param.low <= arg.value <= param.high:
+            yield f"line {call.line}: `{call}`: {param.name} must lie in {param.low}..{param.high}"
+
+
+# Printing ---------------------------------------------------------------------------
+
+
+def format_program(program: Program) -> str:
+    """The IR as stable text: a header, then each block in layout order with its
+    predecessors and one instruction a line, prefixed by its source line."""
+    out = [f"entry {program.entry}"]
+    out += [f"handler :{label} {program.handlers[label]}" for label in sorted(program.handlers)]
+    preds = program.predecessors()
+    for block in program:
+        out.append("")
+        comment = f"  ; from {', '.join(preds[block.id])}" if preds[block.id] else ""
+        out.append(f"{block.id}:{comment}")
+        for item in [*block.instructions, block.terminator]:
+            out.append(f"{item.line:6}  {item}")
+    return "\n".join(out) + "\n"
