@@ -1,0 +1,136 @@
+"""Lowering: the checked AST to IR, statement by statement, without optimizing (-O0).
+
+`V=a op b` becomes load a; op b; store V. A call operand is emitted where it stands and
+its result read from R, so side effects keep the source's left-to-right order: in
+`A=x+(IMG)` the load of x comes before IMG overwrites x. A label starts a block, a jump
+or `(END)` ends one, a conditional jump ends one with a branch to the label or to the
+statement after it, and falling off the end of the program ends it.
+"""
+
+from __future__ import annotations
+
+from . import ast, ir
+from .builtins import HANDLER_LABELS
+
+
+class LoweringError(Exception):
+    """The AST holds a problem the checker refuses (an undefined label, a bad call...);
+    lowering runs only on programs without errors, so this is a compiler bug."""
+
+
+def lower(program: ast.Program) -> ir.Program:
+    """The IR of a program the checker accepted."""
+    lowered = _Lowerer().lower(program)
+    problems = ir.validate(lowered)
+    if problems:
+        raise LoweringError("the checker let through a program with errors: "
+                            + "; ".join(problems))
+    return lowered
+
+
+class _Lowerer:
+    def __init__(self) -> None:
+        self.blocks: dict[ir.BlockId, ir.Block] = {}
+        self.handlers: dict[int, ir.BlockId] = {}
+        self.block_id: ir.BlockId | None = None  # the open block, None after a jump or end
+        self.code: list[ir.Instruction] = []
+        self.unlabelled = 0
+
+    def lower(self, program: ast.Program) -> ir.Program:
+        for line in program.lines:
+            if line.label is not None:
+                self.start_label(line.label)
+            for statement in line.statements:
+                self.statement(statement, line.number)
+        if self.block_id is not None or not self.blocks:
+            last_line = program.lines[-1].number if program.lines else 1
+            self.finish(ir.End(last_line))
+        return ir.Program(self.blocks, next(iter(self.blocks)), self.handlers)
+
+    # Blocks -------------------------------------------------------------------------
+
+    def open_block(self) -> None:
+        """Start a block for code that follows a jump or end (unreachable unless a
+        later pass proves otherwise) or the start of the program."""
+        if self.block_id is None:
+            self.block_id = f"B{self.unlabelled}"
+            self.unlabelled += 1
+
+    def finish(self, terminator: ir.Terminator) -> None:
+        self.open_block()
+        assert self.block_id is not None
+        self.blocks[self.block_id] = ir.Block(self.block_id, self.code, terminator)
+        self.block_id, self.code = None, []
+
+    def start_label(self, label: ast.LabelDef) -> None:
+        block_id = self.target(label.number, label.text, label.span.line)
+        if block_id in self.blocks or block_id == self.block_id:
+            raise LoweringError(f"line {label.span.line}: `{label.text}` is defined twice")
+        if self.block_id is not None:
+            self.finish(ir.Jump(block_id, label.span.line))
+        self.block_id = block_id
+        if label.number is not None and label.number in HANDLER_LABELS:
+            self.handlers[label.number] = block_id
+
+    @staticmethod
+    def target(number: int | None, text: str, line: int) -> ir.BlockId:
+        if number is None:
+            raise LoweringError(f"line {line}: `{text}` is not a two-digit label")
+        return ir.label_block(number)
+
+    # Statements ---------------------------------------------------------------------
+
+    def emit(self, instruction: ir.Instruction) -> None:
+        self.open_block()
+        self.code.append(instruction)
+
+    def statement(self, statement: ast.Statement, line: int) -> None:
+        if isinstance(statement, ast.Assign):
+            self.operand(statement.first, None, line)
+            for step in statement.rest:
+                self.operand(step.operand, step.op, line)
+            self.emit(ir.Store(ir.Var(statement.target.name), line))
+        elif isinstance(statement, ast.IncDec):
+            self.emit(ir.StepVar(ir.Var(statement.target.name), statement.step, line))
+        elif isinstance(statement, ast.Goto):
+            ref = statement.target
+            self.finish(ir.Jump(self.target(ref.number, ref.text, line), line))
+        elif isinstance(statement, ast.CondJump):
+            ref = statement.target
+            taken = self.target(ref.number, ref.text, line)
+            self.open_block()
+            fall_through = f"B{self.unlabelled}"
+            self.finish(ir.Branch(ir.Var(statement.var.name), statement.relation,
+                                  taken, fall_through, line))
+            self.open_block()
+        elif statement.call.mnemonic.upper() == "END":
+            if statement.call.args:
+                raise LoweringError(f"line {line}: `(END)` takes no arguments")
+            self.finish(ir.End(line))
+        else:
+            self.emit(self.call(statement.call, line))
+
+    def operand(self, operand: ast.Operand, op: ast.BinaryOperator | None, line: int) -> None:
+        """Load the first operand of an expression (op None) or apply the next one."""
+        source: ir.Operand
+        if isinstance(operand, ast.Call):
+            self.emit(self.call(operand, line))
+            source = ir.R
+        else:
+            source = self.argument(operand)
+        self.emit(ir.Load(source, line) if op is None else ir.Operate(op, source, line))
+
+    def call(self, call: ast.Call, line: int) -> ir.Call:
+        selector, args = None, call.args
+        if args and isinstance(args[0], ast.Selector):
+            selector, args = args[0].letter.upper(), args[1:]
+        lowered: list[ir.Argument] = []
+        for arg in args:
+            if isinstance(arg, ast.Selector):
+                raise LoweringError(f"line {line}: a selector `{arg.letter}` out of place")
+            lowered.append(self.argument(arg))
+        return ir.Call(call.mnemonic.upper(), selector, tuple(lowered), line)
+
+    @staticmethod
+    def argument(arg: ast.Var | ast.Const) -> ir.Argument:
+        return ir.Var(arg.name) if isinstance(arg, ast.Var) else ir.Imm(arg.value)
