@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from rl1.compiler import ir
-from rl1.compiler.ir import R, Branch, Call, End, Imm, Jump, Load, Operate, StepVar, Store, Var
+from rl1.compiler.ir import Branch, Call, End, Imm, Jump, Load, Operate, R, StepVar, Store, Var
 from rl1.compiler.lower import LoweringError, lower
 from rl1.compiler.parser import parse_program
 
