@@ -1,7 +1,10 @@
 """The RL/I abstract syntax tree: small immutable classes, separate from parsing.
 
-Every node carries a `Span`. Lines are the unit of parsing (RL/I is line-oriented), so
-a `Line` can be re-parsed alone and moved to another line number with `relocate`.
+Every node carries a `Span`. Nodes are treated as immutable (make changed copies with
+`dataclasses.replace`) and hash by value; they are not declared `frozen` only because
+frozen dataclasses are built several times slower, and parsing builds millions of them.
+Lines are the unit of parsing (RL/I is line-oriented), so a `Line` can be re-parsed
+alone and moved to another line number with `relocate`.
 
 Walk a tree with a `Visitor` subclass: `visit(node)` calls `visit_<ClassName>`, falling
 back to `generic_visit`, which visits the children.
@@ -18,7 +21,7 @@ Relation = Literal["=", ">", "<"]
 Step = Literal["++", "--"]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class Span:
     """A source range. Lines and columns are 1-based; columns count code points and
     `end_column` is exclusive (one past the last character), as in SARIF."""
@@ -41,7 +44,7 @@ class Span:
         return (self.line, self.column) <= (line, column) < (self.end_line, self.end_column)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class Node:
     span: Span
 
@@ -57,14 +60,14 @@ class Node:
 # Operands and arguments -------------------------------------------------------------
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class Var(Node):
     """A one-letter variable: `A`-`Z`, `a`-`z` or `@`."""
 
     name: str
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class Const(Node):
     """A constant as written. `value` is the number written (a decimal may lie outside
     16 bits; the checker reports it); `hex` constants are 16-bit bit patterns."""
@@ -74,7 +77,7 @@ class Const(Node):
     hex: bool
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class Selector(Node):
     """The letter that selects a form of `(CAM ...)` or a sensor of `(ULT ...)`."""
 
@@ -84,7 +87,7 @@ class Selector(Node):
 Arg = Var | Const | Selector
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class Call(Node):
     """A built-in function call `(MNEMONIC args)`; `mnemonic` is as written."""
 
@@ -99,7 +102,7 @@ Operand = Var | Const | Call
 # Statements -------------------------------------------------------------------------
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class BinaryStep(Node):
     """One `op operand` of a left-to-right expression."""
 
@@ -108,7 +111,7 @@ class BinaryStep(Node):
     operand: Operand
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class Assign(Node):
     """`V=operand {op operand}`, evaluated strictly left to right."""
 
@@ -117,7 +120,7 @@ class Assign(Node):
     rest: tuple[BinaryStep, ...]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class IncDec(Node):
     """`V++` or `V--`."""
 
@@ -125,7 +128,7 @@ class IncDec(Node):
     step: Step
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class LabelRef(Node):
     """`#NN` as written; `number` is None when the digits are not a valid label."""
 
@@ -133,12 +136,12 @@ class LabelRef(Node):
     number: int | None
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class Goto(Node):
     target: LabelRef
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class CondJump(Node):
     """`?V=#NN`, `?V>#NN`, `?V<#NN`: jump when V compares so with zero."""
 
@@ -147,7 +150,7 @@ class CondJump(Node):
     target: LabelRef
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class CallStmt(Node):
     call: Call
 
@@ -158,7 +161,7 @@ Statement = Assign | IncDec | Goto | CondJump | CallStmt
 # Lines and programs -----------------------------------------------------------------
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class LabelDef(Node):
     """`:NN` at the start of a line; `number` is None when not exactly two digits."""
 
@@ -166,14 +169,14 @@ class LabelDef(Node):
     number: int | None
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class Comment(Node):
     """`' text` to the end of the line; `text` excludes the quote."""
 
     text: str
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class Line(Node):
     """One source line. `ok` is False when the line has a syntax error; its
     statements are then empty and the parser's diagnostic says why."""
@@ -185,7 +188,7 @@ class Line(Node):
     ok: bool = True
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True, unsafe_hash=True)
 class Program(Node):
     lines: tuple[Line, ...]
 

@@ -1,9 +1,13 @@
 """The parser: RL/I text to the AST, one line at a time.
 
-Each line is parsed alone by lark's LALR parser (grammar.lark, tokens from scanner.py), so
-a syntax error on one line never hides the errors on the others, and the language server
-can re-parse only the lines an edit touches. The lark parser is built once per process
-and cached on disk between processes.
+Each line is parsed alone, so a syntax error on one line never hides the errors on the
+others, and the language server can re-parse only the lines an edit touches.
+
+lark builds the LALR(1) tables and the tree-building callbacks from grammar.lark (once per
+process, cached on disk between processes); `_run_lalr` runs those tables over the
+scanner's tokens. That loop is lark's own shift/reduce loop minus its per-token Token
+objects and per-parse set-up, which made lark's `parse()` three times slower on the
+front end's hot path.
 """
 
 from __future__ import annotations
@@ -11,17 +15,18 @@ from __future__ import annotations
 import gc
 import tempfile
 import unicodedata
+from collections.abc import Callable, Iterable
 from pathlib import Path
-from typing import cast
+from typing import Any, cast
 
 import lark
-from lark.exceptions import UnexpectedInput, UnexpectedToken
-from lark.lexer import Lexer, Token
+from lark.lexer import Lexer
+from lark.parsers.lalr_analysis import Shift
 
 from . import ast
 from .builtins import BUILTINS
 from .diagnostics import Diagnostic, Severity
-from .scanner import ScanError, scan
+from .scanner import ScanError, Token, scan
 from .source import split_lines
 
 GRAMMAR = Path(__file__).with_name("grammar.lark")
@@ -41,13 +46,20 @@ _ParsedLine = tuple[ast.LabelDef | None, tuple[ast.Statement, ...]]
 
 
 class _ScannerLexer(Lexer):
-    """Adapts scanner.scan to lark's custom-lexer interface."""
+    """Declares to lark that tokens come from scanner.py (lark never calls it)."""
 
     def __init__(self, lexer_conf: object) -> None:
         pass
 
     def lex(self, data: str) -> object:  # type: ignore[override]
         return scan(data)
+
+
+class _SyntaxError(Exception):
+    def __init__(self, token: Token | None, expected: set[str]) -> None:
+        super().__init__("syntax error")
+        self.token = token  # None at the end of the line
+        self.expected = expected
 
 
 class _AstBuilder(lark.Transformer):  # type: ignore[type-arg]
@@ -59,18 +71,18 @@ class _AstBuilder(lark.Transformer):  # type: ignore[type-arg]
         self.problems: list[Diagnostic] = []
 
     def span(self, token: Token) -> ast.Span:
-        start = int(token.start_pos or 0) + 1
-        return ast.Span(self.line_number, start, self.line_number, start + len(token))
+        start = token.column + 1
+        return ast.Span(self.line_number, start, self.line_number, start + len(token.text))
 
     def operand(self, item: Token | ast.Call) -> ast.Var | ast.Const | ast.Call:
         if isinstance(item, ast.Call):
             return item
         if item.type == "VAR":
-            return ast.Var(self.span(item), str(item))
+            return ast.Var(self.span(item), item.text)
         return self.constant(item)
 
     def constant(self, token: Token) -> ast.Const:
-        text = str(token)
+        text = token.text
         if token.type == "NUMBER":
             return ast.Const(self.span(token), int(text), text, False)
         digits = text[1:]
@@ -94,15 +106,15 @@ class _AstBuilder(lark.Transformer):  # type: ignore[type-arg]
         if items and isinstance(items[0], Token):
             token = items.pop(0)
             assert isinstance(token, Token)
-            digits = str(token)[1:]
+            digits = token.text[1:]
             number = int(digits) if len(digits) == 2 else None
-            label = ast.LabelDef(self.span(token), str(token), number)
+            label = ast.LabelDef(self.span(token), token.text, number)
         return label, tuple(items)  # type: ignore[arg-type]
 
     def assign(self, items: list[object]) -> ast.Assign:
         target_token, _, first, *steps = items
         assert isinstance(target_token, Token)
-        target = ast.Var(self.span(target_token), str(target_token))
+        target = ast.Var(self.span(target_token), target_token.text)
         first_operand = self.operand(first)  # type: ignore[arg-type]
         rest = tuple(step for step in steps if isinstance(step, ast.BinaryStep))
         end = rest[-1].span if rest else first_operand.span
@@ -113,18 +125,18 @@ class _AstBuilder(lark.Transformer):  # type: ignore[type-arg]
         assert isinstance(op_token, Token)
         operand = self.operand(operand_item)  # type: ignore[arg-type]
         op_span = self.span(op_token)
-        return ast.BinaryStep(op_span.cover(operand.span), str(op_token),  # type: ignore[arg-type]
+        return ast.BinaryStep(op_span.cover(operand.span), op_token.text,  # type: ignore[arg-type]
                               op_span, operand)
 
     def incdec(self, items: list[Token]) -> ast.IncDec:
         var_token, step_token = items
-        target = ast.Var(self.span(var_token), str(var_token))
+        target = ast.Var(self.span(var_token), var_token.text)
         return ast.IncDec(target.span.cover(self.span(step_token)), target,
-                          str(step_token))  # type: ignore[arg-type]
+                          step_token.text)  # type: ignore[arg-type]
 
     def label_ref(self, token: Token) -> ast.LabelRef:
-        digits = str(token)[1:]
-        return ast.LabelRef(self.span(token), str(token), int(digits) if len(digits) == 2 else None)
+        digits = token.text[1:]
+        return ast.LabelRef(self.span(token), token.text, int(digits) if len(digits) == 2 else None)
 
     def goto(self, items: list[Token]) -> ast.Goto:
         target = self.label_ref(items[0])
@@ -134,73 +146,125 @@ class _AstBuilder(lark.Transformer):  # type: ignore[type-arg]
         qmark, var_token, relation, target_token = items
         target = self.label_ref(target_token)
         return ast.CondJump(self.span(qmark).cover(target.span),
-                            ast.Var(self.span(var_token), str(var_token)),
-                            str(relation), target)  # type: ignore[arg-type]
+                            ast.Var(self.span(var_token), var_token.text),
+                            relation.text, target)  # type: ignore[arg-type]
 
     def call(self, items: list[Token]) -> ast.Call:
         lpar, mnemonic, *args, rpar = items
-        builtin = BUILTINS.get(str(mnemonic).upper())
+        builtin = BUILTINS.get(mnemonic.text.upper())
         built: list[ast.Arg] = []
         for index, arg in enumerate(args):
             if index == 0 and arg.type == "VAR" and builtin is not None and builtin.has_selector:
-                built.append(ast.Selector(self.span(arg), str(arg)))
+                built.append(ast.Selector(self.span(arg), arg.text))
             else:
                 built.append(self.operand(arg))  # type: ignore[arg-type]
-        return ast.Call(self.span(lpar).cover(self.span(rpar)), str(mnemonic),
+        return ast.Call(self.span(lpar).cover(self.span(rpar)), mnemonic.text,
                         self.span(mnemonic), tuple(built))
 
     def call_stmt(self, items: list[ast.Call]) -> ast.CallStmt:
         return ast.CallStmt(items[0].span, items[0])
 
 
-def _build_lark() -> tuple[lark.Lark, _AstBuilder]:
-    builder = _AstBuilder()
-    cache = Path(tempfile.gettempdir()) / f"rl1-grammar-{lark.__version__}.cache"
-    parser = lark.Lark(
-        GRAMMAR.read_text(encoding="utf-8"),
-        start="line",
-        parser="lalr",
-        lexer=_ScannerLexer,
-        transformer=builder,
-        cache=str(cache),
-    )
-    return parser, builder
+class _Tables:
+    """lark's LALR(1) tables for grammar.lark, with callbacks that build the AST."""
+
+    def __init__(self) -> None:
+        self.builder = _AstBuilder()
+        cache = Path(tempfile.gettempdir()) / f"rl1-grammar-{lark.__version__}.cache"
+        parser = lark.Lark(
+            GRAMMAR.read_text(encoding="utf-8"),
+            start="line",
+            parser="lalr",
+            lexer=_ScannerLexer,
+            transformer=self.builder,
+            cache=str(cache),
+        )
+        lalr = parser.parser.parser.parser
+        self.states: dict[int, dict[str, tuple[object, Any]]] = lalr.parse_table.states
+        self.start: int = lalr.parse_table.start_states["line"]
+        self.callbacks: dict[Any, Callable[[list[Any]], Any]] = lalr.callbacks
 
 
-_parser: tuple[lark.Lark, _AstBuilder] | None = None
+_tables: _Tables | None = None
 
 
-def _lark() -> tuple[lark.Lark, _AstBuilder]:
-    global _parser
-    if _parser is None:
-        _parser = _build_lark()
-    return _parser
+def _lalr_tables() -> _Tables:
+    global _tables
+    if _tables is None:
+        _tables = _Tables()
+    return _tables
 
 
-def _syntax_error(line: int, error: Exception, code: str) -> Diagnostic:
+def _run_lalr(tables: _Tables, tokens: Iterable[Token]) -> Any:
+    """Shift/reduce `tokens` through the LALR tables; the value of the `line` rule."""
+    states, callbacks = tables.states, tables.callbacks
+    state_stack = [tables.start]
+    value_stack: list[Any] = []
+    for token in tokens:
+        kind = token.type
+        while True:
+            row = states[state_stack[-1]]
+            if kind not in row:
+                raise _SyntaxError(token, {name for name in row if name.isupper()})
+            action, argument = row[kind]
+            if action is Shift:
+                state_stack.append(argument)
+                value_stack.append(token)
+                break
+            _reduce(states, callbacks, argument, state_stack, value_stack)
+    while True:
+        row = states[state_stack[-1]]
+        if "$END" not in row:
+            raise _SyntaxError(None, {name for name in row if name.isupper()})
+        action, rule = row["$END"]
+        if action is Shift:
+            return value_stack[-1]
+        if rule.origin.name == "line" and len(state_stack) == len(rule.expansion) + 1:
+            size = len(rule.expansion)
+            return callbacks[rule](value_stack[-size:] if size else [])
+        _reduce(states, callbacks, rule, state_stack, value_stack)
+
+
+def _reduce(states: dict[int, dict[str, tuple[object, Any]]],
+            callbacks: dict[Any, Callable[[list[Any]], Any]], rule: Any,
+            state_stack: list[int], value_stack: list[Any]) -> None:
+    size = len(rule.expansion)
+    if size:
+        children = value_stack[-size:]
+        del state_stack[-size:]
+        del value_stack[-size:]
+    else:
+        children = []
+    value_stack.append(callbacks[rule](children))
+    state_stack.append(states[state_stack[-1]][rule.origin.name][1])
+
+
+def _syntax_error(line: int, error: ScanError | _SyntaxError, code: str) -> Diagnostic:
     if isinstance(error, ScanError):
         span = ast.Span(line, error.column + 1, line, error.column + 2)
         return _bad_character(span, error.character)
-    assert isinstance(error, UnexpectedToken)
     token = error.token
-    if token.type == "$END":
+    if token is None:
         column, width = len(code.rstrip()) + 1, 1
     else:
-        column, width = int(token.start_pos or 0) + 1, max(len(token), 1)
+        column, width = token.column + 1, max(len(token.text), 1)
     span = ast.Span(line, column, line, column + width)
-    if token.type == "WORD":
-        return _misused_word(span, str(token))
-    if token.type == "LABEL":
+    if token is None:
+        found = "the end of the line"
+    elif token.type == "WORD":
+        return _misused_word(span, token.text)
+    elif token.type == "LABEL":
         return Diagnostic(
-            "E0104", Severity.ERROR, f"the label `{token}` is not at the start of its line",
+            "E0104", Severity.ERROR, f"the label `{token.text}` is not at the start of its line",
             span, help="a label `:NN` may only start a line: move it to a line of its own",
         )
+    else:
+        found = f"`{token.text}`"
     expected = sorted({TERMINAL_NAMES.get(name, name) for name in error.expected})
-    found = "the end of the line" if token.type == "$END" else f"`{token}`"
     return Diagnostic(
         "E0101", Severity.ERROR,
         f"expected {_either(expected)}, found {found}", span,
-        help=_syntax_help(str(token), error.expected),
+        help=_syntax_help(token.text if token else "", error.expected),
     )
 
 
@@ -254,12 +318,13 @@ def parse_line(text: str, number: int) -> tuple[ast.Line, list[Diagnostic]]:
     span = ast.Span(number, 1, number, len(text) + 1)
     if not code.strip():
         return ast.Line(span, number, None, (), comment), []
-    parser, builder = _lark()
+    tables = _lalr_tables()
+    builder = tables.builder
     builder.line_number = number
     builder.problems = []
     try:
-        label, statements = cast(_ParsedLine, parser.parse(code))
-    except (ScanError, UnexpectedInput) as error:
+        label, statements = cast(_ParsedLine, _run_lalr(tables, scan(code)))
+    except (ScanError, _SyntaxError) as error:
         return ast.Line(span, number, None, (), comment, ok=False), [
             _syntax_error(number, error, code)
         ]

@@ -13,8 +13,6 @@ from __future__ import annotations
 import re
 from collections.abc import Iterator
 
-from lark import Token
-
 _TOKEN = re.compile(
     r"""
      (?P<SPACE>[ \t\f\v]+)
@@ -35,6 +33,21 @@ PUNCTUATION = {
     ";": "_SEMI",
 }
 _ENDS_OPERAND = frozenset({"VAR", "NUMBER", "HEX", "RPAR"})
+
+
+class Token:
+    """A token: its kind (a terminal of grammar.lark), its text and its 0-based column.
+    Deliberately lighter than lark's Token: the scanner makes millions of them."""
+
+    __slots__ = ("column", "text", "type")
+
+    def __init__(self, kind: str, text: str, column: int) -> None:
+        self.type = kind
+        self.text = text
+        self.column = column
+
+    def __repr__(self) -> str:
+        return f"Token({self.type}, {self.text!r}, {self.column})"
 
 
 class ScanError(Exception):
@@ -68,7 +81,7 @@ def scan(code: str) -> Iterator[Token]:
             elif len(text) == 1:
                 kind = "VAR"
         elif kind == "NUMBER" and text[0] == "-" and previous in _ENDS_OPERAND:
-            yield Token("MINUS", "-", start, column=start)
+            yield Token("MINUS", "-", start)
             kind, text, start = "NUMBER", text[1:], start + 1
         previous = kind
-        yield Token(kind, text, start, column=start)
+        yield Token(kind, text, start)
