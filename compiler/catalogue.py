@@ -40,4 +40,5 @@ CODES: dict[str, CodeInfo] = _entries(
     ("E0103", E, "a word that is not a variable"),
     ("E0104", E, "label not at the start of a line"),
     ("E0105", E, "malformed hex constant"),
+    ("E0190", E, "compiled code too large for .ilc"),
 )

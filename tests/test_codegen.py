@@ -1,0 +1,205 @@
+"""Code generation: the bytes of each construct, jump layout, handler table, features,
+the line map and the code size limit; every valid program compiles to a verified file."""
+
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rl1.compiler import ir
+from rl1.compiler.builtins import BUILTINS, VARIABLES, Feature
+from rl1.compiler.codegen import CodeTooLarge, generate
+from rl1.compiler.lower import lower
+from rl1.compiler.parser import parse_program
+from rl1.vm import ilc, isa
+from rl1.vm.verifier import verify
+
+SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
+
+
+def compile_text(text: str) -> ilc.Image:
+    program, diagnostics = parse_program(text)
+    assert diagnostics == []
+    return generate(lower(program), "test.rob")
+
+
+def var(name: str) -> int:
+    return VARIABLES.index(name)
+
+
+def names(image: ilc.Image) -> list[str]:
+    return [instruction.info.name for instruction in verify(ilc.encode(image)).instructions]
+
+
+def test_expression_encodes_as_load_operate_store() -> None:
+    # C=a<3+b>6+C: LDV a; SHLI 3; ADDV b; SHRI 6; ADDV C; STV C; then END.
+    image = compile_text("C=a<3+b>6+C")
+    assert image.code == bytes([
+        0x01, var("a"), 0x1D, 3, 0, 0x10, var("b"), 0x1E, 6, 0, 0x10, var("C"),
+        0x04, var("C"), 0x00,
+    ])
+
+
+def test_call_operand_reads_r_with_the_r_form_of_the_operator() -> None:
+    image = compile_text("A=x+(IMG); B=(KYO)")
+    assert names(image) == ["LDV", "IMG", "ADDR", "STV", "KYO", "LDR", "STV", "END"]
+
+
+def test_call_arguments_mask_marks_the_variables() -> None:
+    # MVI is the fourth call form; mask 0b010: only the middle argument is a variable.
+    image = compile_text("(MVI 3,c,-50)")
+    assert image.code == bytes([isa.CALL_BASE + 3, 0b010, 3, 0, var("c"), 0,
+                                0xCE, 0xFF, 0x00])
+
+
+def test_jump_to_the_next_block_is_left_out_and_others_resolve_to_offsets() -> None:
+    # B0 falls into :10 (no JMP); the branch falls into B1 (no JMP); #10 goes back.
+    image = compile_text("A=1\n:10 A--; ?A=#20; #10\n:20 (END)")
+    instructions = verify(ilc.encode(image)).instructions
+    assert [i.info.name for i in instructions] == ["LDI", "STV", "DEC", "JZ", "JMP", "END"]
+    label_10, label_20 = instructions[2].offset, instructions[5].offset
+    assert instructions[3].operands == (var("A"), label_20)
+    assert instructions[4].operands == (label_10,)
+
+
+def test_branch_whose_fall_through_is_not_next_gets_a_jump() -> None:
+    program = ir.Program({
+        "B0": ir.Block("B0", [], ir.Branch(ir.Var("A"), ">", "B1", "B2", 1)),
+        "B1": ir.Block("B1", [], ir.End(2)),
+        "B2": ir.Block("B2", [], ir.End(3)),
+    }, "B0")
+    instructions = verify(ilc.encode(generate(program, "x.rob"))).instructions
+    assert [(i.info.name, i.operands) for i in instructions] == [
+        ("JGT", (var("A"), 7)), ("JMP", (8,)), ("END", ()), ("END", ()),
+    ]
+
+
+def test_sample_compiles_decodes_and_verifies() -> None:
+    image = generate(lower(parse_program(SAMPLE.read_text(encoding="utf-8"))[0]), "sample.rob")
+    data = ilc.encode(image)
+    assert ilc.decode(data) == image
+    verified = verify(data)
+    by_offset = {i.offset: i for i in verified.instructions}
+    # :96 starts with (MOV 0,0), :99 with (FRE).
+    assert set(image.handlers) == {96, 99}
+    assert by_offset[image.handlers[96]].info.name == "MOV"
+    assert by_offset[image.handlers[99]].info.name == "FRE"
+    assert image.features == {Feature.MOTION, Feature.STEERING, Feature.CAMERA,
+                              Feature.VISION}
+    assert image.debug is not None
+    assert image.debug.source_name == "sample.rob"
+    assert image.debug.line_at(image.handlers[96]) == 41
+    assert image.debug.line_at(len(image.code) - 1) == 43
+
+
+def test_line_map_has_one_entry_per_instruction() -> None:
+    image = compile_text("A=1\n\n(MOV 1,1); B++\n#00\n:00 (END)")
+    assert image.debug is not None
+    # LDI, STV on line 1; MOV, INC on line 3; #00 jumps to the next block: no code.
+    assert image.debug.lines == ((0, 1), (3, 1), (5, 3), (11, 3), (13, 5))
+
+
+def test_features_are_those_of_the_calls_made() -> None:
+    assert compile_text("A=(ULT C); (FZI); (TIM 5)").features == {
+        Feature.ULTRASONIC, Feature.FUZZY,  # TIM needs no device feature
+    }
+    assert compile_text("(OUT 1,2)").features == {Feature.IO}
+
+
+def test_code_of_exactly_65535_bytes_fits() -> None:
+    # 32767 two-byte INCs and a one-byte END.
+    image = generate(_incs(32767), "big.rob")
+    assert len(image.code) == 65535
+    verify(ilc.encode(ilc.strip_debug(image)))
+
+
+def test_code_past_65535_bytes_is_refused_at_the_line_where_it_passes() -> None:
+    with pytest.raises(CodeTooLarge) as refused:
+        generate(_incs(32768), "big.rob")
+    diagnostic = refused.value.diagnostic
+    assert diagnostic.code == "E0190" and diagnostic.is_error
+    # INC number 32768 (line 32768) would end at byte 65536.
+    assert diagnostic.span.line == 32768
+    assert "65535 bytes" in diagnostic.message
+
+
+def _incs(count: int) -> ir.Program:
+    block = ir.Block("B0", [ir.StepVar(ir.Var("A"), "++", line)
+                           for line in range(1, count + 1)], ir.End(count))
+    return ir.Program({"B0": block}, "B0")
+
+
+# Every valid program compiles to a file the verifier accepts ----------------------------
+
+VALUE_CALLS = ["(KYO)", "(IMG)", "(CAM R)", "(ULT A)", "(ULT D)", "(INP 3)", "(INP q)"]
+OPERATORS = "+-&|^<>"
+LABELS = st.integers(0, 99).map(lambda n: f"{n:02d}")
+
+
+@st.composite
+def operands(draw: st.DrawFn) -> str:
+    return draw(st.one_of(
+        st.sampled_from(VARIABLES),
+        st.integers(-32768, 32767).map(str),
+        st.integers(0, 0xFFFF).map(lambda n: f"${n:X}"),
+        st.sampled_from(VALUE_CALLS),
+    ))
+
+
+@st.composite
+def calls(draw: st.DrawFn) -> str:
+    builtin = draw(st.sampled_from(sorted(BUILTINS.values(), key=lambda b: b.mnemonic)))
+    form = draw(st.sampled_from(builtin.forms))
+    args = [draw(st.one_of(st.sampled_from(VARIABLES), st.integers(p.low, p.high).map(str)))
+            for p in form.params]
+    words = [builtin.mnemonic, *([form.selector] if form.selector else [])]
+    return "(" + " ".join(words) + (" " + ",".join(args) if args else "") + ")"
+
+
+@st.composite
+def valid_programs(draw: st.DrawFn) -> str:
+    """Source texts without errors: each jump targets a label that is defined."""
+    defined = draw(st.lists(LABELS, min_size=1, max_size=6, unique=True))
+    lines: list[str] = []
+    for index in range(draw(st.integers(1, 12))):
+        statements = []
+        for _ in range(draw(st.integers(0, 4))):
+            kind = draw(st.integers(0, 4))
+            variable = draw(st.sampled_from(VARIABLES))
+            if kind == 0:
+                rest = draw(st.lists(st.tuples(st.sampled_from(OPERATORS), operands()),
+                                     max_size=4))
+                statements.append(variable + "=" + draw(operands())
+                                  + "".join(op + operand for op, operand in rest))
+            elif kind == 1:
+                statements.append(variable + draw(st.sampled_from(["++", "--"])))
+            elif kind == 2:
+                statements.append("#" + draw(st.sampled_from(defined)))
+            elif kind == 3:
+                relation = draw(st.sampled_from("=<>"))
+                statements.append(f"?{variable}{relation}#{draw(st.sampled_from(defined))}")
+            else:
+                statements.append(draw(calls()))
+        label = f":{defined[index]} " if index < len(defined) else ""
+        lines.append(label + "; ".join(statements))
+    lines += [f":{label}" for label in defined[len(lines):]]
+    return "\n".join(lines) + "\n"
+
+
+@settings(max_examples=100, deadline=None)
+@given(valid_programs())
+def test_every_valid_program_compiles_to_valid_ir_and_verified_bytes(text: str) -> None:
+    program, diagnostics = parse_program(text)
+    assert diagnostics == []
+    lowered = lower(program)
+    assert ir.validate(lowered) == []
+    image = generate(lowered, "generated.rob")
+    data = ilc.encode(image)
+    assert ilc.decode(data) == image
+    verified = verify(data)
+    assert image.debug is not None
+    assert [offset for offset, _ in image.debug.lines] == [
+        instruction.offset for instruction in verified.instructions
+    ]
+    assert verify(ilc.encode(ilc.strip_debug(image))).instructions == verified.instructions
