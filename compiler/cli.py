@@ -2,23 +2,45 @@
 
 Each action is a thin wrapper: parse options, call the stage that does the work, map the
 outcome to an exit status. Exit statuses: 0 success, 1 the input has errors,
-2 a usage problem or an unreadable file.
+2 a usage problem or an unreadable file, 3 an internal error (a bug in rl1c).
+
+To add a command: one function decorated `@main.command()`; read inputs with
+`read_input`, report diagnostics with `emit` (or render.report), end with `ctx.exit`.
 """
 
 from __future__ import annotations
 
+import os
 import sys
+import traceback
 
 import click
 
+from .ast import Span
+from .catalogue import CODES
+from .diagnostics import Diagnostic, Severity
 from .frontend import analyze
-from .source import SourceError, read_source
+from .render import (
+    COLOR_CHOICES,
+    EXIT_USAGE,
+    FORMATS,
+    ColorChoice,
+    FileDiagnostics,
+    Format,
+    exit_status,
+    report,
+    use_color,
+)
+from .source import MAX_SOURCE_BYTES, Source, SourceError, decode, read_source
 
-EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
+EXIT_INTERNAL = 3
+
+STDIN_NAME = "<stdin>"
 
 
-class _CompileByDefault(click.Group):
-    """Treats `rl1c FILE ...` as `rl1c compile FILE ...`, so compiling needs no verb."""
+class _Toolchain(click.Group):
+    """The `rl1c` group: `rl1c FILE ...` means `rl1c compile FILE ...`, so compiling
+    needs no verb; and an unexpected exception ends in a short message, not a traceback."""
 
     def resolve_command(
         self, ctx: click.Context, args: list[str]
@@ -27,30 +49,107 @@ class _CompileByDefault(click.Group):
             args = ["compile", *args]
         return super().resolve_command(ctx, args)
 
+    def invoke(self, ctx: click.Context) -> object:
+        try:
+            return super().invoke(ctx)
+        except (click.exceptions.Exit, click.ClickException, click.Abort, BrokenPipeError):
+            raise  # click turns these into their messages and exit statuses
+        except Exception as error:
+            # A traceback tells a robot programmer nothing they can act on and reads as
+            # if their program were at fault; a distinct status (3) lets scripts and CI
+            # tell a bug in rl1c from a program with errors (1) or a usage problem (2).
+            # RL1C_BACKTRACE=1 shows the traceback to whoever debugs rl1c.
+            if os.environ.get("RL1C_BACKTRACE"):
+                traceback.print_exc()
+            summary = f"{type(error).__name__}: {error}"
+            click.echo(
+                f"rl1c: internal error: {summary[:300]}\n"
+                "This is a bug in rl1c, not in your program. Please report it with the "
+                "command line and the input file (RL1C_BACKTRACE=1 shows the details).",
+                err=True,
+            )
+            ctx.exit(EXIT_INTERNAL)
 
-@click.group(cls=_CompileByDefault, context_settings={"help_option_names": ["-h", "--help"]})
+
+@click.group(cls=_Toolchain, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="rl1", prog_name="rl1c")
 def main() -> None:
     """The RL/I toolchain. `rl1c FILE.rob -o FILE.ilc` compiles; the commands below
     check, format, explain, disassemble, assemble and run programs."""
 
 
+# Shared by the commands that report diagnostics.
+format_option = click.option(
+    "--format", "output_format", type=click.Choice(FORMATS), default="human",
+    show_default=True, help="human: text for people; json or sarif: for tools.",
+)
+color_option = click.option(
+    "--color", "color", type=click.Choice(COLOR_CHOICES), default="auto", show_default=True,
+    help="Colour the human format; auto: only on a terminal, and not if NO_COLOR is set.",
+)
+
+
+def read_input(name: str) -> Source | FileDiagnostics:
+    """The source file `name` (`-` is standard input), or the E0100 report of why it
+    cannot be read."""
+    try:
+        if name != "-":
+            return read_source(name)
+        data = sys.stdin.buffer.read(MAX_SOURCE_BYTES + 1)
+        if len(data) > MAX_SOURCE_BYTES:
+            raise SourceError(f"{STDIN_NAME} holds more than {MAX_SOURCE_BYTES} bytes; "
+                              "RL/I sources are limited to that size")
+        return decode(data, STDIN_NAME)
+    except SourceError as error:
+        unreadable = Diagnostic("E0100", Severity.ERROR, str(error), Span(1, 1, 1, 1))
+        return FileDiagnostics(STDIN_NAME if name == "-" else name, None, [unreadable])
+
+
+def emit(files: list[FileDiagnostics], output_format: Format, color: ColorChoice,
+         action: str) -> int:
+    """Print the diagnostics of `files` on standard output; the exit status they call for."""
+    colored = output_format == "human" and use_color(color, sys.stdout)
+    click.echo(report(files, output_format, color=colored, action=action), nl=False,
+               color=colored)
+    return exit_status(files)
+
+
 @main.command()
 @click.argument("files", nargs=-1, required=True)
-def check(files: tuple[str, ...]) -> None:
-    """Check RL/I programs and report every problem found."""
-    status = EXIT_OK
+@format_option
+@color_option
+@click.pass_context
+def check(ctx: click.Context, files: tuple[str, ...], output_format: Format,
+          color: ColorChoice) -> None:
+    """Check RL/I programs (`-` reads standard input) and report every problem found.
+    Exit status: 0 no errors (warnings allowed), 1 errors, 2 an unreadable file."""
+    checked: list[FileDiagnostics] = []
     for name in files:
-        try:
-            source = read_source(name)
-        except SourceError as error:
-            click.echo(f"error[E0100]: {error}", err=True)
-            status = EXIT_USAGE
-            continue
-        analysis = analyze(source.text)
-        for d in analysis.diagnostics:
-            click.echo(f"{name}:{d.span.line}:{d.span.column}: "
-                       f"{d.severity.value}[{d.code}]: {d.message}")
-        if analysis.has_errors and status == EXIT_OK:
-            status = EXIT_ERRORS
-    sys.exit(status)
+        source = read_input(name)
+        if isinstance(source, Source):
+            checked.append(FileDiagnostics(source.name, source.text,
+                                           analyze(source.text).diagnostics))
+        else:
+            checked.append(source)
+    ctx.exit(emit(checked, output_format, color, "check"))
+
+
+@main.command()
+@click.argument("code", required=False)
+@click.option("--list", "list_codes", is_flag=True, help="List every code with its title.")
+@click.pass_context
+def explain(ctx: click.Context, code: str | None, list_codes: bool) -> None:
+    """Explain a diagnostic code in depth, with examples: `rl1c explain E0101`."""
+    if list_codes == (code is not None):
+        raise click.UsageError("give a code, as in `rl1c explain E0101`, or --list")
+    if code is None:
+        for entry in CODES.values():
+            click.echo(f"{entry.code}  {entry.title}")
+        return
+    info = CODES.get(code.strip().upper())
+    if info is None:
+        click.echo(f"error: `{code}` is not a diagnostic code of rl1c\n"
+                   "  = help: `rl1c explain --list` lists every code with its title",
+                   err=True)
+        ctx.exit(EXIT_USAGE)
+    click.echo(info.explanation(), nl=False)

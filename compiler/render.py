@@ -1,0 +1,394 @@
+"""Renderers: diagnostics to text for people (rustc/Elm style), JSON, or SARIF 2.1.0.
+
+`report` renders the diagnostics of several files in one of the three formats, and
+`exit_status` says how a command should end after reporting them. Diagnostics stay data
+until here; nothing else turns them into text.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import unicodedata
+from collections.abc import Sequence
+from importlib.metadata import version
+from pathlib import Path
+from typing import IO, Any, Literal, NamedTuple
+from urllib.parse import quote
+
+import click
+
+from .ast import Span
+from .catalogue import CODES
+from .diagnostics import Diagnostic, Fix, Severity, sort_key
+from .source import split_lines
+
+Format = Literal["human", "json", "sarif"]
+FORMATS: tuple[Format, ...] = ("human", "json", "sarif")
+ColorChoice = Literal["auto", "always", "never"]
+COLOR_CHOICES: tuple[ColorChoice, ...] = ("auto", "always", "never")
+
+# Exit statuses of a command that reports diagnostics.
+EXIT_OK, EXIT_ERRORS, EXIT_USAGE = 0, 1, 2
+
+TAB_STOP = 4
+# Snippet lines wider than this (in terminal cells) are cut to a window around the span.
+SNIPPET_WIDTH = 120
+_CONTEXT = 40  # code points kept before the span in a cut line
+_ELLIPSIS = "..."
+
+SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
+_SARIF_LEVELS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
+
+
+class FileDiagnostics(NamedTuple):
+    """The diagnostics of one source file. `text` is None when the file could not be
+    read; its diagnostics then say why (E0100) and have no place in the text."""
+
+    name: str
+    text: str | None
+    diagnostics: Sequence[Diagnostic]
+
+
+def report(
+    files: Sequence[FileDiagnostics],
+    output_format: Format = "human",
+    *,
+    color: bool = False,
+    action: str = "check",
+) -> str:
+    """The diagnostics of `files`, in the order given, as one text ending in a newline
+    (empty for people when there is nothing to say). `action` names what failed in the
+    human summary: "could not check `x.rob`"."""
+    if output_format == "json":
+        return _json_report(files)
+    if output_format == "sarif":
+        return _sarif_report(files)
+    rendered = (_HumanRenderer(file, color).render(action) for file in files)
+    return "\n".join(text for text in rendered if text)
+
+
+def exit_status(files: Sequence[FileDiagnostics]) -> int:
+    """2 when a file could not be read, else 1 when any diagnostic is an error, else 0."""
+    if any(file.text is None for file in files):
+        return EXIT_USAGE
+    if any(d.is_error for file in files for d in file.diagnostics):
+        return EXIT_ERRORS
+    return EXIT_OK
+
+
+def use_color(choice: ColorChoice, stream: IO[Any]) -> bool:
+    """`auto` colours only a terminal, and never when NO_COLOR is set (no-color.org)."""
+    if choice == "auto":
+        return stream.isatty() and not os.environ.get("NO_COLOR")
+    return choice == "always"
+
+
+def _ordered(diagnostics: Sequence[Diagnostic]) -> list[Diagnostic]:
+    return sorted(diagnostics, key=sort_key)
+
+
+# Human ------------------------------------------------------------------------------
+
+_STYLES: dict[str, dict[str, Any]] = {
+    "error": {"fg": "red", "bold": True},
+    "warning": {"fg": "yellow", "bold": True},
+    "info": {"fg": "cyan", "bold": True},
+    "note": {"fg": "green", "bold": True},
+    "help": {"fg": "cyan", "bold": True},
+    "gutter": {"fg": "blue", "bold": True},
+    "message": {"bold": True},
+}
+
+
+def _glyph(character: str, cell: int) -> str:
+    """How `character` is shown at display cell `cell`: tabs become spaces, and
+    characters that would act on the terminal instead of printing are made visible."""
+    if character == "\t":
+        return " " * (TAB_STOP - cell % TAB_STOP)
+    code = ord(character)
+    if code < 0x20:
+        return chr(0x2400 + code)  # the Control Pictures block: ␀ to ␟
+    if code == 0x7F:
+        return "\u2421"  # ␡
+    if unicodedata.category(character) in ("Cc", "Cf", "Zl", "Zp", "Cs"):
+        return f"<U+{code:04X}>"  # C1 controls, bidi overrides, line separators...
+    return character
+
+
+def _cells(text: str) -> int:
+    """Terminal cells taken by `text`: wide East Asian characters take two, combining
+    marks none."""
+    width = 0
+    for character in text:
+        if unicodedata.combining(character):
+            continue
+        width += 2 if unicodedata.east_asian_width(character) in ("W", "F") else 1
+    return width
+
+
+def _visible(text: str) -> str:
+    """`text` with the characters that would act on a terminal made visible."""
+    if text.isascii() and text.isprintable():
+        return text
+    return "".join(_glyph(c, 0) if c != "\t" else " " for c in text)
+
+
+def excerpt(line: str, first: int, last: int) -> tuple[str, int, int]:
+    """How to show `line` with code points [first, last) underlined: the text shown, and
+    the cell where the underline starts and its width (at least one cell). A line wider
+    than SNIPPET_WIDTH is cut to a window around `first`, marked with `...`."""
+    start = max(0, first - _CONTEXT) if len(line) > SNIPPET_WIDTH else 0
+    pieces = [_ELLIPSIS] if start > 0 else []
+    cell = len(pieces[0]) if pieces else 0
+    limit = cell + SNIPPET_WIDTH
+    starts: list[int] = []
+    index = start
+    while index < len(line) and cell < limit:
+        glyph = _glyph(line[index], cell)
+        starts.append(cell)
+        pieces.append(glyph)
+        cell += _cells(glyph)
+        index += 1
+    end_cell = cell
+    cut_right = index < len(line)
+    if cut_right:
+        pieces.append(_ELLIPSIS)
+
+    def cell_of(position: int) -> int:
+        if position < index:
+            return starts[position - start]
+        # Past the shown text: hidden by the cut, or one cell per position past the end.
+        return end_cell if cut_right else end_cell + position - len(line)
+
+    caret = cell_of(first)
+    return "".join(pieces), caret, max(1, cell_of(max(first, last)) - caret)
+
+
+class _HumanRenderer:
+    """The rustc-like text of one file's diagnostics and its closing summary."""
+
+    def __init__(self, file: FileDiagnostics, color: bool) -> None:
+        self.file = file
+        self.color = color
+        self.lines = split_lines(file.text) if file.text is not None else []
+
+    def paint(self, text: str, role: str) -> str:
+        return click.style(text, **_STYLES[role]) if self.color else text
+
+    def render(self, action: str) -> str:
+        blocks = [self.diagnostic(d) for d in _ordered(self.file.diagnostics)]
+        summary = self.summary(action)
+        if summary:
+            blocks.append(summary)
+        return "".join(blocks)
+
+    def diagnostic(self, diagnostic: Diagnostic) -> str:
+        level = diagnostic.severity.value
+        spans = [diagnostic.span, *(related.span for related in diagnostic.related)]
+        gutter = max(len(str(span.end_line)) for span in spans)
+        out = [
+            self.paint(f"{level}[{diagnostic.code}]", level)
+            + self.paint(f": {_visible(diagnostic.message)}", "message")
+        ]
+        out += self.snippet(diagnostic.span, gutter, level)
+        if diagnostic.help:
+            pad = " " * gutter
+            help_lines = _visible_lines(diagnostic.help)
+            out.append(self.paint(f"{pad} |", "gutter"))
+            out.append(
+                self.paint(f"{pad} = ", "gutter") + self.paint("help", "help") + ": "
+                + ("\n" + " " * (gutter + 9)).join(help_lines)
+            )
+        for related in diagnostic.related:
+            out.append(self.paint("note", "note") + self.paint(
+                f": {_visible(related.message)}", "message"))
+            out += self.snippet(related.span, gutter, "note")
+        return "\n".join(out) + "\n\n"
+
+    def snippet(self, span: Span, gutter: int, role: str) -> list[str]:
+        """The ` --> file:line:col` line and the underlined source lines of `span`."""
+        pad = " " * gutter
+        if self.file.text is None:
+            return [self.paint(f"{pad}--> ", "gutter") + _visible(self.file.name)]
+        where = f"{_visible(self.file.name)}:{span.line}:{max(span.column, 1)}"
+        out = [self.paint(f"{pad}--> ", "gutter") + where]
+        if not 1 <= span.line <= len(self.lines):
+            return out  # a place past the end of the text: nothing to show
+        out.append(self.paint(f"{pad} |", "gutter"))
+        last_line = min(span.end_line, len(self.lines))
+        for number in dict.fromkeys((span.line, last_line)):  # the first and last lines
+            if number == last_line and last_line > span.line + 1:
+                out.append(self.paint("...", "gutter"))
+            line = self.lines[number - 1]
+            first = span.column - 1 if number == span.line else 0
+            last = span.end_column - 1 if number == span.end_line else len(line)
+            shown, caret, width = excerpt(line, max(first, 0), last)
+            out.append(self.paint(f"{number:>{gutter}} |", "gutter") + f" {shown}".rstrip())
+            out.append(self.paint(f"{pad} |", "gutter") + " " * (caret + 1)
+                       + self.paint("^" * width, role))
+        return out
+
+    def summary(self, action: str) -> str:
+        counts = {severity: 0 for severity in Severity}
+        for diagnostic in self.file.diagnostics:
+            counts[diagnostic.severity] += 1
+        errors, warnings = counts[Severity.ERROR], counts[Severity.WARNING]
+        emitted = ", ".join(
+            _plural(count, noun) for count, noun in ((errors, "error"), (warnings, "warning"))
+            if count
+        )
+        name = _visible(self.file.name)
+        if errors:
+            return (self.paint("error", "error")
+                    + self.paint(f": could not {action} `{name}`: {emitted} emitted", "message")
+                    + "\n")
+        if warnings:
+            return (self.paint("warning", "warning")
+                    + self.paint(f": `{name}`: {emitted} emitted", "message") + "\n")
+        return ""
+
+
+def _visible_lines(text: str) -> list[str]:
+    return [_visible(line) for line in split_lines(text)] or [""]
+
+
+def _plural(count: int, noun: str) -> str:
+    return f"{count} {noun}" if count == 1 else f"{count} {noun}s"
+
+
+# JSON -------------------------------------------------------------------------------
+
+
+def _json_report(files: Sequence[FileDiagnostics]) -> str:
+    items = [
+        {
+            "file": file.name,
+            **_json_span(d.span),
+            "severity": d.severity.value,
+            "code": d.code,
+            "message": d.message,
+            "help": d.help,
+            "fixes": [_json_fix(fix) for fix in d.fixes],
+            "related": [{**_json_span(r.span), "message": r.message} for r in d.related],
+        }
+        for file in files
+        for d in _ordered(file.diagnostics)
+    ]
+    # ASCII only: valid JSON whatever the encoding of the stream it is written to.
+    return json.dumps(items, indent=2, ensure_ascii=True) + "\n"
+
+
+def _json_span(span: Span) -> dict[str, int]:
+    return {"line": span.line, "column": span.column,
+            "end_line": span.end_line, "end_column": span.end_column}
+
+
+def _json_fix(fix: Fix) -> dict[str, Any]:
+    return {"title": fix.title,
+            "edits": [{**_json_span(edit.span), "text": edit.text} for edit in fix.edits]}
+
+
+# SARIF ------------------------------------------------------------------------------
+
+
+def _sarif_report(files: Sequence[FileDiagnostics]) -> str:
+    rule_index = {code: index for index, code in enumerate(CODES)}
+    results = [
+        _sarif_result(file, d, rule_index)
+        for file in files
+        for d in _ordered(file.diagnostics)
+    ]
+    log = {
+        "$schema": SARIF_SCHEMA,
+        "version": "2.1.0",
+        "runs": [{
+            "tool": {"driver": {
+                "name": "rl1c",
+                "version": version("rl1"),
+                "rules": [_sarif_rule(code) for code in CODES],
+            }},
+            "columnKind": "unicodeCodePoints",  # as our Span columns count
+            "results": results,
+        }],
+    }
+    return json.dumps(log, indent=2, ensure_ascii=True) + "\n"
+
+
+def _sarif_rule(code: str) -> dict[str, Any]:
+    info = CODES[code]
+    explanation = info.explanation()
+    return {
+        "id": code,
+        "shortDescription": {"text": info.title},
+        "fullDescription": {"text": first_paragraph(explanation)},
+        "help": {"text": explanation, "markdown": explanation},
+        "defaultConfiguration": {"level": _SARIF_LEVELS[info.severity]},
+    }
+
+
+def first_paragraph(markdown: str) -> str:
+    """The first paragraph of prose of an explanation, on one line (headings skipped)."""
+    for paragraph in markdown.split("\n\n"):
+        text = " ".join(line.strip() for line in paragraph.strip().splitlines())
+        if text and not text.startswith("#"):
+            return text
+    return ""
+
+
+def _sarif_result(
+    file: FileDiagnostics, diagnostic: Diagnostic, rule_index: dict[str, int]
+) -> dict[str, Any]:
+    uri = artifact_uri(file.name)
+    result: dict[str, Any] = {"ruleId": diagnostic.code}
+    if diagnostic.code in rule_index:
+        result["ruleIndex"] = rule_index[diagnostic.code]
+    text = diagnostic.message + (f"\nhelp: {diagnostic.help}" if diagnostic.help else "")
+    result["level"] = _SARIF_LEVELS[diagnostic.severity]
+    result["message"] = {"text": text}
+    # An unreadable file has no text, so its diagnostic has no region in it.
+    has_text = file.text is not None
+    result["locations"] = [_sarif_location(uri, diagnostic.span if has_text else None)]
+    if diagnostic.related:
+        result["relatedLocations"] = [
+            {**_sarif_location(uri, related.span), "id": index,
+             "message": {"text": related.message}}
+            for index, related in enumerate(diagnostic.related)
+        ]
+    if diagnostic.fixes:
+        result["fixes"] = [
+            {
+                "description": {"text": fix.title},
+                "artifactChanges": [{
+                    "artifactLocation": {"uri": uri},
+                    "replacements": [
+                        {"deletedRegion": _sarif_region(edit.span),
+                         "insertedContent": {"text": edit.text}}
+                        for edit in fix.edits
+                    ],
+                }],
+            }
+            for fix in diagnostic.fixes
+        ]
+    return result
+
+
+def _sarif_location(uri: str, span: Span | None) -> dict[str, Any]:
+    physical: dict[str, Any] = {"artifactLocation": {"uri": uri}}
+    if span is not None:
+        physical["region"] = _sarif_region(span)
+    return {"physicalLocation": physical}
+
+
+def _sarif_region(span: Span) -> dict[str, int]:
+    return {"startLine": span.line, "startColumn": span.column,
+            "endLine": span.end_line, "endColumn": span.end_column}
+
+
+def artifact_uri(name: str) -> str:
+    """The SARIF URI of a file named on the command line: the relative path as given,
+    percent-encoded where a URI needs it; an absolute path becomes a file: URI."""
+    path = Path(name)
+    if path.is_absolute():
+        return path.as_uri()
+    return quote(path.as_posix())
