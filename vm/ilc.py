@@ -22,12 +22,15 @@ MAGIC = b"RLIC"
 VERSION_MAJOR, VERSION_MINOR = 1, 0
 
 # magic, major, minor, flags, crc, header size, then the size of each section in order.
-HEADER = struct.Struct("<4sBBHIHHHHH")
+# The debug section's size is a u32: one entry per instruction can pass 64 KiB.
+HEADER = struct.Struct("<4sBBHIHHHHI")
 CRC_OFFSET = 8  # the CRC-32 field; it counts as zero while the CRC is computed
 HANDLER_SIZE = 2 * len(HANDLER_LABELS)
 FEATURE_SIZE = 2
 ABSENT = 0xFFFF  # a handler table entry for a label the program does not define
 MAX_CODE_SIZE = 0xFFFF  # code offsets are u16
+MAX_LINE_ENTRIES = 0xFFFF  # the debug section's entry count is a u16
+MAX_LINE = 0xFFFF  # source lines are u16, from 1
 MAX_NAME_SIZE = 255  # the debug source name's length is one byte
 MAX_VARINT_SIZE = 3  # 3 x 7 bits hold any u16
 
@@ -149,13 +152,15 @@ def _encode_debug(debug: DebugInfo) -> bytes:
     name = debug.source_name.encode("utf-8")
     if len(name) > MAX_NAME_SIZE:
         raise ValueError(f"source name is {len(name)} bytes; the format allows {MAX_NAME_SIZE}")
-    if len(debug.lines) > 0xFFFF:
-        raise ValueError(f"{len(debug.lines)} line entries; the format allows 65535")
+    if len(debug.lines) > MAX_LINE_ENTRIES:
+        raise ValueError(f"{len(debug.lines)} line entries; the format allows "
+                         f"{MAX_LINE_ENTRIES}")
     out = bytearray([len(name)]) + name + struct.pack("<H", len(debug.lines))
     previous_offset, previous_line = 0, 0
     for index, (offset, line) in enumerate(debug.lines):
-        if not (0 <= offset <= 0xFFFF and 1 <= line <= 0xFFFF):
-            raise ValueError(f"line entry {(offset, line)}: offsets are u16, lines 1..65535")
+        if not (0 <= offset <= MAX_CODE_SIZE and 1 <= line <= MAX_LINE):
+            raise ValueError(f"line entry {(offset, line)}: offsets are u16, "
+                             f"lines 1..{MAX_LINE}")
         if index and offset <= previous_offset:
             raise ValueError(f"line entry {(offset, line)}: offsets must increase")
         if line < previous_line:
@@ -279,9 +284,9 @@ def _decode_debug(data: bytes, header: Header) -> tuple[DebugInfo, tuple[int, ..
         if index and offset_delta == 0:
             raise IlcFormatError(start, "line entry repeats the previous entry's code offset")
         offset, line = offset + offset_delta, line + line_delta
-        if offset > 0xFFFF or line > 0xFFFF or line == 0:
+        if offset > MAX_CODE_SIZE or line > MAX_LINE or line == 0:
             raise IlcFormatError(start, f"line entry (offset {offset}, line {line}) is out "
-                                 "of range: offsets are u16, lines 1..65535")
+                                 f"of range: offsets are u16, lines 1..{MAX_LINE}")
         lines.append((offset, line))
         starts.append(start)
     if reader.position != header.end:
