@@ -13,12 +13,15 @@ from __future__ import annotations
 import os
 import sys
 import traceback
+from pathlib import Path
 
 import click
 
 from .ast import Span
+from .atomic import write_atomically
 from .catalogue import CODES
 from .diagnostics import Diagnostic, Severity
+from .driver import EMITS, OPTIMIZATION_LEVELS, Emit, compile_text
 from .frontend import analyze
 from .render import (
     COLOR_CHOICES,
@@ -45,7 +48,8 @@ class _Toolchain(click.Group):
     def resolve_command(
         self, ctx: click.Context, args: list[str]
     ) -> tuple[str | None, click.Command | None, list[str]]:
-        if args and args[0] not in self.commands and not args[0].startswith("-"):
+        if args and args[0] not in self.commands and (args[0] == "-"  # standard input
+                                                      or not args[0].startswith("-")):
             args = ["compile", *args]
         return super().resolve_command(ctx, args)
 
@@ -106,11 +110,12 @@ def read_input(name: str) -> Source | FileDiagnostics:
 
 
 def emit(files: list[FileDiagnostics], output_format: Format, color: ColorChoice,
-         action: str) -> int:
-    """Print the diagnostics of `files` on standard output; the exit status they call for."""
-    colored = output_format == "human" and use_color(color, sys.stdout)
+         action: str, *, err: bool = False) -> int:
+    """Print the diagnostics of `files` on standard output (`err`: standard error);
+    the exit status they call for."""
+    colored = output_format == "human" and use_color(color, sys.stderr if err else sys.stdout)
     click.echo(report(files, output_format, color=colored, action=action), nl=False,
-               color=colored)
+               err=err, color=colored)
     return exit_status(files)
 
 
@@ -132,6 +137,69 @@ def check(ctx: click.Context, files: tuple[str, ...], output_format: Format,
         else:
             checked.append(source)
     ctx.exit(emit(checked, output_format, color, "check"))
+
+
+@main.command("compile")
+@click.argument("file")
+@click.option("-o", "--output", metavar="PATH",
+              help="Where to write; `-` is standard output. Default: FILE.ilc beside the "
+                   "source (standard output with --emit ir).")
+@click.option("-s", "--strip", is_flag=True,
+              help="Leave out the debug section (the map from code to source lines).")
+@click.option("--emit", "emit_kind", type=click.Choice(EMITS), default="ilc",
+              show_default=True, help="ilc: the .ilc file; ir: the IR as text.")
+@click.option("-O", "optimize", default="0", metavar="LEVEL",
+              help="Optimization level; only -O0 (none) exists so far.")
+@format_option
+@color_option
+@click.pass_context
+def compile_program(ctx: click.Context, file: str, output: str | None, strip: bool,
+                    emit_kind: Emit, optimize: str, output_format: Format,
+                    color: ColorChoice) -> None:
+    """Compile an RL/I program (`-` reads standard input): `rl1c FILE.rob -o FILE.ilc`.
+    Diagnostics go to standard error; nothing is written when the program has errors.
+    Exit status: 0 compiled (warnings allowed), 1 errors, 2 an unreadable input or an
+    output that cannot be written."""
+    if optimize not in {str(level) for level in OPTIMIZATION_LEVELS}:
+        raise click.BadParameter(f"`-O{optimize}`: only -O0 (no optimization) exists so far",
+                                 param_hint="-O")
+    if strip and emit_kind == "ir":
+        raise click.UsageError("--strip drops the debug section of an .ilc file; "
+                               "it has no meaning with --emit ir")
+    target = output or ("-" if emit_kind == "ir" else _default_output(file))
+    source = read_input(file)
+    if not isinstance(source, Source):
+        ctx.exit(emit([source], output_format, color, "compile", err=True))
+    if target != "-" and file != "-" and os.path.exists(target) \
+            and os.path.samefile(file, target):
+        raise click.UsageError(f"the output `{target}` is the source file itself: "
+                               "give another path with -o")
+    compilation = compile_text(source.text, Path(source.name).name, emit=emit_kind,
+                               strip_debug=strip)
+    status = emit([FileDiagnostics(source.name, source.text, compilation.diagnostics)],
+                  output_format, color, "compile", err=True)
+    if compilation.output is None:
+        ctx.exit(status)
+    if target == "-":
+        stdout = sys.stdout.buffer
+        if emit_kind == "ilc" and stdout.isatty():
+            raise click.UsageError("an .ilc file is binary and standard output is a "
+                                   "terminal: redirect it, or give -o FILE.ilc")
+        stdout.write(compilation.output)
+        stdout.flush()
+        return
+    try:
+        write_atomically(target, compilation.output)
+    except OSError as error:
+        click.echo(f"error: cannot write `{target}`: {error.strerror or error}", err=True)
+        ctx.exit(EXIT_USAGE)
+
+
+def _default_output(source: str) -> str:
+    if source == "-":
+        raise click.UsageError("reading standard input there is no file name to name the "
+                               "output after: give -o FILE.ilc (or -o - for standard output)")
+    return str(Path(source).with_suffix(".ilc"))
 
 
 @main.command()

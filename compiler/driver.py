@@ -1,0 +1,50 @@
+"""Compiling one program: source text to the bytes of an .ilc file, or to its IR as text.
+
+The stages run in order (front end, lowering, code generation) and the first that
+refuses the program stops the compilation; its diagnostics say why. Reading the input
+and writing the output are the CLI's job.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+from rl1.vm import ilc
+
+from .codegen import CodeTooLarge, generate
+from .diagnostics import Diagnostic, sort_key
+from .frontend import analyze
+from .ir import format_program
+from .lower import lower
+
+Emit = Literal["ilc", "ir"]
+EMITS: tuple[Emit, ...] = ("ilc", "ir")
+OPTIMIZATION_LEVELS = (0,)  # -O0 only, until the optimizer exists
+
+
+@dataclass(frozen=True, slots=True)
+class Compilation:
+    """Every diagnostic of the program and, when none is an error, the output."""
+
+    diagnostics: list[Diagnostic]
+    output: bytes | None
+
+
+def compile_text(text: str, source_name: str, *, emit: Emit = "ilc",
+                 strip_debug: bool = False) -> Compilation:
+    """Compile a program; `source_name` is recorded in the debug section."""
+    analysis = analyze(text)
+    if analysis.has_errors:
+        return Compilation(analysis.diagnostics, None)
+    program = lower(analysis.program)
+    if emit == "ir":
+        return Compilation(analysis.diagnostics, format_program(program).encode("utf-8"))
+    try:
+        image = generate(program, source_name)
+    except CodeTooLarge as refused:
+        diagnostics = sorted([*analysis.diagnostics, refused.diagnostic], key=sort_key)
+        return Compilation(diagnostics, None)
+    if strip_debug:
+        image = ilc.strip_debug(image)
+    return Compilation(analysis.diagnostics, ilc.encode(image))

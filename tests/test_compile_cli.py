@@ -1,0 +1,205 @@
+"""`rl1c FILE.rob -o FILE.ilc`: what is written, what is refused, and that a refused or
+failed compilation never leaves a file behind or damages one."""
+
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner, Result
+
+from rl1.compiler import driver
+from rl1.compiler.ast import Span
+from rl1.compiler.atomic import write_atomically
+from rl1.compiler.cli import main
+from rl1.compiler.diagnostics import Diagnostic, Severity
+from rl1.compiler.frontend import Analysis
+from rl1.compiler.ir import format_program
+from rl1.compiler.lower import lower
+from rl1.compiler.parser import parse_program
+from rl1.vm import ilc
+from rl1.vm.verifier import verify
+
+SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
+BROKEN = "A=1\nB=(MOV 1\nC=2\n"
+
+
+def rl1c(*args: str, input: bytes | None = None) -> Result:
+    return CliRunner().invoke(main, list(args), input=input)
+
+
+@pytest.fixture
+def sample(tmp_path: Path) -> Path:
+    return Path(shutil.copy(SAMPLE, tmp_path / "sample.rob"))
+
+
+def test_compiles_to_an_ilc_beside_the_source_that_verifies(sample: Path) -> None:
+    result = rl1c(str(sample))
+    assert result.exit_code == 0, result.stderr
+    assert result.stdout == ""
+    image = verify((sample.parent / "sample.ilc").read_bytes()).image
+    assert image.debug is not None and image.debug.source_name == "sample.rob"
+    assert set(image.handlers) == {96, 99}
+
+
+def test_output_path_and_o0(sample: Path, tmp_path: Path) -> None:
+    result = rl1c(str(sample), "-O0", "-o", str(tmp_path / "out.ilc"))
+    assert result.exit_code == 0, result.stderr
+    verify((tmp_path / "out.ilc").read_bytes())
+    assert not (tmp_path / "sample.ilc").exists()
+
+
+def test_strip_drops_only_the_debug_section(sample: Path, tmp_path: Path) -> None:
+    assert rl1c(str(sample), "-o", str(tmp_path / "full.ilc")).exit_code == 0
+    assert rl1c(str(sample), "-s", "-o", str(tmp_path / "bare.ilc")).exit_code == 0
+    full = ilc.decode((tmp_path / "full.ilc").read_bytes())
+    bare = verify((tmp_path / "bare.ilc").read_bytes()).image
+    assert bare.debug is None
+    assert bare == ilc.strip_debug(full)
+    assert (tmp_path / "bare.ilc").stat().st_size < (tmp_path / "full.ilc").stat().st_size
+
+
+def test_emit_ir_prints_the_ir_or_writes_it_with_o(sample: Path, tmp_path: Path) -> None:
+    expected = format_program(lower(parse_program(SAMPLE.read_text(encoding="utf-8"))[0]))
+    printed = rl1c(str(sample), "--emit", "ir")
+    assert printed.exit_code == 0 and printed.stdout == expected
+    assert rl1c(str(sample), "--emit", "ir", "-o", str(tmp_path / "s.ir")).exit_code == 0
+    assert (tmp_path / "s.ir").read_text(encoding="utf-8") == expected
+    assert not (tmp_path / "sample.ilc").exists()
+
+
+def test_standard_input_and_output(tmp_path: Path) -> None:
+    result = rl1c("-", "-o", "-", input=SAMPLE.read_bytes())
+    assert result.exit_code == 0, result.stderr
+    image = verify(result.stdout_bytes).image
+    assert image.debug is not None and image.debug.source_name == "<stdin>"
+    unnamed = rl1c("-", input=SAMPLE.read_bytes())
+    assert unnamed.exit_code == 2 and "give -o FILE.ilc" in unnamed.stderr
+
+
+@pytest.mark.parametrize("args, message", [
+    (["-O1"], "only -O0"),
+    (["-O", "s"], "only -O0"),
+    (["--emit", "ir", "-s"], "no meaning with --emit ir"),
+    (["--emit", "asm"], "'asm' is not one of"),
+])
+def test_bad_options_are_usage_errors_and_write_nothing(
+    sample: Path, args: list[str], message: str,
+) -> None:
+    result = rl1c(str(sample), *args)
+    assert result.exit_code == 2
+    assert message in result.stderr
+    assert sorted(os.listdir(sample.parent)) == ["sample.rob"]
+
+
+def test_errors_refuse_to_write_and_are_printed_as_check_prints_them(tmp_path: Path) -> None:
+    source = tmp_path / "broken.rob"
+    source.write_text(BROKEN, encoding="utf-8")
+    output = tmp_path / "broken.ilc"
+    output.write_bytes(b"an older build")
+    result = rl1c(str(source), "--color", "never")
+    assert result.exit_code == 1
+    assert result.stdout == ""
+    checked = rl1c("check", str(source), "--color", "never")
+    assert checked.exit_code == 1
+    assert result.stderr == checked.stdout.replace("could not check", "could not compile")
+    assert "error[E0101]" in result.stderr
+    assert output.read_bytes() == b"an older build"
+    assert sorted(os.listdir(tmp_path)) == ["broken.ilc", "broken.rob"]
+
+
+def test_warnings_are_printed_and_do_not_block(
+    sample: Path, monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    warning = Diagnostic("W0601", Severity.WARNING, "a warning for the test", Span(2, 1, 2, 8))
+
+    def analyze_with_warning(text: str) -> Analysis:
+        return Analysis(parse_program(text)[0], [warning])
+
+    monkeypatch.setattr(driver, "analyze", analyze_with_warning)
+    result = rl1c(str(sample), "--color", "never")
+    assert result.exit_code == 0
+    assert "warning[W0601]: a warning for the test" in result.stderr
+    assert "sample.rob:2:1" in result.stderr
+    verify((sample.parent / "sample.ilc").read_bytes())
+
+
+def test_code_too_large_is_refused_with_e0190(tmp_path: Path) -> None:
+    # A=B+1 is 7 bytes (LDV, ADDI, STV): 9363 of them pass 65535 bytes at line 9363.
+    source = tmp_path / "huge.rob"
+    source.write_text("A=B+1\n" * 9363, encoding="utf-8")
+    result = rl1c(str(source), "--color", "never")
+    assert result.exit_code == 1
+    assert "error[E0190]" in result.stderr and "huge.rob:9363:1" in result.stderr
+    assert sorted(os.listdir(tmp_path)) == ["huge.rob"]
+
+
+def test_unreadable_source_is_exit_2(tmp_path: Path) -> None:
+    missing = rl1c(str(tmp_path / "missing.rob"))
+    assert missing.exit_code == 2 and "error[E0100]" in missing.stderr
+    directory = rl1c(str(tmp_path))
+    assert directory.exit_code == 2 and "is a directory" in directory.stderr
+    assert os.listdir(tmp_path) == []
+
+
+def test_unwritable_output_is_exit_2_with_the_reason(sample: Path, tmp_path: Path) -> None:
+    result = rl1c(str(sample), "-o", str(tmp_path / "no" / "such" / "dir.ilc"))
+    assert result.exit_code == 2
+    assert "cannot write" in result.stderr and "No such file or directory" in result.stderr
+
+
+def test_the_source_is_never_the_output(sample: Path) -> None:
+    result = rl1c(str(sample), "-o", str(sample))
+    assert result.exit_code == 2 and "is the source file itself" in result.stderr
+    assert sample.read_bytes() == SAMPLE.read_bytes()
+
+
+# Atomic writes ------------------------------------------------------------------------
+
+
+def test_atomic_write_replaces_a_file_and_keeps_its_permissions(tmp_path: Path) -> None:
+    target = tmp_path / "out.ilc"
+    target.write_bytes(b"old")
+    target.chmod(0o640)
+    write_atomically(target, b"new")
+    assert target.read_bytes() == b"new"
+    assert target.stat().st_mode & 0o777 == 0o640
+    assert os.listdir(tmp_path) == ["out.ilc"]
+
+
+def test_atomic_write_gives_a_new_file_the_usual_permissions(tmp_path: Path) -> None:
+    umask = os.umask(0o022)
+    try:
+        write_atomically(tmp_path / "new.ilc", b"data")
+    finally:
+        os.umask(umask)
+    assert (tmp_path / "new.ilc").stat().st_mode & 0o777 == 0o644
+
+
+def test_failed_write_leaves_the_old_file_and_no_temporary(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    target = tmp_path / "out.ilc"
+    target.write_bytes(b"old")
+
+    def failing_replace(source: str, destination: object) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(os, "replace", failing_replace)
+    with pytest.raises(OSError):
+        write_atomically(target, b"new")
+    assert target.read_bytes() == b"old"
+    assert os.listdir(tmp_path) == ["out.ilc"]
+
+
+def test_failed_write_through_the_cli_reports_and_leaves_nothing(
+    sample: Path, monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def failing_replace(source: str, destination: object) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(os, "replace", failing_replace)
+    result = rl1c(str(sample))
+    assert result.exit_code == 2
+    assert "cannot write" in result.stderr and "No space left on device" in result.stderr
+    assert sorted(os.listdir(sample.parent)) == ["sample.rob"]
