@@ -1,0 +1,51 @@
+"""Run-time faults and the outcome of a run, shared by the interpreter and the VM.
+
+A fault ends a run: the engine first stops the vehicle (Device.stop), then reports the
+fault with the source line it happened on. Each kind has its own exit status for
+`rl1c run` (1 and 2 are taken: "the program has errors" and "usage or unreadable file").
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+from typing import Any
+
+from rl1.compiler.builtins import VARIABLES
+
+DEFAULT_BUDGET = 10_000_000
+"""Steps a run may take before the watchdog ends it: VM instructions, or interpreter
+statements (so the two engines stop a runaway program at different points)."""
+
+
+class FaultKind(Enum):
+    ARGUMENT_RANGE = ("argument-range", 10)  # a variable argument outside its range
+    MISSING_HANDLER = ("missing-handler", 11)  # a lost line jumps to an undefined :96-:99
+    BUDGET = ("budget", 12)  # the watchdog: the step budget is used up
+    DEVICE = ("device-error", 13)  # the device failed (DeviceError)
+
+    def __init__(self, code: str, exit_status: int) -> None:
+        self.code = code
+        self.exit_status = exit_status
+
+
+@dataclass(frozen=True, slots=True)
+class Fault:
+    kind: FaultKind
+    message: str
+    line: int | None  # the source line, when known
+
+    def to_json(self) -> dict[str, Any]:
+        return {"code": self.kind.code, "message": self.message, "line": self.line}
+
+
+@dataclass(frozen=True, slots=True)
+class RunResult:
+    """The final variables (53, in builtins.VARIABLES order) and the fault that ended
+    the run, None when it ended normally."""
+
+    variables: tuple[int, ...]
+    fault: Fault | None = None
+
+    def named(self) -> dict[str, int]:
+        return dict(zip(VARIABLES, self.variables, strict=True))

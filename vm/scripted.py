@@ -1,0 +1,470 @@
+"""A deterministic Device driven by a sensor script, recording every command it gets.
+
+The script (JSON, or TOML when the file name ends in .toml) says what each sensing call
+returns, in order, and when the guidance line is lost:
+
+    {
+      "IMG": [{"area": 120, "x": 130, "y": 100, "z": 0}, ...],
+      "KYO": [{"centre": 50, "right": 52, "left": 48}, ...],
+      "CAM R": [392, ...],
+      "ULT A": [150, ...],          (also "ULT B", "ULT C", "ULT D")
+      "INP": {"3": [1, 0], ...},    (per input port, the port number in decimal)
+      "FZI": [{"s": 1, "t": -2}, ...],
+      "line_lost": [{"time": 2500}, {"during": "MVI", "nth": 1, "after": 300}],
+      "comment": "free text, ignored"
+    }
+
+Each call takes the next reading of its list; when a list runs out its last reading
+repeats; a call with no list reads zeros. Values are 16-bit signed integers (INP data
+0..255, CAM R 0..784).
+
+Line losses: `{"time": T}` at device time T ms; `{"during": "MOV"|"MVI", "nth": N,
+"after": A}` A ms after the N-th MOV or MVI call of the run (counting every call, MOV 0,0
+included) started, if that command is still in effect then. A loss matters only while
+motion is in effect (a non-zero MOV, or an MVI in progress); see device.py for what each
+tracing mode does with it.
+
+The motion model (device time in integer milliseconds, starting at 0):
+- TIM t waits t x 100 ms; MVI l,r,cm moves the centre at |l+r|/2 x 5 cm/s (a wheel speed
+  unit is 5 cm/s), so it takes ceil(|cm| x 400 / |l+r|) ms; ROT a takes |a| x 10 ms;
+  every other built-in that waits (builtins.Builtin.waits) takes 100 ms; the rest 0 ms.
+- A loss interrupts only TIM and MVI (they return at the loss's time); any other call
+  completes first, and the loss reaches the program after it.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TypeVar
+
+from rl1.compiler.builtins import BUILTINS
+
+from .device import (
+    DeviceError,
+    FuzzyReading,
+    ImageReading,
+    LineLost,
+    MotionCommand,
+    Odometry,
+)
+
+T = TypeVar("T")
+
+WHEEL_UNIT_CM_PER_S = 5
+STEP_MS = 100  # a waiting built-in with no duration of its own
+ROT_MS_PER_DEGREE = 10
+
+
+class ScriptError(Exception):
+    """A sensor script that cannot be used; the message starts `file:key:`."""
+
+
+@dataclass(frozen=True, slots=True)
+class LossAt:
+    """The line is lost at device time `time` ms."""
+
+    time: int
+
+
+@dataclass(frozen=True, slots=True)
+class LossDuring:
+    """The line is lost `after` ms into the `nth` call of `command`."""
+
+    command: MotionCommand
+    nth: int
+    after: int
+
+
+@dataclass(frozen=True, slots=True)
+class Script:
+    images: tuple[ImageReading, ...] = ()
+    odometry: tuple[Odometry, ...] = ()
+    camera: tuple[int, ...] = ()
+    ultrasonic: dict[str, tuple[int, ...]] = field(default_factory=dict)
+    ports: dict[int, tuple[int, ...]] = field(default_factory=dict)
+    fuzzy: tuple[FuzzyReading, ...] = ()
+    losses: tuple[LossAt | LossDuring, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class TraceEntry:
+    """One command the device received (or a line it lost), at device time `time` ms."""
+
+    time: int
+    call: str
+    args: tuple[int, ...] = ()
+    result: tuple[int, ...] | None = None  # what a sensing call read
+
+    def to_json(self) -> dict[str, Any]:
+        entry: dict[str, Any] = {"time": self.time, "call": self.call, "args": list(self.args)}
+        if self.result is not None:
+            entry["result"] = list(self.result)
+        return entry
+
+
+# Loading and validating scripts --------------------------------------------------------
+
+_INT16 = (-32768, 32767)
+_LIST_KEYS = ("IMG", "KYO", "CAM R", "ULT A", "ULT B", "ULT C", "ULT D", "FZI")
+_KEYS = (*_LIST_KEYS, "INP", "line_lost", "comment")
+
+
+def load_script(path: str | Path) -> Script:
+    """Read and validate a sensor script; ScriptError says what is wrong and where."""
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise ScriptError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise ScriptError(f"{path}: is a directory, not a sensor script") from None
+    except OSError as error:
+        raise ScriptError(f"{path}: cannot read ({error.strerror or error})") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise ScriptError(f"{path}: not UTF-8 text (byte {error.start})") from None
+    if path.suffix.lower() == ".toml":
+        try:
+            document: object = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as error:
+            raise ScriptError(f"{path}: invalid TOML: {error}") from None
+    else:
+        try:
+            document = json.loads(text)
+        except json.JSONDecodeError as error:
+            raise ScriptError(f"{path}:{error.lineno}:{error.colno}: invalid JSON: "
+                              f"{error.msg}") from None
+    return parse_script(document, str(path))
+
+
+def parse_script(document: object, name: str = "<script>") -> Script:
+    """A Script from decoded JSON/TOML data; ScriptError names the offending key."""
+    if not isinstance(document, dict):
+        raise ScriptError(f"{name}: the script must be an object of sensor lists, "
+                          f"found {_kind(document)}")
+    for key in document:
+        if key not in _KEYS:
+            raise ScriptError(f"{name}:{key}: unknown key; expected one of "
+                              + ", ".join(f'"{k}"' for k in _KEYS))
+    if not isinstance(document.get("comment", ""), str):
+        raise ScriptError(f"{name}:comment: expected a string")
+
+    def readings(key: str) -> list[object]:
+        return _list(document[key], f"{name}:{key}") if key in document else []
+
+    return Script(
+        images=tuple(ImageReading(*_fields(item, f"{name}:IMG[{i}]", ("area", "x", "y", "z")))
+                     for i, item in enumerate(readings("IMG"))),
+        odometry=tuple(Odometry(*_fields(item, f"{name}:KYO[{i}]", ("centre", "right", "left")))
+                       for i, item in enumerate(readings("KYO"))),
+        camera=tuple(_int(item, f"{name}:CAM R[{i}]", 0, 784)
+                     for i, item in enumerate(readings("CAM R"))),
+        ultrasonic={
+            letter: tuple(_int(item, f"{name}:ULT {letter}[{i}]", *_INT16)
+                          for i, item in enumerate(readings(f"ULT {letter}")))
+            for letter in "ABCD" if f"ULT {letter}" in document
+        },
+        ports=_ports(document.get("INP", {}), f"{name}:INP"),
+        fuzzy=tuple(FuzzyReading(*_fields(item, f"{name}:FZI[{i}]", ("s", "t")))
+                    for i, item in enumerate(readings("FZI"))),
+        losses=tuple(_loss(item, f"{name}:line_lost[{i}]")
+                     for i, item in enumerate(readings("line_lost"))),
+    )
+
+
+def _kind(value: object) -> str:
+    if isinstance(value, bool):
+        return "true/false"
+    if isinstance(value, dict):
+        return "an object"
+    if isinstance(value, list):
+        return "a list"
+    if isinstance(value, str):
+        return f'the string "{value}"'
+    return "null" if value is None else repr(value)
+
+
+def _list(value: object, where: str) -> list[object]:
+    if not isinstance(value, list):
+        raise ScriptError(f"{where}: expected a list of readings, found {_kind(value)}")
+    if not value:
+        raise ScriptError(f"{where}: the list is empty; give at least one reading "
+                          "or leave the key out (readings are then 0)")
+    return value
+
+
+def _int(value: object, where: str, low: int, high: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ScriptError(f"{where}: expected an integer in {low}..{high}, found {_kind(value)}")
+    if not low <= value <= high:
+        raise ScriptError(f"{where}: {value} is outside {low}..{high}")
+    return value
+
+
+def _fields(value: object, where: str, names: tuple[str, ...]) -> list[int]:
+    if not isinstance(value, dict):
+        raise ScriptError(f"{where}: expected an object with "
+                          + ", ".join(f'"{n}"' for n in names) + f", found {_kind(value)}")
+    for key in value:
+        if key not in names:
+            raise ScriptError(f"{where}.{key}: unknown field; expected "
+                              + ", ".join(f'"{n}"' for n in names))
+    missing = [n for n in names if n not in value]
+    if missing:
+        raise ScriptError(f"{where}: missing " + ", ".join(f'"{n}"' for n in missing))
+    return [_int(value[n], f"{where}.{n}", *_INT16) for n in names]
+
+
+def _ports(value: object, where: str) -> dict[int, tuple[int, ...]]:
+    if not isinstance(value, dict):
+        raise ScriptError(f"{where}: expected an object from port number to a list of "
+                          f'readings, e.g. {{"3": [1, 0]}}, found {_kind(value)}')
+    ports: dict[int, tuple[int, ...]] = {}
+    port_range = BUILTINS["INP"].forms[0].params[0]
+    for key, readings in value.items():
+        if not (key.isascii() and key.isdigit()):
+            raise ScriptError(f"{where}.{key}: a port is a decimal number "
+                              f"{port_range.low}..{port_range.high}")
+        port = _int(int(key), f"{where}.{key}", port_range.low, port_range.high)
+        ports[port] = tuple(_int(item, f"{where}.{key}[{i}]", 0, 255)
+                            for i, item in enumerate(_list(readings, f"{where}.{key}")))
+    return ports
+
+
+def _loss(value: object, where: str) -> LossAt | LossDuring:
+    if isinstance(value, dict) and set(value) == {"time"}:
+        return LossAt(_int(value["time"], f"{where}.time", 1, 2**31 - 1))
+    if isinstance(value, dict) and set(value) in ({"during", "nth"}, {"during", "nth", "after"}):
+        command = value["during"]
+        if command not in ("MOV", "MVI"):
+            raise ScriptError(f'{where}.during: expected "MOV" or "MVI", found {_kind(command)}')
+        return LossDuring(command, _int(value["nth"], f"{where}.nth", 1, 2**31 - 1),
+                          _int(value.get("after", 1), f"{where}.after", 1, 2**31 - 1))
+    raise ScriptError(f'{where}: expected {{"time": MS}} or '
+                      f'{{"during": "MOV"|"MVI", "nth": N, "after": MS}}, found {_kind(value)}')
+
+
+# The device ----------------------------------------------------------------------------
+
+
+@dataclass(slots=True)
+class _Motion:
+    """The motion in effect: a non-zero MOV (no end) or an MVI (ends at `end`)."""
+
+    command: MotionCommand
+    nth: int
+    start: int
+    end: int | None = None
+
+
+class ScriptedDevice:
+    """A Device whose sensors replay a Script and whose clock follows the motion model
+    above. `trace` lists every command received, in order."""
+
+    def __init__(self, script: Script | None = None) -> None:
+        self.script = script or Script()
+        self.trace: list[TraceEntry] = []
+        self.time = 0
+        self.mode = 0
+        self._motion: _Motion | None = None
+        self._calls = {"MOV": 0, "MVI": 0}
+        self._pending: LineLost | None = None
+        self._losses_at = sorted(loss.time for loss in self.script.losses
+                                 if isinstance(loss, LossAt))
+        self._losses_during = [loss for loss in self.script.losses
+                               if isinstance(loss, LossDuring)]
+        self._read_counts: dict[str, int] = {}
+
+    # Bookkeeping
+
+    def _record(self, call: str, *args: int, result: tuple[int, ...] | None = None) -> None:
+        self.trace.append(TraceEntry(self.time, call, args, result))
+
+    def _next(self, key: str, readings: tuple[T, ...], nothing: T) -> T:
+        count = self._read_counts.get(key, 0)
+        self._read_counts[key] = count + 1
+        if not readings:
+            return nothing
+        return readings[min(count, len(readings) - 1)]
+
+    def _next_loss(self, until: int) -> int | None:
+        """The time of the next loss that could matter in (time, until]."""
+        while self._losses_at and self._losses_at[0] <= self.time:
+            self._losses_at.pop(0)
+        times = [t for t in self._losses_at[:1] if t <= until]
+        motion = self._motion
+        if motion is not None:
+            times += [motion.start + loss.after for loss in self._losses_during
+                      if (loss.command, loss.nth) == (motion.command, motion.nth)
+                      and self.time < motion.start + loss.after <= until]
+        return min(times, default=None)
+
+    def _advance(self, duration: int, interruptible: bool) -> None:
+        """Let `duration` ms of device time pass, meeting motion ends and line losses in
+        time order; an interruptible wait ends at the first loss the program must hear."""
+        until = self.time + duration
+        while True:
+            motion = self._motion
+            loss = self._next_loss(until)
+            motion_end = motion.end if motion is not None else None
+            if motion_end is not None and motion_end <= until and (
+                    loss is None or motion_end <= loss):
+                self.time = motion_end
+                self._motion = None
+                continue
+            if loss is None:
+                self.time = until
+                return
+            self.time = loss
+            if self._lose_line() and interruptible:
+                return
+
+    def _lose_line(self) -> bool:
+        """The line is lost now; True if the program is to hear of it."""
+        motion = self._motion
+        if motion is None or self.mode == 0:
+            return False
+        self._record("LINE LOST", self.mode)
+        if self.mode == 1 or self._pending is not None:
+            return False
+        self._pending = LineLost(motion.command, self.mode)
+        if self.mode == 2:
+            self._motion = None
+        return True
+
+    def _stopped(self, call: str) -> None:
+        self._record(call)
+        self._motion = None
+
+    def _takes(self, call: str, *args: int, result: tuple[int, ...] | None = None) -> None:
+        """Record a command of fixed duration and let its time pass."""
+        self._record(call, *args, result=result)
+        if BUILTINS[call.split()[0]].waits:
+            self._advance(STEP_MS, interruptible=False)
+
+    # Motion and steering
+
+    def free(self) -> None:
+        self._stopped("FRE")
+
+    def hold(self) -> None:
+        self._stopped("HLD")
+
+    def steering_origin(self) -> None:
+        self._takes("ORG")
+
+    def move_distance(self, left: int, right: int, cm: int) -> None:
+        self._calls["MVI"] += 1
+        self._record("MVI", left, right, cm)
+        if cm == 0:
+            self._motion = None
+            return
+        if left + right == 0:
+            raise DeviceError(f"(MVI {left},{right},{cm}) would never end: with wheel speeds "
+                              f"{left} and {right} the vehicle's centre does not move")
+        duration = math.ceil(abs(cm) * 1000 * 2 / (abs(left + right) * WHEEL_UNIT_CM_PER_S))
+        self._motion = _Motion("MVI", self._calls["MVI"], self.time, self.time + duration)
+        self._advance(duration, interruptible=True)
+
+    def move(self, left: int, right: int) -> None:
+        self._calls["MOV"] += 1
+        self._record("MOV", left, right)
+        moving = left != 0 or right != 0
+        self._motion = _Motion("MOV", self._calls["MOV"], self.time) if moving else None
+
+    def steer_right(self, degrees: int) -> None:
+        self._takes("STR", degrees)
+
+    def steer_left(self, degrees: int) -> None:
+        self._takes("STL", degrees)
+
+    def steer_to(self, tenths: int) -> None:
+        self._takes("STX", tenths)
+
+    def rotate(self, degrees: int) -> None:
+        self._record("ROT", degrees)
+        self._advance(abs(degrees) * ROT_MS_PER_DEGREE, interruptible=False)
+
+    def set_tracing(self, mode: int) -> None:
+        self._record("TRC", mode)
+        self.mode = mode
+
+    def wait(self, tenths: int) -> None:
+        self._record("TIM", tenths)
+        self._advance(tenths * 100, interruptible=True)
+
+    # Sensing, camera, I/O, fuzzy board
+
+    def clear_distance(self) -> None:
+        self._takes("KYC")
+
+    def read_distance(self) -> Odometry:
+        reading = self._next("KYO", self.script.odometry, Odometry(0, 0, 0))
+        self._takes("KYO", result=(reading.centre, reading.right, reading.left))
+        return reading
+
+    def select_scene(self, scene: int) -> None:
+        self._takes("SCN", scene)
+
+    def measure_image(self) -> ImageReading:
+        reading = self._next("IMG", self.script.images, ImageReading(0, 0, 0, 0))
+        self._takes("IMG", result=(reading.area, reading.x, reading.y, reading.z))
+        return reading
+
+    def camera_origin(self) -> None:
+        self._takes("CAM Z")
+
+    def camera_up(self) -> None:
+        self._takes("CAM U")
+
+    def camera_down(self) -> None:
+        self._takes("CAM D")
+
+    def camera_pan_angle(self, degrees: int) -> None:
+        self._takes("CAM A", degrees)
+
+    def camera_pan_pulse(self, pulse: int) -> None:
+        self._takes("CAM P", pulse)
+
+    def camera_position(self) -> int:
+        position = self._next("CAM R", self.script.camera, 0)
+        self._takes("CAM R", result=(position,))
+        return position
+
+    def ultrasonic(self, sensor: str) -> int:
+        distance = self._next(f"ULT {sensor}", self.script.ultrasonic.get(sensor, ()), 0)
+        self._takes(f"ULT {sensor}", result=(distance,))
+        return distance
+
+    def lamp(self, on: int) -> None:
+        self._takes("LMP", on)
+
+    def read_port(self, port: int) -> int:
+        data = self._next(f"INP {port}", self.script.ports.get(port, ()), 0)
+        self._takes("INP", port, result=(data,))
+        return data
+
+    def write_port(self, port: int, data: int) -> None:
+        self._takes("OUT", port, data)
+
+    def fuzzy_write(self, a: int, b: int) -> None:
+        self._takes("FZO", a, b)
+
+    def fuzzy_read(self) -> FuzzyReading:
+        reading = self._next("FZI", self.script.fuzzy, FuzzyReading(0, 0))
+        self._takes("FZI", result=(reading.s, reading.t))
+        return reading
+
+    # Engine services
+
+    def stop(self) -> None:
+        self._stopped("STOP")
+
+    def poll_event(self) -> LineLost | None:
+        event, self._pending = self._pending, None
+        return event
