@@ -1,0 +1,161 @@
+"""spec/language.md agrees with the code it describes: the built-in table with
+builtins.py, the EBNF with grammar.lark, and the token examples with the scanner."""
+
+import re
+from pathlib import Path
+
+import pytest
+
+from rl1.compiler import ast
+from rl1.compiler.builtins import BUILTINS, Feature
+from rl1.compiler.parser import GRAMMAR, parse_line
+from rl1.compiler.scanner import PUNCTUATION, scan
+
+SPEC = (Path(__file__).parent.parent / "spec" / "language.md").read_text(encoding="utf-8")
+NONE = "—"
+
+
+# The built-in table ------------------------------------------------------------------
+
+
+def _spec_table_rows() -> list[list[str]]:
+    header = "| call | arguments | result | writes | waits | feature | what it does |"
+    start = SPEC.index(header)
+    rows = []
+    for line in SPEC[start:].splitlines()[2:]:
+        if not line.startswith("|"):
+            break
+        rows.append([cell.strip() for cell in line.strip("|").split("|")])
+    return rows
+
+
+def _number(text: str) -> int:
+    return int(text[1:], 16) if text.startswith("$") else int(text)
+
+
+def _row_of_form(mnemonic: str, selector: str | None) -> list[str]:
+    """How builtins.py says a form's row should read, in the spec's notation."""
+    builtin = BUILTINS[mnemonic]
+    form = builtin.form(selector)
+    assert form is not None
+    names = ",".join(param.name for param in form.params)
+    call = "(" + " ".join(part for part in (mnemonic, selector, names) if part) + ")"
+    return [
+        f"`{call}`",
+        "; ".join(f"{p.name}: {p.low}..{p.high}" for p in form.params) or NONE,
+        form.result or NONE,
+        ", ".join(form.writes) or NONE,
+        "yes" if builtin.waits else "no",
+        builtin.feature.name.lower() if builtin.feature else NONE,
+        form.summary,
+    ]
+
+
+def _normalise(row: list[str]) -> list[str]:
+    """The spec may write a range in hex (`$0..$7D`); compare numbers, not spellings."""
+    ranges = re.sub(r"(-?\$?[0-9A-Fa-f]+)\.\.(-?\$?[0-9A-Fa-f]+)",
+                    lambda m: f"{_number(m[1])}..{_number(m[2])}", row[1])
+    return [row[0], ranges, *row[2:]]
+
+
+def test_builtin_table_lists_every_form_of_builtins_py_in_order() -> None:
+    forms = [(b.mnemonic, form.selector) for b in BUILTINS.values() for form in b.forms]
+    rows = _spec_table_rows()
+    assert len(rows) == len(forms)
+    for row, (mnemonic, selector) in zip(rows, forms, strict=True):
+        assert _normalise(row) == _row_of_form(mnemonic, selector), mnemonic
+
+
+def test_every_feature_in_the_table_is_a_feature() -> None:
+    named = {row[5] for row in _spec_table_rows()} - {NONE}
+    assert named <= {feature.name.lower() for feature in Feature}
+
+
+# The EBNF and grammar.lark ------------------------------------------------------------
+
+_QUOTED = {text: name for text, name in PUNCTUATION.items()}
+
+
+def _rules(text: str, assign: str) -> dict[str, list[str]]:
+    """Rule name to the body's tokens; `assign` is `::=` (EBNF) or `:` (lark)."""
+    rules: dict[str, list[str]] = {}
+    name = ""
+    for line in text.splitlines():
+        line = line.split("//")[0].rstrip()
+        if not line or line.startswith("%"):
+            continue
+        head = re.match(rf"^([?_]?[a-z_]+)\s*{re.escape(assign)}\s*(.*)$", line)
+        if head:
+            name, body = head[1].lstrip("?_"), head[2]
+            rules[name] = []
+        else:
+            body = line
+        rules[name] += re.findall(r'"[^"]+"|[A-Za-z_]+|[()|*+?]', body)
+    return rules
+
+
+def _ebnf_block() -> str:
+    return SPEC.split("```ebnf\n", 1)[1].split("```", 1)[0]
+
+
+def test_ebnf_rules_are_grammar_lark_rules() -> None:
+    def lark_token(token: str) -> str:
+        return token.lstrip("_") if token.islower() else token
+
+    def ebnf_token(token: str) -> str:
+        return _QUOTED[token.strip('"')] if token.startswith('"') else token
+
+    lark = {name: [lark_token(token) for token in body]
+            for name, body in _rules(GRAMMAR.read_text(encoding="utf-8"), ":").items()}
+    ebnf = {name: [ebnf_token(token) for token in body]
+            for name, body in _rules(_ebnf_block(), "::=").items()}
+    assert ebnf == lark
+
+
+# Token examples of section 3 ----------------------------------------------------------
+
+
+@pytest.mark.parametrize(("code", "tokens"), [
+    ("B-5", ["VAR B", "MINUS -", "NUMBER 5"]),
+    ("(IMG)-180", ["LPAR (", "MNEMONIC IMG", "RPAR )", "MINUS -", "NUMBER 180"]),
+    ("d=-450", ["VAR d", "EQUAL =", "NUMBER -450"]),
+    ("A=B+-5", ["VAR A", "EQUAL =", "VAR B", "PLUS +", "NUMBER -5"]),
+    ("A=B--5", ["VAR A", "EQUAL =", "VAR B", "MINUS -", "NUMBER -5"]),
+    ("A=B- -5", ["VAR A", "EQUAL =", "VAR B", "MINUS -", "NUMBER -5"]),
+    ("@--", ["VAR @", "INCDEC --"]),
+    ("(mov", ["LPAR (", "MNEMONIC mov"]),
+    ("(X", ["LPAR (", "MNEMONIC X"]),
+    ("AB", ["WORD AB"]),
+    (":1 #123", ["LABEL :1", "LABELREF #123"]),
+])
+def test_tokens_are_as_section_3_says(code: str, tokens: list[str]) -> None:
+    assert [f"{token.type} {token.text}" for token in scan(code)] == tokens
+
+
+@pytest.mark.parametrize(("text", "code"), [
+    ("A=-B", "E0101"), ("(MOV 3 -3)", "E0101"), ("A=-$10", "E0101"), ("AB=3", "E0103"),
+    ("A=1; :10", "E0104"), ("A=$G1", "E0105"), ("A=$10000", "E0105"), ("A=1 B=2", "E0101"),
+    ("A=1．", "E0102"),
+])
+def test_lines_the_spec_calls_errors_are_errors(text: str, code: str) -> None:
+    _, diagnostics = parse_line(text, 1)
+    assert [d.code for d in diagnostics] == [code]
+
+
+@pytest.mark.parametrize("text", [
+    ":13", ";", ":12 c=579; d=450;", "(CAM A 90)", "(MVI 1,1,50)", "(MOV 3 3)", "(CAM A,-5)",
+    "A=$FFFF", "A=$00FF", ":10A=1", "\u3000\u3000' 全角の空白だけ",
+])
+def test_lines_the_spec_accepts_parse(text: str) -> None:
+    line, diagnostics = parse_line(text, 1)
+    assert diagnostics == [] and line.ok
+
+
+def test_hex_is_a_bit_pattern_and_selectors_are_letters() -> None:
+    line, _ = parse_line("A=$8000; (CAM P c); (ULT A)", 1)
+    assign, cam, ult = line.statements
+    assert isinstance(assign, ast.Assign) and isinstance(assign.first, ast.Const)
+    assert assign.first.value == -32768
+    assert isinstance(cam, ast.CallStmt) and isinstance(ult, ast.CallStmt)
+    assert [type(arg) for arg in cam.call.args] == [ast.Selector, ast.Var]
+    assert [type(arg) for arg in ult.call.args] == [ast.Selector]
