@@ -41,4 +41,5 @@ CODES: dict[str, CodeInfo] = _entries(
     ("E0104", E, "label not at the start of a line"),
     ("E0105", E, "malformed hex constant"),
     ("E0190", E, "compiled code too large for .ilc"),
+    ("E0191", E, "code past line 65535 with a debug section"),
 )

@@ -20,8 +20,11 @@ from .diagnostics import Diagnostic, Severity
 VARIABLE_INDEX = {name: index for index, name in enumerate(VARIABLES)}
 
 
-class CodeTooLarge(Exception):
-    """The code does not fit the 16-bit address space; `diagnostic` says where it ends."""
+MAX_DEBUG_LINE = 0xFFFF  # the line map records u16 line numbers
+
+
+class CodegenError(Exception):
+    """The program does not fit a limit of the .ilc format; `diagnostic` says which."""
 
     def __init__(self, diagnostic: Diagnostic) -> None:
         super().__init__(diagnostic.message)
@@ -39,9 +42,9 @@ class _MachineOp:
     line: int
 
 
-def generate(program: ir.Program, source_name: str) -> ilc.Image:
-    """The image of a valid IR program, with its debug line map; CodeTooLarge when the
-    code passes 65535 bytes."""
+def generate(program: ir.Program, source_name: str, *, debug: bool = True) -> ilc.Image:
+    """The image of a valid IR program, with its line map unless `debug` is False;
+    CodegenError when the code passes 65535 bytes or the map a line it cannot record."""
     order = list(program.blocks)
     layout = [(block_id, _select(program.blocks[block_id], following))
               for block_id, following in zip(order, [*order[1:], None], strict=True)]
@@ -51,7 +54,9 @@ def generate(program: ir.Program, source_name: str) -> ilc.Image:
         block_offsets[block_id] = offset
         for op in ops:
             if offset + op.info.length > ilc.MAX_CODE_SIZE:
-                raise CodeTooLarge(_too_large(op.line))
+                raise CodegenError(_too_large(op.line))
+            if debug and op.line > MAX_DEBUG_LINE:
+                raise CodegenError(_line_too_far(op.line))
             offset += op.info.length
     code = bytearray()
     lines: list[tuple[int, int]] = []
@@ -68,7 +73,7 @@ def generate(program: ir.Program, source_name: str) -> ilc.Image:
         bytes(code),
         {label: block_offsets[block_id] for label, block_id in program.handlers.items()},
         frozenset(feature for feature in features if feature is not None),
-        ilc.DebugInfo(source_name, tuple(lines)),
+        ilc.DebugInfo(source_name, tuple(lines)) if debug else None,
     )
 
 
@@ -80,6 +85,17 @@ def _too_large(line: int) -> Diagnostic:
         Span(line, 1, line, 1),
         help="split the program into smaller programs, or shorten repeated code "
              "with a loop",
+    )
+
+
+def _line_too_far(line: int) -> Diagnostic:
+    return Diagnostic(
+        "E0191", Severity.ERROR,
+        f"line {line} holds code, but the .ilc debug section records line numbers up to "
+        f"{MAX_DEBUG_LINE} only",
+        Span(line, 1, line, 1),
+        help="compile with -s to leave the debug section out, or remove blank and "
+             "comment lines before this one",
     )
 
 

@@ -12,7 +12,7 @@ from typing import Literal
 
 from rl1.vm import ilc
 
-from .codegen import CodeTooLarge, generate
+from .codegen import CodegenError, generate
 from .diagnostics import Diagnostic, sort_key
 from .frontend import analyze
 from .ir import format_program
@@ -41,10 +41,8 @@ def compile_text(text: str, source_name: str, *, emit: Emit = "ilc",
     if emit == "ir":
         return Compilation(analysis.diagnostics, format_program(program).encode("utf-8"))
     try:
-        image = generate(program, source_name)
-    except CodeTooLarge as refused:
+        image = generate(program, source_name, debug=not strip_debug)
+    except CodegenError as refused:
         diagnostics = sorted([*analysis.diagnostics, refused.diagnostic], key=sort_key)
         return Compilation(diagnostics, None)
-    if strip_debug:
-        image = ilc.strip_debug(image)
     return Compilation(analysis.diagnostics, ilc.encode(image))

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from rl1.compiler import ir
 from rl1.compiler.builtins import BUILTINS, VARIABLES, Feature
-from rl1.compiler.codegen import CodeTooLarge, generate
+from rl1.compiler.codegen import CodegenError, generate
 from rl1.compiler.lower import lower
 from rl1.compiler.parser import parse_program
 from rl1.vm import ilc, isa
@@ -115,13 +115,24 @@ def test_code_of_exactly_65535_bytes_fits() -> None:
 
 
 def test_code_past_65535_bytes_is_refused_at_the_line_where_it_passes() -> None:
-    with pytest.raises(CodeTooLarge) as refused:
+    with pytest.raises(CodegenError) as refused:
         generate(_incs(32768), "big.rob")
     diagnostic = refused.value.diagnostic
     assert diagnostic.code == "E0190" and diagnostic.is_error
     # INC number 32768 (line 32768) would end at byte 65536.
     assert diagnostic.span.line == 32768
     assert "65535 bytes" in diagnostic.message
+
+
+def test_lines_past_65535_are_refused_in_the_line_map_only() -> None:
+    program = ir.Program({"B0": ir.Block("B0", [ir.StepVar(ir.Var("A"), "++", 65535)],
+                                         ir.End(65536))}, "B0")
+    with pytest.raises(CodegenError) as refused:
+        generate(program, "long.rob")
+    assert refused.value.diagnostic.code == "E0191"
+    assert refused.value.diagnostic.span.line == 65536
+    image = generate(program, "long.rob", debug=False)
+    assert image.debug is None and names(image) == ["INC", "END"]
 
 
 def _incs(count: int) -> ir.Program:

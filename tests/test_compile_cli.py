@@ -134,6 +134,18 @@ def test_code_too_large_is_refused_with_e0190(tmp_path: Path) -> None:
     assert sorted(os.listdir(tmp_path)) == ["huge.rob"]
 
 
+def test_code_past_line_65535_needs_strip(tmp_path: Path) -> None:
+    source = tmp_path / "long.rob"
+    source.write_text("\n" * 70000 + "(MOV 1,1)\n", encoding="utf-8")
+    refused = rl1c(str(source), "--color", "never")
+    assert refused.exit_code == 1
+    assert "error[E0191]" in refused.stderr and "long.rob:70001:1" in refused.stderr
+    assert sorted(os.listdir(tmp_path)) == ["long.rob"]
+    stripped = rl1c(str(source), "-s")
+    assert stripped.exit_code == 0, stripped.stderr
+    verify((tmp_path / "long.ilc").read_bytes())
+
+
 def test_unreadable_source_is_exit_2(tmp_path: Path) -> None:
     missing = rl1c(str(tmp_path / "missing.rob"))
     assert missing.exit_code == 2 and "error[E0100]" in missing.stderr
