@@ -35,6 +35,7 @@ TAB_STOP = 4
 # Snippet lines wider than this (in terminal cells) are cut to a window around the span.
 SNIPPET_WIDTH = 120
 _CONTEXT = 40  # code points kept before the span in a cut line
+MESSAGE_LENGTH = 400  # code points of a message shown to people
 _ELLIPSIS = "..."
 
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
@@ -128,7 +129,10 @@ def _cells(text: str) -> int:
 
 
 def _visible(text: str) -> str:
-    """`text` with the characters that would act on a terminal made visible."""
+    """`text` with the characters that would act on a terminal made visible, and cut
+    to MESSAGE_LENGTH (a message may quote a whole line of a hostile input)."""
+    if len(text) > MESSAGE_LENGTH:
+        text = text[: MESSAGE_LENGTH - len(_ELLIPSIS)] + _ELLIPSIS
     if text.isascii() and text.isprintable():
         return text
     return "".join(_glyph(c, 0) if c != "\t" else " " for c in text)

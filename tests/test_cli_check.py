@@ -1,0 +1,274 @@
+"""`rl1c check` and `rl1c explain`: formats, exit statuses, and bad input of every kind.
+
+Whatever the input, `rl1c check` ends with 0, 1 or 2 and a well-formed report, never a
+traceback; an unexpected failure inside rl1c ends with 3 and a short message.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import Any
+
+import pytest
+from click.testing import CliRunner, Result
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from sarif_structure import sarif_problems
+
+from rl1.compiler import cli
+from rl1.compiler.ast import Span
+from rl1.compiler.catalogue import CODES
+from rl1.compiler.diagnostics import Diagnostic, Severity
+from rl1.compiler.frontend import Analysis, analyze
+
+ROOT = Path(__file__).parent.parent
+SAMPLE = ROOT / "examples" / "sample.rob"
+CP932_COMMENTS = Path(__file__).parent / "data" / "cp932_comments.rob"
+
+
+def run(*args: str, stdin: bytes | None = None, **env: str) -> Result:
+    return CliRunner().invoke(cli.main, list(args), input=stdin, env=env)
+
+
+def check_json(*args: str, stdin: bytes | None = None) -> tuple[int, list[dict[str, Any]]]:
+    result = run("check", "--format", "json", *args, stdin=stdin)
+    return result.exit_code, json.loads(result.stdout)
+
+
+def write(tmp_path: Path, data: bytes | str, name: str = "prog.rob") -> str:
+    path = tmp_path / name
+    if isinstance(data, str):
+        path.write_text(data, encoding="utf-8", newline="")
+    else:
+        path.write_bytes(data)
+    return str(path)
+
+
+# Exit statuses and formats ------------------------------------------------------------
+
+
+def test_the_sample_program_has_no_errors() -> None:
+    result = run("check", str(SAMPLE))
+    assert result.exit_code == 0, result.stdout
+    assert "error" not in result.stdout
+
+
+def test_errors_exit_1_with_the_place_and_the_line(tmp_path: Path) -> None:
+    name = write(tmp_path, "(MOV 3,3)\nA=B+\n")
+    result = run("check", name)
+    assert result.exit_code == 1
+    assert result.stdout.startswith("error[E0101]: ")
+    assert f" --> {name}:2:5\n  |\n2 | A=B+\n  |     ^\n" in result.stdout
+    assert result.stdout.endswith(f"error: could not check `{name}`: 1 error emitted\n")
+
+
+def test_warnings_alone_exit_0(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    def only_a_warning(text: str) -> Analysis:
+        program = analyze(text).program
+        return Analysis(program, [Diagnostic("W0601", Severity.WARNING, "odd", Span(1, 1, 1, 2))])
+
+    monkeypatch.setattr(cli, "analyze", only_a_warning)
+    result = run("check", write(tmp_path, "A=1\n"))
+    assert result.exit_code == 0
+    assert "warning[W0601]: odd" in result.stdout
+
+
+def test_json_reports_every_file_in_one_array_in_order(tmp_path: Path) -> None:
+    first = write(tmp_path, "A=\n", "first.rob")
+    second = write(tmp_path, "B=1\nC=%\n", "second.rob")
+    status, items = check_json(second, first)
+    assert status == 1
+    assert [(i["file"], i["line"], i["column"], i["code"]) for i in items] == [
+        (second, 2, 3, "E0102"), (first, 1, 3, "E0101")]
+
+
+def test_sarif_output_is_well_formed(tmp_path: Path) -> None:
+    result = run("check", "--format", "sarif", write(tmp_path, "A=％\n"), "missing.rob")
+    assert result.exit_code == 2
+    log = json.loads(result.stdout)
+    assert sarif_problems(log) == []
+    assert [r["ruleId"] for r in log["runs"][0]["results"]] == ["E0102", "E0100"]
+
+
+def test_standard_input_is_read_for_a_dash() -> None:
+    status, items = check_json("-", stdin=b"A=\n")
+    assert status == 1
+    assert items[0]["file"] == "<stdin>"
+
+
+def test_colour_is_off_when_not_a_terminal_unless_asked(tmp_path: Path) -> None:
+    name = write(tmp_path, "A=\n")
+    assert "\x1b[" not in run("check", name).stdout
+    assert "\x1b[" not in run("check", "--color", "auto", name).stdout
+    assert "\x1b[31m" in run("check", "--color", "always", name).stdout
+    assert "\x1b[" not in run("check", "--color", "always", "--format", "json", name).stdout
+
+
+@pytest.mark.parametrize("args", [
+    ["check"],
+    ["check", "--format", "xml", "a.rob"],
+    ["check", "--color", "sometimes", "a.rob"],
+    ["explain"],
+    ["explain", "E0101", "--list"],
+])
+def test_usage_problems_exit_2(args: list[str]) -> None:
+    assert run(*args).exit_code == 2
+
+
+# Unreadable files: E0100 in the chosen format, exit 2 ---------------------------------
+
+
+def test_a_missing_file_is_reported_after_the_others(tmp_path: Path) -> None:
+    good = write(tmp_path, "A=\n")
+    status, items = check_json("missing.rob", good)
+    assert status == 2
+    assert [(i["file"], i["code"]) for i in items] == [("missing.rob", "E0100"), (good, "E0101")]
+    assert "no such file" in items[0]["message"]
+    human = run("check", "missing.rob").stdout
+    assert human.startswith("error[E0100]: missing.rob: no such file\n --> missing.rob\n")
+
+
+@pytest.mark.parametrize("data, says", [
+    (b"A=1\x00\x01\x02", "binary"),
+    (bytes(range(256)) * 4, "binary"),
+    (b"A=1 '\x81\x20\xff\n", "neither UTF-8 nor Shift-JIS"),
+])
+def test_binary_and_undecodable_files_are_e0100(tmp_path: Path, data: bytes, says: str) -> None:
+    status, items = check_json(write(tmp_path, data))
+    assert status == 2
+    assert [i["code"] for i in items] == ["E0100"]
+    assert says in items[0]["message"]
+
+
+def test_a_directory_is_e0100(tmp_path: Path) -> None:
+    status, items = check_json(str(tmp_path))
+    assert status == 2
+    assert "is a directory" in items[0]["message"]
+
+
+# Text of every shape ------------------------------------------------------------------
+
+
+def test_shift_jis_comments_are_read(tmp_path: Path) -> None:
+    assert run("check", str(CP932_COMMENTS)).exit_code == 0
+    # An error after a Shift-JIS comment has the right line, and its line shows as text.
+    data = CP932_COMMENTS.read_bytes() + "A=% ' 未完成\r\n".encode("cp932")
+    result = run("check", write(tmp_path, data))
+    assert result.exit_code == 1
+    assert "7 | A=% ' 未完成\n" in result.stdout
+
+
+@pytest.mark.parametrize("line_end", ["\r\n", "\r", "\n"])
+def test_any_line_end_counts_lines_alike(tmp_path: Path, line_end: str) -> None:
+    name = write(tmp_path, line_end.join(["A=1", "B=+", "C=3"]) + line_end)
+    status, items = check_json(name)
+    assert (status, items[0]["line"], items[0]["column"]) == (1, 2, 3)
+    assert "\r" not in run("check", name).stdout
+
+
+@pytest.mark.parametrize("text", ["", "\n", "A=1", "' only a comment", "\t\n  \n"])
+def test_empty_and_unterminated_files_are_fine(tmp_path: Path, text: str) -> None:
+    result = run("check", write(tmp_path, text))
+    assert result.exit_code == 0
+    assert "error" not in result.stdout
+
+
+def test_a_megabyte_line_is_checked_and_shown_briefly(tmp_path: Path) -> None:
+    comment = write(tmp_path, "A=1 '" + "x" * 1_000_000 + "\n", "comment.rob")
+    assert run("check", comment).exit_code == 0
+    word = write(tmp_path, "A" * 1_000_000 + "\n", "word.rob")
+    result = run("check", word)
+    assert result.exit_code == 1
+    assert max(len(line) for line in result.stdout.splitlines()) < 1000
+
+
+# Never a traceback ---------------------------------------------------------------------
+
+_FRAGMENTS = [
+    "A", "z", "@", "=", "+", "-", "<", ">", "&", "|", "^", "++", "--", "1", "-5", "32768",
+    "$FF", "$", "#10", "#1", ":10", ":96", ":1", "?A=", "?b>", "(", ")", ",", ";", " ", "\t",
+    "(MOV 3,3)", "(MVI 1,1,50)", "(TRC 3)", "(IMG)", "(CAM P c)", "(ULT A)", "(KYO)",
+    "(END)", "(FRE)", "(TIM 5)", "'", "' コメント", "\n", "\r\n", "\r", "Ａ", "\u3000", "\x1b",
+]
+rl1_like = st.lists(st.sampled_from(_FRAGMENTS), max_size=60).map("".join)
+any_text = st.text(alphabet=st.characters(exclude_categories=["Cs"]), max_size=300)
+
+
+def assert_well_formed(result: Result, output_format: str) -> None:
+    assert result.exit_code in (0, 1, 2), result.stdout + result.stderr
+    assert result.exception is None or isinstance(result.exception, SystemExit)
+    assert "Traceback" not in result.stdout + result.stderr
+    if output_format == "json":
+        assert isinstance(json.loads(result.stdout), list)
+    elif output_format == "sarif":
+        assert sarif_problems(json.loads(result.stdout)) == []
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.one_of(rl1_like, any_text), st.sampled_from(["human", "json", "sarif"]))
+def test_any_text_file_gets_a_report(
+    tmp_path_factory: pytest.TempPathFactory, text: str, output_format: str
+) -> None:
+    path = tmp_path_factory.getbasetemp() / "any_text.rob"
+    path.write_text(text, encoding="utf-8", newline="")
+    result = run("check", "--format", output_format, str(path))
+    assert_well_formed(result, output_format)
+    if output_format == "json":  # text that decodes is never "unreadable"
+        assert "E0100" not in {item["code"] for item in json.loads(result.stdout)}
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.binary(max_size=300), st.sampled_from(["human", "json", "sarif"]))
+def test_any_bytes_get_a_report(
+    tmp_path_factory: pytest.TempPathFactory, data: bytes, output_format: str
+) -> None:
+    path = tmp_path_factory.getbasetemp() / "any_bytes.rob"
+    path.write_bytes(data)
+    assert_well_formed(run("check", "--format", output_format, str(path)), output_format)
+    assert_well_formed(run("check", "--format", output_format, "-", stdin=data), output_format)
+
+
+def test_an_internal_error_is_a_short_message_and_exit_3(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def broken(text: str) -> Analysis:
+        raise KeyError("no such rule")
+
+    monkeypatch.setattr(cli, "analyze", broken)
+    monkeypatch.delenv("RL1C_BACKTRACE", raising=False)
+    result = run("check", write(tmp_path, "A=1\n"))
+    assert result.exit_code == 3
+    assert result.stderr.startswith("rl1c: internal error: KeyError: 'no such rule'\n")
+    assert "This is a bug in rl1c" in result.stderr
+    assert "Traceback" not in result.stdout + result.stderr
+
+
+# rl1c explain ----------------------------------------------------------------------------
+
+
+def test_explain_prints_the_explanation_whatever_the_case() -> None:
+    upper, lower = run("explain", "E0101"), run("explain", "e0101")
+    assert upper.exit_code == lower.exit_code == 0
+    assert upper.stdout == lower.stdout == CODES["E0101"].explanation()
+
+
+def test_explain_an_unknown_code_says_how_to_list_them() -> None:
+    result = run("explain", "E9999")
+    assert result.exit_code == 2
+    assert "`E9999` is not a diagnostic code" in result.stderr
+    assert "rl1c explain --list" in result.stderr
+
+
+def test_explain_list_shows_every_code_with_its_title() -> None:
+    result = run("explain", "--list")
+    assert result.exit_code == 0
+    assert result.stdout.splitlines() == [f"{code}  {info.title}" for code, info in CODES.items()]
+
+
+@pytest.mark.parametrize("code", list(CODES))
+def test_every_code_has_an_explanation_titled_as_in_the_catalogue(code: str) -> None:
+    explanation = CODES[code].explanation()
+    assert explanation.splitlines()[0] == f"# {code}: {CODES[code].title}"
+    assert re.search(r"```.*```", explanation, re.DOTALL), "an example is missing"
