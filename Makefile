@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint typecheck pytest clean
+.PHONY: demo test lint typecheck pytest clean vscode-test vscode-package
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(BIN)/rl1c check examples/sample.rob
 
-test: lint typecheck pytest
+test: lint typecheck vscode-test pytest
 
 lint: $(STAMP)
 	$(BIN)/ruff check compiler vm lsp tests bench
@@ -35,5 +35,21 @@ typecheck: $(STAMP)
 pytest: $(STAMP)
 	$(BIN)/pytest -n 2
 
+# The VS Code extension (editors/vscode): its exact dependencies from the npm lock file
+# (none needs an install script), then tsc, then its grammar and settings tests on node.
+VSCODE := editors/vscode
+VSCODE_STAMP := $(VSCODE)/node_modules/.installed
+
+$(VSCODE_STAMP): $(VSCODE)/package-lock.json
+	cd $(VSCODE) && npm ci --ignore-scripts --no-audit --no-fund
+	touch $@
+
+vscode-test: $(VSCODE_STAMP)
+	cd $(VSCODE) && npm run --silent compile && npm test --silent
+
+vscode-package: vscode-test
+	cd $(VSCODE) && npm run --silent package
+
 clean:
 	rm -rf $(VENV) .typecheck .mypy_cache .pytest_cache .ruff_cache .hypothesis
+	rm -rf $(VSCODE)/node_modules $(VSCODE)/out $(VSCODE)/rl1.vsix
