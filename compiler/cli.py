@@ -80,6 +80,12 @@ class _Toolchain(click.Group):
 def main() -> None:
     """The RL/I toolchain. `rl1c FILE.rob -o FILE.ilc` compiles; the commands below
     check, format, explain, disassemble, assemble and run programs."""
+    # A terminal that cannot show a character (a Japanese comment in a Latin-1 locale)
+    # gets an escape for it instead of a failure.
+    for stream in (sys.stdout, sys.stderr):
+        reconfigure = getattr(stream, "reconfigure", None)
+        if reconfigure is not None:
+            reconfigure(errors="backslashreplace")
 
 
 # Shared by the commands that report diagnostics.

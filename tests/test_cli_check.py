@@ -272,3 +272,9 @@ def test_every_code_has_an_explanation_titled_as_in_the_catalogue(code: str) -> 
     explanation = CODES[code].explanation()
     assert explanation.splitlines()[0] == f"# {code}: {CODES[code].title}"
     assert re.search(r"```.*```", explanation, re.DOTALL), "an example is missing"
+
+
+def test_a_terminal_that_cannot_show_a_character_gets_an_escape(tmp_path: Path) -> None:
+    result = CliRunner(charset="latin-1").invoke(cli.main, ["check", write(tmp_path, "A=％\n")])
+    assert result.exit_code == 1
+    assert "1 | A=\\uff05\n" in result.stdout
