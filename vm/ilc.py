@@ -322,6 +322,10 @@ class _Reader:
             byte = self.byte()
             value |= (byte & 0x7F) << 7 * index
             if not byte & 0x80:
+                if index and not byte:
+                    # Only the shortest form is valid, so that every image has one encoding.
+                    raise IlcFormatError(start, f"a number in the {self.what} is not in "
+                                         "its shortest form (a trailing zero byte)")
                 return value
         raise IlcFormatError(start, f"a number in the {self.what} is longer than "
                              f"{MAX_VARINT_SIZE} bytes")

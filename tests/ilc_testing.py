@@ -1,0 +1,81 @@
+"""Test helpers for .ilc files: Hypothesis strategies for valid images (random instruction
+sequences whose jumps, handlers and line entries all land on instruction boundaries, with
+in-range operands), and the CRC as the spec defines it."""
+
+from __future__ import annotations
+
+import struct
+import zlib
+
+from hypothesis import strategies as st
+
+from rl1.compiler.builtins import BUILTINS, HANDLER_LABELS, VARIABLES, Feature
+from rl1.vm import ilc, isa
+
+
+def with_crc(data: bytes | bytearray) -> bytes:
+    """`data` with its CRC field recomputed as the spec defines it, independently of
+    the implementation: zlib's CRC-32 of the file with bytes 8..11 taken as zero."""
+    out = bytearray(data)
+    out[8:12] = bytes(4)
+    out[8:12] = struct.pack("<I", zlib.crc32(bytes(out)))
+    return bytes(out)
+
+
+OPCODE_INFOS = sorted(isa.OPCODES.values(), key=lambda info: info.opcode)
+variable_indexes = st.integers(0, len(VARIABLES) - 1)
+
+
+def needed_features(infos: list[isa.OpInfo]) -> set[Feature]:
+    builtins = (BUILTINS[info.builtin[0]] for info in infos if info.builtin is not None)
+    return {b.feature for b in builtins if b.feature is not None}
+
+
+@st.composite
+def instruction_bytes(draw: st.DrawFn, info: isa.OpInfo, offsets: list[int]) -> bytes:
+    operands: list[int] = []
+    for operand in info.operands:
+        if operand is isa.Operand.VAR:
+            operands.append(draw(variable_indexes))
+        elif operand is isa.Operand.IMM:
+            operands.append(draw(st.integers(-0x8000, 0x7FFF)))
+        elif operand is isa.Operand.ADDR:
+            operands.append(draw(st.sampled_from(offsets)))
+    form = info.form
+    params = form.params if form is not None else ()
+    args = tuple(
+        isa.Arg(True, draw(variable_indexes)) if draw(st.booleans())
+        else isa.Arg(False, draw(st.integers(param.low, param.high)))
+        for param in params
+    )
+    return isa.encode(info, tuple(operands), args)
+
+
+@st.composite
+def debug_infos(draw: st.DrawFn, offsets: list[int]) -> ilc.DebugInfo:
+    name = draw(st.text(max_size=20))
+    covered = [offset for offset in offsets if draw(st.integers(0, 4))]  # most, not all
+    line = draw(st.integers(1, 100))
+    lines: list[tuple[int, int]] = []
+    for offset in covered:
+        lines.append((offset, line))
+        # Mostly small steps; sometimes large ones, for the multi-byte numbers.
+        line = min(ilc.MAX_LINE, line + draw(st.integers(0, 3) | st.integers(0, 40000)))
+    return ilc.DebugInfo(name, tuple(lines))
+
+
+@st.composite
+def images(draw: st.DrawFn, max_instructions: int = 25) -> ilc.Image:
+    infos = draw(st.lists(st.sampled_from(OPCODE_INFOS), max_size=max_instructions))
+    offsets: list[int] = []
+    size = 0
+    for info in infos:
+        offsets.append(size)
+        size += info.length
+    code = b"".join(draw(instruction_bytes(info, offsets)) for info in infos)
+    handlers = draw(st.dictionaries(st.sampled_from(list(HANDLER_LABELS)),
+                                    st.sampled_from(offsets))) if offsets else {}
+    extra = draw(st.frozensets(st.sampled_from(list(Feature))))
+    features = frozenset(needed_features(infos)) | extra
+    debug = draw(st.none() | debug_infos(offsets))
+    return ilc.Image(code, handlers, features, debug)

@@ -1,0 +1,201 @@
+"""The verifier (vm/verifier.py): what it accepts, every refusal with the file offset it
+points at, and that no damage to a valid file makes it fail in any other way."""
+
+from __future__ import annotations
+
+import struct
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from ilc_testing import images, with_crc
+
+from rl1.compiler.builtins import BUILTINS, Feature
+from rl1.vm import ilc, isa
+from rl1.vm.verifier import VerifyError, verify
+
+CODE = 24  # file offset of the code section (the 1.0 header's size)
+ALL_FEATURES = frozenset(Feature)
+
+
+def op(name: str, *operands: int, args: tuple[isa.Arg, ...] = ()) -> bytes:
+    return isa.encode(isa.BY_NAME[name], operands, args)
+
+
+def const(value: int) -> isa.Arg:
+    return isa.Arg(False, value)
+
+
+def var(index: int) -> isa.Arg:
+    return isa.Arg(True, index)
+
+
+def file_of(code: bytes, handlers: dict[int, int] | None = None,
+            features: frozenset[Feature] = ALL_FEATURES,
+            debug: ilc.DebugInfo | None = None) -> bytes:
+    return ilc.encode(ilc.Image(code, handlers or {}, features, debug))
+
+
+def refusal(data: bytes) -> VerifyError:
+    with pytest.raises(VerifyError) as caught:
+        verify(data)
+    return caught.value
+
+
+def test_a_valid_file_gives_its_instructions_and_their_index() -> None:
+    code = op("LDI", 5) + op("STV", 0) + op("MOV", args=(var(0), const(-3))) + op("JMP", 3)
+    program = verify(file_of(code, {96: 5}))
+    assert [i.info.name for i in program.instructions] == ["LDI", "STV", "MOV", "JMP"]
+    assert program.index_of == {0: 0, 3: 1, 5: 2, 11: 3}
+    assert program.instructions[2].args == (var(0), const(-3))
+    assert program.image.handlers == {96: 5}
+
+
+@settings(max_examples=100, deadline=None)
+@given(images())
+def test_every_valid_image_verifies_and_decodes_to_its_own_code(image: ilc.Image) -> None:
+    program = verify(ilc.encode(image))
+    assert program.image == image
+    reencoded = b"".join(isa.encode(i.info, i.operands, i.args)
+                         for i in program.instructions)
+    assert reencoded == image.code
+    assert [program.index_of[i.offset] for i in program.instructions] == list(
+        range(len(program.instructions)))
+
+
+def test_falling_off_the_end_is_allowed() -> None:
+    verify(file_of(op("LDI", 1)))
+    assert verify(file_of(b"")).instructions == ()
+
+
+def test_container_refusals_come_as_verify_errors() -> None:
+    error = refusal(b"RLIX" + file_of(op("END"))[4:])
+    assert isinstance(error, ilc.IlcFormatError)
+    assert error.offset == 0
+
+
+@pytest.mark.parametrize(("code", "offset", "message"), [
+    (op("LDI", 0) + bytes([0x07]), CODE + 3, "code offset 3: unknown opcode 0x07"),
+    (op("LDI", 0)[:2], CODE, "LDI needs 3 bytes, only 2 remain"),
+    (op("LDI", 0) + op("MVI", args=(const(1), const(1), const(1)))[:5], CODE + 3,
+     "MVI needs 8 bytes, only 5 remain"),
+    (op("JMP", 3), CODE + 1, "jump target 3 is outside the 3-byte code"),
+    (op("JMP", 0xFFFF), CODE + 1, "jump target 65535 is outside"),
+    (op("LDI", 0) + op("JGT", 0, 1), CODE + 5, "target 1 is in the middle of the "
+                                               "instruction at 0"),
+    (op("LDV", 53), CODE + 1, "LDV: variable index 53 is out of range 0..52"),
+    (op("LDI", 0) + op("JZ", 255, 0), CODE + 4, "JZ: variable index 255"),
+    (op("MOV", args=(const(0), var(53))), CODE + 4, "MOV argument r: variable index 53"),
+    (op("MOV", args=(const(0), var(0x100))), CODE + 4, "variable index 256"),
+    (op("MOV", args=(const(13), const(0))), CODE + 2, "MOV argument l = 13 is out of "
+                                                      "range -12..12"),
+    (bytes([isa.BY_NAME["MOV"].opcode, 0x04, 0, 0, 0, 0]), CODE + 1,
+     "argument mask 0x04 marks arguments beyond its 2"),
+])
+def test_bad_code_is_refused_at_the_offending_byte(code: bytes, offset: int,
+                                                   message: str) -> None:
+    error = refusal(file_of(code))
+    assert error.offset == offset
+    assert message in error.message
+
+
+PARAMETERS = [(info, index, param) for info in isa.OPCODES.values()
+              if info.form is not None for index, param in enumerate(info.form.params)]
+
+
+@pytest.mark.parametrize(("info", "index", "param"), PARAMETERS,
+                         ids=[f"{info.name}-{param.name}" for info, _, param in PARAMETERS])
+def test_constant_arguments_are_checked_against_the_builtin_table(
+    info: isa.OpInfo, index: int, param: object,
+) -> None:
+    assert info.form is not None
+    params = info.form.params
+
+    def call_with(value: int) -> bytes:
+        args = tuple(const(value if i == index else p.low) for i, p in enumerate(params))
+        return file_of(isa.encode(info, (), args))
+
+    low, high = params[index].low, params[index].high
+    verify(call_with(low))
+    verify(call_with(high))
+    for outside in (low - 1, high + 1):
+        if -0x8000 <= outside <= 0x7FFF:  # a range as wide as 16 bits has no outside
+            error = refusal(call_with(outside))
+            assert error.offset == CODE + 2 + 2 * index
+            assert f"= {outside} is out of range {low}..{high}" in error.message
+
+
+def test_a_call_needs_its_feature_in_the_header() -> None:
+    error = refusal(file_of(op("LDI", 0) + op("IMG"),
+                            features=ALL_FEATURES - {Feature.VISION}))
+    assert error.offset == CODE + 3
+    assert "IMG needs the device feature VISION" in error.message
+    assert BUILTINS["TIM"].feature is None
+    verify(file_of(op("TIM", args=(const(5),)), features=frozenset()))
+
+
+def test_a_handler_must_start_an_instruction() -> None:
+    code = op("LDI", 0) + op("END")
+    handler_98 = CODE + len(code) + 2 * 2
+    error = refusal(file_of(code, {96: 3, 98: 1}))
+    assert error.offset == handler_98
+    assert "handler :98 at code offset 1 is in the middle of the instruction at 0" \
+        in error.message
+
+
+def test_a_line_entry_must_start_an_instruction() -> None:
+    code = op("LDI", 0) + op("END")
+    debug_start = CODE + len(code) + 8 + 2
+    data = file_of(code, debug=ilc.DebugInfo("p.rob", ((0, 1), (2, 1))))
+    error = refusal(data)
+    # name length byte, name, count; then the entries, 2 bytes each here.
+    assert error.offset == debug_start + 1 + 5 + 2 + 2
+    assert "line entry for code offset 2 is in the middle of the instruction at 0" \
+        in error.message
+    error = refusal(file_of(code, debug=ilc.DebugInfo("p.rob", ((0, 1), (4, 1)))))
+    assert "line entry for code offset 4 is outside the 4-byte code" in error.message
+
+
+# --- damage of every kind ------------------------------------------------------------
+
+HEADER_FIELDS = [(4, "<B"), (5, "<B"), (6, "<H"), (12, "<H"), (14, "<H"), (16, "<H"),
+                 (18, "<H"), (20, "<I")]
+
+
+@st.composite
+def damaged(draw: st.DrawFn) -> bytes:
+    data = bytearray(ilc.encode(draw(images())))
+    # Hypothesis favours small numbers: pick the region first, so that damage reaches
+    # the code, the tables and the debug section as often as the header.
+    header = ilc.read_header(bytes(data))
+    start = draw(st.sampled_from([0, CODE, header.handler_start, header.debug_start]))
+    position = draw(st.integers(min(start, len(data) - 1), len(data) - 1))
+    kind = draw(st.sampled_from(["flip", "overwrite", "truncate", "insert", "header"]))
+    if kind == "flip":
+        data[position] ^= 1 << draw(st.integers(0, 7))
+    elif kind == "overwrite":
+        data[position] = draw(st.integers(0, 255))
+    elif kind == "truncate":
+        del data[position:]
+    elif kind == "insert":
+        data[position:position] = draw(st.binary(min_size=1, max_size=8))
+    else:
+        offset, fmt = draw(st.sampled_from(HEADER_FIELDS))
+        limit = 1 << 8 * struct.calcsize(fmt)
+        struct.pack_into(fmt, data, offset, draw(st.integers(0, limit - 1) | st.integers(0, 40)))
+    # Fixing the CRC lets the damage reach the checks behind it.
+    return with_crc(data) if len(data) >= 12 and draw(st.booleans()) else bytes(data)
+
+
+@settings(max_examples=300, deadline=None)
+@given(damaged())
+def test_damage_is_refused_or_verifies_never_anything_else(data: bytes) -> None:
+    try:
+        program = verify(data)
+    except VerifyError as error:
+        assert 0 <= error.offset <= len(data)
+        return
+    header = ilc.read_header(data)
+    if (header.minor, header.flags) == (0, 0):
+        # One image, one encoding: what verifies is exactly what the writer writes.
+        assert ilc.encode(program.image) == data
