@@ -122,7 +122,7 @@ def _cells(text: str) -> int:
     marks none."""
     width = 0
     for character in text:
-        if unicodedata.combining(character):
+        if unicodedata.category(character) in ("Mn", "Me"):
             continue
         width += 2 if unicodedata.east_asian_width(character) in ("W", "F") else 1
     return width
@@ -190,7 +190,7 @@ class _HumanRenderer:
     def diagnostic(self, diagnostic: Diagnostic) -> str:
         level = diagnostic.severity.value
         spans = [diagnostic.span, *(related.span for related in diagnostic.related)]
-        gutter = max(len(str(span.end_line)) for span in spans)
+        gutter = max(len(str(max(span.line, span.end_line))) for span in spans)
         out = [
             self.paint(f"{level}[{diagnostic.code}]", level)
             + self.paint(f": {_visible(diagnostic.message)}", "message")
@@ -228,7 +228,8 @@ class _HumanRenderer:
             first = span.column - 1 if number == span.line else 0
             last = span.end_column - 1 if number == span.end_line else len(line)
             shown, caret, width = excerpt(line, max(first, 0), last)
-            out.append(self.paint(f"{number:>{gutter}} |", "gutter") + f" {shown}".rstrip())
+            # Only ASCII spaces are trimmed: a trailing U+3000 may be what is underlined.
+            out.append(self.paint(f"{number:>{gutter}} |", "gutter") + f" {shown}".rstrip(" "))
             out.append(self.paint(f"{pad} |", "gutter") + " " * (caret + 1)
                        + self.paint("^" * width, role))
         return out

@@ -406,3 +406,8 @@ def test_colour_auto_means_a_terminal_without_no_color(monkeypatch: pytest.Monke
     monkeypatch.setenv("NO_COLOR", "1")
     assert not use_color("auto", _Stream(tty=True))
     assert use_color("always", _Stream(tty=True))
+
+
+def test_combining_marks_take_no_cell_and_a_trailing_wide_space_stays_visible() -> None:
+    assert snippet_rows("e\u0301A=1", Span(1, 3, 1, 4)) == ["1 | e\u0301A=1", "  |  ^"]
+    assert snippet_rows("(MOV\u3000", Span(1, 5, 1, 6)) == ["1 | (MOV\u3000", "  |     ^^"]
