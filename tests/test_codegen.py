@@ -12,7 +12,11 @@ from rl1.compiler.builtins import BUILTINS, VARIABLES, Feature
 from rl1.compiler.codegen import CodegenError, generate
 from rl1.compiler.lower import lower
 from rl1.compiler.parser import parse_program
-from rl1.vm import ilc, isa
+from rl1.vm import ilc, isa, machine
+from rl1.vm.device import FuzzyReading, ImageReading, Odometry
+from rl1.vm.faults import FaultKind, RunResult
+from rl1.vm.interpreter import interpret
+from rl1.vm.scripted import Script, ScriptedDevice, TraceEntry
 from rl1.vm.verifier import verify
 
 SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
@@ -214,3 +218,61 @@ def test_every_valid_program_compiles_to_valid_ir_and_verified_bytes(text: str) 
         instruction.offset for instruction in verified.instructions
     ]
     assert verify(ilc.encode(ilc.strip_debug(image))).instructions == verified.instructions
+
+
+INT16 = st.integers(-32768, 32767)
+
+
+@st.composite
+def scripts(draw: st.DrawFn) -> Script:
+    """Sensor readings without line losses (the two engines take a loss at different
+    points, by design), so that a run is a function of the program's code alone."""
+    return Script(
+        images=tuple(draw(st.lists(st.builds(ImageReading, INT16, INT16, INT16, INT16),
+                                   max_size=3))),
+        odometry=tuple(draw(st.lists(st.builds(Odometry, INT16, INT16, INT16), max_size=3))),
+        camera=tuple(draw(st.lists(st.integers(0, 784), max_size=3))),
+        ultrasonic={letter: (draw(INT16),) for letter in "ABCD"},
+        ports={3: tuple(draw(st.lists(st.integers(0, 255), min_size=1, max_size=3)))},
+        fuzzy=tuple(draw(st.lists(st.builds(FuzzyReading, INT16, INT16), max_size=3))),
+    )
+
+
+STATEMENT_BUDGET = 300
+INSTRUCTION_BUDGET = 3000
+
+
+def ran_away(result: RunResult) -> bool:
+    return result.fault is not None and result.fault.kind is FaultKind.BUDGET
+
+
+def commands(device: ScriptedDevice, result: RunResult) -> list[TraceEntry]:
+    """The commands of a run, without the stop that ends a runaway."""
+    if not ran_away(result):
+        return device.trace
+    *before, stop = device.trace
+    assert stop.call == "STOP"
+    return before
+
+
+@settings(max_examples=100, deadline=None)
+@given(valid_programs(), scripts())
+def test_compiled_code_runs_as_the_interpreter_runs_the_source(
+    text: str, script: Script,
+) -> None:
+    program, _ = parse_program(text)
+    interpreted_device, vm_device = ScriptedDevice(script), ScriptedDevice(script)
+    interpreted = interpret(program, interpreted_device, STATEMENT_BUDGET)
+    compiled = verify(ilc.encode(generate(lower(program), "generated.rob")))
+    ran = machine.run(compiled, vm_device, INSTRUCTION_BUDGET)
+    # The engines count steps differently (statements, instructions), so a runaway is
+    # stopped at different points: up to the stop, both traces follow the same one.
+    vm_trace, interpreted_trace = commands(vm_device, ran), commands(interpreted_device,
+                                                                     interpreted)
+    shorter = min(len(vm_trace), len(interpreted_trace))
+    assert vm_trace[:shorter] == interpreted_trace[:shorter]
+    if not (ran_away(interpreted) or ran_away(ran)):
+        assert vm_device.trace == interpreted_device.trace
+        assert ran.named() == interpreted.named()
+        assert (ran.fault and (ran.fault.kind, ran.fault.line)) == (
+            interpreted.fault and (interpreted.fault.kind, interpreted.fault.line))
