@@ -50,8 +50,9 @@ class _Lowerer:
     # Blocks -------------------------------------------------------------------------
 
     def open_block(self) -> None:
-        """Start a block for code that follows a jump or end (unreachable unless a
-        later pass proves otherwise) or the start of the program."""
+        """Open an unlabelled block unless one is open: at the start of the program,
+        for the fall-through of a conditional jump, or for code after a jump or
+        `(END)` (which only a label could reach, so nothing does)."""
         if self.block_id is None:
             self.block_id = f"B{self.unlabelled}"
             self.unlabelled += 1
