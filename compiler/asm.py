@@ -132,11 +132,14 @@ def _number(token: _Token, low: int, high: int, what: str) -> int:
     return value
 
 
+_VARIABLE_INDEX = {name: index for index, name in enumerate(VARIABLES)}
+
+
 def _variable(token: _Token) -> int:
-    if token.kind != "name" or token.text not in VARIABLES:
+    if token.kind != "name" or token.text not in _VARIABLE_INDEX:
         raise _LineError(token.column, f"expected a variable (A-Z, a-z or @), "
                                        f"found {token.text or 'nothing'!r}")
-    return VARIABLES.index(token.text)
+    return _VARIABLE_INDEX[token.text]
 
 
 @dataclass
@@ -303,7 +306,9 @@ class _Assembler:
         expected = sum(info.arity if operand is isa.Operand.ARGS else 1
                        for operand in info.operands)
         if len(tokens) != expected:
-            raise _LineError(token.column, f"{info.name} takes {expected} operand"
+            # Too many: point at the first one too many; too few: at the instruction.
+            column = tokens[expected].column if len(tokens) > expected else token.column
+            raise _LineError(column, f"{info.name} takes {expected} operand"
                                            f"{'' if expected == 1 else 's'}, found {len(tokens)}")
         return tokens
 

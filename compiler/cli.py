@@ -17,14 +17,19 @@ from pathlib import Path
 
 import click
 
+from rl1.vm.verifier import VerifyError
+
+from .asm import AsmError, assemble
 from .ast import Span
 from .atomic import write_atomically
 from .catalogue import CODES
 from .diagnostics import Diagnostic, Severity
+from .disasm import disassemble, source_beside
 from .driver import EMITS, OPTIMIZATION_LEVELS, Emit, compile_text
 from .frontend import analyze
 from .render import (
     COLOR_CHOICES,
+    EXIT_ERRORS,
     EXIT_USAGE,
     FORMATS,
     ColorChoice,
@@ -227,3 +232,67 @@ def explain(ctx: click.Context, code: str | None, list_codes: bool) -> None:
                    err=True)
         ctx.exit(EXIT_USAGE)
     click.echo(info.explanation(), nl=False)
+
+
+MAX_ILC_BYTES = 16 * 1024 * 1024  # far more than any .ilc file holds
+
+
+@main.command()
+@click.argument("file")
+@click.pass_context
+def dis(ctx: click.Context, file: str) -> None:
+    """Disassemble an .ilc file into .ils text on standard output, with the program's
+    source lines when its source file is found (beside the .ilc, or by the recorded name).
+    Exit status: 0 done, 1 the file is not valid intermediate code, 2 an unreadable file."""
+    try:
+        with open(file, "rb") as stream:
+            data = stream.read(MAX_ILC_BYTES + 1)
+    except OSError as error:
+        click.echo(f"error: cannot read `{file}`: {error.strerror or error}", err=True)
+        ctx.exit(EXIT_USAGE)
+    if len(data) > MAX_ILC_BYTES:
+        click.echo(f"error: `{file}` is larger than {MAX_ILC_BYTES} bytes: not an .ilc file",
+                   err=True)
+        ctx.exit(EXIT_ERRORS)
+    try:
+        text = disassemble(data, file, source_beside(file))
+    except VerifyError as error:
+        click.echo(f"error: {file}: byte {error.offset}: {error.message}", err=True)
+        ctx.exit(EXIT_ERRORS)
+    click.echo(text, nl=False)
+
+
+@main.command("asm")
+@click.argument("file")
+@click.option("-o", "--output", metavar="PATH",
+              help="Where to write the .ilc file; `-` is standard output. "
+                   "Default: FILE.ilc beside the .ils file.")
+@click.pass_context
+def assemble_file(ctx: click.Context, file: str, output: str | None) -> None:
+    """Assemble .ils text (as `rl1c dis` prints it) into an .ilc file; the result must
+    pass the verifier. Exit status: 0 written, 1 errors in the text (nothing is written),
+    2 an unreadable input or an output that cannot be written."""
+    try:
+        source = read_source(file)
+    except SourceError as error:
+        click.echo(f"error: {error}", err=True)
+        ctx.exit(EXIT_USAGE)
+    target = output or str(Path(file).with_suffix(".ilc"))
+    if target != "-" and os.path.exists(target) and os.path.samefile(file, target):
+        raise click.UsageError(f"the output `{target}` is the input file itself: "
+                               "give another path with -o")
+    try:
+        data = assemble(source.text)
+    except AsmError as error:
+        for problem in error.problems:
+            click.echo(f"{file}:{problem.line}:{problem.column}: error: {problem.message}",
+                       err=True)
+        ctx.exit(EXIT_ERRORS)
+    if target == "-":
+        sys.stdout.buffer.write(data)
+        return
+    try:
+        write_atomically(target, data)
+    except OSError as error:
+        click.echo(f"error: cannot write `{target}`: {error.strerror or error}", err=True)
+        ctx.exit(EXIT_USAGE)

@@ -1,0 +1,170 @@
+"""The .ils text form: `dis` then `asm` gives back the same bytes, errors point at their
+line and column, and the `rl1c dis` / `rl1c asm` commands."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from ilc_testing import images
+
+from rl1.compiler.asm import AsmError, assemble
+from rl1.compiler.builtins import Feature
+from rl1.compiler.cli import main
+from rl1.compiler.disasm import disassemble
+from rl1.vm import ilc
+from rl1.vm.verifier import verify
+
+HAND_WRITTEN = """\
+; a loop that counts A down from 5
+.handler 96 loop
+.source "count.rob"
+.line 1
+        LDI 5
+        STV A
+.line 3
+loop:   DEC A
+        JGT A, loop
+        MOV A, -3        ; a variable and a constant argument
+        MVI 3, 3, $10
+        .line none
+        ULTA
+        ADDR
+        END
+"""
+
+
+@settings(max_examples=100, deadline=None)
+@given(images(), st.lists(st.text(alphabet=st.characters(exclude_categories=["Cs", "Cc"])),
+                          max_size=30) | st.none())
+def test_assembling_the_disassembly_gives_the_same_bytes(
+    image: ilc.Image, source: list[str] | None,
+) -> None:
+    data = ilc.encode(image)
+    text = disassemble(data, "x.ilc", lambda _: source)
+    assert assemble(text) == data
+
+
+def test_a_hand_written_program_assembles_to_what_it_says() -> None:
+    program = verify(assemble(HAND_WRITTEN))
+    names = [i.info.name for i in program.instructions]
+    assert names == ["LDI", "STV", "DEC", "JGT", "MOV", "MVI", "ULTA", "ADDR", "END"]
+    loop = program.instructions[2].offset
+    assert program.instructions[3].operands == (0, loop)
+    assert program.instructions[5].args[2].value == 16
+    assert program.image.handlers == {96: loop}
+    # Without .features, the features are what the calls need.
+    assert program.image.features == {Feature.MOTION, Feature.ULTRASONIC}
+    debug = program.image.debug
+    assert debug is not None and debug.source_name == "count.rob"
+    # `.line none` ends the map: the last three instructions have no entry.
+    assert [line for _, line in debug.lines] == [1, 1, 3, 3, 3, 3]
+
+
+def test_the_disassembly_shows_the_header_tables_offsets_and_source() -> None:
+    data = assemble(HAND_WRITTEN)
+    source = ["A=5", "' count down", ":10 A--; ?A>#10", "(MOV A,-3)"]
+    text = disassemble(data, "count.ilc", lambda name: source if name == "count.rob" else None)
+    assert f"CRC-32 0x{ilc.read_header(data).crc:08X}, {len(data)} bytes" in text
+    assert ".features MOTION ULTRASONIC\n.handler 96 L0005\n.handler 97 none\n" in text
+    # The source lines up to an instruction's line come before it, as comments.
+    assert ";    2 | ' count down\n        ;    3 | :10 A--; ?A>#10\n        .line 3\n" \
+        "L0005:\n  0005  DEC A\n  0007  JGT A, L0005\n" in text
+    assert disassemble(data, "count.ilc").count(" | ") == 0
+
+
+@pytest.mark.parametrize(("text", "line", "column", "message"), [
+    ("LDI 40000", 1, 5, "constant 40000 is out of range -32768..32767"),
+    ("LDI $10000", 1, 5, "out of range"),
+    ("END\nFOO", 2, 1, "unknown instruction FOO"),
+    ("LDV AB", 1, 5, "expected a variable (A-Z, a-z or @), found 'AB'"),
+    ("MOV 1", 1, 1, "MOV takes 2 operands, found 1"),
+    ("LDV A,", 1, 7, "expected an operand after ','"),
+    ("END extra", 1, 5, "END takes 0 operands, found 1"),
+    ("LDI 1 2", 1, 7, "unexpected '2' at the end of the line"),
+    ("JMP nowhere", 1, 5, "unknown label nowhere"),
+    ("x: END\nx: END", 2, 1, "label x is defined twice"),
+    ("  0003 END", 1, 3, "this line says code offset 3, but its instruction assembles at 0"),
+    (".line 3", 1, 1, ".line needs a .source"),
+    ('.source "a"\n.line 3\nEND\n.line 2', 4, 1, "line 2 comes after line 3"),
+    ('.source "a\\q"', 1, 11, "bad string"),
+    ('.source "a', 1, 9, "a string without its closing quote"),
+    (".features WARP", 1, 11, "unknown feature WARP"),
+    (".features\n.features", 2, 1, ".features is given twice"),
+    (".handler 95 none", 1, 10, "handler label 95 is out of range 96..99"),
+    ("END\n.handler 96 5", 2, 13, "handler :96 at 5 is outside the 1-byte code"),
+    (".bogus", 1, 1, "unknown directive .bogus"),
+    ("LDI 1 # 2", 1, 7, "unexpected character '#'"),
+    # Refusals of the verifier, reported at the operand that caused them.
+    ("LDI 0\nJMP 1", 2, 5, "jump target 1 is in the middle of the instruction at 0"),
+    ("MOV 0, 13", 1, 8, "MOV argument r = 13 is out of range -12..12"),
+    (".features\nIMG", 2, 1, "IMG needs the device feature VISION"),
+    ("LDI 0\nEND\n.handler 99 1", 3, 1, "handler :99 at code offset 1 is in the middle"),
+])
+def test_errors_say_where(text: str, line: int, column: int, message: str) -> None:
+    with pytest.raises(AsmError) as caught:
+        assemble(text)
+    problem = caught.value.problems[0]
+    assert (problem.line, problem.column) == (line, column)
+    assert message in problem.message
+
+
+def test_every_line_with_an_error_is_reported() -> None:
+    with pytest.raises(AsmError) as caught:
+        assemble("FOO\nLDI 5\nLDV 7\nBAR")
+    assert [(p.line, p.column) for p in caught.value.problems] == [(1, 1), (3, 5), (4, 1)]
+
+
+def test_check_false_assembles_a_file_the_verifier_refuses() -> None:
+    data = assemble("MOV 13, 0", check=False)
+    assert ilc.decode(data).code[2:4] == (13).to_bytes(2, "little")
+
+
+# --- the commands --------------------------------------------------------------------
+
+def test_dis_then_asm_on_the_command_line(tmp_path: Path) -> None:
+    (tmp_path / "count.rob").write_text("A=5\n' count down\n:10 A--; ?A>#10\n")
+    (tmp_path / "count.ilc").write_bytes(assemble(HAND_WRITTEN))
+    runner = CliRunner()
+    shown = runner.invoke(main, ["dis", str(tmp_path / "count.ilc")])
+    assert shown.exit_code == 0
+    assert ";    3 | :10 A--; ?A>#10" in shown.output  # found beside the .ilc
+    (tmp_path / "count.ils").write_text(shown.output)
+    built = runner.invoke(main, ["asm", str(tmp_path / "count.ils"), "-o",
+                                 str(tmp_path / "again.ilc")])
+    assert built.exit_code == 0
+    assert (tmp_path / "again.ilc").read_bytes() == (tmp_path / "count.ilc").read_bytes()
+    default = runner.invoke(main, ["asm", str(tmp_path / "count.ils")])
+    assert default.exit_code == 0  # FILE.ilc beside the .ils by default
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "again.ilc", "count.ilc", "count.ils", "count.rob"]  # no temporary file left
+
+
+def test_asm_reports_errors_with_file_line_column_and_writes_nothing(tmp_path: Path) -> None:
+    source = tmp_path / "bad.ils"
+    source.write_text("LDI 5\nFOO\n")
+    result = CliRunner().invoke(main, ["asm", str(source), "-o", str(tmp_path / "bad.ilc")])
+    assert result.exit_code == 1
+    assert f"{source}:2:1: error: unknown instruction FOO" in result.output
+    assert not (tmp_path / "bad.ilc").exists()
+
+
+def test_unreadable_files_exit_2(tmp_path: Path) -> None:
+    runner = CliRunner()
+    assert runner.invoke(main, ["dis", str(tmp_path / "none.ilc")]).exit_code == 2
+    assert runner.invoke(main, ["asm", str(tmp_path / "none.ils")]).exit_code == 2
+    (tmp_path / "ok.ils").write_text("END\n")
+    unwritable = runner.invoke(main, ["asm", str(tmp_path / "ok.ils"), "-o",
+                                      str(tmp_path / "no" / "dir.ilc")])
+    assert unwritable.exit_code == 2
+    assert "cannot write" in unwritable.output
+
+
+def test_dis_refuses_an_invalid_file_with_its_offset(tmp_path: Path) -> None:
+    (tmp_path / "x.ilc").write_bytes(b"RLIX" + assemble("END")[4:])
+    result = CliRunner().invoke(main, ["dis", str(tmp_path / "x.ilc")])
+    assert result.exit_code == 1
+    assert "byte 0: not an .ilc file" in result.output
