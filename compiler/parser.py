@@ -93,7 +93,7 @@ class _AstBuilder(lark.Transformer):  # type: ignore[type-arg]
         if not 0 <= value <= 0xFFFF:
             self.problems.append(Diagnostic(
                 "E0105", Severity.ERROR,
-                f"`{text}` is not a 16-bit hex constant",
+                f"`{_excerpt(text)}` is not a 16-bit hex constant",
                 self.span(token),
                 help="write `$` and one to four hex digits 0-9, A-F, e.g. `$FF` or `$AA55`",
             ))
@@ -255,11 +255,12 @@ def _syntax_error(line: int, error: ScanError | _SyntaxError, code: str) -> Diag
         return _misused_word(span, token.text)
     elif token.type == "LABEL":
         return Diagnostic(
-            "E0104", Severity.ERROR, f"the label `{token.text}` is not at the start of its line",
+            "E0104", Severity.ERROR,
+            f"the label `{_excerpt(token.text)}` is not at the start of its line",
             span, help="a label `:NN` may only start a line: move it to a line of its own",
         )
     else:
-        found = f"`{token.text}`"
+        found = f"`{_excerpt(token.text)}`"
     expected = sorted({TERMINAL_NAMES.get(name, name) for name in error.expected})
     return Diagnostic(
         "E0101", Severity.ERROR,
@@ -295,6 +296,11 @@ def _bad_character(span: ast.Span, character: str) -> Diagnostic:
                       f"unexpected character `{character}` ({name})", span, help=help_text)
 
 
+def _excerpt(text: str, limit: int = 24) -> str:
+    """Token text short enough to quote in a message (the span still marks all of it)."""
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
 def _misused_word(span: ast.Span, word: str) -> Diagnostic:
     if word.upper() in BUILTINS:
         return Diagnostic(
@@ -303,7 +309,8 @@ def _misused_word(span: ast.Span, word: str) -> Diagnostic:
             help=f"write `({word.upper()} ...)`",
         )
     return Diagnostic(
-        "E0103", Severity.ERROR, f"`{word}` is not a variable: variable names are one letter",
+        "E0103", Severity.ERROR,
+        f"`{_excerpt(word)}` is not a variable: variable names are one letter",
         span, help="use one of A-Z, a-z or @; built-in functions are written `(NAME ...)`",
     )
 

@@ -62,3 +62,11 @@ def test_multi_letter_word_and_bare_mnemonic_get_specific_messages() -> None:
     assert word.code == bare.code == "E0103"
     assert "one letter" in word.message
     assert bare.help == "write `(MOV ...)`"
+
+
+def test_messages_quote_an_excerpt_of_a_huge_token_but_span_all_of_it() -> None:
+    word = "AB" * 50_000
+    _, [diagnostic] = parse_line(word + "=1", 1)
+    assert diagnostic.code == "E0103"
+    assert len(diagnostic.message) < 100
+    assert diagnostic.span.end_column == len(word) + 1
