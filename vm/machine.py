@@ -1,6 +1,6 @@
 """The reference VM: what every instruction of a verified .ilc program means.
 
-Later implementations (a C VM on the vehicle) must behave exactly as this one does.
+Later implementations (a C VM on the vehicle) must behave as this one does.
 State: 53 variables (builtins.VARIABLES order, all 0 at start), the accumulator, the
 result register R (the value of the last value-returning call, 0 at start) and the
 program counter. Every value is a 16-bit two's complement integer and every result
@@ -13,12 +13,25 @@ the event's tracing mode and command: 2 MOV :98, 2 MVI :99, 3 MOV :96, 3 MVI :97
 
 Faults end the run after the device is stopped: a variable argument outside its range,
 a lost line whose handler the program lacks, the watchdog's instruction budget used up,
-and a device error (faults.py has their exit statuses).
+and a device error (faults.py has their exit statuses). The watchdog counts every
+instruction run and looks at the count when a jump is taken and before a call runs: the
+run faults at the first such point where more than `budget` instructions have run. Every
+loop takes a jump, so a runaway program always meets it.
 
-The dispatch loop runs on instructions decoded once into (op, a, b) tuples, where jump
-targets are instruction indices. Operands live in one list of cells: the variables at
-0..52, R at 53, then the program's immediates; so LDV/LDI/LDR are one load and each ALU
-operator is one case whatever its operand kind.
+How this implementation is fast enough (bench/vm_speed.py) without hiding the meaning:
+- Instructions are decoded once into (op, a, b) tuples; jump targets become instruction
+  indices. Operands live in one list of cells: the variables at 0..52, R at 53, then
+  the program's immediates; so LDV/LDI/LDR are one load, and each ALU operator one case
+  whatever its operand kind.
+- The accumulator is kept modulo 2**16 rather than wrapped after every operation: + - &
+  | and ^ give the same low 16 bits either way, so it is wrapped only where its value is
+  read as a number (a store, a shift) and where it could grow fast (a left shift).
+- A statement's run "load; operators; store" is also decoded as one EXPRESSION step at
+  the index of its load. Nothing in such a run can fault, call the device or be seen
+  before the store, so running it at once means the same; a jump into the middle of it
+  (none comes from the compiler) runs the single instructions, which stay in place.
+- Instructions are counted by index arithmetic when control leaves a straight run (a
+  jump taken, a handler entered, the end), not one by one.
 """
 
 from __future__ import annotations
@@ -28,7 +41,7 @@ from dataclasses import dataclass
 from rl1.compiler.builtins import VARIABLES, Param
 
 from . import isa
-from .device import Device, DeviceError, form_name, perform
+from .device import Device, DeviceError, LineLost, form_name, perform
 from .faults import DEFAULT_BUDGET, Fault, FaultKind, RunResult
 from .verifier import VerifiedProgram
 
@@ -40,9 +53,10 @@ HANDLERS = {(2, "MOV"): 98, (2, "MVI"): 99, (3, "MOV"): 96, (3, "MVI"): 97}
 
 # The operations of the dispatch loop (not opcodes: decoding folds operand kinds).
 (LOAD, STORE, ADD, SUB, AND, OR, XOR, SHL, SHR, INC, DEC,
- JUMP, JUMP_ZERO, JUMP_POSITIVE, JUMP_NEGATIVE, CALL, END) = range(17)
+ JUMP, JUMP_ZERO, JUMP_POSITIVE, JUMP_NEGATIVE, CALL, END, EXPRESSION) = range(18)
 
 _ALU = (ADD, SUB, AND, OR, XOR, SHL, SHR)  # in isa.ALU_OPERATORS order
+_ALU_BASES = (isa.ALU_RESULT, isa.ALU_IMM, isa.ALU_VAR)  # highest first
 _SIMPLE = {"STV": STORE, "INC": INC, "DEC": DEC}
 _JUMPS = {"JMP": JUMP, "JZ": JUMP_ZERO, "JGT": JUMP_POSITIVE, "JLT": JUMP_NEGATIVE}
 
@@ -59,10 +73,23 @@ class _CallSite:
     returns_value: bool
 
 
+@dataclass(frozen=True, slots=True)
+class _Expression:
+    """A load, the (operator, cell) steps after it, and the cell stored to."""
+
+    first: int
+    steps: tuple[tuple[int, int], ...]
+    target: int
+
+
 class _Faulted(Exception):
     def __init__(self, kind: FaultKind, message: str) -> None:
         self.kind = kind
         self.message = message
+
+
+def _wrap(value: int) -> int:
+    return ((value + 0x8000) & 0xFFFF) - 0x8000
 
 
 def _shift_left(value: int, count: int) -> int:
@@ -72,7 +99,7 @@ def _shift_left(value: int, count: int) -> int:
         return _shift_right(value, -count)
     if count >= 16:
         return 0
-    return (((value << count) + 0x8000) & 0xFFFF) - 0x8000
+    return _wrap(value << count)
 
 
 def _shift_right(value: int, count: int) -> int:
@@ -92,17 +119,24 @@ class Machine:
         self.device = device
         self.budget = budget
         self.cells: list[int] = [0] * (R_CELL + 1)
+        self._immediates: dict[int, int] = {}
         self.sites: list[_CallSite] = []
         self.code = [self._decode(instruction) for instruction in program.instructions]
         self.code.append((END, 0, 0))  # running off the end is (END)
-        index_of = program.index_of
-        self.handlers = {label: index_of[offset]
+        self.expressions: list[_Expression] = []
+        self._group_expressions()
+        self.handlers = {label: program.index_of[offset]
                          for label, offset in program.image.handlers.items()}
+        self.executed = 0  # instructions the last run executed
 
-    def _cell_of_immediate(self, value: int) -> int:
-        if value not in self.cells[R_CELL + 1:]:
+    # Decoding
+
+    def _immediate(self, value: int) -> int:
+        """The cell holding the constant `value`."""
+        if value not in self._immediates:
+            self._immediates[value] = len(self.cells)
             self.cells.append(value)
-        return self.cells.index(value, R_CELL + 1)
+        return self._immediates[value]
 
     def _decode(self, instruction: isa.Instruction) -> tuple[int, int, int]:
         info = instruction.info
@@ -112,7 +146,7 @@ class Machine:
         if name == "LDV":
             return (LOAD, operands[0], 0)
         if name == "LDI":
-            return (LOAD, self._cell_of_immediate(operands[0]), 0)
+            return (LOAD, self._immediate(operands[0]), 0)
         if name == "LDR":
             return (LOAD, R_CELL, 0)
         if name in _SIMPLE:
@@ -121,87 +155,153 @@ class Machine:
             *condition, target = operands
             return (_JUMPS[name], condition[0] if condition else 0,
                     self.program.index_of[target])
-        if isa.ALU_VAR <= info.opcode < isa.CALL_BASE:
-            base = info.opcode & ~7
+        if info.form is None:  # an ALU instruction: base + operator index
+            base = next(base for base in _ALU_BASES if info.opcode >= base)
             op = _ALU[info.opcode - base]
             if base == isa.ALU_VAR:
                 return (op, operands[0], 0)
             if base == isa.ALU_IMM:
-                return (op, self._cell_of_immediate(operands[0]), 0)
+                return (op, self._immediate(operands[0]), 0)
             return (op, R_CELL, 0)
         form = info.form
-        assert info.builtin is not None and form is not None
+        assert info.builtin is not None
         self.sites.append(_CallSite(info.builtin, form.params, instruction.args,
                                     tuple(_INDEX[name] for name in form.writes),
                                     form.returns_value))
         return (CALL, len(self.sites) - 1, 0)
 
+    def _group_expressions(self) -> None:
+        """Put an EXPRESSION step at each load that starts a load-operators-store run;
+        its b is the index after the store."""
+        code = self.code
+        for index, (op, a, _) in enumerate(code):
+            if op != LOAD:
+                continue
+            end = index + 1
+            while code[end][0] in _ALU:
+                end += 1
+            if code[end][0] == STORE:
+                steps = tuple((step[0], step[1]) for step in code[index + 1:end])
+                self.expressions.append(_Expression(a, steps, code[end][1]))
+                code[index] = (EXPRESSION, len(self.expressions) - 1, end + 1)
+
     # The dispatch loop
 
     def run(self) -> RunResult:
         """Run from the first instruction until (END) or a fault."""
-        code = self.code
+        code, expressions, budget = self.code, self.expressions, self.budget
         cells = self.cells[:]
-        acc = 0
+        poll, divert = self.device.poll_event, self._divert
+        acc = 0  # modulo 2**16: see the module's docstring
         pc = 0
+        start = 0  # where the current straight run of instructions began
+        executed = 0  # instructions run before `start`
         try:
-            for _ in range(self.budget):
+            while True:
                 op, a, b = code[pc]
                 pc += 1
-                if op == LOAD:
-                    acc = cells[a]
-                elif op == STORE:
-                    cells[a] = acc
-                elif op == ADD:
-                    acc = ((acc + cells[a] + 0x8000) & 0xFFFF) - 0x8000
-                elif op == SUB:
-                    acc = ((acc - cells[a] + 0x8000) & 0xFFFF) - 0x8000
-                elif op == JUMP:
-                    pc = self._after_jump(b)
-                elif op == JUMP_ZERO:
-                    if cells[a] == 0:
-                        pc = self._after_jump(b)
-                elif op == JUMP_POSITIVE:
-                    if cells[a] > 0:
-                        pc = self._after_jump(b)
-                elif op == JUMP_NEGATIVE:
-                    if cells[a] < 0:
-                        pc = self._after_jump(b)
+                if op == EXPRESSION:
+                    expression = expressions[a]
+                    acc = cells[expression.first]
+                    for operator, cell in expression.steps:
+                        if operator == ADD:
+                            acc += cells[cell]
+                        elif operator == SUB:
+                            acc -= cells[cell]
+                        elif operator == AND:
+                            acc &= cells[cell]
+                        elif operator == OR:
+                            acc |= cells[cell]
+                        elif operator == XOR:
+                            acc ^= cells[cell]
+                        elif operator == SHL:
+                            acc = _shift_left(_wrap(acc), cells[cell])
+                        else:  # SHR
+                            count = cells[cell]
+                            acc = _wrap(acc)
+                            acc = acc >> count if 0 <= count < 16 else _shift_right(acc, count)
+                    cells[expression.target] = ((acc + 0x8000) & 0xFFFF) - 0x8000
+                    pc = b
                 elif op == INC:
                     cells[a] = ((cells[a] + 1 + 0x8000) & 0xFFFF) - 0x8000
                 elif op == DEC:
                     cells[a] = ((cells[a] - 1 + 0x8000) & 0xFFFF) - 0x8000
+                elif op == JUMP_POSITIVE:
+                    if cells[a] > 0:
+                        # A jump taken: count the straight run it ends, check the budget,
+                        # take a pending event. The other jumps do the same.
+                        executed += pc - start
+                        if executed > budget:
+                            break
+                        event = poll()
+                        pc = start = b if event is None else divert(event, b)
+                elif op == JUMP_ZERO:
+                    if cells[a] == 0:
+                        executed += pc - start
+                        if executed > budget:
+                            break
+                        event = poll()
+                        pc = start = b if event is None else divert(event, b)
+                elif op == JUMP_NEGATIVE:
+                    if cells[a] < 0:
+                        executed += pc - start
+                        if executed > budget:
+                            break
+                        event = poll()
+                        pc = start = b if event is None else divert(event, b)
+                elif op == JUMP:
+                    executed += pc - start
+                    if executed > budget:
+                        break
+                    event = poll()
+                    pc = start = b if event is None else divert(event, b)
+                elif op == CALL:
+                    if executed + pc - start > budget:
+                        executed += pc - start
+                        break
+                    self._call(self.sites[a], cells)
+                    event = poll()
+                    if event is not None:
+                        executed += pc - start
+                        pc = start = divert(event, pc)
+                elif op == LOAD:
+                    acc = cells[a]
+                elif op == STORE:
+                    cells[a] = ((acc + 0x8000) & 0xFFFF) - 0x8000
+                elif op == ADD:
+                    acc += cells[a]
+                elif op == SUB:
+                    acc -= cells[a]
                 elif op == AND:
-                    acc &= cells[a]  # & | ^ of two 16-bit signed values stay in range
+                    acc &= cells[a]
                 elif op == OR:
                     acc |= cells[a]
                 elif op == XOR:
                     acc ^= cells[a]
                 elif op == SHL:
-                    acc = _shift_left(acc, cells[a])
+                    acc = _shift_left(_wrap(acc), cells[a])
                 elif op == SHR:
-                    acc = _shift_right(acc, cells[a])
-                elif op == CALL:
-                    handler = self._call(self.sites[a], cells)
-                    if handler is not None:
-                        pc = handler
+                    count = cells[a]
+                    acc = _wrap(acc)
+                    acc = acc >> count if 0 <= count < 16 else _shift_right(acc, count)
                 else:  # END
+                    self.executed = executed + pc - start
                     return RunResult(tuple(cells[:R_CELL]))
-        except _Faulted as fault:
+        except (_Faulted, DeviceError) as error:
             # pc has already moved past the instruction that faulted.
+            self.executed = executed + pc - start
+            fault = (error if isinstance(error, _Faulted)
+                     else _Faulted(FaultKind.DEVICE, str(error)))
             return RunResult(tuple(cells[:R_CELL]), self._fault(fault, pc - 1))
-        budget = _Faulted(FaultKind.BUDGET, f"the program ran {self.budget} instructions "
-                          "without ending (raise the budget if it should run longer)")
-        return RunResult(tuple(cells[:R_CELL]), self._fault(budget, pc))
+        self.executed = executed
+        watchdog = _Faulted(FaultKind.BUDGET, f"the program ran more than {budget} "
+                            "instructions without ending (raise the budget if it should "
+                            "run longer)")
+        return RunResult(tuple(cells[:R_CELL]), self._fault(watchdog, pc - 1))
 
     # The slow paths: calls, events and faults
 
-    def _after_jump(self, target: int) -> int:
-        handler = self._take_event()
-        return target if handler is None else handler
-
-    def _call(self, site: _CallSite, cells: list[int]) -> int | None:
-        """Carry out a call; the handler's index if a lost line interrupts, else None."""
+    def _call(self, site: _CallSite, cells: list[int]) -> None:
         values = []
         for param, arg in zip(site.params, site.args, strict=True):
             value = cells[arg.value] if arg.is_var else arg.value
@@ -211,28 +311,19 @@ class Machine:
                                f"{value} (the value of {VARIABLES[arg.value]}), outside "
                                f"{param.low}..{param.high}")
             values.append(value)
-        try:
-            outcome = perform(self.device, site.form, tuple(values))
-        except DeviceError as error:
-            raise _Faulted(FaultKind.DEVICE, str(error)) from None
+        outcome = perform(self.device, site.form, tuple(values))
         for cell, value in zip(site.writes, outcome.writes, strict=True):
             cells[cell] = value
         if site.returns_value:
             assert outcome.result is not None
             cells[R_CELL] = outcome.result
-        return self._take_event()
 
-    def _take_event(self) -> int | None:
-        """The handler's index for a pending lost-line event, None if there is none."""
-        try:
-            event = self.device.poll_event()
-        except DeviceError as error:
-            raise _Faulted(FaultKind.DEVICE, str(error)) from None
-        if event is None:
-            return None
+    def _divert(self, event: LineLost, resume: int) -> int:
+        """Where a lost-line event sends the program: its handler's index, or `resume`
+        when the event's mode calls for no jump."""
         label = HANDLERS.get((event.mode, event.command))
         if label is None:
-            return None
+            return resume
         handler = self.handlers.get(label)
         if handler is None:
             raise _Faulted(FaultKind.MISSING_HANDLER,

@@ -1,0 +1,84 @@
+"""VM speed: a loop-heavy RL/I program on the reference VM, against the same computation
+written as plain Python and run by CPython, in the same process.
+
+Prints the VM's instructions per second, both times, and the ratio of CPython's time to
+the VM's (goal: at least 0.2, i.e. the VM within 5x of CPython on the same work).
+
+    .venv/bin/python bench/vm_speed.py [--repeat 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable
+
+from rl1.compiler.frontend import analyze
+from rl1.vm.machine import Machine
+from rl1.vm.runner import compile_program
+from rl1.vm.scripted import ScriptedDevice
+
+OUTER, INNER = 100, 1000
+
+PROGRAM = f"""' nested counting loops with 16-bit arithmetic
+N={OUTER}
+:10 M={INNER}
+:20 A=A+M&$3FF; B=B+A>2^M; C=C-B|1
+M--; ?M>#20
+N--; ?N>#10
+(END)
+"""
+
+
+def python_equivalent() -> tuple[int, int, int]:
+    """PROGRAM as a Python programmer would write it, wrapping where a sum can overflow."""
+    a = b = c = 0
+    n = OUTER
+    while n > 0:
+        m = INNER
+        while m > 0:
+            a = (((a + m + 0x8000) & 0xFFFF) - 0x8000) & 0x3FF
+            b = ((((b + a + 0x8000) & 0xFFFF) - 0x8000) >> 2) ^ m
+            c = (((c - b + 0x8000) & 0xFFFF) - 0x8000) | 1
+            m -= 1
+        n -= 1
+    return a, b, c
+
+
+def best_time(run: Callable[[], object], repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        run()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=5, help="runs of each; the best counts")
+    options = parser.parse_args()
+
+    analysis = analyze(PROGRAM)
+    assert not analysis.has_errors, analysis.diagnostics
+    program = compile_program(analysis.program, "vm_speed.rob")
+
+    counted = Machine(program, ScriptedDevice())
+    result = counted.run()
+    assert result.fault is None, result.fault
+    named = result.named()
+    expected = python_equivalent()
+    assert (named["A"], named["B"], named["C"]) == expected, (named, expected)
+    instructions = counted.executed
+
+    vm_time = best_time(lambda: Machine(program, ScriptedDevice()).run(), options.repeat)
+    python_time = best_time(python_equivalent, options.repeat)
+    print(f"instructions per run:     {instructions:,}")
+    print(f"VM:                       {vm_time * 1000:8.1f} ms, "
+          f"{instructions / vm_time / 1e6:.2f} M instructions/s")
+    print(f"CPython, same work:       {python_time * 1000:8.1f} ms")
+    print(f"ratio CPython/VM time:    {python_time / vm_time:.2f} (goal >= 0.2)")
+
+
+if __name__ == "__main__":
+    main()
