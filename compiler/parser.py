@@ -13,6 +13,7 @@ front end's hot path.
 from __future__ import annotations
 
 import gc
+import itertools
 import tempfile
 import unicodedata
 from collections.abc import Callable, Iterable
@@ -180,11 +181,22 @@ class _Tables:
             cache=str(cache),
         )
         lalr = parser.parser.parser.parser
-        self.states: dict[int, dict[str, tuple[object, Any]]] = lalr.parse_table.states
         self.start: int = lalr.parse_table.start_states["line"]
-        self.callbacks: dict[Any, Callable[[list[Any]], Any]] = lalr.callbacks
+        # The table recompiled into plain values, so that the loop below does no
+        # attribute lookups or Rule hashing: a shift is the next state (an int); a
+        # reduction is (number of children, rule name, callback building the value).
+        self.actions: dict[int, dict[str, int | _Reduction]] = {
+            state: {
+                symbol: target if action is Shift
+                else (len(target.expansion), target.origin.name, lalr.callbacks[target])
+                for symbol, (action, target) in row.items()
+            }
+            for state, row in lalr.parse_table.states.items()
+        }
 
 
+_Reduction = tuple[int, str, Callable[[list[Any]], Any]]
+_END = Token("$END", "", 0)
 _tables: _Tables | None = None
 
 
@@ -197,46 +209,33 @@ def _lalr_tables() -> _Tables:
 
 def _run_lalr(tables: _Tables, tokens: Iterable[Token]) -> Any:
     """Shift/reduce `tokens` through the LALR tables; the value of the `line` rule."""
-    states, callbacks = tables.states, tables.callbacks
-    state_stack = [tables.start]
-    value_stack: list[Any] = []
-    for token in tokens:
+    actions = tables.actions
+    states = [tables.start]
+    values: list[Any] = []
+    for token in itertools.chain(tokens, (_END,)):
         kind = token.type
         while True:
-            row = states[state_stack[-1]]
-            if kind not in row:
-                raise _SyntaxError(token, {name for name in row if name.isupper()})
-            action, argument = row[kind]
-            if action is Shift:
-                state_stack.append(argument)
-                value_stack.append(token)
+            action = actions[states[-1]].get(kind)
+            if action is None:
+                expected = {name for name in actions[states[-1]] if name.isupper()}
+                raise _SyntaxError(None if token is _END else token, expected)
+            if type(action) is int:
+                states.append(action)
+                values.append(token)
                 break
-            _reduce(states, callbacks, argument, state_stack, value_stack)
-    while True:
-        row = states[state_stack[-1]]
-        if "$END" not in row:
-            raise _SyntaxError(None, {name for name in row if name.isupper()})
-        action, rule = row["$END"]
-        if action is Shift:
-            return value_stack[-1]
-        if rule.origin.name == "line" and len(state_stack) == len(rule.expansion) + 1:
-            size = len(rule.expansion)
-            return callbacks[rule](value_stack[-size:] if size else [])
-        _reduce(states, callbacks, rule, state_stack, value_stack)
-
-
-def _reduce(states: dict[int, dict[str, tuple[object, Any]]],
-            callbacks: dict[Any, Callable[[list[Any]], Any]], rule: Any,
-            state_stack: list[int], value_stack: list[Any]) -> None:
-    size = len(rule.expansion)
-    if size:
-        children = value_stack[-size:]
-        del state_stack[-size:]
-        del value_stack[-size:]
-    else:
-        children = []
-    value_stack.append(callbacks[rule](children))
-    state_stack.append(states[state_stack[-1]][rule.origin.name][1])
+            size, rule, build = action  # type: ignore[misc]
+            if size:
+                children = values[-size:]
+                del states[-size:]
+                del values[-size:]
+            else:
+                children = []
+            value = build(children)
+            if len(states) == 1 and rule == "line":
+                return value
+            values.append(value)
+            states.append(actions[states[-1]][rule])  # type: ignore[arg-type]
+    raise AssertionError("the LALR tables accept no input without reducing `line`")
 
 
 def _syntax_error(line: int, error: ScanError | _SyntaxError, code: str) -> Diagnostic:
