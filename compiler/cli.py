@@ -19,6 +19,7 @@ import click
 
 from rl1.vm.verifier import VerifyError
 
+from . import formatter
 from .asm import AsmError, assemble
 from .ast import Span
 from .atomic import write_atomically
@@ -296,3 +297,42 @@ def assemble_file(ctx: click.Context, file: str, output: str | None) -> None:
     except OSError as error:
         click.echo(f"error: cannot write `{target}`: {error.strerror or error}", err=True)
         ctx.exit(EXIT_USAGE)
+
+
+@main.command("fmt")
+@click.argument("files", nargs=-1, required=True)
+@click.option("--check", is_flag=True,
+              help="Change nothing; list the files formatting would change (exit status 1).")
+@click.option("--diff", is_flag=True,
+              help="Change nothing; print what formatting would change as a unified diff.")
+@click.pass_context
+def fmt(ctx: click.Context, files: tuple[str, ...], check: bool, diff: bool) -> None:
+    """Put RL/I programs in the canonical layout (spec/language.md, section 11), rewriting
+    each file in place in its own encoding; `-` formats standard input to standard output.
+    Exit status: 0 done, 1 (--check) a file would change, 2 a file cannot be read or
+    written."""
+    status = 0
+    for name in files:
+        source = read_input(name)
+        if not isinstance(source, Source):
+            emit([source], "human", "auto", "format", err=True)
+            status = EXIT_USAGE
+            continue
+        formatted = formatter.format_text(source.text)
+        changed = formatted != source.text
+        if diff and changed:
+            click.echo(formatter.unified_diff(source.name, source.text, formatted), nl=False)
+        if check and changed:
+            click.echo(source.name)
+            status = max(status, EXIT_ERRORS)
+        if check or diff:
+            continue
+        if name == "-":
+            sys.stdout.buffer.write(formatter.encode_like(source, formatted, bom=False))
+        elif changed:
+            try:
+                formatter.rewrite(source, formatted)
+            except OSError as error:
+                click.echo(f"error: cannot write `{name}`: {error.strerror or error}", err=True)
+                status = EXIT_USAGE
+    ctx.exit(status)

@@ -1,0 +1,136 @@
+"""The formatter: RL/I source in the canonical layout of spec/language.md, section 11.
+
+Each line is re-printed from its parse tree, so the layout depends only on what the line
+means; a line with a syntax error has no tree and is kept exactly as written. The output
+has one line per input line, so positions keep their line numbers: the language server's
+range formatting (`format_lines`) and the whole-document form (`format_text`) agree.
+"""
+
+from __future__ import annotations
+
+import difflib
+import os
+import re
+
+from . import ast
+from .atomic import write_atomically
+from .diagnostics import Edit
+from .parser import parse_line
+from .source import Source, split_lines
+
+_LINE_END = re.compile(r"\r\n|\r|\n")
+_UTF8_BOM = b"\xef\xbb\xbf"
+
+
+def format_line(text: str) -> str:
+    """One line (without its line end) in the canonical layout."""
+    line, _ = parse_line(text, 1)
+    if not line.ok:
+        return text
+    parts = [line.label.text] if line.label else []
+    if line.statements:
+        parts.append("; ".join(_statement(statement) for statement in line.statements))
+    if line.comment:
+        parts.append("'" + line.comment.text)
+    return " ".join(parts)
+
+
+def format_text(text: str) -> str:
+    """A whole document in the canonical layout: every line formatted, blank lines at
+    the end dropped, every line ended as the document's first line end is."""
+    lines = [format_line(line) for line in split_lines(text)]
+    while lines and not lines[-1]:
+        lines.pop()
+    if not lines:
+        return ""
+    first_end = _LINE_END.search(text)
+    line_end = first_end.group() if first_end else "\n"
+    return line_end.join(lines) + line_end
+
+
+def format_lines(text: str, first_line: int, last_line: int) -> list[Edit]:
+    """The edits that put lines `first_line`..`last_line` (1-based, inclusive; clipped
+    to the document) in the canonical layout. Each edit replaces one line's text, never
+    its line end; lines already canonical get none."""
+    lines = split_lines(text)
+    edits = []
+    for number in range(max(first_line, 1), min(last_line, len(lines)) + 1):
+        old = lines[number - 1]
+        new = format_line(old)
+        if new != old:
+            edits.append(Edit(ast.Span(number, 1, number, len(old) + 1), new))
+    return edits
+
+
+# Printing the tree -----------------------------------------------------------------------
+
+
+def _statement(statement: ast.Statement) -> str:
+    if isinstance(statement, ast.Assign):
+        steps = "".join(step.op + _operand(step.operand) for step in statement.rest)
+        return f"{statement.target.name}={_operand(statement.first)}{steps}"
+    if isinstance(statement, ast.IncDec):
+        return statement.target.name + statement.step
+    if isinstance(statement, ast.Goto):
+        return statement.target.text
+    if isinstance(statement, ast.CondJump):
+        return f"?{statement.var.name}{statement.relation}{statement.target.text}"
+    return _call(statement.call)
+
+
+def _operand(operand: ast.Operand) -> str:
+    if isinstance(operand, ast.Call):
+        return _call(operand)
+    return _arg(operand)
+
+
+def _arg(arg: ast.Arg) -> str:
+    if isinstance(arg, ast.Var):
+        return arg.name
+    if isinstance(arg, ast.Const):
+        return arg.text
+    return arg.letter
+
+
+def _call(call: ast.Call) -> str:
+    """`(MOV 3,3)`, `(CAM A 90)`: a selector is followed by a space, other arguments by
+    commas. After a selector, a negative number needs the comma: `(CAM A -5)` would scan
+    as the letter minus 5."""
+    text = "(" + call.mnemonic
+    for index, arg in enumerate(call.args):
+        written = _arg(arg)
+        after_selector = index > 0 and isinstance(call.args[index - 1], ast.Selector)
+        if index == 0 or (after_selector and not written.startswith("-")):
+            text += " " + written
+        else:
+            text += "," + written
+    return text + ")"
+
+
+# Files -----------------------------------------------------------------------------------
+
+
+def unified_diff(name: str, before: str, after: str) -> str:
+    """What formatting changes, as a unified diff (line ends shown as LF)."""
+    return "".join(difflib.unified_diff(
+        [line + "\n" for line in split_lines(before)],
+        [line + "\n" for line in split_lines(after)],
+        fromfile=name, tofile=f"{name} (formatted)",
+    ))
+
+
+def encode_like(source: Source, text: str, *, bom: bool) -> bytes:
+    """`text` in the encoding `source` was read in. Formatting keeps every non-ASCII
+    character of the source (they are all in comments), so a CP932 source's characters
+    all have a CP932 encoding."""
+    return (_UTF8_BOM if bom else b"") + text.encode(source.encoding)
+
+
+def rewrite(source: Source, text: str) -> None:
+    """Replace the file `source` was read from with `text`, in the file's own encoding
+    (keeping a UTF-8 byte-order mark), atomically. A symbolic link is followed, so the
+    link stays a link. OSError if that cannot be done."""
+    path = os.path.realpath(source.name)
+    with open(path, "rb") as original:
+        bom = original.read(len(_UTF8_BOM)) == _UTF8_BOM
+    write_atomically(path, encode_like(source, text, bom=bom))

@@ -1,0 +1,410 @@
+"""Hypothesis strategies that generate RL/I source text, for fuzzing the toolchain.
+
+For us and for anyone testing a tool that reads RL/I (an interpreter, a device
+simulator, an editor plug-in):
+
+- `lines()`: one line of source, syntactically valid (it parses without a diagnostic),
+  covering every construct: labels, every statement, every operator, every built-in form
+  with constant and variable arguments, decimal, negative and hex constants, comments in
+  any script, empty statements, and odd spacing (tabs, no spaces, spaces everywhere).
+  It need not pass the checker (a jump may name no label, an argument may be out of
+  range, a call without a result may be an operand).
+- `programs()`: whole sources of such lines, with LF, CR LF or CR line ends.
+- `checked_programs()`: programs the checker accepts without errors and that always end:
+  loops are counted (a counter set to a small constant, stepped, tested), other jumps go
+  forward, handlers `:96`-`:99` end with `(END)`, every argument is in range (a variable
+  argument is set just before its call). Their expressions use every operator with
+  constants chosen to hit the edges: wrap-around at both ends, shift counts below 0 and
+  of 16 or more. Use them to run two engines side by side:
+
+      from hypothesis import given
+      from rl1.compiler.strategies import checked_programs
+
+      @given(checked_programs())
+      def test_engines_agree(source: str) -> None:
+          assert interpreter_run(source) == vm_run(source)
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+from hypothesis import strategies as st
+
+from .builtins import BUILTINS, HANDLER_LABELS, RESERVED_VARIABLES, VARIABLES, Form
+
+Tokens = tuple[str, ...]
+
+OPERATORS = ("+", "-", "&", "|", "^", "<", ">")
+RELATIONS = ("=", ">", "<")
+
+# Values where 16-bit arithmetic and shifts change behaviour.
+EDGE_VALUES = (0, 1, -1, 2, -2, 7, 15, 16, 17, 31, -15, -16, -17, 255, 256, 1000,
+               16383, 16384, 32766, 32767, -32767, -32768)
+
+# Comment text: any printable text, and Japanese as the paper's authors wrote it.
+JAPANESE = ("誘導ラインを追尾", "分岐マークで停止", "作業台に接近", "カメラを原点へ",
+            "全角　スペース", "ﾊﾝｶｸ", "①②③", "異常時ジャンプ先")
+
+_WORD_CHARACTERS = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz"
+                             "0123456789@$")
+_FORMS: tuple[tuple[str, Form], ...] = tuple(
+    (builtin.mnemonic, form) for builtin in BUILTINS.values() for form in builtin.forms
+)
+_VALUE_FORMS = tuple((mnemonic, form) for mnemonic, form in _FORMS if form.returns_value)
+_ORDINARY_VARIABLES = tuple(v for v in VARIABLES if v not in RESERVED_VARIABLES)
+
+
+# Text -----------------------------------------------------------------------------------
+
+_gaps = st.sampled_from(("", "", "", " ", " ", "  ", "\t", " \t ", "\f", "\v"))
+_indents = st.sampled_from(("", "", "", " ", "      ", "\t", "\t\t"))
+_separators = st.sampled_from(("; ", "; ", ";", " ; ", ";;", "; ;", "\t;\t", ";  "))
+
+comment_texts = st.one_of(
+    st.sampled_from(JAPANESE),
+    st.text(st.characters(blacklist_categories=("Cs", "Cc"), blacklist_characters="\r\n")
+            | st.just("\t"), max_size=30),
+)
+"""The text after `'`: anything but a line end."""
+
+
+def _needs_space(left: str, right: str) -> bool:
+    """Would `left` and `right` written together scan as one token (`A` `B` as `AB`)?"""
+    return left[-1] in _WORD_CHARACTERS and right[0] in _WORD_CHARACTERS
+
+
+def _spaced(draw: st.DrawFn, tokens: Sequence[str], odd: bool) -> str:
+    """Tokens with random white space between them where it is allowed."""
+    text = tokens[0]
+    for left, right in itertools.pairwise(tokens):
+        gap = draw(_gaps) if odd else ""
+        if not gap and _needs_space(left, right):
+            gap = " "
+        text += gap + right
+    return text
+
+
+def _line_text(draw: st.DrawFn, label: str | None, statements: Sequence[Tokens],
+               comment: str | None, odd: bool) -> str:
+    parts = [draw(_indents)] if odd else []
+    code = ""
+    for index, statement in enumerate(statements):
+        if index:
+            code += draw(_separators) if odd else "; "
+        code += _spaced(draw, statement, odd)
+    if odd and draw(st.integers(0, 5)) == 0:  # an empty statement, before or after
+        code = ";" + draw(_gaps) + code if draw(st.booleans()) else code + draw(_gaps) + ";"
+    if label:
+        parts.append(label)
+        if code:
+            parts.append(draw(_gaps) if odd else " ")
+    parts.append(code)
+    if comment is not None:
+        if label or code:
+            parts.append(draw(_gaps) if odd else " ")
+        parts.append("'" + comment)
+    return "".join(parts)
+
+
+def _joined(draw: st.DrawFn, lines: Sequence[str]) -> str:
+    """Lines with one line-end style, or (rarely) a mix, and maybe a final line end."""
+    style = draw(st.sampled_from(("\n", "\n", "\r\n", "\r", "mixed")))
+    ends = [draw(st.sampled_from(("\n", "\r\n", "\r"))) if style == "mixed" else style
+            for _ in lines]
+    for index in range(len(lines) - 1):  # CR, empty line, LF would read as one CR LF
+        if ends[index] == "\r" and not lines[index + 1] and ends[index + 1] == "\n":
+            ends[index] = "\r\n"
+    text = "".join(line + end for line, end in zip(lines, ends, strict=True))
+    return text if draw(st.booleans()) else text[: len(text) - len(ends[-1])]
+
+
+# Constants and arguments ----------------------------------------------------------------
+
+
+def _constant_text(draw: st.DrawFn, value: int) -> str:
+    """A 16-bit value as decimal, or as a `$` bit pattern in either case, maybe with
+    leading zeros."""
+    if draw(st.integers(0, 3)):
+        return str(value)
+    digits = f"{value & 0xFFFF:X}"
+    digits = digits.rjust(draw(st.integers(len(digits), 4)), "0")
+    return "$" + (digits.lower() if draw(st.booleans()) else digits)
+
+
+def _value(draw: st.DrawFn, low: int = -32768, high: int = 32767) -> int:
+    edges = [v for v in EDGE_VALUES if low <= v <= high] + [low, high]
+    return draw(st.sampled_from(edges) | st.integers(low, high))
+
+
+def _label_number(draw: st.DrawFn) -> str:
+    return f"{draw(st.integers(0, 99)):02d}"
+
+
+# lines() and programs() -------------------------------------------------------------------
+
+
+def _any_call(draw: st.DrawFn) -> Tokens:
+    """Any built-in form, its arguments constants or variables of any value."""
+    mnemonic, form = draw(st.sampled_from(_FORMS))
+    args = [draw(st.sampled_from(VARIABLES)) if draw(st.booleans())
+            else _constant_text(draw, _value(draw)) for _ in form.params]
+    return _call_tokens(draw, mnemonic, form.selector, args)
+
+
+def _call_tokens(draw: st.DrawFn, mnemonic: str, selector: str | None,
+                 args: Sequence[str]) -> Tokens:
+    """`( MNEMONIC [selector] args )`; commas are optional except before a negative
+    number (after an operand, `-5` would read as minus 5)."""
+    tokens = ["(", mnemonic]
+    if selector:
+        tokens.append(selector)
+    for index, arg in enumerate(args):
+        first = index == 0 and not selector
+        if not first and (arg.startswith("-") or draw(st.booleans())):
+            tokens.append(",")
+        tokens.append(arg)
+    return (*tokens, ")")
+
+
+def _any_operand(draw: st.DrawFn) -> Tokens:
+    kind = draw(st.sampled_from(("variable", "constant", "constant", "call")))
+    if kind == "variable":
+        return (draw(st.sampled_from(VARIABLES)),)
+    if kind == "constant":
+        return (_constant_text(draw, _value(draw)),)
+    return _any_call(draw)
+
+
+def _any_statement(draw: st.DrawFn) -> Tokens:
+    kind = draw(st.sampled_from(("assign", "assign", "step", "goto", "jump", "call")))
+    variable = draw(st.sampled_from(VARIABLES))
+    if kind == "assign":
+        tokens = [variable, "=", *_any_operand(draw)]
+        for _ in range(draw(st.integers(0, 4))):
+            tokens += [draw(st.sampled_from(OPERATORS)), *_any_operand(draw)]
+        return tuple(tokens)
+    if kind == "step":
+        return (variable, draw(st.sampled_from(("++", "--"))))
+    if kind == "goto":
+        return ("#" + _label_number(draw),)
+    if kind == "jump":
+        return ("?", variable, draw(st.sampled_from(RELATIONS)), "#" + _label_number(draw))
+    return _any_call(draw)
+
+
+@st.composite
+def lines(draw: st.DrawFn) -> str:
+    """One syntactically valid line of RL/I, without a line end."""
+    label = ":" + _label_number(draw) if draw(st.integers(0, 3)) == 0 else None
+    statements = [_any_statement(draw) for _ in range(draw(st.integers(0, 4)))]
+    comment = draw(comment_texts) if draw(st.integers(0, 3)) == 0 else None
+    return _line_text(draw, label, statements, comment, odd=draw(st.booleans()))
+
+
+@st.composite
+def programs(draw: st.DrawFn, max_lines: int = 30) -> str:
+    """A whole syntactically valid source text."""
+    return _joined(draw, draw(st.lists(lines(), min_size=1, max_size=max_lines)))
+
+
+# checked_programs() -----------------------------------------------------------------------
+
+
+@dataclass
+class _Line:
+    label: str | None = None
+    statements: list[Tokens] = field(default_factory=list)
+
+
+@dataclass
+class _Builder:
+    """Builds a program that passes the checker and ends: counted loops, forward jumps,
+    arguments in range. Variables that count a loop in progress are never written by the
+    loop's body."""
+
+    draw: st.DrawFn
+    free_labels: list[int]
+    lines: list[_Line] = field(default_factory=lambda: [_Line()])
+    counters: set[str] = field(default_factory=set)
+    traces: bool = False  # some (TRC 2) or (TRC 3) may run
+
+    # Layout
+
+    def label(self, number: int) -> None:
+        self.lines.append(_Line(f":{number:02d}"))
+
+    def emit(self, statement: Tokens) -> None:
+        line = self.lines[-1]
+        if len(line.statements) >= self.draw(st.integers(1, 4)):
+            self.lines.append(line := _Line())
+        line.statements.append(statement)
+
+    def new_label(self) -> int | None:
+        return self.free_labels.pop() if self.free_labels else None
+
+    # Variables and values
+
+    def writable(self) -> str:
+        """A variable the program may assign now: not a loop counter in use; rarely a
+        reserved one (the checker only warns)."""
+        pool = [v for v in _ORDINARY_VARIABLES if v not in self.counters]
+        if self.draw(st.integers(0, 15)) == 0:
+            pool += RESERVED_VARIABLES
+        return self.draw(st.sampled_from(pool))
+
+    def operand(self) -> Tokens:
+        kind = self.draw(st.sampled_from(("variable", "constant", "constant", "call")))
+        if kind == "variable":
+            return (self.draw(st.sampled_from(VARIABLES)),)
+        if kind == "constant":
+            return (_constant_text(self.draw, _value(self.draw)),)
+        mnemonic, form = self.draw(st.sampled_from(_VALUE_FORMS))
+        return self.call(mnemonic, form)
+
+    def call(self, mnemonic: str, form: Form) -> Tokens:
+        """A call whose arguments are in range: constants, or variables set just before
+        (to distinct variables, so one setting cannot undo another)."""
+        args: list[str] = []
+        values = self.arguments(mnemonic, form)
+        spare = [v for v in _ORDINARY_VARIABLES if v not in self.counters]
+        for value in values:
+            if self.draw(st.integers(0, 2)) == 0:
+                variable = self.draw(st.sampled_from(spare))
+                spare.remove(variable)
+                self.emit((variable, "=", str(value)))
+                args.append(variable)
+            else:
+                args.append(_constant_text(self.draw, value))
+        return _call_tokens(self.draw, mnemonic, form.selector, args)
+
+    def arguments(self, mnemonic: str, form: Form) -> list[int]:
+        values = [_value(self.draw, param.low, param.high) for param in form.params]
+        if mnemonic == "MVI" and values[0] + values[1] == 0:
+            values[2] = 0  # a distance the centre never covers would be a device error
+        if mnemonic == "TRC" and values[0] >= 2:
+            self.traces = True
+        return values
+
+    # Statements and blocks
+
+    def statement(self, tracing: bool = True) -> None:
+        """One statement; with `tracing` False, no (TRC ...) (handlers must not set a
+        mode whose handlers might not exist)."""
+        kind = self.draw(st.sampled_from(("assign", "assign", "assign", "step", "call")))
+        if kind == "assign":
+            target = self.writable()
+            tokens = [target, "=", *self.operand()]
+            for _ in range(self.draw(st.integers(0, 5))):
+                tokens += [self.draw(st.sampled_from(OPERATORS)), *self.operand()]
+            self.emit(tuple(tokens))
+        elif kind == "step":
+            self.emit((self.writable(), self.draw(st.sampled_from(("++", "--")))))
+        else:
+            mnemonic, form = self.draw(st.sampled_from(_FORMS))
+            if mnemonic != "END" and (tracing or mnemonic != "TRC"):
+                self.emit(self.call(mnemonic, form))
+
+    def block(self, depth: int) -> None:
+        kind = self.draw(st.sampled_from(("straight", "straight", "loop", "skip")))
+        if kind == "loop" and depth < 2 and len(self.free_labels) >= 2:
+            self.loop(depth)
+        elif kind == "skip" and depth < 3 and self.free_labels:
+            self.skip(depth)
+        else:
+            for _ in range(self.draw(st.integers(1, 4))):
+                self.statement()
+
+    def body(self, depth: int) -> None:
+        for _ in range(self.draw(st.integers(1, 3))):
+            self.block(depth + 1)
+
+    def loop(self, depth: int) -> None:
+        """A counted loop in one of three shapes; `count` passes (0 for the third shape
+        means the body never runs)."""
+        counter = self.draw(st.sampled_from(
+            [v for v in _ORDINARY_VARIABLES if v not in self.counters]))
+        count = self.draw(st.integers(1, 4))
+        top, exit_label = self.new_label(), self.new_label()
+        assert top is not None and exit_label is not None
+        self.counters.add(counter)
+        shape = self.draw(st.sampled_from(("down", "up", "while")))
+        if shape == "down":
+            self.emit((counter, "=", str(count)))
+            self.label(top)
+            self.body(depth)
+            self.emit((counter, "--"))
+            self.emit(("?", counter, ">", f"#{top:02d}"))
+        elif shape == "up":
+            self.emit((counter, "=", str(-count)))
+            self.label(top)
+            self.body(depth)
+            self.emit((counter, "++"))
+            self.emit(("?", counter, "<", f"#{top:02d}"))
+        else:
+            self.emit((counter, "=", str(count - 1)))
+            self.label(top)
+            self.emit(("?", counter, "=", f"#{exit_label:02d}"))
+            self.body(depth)
+            self.emit((counter, "--"))
+            self.emit((f"#{top:02d}",))
+        if shape == "while":
+            self.label(exit_label)
+        else:
+            self.free_labels.append(exit_label)
+        self.counters.discard(counter)
+
+    def skip(self, depth: int) -> None:
+        """A forward jump over a block: conditional, or rarely an early `(END)`."""
+        target = self.new_label()
+        assert target is not None
+        variable = self.draw(st.sampled_from(VARIABLES))
+        self.emit(("?", variable, self.draw(st.sampled_from(RELATIONS)), f"#{target:02d}"))
+        if self.draw(st.integers(0, 7)) == 0:
+            self.emit(("(", "END", ")"))
+        else:
+            self.body(depth)
+        self.label(target)
+
+    def end(self) -> None:
+        if self.draw(st.booleans()):
+            self.emit(self.draw(st.sampled_from((("(", "MOV", "0", ",", "0", ")"),
+                                                 ("(", "FRE", ")"), ("(", "HLD", ")")))))
+        self.emit(("(", "END", ")"))
+
+    def handlers(self) -> None:
+        """:96-:99, each ending the program; all four when a mode 2 or 3 may be set."""
+        for number in HANDLER_LABELS:
+            if self.traces or self.draw(st.booleans()):
+                self.label(number)
+                for _ in range(self.draw(st.integers(0, 2))):
+                    self.statement(tracing=False)
+                self.end()
+
+    def text(self) -> str:
+        draw = self.draw
+        odd = draw(st.integers(0, 3)) == 0
+        rendered = [
+            _line_text(draw, line.label, line.statements,
+                       draw(comment_texts) if draw(st.integers(0, 7)) == 0 else None, odd)
+            for line in self.lines if line.label or line.statements
+        ]
+        return _joined(draw, rendered)
+
+
+@st.composite
+def checked_programs(draw: st.DrawFn, max_blocks: int = 6) -> str:
+    """A program with no checker errors that always ends (see the module's notes)."""
+    labels = list(draw(st.permutations(range(96))))
+    builder = _Builder(draw, labels)
+    if draw(st.booleans()):
+        mode = draw(st.integers(0, 3))
+        builder.emit(("(", "TRC", str(mode), ")"))
+        builder.traces = mode >= 2
+    for _ in range(draw(st.integers(1, max_blocks))):
+        builder.block(0)
+    builder.end()
+    builder.handlers()
+    return builder.text()
