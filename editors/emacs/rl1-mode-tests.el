@@ -60,8 +60,10 @@
 
 (ert-deftest rl1-mode-registers-rob-files-and-the-server ()
   (should (eq (assoc-default "SAMPLE.ROB" auto-mode-alist #'string-match) 'rl1-mode))
-  (require 'eglot nil t)
-  (when (boundp 'eglot-server-programs)
-    (should (equal (alist-get 'rl1-mode eglot-server-programs) '("rl1-lsp")))))
+  ;; Before Emacs 29 eglot may be missing: a stand-in still runs the set-up.
+  (unless (require 'eglot nil t)
+    (defvar eglot-server-programs nil)
+    (provide 'eglot))
+  (should (equal (alist-get 'rl1-mode eglot-server-programs) '("rl1-lsp"))))
 
 ;;; rl1-mode-tests.el ends here

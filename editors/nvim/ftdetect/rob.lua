@@ -1,0 +1,2 @@
+-- .rob files are RL/I robot programs.
+vim.filetype.add({ extension = { rob = 'rl1', ROB = 'rl1' } })
