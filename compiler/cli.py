@@ -17,6 +17,10 @@ from pathlib import Path
 
 import click
 
+from rl1.vm.faults import DEFAULT_BUDGET, RunResult
+from rl1.vm.report import render_json, render_text
+from rl1.vm.runner import ENGINES, Engine, run_ilc, run_source
+from rl1.vm.scripted import Script, ScriptedDevice, ScriptError, load_script
 from rl1.vm.verifier import VerifyError
 
 from . import formatter
@@ -336,3 +340,58 @@ def fmt(ctx: click.Context, files: tuple[str, ...], check: bool, diff: bool) -> 
                 click.echo(f"error: cannot write `{name}`: {error.strerror or error}", err=True)
                 status = EXIT_USAGE
     ctx.exit(status)
+
+
+@main.command()
+@click.argument("file")
+@click.option("--sensors", metavar="FILE",
+              help="Sensor script for the scripted device (JSON, or TOML if FILE ends in "
+                   ".toml). Without one every sensor reads 0 and the line is never lost.")
+@click.option("--format", "run_format", type=click.Choice(("text", "json")), default="text",
+              show_default=True, help="text: for people; json: one object for tools.")
+@click.option("--budget", type=click.IntRange(min=1), default=DEFAULT_BUDGET,
+              show_default=True,
+              help="Instructions (statements with --engine ast) before the watchdog stops "
+                   "a runaway program.")
+@click.option("--engine", type=click.Choice(ENGINES), default="vm", show_default=True,
+              help="vm: compile, then run on the reference VM; ast: interpret the source.")
+@click.pass_context
+def run(ctx: click.Context, file: str, sensors: str | None, run_format: str, budget: int,
+        engine: Engine) -> None:
+    """Run a program (.rob source, or a compiled .ilc file) on the scripted device; print
+    the device's trace and the final variables. Exit status: 0 the program ended; 1 it
+    has errors (or the .ilc file is not valid); 2 a usage problem or an unreadable file
+    (sensor scripts included); faults: 10 argument out of range, 11 missing handler,
+    12 budget exhausted, 13 device error."""
+    try:
+        device = ScriptedDevice(load_script(sensors) if sensors is not None else Script())
+    except ScriptError as error:
+        click.echo(f"error: {error}", err=True)
+        ctx.exit(EXIT_USAGE)
+    if file.lower().endswith(".ilc"):
+        if engine == "ast":
+            raise click.UsageError("--engine ast interprets RL/I source; an .ilc file runs "
+                                   "on the VM: leave out --engine, or run the .rob file")
+        try:
+            with open(file, "rb") as stream:
+                data = stream.read(MAX_ILC_BYTES + 1)
+        except OSError as error:
+            click.echo(f"error: cannot read `{file}`: {error.strerror or error}", err=True)
+            ctx.exit(EXIT_USAGE)
+        try:
+            result = run_ilc(data, device, budget)
+        except VerifyError as error:
+            click.echo(f"error: {file}: byte {error.offset}: {error.message}", err=True)
+            ctx.exit(EXIT_ERRORS)
+    else:
+        source = read_input(file)
+        if not isinstance(source, Source):
+            ctx.exit(emit([source], "human", "auto", "run", err=True))
+        outcome = run_source(source.text, Path(source.name).name, device, engine, budget)
+        if not isinstance(outcome, RunResult):
+            ctx.exit(emit([FileDiagnostics(source.name, source.text, outcome)], "human",
+                          "auto", "run", err=True))
+        result = outcome
+    render = render_json if run_format == "json" else render_text
+    click.echo(render(result, device.trace), nl=False)
+    ctx.exit(result.fault.kind.exit_status if result.fault is not None else 0)
