@@ -13,10 +13,10 @@ import argparse
 import time
 from collections.abc import Callable
 
-from rl1.compiler.frontend import analyze
+from rl1.compiler.driver import compile_text
 from rl1.vm.machine import Machine
-from rl1.vm.runner import compile_program
 from rl1.vm.scripted import ScriptedDevice
+from rl1.vm.verifier import verify
 
 OUTER, INNER = 100, 1000
 
@@ -59,9 +59,9 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5, help="runs of each; the best counts")
     options = parser.parse_args()
 
-    analysis = analyze(PROGRAM)
-    assert not analysis.has_errors, analysis.diagnostics
-    program = compile_program(analysis.program, "vm_speed.rob")
+    compilation = compile_text(PROGRAM, "vm_speed.rob")
+    assert compilation.output is not None, compilation.diagnostics
+    program = verify(compilation.output)
 
     counted = Machine(program, ScriptedDevice())
     result = counted.run()
