@@ -11,8 +11,9 @@ from hypothesis import strategies as st
 from ilc_testing import images, with_crc
 
 from rl1.compiler.builtins import BUILTINS, Feature
-from rl1.vm import ilc, isa
-from rl1.vm.verifier import VerifyError, verify
+from rl1.vm import ilc, isa, machine
+from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
+from rl1.vm.verifier import VerifiedProgram, VerifyError, verify
 
 CODE = 24  # file offset of the code section (the 1.0 header's size)
 ALL_FEATURES = frozenset(Feature)
@@ -187,6 +188,17 @@ def damaged(draw: st.DrawFn) -> bytes:
     return with_crc(data) if len(data) >= 12 and draw(st.booleans()) else bytes(data)
 
 
+# Lost lines early and often, so that runs take the handler paths too.
+LOSSES = Script(losses=(LossAt(0), LossDuring("MOV", 1, 0), LossDuring("MVI", 1, 0),
+                        LossAt(700)))
+
+
+def runs_safely(program: VerifiedProgram) -> None:
+    """The VM runs a verified program to an end or a fault, never to an exception."""
+    result = machine.run(program, ScriptedDevice(LOSSES), budget=300)
+    assert len(result.variables) == 53
+
+
 @settings(max_examples=300, deadline=None)
 @given(damaged())
 def test_damage_is_refused_or_verifies_never_anything_else(data: bytes) -> None:
@@ -199,3 +211,10 @@ def test_damage_is_refused_or_verifies_never_anything_else(data: bytes) -> None:
     if (header.minor, header.flags) == (0, 0):
         # One image, one encoding: what verifies is exactly what the writer writes.
         assert ilc.encode(program.image) == data
+    runs_safely(program)
+
+
+@settings(max_examples=100, deadline=None)
+@given(images())
+def test_every_valid_image_runs_safely(image: ilc.Image) -> None:
+    runs_safely(verify(ilc.encode(image)))

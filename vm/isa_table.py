@@ -1,0 +1,70 @@
+"""The instruction table of spec/ilc.md, rendered from isa.OPCODES.
+
+`python -m rl1.vm.isa_table` prints it; tests/test_ilc_spec.py checks that the spec
+holds exactly this table, so the document cannot drift from the code.
+"""
+
+from __future__ import annotations
+
+from . import isa
+
+HEADER = ("| opcode | mnemonic | operands | bytes | meaning | writes | serves |\n"
+          "|---|---|---|---|---|---|---|")
+
+_OPERAND_TEXT = {isa.Operand.VAR: "v", isa.Operand.IMM: "i", isa.Operand.ADDR: "a"}
+
+# What source construct each non-call instruction compiles from (spec/language.md).
+_SERVES = {
+    "END": "`(END)`",
+    "LDV": "`V=` with a variable first", "LDI": "`V=` with a constant first",
+    "LDR": "`V=` with a call first", "STV": "`V=` (the store)",
+    "INC": "`V++`", "DEC": "`V--`",
+    "JMP": "`#NN`", "JZ": "`?V=#NN`", "JGT": "`?V>#NN`", "JLT": "`?V<#NN`",
+}
+_ALU_SERVES = {isa.ALU_VAR: "a variable", isa.ALU_IMM: "a constant", isa.ALU_RESULT: "a call"}
+
+
+def operands(info: isa.OpInfo) -> str:
+    if isa.Operand.ARGS in info.operands:
+        form = info.form
+        assert form is not None
+        return "mask, " + ", ".join(param.name for param in form.params)
+    return ", ".join(_OPERAND_TEXT[operand] for operand in info.operands) or "—"
+
+
+def serves(info: isa.OpInfo) -> str:
+    if info.builtin is not None and info.name != "END":
+        mnemonic, selector = info.builtin
+        form = info.form
+        assert form is not None
+        words = " ".join(filter(None, [mnemonic, selector,
+                                       ",".join(param.name for param in form.params)]))
+        return f"`({words})`"
+    if info.name in _SERVES:
+        return _SERVES[info.name]
+    base = info.opcode & ~7
+    return f"`{isa.ALU_OPERATORS[info.opcode - base]}` then {_ALU_SERVES[base]}"
+
+
+def writes(info: isa.OpInfo) -> str:
+    """The reserved variables a call sets (spec/language.md, section 8)."""
+    form = info.form
+    return ", ".join(form.writes) if form is not None and form.writes else "—"
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|")  # GitHub's tables split on | even in code spans
+
+
+def row(info: isa.OpInfo) -> str:
+    return (f"| 0x{info.opcode:02X} | {info.name} | {operands(info)} | {info.length} "
+            f"| {_cell(info.meaning)} | {writes(info)} | {_cell(serves(info))} |")
+
+
+def render() -> str:
+    rows = [row(info) for info in sorted(isa.OPCODES.values(), key=lambda i: i.opcode)]
+    return "\n".join([HEADER, *rows])
+
+
+if __name__ == "__main__":
+    print(render())
