@@ -15,6 +15,7 @@ from rl1.compiler.asm import AsmError, assemble
 from rl1.compiler.builtins import Feature
 from rl1.compiler.cli import main
 from rl1.compiler.disasm import disassemble
+from rl1.compiler.driver import compile_text
 from rl1.vm import ilc
 from rl1.vm.verifier import verify
 
@@ -46,6 +47,19 @@ def test_assembling_the_disassembly_gives_the_same_bytes(
     data = ilc.encode(image)
     text = disassemble(data, "x.ilc", lambda _: source)
     assert assemble(text) == data
+
+
+SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
+
+
+@pytest.mark.parametrize("strip", [False, True])
+def test_listing_1_compiled_survives_dis_and_asm(strip: bool) -> None:
+    text = SAMPLE.read_text(encoding="utf-8")
+    data = compile_text(text, "sample.rob", strip_debug=strip).output
+    assert data is not None
+    shown = disassemble(data, "sample.ilc", lambda _: text.splitlines())
+    assert assemble(shown) == data
+    assert ("; 4 | :10 A=(IMG)-180; ?A<#10" in " ".join(shown.split())) != strip
 
 
 def test_a_hand_written_program_assembles_to_what_it_says() -> None:
