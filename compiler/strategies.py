@@ -293,7 +293,7 @@ class _Builder:
     def statement(self, tracing: bool = True) -> None:
         """One statement; with `tracing` False, no (TRC ...) (handlers must not set a
         mode whose handlers might not exist)."""
-        kind = self.draw(st.sampled_from(("assign", "assign", "assign", "step", "call")))
+        kind = self.draw(st.sampled_from(("assign", "assign", "step", "call", "call")))
         if kind == "assign":
             target = self.writable()
             tokens = [target, "=", *self.operand()]

@@ -8,6 +8,7 @@ import pytest
 
 from rl1.compiler import ast
 from rl1.compiler.builtins import BUILTINS, Feature
+from rl1.compiler.catalogue import CODES
 from rl1.compiler.parser import GRAMMAR, parse_line
 from rl1.compiler.scanner import PUNCTUATION, scan
 
@@ -69,6 +70,15 @@ def test_builtin_table_lists_every_form_of_builtins_py_in_order() -> None:
 def test_every_feature_in_the_table_is_a_feature() -> None:
     named = {row[5] for row in _spec_table_rows()} - {NONE}
     assert named <= {feature.name.lower() for feature in Feature}
+
+
+# Diagnostic codes ---------------------------------------------------------------------
+
+
+def test_every_diagnostic_code_has_a_row_in_section_5() -> None:
+    section = SPEC.split("## 5. Static rules", 1)[1].split("## 6.", 1)[0]
+    rows = set(re.findall(r"^\| ([EW]\d{4}) \|", section, re.MULTILINE))
+    assert set(CODES) <= rows
 
 
 # The EBNF and grammar.lark ------------------------------------------------------------
