@@ -9,8 +9,14 @@ import pytest
 from rl1.compiler import ast
 from rl1.compiler.builtins import BUILTINS, Feature
 from rl1.compiler.catalogue import CODES
-from rl1.compiler.parser import GRAMMAR, parse_line
+from rl1.compiler.codegen import generate
+from rl1.compiler.lower import lower
+from rl1.compiler.parser import GRAMMAR, parse_line, parse_program
 from rl1.compiler.scanner import PUNCTUATION, scan
+from rl1.vm import ilc, machine
+from rl1.vm.interpreter import interpret
+from rl1.vm.scripted import ScriptedDevice
+from rl1.vm.verifier import verify
 
 SPEC = (Path(__file__).parent.parent / "spec" / "language.md").read_text(encoding="utf-8")
 NONE = "—"
@@ -169,3 +175,26 @@ def test_hex_is_a_bit_pattern_and_selectors_are_letters() -> None:
     assert isinstance(cam, ast.CallStmt) and isinstance(ult, ast.CallStmt)
     assert [type(arg) for arg in cam.call.args] == [ast.Selector, ast.Var]
     assert [type(arg) for arg in ult.call.args] == [ast.Selector]
+
+
+# The arithmetic examples of section 7.2, on both engines -------------------------------
+
+
+def _expression_examples() -> list[tuple[str, int]]:
+    section = SPEC.split("### 7.2 Expressions", 1)[1].split("### 7.3", 1)[0]
+    rows = re.findall(r"^\| `(A=[^`]+)` \| (-?\d+)", section, re.MULTILINE)
+    return [(code, int(value)) for code, value in rows]
+
+
+def test_section_7_2_has_its_examples() -> None:
+    assert len(_expression_examples()) >= 10
+
+
+@pytest.mark.parametrize(("code", "value"), _expression_examples())
+def test_arithmetic_examples_hold_in_the_interpreter_and_the_vm(code: str, value: int) -> None:
+    program, diagnostics = parse_program(code)
+    assert diagnostics == []
+    interpreted = interpret(program, ScriptedDevice())
+    compiled = machine.run(verify(ilc.encode(generate(lower(program), "spec.rob"))),
+                           ScriptedDevice())
+    assert interpreted.named()["A"] == compiled.named()["A"] == value
