@@ -43,6 +43,9 @@ TERMINAL_NAMES = {
 }
 
 
+_HEX_DIGITS = frozenset("0123456789ABCDEFabcdef")
+_SPACE = " \t\f\v"  # the scanner's whitespace; other Unicode spaces are errors
+
 _ParsedLine = tuple[ast.LabelDef | None, tuple[ast.Statement, ...]]
 
 
@@ -87,10 +90,8 @@ class _AstBuilder(lark.Transformer):  # type: ignore[type-arg]
         if token.type == "NUMBER":
             return ast.Const(self.span(token), int(text), text, False)
         digits = text[1:]
-        try:
-            value = int(digits, 16)
-        except ValueError:
-            value = -1
+        # Checked by hand: int(..., 16) would also take "0x10" and "1_0".
+        value = int(digits, 16) if digits and set(digits) <= _HEX_DIGITS else -1
         if not 0 <= value <= 0xFFFF:
             self.problems.append(Diagnostic(
                 "E0105", Severity.ERROR,
@@ -322,7 +323,7 @@ def parse_line(text: str, number: int) -> tuple[ast.Line, list[Diagnostic]]:
         start = len(code) + 1
         comment = ast.Comment(ast.Span(number, start, number, len(text) + 1), comment_text)
     span = ast.Span(number, 1, number, len(text) + 1)
-    if not code.strip():
+    if not code.strip(_SPACE):
         return ast.Line(span, number, None, (), comment), []
     tables = _lalr_tables()
     builder = tables.builder

@@ -70,3 +70,17 @@ def test_messages_quote_an_excerpt_of_a_huge_token_but_span_all_of_it() -> None:
     assert diagnostic.code == "E0103"
     assert len(diagnostic.message) < 100
     assert diagnostic.span.end_column == len(word) + 1
+
+
+def test_hex_constant_takes_hex_digits_only() -> None:
+    for text in ("$0x10", "$", "$10000", "$0FG"):
+        _, diagnostics = parse_line(f"A={text}", 1)
+        assert [d.code for d in diagnostics] == ["E0105"], text
+    _, diagnostics = parse_line("A=$00FF", 1)
+    assert diagnostics == []
+
+
+def test_a_line_of_full_width_spaces_is_an_error_not_blank() -> None:
+    _, [diagnostic] = parse_line("\u3000\u3000", 1)
+    assert diagnostic.code == "E0102"
+    assert diagnostic.help is not None and "full-width space" in diagnostic.help

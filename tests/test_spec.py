@@ -160,7 +160,7 @@ def test_lines_the_spec_calls_errors_are_errors(text: str, code: str) -> None:
 
 @pytest.mark.parametrize("text", [
     ":13", ";", ":12 c=579; d=450;", "(CAM A 90)", "(MVI 1,1,50)", "(MOV 3 3)", "(CAM A,-5)",
-    "A=$FFFF", "A=$00FF", ":10A=1", "\u3000\u3000' 全角の空白だけ",
+    "A=$FFFF", "A=$00FF", ":10A=1", "\t ' 空白だけ",
 ])
 def test_lines_the_spec_accepts_parse(text: str) -> None:
     line, diagnostics = parse_line(text, 1)
