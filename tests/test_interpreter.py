@@ -181,10 +181,15 @@ def test_a_missing_handler_is_a_fault_on_the_line_of_the_interrupted_call() -> N
     assert trace[-1] == "STOP"
 
 
-def test_the_budget_counts_statements() -> None:
-    kind, _, line, trace = fault_of("A=0\n:10 A++\n#10\n", budget=7)
-    assert (kind, line) == (FaultKind.BUDGET, 2)  # statements 1, 2, 3, 2, 3, 2, 3, then 2
-    assert trace == ["STOP"]
+def test_the_budget_counts_statements_and_is_checked_at_jumps_and_calls() -> None:
+    result, device = run("A=0\n:10 A++\n#10\n", budget=7)
+    assert result.fault is not None
+    # Statements 1 (A=0), 2-3, 4-5, 6-7 pass; the jump that is statement 9 faults.
+    assert (result.fault.kind, result.fault.line) == (FaultKind.BUDGET, 3)
+    assert (result.named()["A"], commands(device)) == (4, ["STOP"])
+    kind, _, line, trace = fault_of("A=1; B=2\n(FRE)\n", budget=2)
+    assert (kind, line, trace) == (FaultKind.BUDGET, 2, ["STOP"])  # FRE never ran
+    assert run("A=1; B=2; C=3; (END)", budget=1)[0].fault is None
 
 
 def test_a_device_error_is_a_fault() -> None:

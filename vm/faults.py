@@ -15,7 +15,9 @@ from rl1.compiler.builtins import VARIABLES
 
 DEFAULT_BUDGET = 10_000_000
 """Steps a run may take before the watchdog ends it: VM instructions, or interpreter
-statements (so the two engines stop a runaway program at different points)."""
+statements. Both engines look at the count when a jump is taken and before a device call
+runs (every loop takes a jump); since they count different steps, they stop a runaway
+program at different points."""
 
 
 class FaultKind(Enum):

@@ -117,6 +117,7 @@ class Interpreter:
     def __init__(self, program: ast.Program, device: Device, budget: int = DEFAULT_BUDGET):
         self.device = device
         self.budget = budget
+        self.steps = 0  # statements run so far
         self.variables = [0] * len(VARIABLES)
         self.statements: list[ast.Statement] = []
         self.labels: dict[int, int] = {}
@@ -175,16 +176,11 @@ class Interpreter:
 
     def run(self) -> RunResult:
         pc = 0
-        steps = 0
         statement: ast.Statement | None = None
         try:
             while pc < len(self.statements):
                 statement = self.statements[pc]
-                if steps == self.budget:
-                    raise _Faulted(FaultKind.BUDGET, f"the program ran {self.budget} "
-                                   "statements without ending (raise the budget if it "
-                                   "should run longer)")
-                steps += 1
+                self.steps += 1
                 try:
                     pc = self._execute(statement, pc + 1)
                 except _Jump as jump:
@@ -226,8 +222,17 @@ class Interpreter:
         return next_pc
 
     def _jump(self, target: ast.LabelRef) -> int:
+        self._watchdog()
         self._take_event()
         return self._label_index(target)
+
+    def _watchdog(self) -> None:
+        """At each jump taken and before each device call, as the VM does: every loop
+        takes a jump, so a runaway program always meets it."""
+        if self.steps > self.budget:
+            raise _Faulted(FaultKind.BUDGET, f"the program ran more than {self.budget} "
+                           "statements without ending (raise the budget if it should "
+                           "run longer)")
 
     def _operand(self, operand: ast.Operand) -> int:
         if isinstance(operand, ast.Var):
@@ -242,6 +247,7 @@ class Interpreter:
         resolved = self.calls[call]
         if resolved.form == ("END", None):
             raise _Halt
+        self._watchdog()
         values = tuple(self._operand(arg) for arg in resolved.args)
         for param, arg, value in zip(resolved.spec.params, resolved.args, values, strict=True):
             if not param.low <= value <= param.high:
