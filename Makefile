@@ -16,6 +16,7 @@ $(STAMP): pyproject.toml
 
 demo: $(STAMP)
 	$(BIN)/rl1c check examples/sample.rob
+	$(BIN)/rl1c run examples/sample.rob --sensors examples/sample.sensors.json
 
 test: lint typecheck vscode-test pytest
 
