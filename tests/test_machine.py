@@ -88,15 +88,20 @@ OPERATORS = dict(zip(isa.ALU_OPERATORS, ("ADD", "SUB", "AND", "OR", "XOR", "SHL"
 
 
 @settings(max_examples=300, deadline=None)
-@given(st.sampled_from(isa.ALU_OPERATORS), st.sampled_from("VIR"), int16s, int16s)
+@given(st.sampled_from(isa.ALU_OPERATORS), st.sampled_from("VIR"), int16s, int16s,
+       st.booleans())
 def test_each_alu_instruction_with_each_operand_kind(
-    operator: str, kind: str, left: int, right: int,
+    operator: str, kind: str, left: int, right: int, grouped: bool,
 ) -> None:
+    """`grouped`: the load-operate-store run executes as one expression step; otherwise
+    a jump lands on the operator, which then runs as a single instruction."""
     name = OPERATORS[operator] + kind
     setup = {"V": [op("LDI", right), op("STV", v("B"))], "I": [], "R": [call("ULTA")]}[kind]
     operand = {"V": (v("B"),), "I": (right,), "R": ()}[kind]
-    program = assemble(*setup, op("LDI", left), op(name, *operand), op("STV", v("A")),
-                       op("END"))
+    entry = len(setup) + 3
+    start = [op("LDI", left)] if grouped else [op("LDI", left), op("JMP", To(entry)),
+                                              op("LDI", 0)]
+    program = assemble(*setup, *start, op(name, *operand), op("STV", v("A")), op("END"))
     result, _ = execute(program, Script(ultrasonic={"A": (right,)}))
     assert result.named()["A"] == operate(operator, left, right)
 

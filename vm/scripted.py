@@ -19,8 +19,9 @@ repeats; a call with no list reads zeros. Values are 16-bit signed integers (INP
 0..255, CAM R 0..784).
 
 Line losses: `{"time": T}` at device time T ms; `{"during": "MOV"|"MVI", "nth": N,
-"after": A}` A ms after the N-th MOV or MVI call of the run (counting every call, MOV 0,0
-included) started, if that command is still in effect then. A loss matters only while
+"after": A}` A ms (default 1) after the N-th MOV or MVI call of the run (counting every
+call, MOV 0,0 included) started, if that command is still in effect then. A loss at the
+very moment an MVI covers its distance is too late for it. A loss matters only while
 motion is in effect (a non-zero MOV, or an MVI in progress); see device.py for what each
 tracing mode does with it.
 
