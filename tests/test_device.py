@@ -104,9 +104,11 @@ def test_unreadable_and_malformed_files_are_script_errors(tmp_path: Path) -> Non
     (tmp_path / "bad.json").write_text('{"IMG": [\n')
     (tmp_path / "bad.toml").write_text("IMG = [\n")
     (tmp_path / "bin.json").write_bytes(b"\xff\xfe")
+    (tmp_path / "deep.json").write_text("[" * 100_000)
     expected = {
         "bad.json": "bad.json:2:1: invalid JSON", "bad.toml": "bad.toml: invalid TOML",
         "bin.json": "bin.json: not UTF-8 text", "none.json": "none.json: no such file",
+        "deep.json": "deep.json(:1:100001)?: invalid JSON",
         ".": "is a directory",
     }
     for name, message in expected.items():

@@ -109,6 +109,7 @@ class TraceEntry:
 
 # Loading and validating scripts --------------------------------------------------------
 
+MAX_SCRIPT_BYTES = 16 * 2**20
 _INT16 = (-32768, 32767)
 _LIST_KEYS = ("IMG", "KYO", "CAM R", "ULT A", "ULT B", "ULT C", "ULT D", "FZI")
 _KEYS = (*_LIST_KEYS, "INP", "line_lost", "comment")
@@ -118,13 +119,17 @@ def load_script(path: str | Path) -> Script:
     """Read and validate a sensor script; ScriptError says what is wrong and where."""
     path = Path(path)
     try:
-        data = path.read_bytes()
+        with path.open("rb") as stream:
+            data = stream.read(MAX_SCRIPT_BYTES + 1)
     except FileNotFoundError:
         raise ScriptError(f"{path}: no such file") from None
     except IsADirectoryError:
         raise ScriptError(f"{path}: is a directory, not a sensor script") from None
     except OSError as error:
         raise ScriptError(f"{path}: cannot read ({error.strerror or error})") from None
+    if len(data) > MAX_SCRIPT_BYTES:
+        raise ScriptError(f"{path}: larger than {MAX_SCRIPT_BYTES // 2**20} MiB; a sensor "
+                          "script is a small file of readings")
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as error:
@@ -134,12 +139,16 @@ def load_script(path: str | Path) -> Script:
             document: object = tomllib.loads(text)
         except tomllib.TOMLDecodeError as error:
             raise ScriptError(f"{path}: invalid TOML: {error}") from None
+        except RecursionError:
+            raise ScriptError(f"{path}: invalid TOML: nested too deeply") from None
     else:
         try:
             document = json.loads(text)
         except json.JSONDecodeError as error:
             raise ScriptError(f"{path}:{error.lineno}:{error.colno}: invalid JSON: "
                               f"{error.msg}") from None
+        except RecursionError:
+            raise ScriptError(f"{path}: invalid JSON: nested too deeply") from None
     return parse_script(document, str(path))
 
 
