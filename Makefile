@@ -21,7 +21,7 @@ demo: $(STAMP)
 test: lint typecheck vscode-test pytest
 
 lint: $(STAMP)
-	$(BIN)/ruff check compiler vm lsp tests bench
+	$(BIN)/ruff check compiler vm lsp tests bench spec/vectors
 
 # mypy cannot follow setuptools' editable-install mapping of rl1.compiler onto
 # compiler/, so it checks a tree of symlinks with the installed names.
@@ -31,7 +31,7 @@ typecheck: $(STAMP)
 	ln -s ../../vm .typecheck/rl1/vm
 	ln -s ../../lsp .typecheck/rl1/lsp
 	MYPYPATH=.typecheck $(BIN)/mypy -p rl1.compiler -p rl1.vm -p rl1.lsp
-	MYPYPATH=.typecheck $(BIN)/mypy tests $(wildcard bench/*.py)
+	MYPYPATH=.typecheck:spec/vectors $(BIN)/mypy tests $(wildcard bench/*.py) spec/vectors
 
 pytest: $(STAMP)
 	$(BIN)/pytest -n 2
