@@ -65,6 +65,15 @@ def test_vectors_exist_and_have_unique_names() -> None:
     assert len(BY_NAME) == len(VECTORS)
 
 
+def test_the_readme_counts_the_vectors_of_each_file() -> None:
+    readme = (VECTOR_DIR / "README.md").read_text(encoding="utf-8")
+    listed = {name: int(count) for name, count
+              in re.findall(r"^\| `(\w+)\.json` \| (\d+) \|", readme, re.MULTILINE)}
+    actual = {path.stem: len(json.loads(path.read_text(encoding="ascii"))["vectors"])
+              for path in VECTOR_DIR.glob("*.json")}
+    assert listed == actual
+
+
 @each_vector
 def test_the_compiler_writes_the_bytes(vector: dict[str, Any]) -> None:
     for key, strip in (("ilc", False), ("ilc_stripped", True)):

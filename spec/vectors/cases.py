@@ -228,6 +228,8 @@ def control() -> Iterator[Case]:
     yield Case("control", "jump-to-the-end",
                "a label with no statement after it names the end of the program",
                "A=1; #50\nA=2\n:50\n", {"A": 1})
+    yield Case("control", "end-keeps-moving", "(END) does not stop a MOV in effect: the "
+               "device gets no stop", "(MOV 3,3)\n(END)\n", {}, trace=((0, "MOV", (3, 3)),))
     yield Case("control", "fall-off-the-end", "running past the last statement is (END)",
                "A=1\nB=A+1\n", {"A": 1, "B": 2})
     yield Case("control", "layout",
@@ -414,6 +416,11 @@ def tracing() -> Iterator[Case]:
                       (1000, "TIM", (10,)), (2000, "TRC", (3,)), (2000, "MOV", (3, 3)),
                       (2000, "FRE", ()), (2000, "TIM", (10,)), (3000, "MOV", (2, 2)),
                       (3000, "HLD", ()), (3000, "TIM", (10,))))
+    yield Case(group, "mvi-zero-distance", "(MVI l,r,0) returns at once and leaves no "
+               "motion in effect: a lost line after it is ignored",
+               "(TRC 3)\n(MVI 2,2,0)\n(TIM 10)\nH=1\n(END)\n" + HANDLERS, {"H": 1},
+               sensors={"line_lost": [{"time": 500}]},
+               trace=((0, "TRC", (3,)), (0, "MVI", (2, 2, 0)), (0, "TIM", (10,))))
     yield Case(group, "lost-during-an-operand",
                "a line lost during (IMG) in `A=(IMG)-180` jumps right after the call: "
                "IMG's variables are written, A is not",
@@ -508,17 +515,18 @@ def faults() -> Iterator[Case]:
                                  (3, "MVI", 97)):
         yield _missing_handler(mode, command, label)
     yield Case(group, "budget-loop",
-               "the instruction budget runs out in an endless loop (1 + 999 instructions: "
-               "A++ and #10 are one instruction each)",
-               "(MOV 1,1)\n:10 A++; #10\n", {"A": 500}, budget=1000, status="budget",
+               "the budget runs out in an endless loop; it is looked at when a jump is "
+               "taken: the 501st #10 brings the count to 1 + 2 x 501 = 1003 > 1001",
+               "(MOV 1,1)\n:10 A++; #10\n", {"A": 501}, budget=1001, status="budget",
                fault_line=2, trace=((0, "MOV", (1, 1)), (0, "STOP", ())))
     yield Case(group, "budget-waiting-loop", "the budget runs out in a loop that waits",
                "(MOV 2,2)\n:10 (TIM 1)\n#10\n", {}, budget=11, status="budget",
                fault_line=2,
                trace=((0, "MOV", (2, 2)), *((100 * n, "TIM", (1,)) for n in range(5)),
                       (500, "STOP", ())))
-    yield Case(group, "budget-enough", "a budget that the program does not use up",
-               "A++\nB++\n(END)\n", {"A": 1, "B": 1}, budget=3)
+    yield Case(group, "budget-straight-code", "the budget is looked at only at jumps "
+               "taken and calls: straight code and (END) run on past it",
+               "A++\nB++\nC++\n(END)\n", {"A": 1, "B": 1, "C": 1}, budget=1)
     yield Case(group, "budget-before-a-call", "the budget is checked before a call runs: "
                "the call does not reach the device", "A++\nB++\n(MOV 1,1)\n(END)\n",
                {"A": 1, "B": 1}, budget=2, status="budget", fault_line=3,
