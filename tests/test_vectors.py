@@ -111,6 +111,7 @@ def test_the_fields_are_consistent(vector: dict[str, Any]) -> None:
     assert (vector["fault_line"] == 0) == (vector["status"] == "ok")
     assert len(vector["variables"]) == len(VARIABLES)
     assert all(-32768 <= value <= 32767 for value in vector["variables"])
+    assert re.fullmatch("[a-z0-9-]+", vector["name"])
     assert vector["source_name"] == vector["name"] + ".rob"
 
 
