@@ -216,11 +216,19 @@ def test_an_event_after_a_jump_is_taken_there() -> None:
     """A device that reports a loss between calls: the VM takes it at the jump."""
 
     class Asynchronous(ScriptedDevice):
-        polls = 0
+        looks = 0  # at `pending`: the line is lost between the first look and the second
+
+        @property
+        def pending(self) -> LineLost | None:
+            self.looks += 1
+            return self.poll_event()
+
+        @pending.setter
+        def pending(self, event: LineLost | None) -> None:
+            pass
 
         def poll_event(self) -> LineLost | None:
-            self.polls += 1
-            return LineLost("MOV", 3) if self.polls == 3 else None
+            return LineLost("MOV", 3) if self.looks == 2 else None
 
     program = assemble(call("MOV", 1, 1), op("INC", v("C")), op("JMP", To(1)),
                        op("LDI", 96), op("STV", v("H")), handlers={96: 3})

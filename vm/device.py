@@ -16,7 +16,8 @@ Division of work for a lost guidance line (Table 4):
 - In modes 2 and 3, while motion is in effect (a non-zero MOV, or an MVI in progress),
   it then holds a `LineLost` for the program; a `wait` or `move_distance` in progress
   returns early so that the program gets it promptly.
-- The engine takes the event between instructions (`poll_event`) and decides the jump
+- The engine takes the event between instructions (`poll_event`; `pending` lets it look
+  without a call where speed matters) and decides the jump
   target from the event's mode and command: :98/:99 for mode 2 during MOV/MVI, :96/:97
   for mode 3. A target the program does not define is a run-time fault.
 """
@@ -108,6 +109,9 @@ class Device(Protocol):
     # Engine services
     def stop(self) -> None:
         """Stop the vehicle at once; the engine calls this first on any fault."""
+
+    pending: LineLost | None
+    """The lost-line event waiting to be taken, if any; reading it takes nothing."""
 
     def poll_event(self) -> LineLost | None:
         """The pending lost-line event, if any, removing it."""

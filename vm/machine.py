@@ -32,6 +32,8 @@ How this implementation is fast enough (bench/vm_speed.py) without hiding the me
   (none comes from the compiler) runs the single instructions, which stay in place.
 - Instructions are counted by index arithmetic when control leaves a straight run (a
   jump taken, a handler entered, the end), not one by one.
+- A jump looks at the device's `pending` event and calls `poll_event` only when there
+  is one.
 """
 
 from __future__ import annotations
@@ -191,7 +193,8 @@ class Machine:
         """Run from the first instruction until (END) or a fault."""
         code, expressions, budget = self.code, self.expressions, self.budget
         cells = self.cells[:]
-        poll, divert = self.device.poll_event, self._divert
+        device = self.device
+        poll, divert = device.poll_event, self._divert
         acc = 0  # modulo 2**16: see the module's docstring
         pc = 0
         start = 0  # where the current straight run of instructions began
@@ -233,28 +236,24 @@ class Machine:
                         executed += pc - start
                         if executed > budget:
                             break
-                        event = poll()
-                        pc = start = b if event is None else divert(event, b)
+                        pc = start = b if device.pending is None else divert(poll(), b)
                 elif op == JUMP_ZERO:
                     if cells[a] == 0:
                         executed += pc - start
                         if executed > budget:
                             break
-                        event = poll()
-                        pc = start = b if event is None else divert(event, b)
+                        pc = start = b if device.pending is None else divert(poll(), b)
                 elif op == JUMP_NEGATIVE:
                     if cells[a] < 0:
                         executed += pc - start
                         if executed > budget:
                             break
-                        event = poll()
-                        pc = start = b if event is None else divert(event, b)
+                        pc = start = b if device.pending is None else divert(poll(), b)
                 elif op == JUMP:
                     executed += pc - start
                     if executed > budget:
                         break
-                    event = poll()
-                    pc = start = b if event is None else divert(event, b)
+                    pc = start = b if device.pending is None else divert(poll(), b)
                 elif op == CALL:
                     if executed + pc - start > budget:
                         executed += pc - start
@@ -318,9 +317,11 @@ class Machine:
             assert outcome.result is not None
             cells[R_CELL] = outcome.result
 
-    def _divert(self, event: LineLost, resume: int) -> int:
+    def _divert(self, event: LineLost | None, resume: int) -> int:
         """Where a lost-line event sends the program: its handler's index, or `resume`
-        when the event's mode calls for no jump."""
+        when there is no event or its mode calls for no jump."""
+        if event is None:
+            return resume
         label = HANDLERS.get((event.mode, event.command))
         if label is None:
             return resume

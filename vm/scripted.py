@@ -283,7 +283,7 @@ class ScriptedDevice:
         self.mode = 0
         self._motion: _Motion | None = None
         self._calls = {"MOV": 0, "MVI": 0}
-        self._pending: LineLost | None = None
+        self.pending: LineLost | None = None
         self._losses_at = sorted(loss.time for loss in self.script.losses
                                  if isinstance(loss, LossAt))
         self._losses_during = [loss for loss in self.script.losses
@@ -340,9 +340,9 @@ class ScriptedDevice:
         if motion is None or self.mode == 0:
             return False
         self._record("LINE LOST", self.mode)
-        if self.mode == 1 or self._pending is not None:
+        if self.mode == 1 or self.pending is not None:
             return False
-        self._pending = LineLost(motion.command, self.mode)
+        self.pending = LineLost(motion.command, self.mode)
         if self.mode == 2:
             self._motion = None
         return True
@@ -476,5 +476,5 @@ class ScriptedDevice:
         self._stopped("STOP")
 
     def poll_event(self) -> LineLost | None:
-        event, self._pending = self._pending, None
+        event, self.pending = self.pending, None
         return event
