@@ -1,0 +1,153 @@
+"""What the vehicle may be doing at each point of a program: the tracing mode in effect
+and the motion. One forward data-flow over the CFG gives both, and from them the
+lost-line handler edges: where a lost guidance line can send the program.
+
+The model (spec/language.md 7.5 and 7.7):
+- the program starts in tracing mode 0 with the vehicle stopped; `(TRC m)` sets the
+  mode, and `(TRC V)` may set any;
+- `(MOV l,r)` with both speeds constant 0 stops the vehicle, with a non-zero constant
+  moves it, with variables may do either; `(MVI ...)` runs to its distance and leaves
+  the vehicle stopped (at once with a constant 0 cm); `(FRE)` and `(HLD)` stop it;
+- a line lost while a MOV drives or an MVI runs becomes a pending event, taken at the
+  next event point: right after a call, or after a jump. Mode 2 stops the vehicle and
+  jumps to :98 (MOV) or :99 (MVI); mode 3 jumps to :96 (MOV) or :97 (MVI, which goes on
+  in the background, still an MVI in progress). The event may have been recorded at any
+  moment since the previous event point, so each event point looks at the states before
+  and after its call.
+A call with the wrong number of arguments or an out-of-range constant (already an error)
+changes nothing, and a line that could not be parsed is assumed to leave tracing off and
+the vehicle stopped, so that neither cascades into warnings.
+
+A state is a bitset: bit m (0-3) when mode m may be in effect, then STOPPED, MOVING (a
+non-zero MOV in effect) and RUNNING (an MVI in progress).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from .. import ast
+from . import dataflow
+
+if TYPE_CHECKING:
+    from .cfg import ControlFlowGraph
+
+ALL_MODES = 0b1111
+STOPPED = 1 << 4
+MOVING = 1 << 5
+RUNNING = 1 << 6
+MOTION = STOPPED | MOVING | RUNNING
+START = 1 << 0 | STOPPED
+MODE_2 = 1 << 2
+MODE_3 = 1 << 3
+
+# What a call does to the device state: (kind, value), and where in its block.
+_SET_MODES, _SET_MOTION, _MVI, _END = range(4)
+Operation = tuple[int, int, int]  # (statement index, kind, value)
+CALLS = frozenset({"TRC", "MOV", "MVI", "END", "FRE", "HLD"})  # the calls that may matter
+
+# handler label -> (entry state, index of its first event point) for one block
+Triggers = dict[int, tuple[int, int]]
+
+
+def operation(call: ast.Call) -> tuple[int, int] | None:
+    """What `call` does to the device state, None for nothing."""
+    name = call.mnemonic.upper()
+    args = call.args
+    if name == "TRC":
+        modes = _modes(args)
+        return (_SET_MODES, modes) if modes else None
+    if name == "MOV":
+        motion = _motion(args)
+        return (_SET_MOTION, motion) if motion else None
+    if name == "MVI":
+        if len(args) != 3:
+            return None
+        distance = args[2]
+        stops_at_once = isinstance(distance, ast.Const) and distance.value == 0
+        return (_SET_MOTION, STOPPED) if stops_at_once else (_MVI, STOPPED)
+    if name == "END":
+        return (_END, 0)
+    return (_SET_MOTION, STOPPED) if name in ("FRE", "HLD") else None
+
+
+def _modes(args: tuple[ast.Arg, ...]) -> int:
+    if len(args) != 1:
+        return 0
+    (arg,) = args
+    if isinstance(arg, ast.Var):
+        return ALL_MODES
+    return 1 << arg.value if isinstance(arg, ast.Const) and 0 <= arg.value <= 3 else 0
+
+
+def _motion(args: tuple[ast.Arg, ...]) -> int:
+    if len(args) != 2:
+        return 0
+    speeds = [arg.value for arg in args if isinstance(arg, ast.Const)]
+    if any(not -12 <= speed <= 12 for speed in speeds):
+        return 0
+    if any(speeds):
+        return MOVING
+    return STOPPED if len(speeds) == 2 else STOPPED | MOVING  # a variable may be 0 or not
+
+
+def run(operations: list[Operation], events: list[int], state: int) -> tuple[int, Triggers]:
+    """A block's effect: its state at the end (before its `(END)`, if it has one) and the
+    handlers a lost line may jump to from it, each with the state it enters with and the
+    block's first event point where it may."""
+    triggers: Triggers = {}
+    pending = iter(operations)
+    following = next(pending, None)
+    for index in events:
+        # A pending event may have been recorded before, during or after this call.
+        recorded = [state]
+        from_mvi = False
+        if following is not None and following[0] == index:
+            _, kind, value = following
+            following = next(pending, None)
+            if kind == _END:
+                return state, triggers
+            if kind == _MVI:
+                from_mvi = True
+                recorded.append(state & ALL_MODES | RUNNING)
+            state = state & (MOTION if kind == _SET_MODES else ALL_MODES) | value
+            recorded.append(state)
+        if any(seen & (MOVING | RUNNING) and seen & (MODE_2 | MODE_3) for seen in recorded):
+            _lost_line(recorded, state, from_mvi, index, triggers)
+    return state, triggers
+
+
+def _lost_line(recorded: list[int], now: int, from_mvi: bool, index: int,
+               triggers: Triggers) -> None:
+    """The handlers an event taken at this event point may jump to, and the state each
+    is entered with: the tracing mode stays as it is now; mode 3 keeps the motion now in
+    effect (an MVI that lost the line here goes on in the background), mode 2 stops it."""
+    modes = now & ALL_MODES
+    for label, motion, mode, entry in (
+        (96, MOVING, MODE_3, now),
+        (97, RUNNING, MODE_3, modes | RUNNING if from_mvi else now),
+        (98, MOVING, MODE_2, modes | STOPPED),
+        (99, RUNNING, MODE_2, modes | STOPPED),
+    ):
+        if any(seen & motion and seen & mode for seen in recorded):
+            first, entries = triggers.get(label, (index, 0))
+            triggers[label] = (first, entries | entry)
+
+
+def trace(graph: ControlFlowGraph) -> tuple[list[int], list[Triggers]]:
+    """The state on entry to every block (0: unreachable) and, per block, the handlers a
+    lost line may jump to from it."""
+    blocks = graph.blocks
+    triggers: list[Triggers] = [{} for _ in blocks]
+
+    def transfer(index: int, state: int) -> tuple[int, list[tuple[int, int]]]:
+        block = blocks[index]
+        if block.opaque:
+            return START, []
+        # A block's last visit is with its final state, so its last triggers are final.
+        effects = block.effects
+        out, triggers[index] = run(effects.operations, effects.events, state)
+        return out, [(graph.labels[label], entry)
+                     for label, (_, entry) in triggers[index].items() if label in graph.labels]
+
+    return dataflow.solve(graph, START, transfer), triggers

@@ -1,0 +1,139 @@
+"""What a block's statements do, summarized once for all the data-flow rules: the calls
+that change the device state (device.py), the reserved variables read and written
+(reserved.py), and whether the block observes the world (loops.py).
+
+"Observing" is the checker's word for a call through which a program can see the world
+change or let device time pass: a call that returns a reading or writes reserved
+variables (KYO, IMG, CAM R, ULT, INP, FZI), or one the device takes time over (`waits`
+in builtins.py: MVI, TIM, ORG, STR, STL, STX, ROT, IMG, CAM, ULT). A loop without one
+spins at the speed of the interpreter, blind. For `(CAM ...)` and `(ULT ...)` a call is
+taken to do what any of their forms does: the summary never resolves selectors.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import NamedTuple
+
+from .. import ast
+from ..builtins import BUILTINS, RESERVED_VARIABLES
+from . import device
+
+RESERVED_BIT = {name: 1 << index for index, name in enumerate(RESERVED_VARIABLES)}
+ALL_RESERVED = (1 << len(RESERVED_VARIABLES)) - 1
+
+
+@dataclass(slots=True)
+class BlockEffects:
+    operations: list[device.Operation]  # the calls that change the device state
+    # The event points, where a pending lost line is taken: the statements that make a
+    # call (right after it, before an assignment stores) or jump.
+    events: list[int]
+    reads: int  # reserved variables read anywhere in the block (RESERVED_BIT bits)
+    # (statement index, reserved variables its calls write, those its store writes)
+    writes: list[tuple[int, int, int]]
+    observes: bool
+
+    @staticmethod
+    def nothing() -> BlockEffects:
+        return BlockEffects([], [], 0, [], False)
+
+
+class _CallFacts(NamedTuple):
+    writes: int
+    observes: bool
+    device: bool  # whether device.operation may find something in it
+
+
+def _facts_of(name: str) -> _CallFacts:
+    builtin = BUILTINS.get(name.upper())
+    if builtin is None:
+        return _CallFacts(0, False, False)
+    writes = 0
+    for form in builtin.forms:
+        for variable in form.writes:
+            writes |= RESERVED_BIT[variable]
+    observes = builtin.waits or any(form.returns_value or form.writes for form in builtin.forms)
+    return _CallFacts(writes, observes, builtin.mnemonic in device.CALLS)
+
+
+_FACTS = {builtin.mnemonic: _facts_of(builtin.mnemonic) for builtin in BUILTINS.values()}
+
+
+def _facts(call: ast.Call) -> _CallFacts:
+    facts = _FACTS.get(call.mnemonic)
+    if facts is None:
+        facts = _facts_of(call.mnemonic)
+        if call.mnemonic.upper() in BUILTINS:  # remember other spellings of built-ins only
+            _FACTS[call.mnemonic] = facts
+    return facts
+
+
+def reserved_writes(call: ast.Call) -> int:
+    """The reserved variables the call sets, as RESERVED_BIT bits."""
+    return _facts(call).writes
+
+
+def summarize(statements: Sequence[ast.Statement]) -> BlockEffects:
+    """The effects of a block's statements, in one pass (the checker's hottest loop)."""
+    operations: list[device.Operation] = []
+    events: list[int] = []
+    writes: list[tuple[int, int, int]] = []
+    reads = 0
+    observes = False
+    bit = RESERVED_BIT.get
+    known = _FACTS.get
+    var, call_type = ast.Var, ast.Call
+    for index, statement in enumerate(statements):
+        if isinstance(statement, ast.Assign):
+            by_calls = 0
+            calls = False
+            operand: ast.Operand = statement.first
+            rest = statement.rest
+            position = 0
+            while True:
+                if isinstance(operand, var):
+                    reads |= bit(operand.name, 0)
+                elif isinstance(operand, call_type):
+                    calls = True
+                    facts = known(operand.mnemonic) or _facts(operand)
+                    for arg in operand.args:
+                        if isinstance(arg, var):
+                            reads |= bit(arg.name, 0)
+                    by_calls |= facts.writes
+                    observes = observes or facts.observes
+                if position == len(rest):
+                    break
+                operand = rest[position].operand
+                position += 1
+            if calls:
+                events.append(index)
+            by_store = bit(statement.target.name, 0)
+            if by_calls or by_store:
+                writes.append((index, by_calls, by_store))
+        elif isinstance(statement, ast.CallStmt):
+            events.append(index)
+            call = statement.call
+            facts = known(call.mnemonic) or _facts(call)
+            for arg in call.args:
+                if isinstance(arg, var):
+                    reads |= bit(arg.name, 0)
+            if facts.writes:
+                writes.append((index, facts.writes, 0))
+            observes = observes or facts.observes
+            if facts.device:
+                operation = device.operation(call)
+                if operation is not None:
+                    operations.append((index, *operation))
+        elif isinstance(statement, ast.CondJump):
+            events.append(index)
+            reads |= bit(statement.var.name, 0)
+        elif isinstance(statement, ast.IncDec):
+            by_store = bit(statement.target.name, 0)
+            if by_store:
+                reads |= by_store
+                writes.append((index, 0, by_store))
+        else:
+            events.append(index)
+    return BlockEffects(operations, events, reads, writes, observes)

@@ -1,0 +1,74 @@
+"""Label rules over the whole program: jumps to labels nobody defines, labels defined
+twice, labels nobody jumps to.
+
+A line with a syntax error may have defined a label or jumped to one, so while the
+program has such a line (and the parser could not recover its label), undefined and
+unused labels are not reported: they are likely cascades of that error.
+"""
+
+from __future__ import annotations
+
+from .. import ast
+from ..builtins import HANDLER_LABELS
+from ..diagnostics import Diagnostic, Edit, Fix, Related, Severity
+from .cfg import ControlFlowGraph
+
+
+def check_labels(graph: ControlFlowGraph) -> list[Diagnostic]:
+    found: list[Diagnostic] = []
+    first: dict[int, ast.LabelDef] = {}
+    for block in graph.blocks:
+        for label in block.labels:
+            if label.number is None:
+                continue
+            if label.number in first:
+                found.append(_defined_twice(label, first[label.number]))
+            else:
+                first[label.number] = label
+
+    jumps = [block.jump for block in graph.blocks]
+    targets = {jump.target.number for jump in jumps if jump is not None}
+    blind = any(block.opaque and not block.labels for block in graph.blocks)
+    if not blind:
+        found.extend(_undefined(jump.target, first) for jump in jumps
+                     if jump is not None and jump.target.number is not None
+                     and jump.target.number not in first)
+    if not any(block.opaque for block in graph.blocks):
+        found.extend(_unused(graph, number, label) for number, label in first.items()
+                     if number not in targets and number not in HANDLER_LABELS)
+    return found
+
+
+def _defined_twice(label: ast.LabelDef, earlier: ast.LabelDef) -> Diagnostic:
+    return Diagnostic(
+        "E0204", Severity.ERROR, f"the label `{label.text}` is defined twice", label.span,
+        help=f"every jump to `#{label.text[1:]}` goes to the first definition: "
+             "give this one another number",
+        related=(Related(earlier.span, f"`{label.text}` is first defined here"),),
+    )
+
+
+def _undefined(ref: ast.LabelRef, defined: dict[int, ast.LabelDef]) -> Diagnostic:
+    help_text = f"start the line to jump to with `:{ref.text[1:]}`"
+    if defined:
+        listed = ", ".join(f"`{label.text}`" for _, label in sorted(defined.items())[:12])
+        more = ", ..." if len(defined) > 12 else ""
+        help_text += f"; the labels defined are {listed}{more}"
+    return Diagnostic("E0203", Severity.ERROR,
+                      f"the jump target `{ref.text}` is not defined: no line starts with "
+                      f"`:{ref.text[1:]}`", ref.span, help=help_text)
+
+
+def _unused(graph: ControlFlowGraph, number: int, label: ast.LabelDef) -> Diagnostic:
+    block = graph.blocks[graph.labels[number]]
+    following = [statement.span for statement in block.statements[:1]
+                 if statement.span.line == label.span.line]
+    end = following[0] if following else label.span
+    removal = ast.Span(label.span.line, label.span.column, end.line,
+                       end.column if following else end.end_column)
+    return Diagnostic(
+        "W0205", Severity.WARNING, f"the label `{label.text}` is never jumped to", label.span,
+        help=f"no `#{label.text[1:]}` or `?V..#{label.text[1:]}` jumps here: remove the label, "
+             "or jump to it",
+        fixes=(Fix(f"remove `{label.text}`", (Edit(removal, ""),)),),
+    )

@@ -1,0 +1,71 @@
+"""Code actions: the checker's fixes as quick fixes, and all of them at once as
+`source.fixAll`."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from lsprotocol import types
+
+from rl1.compiler.diagnostics import Diagnostic, Edit, Fix
+
+from .checking import to_lsp
+from .document import Document
+from .positions import Columns
+
+
+def _edit(document: Document, fix: Fix, columns: Columns) -> types.WorkspaceEdit:
+    return types.WorkspaceEdit(changes={document.uri: [
+        types.TextEdit(range=document.range_of(edit.span, columns), new_text=edit.text)
+        for edit in fix.edits
+    ]})
+
+
+def _touches(diagnostic: Diagnostic, start: tuple[int, int], end: tuple[int, int]) -> bool:
+    span = diagnostic.span
+    return (span.line, span.column) <= end and start <= (span.end_line, span.end_column)
+
+
+def code_actions(document: Document, diagnostics: list[Diagnostic], requested: types.Range,
+                 only: Sequence[str] | None, columns: Columns) -> list[types.CodeAction]:
+    """Quick fixes for the diagnostics in `requested`, then one fix-all action."""
+    start = document.locate(requested.start, columns)
+    end = document.locate(requested.end, columns)
+    actions: list[types.CodeAction] = []
+    if only is None or any(kind.startswith("quickfix") for kind in only):
+        for diagnostic in diagnostics:
+            if not _touches(diagnostic, start, end):
+                continue
+            for fix in diagnostic.fixes:
+                actions.append(types.CodeAction(
+                    title=fix.title,
+                    kind=types.CodeActionKind.QuickFix,
+                    diagnostics=[to_lsp(diagnostic, document, columns)],
+                    edit=_edit(document, fix, columns),
+                    is_preferred=len(diagnostic.fixes) == 1,
+                ))
+    if only is None or any(types.CodeActionKind.SourceFixAll.startswith(kind) for kind in only):
+        fix_all = _fix_all(diagnostics)
+        if fix_all.edits:
+            actions.append(types.CodeAction(
+                title=fix_all.title, kind=types.CodeActionKind.SourceFixAll,
+                edit=_edit(document, fix_all, columns)))
+    return actions
+
+
+def _fix_all(diagnostics: list[Diagnostic]) -> Fix:
+    """The only fix of each diagnostic that has exactly one, skipping any whose edits
+    overlap an earlier one's (an editor cannot apply overlapping edits)."""
+    taken: list[tuple[tuple[int, int], tuple[int, int]]] = []
+    edits: list[Edit] = []
+    for diagnostic in diagnostics:
+        if len(diagnostic.fixes) != 1:
+            continue
+        fix = diagnostic.fixes[0]
+        spans = [((e.span.line, e.span.column), (e.span.end_line, e.span.end_column))
+                 for e in fix.edits]
+        if any((s < te and ts < e) or s == ts for s, e in spans for ts, te in taken):
+            continue
+        taken += spans
+        edits += fix.edits
+    return Fix("Apply every fix the checker suggests", tuple(edits))

@@ -1,0 +1,192 @@
+"""Diagnostics: what they are for a document, how the client sees them, and when they
+are published.
+
+A change schedules a check after a short debounce, so a burst of changes is checked
+once. The check yields to the event loop while it parses, so requests are answered in
+the meantime, and it gives up as soon as a newer version arrives: diagnostics are never
+published for a stale version.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import gc
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+from lsprotocol import types
+
+from rl1.compiler import catalogue
+from rl1.compiler.checker import check_program
+from rl1.compiler.diagnostics import Diagnostic, Severity, sort_key
+
+from .document import MAX_ANALYSED_CHARACTERS, Document
+from .positions import Columns
+
+log = logging.getLogger(__name__)
+
+SOURCE = "rl1"
+DEBOUNCE_SECONDS = 0.005
+PARSE_SLICE = 500  # lines parsed between two chances for requests to run
+
+_SEVERITIES = {
+    Severity.ERROR: types.DiagnosticSeverity.Error,
+    Severity.WARNING: types.DiagnosticSeverity.Warning,
+    Severity.INFO: types.DiagnosticSeverity.Information,
+}
+
+
+@dataclass(frozen=True, slots=True)
+class Checked:
+    """The diagnostics of one version of a document."""
+
+    version: int
+    diagnostics: list[Diagnostic]
+    checker_failed: bool = False  # the whole-program rules crashed (logged)
+
+
+def diagnose(document: Document) -> Checked:
+    """Every diagnostic of the document, as `rl1c check` reports them: each line's own
+    (cached), then the whole program's rules."""
+    found = [
+        problem
+        for number in range(1, document.program_lines() + 1)
+        for problem in document.line_problems(number)
+    ]
+    failed = False
+    collecting = gc.isenabled()
+    gc.disable()  # as check() does: the checker builds no cycles for the collector to find
+    try:
+        found.extend(check_program(document.program()))
+    except Exception:  # a checker bug must not cost the user the syntax errors
+        log.exception("the whole-program checker failed on %s", document.uri)
+        failed = True
+    finally:
+        if collecting:
+            gc.enable()
+    found.sort(key=sort_key)
+    return Checked(document.version, found, failed)
+
+
+@cache
+def explanation_uri(code: str) -> str | None:
+    """A file URI to the long explanation of `code` (what `rl1c explain` prints)."""
+    path = Path(catalogue.__file__).with_name("explanations") / f"{code}.md"
+    return path.resolve().as_uri() if path.is_file() else None
+
+
+def to_lsp(diagnostic: Diagnostic, document: Document, columns: Columns) -> types.Diagnostic:
+    message = diagnostic.message
+    if diagnostic.help:
+        message += f"\nhelp: {diagnostic.help}"
+    href = explanation_uri(diagnostic.code)
+    return types.Diagnostic(
+        range=document.range_of(diagnostic.span, columns),
+        message=message,
+        severity=_SEVERITIES[diagnostic.severity],
+        code=diagnostic.code,
+        code_description=types.CodeDescription(href=href) if href else None,
+        source=SOURCE,
+        related_information=[
+            types.DiagnosticRelatedInformation(
+                location=types.Location(document.uri, document.range_of(related.span, columns)),
+                message=related.message,
+            )
+            for related in diagnostic.related
+        ] or None,
+    )
+
+
+def notice(message: str) -> types.Diagnostic:
+    """A diagnostic about the server itself, on the first character."""
+    return types.Diagnostic(
+        range=types.Range(types.Position(0, 0), types.Position(0, 0)),
+        message=message, severity=types.DiagnosticSeverity.Warning, source=SOURCE,
+    )
+
+
+def too_large_notice(document: Document) -> types.Diagnostic:
+    return notice(
+        f"this document has {document.size:,} characters; rl1-lsp analyses documents of up "
+        f"to {MAX_ANALYSED_CHARACTERS:,}, so it shows no diagnostics and answers no requests "
+        "for it. Check it with `rl1c check FILE`.")
+
+
+CHECKER_FAILED = notice(
+    "rl1-lsp: the whole-program checker failed on this document (an internal error, "
+    "logged on the server's standard error), so only syntax and per-line problems are "
+    "shown. Please report it with the program that caused it.")
+
+
+Publish = Callable[[types.PublishDiagnosticsParams], None]
+
+
+class DiagnosticsScheduler:
+    """Runs the debounced check of each open document and publishes the result."""
+
+    def __init__(self, publish: Publish, columns: Callable[[], Columns]) -> None:
+        self._publish = publish
+        self._columns = columns
+        self._tasks: dict[str, asyncio.Task[None]] = {}
+        self.checked: dict[str, Checked] = {}
+
+    def schedule(self, document: Document) -> None:
+        self.cancel(document.uri)
+        task = asyncio.get_running_loop().create_task(self._run(document, document.version))
+        self._tasks[document.uri] = task
+        task.add_done_callback(self._finished)
+
+    def cancel(self, uri: str) -> None:
+        task = self._tasks.pop(uri, None)
+        if task is not None:
+            task.cancel()
+        self.checked.pop(uri, None)
+
+    def close(self, uri: str) -> None:
+        """Forget a closed document and clear its diagnostics in the client."""
+        self.cancel(uri)
+        self._publish(types.PublishDiagnosticsParams(uri=uri, diagnostics=[]))
+
+    def current(self, document: Document) -> list[Diagnostic]:
+        """The diagnostics of the document's current version, checking it now if the
+        scheduled check has not run yet (a code action may ask first)."""
+        return self._checked(document).diagnostics
+
+    def _checked(self, document: Document) -> Checked:
+        checked = self.checked.get(document.uri)
+        if checked is None or checked.version != document.version:
+            checked = diagnose(document)
+            self.checked[document.uri] = checked
+        return checked
+
+    async def _run(self, document: Document, version: int) -> None:
+        await asyncio.sleep(DEBOUNCE_SECONDS)
+        if document.too_large:
+            self._send(document, version, [too_large_notice(document)])
+            return
+        lines = document.program_lines()
+        for first in range(1, lines + 1, PARSE_SLICE):
+            for number in range(first, min(first + PARSE_SLICE, lines + 1)):
+                document.line(number)
+            await asyncio.sleep(0)
+            if document.version != version:
+                return
+        columns = self._columns()
+        checked = self._checked(document)
+        found = [to_lsp(d, document, columns) for d in checked.diagnostics]
+        self._send(document, version, [CHECKER_FAILED, *found] if checked.checker_failed else found)
+
+    def _send(self, document: Document, version: int, diagnostics: list[types.Diagnostic]) -> None:
+        current = self._tasks.get(document.uri) is asyncio.current_task()
+        if document.version != version or not current:
+            return  # stale: a newer version or a closed document
+        self._publish(types.PublishDiagnosticsParams(
+            uri=document.uri, diagnostics=diagnostics, version=version,
+        ))
+
+    def _finished(self, task: asyncio.Task[None]) -> None:
+        if not task.cancelled() and task.exception() is not None:
+            log.error("checking a document failed", exc_info=task.exception())

@@ -1,0 +1,196 @@
+"""An open document: its lines, and a per-line cache of parse results.
+
+RL/I is line-oriented, so an edit re-parses and re-checks (the checker's per-line rules)
+only the lines whose text it changes. A cached line keeps the AST it was parsed with and
+its diagnostics; when an edit above it moves it, it is
+relocated to its new line number the next time it is asked for (`ast.relocate`), which
+costs far less than parsing it again. Lines end with LF, CRLF or a lone CR, as LSP
+counts them; the last line has no ending and may be empty.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import TypeVar, cast
+
+from lsprotocol import types
+
+from rl1.compiler import ast
+from rl1.compiler.checker import check_line
+from rl1.compiler.diagnostics import Diagnostic, Edit, Fix, Related
+from rl1.compiler.parser import parse_line
+
+from .positions import Columns, span_range
+
+T = TypeVar("T")
+
+_LINE_BREAK = re.compile(r"(\r\n|\r|\n)")
+
+MAX_ANALYSED_CHARACTERS = 2_000_000
+"""Beyond this a document is kept in sync but not analysed. An RL/I program of 10,000
+lines is about 200,000 characters; parsing tens of megabytes would stall the server."""
+
+
+@dataclass(slots=True)
+class CachedLine:
+    text: str
+    parsed: ast.Line | None = None  # None until first asked for
+    problems: tuple[Diagnostic, ...] = ()  # the line's own diagnostics, numbered like `parsed`
+
+
+def _split(text: str) -> tuple[list[str], list[str]]:
+    """Line texts and their endings; the last line's ending is ""."""
+    parts = _LINE_BREAK.split(text)
+    return parts[0::2], [*parts[1::2], ""]
+
+
+def _move_diagnostic(diagnostic: Diagnostic, line: int) -> Diagnostic:
+    """A one-line diagnostic moved, with its fixes and related spans, to `line`."""
+    return replace(
+        diagnostic,
+        span=diagnostic.span.on_line(line),
+        fixes=tuple(
+            Fix(fix.title, tuple(Edit(edit.span.on_line(line), edit.text) for edit in fix.edits))
+            for fix in diagnostic.fixes
+        ),
+        related=tuple(Related(r.span.on_line(line), r.message) for r in diagnostic.related),
+    )
+
+
+class Document:
+    def __init__(self, uri: str, text: str, version: int) -> None:
+        self.uri = uri
+        self.version = version
+        texts, self._endings = _split(text)
+        self._lines = [CachedLine(line) for line in texts]
+        self._size = len(text)
+        self._program: ast.Program | None = None
+        self._derived: dict[Callable[[Document], object], object] = {}
+
+    # Text ---------------------------------------------------------------------------
+
+    @property
+    def line_count(self) -> int:
+        """Lines as LSP counts them (a final line end starts one more, empty, line)."""
+        return len(self._lines)
+
+    @property
+    def too_large(self) -> bool:
+        return self._size > MAX_ANALYSED_CHARACTERS
+
+    @property
+    def size(self) -> int:
+        return self._size
+
+    def text(self) -> str:
+        pairs = zip(self._lines, self._endings, strict=True)
+        return "".join(line.text + ending for line, ending in pairs)
+
+    def line_text(self, number: int) -> str:
+        """The text of 1-based line `number`, "" outside the document."""
+        return self._lines[number - 1].text if 1 <= number <= len(self._lines) else ""
+
+    def locate(self, position: types.Position, columns: Columns) -> tuple[int, int]:
+        """A client position as a 1-based (line, code-point column), clamped into the
+        document: a line past the end is the end of the document."""
+        if position.line >= len(self._lines):
+            last = len(self._lines)
+            return last, len(self._lines[-1].text) + 1
+        line = max(position.line, 0) + 1
+        return line, columns.from_client(self._lines[line - 1].text, position.character) + 1
+
+    def range_of(self, span: ast.Span, columns: Columns) -> types.Range:
+        return span_range(span, self.line_text(span.line), self.line_text(span.end_line), columns)
+
+    def end_position(self, columns: Columns) -> types.Position:
+        last = self._lines[-1].text
+        return types.Position(len(self._lines) - 1, columns.length(last))
+
+    # Editing ------------------------------------------------------------------------
+
+    def apply(self, change: types.TextDocumentContentChangeEvent, columns: Columns) -> None:
+        """Apply one change; a range outside the document is clamped into it."""
+        self._program = None
+        self._derived.clear()
+        if isinstance(change, types.TextDocumentContentChangeWholeDocument):
+            texts, endings = _split(change.text)
+            self._splice(0, len(self._lines), texts, endings)
+            return
+        start = self.locate(change.range.start, columns)
+        end = self.locate(change.range.end, columns)
+        start, end = min(start, end), max(start, end)
+        first, last = start[0] - 1, end[0] - 1
+        # A CR ending the line above and an LF starting the new text make one CRLF.
+        if first > 0 and start[1] == 1 and self._endings[first - 1] == "\r":
+            first -= 1
+            before = self._lines[first].text + "\r"
+        else:
+            before = self._lines[first].text[: start[1] - 1]
+        after = self._lines[last].text[end[1] - 1 :] + self._endings[last]
+        texts, endings = _split(before + change.text + after)
+        if self._endings[last]:
+            # The window ends with a line end, so _split saw the start of the next line,
+            # which the edit does not touch.
+            texts.pop()
+            endings.pop()
+        self._splice(first, last + 1, texts, endings)
+
+    def _splice(self, low: int, high: int, texts: list[str], endings: list[str]) -> None:
+        """Replace lines [low, high) by `texts`, keeping the cache of lines whose text
+        is unchanged at either end of the window."""
+        old = self._lines[low:high]
+        same_start = 0
+        while same_start < min(len(old), len(texts)) and old[same_start].text == texts[same_start]:
+            same_start += 1
+        same_end = 0
+        while (same_end < min(len(old), len(texts)) - same_start
+               and old[-1 - same_end].text == texts[-1 - same_end]):
+            same_end += 1
+        middle = [CachedLine(text) for text in texts[same_start : len(texts) - same_end]]
+        kept_end = old[len(old) - same_end :] if same_end else []
+        removed = sum(len(line.text) for line in old) + sum(map(len, self._endings[low:high]))
+        self._lines[low:high] = old[:same_start] + middle + kept_end
+        self._endings[low:high] = endings
+        self._size += sum(map(len, texts)) + sum(map(len, endings)) - removed
+
+    # Syntax -------------------------------------------------------------------------
+
+    def line(self, number: int) -> ast.Line:
+        """The AST of 1-based line `number`, parsing or relocating it if need be."""
+        cached = self._lines[number - 1]
+        if cached.parsed is None:
+            cached.parsed, problems = parse_line(cached.text, number)
+            cached.problems = (*problems, *check_line(cached.parsed))
+        elif cached.parsed.number != number:
+            moved = ast.relocate(cached.parsed, number)
+            assert isinstance(moved, ast.Line)
+            cached.parsed = moved
+            cached.problems = tuple(_move_diagnostic(d, number) for d in cached.problems)
+        return cached.parsed
+
+    def line_problems(self, number: int) -> tuple[Diagnostic, ...]:
+        """The diagnostics of line `number` alone: syntax and the per-line rules."""
+        self.line(number)
+        return self._lines[number - 1].problems
+
+    def program_lines(self) -> int:
+        """The lines the compiler sees: a final empty line after a line end is not one."""
+        if self._lines[-1].text == "":
+            return len(self._lines) - 1
+        return len(self._lines)
+
+    def program(self) -> ast.Program:
+        """The whole program, as `parser.parse_program` would build it from the text."""
+        if self._program is None:
+            lines = tuple(self.line(number) for number in range(1, self.program_lines() + 1))
+            end = lines[-1].span if lines else ast.Span(1, 1, 1, 1)
+            self._program = ast.Program(ast.Span(1, 1, end.end_line, end.end_column), lines)
+        return self._program
+
+    def derived(self, build: Callable[[Document], T]) -> T:
+        """`build(self)`, computed once per version: the indexes features share."""
+        if build not in self._derived:
+            self._derived[build] = build(self)
+        return cast(T, self._derived[build])

@@ -1,0 +1,211 @@
+"""`rl1-lsp`: the RL/I language server. This module only wires LSP methods to the
+feature modules; each handler finds the document and hands over.
+
+Documents are kept by this server (document.py), not by pygls' workspace: the per-line
+parse cache needs to see each change, and LSP's line breaks (LF, CRLF, CR) must be
+honoured exactly.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable, Generator
+from importlib.metadata import version
+from typing import Any
+
+import click
+from lsprotocol import types
+from pygls.lsp.server import LanguageServer
+from pygls.protocol import LanguageServerProtocol
+from pygls.protocol.language_server import lsp_method
+
+from . import actions, checking, completion, hints, hover, navigation, tokens
+from .document import Document
+from .positions import UTF16, Columns
+
+NAME = "rl1-lsp"
+
+
+class Rl1Protocol(LanguageServerProtocol):
+    """Passes document synchronisation straight to the server's handlers, leaving
+    pygls' own copy of the documents out."""
+
+    def _user(self, method: str, params: object) -> Generator[Any, Any, None]:
+        if (handler := self.fm.features.get(method)) is not None:
+            yield handler, (params,), None
+
+    @lsp_method(types.TEXT_DOCUMENT_DID_OPEN)
+    def lsp_text_document__did_open(
+            self, params: types.DidOpenTextDocumentParams) -> Generator[Any, Any, None]:
+        yield from self._user(types.TEXT_DOCUMENT_DID_OPEN, params)
+
+    @lsp_method(types.TEXT_DOCUMENT_DID_CHANGE)
+    def lsp_text_document__did_change(
+            self, params: types.DidChangeTextDocumentParams) -> Generator[Any, Any, None]:
+        yield from self._user(types.TEXT_DOCUMENT_DID_CHANGE, params)
+
+    @lsp_method(types.TEXT_DOCUMENT_DID_CLOSE)
+    def lsp_text_document__did_close(
+            self, params: types.DidCloseTextDocumentParams) -> Generator[Any, Any, None]:
+        yield from self._user(types.TEXT_DOCUMENT_DID_CLOSE, params)
+
+
+class Rl1Server(LanguageServer):
+    def __init__(self) -> None:
+        super().__init__(NAME, version("rl1"), protocol_cls=Rl1Protocol,
+                         text_document_sync_kind=types.TextDocumentSyncKind.Incremental)
+        self.documents: dict[str, Document] = {}
+        self.columns = Columns(UTF16)
+        self.snippets = False
+        self.checks = checking.DiagnosticsScheduler(
+            self.text_document_publish_diagnostics, lambda: self.columns)
+        self.token_history = tokens.TokenHistory()
+
+    def document(self, uri: str) -> Document | None:
+        """An open document the server analyses; None for unknown or huge ones."""
+        document = self.documents.get(uri)
+        return None if document is None or document.too_large else document
+
+
+def create_server() -> Rl1Server:
+    server = Rl1Server()
+
+    @server.feature(types.INITIALIZE)
+    def initialize(params: types.InitializeParams) -> None:
+        encoding = server.workspace.position_encoding or UTF16
+        if isinstance(encoding, types.PositionEncodingKind):
+            encoding = encoding.value
+        server.columns = Columns(encoding)
+        completion_caps = params.capabilities.text_document and \
+            params.capabilities.text_document.completion
+        item = completion_caps.completion_item if completion_caps else None
+        server.snippets = bool(item and item.snippet_support)
+
+    # Synchronisation ----------------------------------------------------------------
+
+    @server.feature(types.TEXT_DOCUMENT_DID_OPEN)
+    def did_open(params: types.DidOpenTextDocumentParams) -> None:
+        item = params.text_document
+        document = Document(item.uri, item.text, item.version)
+        server.documents[item.uri] = document
+        server.checks.schedule(document)
+
+    @server.feature(types.TEXT_DOCUMENT_DID_CHANGE)
+    def did_change(params: types.DidChangeTextDocumentParams) -> None:
+        document = server.documents.get(params.text_document.uri)
+        if document is None:
+            logging.warning("change to %s, which is not open: ignored", params.text_document.uri)
+            return
+        for change in params.content_changes:
+            document.apply(change, server.columns)
+        document.version = params.text_document.version
+        server.checks.schedule(document)
+
+    @server.feature(types.TEXT_DOCUMENT_DID_CLOSE)
+    def did_close(params: types.DidCloseTextDocumentParams) -> None:
+        uri = params.text_document.uri
+        server.documents.pop(uri, None)
+        server.token_history.forget(uri)
+        server.checks.close(uri)
+
+    # Everything else reads one document -----------------------------------------------
+
+    def reads(method: str, empty: Any = None, options: Any = None) -> Callable[
+            [Callable[[Document, Any], Any]], None]:
+        """Registers a handler of `method` called with the open document and the params;
+        the answer is `empty` for a document that is not open or too large."""
+        def register(handler: Callable[[Document, Any], Any]) -> None:
+            @server.feature(method, options)
+            def run(params: Any) -> Any:
+                document = server.document(params.text_document.uri)
+                return empty if document is None else handler(document, params)
+        return register
+
+    @reads(types.TEXT_DOCUMENT_HOVER)
+    def _(document: Document, params: types.HoverParams) -> types.Hover | None:
+        return hover.hover(document, params.position, server.columns)
+
+    @reads(types.TEXT_DOCUMENT_COMPLETION, [],
+           types.CompletionOptions(trigger_characters=completion.TRIGGER_CHARACTERS))
+    def _(document: Document, params: types.CompletionParams) -> list[types.CompletionItem]:
+        return completion.complete(document, params.position, server.columns, server.snippets)
+
+    @reads(types.TEXT_DOCUMENT_SIGNATURE_HELP, None,
+           types.SignatureHelpOptions(trigger_characters=completion.SIGNATURE_TRIGGERS))
+    def _(document: Document, params: types.SignatureHelpParams) -> types.SignatureHelp | None:
+        return completion.signature_help(document, params.position, server.columns)
+
+    @reads(types.TEXT_DOCUMENT_INLAY_HINT, [])
+    def _(document: Document, params: types.InlayHintParams) -> list[types.InlayHint]:
+        return hints.inlay_hints(document, params.range, server.columns)
+
+    @reads(types.TEXT_DOCUMENT_SEMANTIC_TOKENS_FULL, None, tokens.LEGEND)
+    def _(document: Document, params: types.SemanticTokensParams) -> types.SemanticTokens:
+        return server.token_history.full(document, server.columns)
+
+    @reads(types.TEXT_DOCUMENT_SEMANTIC_TOKENS_FULL_DELTA, None, tokens.LEGEND)
+    def _(document: Document, params: types.SemanticTokensDeltaParams
+          ) -> types.SemanticTokens | types.SemanticTokensDelta:
+        return server.token_history.delta(document, server.columns, params.previous_result_id)
+
+    @reads(types.TEXT_DOCUMENT_DEFINITION)
+    def _(document: Document, params: types.DefinitionParams) -> list[types.Location] | None:
+        return navigation.definition(document, params.position, server.columns)
+
+    @reads(types.TEXT_DOCUMENT_REFERENCES, [])
+    def _(document: Document, params: types.ReferenceParams) -> list[types.Location]:
+        return navigation.references(document, params.position, server.columns,
+                                     params.context.include_declaration)
+
+    @reads(types.TEXT_DOCUMENT_DOCUMENT_HIGHLIGHT, [])
+    def _(document: Document, params: types.DocumentHighlightParams
+          ) -> list[types.DocumentHighlight]:
+        return navigation.highlights(document, params.position, server.columns)
+
+    @reads(types.TEXT_DOCUMENT_PREPARE_RENAME)
+    def _(document: Document, params: types.PrepareRenameParams) -> types.PrepareRenameResult:
+        return navigation.prepare_rename(document, params.position, server.columns)
+
+    @reads(types.TEXT_DOCUMENT_RENAME)
+    def _(document: Document, params: types.RenameParams) -> types.WorkspaceEdit:
+        return navigation.rename(document, params.position, server.columns, params.new_name)
+
+    @reads(types.TEXT_DOCUMENT_DOCUMENT_SYMBOL, [])
+    def _(document: Document, params: types.DocumentSymbolParams) -> list[types.DocumentSymbol]:
+        return navigation.symbols(document, server.columns)
+
+    @reads(types.TEXT_DOCUMENT_FOLDING_RANGE, [])
+    def _(document: Document, params: types.FoldingRangeParams) -> list[types.FoldingRange]:
+        return navigation.folding_ranges(document)
+
+    @reads(types.TEXT_DOCUMENT_CODE_ACTION, [], types.CodeActionOptions(
+        code_action_kinds=[types.CodeActionKind.QuickFix, types.CodeActionKind.SourceFixAll]))
+    def _(document: Document, params: types.CodeActionParams) -> list[types.CodeAction]:
+        return actions.code_actions(document, server.checks.current(document), params.range,
+                                    params.context.only, server.columns)
+
+    return server
+
+
+@click.command(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="rl1", prog_name=NAME)
+@click.option("--stdio", is_flag=True,
+              help="Talk LSP over standard input and output (the default).")
+@click.option("--tcp", metavar="HOST:PORT", help="Listen for one client on a TCP port instead.")
+@click.option("--log-level", type=click.Choice(["debug", "info", "warning", "error"]),
+              default="warning", show_default=True, help="What to log on standard error.")
+def main(stdio: bool, tcp: str | None, log_level: str) -> None:
+    """The RL/I language server: diagnostics, hover, completion, navigation, renaming
+    of labels, formatting and quick fixes for .rob files in any LSP editor."""
+    logging.basicConfig(level=log_level.upper(), format="rl1-lsp %(levelname)s: %(message)s")
+    if tcp is not None and stdio:
+        raise click.UsageError("choose one of --stdio and --tcp")
+    server = create_server()
+    if tcp is None:
+        server.start_io()
+        return
+    host, _, port = tcp.rpartition(":")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise click.BadParameter(f"expected HOST:PORT such as 127.0.0.1:2087, got {tcp!r}",
+                                 param_hint="--tcp")
+    server.start_tcp(host, int(port))

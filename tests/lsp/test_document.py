@@ -1,0 +1,102 @@
+"""The document model and column conversion, in process: properties over many edits."""
+
+from __future__ import annotations
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from lsprotocol import types
+
+from rl1.compiler.parser import parse_program
+from rl1.lsp.document import Document
+from rl1.lsp.positions import UTF8, UTF16, UTF32, Columns
+
+PIECES = st.sampled_from([
+    "A=1", ":10 B=A+2", "?B>#10", "(MOV 3,3)", "(MVI", "'日本語😀", "ｺﾒﾝﾄ", "\n", "\r\n",
+    "\r", " ", "#", ";", "\x00", "\u2028", "\x0c", "$FF", "é",
+])
+TEXT = st.lists(PIECES, max_size=12).map("".join)
+ENCODINGS = st.sampled_from([UTF8, UTF16, UTF32])
+
+
+def units(text: str, encoding: str) -> int:
+    if encoding == UTF8:
+        return len(text.encode("utf-8", "surrogatepass"))
+    if encoding == UTF16:
+        return len(text.encode("utf-16-le", "surrogatepass")) // 2
+    return len(text)
+
+
+def reference_offset(text: str, position: types.Position, encoding: str) -> int:
+    """Code-point offset of a client position; the obvious, slow way."""
+    # not str.splitlines: it knows more line breaks than LSP's three
+    lines, current = [], ""
+    index = 0
+    while index < len(text):
+        current += text[index]
+        if text[index] == "\r" and text[index + 1 : index + 2] == "\n":
+            current += "\n"
+            index += 1
+        if text[index] in "\r\n":
+            lines.append(current)
+            current = ""
+        index += 1
+    lines.append(current)
+    if position.line >= len(lines):
+        return len(text)
+    start = sum(map(len, lines[: position.line]))
+    content = lines[position.line].rstrip("\r\n")
+    for column in range(len(content) + 1):
+        if units(content[:column], encoding) > position.character:
+            return start + column - 1
+    return start + len(content)
+
+
+@st.composite
+def changes(draw: st.DrawFn) -> types.TextDocumentContentChangeEvent:
+    if draw(st.integers(0, 9)) == 0:
+        return types.TextDocumentContentChangeWholeDocument(text=draw(TEXT))
+    a, b, c, d = (draw(st.integers(0, 8)) for _ in range(4))
+    start, end = sorted([types.Position(a, b), types.Position(c, d)],
+                        key=lambda p: (p.line, p.character))
+    return types.TextDocumentContentChangePartial(range=types.Range(start, end), text=draw(TEXT))
+
+
+@settings(max_examples=300, deadline=None)
+@given(text=TEXT, edits=st.lists(changes(), max_size=6), encoding=ENCODINGS)
+def test_edits_keep_text_and_syntax_as_if_parsed_afresh(
+        text: str, edits: list[types.TextDocumentContentChangeEvent], encoding: str) -> None:
+    columns = Columns(encoding)
+    document = Document("file:///t.rob", text, 1)
+    document.program()  # fill the cache so that edits must keep it right
+    for change in edits:
+        if isinstance(change, types.TextDocumentContentChangeWholeDocument):
+            text = change.text
+        else:
+            low = reference_offset(text, change.range.start, encoding)
+            high = reference_offset(text, change.range.end, encoding)
+            text = text[:low] + change.text + text[high:]
+        document.apply(change, columns)
+        assert document.text() == text
+    program, syntax = parse_program(text)
+    assert document.program() == program
+    mine = [d for n in range(1, document.program_lines() + 1) for d in document.line_problems(n)]
+    assert [d for d in mine if d.code.startswith("E01")] == syntax
+
+
+@settings(max_examples=300, deadline=None)
+@given(text=st.text(max_size=20), encoding=ENCODINGS, column=st.integers(0, 25))
+def test_columns_round_trip_and_count_code_units(text: str, encoding: str, column: int) -> None:
+    columns = Columns(encoding)
+    client = columns.to_client(text, column)
+    assert client == units(text[:column], encoding)
+    assert columns.from_client(text, client) == min(column, len(text))
+
+
+def test_japanese_comment_positions_in_each_encoding() -> None:
+    text = "A=1 '日本語😀x"
+    end = len(text)
+    assert Columns(UTF32).to_client(text, end) == 10
+    assert Columns(UTF16).to_client(text, end) == 11
+    assert Columns(UTF8).to_client(text, end) == 5 + 9 + 4 + 1
+    # the middle of the emoji's surrogate pair rounds down to the emoji
+    assert Columns(UTF16).from_client(text, 9) == 8
