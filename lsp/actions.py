@@ -21,20 +21,21 @@ def _edit(document: Document, fix: Fix, columns: Columns) -> types.WorkspaceEdit
     ]})
 
 
-def _touches(diagnostic: Diagnostic, start: tuple[int, int], end: tuple[int, int]) -> bool:
-    span = diagnostic.span
-    return (span.line, span.column) <= end and start <= (span.end_line, span.end_column)
+def _on_lines(diagnostic: Diagnostic, first: int, last: int) -> bool:
+    """Whether the diagnostic shares a line with the request: a cursor anywhere on the
+    line of a problem is offered its fix."""
+    return diagnostic.span.line <= last and first <= diagnostic.span.end_line
 
 
 def code_actions(document: Document, diagnostics: list[Diagnostic], requested: types.Range,
                  only: Sequence[str] | None, columns: Columns) -> list[types.CodeAction]:
     """Quick fixes for the diagnostics in `requested`, then one fix-all action."""
-    start = document.locate(requested.start, columns)
-    end = document.locate(requested.end, columns)
+    first = document.locate(requested.start, columns)[0]
+    last = document.locate(requested.end, columns)[0]
     actions: list[types.CodeAction] = []
     if only is None or any(kind.startswith("quickfix") for kind in only):
         for diagnostic in diagnostics:
-            if not _touches(diagnostic, start, end):
+            if not _on_lines(diagnostic, first, last):
                 continue
             for fix in diagnostic.fixes:
                 actions.append(types.CodeAction(

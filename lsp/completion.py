@@ -48,7 +48,11 @@ def _snippet(words: list[str], form: Form, first: int, close: bool) -> str:
     return " ".join(words + ([params] if params else [])) + (")" if close else "")
 
 
-def _mnemonic_items(builtin: Builtin, snippets: bool, close: bool,
+def _documentation(text: str, markdown: bool) -> types.MarkupContent | str:
+    return types.MarkupContent(kind=types.MarkupKind.Markdown, value=text) if markdown else text
+
+
+def _mnemonic_items(builtin: Builtin, snippets: bool, markdown: bool, close: bool,
                     edit_range: types.Range) -> list[types.CompletionItem]:
     items = []
     for form in builtin.forms:
@@ -59,8 +63,7 @@ def _mnemonic_items(builtin: Builtin, snippets: bool, close: bool,
             label=label,
             kind=types.CompletionItemKind.Function,
             detail=signature(builtin, form),
-            documentation=types.MarkupContent(
-                kind=types.MarkupKind.Markdown, value=describe_builtin(builtin, form.selector)),
+            documentation=_documentation(describe_builtin(builtin, form.selector), markdown),
             filter_text=label,
             text_edit=types.TextEdit(range=edit_range, new_text=text),
             insert_text_format=(types.InsertTextFormat.Snippet if snippets
@@ -77,7 +80,9 @@ def _variable_detail(name: str) -> str:
 
 
 def complete(document: Document, position: types.Position, columns: Columns,
-             snippets: bool) -> list[types.CompletionItem]:
+             snippets: bool, markdown: bool) -> list[types.CompletionItem]:
+    """Labels after `#`, selectors after `(CAM ` and `(ULT `, mnemonics after `(`,
+    variables where an operand or a statement may start."""
     context = _code_before(document, position, columns)
     if context is None:
         return []
@@ -106,8 +111,7 @@ def complete(document: Document, position: types.Position, columns: Columns,
                 label=form.selector or "",
                 kind=types.CompletionItemKind.EnumMember,
                 detail=form.summary,
-                documentation=types.MarkupContent(
-                    kind=types.MarkupKind.Markdown, value=describe_form(builtin, form)),
+                documentation=_documentation(describe_form(builtin, form), markdown),
                 text_edit=types.TextEdit(
                     range=edit_range,
                     new_text=_snippet([form.selector or ""], form, 1, close) if snippets
@@ -120,7 +124,7 @@ def complete(document: Document, position: types.Position, columns: Columns,
     if found := _MNEMONIC_PREFIX.search(before):
         edit_range = _replace(number, text, column - len(found.group(1)), column, columns)
         return [item for builtin in BUILTINS.values()
-                for item in _mnemonic_items(builtin, snippets, close, edit_range)]
+                for item in _mnemonic_items(builtin, snippets, markdown, close, edit_range)]
     if found := _VARIABLE_PREFIX.search(before):
         edit_range = _replace(number, text, column - len(found.group(1)), column, columns)
         return [

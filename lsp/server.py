@@ -19,7 +19,7 @@ from pygls.lsp.server import LanguageServer
 from pygls.protocol import LanguageServerProtocol
 from pygls.protocol.language_server import lsp_method
 
-from . import actions, checking, completion, hints, hover, navigation, tokens
+from . import actions, checking, completion, formatting, hints, hover, navigation, tokens
 from .document import Document
 from .positions import UTF16, Columns
 
@@ -56,7 +56,8 @@ class Rl1Server(LanguageServer):
                          text_document_sync_kind=types.TextDocumentSyncKind.Incremental)
         self.documents: dict[str, Document] = {}
         self.columns = Columns(UTF16)
-        self.snippets = False
+        self.snippets = False  # what the client's completion accepts
+        self.markdown = False
         self.checks = checking.DiagnosticsScheduler(
             self.text_document_publish_diagnostics, lambda: self.columns)
         self.token_history = tokens.TokenHistory()
@@ -80,6 +81,8 @@ def create_server() -> Rl1Server:
             params.capabilities.text_document.completion
         item = completion_caps.completion_item if completion_caps else None
         server.snippets = bool(item and item.snippet_support)
+        formats = (item.documentation_format if item else None) or []
+        server.markdown = types.MarkupKind.Markdown in formats
 
     # Synchronisation ----------------------------------------------------------------
 
@@ -128,7 +131,8 @@ def create_server() -> Rl1Server:
     @reads(types.TEXT_DOCUMENT_COMPLETION, [],
            types.CompletionOptions(trigger_characters=completion.TRIGGER_CHARACTERS))
     def _(document: Document, params: types.CompletionParams) -> list[types.CompletionItem]:
-        return completion.complete(document, params.position, server.columns, server.snippets)
+        return completion.complete(document, params.position, server.columns,
+                                   server.snippets, server.markdown)
 
     @reads(types.TEXT_DOCUMENT_SIGNATURE_HELP, None,
            types.SignatureHelpOptions(trigger_characters=completion.SIGNATURE_TRIGGERS))
@@ -177,6 +181,15 @@ def create_server() -> Rl1Server:
     @reads(types.TEXT_DOCUMENT_FOLDING_RANGE, [])
     def _(document: Document, params: types.FoldingRangeParams) -> list[types.FoldingRange]:
         return navigation.folding_ranges(document)
+
+    @reads(types.TEXT_DOCUMENT_FORMATTING, [])
+    def _(document: Document, params: types.DocumentFormattingParams) -> list[types.TextEdit]:
+        return formatting.format_document(document, server.columns)
+
+    @reads(types.TEXT_DOCUMENT_RANGE_FORMATTING, [])
+    def _(document: Document, params: types.DocumentRangeFormattingParams
+          ) -> list[types.TextEdit]:
+        return formatting.format_range(document, params.range, server.columns)
 
     @reads(types.TEXT_DOCUMENT_CODE_ACTION, [], types.CodeActionOptions(
         code_action_kinds=[types.CodeActionKind.QuickFix, types.CodeActionKind.SourceFixAll]))

@@ -21,7 +21,8 @@ TIMEOUT = 30.0
 CAPABILITIES = types.ClientCapabilities(
     text_document=types.TextDocumentClientCapabilities(
         completion=types.CompletionClientCapabilities(
-            completion_item=types.ClientCompletionItemOptions(snippet_support=True)),
+            completion_item=types.ClientCompletionItemOptions(
+                snippet_support=True, documentation_format=[types.MarkupKind.Markdown])),
         rename=types.RenameClientCapabilities(prepare_support=True),
         semantic_tokens=types.SemanticTokensClientCapabilities(
             requests=types.ClientSemanticTokensRequestOptions(
