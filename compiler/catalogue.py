@@ -48,6 +48,7 @@ CODES: dict[str, CodeInfo] = _entries(
     ("E0204", E, "label defined twice"),
     ("W0205", W, "label never jumped to"),
     ("W0301", W, "missing lost-line handler"),
+    ("W0401", W, "reserved variable read before a call sets it"),
     ("W0402", W, "assignment to a reserved variable"),
     ("E0501", E, "unknown built-in function"),
     ("W0502", W, "built-in name or selector not in upper case"),
@@ -57,4 +58,8 @@ CODES: dict[str, CodeInfo] = _entries(
     ("E0506", E, "constant out of the parameter's range"),
     ("E0507", E, "decimal constant does not fit in 16 bits"),
     ("E0508", E, "call without a result used as an operand"),
+    ("W0601", W, "unreachable code"),
+    ("W0602", W, "code after (END)"),
+    ("W0603", W, "program without (END)"),
+    ("W0604", W, "busy loop that never observes the world"),
 )

@@ -15,13 +15,15 @@ from rl1.compiler.frontend import analyze
 from rl1.compiler.parser import parse_line, parse_program
 
 SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
-CHECKER_CODES = ["E0201", "E0202", "E0203", "E0204", "W0205", "W0301", "W0402",
-                 "E0501", "W0502", "E0503", "E0504", "E0505", "E0506", "E0507", "E0508"]
+CHECKER_CODES = ["E0201", "E0202", "E0203", "E0204", "W0205", "W0301", "W0401", "W0402",
+                 "E0501", "W0502", "E0503", "E0504", "E0505", "E0506", "E0507", "E0508",
+                 "W0601", "W0602", "W0603", "W0604"]
 
 
 def test_listing_1_has_no_errors_and_only_the_missing_97() -> None:
     # (TRC 3) then (MVI 1,1,50) on line 40: a line lost during that MVI jumps to :97,
-    # which Listing 1 does not define.
+    # which Listing 1 does not define. Everything else in it is sound: reserved
+    # variables are read after (IMG), every loop calls (IMG), it stops before (END).
     [diagnostic] = analyze(SAMPLE.read_text(encoding="utf-8")).diagnostics
     assert diagnostic.code == "W0301"
     assert diagnostic.span == span(40, 1, 13)

@@ -11,6 +11,9 @@ from .cfg import ControlFlowGraph, build_cfg
 from .handlers import check_handlers
 from .labels import check_labels
 from .lines import check_line
+from .loops import check_loops
+from .reachability import check_reachability
+from .reserved import check_reserved
 
 __all__ = ["ControlFlowGraph", "build_cfg", "check", "check_line", "check_program"]
 
@@ -39,4 +42,7 @@ def check_program(program: Program) -> list[Diagnostic]:
     return [
         *check_labels(graph),
         *check_handlers(program, graph),
+        *check_reserved(graph),
+        *check_reachability(program, graph),
+        *check_loops(graph),
     ]

@@ -15,6 +15,10 @@ not read. Blocks are numbered in source order. Edges:
 A line with a syntax error becomes an opaque block: it may have held any statement, so
 it may continue to the next block, to any labelled block or to the end, and a jump to a
 label the program does not define may land on it.
+
+Each block also carries a summary of what its statements do (effects.py), computed once
+for all the data-flow rules, and the graph the device state on entry to each block,
+which says which blocks some path reaches.
 """
 
 from __future__ import annotations

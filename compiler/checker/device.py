@@ -91,45 +91,50 @@ def _motion(args: tuple[ast.Arg, ...]) -> int:
     return STOPPED if len(speeds) == 2 else STOPPED | MOVING  # a variable may be 0 or not
 
 
-def run(operations: list[Operation], events: list[int], state: int) -> tuple[int, Triggers]:
+def run(operations: list[Operation], first_event: int | None,
+        state: int) -> tuple[int, Triggers]:
     """A block's effect: its state at the end (before its `(END)`, if it has one) and the
     handlers a lost line may jump to from it, each with the state it enters with and the
-    block's first event point where it may."""
+    block's first event point where it may. Only the block's first event point and those
+    of its operations need a look: the state changes nowhere else."""
     triggers: Triggers = {}
-    pending = iter(operations)
-    following = next(pending, None)
-    for index in events:
+    if first_event is not None and (not operations or operations[0][0] != first_event):
+        _lost_line((state,), state, False, first_event, triggers)
+    for index, kind, value in operations:
+        if kind == _END:
+            break
+        before = state
+        state = state & (MOTION if kind == _SET_MODES else ALL_MODES) | value
         # A pending event may have been recorded before, during or after this call.
-        recorded = [state]
-        from_mvi = False
-        if following is not None and following[0] == index:
-            _, kind, value = following
-            following = next(pending, None)
-            if kind == _END:
-                return state, triggers
-            if kind == _MVI:
-                from_mvi = True
-                recorded.append(state & ALL_MODES | RUNNING)
-            state = state & (MOTION if kind == _SET_MODES else ALL_MODES) | value
-            recorded.append(state)
-        if any(seen & (MOVING | RUNNING) and seen & (MODE_2 | MODE_3) for seen in recorded):
-            _lost_line(recorded, state, from_mvi, index, triggers)
+        if kind == _MVI:
+            _lost_line((before, before & ALL_MODES | RUNNING, state), state, True, index,
+                       triggers)
+        else:
+            _lost_line((before, state), state, False, index, triggers)
     return state, triggers
 
 
-def _lost_line(recorded: list[int], now: int, from_mvi: bool, index: int,
+def _lost_line(recorded: tuple[int, ...], now: int, from_mvi: bool, index: int,
                triggers: Triggers) -> None:
     """The handlers an event taken at this event point may jump to, and the state each
     is entered with: the tracing mode stays as it is now; mode 3 keeps the motion now in
     effect (an MVI that lost the line here goes on in the background), mode 2 stops it."""
+    under_mov = under_mvi = 0  # the modes a line may be lost in, during MOV and MVI
+    for seen in recorded:
+        if seen & MOVING:
+            under_mov |= seen
+        if seen & RUNNING:
+            under_mvi |= seen
+    if not (under_mov | under_mvi) & (MODE_2 | MODE_3):
+        return
     modes = now & ALL_MODES
-    for label, motion, mode, entry in (
-        (96, MOVING, MODE_3, now),
-        (97, RUNNING, MODE_3, modes | RUNNING if from_mvi else now),
-        (98, MOVING, MODE_2, modes | STOPPED),
-        (99, RUNNING, MODE_2, modes | STOPPED),
+    for label, modes_then, mode, entry in (
+        (96, under_mov, MODE_3, now),
+        (97, under_mvi, MODE_3, modes | RUNNING if from_mvi else now),
+        (98, under_mov, MODE_2, modes | STOPPED),
+        (99, under_mvi, MODE_2, modes | STOPPED),
     ):
-        if any(seen & motion and seen & mode for seen in recorded):
+        if modes_then & mode:
             first, entries = triggers.get(label, (index, 0))
             triggers[label] = (first, entries | entry)
 
@@ -146,7 +151,7 @@ def trace(graph: ControlFlowGraph) -> tuple[list[int], list[Triggers]]:
             return START, []
         # A block's last visit is with its final state, so its last triggers are final.
         effects = block.effects
-        out, triggers[index] = run(effects.operations, effects.events, state)
+        out, triggers[index] = run(effects.operations, effects.first_event, state)
         return out, [(graph.labels[label], entry)
                      for label, (_, entry) in triggers[index].items() if label in graph.labels]
 

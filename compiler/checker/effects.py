@@ -27,9 +27,9 @@ ALL_RESERVED = (1 << len(RESERVED_VARIABLES)) - 1
 @dataclass(slots=True)
 class BlockEffects:
     operations: list[device.Operation]  # the calls that change the device state
-    # The event points, where a pending lost line is taken: the statements that make a
-    # call (right after it, before an assignment stores) or jump.
-    events: list[int]
+    # The first event point, where a pending lost line is taken: the first statement
+    # that makes a call (right after it, before an assignment stores) or jumps.
+    first_event: int | None
     reads: int  # reserved variables read anywhere in the block (RESERVED_BIT bits)
     # (statement index, reserved variables its calls write, those its store writes)
     writes: list[tuple[int, int, int]]
@@ -37,7 +37,7 @@ class BlockEffects:
 
     @staticmethod
     def nothing() -> BlockEffects:
-        return BlockEffects([], [], 0, [], False)
+        return BlockEffects([], None, 0, [], False)
 
 
 class _CallFacts(NamedTuple):
@@ -78,7 +78,7 @@ def reserved_writes(call: ast.Call) -> int:
 def summarize(statements: Sequence[ast.Statement]) -> BlockEffects:
     """The effects of a block's statements, in one pass (the checker's hottest loop)."""
     operations: list[device.Operation] = []
-    events: list[int] = []
+    first_event: int | None = None
     writes: list[tuple[int, int, int]] = []
     reads = 0
     observes = False
@@ -107,13 +107,14 @@ def summarize(statements: Sequence[ast.Statement]) -> BlockEffects:
                     break
                 operand = rest[position].operand
                 position += 1
-            if calls:
-                events.append(index)
+            if calls and first_event is None:
+                first_event = index
             by_store = bit(statement.target.name, 0)
             if by_calls or by_store:
                 writes.append((index, by_calls, by_store))
         elif isinstance(statement, ast.CallStmt):
-            events.append(index)
+            if first_event is None:
+                first_event = index
             call = statement.call
             facts = known(call.mnemonic) or _facts(call)
             for arg in call.args:
@@ -127,13 +128,14 @@ def summarize(statements: Sequence[ast.Statement]) -> BlockEffects:
                 if operation is not None:
                     operations.append((index, *operation))
         elif isinstance(statement, ast.CondJump):
-            events.append(index)
+            if first_event is None:
+                first_event = index
             reads |= bit(statement.var.name, 0)
         elif isinstance(statement, ast.IncDec):
             by_store = bit(statement.target.name, 0)
             if by_store:
                 reads |= by_store
                 writes.append((index, 0, by_store))
-        else:
-            events.append(index)
-    return BlockEffects(operations, events, reads, writes, observes)
+        elif first_event is None:  # a jump
+            first_event = index
+    return BlockEffects(operations, first_event, reads, writes, observes)

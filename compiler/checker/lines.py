@@ -14,7 +14,7 @@ from ..builtins import BUILTINS, RESERVED_VARIABLES, Builtin, Form, writers_of
 from ..diagnostics import Diagnostic, Edit, Fix, Severity
 
 E, W = Severity.ERROR, Severity.WARNING
-INT16 = range(-0x8000, 0x8000)
+INT16_LOW, INT16_HIGH = -0x8000, 0x7FFF
 
 
 def check_line(line: ast.Line) -> list[Diagnostic]:
@@ -28,9 +28,11 @@ def check_line(line: ast.Line) -> list[Diagnostic]:
         if isinstance(statement, ast.Assign):
             if statement.target.name in RESERVED_VARIABLES:
                 found.append(_reserved_target(statement.target))
-            _operand(statement.first, found)
+            if not isinstance(statement.first, ast.Var):
+                _operand(statement.first, found)
             for step in statement.rest:
-                _operand(step.operand, found)
+                if not isinstance(step.operand, ast.Var):
+                    _operand(step.operand, found)
         elif isinstance(statement, ast.IncDec):
             if statement.target.name in RESERVED_VARIABLES:
                 found.append(_reserved_target(statement.target))
@@ -73,9 +75,9 @@ def _reserved_target(target: ast.Var) -> Diagnostic:
     )
 
 
-def _operand(operand: ast.Operand, found: list[Diagnostic]) -> None:
+def _operand(operand: ast.Const | ast.Call, found: list[Diagnostic]) -> None:
     if isinstance(operand, ast.Const):
-        if operand.value not in INT16:
+        if not INT16_LOW <= operand.value <= INT16_HIGH:
             found.append(_too_wide(operand))
     elif isinstance(operand, ast.Call):
         _call(operand, found, used_as_operand=True)
@@ -137,7 +139,7 @@ def _arguments(call: ast.Call, builtin: Builtin, form: Form, values: tuple[ast.A
                 arg.span, help=f"`{signature(builtin, form)}`: {_describe(form)}",
             ))
         elif isinstance(arg, ast.Const):
-            if arg.value not in INT16:
+            if not INT16_LOW <= arg.value <= INT16_HIGH:
                 found.append(_too_wide(arg))
             elif not param.low <= arg.value <= param.high:
                 value = f" ({arg.value})" if arg.hex else ""
@@ -169,7 +171,7 @@ def _arity(call: ast.Call, builtin: Builtin, form: Form, values: tuple[ast.Arg, 
 
 def _wide_constants(args: tuple[ast.Arg, ...], found: list[Diagnostic]) -> None:
     for arg in args:
-        if isinstance(arg, ast.Const) and arg.value not in INT16:
+        if isinstance(arg, ast.Const) and not INT16_LOW <= arg.value <= INT16_HIGH:
             found.append(_too_wide(arg))
 
 

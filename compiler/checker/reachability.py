@@ -1,0 +1,82 @@
+"""Code that never runs, and programs that end only by running off their last line.
+
+Unreachable code is reported once per run of consecutive blocks no path reaches: as code
+after `(END)` (W0602) when the run starts right after an `(END)` on the same straight
+line, otherwise as unreachable (W0601), saying why: it follows a jump, or no path jumps
+to its label.
+"""
+
+from __future__ import annotations
+
+from .. import ast
+from ..diagnostics import Diagnostic, Fix, Severity
+from .cfg import Block, ControlFlowGraph
+from .fixes import append_line
+
+REMOVE_OR_LABEL = "remove it, or start its line with a label and jump there"
+
+
+def check_reachability(program: ast.Program, graph: ControlFlowGraph) -> list[Diagnostic]:
+    found: list[Diagnostic] = []
+    run: list[Block] = []
+    for block in graph.blocks:
+        if not graph.reachable(block.index):
+            run.append(block)
+        elif run:
+            found.extend(_unreachable(graph, run))
+            run = []
+    if run:
+        found.extend(_unreachable(graph, run))
+    found.extend(_no_end(program, graph))
+    return found
+
+
+def _unreachable(graph: ControlFlowGraph, run: list[Block]) -> list[Diagnostic]:
+    statements = [statement for block in run for statement in block.statements]
+    if not statements:
+        return []  # only lines with syntax errors
+    span = statements[0].span.cover(statements[-1].span)
+    first = run[0]
+    before = graph.blocks[first.index - 1].statements[-1:]  # the entry block is reachable
+    if first.labels:
+        label = first.labels[-1].text
+        return [Diagnostic("W0601", Severity.WARNING,
+                           f"this code never runs: no jump that runs goes to `{label}`, and "
+                           "the code before it never continues here", span,
+                           help=f"remove it, or jump to `{label}` from code that runs")]
+    if before and isinstance(before[0], ast.Goto):
+        return [Diagnostic("W0601", Severity.WARNING,
+                           f"this code follows the jump `{before[0].target.text}`, so it never "
+                           "runs",
+                           span, help=REMOVE_OR_LABEL)]
+    return [Diagnostic("W0602", Severity.WARNING, "this code follows `(END)`, so it never runs",
+                       span, help=REMOVE_OR_LABEL)]
+
+
+def _no_end(program: ast.Program, graph: ControlFlowGraph) -> list[Diagnostic]:
+    """W0603: no `(END)` anywhere, and the program can run off its last line."""
+    blocks = graph.blocks
+    if not graph.reachable(graph.exit) or any(block.ends or block.opaque for block in blocks):
+        return []
+    span = fall_off_span(graph)
+    if span is None:
+        return []  # nothing runs at all
+    return [Diagnostic(
+        "W0603", Severity.WARNING, "the program has no `(END)`: it ends by running off its "
+        "last line", span,
+        help="running off the end behaves as `(END)`; write `(END)` where the program stops, "
+             "so that a reader sees it",
+        fixes=(Fix("add `(END)` at the end", (append_line(program, "(END)"),)),),
+    )]
+
+
+def fall_off_span(graph: ControlFlowGraph) -> ast.Span | None:
+    """Where the program runs off its end: the label at the very end naming no code, or
+    else the last statement; None for a program with neither."""
+    exit_block = graph.blocks[graph.exit]
+    if exit_block.labels:
+        return exit_block.labels[-1].span
+    for block in reversed(graph.blocks):
+        if block.statements:
+            return block.statements[-1].span
+    return None

@@ -1,0 +1,114 @@
+"""Reads of a reserved variable (s-z) on a path where nothing has set it yet.
+
+A must-be-set analysis, run as its complement so that the shared solver can join by `|`:
+the state is the set of reserved variables that may still be unset (hold their initial
+0). A call writes its reserved variables (builtins.py), an assignment or `V++` writes its
+target (W0402 has already warned about that), and a line with a syntax error is assumed
+to write them all.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from .. import ast
+from ..builtins import writers_of
+from ..diagnostics import Diagnostic, Severity
+from . import dataflow
+from .cfg import ControlFlowGraph
+from .effects import ALL_RESERVED, RESERVED_BIT, reserved_writes
+
+OnRead = Callable[[ast.Var], None]
+
+
+def check_reserved(graph: ControlFlowGraph) -> list[Diagnostic]:
+    blocks = graph.blocks
+    # "May be unset" only shrinks, so a block's effect is `state & keep`, and a handler
+    # edge's is `state & keep` up to its statement.
+    keep = [ALL_RESERVED] * len(blocks)
+    keep_until: list[list[tuple[int, int]]] = [[] for _ in blocks]
+    for block in blocks:
+        if block.opaque:
+            keep[block.index] = 0
+            continue
+        writes = block.effects.writes
+        for edge in block.handlers:
+            if edge.target is not None:
+                keep_until[block.index].append((edge.target, _kept(writes, edge.index)))
+        keep[block.index] = _kept(writes, len(block.statements))  # past the last statement
+
+    def transfer(index: int, state: int) -> tuple[int, list[tuple[int, int]]]:
+        return state & keep[index], [(target, state & kept)
+                                     for target, kept in keep_until[index]]
+
+    states = dataflow.solve(graph, ALL_RESERVED, transfer)
+    found: list[Diagnostic] = []
+
+    def report(var: ast.Var) -> None:
+        found.append(_unset(var))
+
+    for block in blocks:
+        state = states[block.index]
+        if state & block.effects.reads and graph.reachable(block.index):
+            for statement in block.statements:
+                state = _walk(statement, state, report)
+    return found
+
+
+def _kept(writes: list[tuple[int, int, int]], event: int) -> int:
+    """The reserved variables nothing sets before the event point of statement `event`:
+    the calls of that statement have run, its store has not."""
+    kept = ALL_RESERVED
+    for index, by_calls, by_store in writes:
+        if index < event:
+            kept &= ~(by_calls | by_store)
+        elif index == event:
+            kept &= ~by_calls
+    return kept
+
+
+def _walk(statement: ast.Statement, state: int, on_read: OnRead | None) -> int:
+    """The state after `statement`, calling `on_read` for each read of a variable that
+    may be unset, in evaluation order (left to right; the target is written last)."""
+    if isinstance(statement, ast.Assign):
+        state = _operand(statement.first, state, on_read)
+        for step in statement.rest:
+            state = _operand(step.operand, state, on_read)
+        return state & ~RESERVED_BIT.get(statement.target.name, 0)
+    if isinstance(statement, ast.CallStmt):
+        return _operand(statement.call, state, on_read)
+    if isinstance(statement, ast.IncDec):
+        _read(statement.target, state, on_read)
+        return state & ~RESERVED_BIT.get(statement.target.name, 0)
+    if isinstance(statement, ast.CondJump):
+        _read(statement.var, state, on_read)
+    return state
+
+
+def _operand(operand: ast.Operand, state: int, on_read: OnRead | None) -> int:
+    if isinstance(operand, ast.Var):
+        _read(operand, state, on_read)
+    elif isinstance(operand, ast.Call):
+        for arg in operand.args:
+            if isinstance(arg, ast.Var):
+                _read(arg, state, on_read)
+        state &= ~reserved_writes(operand)
+    return state
+
+
+def _read(var: ast.Var, state: int, on_read: OnRead | None) -> None:
+    if on_read is not None and state & RESERVED_BIT.get(var.name, 0):
+        on_read(var)
+
+
+def _unset(var: ast.Var) -> Diagnostic:
+    writers = writers_of(var.name)
+    calls = " or ".join(f"`({builtin.mnemonic})`" for builtin, _ in writers)
+    sets = "; ".join(f"`({builtin.mnemonic})` sets {', '.join(form.writes)}"
+                     for builtin, form in writers)
+    return Diagnostic(
+        "W0401", Severity.WARNING,
+        f"`{var.name}` is read here, but on some path no {calls} has set it yet",
+        var.span,
+        help=f"until then it holds 0: call {calls} before reading `{var.name}` ({sets})",
+    )
