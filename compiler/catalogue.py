@@ -62,4 +62,5 @@ CODES: dict[str, CodeInfo] = _entries(
     ("W0602", W, "code after (END)"),
     ("W0603", W, "program without (END)"),
     ("W0604", W, "busy loop that never observes the world"),
+    ("W0701", W, "program may end while the vehicle moves"),
 )

@@ -17,7 +17,7 @@ from rl1.compiler.parser import parse_line, parse_program
 SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 CHECKER_CODES = ["E0201", "E0202", "E0203", "E0204", "W0205", "W0301", "W0401", "W0402",
                  "E0501", "W0502", "E0503", "E0504", "E0505", "E0506", "E0507", "E0508",
-                 "W0601", "W0602", "W0603", "W0604"]
+                 "W0601", "W0602", "W0603", "W0604", "W0701"]
 
 
 def test_listing_1_has_no_errors_and_only_the_missing_97() -> None:

@@ -189,3 +189,44 @@ def test_nested_blind_loops_are_reported_once_on_the_last_backward_jump() -> Non
     source = ":10 A=1\n:11 B=2; #11\n#10"
     [diagnostic] = found(source, "W0604")
     assert diagnostic.span == span(2, 10, 13)
+
+
+# Ending while moving (W0701) ------------------------------------------------------------
+
+
+def test_end_while_a_mov_drives_and_the_fix_stops_first() -> None:
+    source = "(MOV 3,3)\n:10 A=(IMG)-180; ?A<#10\n(END)"
+    diagnostic = one(source, "W0701")
+    assert diagnostic.span == span(3, 1, 6)
+    fixed = apply(source, diagnostic.fixes[0])
+    assert fixed.endswith("(MOV 0,0); (END)")
+    assert found(fixed, "W0701") == []
+
+
+def test_running_off_the_end_while_moving() -> None:
+    source = "?B>#50\n(MOV 0,0); (END)\n:50 (MOV A,0)\n"
+    diagnostic = one(source, "W0701")
+    assert diagnostic.span == span(3, 5, 14)
+    assert "run off its end" in diagnostic.message
+
+
+@pytest.mark.parametrize("source", [
+    "(MOV 3,3); (MOV 0,0); (END)",
+    "(MOV 3,3); (HLD); (END)",
+    "(MOV 3,3); (FRE); (END)",
+    "(MOV 3,3); (MVI 1,1,10); (END)",
+    "(MOV 0,0); (END)",
+    # mode 2 stops the vehicle before jumping to :98
+    "(TRC 2); (MOV 3,3)\n:10 (IMG); #10\n:98 (END)",
+])
+def test_ending_stopped(source: str) -> None:
+    assert found(source, "W0701") == []
+
+
+def test_mode_3_keeps_moving_into_the_handler() -> None:
+    source = "(TRC 3); (MOV 3,3)\n:10 (IMG); #10\n:96 (END)"
+    assert one(source, "W0701").span == span(3, 5, 10)
+
+
+def test_a_variable_speed_may_be_moving() -> None:
+    assert one("(MOV A,0); (END)", "W0701").span == span(1, 12, 17)

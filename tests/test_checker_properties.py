@@ -1,5 +1,5 @@
 """Properties of the checker over generated programs: it never fails, its per-line part is
-exactly the per-line rules, and its tracing warnings cover what the
+exactly the per-line rules, and its tracing and safety warnings cover what the
 interpreter does with a device that loses the line at random."""
 
 from __future__ import annotations
@@ -79,6 +79,17 @@ losses = st.lists(st.one_of(
 ), min_size=1, max_size=3)
 
 
+def _motion_left_on(device: ScriptedDevice) -> bool:
+    """Whether the last motion command the device got was a non-zero MOV."""
+    moving = False
+    for entry in device.trace:
+        if entry.call == "MOV":
+            moving = any(entry.args)
+        elif entry.call in ("MVI", "FRE", "HLD"):
+            moving = False
+    return moving
+
+
 @settings(max_examples=300, deadline=None)
 @given(traced_programs(), losses, st.integers(-3, 3))
 def test_every_missing_handler_at_run_time_was_warned_about(
@@ -89,3 +100,13 @@ def test_every_missing_handler_at_run_time_was_warned_about(
     if result.fault is not None and result.fault.kind is FaultKind.MISSING_HANDLER:
         label = re.findall(r":\d\d", result.fault.message)[-1]
         assert label in warned, (text, result.fault)
+
+
+@settings(max_examples=200, deadline=None)
+@given(traced_programs())
+def test_every_run_ending_while_moving_was_warned_about(text: str) -> None:
+    program, _ = parse_program(text)
+    device = ScriptedDevice(Script())  # the line is never lost
+    result = interpret(program, device, budget=10_000)
+    if result.fault is None and _motion_left_on(device):
+        assert "W0701" in {d.code for d in check(program)}, text

@@ -14,6 +14,7 @@ from .lines import check_line
 from .loops import check_loops
 from .reachability import check_reachability
 from .reserved import check_reserved
+from .safety import check_safety
 
 __all__ = ["ControlFlowGraph", "build_cfg", "check", "check_line", "check_program"]
 
@@ -45,4 +46,5 @@ def check_program(program: Program) -> list[Diagnostic]:
         *check_reserved(graph),
         *check_reachability(program, graph),
         *check_loops(graph),
+        *check_safety(program, graph),
     ]

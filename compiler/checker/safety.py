@@ -1,0 +1,39 @@
+"""Ending while the vehicle moves: `(END)` does not stop the motion a `(MOV ...)` started
+(nor does running off the last line), so a program that ends on such a path leaves the
+vehicle driving with nothing in control."""
+
+from __future__ import annotations
+
+from .. import ast
+from ..diagnostics import Diagnostic, Edit, Fix, Severity
+from . import device
+from .cfg import ControlFlowGraph
+from .fixes import append_line
+from .reachability import fall_off_span
+
+HELP = ("`(END)` does not stop the motion a `(MOV)` started: stop the vehicle first with "
+        "`(MOV 0,0)`, `(HLD)` or `(FRE)`")
+
+
+def check_safety(program: ast.Program, graph: ControlFlowGraph) -> list[Diagnostic]:
+    found: list[Diagnostic] = []
+    for block in graph.blocks:
+        entry = graph.device_on_entry[block.index]
+        if entry and block.ends and device.run(
+                block.effects.operations, block.effects.first_event, entry)[0] & device.MOVING:
+            end = block.statements[-1].span
+            found.append(Diagnostic(
+                "W0701", Severity.WARNING,
+                "the program can end here while the vehicle is still moving", end, help=HELP,
+                fixes=(Fix("stop before `(END)`", (Edit(ast.Span(
+                    end.line, end.column, end.line, end.column), "(MOV 0,0); "),)),),
+            ))
+    span = fall_off_span(graph)
+    if graph.device_on_entry[graph.exit] & device.MOVING and span is not None:
+        found.append(Diagnostic(
+            "W0701", Severity.WARNING,
+            "the program can run off its end here while the vehicle is still moving", span,
+            help=HELP + "; running off the last line ends the program like `(END)`",
+            fixes=(Fix("stop at the end", (append_line(program, "(MOV 0,0)"),)),),
+        ))
+    return found
