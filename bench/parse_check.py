@@ -19,17 +19,18 @@ from rl1.compiler.frontend import analyze
 
 
 def rl1_program(lines: int, seed: int = 1997) -> str:
-    """A program of `lines` lines in the style of Listing 1: sections headed by a label,
-    sensing, arithmetic and calls, each section looping on a sensing result."""
+    """A program of `lines` lines in the style of Listing 1: up to 95 sections (RL/I has
+    only 100 labels), each headed by a label and a sensing call, with arithmetic and
+    calls, and looping back on the sensing result."""
     rng = random.Random(seed)
     variables = "ABCDEFGHIJKLMNOPQRabcdefghijklmnopqr@"
     operators = "+-&|^<>"
+    sections = max(1, min(95, lines // 20))
+    body_lines = max(1, (lines - 4) // sections - 2)
     out: list[str] = ["'generated benchmark program", "(TRC 0); (KYC)"]
-    label = 0
-    while len(out) < lines - 3:
-        label = label % 95 + 1
+    for label in range(1, sections + 1):
         out.append(f":{label:02d} (IMG); A=x-{rng.randint(0, 300)}")
-        for _ in range(rng.randint(3, 12)):
+        for _ in range(body_lines):
             kind = rng.random()
             v, w = rng.choice(variables), rng.choice(variables)
             if kind < 0.45:
@@ -49,8 +50,8 @@ def rl1_program(lines: int, seed: int = 1997) -> str:
             else:
                 out.append(f"{v}=$%04X ' comment" % rng.randint(0, 0xFFFF))
         out.append(f"?A<#{label:02d}")
-    out += ["(MOV 0,0)", "(END)"]
-    return "\n".join(out[:lines]) + "\n"
+    out += ["(MOV 0,0)"] * (lines - len(out) - 1) + ["(END)"]
+    return "\n".join(out) + "\n"
 
 
 def python_program(lines: int, seed: int = 1997) -> str:
@@ -84,8 +85,9 @@ def main() -> None:
     python_text = python_program(lines)
     analysis = analyze(rl1_text)  # warm-up, and a sanity check of the generator
     errors = [d for d in analysis.diagnostics if d.is_error]
-    if errors:
-        raise SystemExit(f"generated program has {len(errors)} errors, e.g. {errors[0]}")
+    if len(rl1_text.splitlines()) != lines or errors:
+        raise SystemExit(f"generator broken: {len(rl1_text.splitlines())} lines, "
+                         f"{len(errors)} errors, e.g. {errors[:1]}")
 
     rl1_seconds = best_time(lambda: analyze(rl1_text), options.repeats)
     python_seconds = best_time(lambda: compile(python_text, "<bench>", "exec"), options.repeats)
