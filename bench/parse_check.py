@@ -10,10 +10,9 @@ from 10,000 to 100,000 lines (goal: 10x the lines in at most 11x the time).
 from __future__ import annotations
 
 import argparse
-import gc
 import random
-import time
-from collections.abc import Callable
+
+from timing import best_time
 
 from rl1.compiler.frontend import analyze
 
@@ -61,17 +60,6 @@ def python_program(lines: int, seed: int = 1997) -> str:
         f"{rng.choice(names)} = {rng.choice(names)} + {rng.randint(0, 999)} - {rng.choice(names)}\n"
         for _ in range(lines)
     )
-
-
-def best_time(action: Callable[[], object], repeats: int) -> float:
-    """The fastest of several runs: the least disturbed by a shared, noisy machine."""
-    times = []
-    for _ in range(repeats):
-        gc.collect()
-        start = time.perf_counter()
-        action()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def main() -> None:

@@ -10,8 +10,8 @@ the VM's (goal: at least 0.2, i.e. the VM within 5x of CPython on the same work)
 from __future__ import annotations
 
 import argparse
-import time
-from collections.abc import Callable
+
+from timing import best_time
 
 from rl1.compiler.driver import compile_text
 from rl1.vm.machine import Machine
@@ -43,15 +43,6 @@ def python_equivalent() -> tuple[int, int, int]:
             m -= 1
         n -= 1
     return a, b, c
-
-
-def best_time(run: Callable[[], object], repeat: int) -> float:
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        run()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def main() -> None:

@@ -242,13 +242,9 @@ def explain(ctx: click.Context, code: str | None, list_codes: bool) -> None:
 MAX_ILC_BYTES = 16 * 1024 * 1024  # far more than any .ilc file holds
 
 
-@main.command()
-@click.argument("file")
-@click.pass_context
-def dis(ctx: click.Context, file: str) -> None:
-    """Disassemble an .ilc file into .ils text on standard output, with the program's
-    source lines when its source file is found (beside the .ilc, or by the recorded name).
-    Exit status: 0 done, 1 the file is not valid intermediate code, 2 an unreadable file."""
+def read_ilc(ctx: click.Context, file: str) -> bytes:
+    """The bytes of an .ilc file; exits 2 when it cannot be read, 1 when it is too large
+    to be one (without reading a huge file whole)."""
     try:
         with open(file, "rb") as stream:
             data = stream.read(MAX_ILC_BYTES + 1)
@@ -259,6 +255,17 @@ def dis(ctx: click.Context, file: str) -> None:
         click.echo(f"error: `{file}` is larger than {MAX_ILC_BYTES} bytes: not an .ilc file",
                    err=True)
         ctx.exit(EXIT_ERRORS)
+    return data
+
+
+@main.command()
+@click.argument("file")
+@click.pass_context
+def dis(ctx: click.Context, file: str) -> None:
+    """Disassemble an .ilc file into .ils text on standard output, with the program's
+    source lines when its source file is found (beside the .ilc, or by the recorded name).
+    Exit status: 0 done, 1 the file is not valid intermediate code, 2 an unreadable file."""
+    data = read_ilc(ctx, file)
     try:
         text = disassemble(data, file, source_beside(file))
     except VerifyError as error:
@@ -372,12 +379,7 @@ def run(ctx: click.Context, file: str, sensors: str | None, run_format: str, bud
         if engine == "ast":
             raise click.UsageError("--engine ast interprets RL/I source; an .ilc file runs "
                                    "on the VM: leave out --engine, or run the .rob file")
-        try:
-            with open(file, "rb") as stream:
-                data = stream.read(MAX_ILC_BYTES + 1)
-        except OSError as error:
-            click.echo(f"error: cannot read `{file}`: {error.strerror or error}", err=True)
-            ctx.exit(EXIT_USAGE)
+        data = read_ilc(ctx, file)
         try:
             result = run_ilc(data, device, budget)
         except VerifyError as error:
