@@ -16,7 +16,9 @@ $(STAMP): pyproject.toml
 
 demo: $(STAMP)
 	$(BIN)/rl1c check examples/sample.rob
-	$(BIN)/rl1c run examples/sample.rob --sensors examples/sample.sensors.json
+	mkdir -p build
+	$(BIN)/rl1c examples/sample.rob -o build/sample.ilc
+	$(BIN)/rl1c run build/sample.ilc --sensors examples/sample.sensors.json
 
 test: lint typecheck vscode-test pytest
 
