@@ -186,8 +186,9 @@ def _sections(document: Document) -> list[tuple[ast.LabelDef, int]]:
         (d for found in document.derived(labels).definitions.values() for d in found),
         key=lambda d: d.span.line,
     )
-    last = document.program_lines()
-    ends = [following.span.line - 1 for following in starts[1:]] + [last]
+    if not starts:
+        return []
+    ends = [following.span.line - 1 for following in starts[1:]] + [document.program_lines()]
     sections = []
     for label, end in zip(starts, ends, strict=True):
         while end > label.span.line and not document.line_text(end).strip():

@@ -15,6 +15,7 @@ from typing import Any
 
 import click
 from lsprotocol import types
+from pygls.exceptions import JsonRpcException
 from pygls.lsp.server import LanguageServer
 from pygls.protocol import LanguageServerProtocol
 from pygls.protocol.language_server import lsp_method
@@ -28,7 +29,16 @@ NAME = "rl1-lsp"
 
 class Rl1Protocol(LanguageServerProtocol):
     """Passes document synchronisation straight to the server's handlers, leaving
-    pygls' own copy of the documents out."""
+    pygls' own copy of the documents out, and answers requests whose parameters do not
+    fit the protocol (pygls only logs them, leaving the client waiting forever)."""
+
+    def structure_message(self, data: dict[str, Any]) -> Any:
+        try:
+            return super().structure_message(data)
+        except JsonRpcException as error:
+            if "id" in data and "method" in data:
+                self._send_response(data["id"], error=error.to_response_error())
+            raise
 
     def _user(self, method: str, params: object) -> Generator[Any, Any, None]:
         if (handler := self.fm.features.get(method)) is not None:

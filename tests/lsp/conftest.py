@@ -4,6 +4,7 @@ per test module, driven by pytest-lsp's client."""
 from __future__ import annotations
 
 import asyncio
+import copy
 import itertools
 import sys
 from collections.abc import AsyncIterator
@@ -90,7 +91,8 @@ def make_client() -> Client:
 
 def initialize_params(capabilities: types.ClientCapabilities = CAPABILITIES
                       ) -> types.InitializeParams:
-    return types.InitializeParams(capabilities=capabilities, root_uri="file:///work")
+    return types.InitializeParams(capabilities=copy.deepcopy(capabilities),
+                                  root_uri="file:///work")
 
 
 @pytest_lsp.fixture(  # type: ignore[untyped-decorator]

@@ -1,0 +1,84 @@
+"""The `rl1-lsp` command: --version, --help, bad options, and serving over TCP."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import socket
+import subprocess
+import sys
+from importlib.metadata import version
+
+import pytest
+
+COMMAND = [sys.executable, "-m", "rl1.lsp"]
+
+
+def run(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([*COMMAND, *args], capture_output=True, text=True, timeout=60,
+                          check=False)
+
+
+def test_version_and_help() -> None:
+    shown = run("--version")
+    assert shown.returncode == 0
+    assert version("rl1") in shown.stdout and "rl1-lsp" in shown.stdout
+    helped = run("--help")
+    assert helped.returncode == 0
+    assert "--tcp HOST:PORT" in helped.stdout and "--stdio" in helped.stdout
+
+
+@pytest.mark.parametrize("value", ["2087", "localhost:", "host:port", "h:70000"])
+def test_a_bad_tcp_address_is_a_usage_error(value: str) -> None:
+    failed = run("--tcp", value)
+    assert failed.returncode == 2
+    assert "HOST:PORT" in failed.stderr and "Traceback" not in failed.stderr
+
+
+def free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port: int = probe.getsockname()[1]
+        return port
+
+
+def frame(message: dict[str, object]) -> bytes:
+    body = json.dumps(message).encode()
+    return f"Content-Length: {len(body)}\r\n\r\n".encode() + body
+
+
+async def read_frame(reader: asyncio.StreamReader) -> dict[str, object]:
+    length = 0
+    while (header := await reader.readline()) != b"\r\n":
+        if header.lower().startswith(b"content-length:"):
+            length = int(header.split(b":")[1])
+    answer: dict[str, object] = json.loads(await reader.readexactly(length))
+    return answer
+
+
+@pytest.mark.asyncio
+async def test_serves_over_tcp() -> None:
+    port = free_port()
+    server = await asyncio.create_subprocess_exec(
+        *COMMAND, "--tcp", f"127.0.0.1:{port}", stderr=asyncio.subprocess.PIPE)
+    try:
+        async with asyncio.timeout(60):
+            while True:
+                try:
+                    reader, writer = await asyncio.open_connection("127.0.0.1", port)
+                    break
+                except OSError:
+                    await asyncio.sleep(0.1)
+            writer.write(frame({"jsonrpc": "2.0", "id": 1, "method": "initialize",
+                                "params": {"processId": None, "rootUri": None,
+                                           "capabilities": {}}}))
+            answer = await read_frame(reader)
+            assert answer["id"] == 1
+            result = answer["result"]
+            assert isinstance(result, dict)
+            assert result["serverInfo"]["name"] == "rl1-lsp"
+            assert result["capabilities"]["hoverProvider"]
+            writer.close()
+    finally:
+        server.kill()
+        await server.wait()

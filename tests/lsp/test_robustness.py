@@ -1,0 +1,165 @@
+"""The server never crashes or hangs: arbitrary and binary content, a 10 MB document,
+edits outside the document, unknown documents, malformed and cancelled requests, and a
+feature that fails."""
+
+from __future__ import annotations
+
+import asyncio
+import sys
+from collections.abc import AsyncIterator
+from concurrent.futures import Future
+from pathlib import Path
+
+import pytest
+import pytest_lsp
+from conftest import TIMEOUT, Client, initialize_params, make_client
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from lsprotocol import types
+from pygls.exceptions import JsonRpcException
+from pytest_lsp import ClientServerConfig
+
+pytestmark = pytest.mark.asyncio(loop_scope="module")
+
+UNKNOWN = types.TextDocumentIdentifier("file:///never/opened.rob")
+
+
+async def still_serving(client: Client) -> None:
+    """The server answers a hover on a fresh document correctly."""
+    uri, _ = await client.opened("(MOV 3,3)\n")
+    result = await client.text_document_hover_async(types.HoverParams(
+        types.TextDocumentIdentifier(uri), types.Position(0, 2)))
+    assert result is not None
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=list(HealthCheck))
+@given(text=st.text(max_size=200), line=st.integers(0, 10), character=st.integers(0, 300))
+async def test_arbitrary_text_gets_diagnostics_and_answers(
+        client: Client, text: str, line: int, character: int) -> None:
+    uri, _ = await client.opened(text)
+    position = types.Position(line, character)
+    identifier = types.TextDocumentIdentifier(uri)
+    await client.text_document_hover_async(types.HoverParams(identifier, position))
+    await client.text_document_completion_async(types.CompletionParams(identifier, position))
+    await client.text_document_semantic_tokens_full_async(types.SemanticTokensParams(identifier))
+    await client.text_document_formatting_async(types.DocumentFormattingParams(
+        identifier, types.FormattingOptions(tab_size=4, insert_spaces=True)))
+
+
+async def test_binary_content(client: Client) -> None:
+    binary = bytes(range(256)).decode("latin-1") * 4 + "\x00\ufffe\U0010ffff\ud800"
+    uri, diagnostics = await client.opened(binary)
+    assert any(d.code == "E0102" for d in diagnostics)
+    await client.text_document_document_symbol_async(
+        types.DocumentSymbolParams(types.TextDocumentIdentifier(uri)))
+    await still_serving(client)
+
+
+async def test_a_ten_megabyte_document_is_refused_clearly_and_quickly(client: Client) -> None:
+    huge = "A=B+1; (MOV 3,3) ' padding\n" * 400_000
+    assert len(huge) > 10_000_000
+    async with asyncio.timeout(TIMEOUT):
+        uri, diagnostics = await client.opened(huge)
+    (notice,) = diagnostics
+    assert "rl1c check" in notice.message and "characters" in notice.message
+    hover = await client.text_document_hover_async(types.HoverParams(
+        types.TextDocumentIdentifier(uri), types.Position(5, 1)))
+    assert hover is None
+    # shrinking it below the limit brings the analysis back
+    client.change(uri, 2, ((10, 0, 400_000, 0), ""))
+    assert await client.diagnostics_of(uri, 2) is not None
+    hover = await client.text_document_hover_async(types.HoverParams(
+        types.TextDocumentIdentifier(uri), types.Position(5, 1)))
+    assert hover is not None
+
+
+async def test_edits_outside_the_document_are_clamped(client: Client) -> None:
+    uri, _ = await client.opened("A=1\n")
+    client.change(uri, 2, ((50, 7, 90, 3), "(MOV"))  # past the end: appended
+    diagnostics = await client.diagnostics_of(uri, 2)
+    assert [(d.code, d.range.start.line) for d in diagnostics if d.code == "E0101"] == [
+        ("E0101", 1)]
+    client.change(uri, 3, ((1, 0, 0, 0), ""))  # end before start: taken in order
+    client.change(uri, 4, ((0, 999, 0, 999), " 2,2)"))  # past the end of a line
+    diagnostics = await client.diagnostics_of(uri, 4)  # the text is now "(MOV 2,2)"
+    assert not [d for d in diagnostics if str(d.code).startswith("E01")]
+    symbols = await client.text_document_semantic_tokens_full_async(
+        types.SemanticTokensParams(types.TextDocumentIdentifier(uri)))
+    assert symbols is not None and list(symbols.data[:3]) == [0, 1, 3]  # `MOV` on line 0
+
+
+async def test_requests_for_unknown_documents_answer_empty(client: Client) -> None:
+    position = types.Position(0, 0)
+    assert await client.text_document_hover_async(types.HoverParams(UNKNOWN, position)) is None
+    assert await client.text_document_definition_async(
+        types.DefinitionParams(UNKNOWN, position)) is None
+    assert await client.text_document_completion_async(
+        types.CompletionParams(UNKNOWN, position)) == []
+    assert await client.text_document_document_symbol_async(
+        types.DocumentSymbolParams(UNKNOWN)) == []
+    assert await client.text_document_semantic_tokens_full_async(
+        types.SemanticTokensParams(UNKNOWN)) is None
+    client.change(UNKNOWN.uri, 2, ((0, 0, 0, 0), "A"))  # ignored, not fatal
+    client.text_document_did_close(types.DidCloseTextDocumentParams(UNKNOWN))
+    await still_serving(client)
+
+
+def send_raw(client: Client, message: dict[str, object]) -> asyncio.Future[object]:
+    """Send a message as given, bypassing the client's typed requests; the answer to a
+    request comes back through the returned future."""
+    answer: Future[object] = Future()
+    if "id" in message:
+        client.protocol._request_futures[str(message["id"])] = answer
+    client.protocol._send_data({"jsonrpc": "2.0", **message})
+    return asyncio.wrap_future(answer)
+
+
+async def test_malformed_params_get_an_error_response(client: Client) -> None:
+    with pytest.raises(JsonRpcException, match="Invalid Params"):
+        await send_raw(client, {"id": "bad-1", "method": types.TEXT_DOCUMENT_HOVER,
+                                "params": {"textDocument": {"uri": 42}, "position": "here"}})
+    send_raw(client, {"method": types.TEXT_DOCUMENT_DID_CHANGE, "params": {"textDocument": 1}})
+    await still_serving(client)
+
+
+async def test_cancelled_requests_are_answered_or_cancelled(client: Client) -> None:
+    uri, _ = await client.opened("A=1\n" * 2000)
+    identifier = types.TextDocumentIdentifier(uri)
+    futures = []
+    for index in range(20):
+        msg_id = f"cancel-me-{index}"
+        futures.append(client.protocol.send_request_async(  # type: ignore[no-untyped-call]
+            types.TEXT_DOCUMENT_SEMANTIC_TOKENS_FULL, types.SemanticTokensParams(identifier),
+            msg_id=msg_id))
+        client.protocol.notify(types.CANCEL_REQUEST, types.CancelParams(id=msg_id))
+    for future in futures:
+        try:
+            await future
+        except JsonRpcException as error:
+            assert "cancel" in error.message.lower()
+    await still_serving(client)
+
+
+# A server with a failing feature ---------------------------------------------------------
+
+FAULTY = [sys.executable, str(Path(__file__).with_name("faulty_server.py"))]
+
+
+@pytest_lsp.fixture(  # type: ignore[untyped-decorator]
+    scope="module", config=ClientServerConfig(server_command=FAULTY, client_factory=make_client))
+async def faulty(lsp_client: Client) -> AsyncIterator[None]:
+    await lsp_client.initialize_session(initialize_params())
+    yield
+    await lsp_client.shutdown_session()
+
+
+async def test_a_failing_feature_answers_an_error_and_the_server_goes_on(faulty: Client) -> None:
+    uri, _ = await faulty.opened(":10 (MOV 3,3); #10\n")
+    identifier = types.TextDocumentIdentifier(uri)
+    for _ in range(2):
+        with pytest.raises(JsonRpcException, match="planted failure in hover"):
+            await faulty.text_document_hover_async(
+                types.HoverParams(identifier, types.Position(0, 6)))
+    found = await faulty.text_document_definition_async(
+        types.DefinitionParams(identifier, types.Position(0, 16)))
+    assert found is not None
