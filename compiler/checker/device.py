@@ -46,7 +46,7 @@ _SET_MODES, _SET_MOTION, _MVI, _END = range(4)
 Operation = tuple[int, int, int]  # (statement index, kind, value)
 CALLS = frozenset({"TRC", "MOV", "MVI", "END", "FRE", "HLD"})  # the calls that may matter
 
-# handler label -> (entry state, index of its first event point) for one block
+# handler label -> (index of its first event point in the block, entry state)
 Triggers = dict[int, tuple[int, int]]
 
 
