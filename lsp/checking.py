@@ -51,11 +51,7 @@ class Checked:
 def diagnose(document: Document) -> Checked:
     """Every diagnostic of the document, as `rl1c check` reports them: each line's own
     (cached), then the whole program's rules."""
-    found = [
-        problem
-        for number in range(1, document.program_lines() + 1)
-        for problem in document.line_problems(number)
-    ]
+    found = document.problems()
     failed = False
     collecting = gc.isenabled()
     gc.disable()  # as check() does: the checker builds no cycles for the collector to find
@@ -169,8 +165,7 @@ class DiagnosticsScheduler:
             return
         lines = document.program_lines()
         for first in range(1, lines + 1, PARSE_SLICE):
-            for number in range(first, min(first + PARSE_SLICE, lines + 1)):
-                document.line(number)
+            document.prepare(first, min(first + PARSE_SLICE - 1, lines))
             await asyncio.sleep(0)
             if document.version != version:
                 return

@@ -170,10 +170,24 @@ class Document:
             cached.problems = tuple(_move_diagnostic(d, number) for d in cached.problems)
         return cached.parsed
 
+    def prepare(self, first: int, last: int) -> None:
+        """Parse or relocate lines `first`..`last` (1-based, inclusive) now, so that a
+        caller can spread the work of a large change between other tasks."""
+        for number in range(first, last + 1):
+            cached = self._lines[number - 1]
+            if cached.parsed is None or cached.parsed.number != number:
+                self.line(number)
+
     def line_problems(self, number: int) -> tuple[Diagnostic, ...]:
         """The diagnostics of line `number` alone: syntax and the per-line rules."""
         self.line(number)
         return self._lines[number - 1].problems
+
+    def problems(self) -> list[Diagnostic]:
+        """The diagnostics of every line alone, in line order."""
+        self.program()  # parses and relocates what needs it
+        return [problem for cached in self._lines if cached.problems
+                for problem in cached.problems]
 
     def program_lines(self) -> int:
         """The lines the compiler sees: a final empty line after a line end is not one."""
@@ -184,7 +198,11 @@ class Document:
     def program(self) -> ast.Program:
         """The whole program, as `parser.parse_program` would build it from the text."""
         if self._program is None:
-            lines = tuple(self.line(number) for number in range(1, self.program_lines() + 1))
+            lines = tuple(
+                cached.parsed if cached.parsed is not None and cached.parsed.number == number
+                else self.line(number)
+                for number, cached in enumerate(self._lines[: self.program_lines()], start=1)
+            )
             end = lines[-1].span if lines else ast.Span(1, 1, 1, 1)
             self._program = ast.Program(ast.Span(1, 1, end.end_line, end.end_column), lines)
         return self._program
