@@ -19,8 +19,7 @@ from pathlib import Path
 
 from lsprotocol import types
 
-from rl1.compiler import catalogue
-from rl1.compiler.checker import check_program
+from rl1.compiler import catalogue, checker
 from rl1.compiler.diagnostics import Diagnostic, Severity, sort_key
 
 from .document import MAX_ANALYSED_CHARACTERS, Document
@@ -56,7 +55,7 @@ def diagnose(document: Document) -> Checked:
     collecting = gc.isenabled()
     gc.disable()  # as check() does: the checker builds no cycles for the collector to find
     try:
-        found.extend(check_program(document.program()))
+        found.extend(checker.check_program(document.program()))
     except Exception:  # a checker bug must not cost the user the syntax errors
         log.exception("the whole-program checker failed on %s", document.uri)
         failed = True

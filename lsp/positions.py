@@ -8,11 +8,14 @@ differ; ASCII lines take a fast path.
 
 from __future__ import annotations
 
+import re
+
 from lsprotocol import types
 
 from rl1.compiler.ast import Span
 
 UTF8, UTF16, UTF32 = "utf-8", "utf-16", "utf-32"
+_NON_ASCII = re.compile(r"[^\x00-\x7f]")
 
 
 def _width(character: str, encoding: str) -> int:
@@ -34,13 +37,28 @@ class Columns:
         if encoding not in (UTF8, UTF16, UTF32):
             raise ValueError(f"unsupported position encoding {encoding!r}")
         self.encoding = encoding
+        self._last_text = ""
+        self._last_ascii = 0
+
+    def _ascii_prefix(self, text: str) -> int:
+        """How many code points at the start of `text` are ASCII, where every encoding
+        counts alike. Remembered for the last line asked about: a line's tokens are
+        converted one after another, and a long line must not cost its length each."""
+        if text is not self._last_text:
+            found = _NON_ASCII.search(text)
+            self._last_text, self._last_ascii = text, found.start() if found else len(text)
+        return self._last_ascii
 
     def to_client(self, text: str, column: int) -> int:
         """The client column of 0-based code-point `column` in the line `text`."""
         column = min(column, len(text))
         if self.encoding == UTF32 or text.isascii():
             return column
-        return sum(_width(character, self.encoding) for character in text[:column])
+        ascii_prefix = self._ascii_prefix(text)
+        if column <= ascii_prefix:
+            return column
+        return ascii_prefix + sum(_width(character, self.encoding)
+                                  for character in text[ascii_prefix:column])
 
     def from_client(self, text: str, units: int) -> int:
         """The 0-based code-point column of client column `units`, clamped to the line.
@@ -49,9 +67,12 @@ class Columns:
             return 0
         if self.encoding == UTF32 or text.isascii():
             return min(units, len(text))
-        counted = 0
-        for column, character in enumerate(text):
-            counted += _width(character, self.encoding)
+        ascii_prefix = self._ascii_prefix(text)
+        if units <= ascii_prefix:
+            return units
+        counted = ascii_prefix
+        for column in range(ascii_prefix, len(text)):
+            counted += _width(text[column], self.encoding)
             if counted > units:
                 return column
         return len(text)

@@ -1,19 +1,23 @@
-"""rl1-lsp with a bug planted in hover, to test that a failing feature is answered with
-an error and the server keeps serving. Run as a script by test_robustness.py."""
+"""rl1-lsp with bugs planted in several features and in the whole-program checker, to
+test that a failing feature is answered with an error and the server keeps serving.
+Run as a script by test_robustness.py."""
 
 from __future__ import annotations
 
-from lsprotocol import types
+from typing import NoReturn
 
-from rl1.lsp import hover, server
-from rl1.lsp.document import Document
-from rl1.lsp.positions import Columns
-
-
-def broken_hover(document: Document, position: types.Position,
-                 columns: Columns) -> types.Hover | None:
-    raise RuntimeError("planted failure in hover")
+from rl1.compiler import checker
+from rl1.lsp import completion, hover, navigation, server, tokens
 
 
-hover.hover = broken_hover
+def planted(*args: object, **kwargs: object) -> NoReturn:
+    raise RuntimeError("planted failure")
+
+
+hover.hover = planted
+completion.complete = planted
+navigation.definition = planted
+navigation.symbols = planted
+tokens.encode = planted
+checker.check_program = planted
 server.main()

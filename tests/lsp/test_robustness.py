@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import asyncio
 import sys
-from collections.abc import AsyncIterator
+from collections.abc import AsyncIterator, Awaitable, Callable
 from concurrent.futures import Future
 from pathlib import Path
 
@@ -71,6 +71,17 @@ async def test_a_ten_megabyte_document_is_refused_clearly_and_quickly(client: Cl
     hover = await client.text_document_hover_async(types.HoverParams(
         types.TextDocumentIdentifier(uri), types.Position(5, 1)))
     assert hover is not None
+
+
+async def test_a_long_line_with_a_japanese_comment_is_not_quadratic(client: Client) -> None:
+    text = "A=1;" * 50_000 + "'日本語😀\n"
+    async with asyncio.timeout(TIMEOUT):
+        uri, _ = await client.opened(text)
+        tokens = await client.text_document_semantic_tokens_full_async(
+            types.SemanticTokensParams(types.TextDocumentIdentifier(uri)))
+    assert tokens is not None
+    # the comment: 2 after the last `1` (column 199,998), 6 UTF-16 units long
+    assert list(tokens.data[-5:]) == [0, 2, 6, 7, 0]
 
 
 async def test_edits_outside_the_document_are_clamped(client: Client) -> None:
@@ -153,13 +164,31 @@ async def faulty(lsp_client: Client) -> AsyncIterator[None]:
     await lsp_client.shutdown_session()
 
 
-async def test_a_failing_feature_answers_an_error_and_the_server_goes_on(faulty: Client) -> None:
-    uri, _ = await faulty.opened(":10 (MOV 3,3); #10\n")
+async def test_failing_features_answer_errors_and_the_server_goes_on(faulty: Client) -> None:
+    uri, diagnostics = await faulty.opened(":10 (MOV 3,3); #10\nA=(\n")
+    # the checker's failure is reported, and the syntax error is still shown
+    assert "checker failed" in diagnostics[0].message
+    assert [d.code for d in diagnostics[1:]] == ["E0101"]
     identifier = types.TextDocumentIdentifier(uri)
-    for _ in range(2):
-        with pytest.raises(JsonRpcException, match="planted failure in hover"):
-            await faulty.text_document_hover_async(
-                types.HoverParams(identifier, types.Position(0, 6)))
-    found = await faulty.text_document_definition_async(
-        types.DefinitionParams(identifier, types.Position(0, 16)))
-    assert found is not None
+    position = types.Position(0, 16)
+    failing: list[Callable[[], Awaitable[object]]] = [
+        lambda: faulty.text_document_hover_async(types.HoverParams(identifier, position)),
+        lambda: faulty.text_document_completion_async(
+            types.CompletionParams(identifier, position)),
+        lambda: faulty.text_document_definition_async(
+            types.DefinitionParams(identifier, position)),
+        lambda: faulty.text_document_document_symbol_async(
+            types.DocumentSymbolParams(identifier)),
+        lambda: faulty.text_document_semantic_tokens_full_async(
+            types.SemanticTokensParams(identifier)),
+    ]
+    for request in failing * 2:
+        with pytest.raises(JsonRpcException, match="planted failure"):
+            await request()
+    references = await faulty.text_document_references_async(types.ReferenceParams(
+        context=types.ReferenceContext(include_declaration=True), text_document=identifier,
+        position=position))
+    starts = [r.range.start for r in references or []]
+    assert starts == [types.Position(0, 0), types.Position(0, 15)]
+    faulty.change(uri, 2, ((1, 2, 1, 3), "1"))
+    assert [d.code for d in await faulty.diagnostics_of(uri, 2)] == [None]
