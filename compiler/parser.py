@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import gc
 import itertools
+import re
 import tempfile
 import unicodedata
 from collections.abc import Callable, Iterable
@@ -43,6 +44,7 @@ TERMINAL_NAMES = {
 }
 
 
+_LEADING_LABEL = re.compile(r"[ \t\f\v]*(:[0-9]*)")
 _HEX_DIGITS = frozenset("0123456789ABCDEFabcdef")
 _SPACE = " \t\f\v"  # the scanner's whitespace; other Unicode spaces are errors
 
@@ -332,10 +334,22 @@ def parse_line(text: str, number: int) -> tuple[ast.Line, list[Diagnostic]]:
     try:
         label, statements = cast(_ParsedLine, _run_lalr(tables, scan(code)))
     except (ScanError, _SyntaxError) as error:
-        return ast.Line(span, number, None, (), comment, ok=False), [
+        return ast.Line(span, number, _leading_label(code, number), (), comment, ok=False), [
             _syntax_error(number, error, code)
         ]
     return ast.Line(span, number, label, statements, comment), builder.problems
+
+
+def _leading_label(code: str, number: int) -> ast.LabelDef | None:
+    """The label that starts a line with a syntax error, so that jumps to it still
+    resolve and the checker need not assume the worst about the broken line."""
+    match = _LEADING_LABEL.match(code)
+    if match is None:
+        return None
+    text = match.group(1)
+    column = match.start(1) + 1
+    return ast.LabelDef(ast.Span(number, column, number, column + len(text)), text,
+                        int(text[1:]) if len(text) == 3 else None)
 
 
 def parse_program(text: str) -> tuple[ast.Program, list[Diagnostic]]:

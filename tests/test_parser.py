@@ -84,3 +84,11 @@ def test_a_line_of_full_width_spaces_is_an_error_not_blank() -> None:
     _, [diagnostic] = parse_line("\u3000\u3000", 1)
     assert diagnostic.code == "E0102"
     assert diagnostic.help is not None and "full-width space" in diagnostic.help
+
+
+def test_a_line_with_a_syntax_error_keeps_its_label() -> None:
+    program, [diagnostic] = parse_program("#10\n:10 A=(MOV 1\n(END)\n")
+    broken = program.lines[1]
+    assert diagnostic.code == "E0101" and not broken.ok
+    assert broken.label == ast.LabelDef(ast.Span(2, 1, 2, 4), ":10", 10)
+    assert broken.statements == ()
