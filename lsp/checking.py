@@ -126,7 +126,7 @@ class DiagnosticsScheduler:
         self._publish = publish
         self._columns = columns
         self._tasks: dict[str, asyncio.Task[None]] = {}
-        self.checked: dict[str, Checked] = {}
+        self._results: dict[str, Checked] = {}
 
     def schedule(self, document: Document) -> None:
         self.cancel(document.uri)
@@ -138,7 +138,7 @@ class DiagnosticsScheduler:
         task = self._tasks.pop(uri, None)
         if task is not None:
             task.cancel()
-        self.checked.pop(uri, None)
+        self._results.pop(uri, None)
 
     def close(self, uri: str) -> None:
         """Forget a closed document and clear its diagnostics in the client."""
@@ -151,10 +151,10 @@ class DiagnosticsScheduler:
         return self._checked(document).diagnostics
 
     def _checked(self, document: Document) -> Checked:
-        checked = self.checked.get(document.uri)
+        checked = self._results.get(document.uri)
         if checked is None or checked.version != document.version:
             checked = diagnose(document)
-            self.checked[document.uri] = checked
+            self._results[document.uri] = checked
         return checked
 
     async def _run(self, document: Document, version: int) -> None:

@@ -43,8 +43,9 @@ def _replace(number: int, text: str, start: int, end: int, columns: Columns) -> 
     )
 
 
-def _snippet(words: list[str], form: Form, first: int, close: bool) -> str:
-    params = ",".join(f"${{{first + i}:{p.name}}}" for i, p in enumerate(form.params))
+def _snippet(words: list[str], form: Form, close: bool) -> str:
+    """`MVI ${1:l},${2:r},${3:cm})`: tab stops named after the parameters."""
+    params = ",".join(f"${{{i}:{p.name}}}" for i, p in enumerate(form.params, start=1))
     return " ".join(words + ([params] if params else [])) + (")" if close else "")
 
 
@@ -58,7 +59,7 @@ def _mnemonic_items(builtin: Builtin, snippets: bool, markdown: bool, close: boo
     for form in builtin.forms:
         words = [builtin.mnemonic] + ([form.selector] if form.selector else [])
         label = " ".join(words)
-        text = _snippet(words, form, 1, close) if snippets else builtin.mnemonic
+        text = _snippet(words, form, close) if snippets else label
         items.append(types.CompletionItem(
             label=label,
             kind=types.CompletionItemKind.Function,
@@ -114,7 +115,7 @@ def complete(document: Document, position: types.Position, columns: Columns,
                 documentation=_documentation(describe_form(builtin, form), markdown),
                 text_edit=types.TextEdit(
                     range=edit_range,
-                    new_text=_snippet([form.selector or ""], form, 1, close) if snippets
+                    new_text=_snippet([form.selector or ""], form, close) if snippets
                     else form.selector or ""),
                 insert_text_format=(types.InsertTextFormat.Snippet if snippets
                                     else types.InsertTextFormat.PlainText),

@@ -87,8 +87,8 @@ def create_server() -> Rl1Server:
         if isinstance(encoding, types.PositionEncodingKind):
             encoding = encoding.value
         server.columns = Columns(encoding)
-        completion_caps = params.capabilities.text_document and \
-            params.capabilities.text_document.completion
+        text_document = params.capabilities.text_document
+        completion_caps = text_document.completion if text_document else None
         item = completion_caps.completion_item if completion_caps else None
         server.snippets = bool(item and item.snippet_support)
         formats = (item.documentation_format if item else None) or []
