@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 from lsprotocol import types
 
 from rl1.compiler.frontend import analyze
+from rl1.compiler.strategies import lines
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
@@ -97,10 +98,10 @@ async def test_a_burst_of_edits_never_publishes_a_stale_version(client: Client) 
 
 # Incremental sync against a model of the text ----------------------------------------
 
-LINE_TEXTS = st.sampled_from([
+LINE_TEXTS = st.one_of(lines(), st.sampled_from([
     "A=1", ":10 B=A+2; ?B>#10", "(MOV 3,3)", "(MVI 1,1,50", "'日本語のコメント😀",
     "C=x-128 'ｺﾒﾝﾄ", "", "  ", "#10", "A=(", "\u3000B=1", "?Z<#99",
-])
+]))
 BREAKS = st.sampled_from(["\n", "\r\n", "\r"])
 
 

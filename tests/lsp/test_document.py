@@ -7,6 +7,7 @@ from hypothesis import strategies as st
 from lsprotocol import types
 
 from rl1.compiler.parser import parse_program
+from rl1.compiler.strategies import lines
 from rl1.lsp.document import Document
 from rl1.lsp.positions import UTF8, UTF16, UTF32, Columns
 
@@ -14,7 +15,7 @@ PIECES = st.sampled_from([
     "A=1", ":10 B=A+2", "?B>#10", "(MOV 3,3)", "(MVI", "'日本語😀", "ｺﾒﾝﾄ", "\n", "\r\n",
     "\r", " ", "#", ";", "\x00", "\u2028", "\x0c", "$FF", "é",
 ])
-TEXT = st.lists(PIECES, max_size=12).map("".join)
+TEXT = st.lists(st.one_of(PIECES, lines()), max_size=12).map("".join)
 ENCODINGS = st.sampled_from([UTF8, UTF16, UTF32])
 
 
