@@ -14,24 +14,14 @@ import os
 import sys
 import traceback
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
-from rl1.vm.faults import DEFAULT_BUDGET, RunResult
-from rl1.vm.report import render_json, render_text
-from rl1.vm.runner import ENGINES, Engine, run_ilc, run_source
-from rl1.vm.scripted import Script, ScriptedDevice, ScriptError, load_script
-from rl1.vm.verifier import VerifyError
+from rl1.vm.faults import DEFAULT_BUDGET
 
-from . import formatter
-from .asm import AsmError, assemble
 from .ast import Span
-from .atomic import write_atomically
-from .catalogue import CODES
 from .diagnostics import Diagnostic, Severity
-from .disasm import disassemble, source_beside
-from .driver import EMITS, OPTIMIZATION_LEVELS, Emit, compile_text
-from .frontend import analyze
 from .render import (
     COLOR_CHOICES,
     EXIT_ERRORS,
@@ -45,6 +35,18 @@ from .render import (
     use_color,
 )
 from .source import MAX_SOURCE_BYTES, Source, SourceError, decode, read_source
+
+if TYPE_CHECKING:
+    from rl1.vm.runner import Engine
+
+    from .driver import Emit
+
+# Each command imports the stages it runs when it runs, so that `rl1c check` starts
+# without loading the back end, the VM or the assembler (bench/cold_start.py). For the
+# same reason these option choices are spelled here; tests/test_cli_imports.py holds
+# them equal to driver.EMITS and runner.ENGINES.
+EMIT_CHOICES = ("ilc", "ir")
+ENGINE_CHOICES = ("vm", "ast")
 
 EXIT_INTERNAL = 3
 
@@ -144,6 +146,8 @@ def check(ctx: click.Context, files: tuple[str, ...], output_format: Format,
           color: ColorChoice) -> None:
     """Check RL/I programs (`-` reads standard input) and report every problem found.
     Exit status: 0 no errors (warnings allowed), 1 errors, 2 an unreadable file."""
+    from .frontend import analyze
+
     checked: list[FileDiagnostics] = []
     for name in files:
         source = read_input(name)
@@ -162,7 +166,7 @@ def check(ctx: click.Context, files: tuple[str, ...], output_format: Format,
                    "source (standard output with --emit ir).")
 @click.option("-s", "--strip", is_flag=True,
               help="Leave out the debug section (the map from code to source lines).")
-@click.option("--emit", "emit_kind", type=click.Choice(EMITS), default="ilc",
+@click.option("--emit", "emit_kind", type=click.Choice(EMIT_CHOICES), default="ilc",
               show_default=True, help="ilc: the .ilc file; ir: the IR as text.")
 @click.option("-O", "optimize", default="0", metavar="LEVEL",
               help="Optimization level; only -O0 (none) exists so far.")
@@ -176,6 +180,9 @@ def compile_program(ctx: click.Context, file: str, output: str | None, strip: bo
     Diagnostics go to standard error; nothing is written when the program has errors.
     Exit status: 0 compiled (warnings allowed), 1 errors, 2 an unreadable input or an
     output that cannot be written."""
+    from .atomic import write_atomically
+    from .driver import OPTIMIZATION_LEVELS, compile_text
+
     if optimize not in {str(level) for level in OPTIMIZATION_LEVELS}:
         raise click.BadParameter(f"`-O{optimize}`: only -O0 (no optimization) exists so far",
                                  param_hint="-O")
@@ -224,6 +231,8 @@ def _default_output(source: str) -> str:
 @click.pass_context
 def explain(ctx: click.Context, code: str | None, list_codes: bool) -> None:
     """Explain a diagnostic code in depth, with examples: `rl1c explain E0101`."""
+    from .catalogue import CODES
+
     if list_codes == (code is not None):
         raise click.UsageError("give a code, as in `rl1c explain E0101`, or --list")
     if code is None:
@@ -265,6 +274,10 @@ def dis(ctx: click.Context, file: str) -> None:
     """Disassemble an .ilc file into .ils text on standard output, with the program's
     source lines when its source file is found (beside the .ilc, or by the recorded name).
     Exit status: 0 done, 1 the file is not valid intermediate code, 2 an unreadable file."""
+    from rl1.vm.verifier import VerifyError
+
+    from .disasm import disassemble, source_beside
+
     data = read_ilc(ctx, file)
     try:
         text = disassemble(data, file, source_beside(file))
@@ -284,6 +297,9 @@ def assemble_file(ctx: click.Context, file: str, output: str | None) -> None:
     """Assemble .ils text (as `rl1c dis` prints it) into an .ilc file; the result must
     pass the verifier. Exit status: 0 written, 1 errors in the text (nothing is written),
     2 an unreadable input or an output that cannot be written."""
+    from .asm import AsmError, assemble
+    from .atomic import write_atomically
+
     try:
         source = read_source(file)
     except SourceError as error:
@@ -322,6 +338,8 @@ def fmt(ctx: click.Context, files: tuple[str, ...], check: bool, diff: bool) -> 
     each file in place in its own encoding; `-` formats standard input to standard output.
     Exit status: 0 done, 1 (--check) a file would change, 2 a file cannot be read or
     written."""
+    from . import formatter
+
     status = 0
     for name in files:
         source = read_input(name)
@@ -360,7 +378,7 @@ def fmt(ctx: click.Context, files: tuple[str, ...], check: bool, diff: bool) -> 
               show_default=True,
               help="Instructions (statements with --engine ast) before the watchdog stops "
                    "a runaway program.")
-@click.option("--engine", type=click.Choice(ENGINES), default="vm", show_default=True,
+@click.option("--engine", type=click.Choice(ENGINE_CHOICES), default="vm", show_default=True,
               help="vm: compile, then run on the reference VM; ast: interpret the source.")
 @click.pass_context
 def run(ctx: click.Context, file: str, sensors: str | None, run_format: str, budget: int,
@@ -370,6 +388,12 @@ def run(ctx: click.Context, file: str, sensors: str | None, run_format: str, bud
     has errors (or the .ilc file is not valid); 2 a usage problem or an unreadable file
     (sensor scripts included); faults: 10 argument out of range, 11 missing handler,
     12 budget exhausted, 13 device error."""
+    from rl1.vm.faults import RunResult
+    from rl1.vm.report import render_json, render_text
+    from rl1.vm.runner import run_ilc, run_source
+    from rl1.vm.scripted import Script, ScriptedDevice, ScriptError, load_script
+    from rl1.vm.verifier import VerifyError
+
     try:
         device = ScriptedDevice(load_script(sensors) if sensors is not None else Script())
     except ScriptError as error:

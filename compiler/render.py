@@ -11,7 +11,6 @@ import json
 import os
 import unicodedata
 from collections.abc import Sequence
-from importlib.metadata import version
 from pathlib import Path
 from typing import IO, Any, Literal, NamedTuple
 from urllib.parse import quote
@@ -50,6 +49,13 @@ class FileDiagnostics(NamedTuple):
     text: str | None
     diagnostics: Sequence[Diagnostic]
 
+
+
+def _tool_version() -> str:
+    # importlib.metadata costs milliseconds at start-up; only SARIF needs the version.
+    from importlib.metadata import version
+
+    return version("rl1")
 
 def report(
     files: Sequence[FileDiagnostics],
@@ -310,7 +316,7 @@ def _sarif_report(files: Sequence[FileDiagnostics]) -> str:
         "runs": [{
             "tool": {"driver": {
                 "name": "rl1c",
-                "version": version("rl1"),
+                "version": _tool_version(),
                 "rules": [_sarif_rule(code) for code in CODES],
             }},
             "columnKind": "unicodeCodePoints",  # as our Span columns count
