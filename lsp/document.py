@@ -178,11 +178,6 @@ class Document:
             if cached.parsed is None or cached.parsed.number != number:
                 self.line(number)
 
-    def line_problems(self, number: int) -> tuple[Diagnostic, ...]:
-        """The diagnostics of line `number` alone: syntax and the per-line rules."""
-        self.line(number)
-        return self._lines[number - 1].problems
-
     def problems(self) -> list[Diagnostic]:
         """The diagnostics of every line alone, in line order."""
         self.program()  # parses and relocates what needs it

@@ -44,14 +44,6 @@ class Labels:
         return sorted(self.definitions)
 
 
-def jumps_of(line: ast.Line) -> list[ast.LabelRef]:
-    return [
-        statement.target
-        for statement in line.statements
-        if isinstance(statement, ast.Goto | ast.CondJump)
-    ]
-
-
 def labels(document: Document) -> Labels:
     """The label index of a document; use `document.derived(labels)` to build it once
     per version."""
