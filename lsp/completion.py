@@ -98,8 +98,7 @@ def complete(document: Document, position: types.Position, columns: Columns,
             types.CompletionItem(
                 label=f"{label:02d}",
                 kind=types.CompletionItemKind.Reference,
-                detail=f":{label:02d}, line {index.definitions[label][0].span.line}",
-                documentation=document.line_text(index.definitions[label][0].span.line).strip(),
+                detail=f"line {index.definitions[label][0].span.line}",
                 text_edit=types.TextEdit(range=edit_range, new_text=f"{label:02d}"),
             )
             for label in index.defined()
