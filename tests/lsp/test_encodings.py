@@ -28,6 +28,9 @@ async def test_negotiated_encoding_counts_columns(encoding: str) -> None:
                 position_encodings=[encoding, "utf-16"])
         result = await client.initialize_session(params)
         assert result.capabilities.position_encoding == encoding
+        sync = result.capabilities.text_document_sync
+        assert isinstance(sync, types.TextDocumentSyncOptions)
+        assert sync.change == types.TextDocumentSyncKind.Incremental
         uri, diagnostics = await client.opened(TEXT)
         (error,) = [d for d in diagnostics if d.code == "E0102"]
         assert error.range == types.Range(types.Position(1, 4),

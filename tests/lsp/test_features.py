@@ -223,6 +223,20 @@ async def test_references_of_a_variable(client: Client) -> None:
     assert [r.range.start.line for r in refs or []] == [5, 8]
 
 
+async def test_highlights_of_a_variable_mark_writes_and_reads(client: Client) -> None:
+    text = "A=1; B=A+2\nA++; ?A>#10\n(MOV A,B)\n"
+    uri = await open_program(client, text)
+    found = await client.text_document_document_highlight_async(
+        types.DocumentHighlightParams(doc(uri), position_of(text, "A+2")))
+    write, read = types.DocumentHighlightKind.Write, types.DocumentHighlightKind.Read
+    assert [(h.range.start.line, h.range.start.character, h.kind) for h in found or []] == [
+        (0, 0, write), (0, 7, read), (1, 0, write), (1, 6, read), (2, 5, read)]
+    refs = await client.text_document_references_async(types.ReferenceParams(
+        context=types.ReferenceContext(include_declaration=False), text_document=doc(uri),
+        position=position_of(text, "#10", 1)))
+    assert [r.range.start for r in refs or []] == [types.Position(1, 8)]
+
+
 async def test_rename_a_label_renumbers_definition_and_jumps(client: Client) -> None:
     uri = await open_program(client)
     prepared = await client.text_document_prepare_rename_async(types.PrepareRenameParams(
