@@ -25,7 +25,7 @@ DECLARATION, DEFAULT_LIBRARY = 1, 2  # modifier bits
 _Raw = tuple[int, int, int, int]
 
 _MEMO_LIMIT = 200_000
-_memo: dict[tuple[str, str], tuple[tuple[int, int, int, int], ...]] = {}
+_memo: dict[tuple[str, str], tuple[int, ...]] = {}
 
 
 def _operand(operand: ast.Operand, out: list[_Raw]) -> None:
@@ -79,22 +79,24 @@ def _raw_tokens(line: ast.Line) -> list[_Raw]:
     return out
 
 
-def line_tokens(document: Document, number: int,
-                columns: Columns) -> tuple[tuple[int, int, int, int], ...]:
-    """(start, length, type, modifiers) in client units, 0-based start."""
+def _line_data(document: Document, number: int, columns: Columns) -> tuple[int, ...]:
+    """A line's tokens in the LSP encoding, less the first token's line delta (the one
+    number that depends on the lines before): start, length, type, modifiers, then
+    0, start delta, length, type, modifiers for each further token."""
     text = document.line_text(number)
     key = (text, columns.encoding)
     found = _memo.get(key)
     if found is None:
         if len(_memo) >= _MEMO_LIMIT:
             _memo.clear()
-        found = tuple(
-            (columns.to_client(text, column - 1),
-             columns.to_client(text, column - 1 + length) - columns.to_client(text, column - 1),
-             kind, modifiers)
-            for column, length, kind, modifiers in _raw_tokens(document.line(number))
-        )
-        _memo[key] = found
+        data: list[int] = []
+        previous = 0
+        for column, length, kind, modifiers in _raw_tokens(document.line(number)):
+            start = columns.to_client(text, column - 1)
+            end = columns.to_client(text, column - 1 + length)
+            data += (0, start - previous, end - start, kind, modifiers)
+            previous = start
+        found = _memo[key] = tuple(data[1:])
     return found
 
 
@@ -103,11 +105,27 @@ def encode(document: Document, columns: Columns) -> list[int]:
     data: list[int] = []
     previous_line = 0
     for number in range(1, document.program_lines() + 1):
-        previous_start = 0
-        for start, length, kind, modifiers in line_tokens(document, number, columns):
-            data += (number - 1 - previous_line, start - previous_start, length, kind, modifiers)
-            previous_line, previous_start = number - 1, start
+        line_data = _line_data(document, number, columns)
+        if line_data:
+            data.append(number - 1 - previous_line)
+            data += line_data
+            previous_line = number - 1
     return data
+
+
+def _common_prefix(old: list[int], new: list[int]) -> int:
+    """How many leading items the lists share, compared a block at a time in C."""
+    limit = min(len(old), len(new))
+    same, block = 0, 4096
+    while same < limit:
+        step = min(block, limit - same)
+        if old[same : same + step] == new[same : same + step]:
+            same += step
+        elif step == 1:
+            break
+        else:
+            block = max(step // 2, 1)
+    return same
 
 
 class TokenHistory:
@@ -130,14 +148,9 @@ class TokenHistory:
             return self.full(document, columns)
         old = previous[1]
         new = self.full(document, columns)
-        data = new.data
-        start = 0
-        limit = min(len(old), len(data))
-        while start < limit and old[start] == data[start]:
-            start += 1
-        end = 0
-        while end < limit - start and old[-1 - end] == data[-1 - end]:
-            end += 1
+        data = list(new.data)
+        start = _common_prefix(old, data)
+        end = min(_common_prefix(old[::-1], data[::-1]), len(old) - start, len(data) - start)
         edits = [] if old == data else [types.SemanticTokensEdit(
             start=start, delete_count=len(old) - start - end,
             data=data[start : len(data) - end])]

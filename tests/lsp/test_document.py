@@ -12,6 +12,7 @@ from rl1.compiler.parser import parse_program
 from rl1.compiler.strategies import lines
 from rl1.lsp.document import Document
 from rl1.lsp.positions import UTF8, UTF16, UTF32, Columns
+from rl1.lsp.tokens import TokenHistory, encode
 
 PIECES = st.sampled_from([
     "A=1", ":10 B=A+2", "?B>#10", "(MOV 3,3)", "(MVI", "'日本語😀", "ｺﾒﾝﾄ", "\n", "\r\n",
@@ -103,3 +104,20 @@ def test_japanese_comment_positions_in_each_encoding() -> None:
     assert Columns(UTF8).to_client(text, end) == 5 + 9 + 4 + 1
     # the middle of the emoji's surrogate pair rounds down to the emoji
     assert Columns(UTF16).from_client(text, 9) == 8
+
+
+@settings(max_examples=200, deadline=None)
+@given(text=TEXT, edit=changes())
+def test_semantic_token_deltas_rebuild_the_new_tokens(
+        text: str, edit: types.TextDocumentContentChangeEvent) -> None:
+    columns = Columns(UTF16)
+    document = Document("file:///t.rob", text, 1)
+    history = TokenHistory()
+    before = history.full(document, columns)
+    document.apply(edit, columns)
+    delta = history.delta(document, columns, before.result_id or "")
+    assert isinstance(delta, types.SemanticTokensDelta)
+    data = list(before.data)
+    for change in delta.edits:
+        data[change.start : change.start + change.delete_count] = list(change.data or [])
+    assert data == encode(document, columns)
