@@ -1,0 +1,28 @@
+"""What a normal (non-editable) install contains: every package folder and data file.
+
+An editable install maps whole folders, so a package missing from pyproject.toml only
+shows up in a wheel; these checks catch that without building one."""
+
+import tomllib
+from pathlib import Path
+
+ROOT = Path(__file__).parent.parent
+CONFIG = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["setuptools"]
+
+
+def _package_of(folder: Path) -> str:
+    top, *rest = folder.relative_to(ROOT).parts
+    mapped = {path: name for name, path in CONFIG["package-dir"].items()}
+    return ".".join([mapped[top], *rest])
+
+
+def test_every_package_folder_is_listed() -> None:
+    folders = {init.parent for top in CONFIG["package-dir"].values()
+               for init in (ROOT / top).rglob("__init__.py")}
+    assert {_package_of(folder) for folder in folders} == set(CONFIG["packages"])
+
+
+def test_data_files_the_code_reads_are_package_data() -> None:
+    data = CONFIG["package-data"]["rl1.compiler"]
+    assert "*.lark" in data and "explanations/*.md" in data
+    assert list((ROOT / "compiler" / "explanations").glob("*.md"))
