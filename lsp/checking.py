@@ -55,7 +55,7 @@ def diagnose(document: Document) -> Checked:
     collecting = gc.isenabled()
     gc.disable()  # as check() does: the checker builds no cycles for the collector to find
     try:
-        found.extend(checker.check_program(document.program()))
+        found.extend(checker.check_program(document.program(), document.memo))
     except Exception:  # a checker bug must not cost the user the syntax errors
         log.exception("the whole-program checker failed on %s", document.uri)
         failed = True

@@ -18,7 +18,7 @@ from typing import TypeVar, cast
 from lsprotocol import types
 
 from rl1.compiler import ast
-from rl1.compiler.checker import check_line
+from rl1.compiler.checker import LineMemo, check_line
 from rl1.compiler.diagnostics import Diagnostic, Edit, Fix, Related
 from rl1.compiler.parser import parse_line
 
@@ -68,6 +68,7 @@ class Document:
         self._size = len(text)
         self._program: ast.Program | None = None
         self._derived: dict[Callable[[Document], object], object] = {}
+        self.memo = LineMemo()  # the whole-program checker's facts about kept lines
 
     # Text ---------------------------------------------------------------------------
 
@@ -166,6 +167,7 @@ class Document:
         elif cached.parsed.number != number:
             moved = ast.relocate(cached.parsed, number)
             assert isinstance(moved, ast.Line)
+            self.memo.moved(cached.parsed, moved)
             cached.parsed = moved
             cached.problems = tuple(_move_diagnostic(d, number) for d in cached.problems)
         return cached.parsed

@@ -7,7 +7,7 @@ import gc
 
 from ..ast import Program
 from ..diagnostics import Diagnostic
-from .cfg import ControlFlowGraph, build_cfg
+from .cfg import ControlFlowGraph, LineMemo, build_cfg
 from .handlers import check_handlers
 from .labels import check_labels
 from .lines import check_line
@@ -16,7 +16,7 @@ from .reachability import check_reachability
 from .reserved import check_reserved
 from .safety import check_safety
 
-__all__ = ["ControlFlowGraph", "build_cfg", "check", "check_line", "check_program"]
+__all__ = ["ControlFlowGraph", "LineMemo", "build_cfg", "check", "check_line", "check_program"]
 
 
 def check(program: Program) -> list[Diagnostic]:
@@ -36,10 +36,10 @@ def check(program: Program) -> list[Diagnostic]:
     return found
 
 
-def check_program(program: Program) -> list[Diagnostic]:
+def check_program(program: Program, memo: LineMemo | None = None) -> list[Diagnostic]:
     """The diagnostics of the whole-program rules only (the language server combines
-    them with its cached per-line results)."""
-    graph = build_cfg(program)
+    them with its cached per-line results, and passes a memo of the lines it keeps)."""
+    graph = build_cfg(program, memo)
     return [
         *check_labels(graph),
         *check_handlers(program, graph),

@@ -24,7 +24,7 @@ RESERVED_BIT = {name: 1 << index for index, name in enumerate(RESERVED_VARIABLES
 ALL_RESERVED = (1 << len(RESERVED_VARIABLES)) - 1
 
 
-@dataclass(slots=True)
+@dataclass(slots=True, eq=False)  # shared, never changed: equal only to itself (a memo key)
 class BlockEffects:
     operations: list[device.Operation]  # the calls that change the device state
     # The first event point, where a pending lost line is taken: the first statement
@@ -38,6 +38,12 @@ class BlockEffects:
     @staticmethod
     def nothing() -> BlockEffects:
         return BlockEffects([], None, 0, [], False)
+
+
+# A run of one line's statements that lies in a single block: the statements, what they
+# do (indices counted from the run's first statement; None for nothing), and whether the
+# run ends its block (with a jump or `(END)`). A plain tuple: a line makes one or more.
+Segment = tuple[tuple[ast.Statement, ...], BlockEffects | None, bool]
 
 
 class _CallFacts(NamedTuple):
@@ -75,8 +81,78 @@ def reserved_writes(call: ast.Call) -> int:
     return _facts(call).writes
 
 
-def summarize(statements: Sequence[ast.Statement]) -> BlockEffects:
-    """The effects of a block's statements, in one pass (the checker's hottest loop)."""
+def relocated(segments: tuple[Segment, ...], statements: tuple[ast.Statement, ...]
+              ) -> tuple[Segment, ...]:
+    """The segments of a line moved elsewhere (ast.relocate), whose `statements` are
+    those of the segments' line, moved: only the statements change."""
+    moved: list[Segment] = []
+    start = 0
+    for segment in segments:
+        end = start + len(segment[0])
+        moved.append((statements[start:end], segment[1], segment[2]))
+        start = end
+    return tuple(moved)
+
+
+def combine(parts: list[tuple[int, BlockEffects]]) -> BlockEffects:
+    """The effects of a block from those of its runs, each with the index in the block
+    of its first statement. Summaries are shared, never changed, so one run's is reused
+    as it is."""
+    if not parts:
+        return BlockEffects.nothing()
+    if len(parts) == 1 and parts[0][0] == 0:
+        return parts[0][1]
+    operations: list[device.Operation] = []
+    writes: list[tuple[int, int, int]] = []
+    first_event: int | None = None
+    reads = 0
+    observes = False
+    for offset, part in parts:
+        if first_event is None and part.first_event is not None:
+            first_event = offset + part.first_event
+        if part.operations:
+            operations += [(offset + index, kind, value) for index, kind, value in part.operations]
+        if part.writes:
+            writes += [(offset + index, by_calls, by_store)
+                       for index, by_calls, by_store in part.writes]
+        reads |= part.reads
+        observes = observes or part.observes
+    return BlockEffects(operations, first_event, reads, writes, observes)
+
+
+def line_segments(statements: tuple[ast.Statement, ...]) -> tuple[Segment, ...]:
+    """A line's statements cut after each jump and `(END)`, each run summarized. What a
+    run does depends on its statements alone, not on the line's number, so the language
+    server keeps these across edits (cfg.LineMemo)."""
+    segments: list[Segment] = []
+    start = 0
+    for index, statement in enumerate(statements):
+        if isinstance(statement, ast.Goto | ast.CondJump) or (
+                isinstance(statement, ast.CallStmt) and is_end(statement.call)):
+            run = statements[start : index + 1]
+            segments.append((run, summarize(run), True))
+            start = index + 1
+    if start < len(statements):
+        run = statements[start:]
+        segments.append((run, summarize(run), False))
+    return tuple(segments)
+
+
+def is_end(call: ast.Call) -> bool:
+    return call.mnemonic.upper() == "END"
+
+
+def _summary(operations: list[device.Operation], first_event: int | None, reads: int,
+             writes: list[tuple[int, int, int]], observes: bool) -> BlockEffects | None:
+    """A run's effects; None for a run without calls, jumps or reserved variables."""
+    if first_event is None and not reads and not writes:
+        return None  # no calls either: nothing observes, and there are no operations
+    return BlockEffects(operations, first_event, reads, writes, observes)
+
+
+def summarize(statements: Sequence[ast.Statement]) -> BlockEffects | None:
+    """The effects of a block's statements, in one pass (the checker's hottest loop);
+    None for statements without calls, jumps or reserved variables."""
     operations: list[device.Operation] = []
     first_event: int | None = None
     writes: list[tuple[int, int, int]] = []
@@ -138,4 +214,4 @@ def summarize(statements: Sequence[ast.Statement]) -> BlockEffects:
                 writes.append((index, 0, by_store))
         elif first_event is None:  # a jump
             first_event = index
-    return BlockEffects(operations, first_event, reads, writes, observes)
+    return _summary(operations, first_event, reads, writes, observes)
