@@ -18,7 +18,9 @@ label the program does not define may land on it.
 
 Each block also carries a summary of what its statements do (effects.py), computed once
 for all the data-flow rules, and the graph the device state on entry to each block,
-which says which blocks some path reaches.
+which says which blocks some path reaches. From scratch, a block is summarized in one
+pass; the language server instead keeps a summary per line (LineMemo) and puts each
+block's together from those of its lines, so that an edit summarizes only what changed.
 """
 
 from __future__ import annotations

@@ -128,7 +128,7 @@ def line_segments(statements: tuple[ast.Statement, ...]) -> tuple[Segment, ...]:
     start = 0
     for index, statement in enumerate(statements):
         if isinstance(statement, ast.Goto | ast.CondJump) or (
-                isinstance(statement, ast.CallStmt) and is_end(statement.call)):
+                isinstance(statement, ast.CallStmt) and _is_end(statement.call)):
             run = statements[start : index + 1]
             segments.append((run, summarize(run), True))
             start = index + 1
@@ -138,7 +138,7 @@ def line_segments(statements: tuple[ast.Statement, ...]) -> tuple[Segment, ...]:
     return tuple(segments)
 
 
-def is_end(call: ast.Call) -> bool:
+def _is_end(call: ast.Call) -> bool:
     return call.mnemonic.upper() == "END"
 
 

@@ -79,3 +79,13 @@ def test_one_memo_across_unrelated_programs_agrees_with_none(texts: list[str]) -
         program = parse_program(text)[0]
         assert shape(build_cfg(program, memo)) == shape(build_cfg(program))
         assert check_program(program, memo) == check_program(program)
+
+
+def test_the_memo_forgets_replaced_lines_and_still_agrees() -> None:
+    memo = LineMemo()
+    long = parse_program(":10 (TRC 3); (MOV 3,3)\n" + "A=x+1; (KYO)\n" * 1500 + "#10\n")[0]
+    check_program(long, memo)
+    short = parse_program(":10 (TRC 2); (MOV A,0); #10\n(END)\n")[0]
+    for program in (short, long, short):  # the long program's lines are dropped, then back
+        assert check_program(program, memo) == check_program(program)
+        assert shape(build_cfg(program, memo)) == shape(build_cfg(program))
