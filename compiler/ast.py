@@ -205,8 +205,7 @@ def relocate(node: Node, line: int) -> Node:
     for name in _field_names(type(node)):
         value = getattr(node, name)
         if value.__class__ is Span:
-            value = Span(line, value.column, line + value.end_line - value.line,
-                         value.end_column)
+            value = value.on_line(line)
         elif isinstance(value, Node):
             value = relocate(value, line)
         elif value.__class__ is tuple and value:
