@@ -10,15 +10,13 @@ from __future__ import annotations
 
 import difflib
 import os
-import re
 
 from . import ast
 from .atomic import write_atomically
 from .diagnostics import Edit
 from .parser import parse_line
-from .source import Source, split_lines
+from .source import LINE_BREAK, Source, split_lines
 
-_LINE_END = re.compile(r"\r\n|\r|\n")
 _UTF8_BOM = b"\xef\xbb\xbf"
 
 
@@ -43,7 +41,7 @@ def format_text(text: str) -> str:
         lines.pop()
     if not lines:
         return ""
-    first_end = _LINE_END.search(text)
+    first_end = LINE_BREAK.search(text)
     line_end = first_end.group() if first_end else "\n"
     return line_end.join(lines) + line_end
 

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 MAX_SOURCE_BYTES = 64 * 1024 * 1024
-_LINE_BREAK = re.compile(r"\r\n|\r|\n")
+LINE_BREAK = re.compile(r"\r\n|\r|\n")
+"""A line end: LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them."""
 
 
 class SourceError(Exception):
@@ -32,7 +33,7 @@ class Source:
 def split_lines(text: str) -> list[str]:
     """The lines of `text` without their line ends. A final line end does not start an
     extra line; an empty text has no lines."""
-    lines = _LINE_BREAK.split(text)
+    lines = LINE_BREAK.split(text)
     if lines and lines[-1] == "":
         lines.pop()
     return lines

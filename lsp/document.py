@@ -21,12 +21,13 @@ from rl1.compiler import ast
 from rl1.compiler.checker import LineMemo, check_line
 from rl1.compiler.diagnostics import Diagnostic, Edit, Fix, Related
 from rl1.compiler.parser import parse_line
+from rl1.compiler.source import LINE_BREAK
 
 from .positions import Columns, span_range
 
 T = TypeVar("T")
 
-_LINE_BREAK = re.compile(r"(\r\n|\r|\n)")
+_LINE_BREAK_KEPT = re.compile(f"({LINE_BREAK.pattern})")  # split() keeps the line ends
 
 MAX_ANALYSED_CHARACTERS = 2_000_000
 """Beyond this a document is kept in sync but not analysed. An RL/I program of 10,000
@@ -42,7 +43,7 @@ class CachedLine:
 
 def _split(text: str) -> tuple[list[str], list[str]]:
     """Line texts and their endings; the last line's ending is ""."""
-    parts = _LINE_BREAK.split(text)
+    parts = _LINE_BREAK_KEPT.split(text)
     return parts[0::2], [*parts[1::2], ""]
 
 
