@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import gc
 import itertools
-import re
 import tempfile
 import unicodedata
 from collections.abc import Callable, Iterable
@@ -28,7 +27,7 @@ from lark.parsers.lalr_analysis import Shift
 from . import ast
 from .builtins import BUILTINS
 from .diagnostics import Diagnostic, Severity
-from .scanner import ScanError, Token, scan
+from .scanner import WHITESPACE, ScanError, Token, scan
 from .source import split_lines
 
 GRAMMAR = Path(__file__).with_name("grammar.lark")
@@ -44,9 +43,7 @@ TERMINAL_NAMES = {
 }
 
 
-_LEADING_LABEL = re.compile(r"[ \t\f\v]*(:[0-9]*)")
 _HEX_DIGITS = frozenset("0123456789ABCDEFabcdef")
-_SPACE = " \t\f\v"  # the scanner's whitespace; other Unicode spaces are errors
 
 _ParsedLine = tuple[ast.LabelDef | None, tuple[ast.Statement, ...]]
 
@@ -110,10 +107,13 @@ class _AstBuilder(lark.Transformer):  # type: ignore[type-arg]
         if items and isinstance(items[0], Token):
             token = items.pop(0)
             assert isinstance(token, Token)
-            digits = token.text[1:]
-            number = int(digits) if len(digits) == 2 else None
-            label = ast.LabelDef(self.span(token), token.text, number)
+            label = self.label_def(token)
         return label, tuple(items)  # type: ignore[arg-type]
+
+    def label_def(self, token: Token) -> ast.LabelDef:
+        digits = token.text[1:]
+        return ast.LabelDef(self.span(token), token.text,
+                            int(digits) if len(digits) == 2 else None)
 
     def assign(self, items: list[object]) -> ast.Assign:
         target_token, _, first, *steps = items
@@ -325,7 +325,7 @@ def parse_line(text: str, number: int) -> tuple[ast.Line, list[Diagnostic]]:
         start = len(code) + 1
         comment = ast.Comment(ast.Span(number, start, number, len(text) + 1), comment_text)
     span = ast.Span(number, 1, number, len(text) + 1)
-    if not code.strip(_SPACE):
+    if not code.strip(WHITESPACE):
         return ast.Line(span, number, None, (), comment), []
     tables = _lalr_tables()
     builder = tables.builder
@@ -334,22 +334,20 @@ def parse_line(text: str, number: int) -> tuple[ast.Line, list[Diagnostic]]:
     try:
         label, statements = cast(_ParsedLine, _run_lalr(tables, scan(code)))
     except (ScanError, _SyntaxError) as error:
-        return ast.Line(span, number, _leading_label(code, number), (), comment, ok=False), [
+        return ast.Line(span, number, _leading_label(builder, code), (), comment, ok=False), [
             _syntax_error(number, error, code)
         ]
     return ast.Line(span, number, label, statements, comment), builder.problems
 
 
-def _leading_label(code: str, number: int) -> ast.LabelDef | None:
+def _leading_label(builder: _AstBuilder, code: str) -> ast.LabelDef | None:
     """The label that starts a line with a syntax error, so that jumps to it still
     resolve and the checker need not assume the worst about the broken line."""
-    match = _LEADING_LABEL.match(code)
-    if match is None:
+    try:
+        first = next(scan(code), None)
+    except ScanError:
         return None
-    text = match.group(1)
-    column = match.start(1) + 1
-    return ast.LabelDef(ast.Span(number, column, number, column + len(text)), text,
-                        int(text[1:]) if len(text) == 3 else None)
+    return builder.label_def(first) if first is not None and first.type == "LABEL" else None
 
 
 def parse_program(text: str) -> tuple[ast.Program, list[Diagnostic]]:

@@ -13,9 +13,12 @@ from __future__ import annotations
 import re
 from collections.abc import Iterator
 
+WHITESPACE = " \t\f\v"
+"""What separates tokens; any other character outside a comment, a full-width space
+included, is an error."""
+
 _TOKEN = re.compile(
-    r"""
-     (?P<SPACE>[ \t\f\v]+)
+    r"(?P<SPACE>[" + re.escape(WHITESPACE) + r"]+)" + r"""
     |(?P<LABEL>:[0-9]*)
     |(?P<LABELREF>\#[0-9]*)
     |(?P<NUMBER>-?[0-9]+)
