@@ -16,7 +16,8 @@ LINE_BREAK = re.compile(r"\r\n|\r|\n")
 
 
 class SourceError(Exception):
-    """A file that cannot be read as RL/I text; the message says why and what to do."""
+    """An input file that cannot be read, or not as RL/I text; the message says why and
+    what to do."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -64,21 +65,23 @@ def decode(data: bytes, name: str = "<input>") -> Source:
 
 def read_source(path: str | Path) -> Source:
     """Read and decode a source file, turning every OS failure into a SourceError."""
-    path = Path(path)
+    return decode(read_bounded(Path(path), MAX_SOURCE_BYTES, "an RL/I source file"), str(path))
+
+
+def read_bounded(path: Path, limit: int, what: str) -> bytes:
+    """The bytes of the input file `path`, `what` it should be; SourceError when it cannot
+    be read or holds more than `limit` bytes (found without reading a huge file whole)."""
     try:
-        if path.is_dir():
-            raise SourceError(f"{path} is a directory, not an RL/I source file")
-        size = path.stat().st_size
-        if size > MAX_SOURCE_BYTES:
-            raise SourceError(
-                f"{path} is {size} bytes; RL/I sources are limited to "
-                f"{MAX_SOURCE_BYTES // (1024 * 1024)} MiB"
-            )
-        data = path.read_bytes()
+        with path.open("rb") as stream:
+            data = stream.read(limit + 1)
     except FileNotFoundError:
         raise SourceError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise SourceError(f"{path} is a directory, not {what}") from None
     except PermissionError:
         raise SourceError(f"{path}: permission denied") from None
     except OSError as error:
         raise SourceError(f"{path}: cannot read ({error.strerror or error})") from None
-    return decode(data, str(path))
+    if len(data) > limit:
+        raise SourceError(f"{path} is larger than {limit // 2**20} MiB, the limit for {what}")
+    return data

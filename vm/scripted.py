@@ -43,6 +43,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from rl1.compiler.builtins import BUILTINS
+from rl1.compiler.source import SourceError, read_bounded
 
 from .device import (
     DeviceError,
@@ -119,17 +120,9 @@ def load_script(path: str | Path) -> Script:
     """Read and validate a sensor script; ScriptError says what is wrong and where."""
     path = Path(path)
     try:
-        with path.open("rb") as stream:
-            data = stream.read(MAX_SCRIPT_BYTES + 1)
-    except FileNotFoundError:
-        raise ScriptError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise ScriptError(f"{path}: is a directory, not a sensor script") from None
-    except OSError as error:
-        raise ScriptError(f"{path}: cannot read ({error.strerror or error})") from None
-    if len(data) > MAX_SCRIPT_BYTES:
-        raise ScriptError(f"{path}: larger than {MAX_SCRIPT_BYTES // 2**20} MiB; a sensor "
-                          "script is a small file of readings")
+        data = read_bounded(path, MAX_SCRIPT_BYTES, "a sensor script")
+    except SourceError as error:
+        raise ScriptError(str(error)) from None
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as error:
