@@ -10,7 +10,6 @@ from __future__ import annotations
 import errno
 import os
 import re
-from dataclasses import fields
 from pathlib import Path
 
 import pytest
@@ -80,8 +79,8 @@ def shape(node: object) -> object:
     """A node as nested tuples without its spans: equal shapes mean the same program."""
     if isinstance(node, ast.Node):
         return (type(node).__name__, *(
-            shape(getattr(node, f.name)) for f in fields(node)
-            if not isinstance(getattr(node, f.name), ast.Span)
+            shape(getattr(node, name)) for name in node.__struct_fields__
+            if not isinstance(getattr(node, name), ast.Span)
         ))
     if isinstance(node, tuple):
         return tuple(shape(item) for item in node)
