@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from .ast import Program
 from .checker import check
 from .diagnostics import Diagnostic, sort_key
-from .parser import collector_paused, parse_program
+from .parser import parse_program
 
 
 @dataclass(frozen=True, slots=True)
@@ -21,8 +21,7 @@ class Analysis:
 
 
 def analyze(text: str) -> Analysis:
-    with collector_paused():  # the checker's work, like the parser's, is all acyclic
-        program, diagnostics = parse_program(text)
-        diagnostics.extend(check(program))
+    program, diagnostics = parse_program(text)
+    diagnostics.extend(check(program))
     diagnostics.sort(key=sort_key)
     return Analysis(program, diagnostics)

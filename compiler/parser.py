@@ -15,16 +15,14 @@ a call.
 
 from __future__ import annotations
 
-import contextlib
 import functools
-import gc
 import unicodedata
-from collections.abc import Iterator
 from typing import Any
 
 from . import ast
 from .builders import ACTIONS, Builder, Child, ParsedLine, label_def
 from .builtins import BUILTINS
+from .collector import collector_paused
 from .diagnostics import Diagnostic, Severity
 from .lalr_tables import ACTIONS as TABLE
 from .lalr_tables import RULES, START
@@ -212,20 +210,6 @@ def parse_line(text: str, number: int) -> tuple[ast.Line, list[Diagnostic]]:
         ]
     label, statements = plan(lexemes, number)
     return ast.Line(span, number, label, statements, comment), []
-
-
-@contextlib.contextmanager
-def collector_paused() -> Iterator[None]:
-    """Pause Python's cyclic garbage collector while a program's AST is built and
-    checked. The AST is acyclic, so the collector has nothing to find in it; left on,
-    it re-scans the growing tree again and again, and time grows faster than the file."""
-    collecting = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if collecting:
-            gc.enable()
 
 
 def parse_program(text: str) -> tuple[ast.Program, list[Diagnostic]]:

@@ -10,7 +10,6 @@ published for a stale version.
 from __future__ import annotations
 
 import asyncio
-import gc
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -20,6 +19,7 @@ from pathlib import Path
 from lsprotocol import types
 
 from rl1.compiler import catalogue, checker
+from rl1.compiler.collector import collector_paused
 from rl1.compiler.diagnostics import Diagnostic, Severity, sort_key
 
 from .document import MAX_ANALYSED_CHARACTERS, Document
@@ -52,16 +52,12 @@ def diagnose(document: Document) -> Checked:
     (cached), then the whole program's rules."""
     found = document.problems()
     failed = False
-    collecting = gc.isenabled()
-    gc.disable()  # as check() does: the checker builds no cycles for the collector to find
     try:
-        found.extend(checker.check_program(document.program(), document.memo))
+        with collector_paused():
+            found.extend(checker.check_program(document.program(), document.memo))
     except Exception:  # a checker bug must not cost the user the syntax errors
         log.exception("the whole-program checker failed on %s", document.uri)
         failed = True
-    finally:
-        if collecting:
-            gc.enable()
     found.sort(key=sort_key)
     return Checked(document.version, found, failed)
 

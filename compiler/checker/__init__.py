@@ -3,9 +3,8 @@ the control-flow graph (cfg.py) and the data-flow analyses on it."""
 
 from __future__ import annotations
 
-import gc
-
 from ..ast import Program
+from ..collector import collector_paused
 from ..diagnostics import Diagnostic
 from .cfg import ControlFlowGraph, LineMemo, build_cfg
 from .handlers import check_handlers
@@ -21,18 +20,11 @@ __all__ = ["ControlFlowGraph", "LineMemo", "build_cfg", "check", "check_line", "
 
 def check(program: Program) -> list[Diagnostic]:
     """Every diagnostic of the static rules, in no particular order."""
-    # The checker builds no cycles, so the cyclic collector has nothing to find; left on,
-    # it re-scans the AST each time the graph's many small objects trigger it.
-    collecting = gc.isenabled()
-    gc.disable()
-    try:
-        found: list[Diagnostic] = []
+    found: list[Diagnostic] = []
+    with collector_paused():
         for line in program.lines:
             found.extend(check_line(line))
         found.extend(check_program(program))
-    finally:
-        if collecting:
-            gc.enable()
     return found
 
 
