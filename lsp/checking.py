@@ -1,8 +1,10 @@
 """Diagnostics: what they are for a document, how the client sees them, and when they
 are published.
 
-A change schedules a check after a short debounce, so a burst of changes is checked
-once. The check yields to the event loop while it parses, so requests are answered in
+A change is checked at once when it comes alone, as a keystroke does; a change that
+follows the last one within a few milliseconds (a paste, a multi-cursor edit, a burst
+from a script) is part of a burst, whose check waits a little so that the burst is
+checked once. The check yields to the event loop while it parses, so requests are answered in
 the meantime, and it gives up as soon as a newer version arrives: diagnostics are never
 published for a stale version.
 """
@@ -28,7 +30,8 @@ from .positions import Columns
 log = logging.getLogger(__name__)
 
 SOURCE = "rl1"
-DEBOUNCE_SECONDS = 0.005
+BURST_SECONDS = 0.005
+"""Changes closer together than this are a burst; a burst's check waits this long."""
 PARSE_SLICE = 500  # lines parsed between two chances for requests to run
 
 _SEVERITIES = {
@@ -115,18 +118,31 @@ CHECKER_FAILED = notice(
 Publish = Callable[[types.PublishDiagnosticsParams], None]
 
 
+def wait_before_check(previous_change: float | None, now: float) -> float:
+    """Seconds to wait before checking a change made at `now`: none for a change alone,
+    BURST_SECONDS for one that follows the previous change of its document closely."""
+    in_burst = previous_change is not None and now - previous_change < BURST_SECONDS
+    return BURST_SECONDS if in_burst else 0.0
+
+
 class DiagnosticsScheduler:
-    """Runs the debounced check of each open document and publishes the result."""
+    """Runs the check of each open document (waiting out bursts of changes) and
+    publishes the result."""
 
     def __init__(self, publish: Publish, columns: Callable[[], Columns]) -> None:
         self._publish = publish
         self._columns = columns
         self._tasks: dict[str, asyncio.Task[None]] = {}
         self._results: dict[str, Checked] = {}
+        self._last_change: dict[str, float] = {}
 
     def schedule(self, document: Document) -> None:
         self.cancel(document.uri)
-        task = asyncio.get_running_loop().create_task(self._run(document, document.version))
+        loop = asyncio.get_running_loop()
+        now = loop.time()
+        wait = wait_before_check(self._last_change.get(document.uri), now)
+        self._last_change[document.uri] = now
+        task = loop.create_task(self._run(document, document.version, wait))
         self._tasks[document.uri] = task
         task.add_done_callback(self._finished)
 
@@ -139,6 +155,7 @@ class DiagnosticsScheduler:
     def close(self, uri: str) -> None:
         """Forget a closed document and clear its diagnostics in the client."""
         self.cancel(uri)
+        self._last_change.pop(uri, None)
         self._publish(types.PublishDiagnosticsParams(uri=uri, diagnostics=[]))
 
     def current(self, document: Document) -> list[Diagnostic]:
@@ -153,8 +170,8 @@ class DiagnosticsScheduler:
             self._results[document.uri] = checked
         return checked
 
-    async def _run(self, document: Document, version: int) -> None:
-        await asyncio.sleep(DEBOUNCE_SECONDS)
+    async def _run(self, document: Document, version: int, wait: float) -> None:
+        await asyncio.sleep(wait)
         if document.too_large:
             self._send(document, version, [too_large_notice(document)])
             return

@@ -66,6 +66,9 @@ class Document:
         self.version = version
         texts, self._endings = _split(text)
         self._lines = [CachedLine(line) for line in texts]
+        # Lines [_stale_low, _stale_high) may be unparsed or numbered for another place;
+        # the others are ready, so preparing the program after a small edit skips them.
+        self._stale_low, self._stale_high = 0, len(self._lines)
         self._size = len(text)
         self._program: ast.Program | None = None
         self._derived: dict[Callable[[Document], object], object] = {}
@@ -155,6 +158,10 @@ class Document:
         removed = sum(len(line.text) for line in old) + sum(map(len, self._endings[low:high]))
         self._lines[low:high] = old[:same_start] + middle + kept_end
         self._endings[low:high] = endings
+        # Lines below the window moved when it changed size: they need relocating.
+        stale_high = low + len(texts) if len(texts) == high - low else len(self._lines)
+        self._stale_low = min(self._stale_low, low)
+        self._stale_high = min(max(self._stale_high, stale_high), len(self._lines))
         self._size += sum(map(len, texts)) + sum(map(len, endings)) - removed
 
     # Syntax -------------------------------------------------------------------------
@@ -176,10 +183,15 @@ class Document:
     def prepare(self, first: int, last: int) -> None:
         """Parse or relocate lines `first`..`last` (1-based, inclusive) now, so that a
         caller can spread the work of a large change between other tasks."""
-        for number in range(first, last + 1):
+        low, high = max(first, self._stale_low + 1), min(last, self._stale_high)
+        for number in range(low, high + 1):
             cached = self._lines[number - 1]
             if cached.parsed is None or cached.parsed.number != number:
                 self.line(number)
+        if low <= high and low == self._stale_low + 1:
+            self._stale_low = high  # the stale window now starts below what was done
+        if self._stale_low >= self._stale_high:
+            self._stale_low, self._stale_high = len(self._lines), 0
 
     def problems(self) -> list[Diagnostic]:
         """The diagnostics of every line alone, in line order."""
@@ -196,11 +208,11 @@ class Document:
     def program(self) -> ast.Program:
         """The whole program, as `parser.parse_program` would build it from the text."""
         if self._program is None:
-            lines = tuple(
-                cached.parsed if cached.parsed is not None and cached.parsed.number == number
-                else self.line(number)
-                for number, cached in enumerate(self._lines[: self.program_lines()], start=1)
-            )
+            # All lines, the final empty one too, so that the stale window closes.
+            self.prepare(1, len(self._lines))
+            count = self.program_lines()
+            lines = cast(tuple[ast.Line, ...],  # prepare() parsed every one of them
+                         tuple([cached.parsed for cached in self._lines[:count]]))
             end = lines[-1].span if lines else ast.Span(1, 1, 1, 1)
             self._program = ast.Program(ast.Span(1, 1, end.end_line, end.end_column), lines)
         return self._program

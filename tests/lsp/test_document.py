@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from lsprotocol import types
 
@@ -65,14 +65,23 @@ def changes(draw: st.DrawFn) -> types.TextDocumentContentChangeEvent:
     return types.TextDocumentContentChangePartial(range=types.Range(start, end), text=draw(TEXT))
 
 
+_LINE_INSERTED_ABOVE_PARSED_LINES = [
+    (types.TextDocumentContentChangePartial(
+        range=types.Range(types.Position(0, 0), types.Position(0, 0)), text="\n"), 0, True),
+]
+
+
 @settings(max_examples=300, deadline=None)
-@given(text=TEXT, edits=st.lists(changes(), max_size=6), encoding=ENCODINGS)
+@given(text=TEXT, edits=st.lists(st.tuples(changes(), st.integers(0, 9), st.booleans()),
+                                 max_size=6), encoding=ENCODINGS)
+@example(text="A=1\nB=2\n", edits=_LINE_INSERTED_ABOVE_PARSED_LINES, encoding=UTF16)
 def test_edits_keep_text_and_syntax_as_if_parsed_afresh(
-        text: str, edits: list[types.TextDocumentContentChangeEvent], encoding: str) -> None:
+        text: str, edits: list[tuple[types.TextDocumentContentChangeEvent, int, bool]],
+        encoding: str) -> None:
     columns = Columns(encoding)
     document = Document("file:///t.rob", text, 1)
     document.program()  # fill the cache so that edits must keep it right
-    for change in edits:
+    for change, prepared, look in edits:
         if isinstance(change, types.TextDocumentContentChangeWholeDocument):
             text = change.text
         else:
@@ -81,6 +90,10 @@ def test_edits_keep_text_and_syntax_as_if_parsed_afresh(
             text = text[:low] + change.text + text[high:]
         document.apply(change, columns)
         assert document.text() == text
+        # As the server does: prepare some lines ahead (a slice), look at the program.
+        document.prepare(1, min(prepared, document.program_lines()))
+        if look:
+            assert document.program() == parse_program(text)[0]
     program, syntax = parse_program(text)
     assert document.program() == program
     per_line = syntax + [d for line in program.lines for d in check_line(line)]
