@@ -93,8 +93,15 @@ def _reduce(kinds: Kinds, name: str, expansion: tuple[str, ...], inline_single: 
     for symbol, value in zip(expansion, popped, strict=True):
         if symbol[0] != "_":
             children.append(value)
-        elif not symbol.isupper():
+        elif symbol.isupper():
+            continue
+        elif children:
             children.extend(value)
+        else:
+            # Adopt the list rather than copy it: each list is spliced into one parent
+            # only, and copying it at every step of a left-recursive rule (`A=1+1+...`,
+            # `A=1;A=1;...`) would make a long line's parse time grow with its square.
+            children = value
     if name[0] == "_":
         return children
     if inline_single and len(children) == 1:

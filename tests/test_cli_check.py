@@ -184,6 +184,15 @@ def test_a_megabyte_line_is_checked_and_shown_briefly(tmp_path: Path) -> None:
     assert max(len(line) for line in result.stdout.splitlines()) < 1000
 
 
+@pytest.mark.parametrize("code", ["A=1" + "+1" * 250_000, "B=2;" * 250_000])
+def test_a_megabyte_line_of_code_is_parsed_in_one_pass(tmp_path: Path, code: str) -> None:
+    # Quadratic time on such a line (copying a growing list at every step) would make
+    # this test run for hours rather than seconds.
+    result = run("check", write(tmp_path, code + "\n(END)\n"), "--format", "json")
+    assert result.exit_code == 0
+    assert "E01" not in result.stdout
+
+
 # Never a traceback ---------------------------------------------------------------------
 
 _FRAGMENTS = [
