@@ -175,9 +175,9 @@ class DiagnosticsScheduler:
         if document.too_large:
             self._send(document, version, [too_large_notice(document)])
             return
-        lines = document.program_lines()
-        for first in range(1, lines + 1, PARSE_SLICE):
-            document.prepare(first, min(first + PARSE_SLICE - 1, lines))
+        waiting = document.unprepared()
+        for first in range(waiting.start, waiting.stop, PARSE_SLICE):
+            document.prepare(first, min(first + PARSE_SLICE, waiting.stop) - 1)
             await asyncio.sleep(0)
             if document.version != version:
                 return

@@ -193,6 +193,11 @@ class Document:
         if self._stale_low >= self._stale_high:
             self._stale_low, self._stale_high = len(self._lines), 0
 
+    def unprepared(self) -> range:
+        """The 1-based numbers of the lines an edit may have left unparsed or moved
+        (prepare() makes them ready); the others are ready already."""
+        return range(self._stale_low + 1, min(self._stale_high, self.program_lines()) + 1)
+
     def problems(self) -> list[Diagnostic]:
         """The diagnostics of every line alone, in line order."""
         self.program()  # parses and relocates what needs it

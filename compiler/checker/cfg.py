@@ -21,11 +21,17 @@ for all the data-flow rules, and the graph the device state on entry to each blo
 which says which blocks some path reaches. From scratch, a block is summarized in one
 pass; the language server instead keeps a summary per line (LineMemo) and puts each
 block's together from those of its lines, so that an edit summarizes only what changed.
+The memo also keeps how the last check cut the program into blocks: after an edit, the
+cut is walked again only from the last point before the edit where no block was open
+to the first such point after it, and the blocks on either side are taken as they were.
 """
 
 from __future__ import annotations
 
+import bisect
+from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from .. import ast
 from . import device
@@ -104,6 +110,7 @@ class LineMemo:
     def __init__(self) -> None:
         self._entries: dict[int, tuple[ast.Line, Segments]] = {}
         self._blocks: dict[tuple[Part, ...], BlockEffects] = {}  # the last check's
+        self.last_walk: _Walk | None = None  # how the last check cut its program
 
     def moved(self, old: ast.Line, new: ast.Line) -> None:
         """`new` is `old` relocated (ast.relocate): it has the same segments."""
@@ -111,18 +118,23 @@ class LineMemo:
         if entry is not None and entry[0] is old:
             self._entries[id(new)] = (new, relocated(entry[1], new.statements))
 
-    def segments_of(self, lines: tuple[ast.Line, ...]) -> list[tuple[ast.Line, Segments]]:
-        """Each line with its segments, computing those of lines not seen before."""
+    def segments_of(self, lines: Sequence[ast.Line]) -> list[Segments]:
+        """The segments of each line, computing those of lines not seen before."""
         entries = self._entries
         found = []
         for line in lines:
             entry = entries.get(id(line))
             if entry is None or entry[0] is not line:
                 entry = entries[id(line)] = (line, line_segments(line.statements))
-            found.append(entry)
-        if len(entries) > 2 * len(lines) + 1000:  # forget the lines edits replaced
-            self._entries = {id(entry[0]): entry for entry in found}
+            found.append(entry[1])
         return found
+
+    def forget_all_but(self, lines: tuple[ast.Line, ...]) -> None:
+        """Drop the entries of lines no longer in the program, once they are most."""
+        if len(self._entries) > 2 * len(lines) + 1000:
+            kept = (self._entries.get(id(line)) for line in lines)
+            self._entries = {id(entry[0]): entry for entry in kept
+                             if entry is not None}
 
     def block_effects(self, parts: list[list[Part]]) -> list[BlockEffects]:
         """`effects.combine` of each block's parts, reusing the last check's for a block
@@ -220,32 +232,114 @@ def _blocks(program: ast.Program) -> tuple[list[Block], dict[int, int], list[Blo
     return cut.blocks, cut.labels, summaries
 
 
+class _Cut(NamedTuple):
+    """A block as the walk over the lines cut it, before any edge is known."""
+
+    statements: list[ast.Statement]
+    labels: list[ast.LabelDef]
+    opaque: bool
+    parts: list[Part]  # its runs' effects (none for the exit block)
+
+
+class _Walk(NamedTuple):
+    """How a check cut its program into blocks: the lines, the blocks (the exit block
+    last), and the lines before which no block was open and no label waited for one,
+    where a walk may start afresh, each with the number of blocks cut before it."""
+
+    lines: tuple[ast.Line, ...]
+    cuts: list[_Cut]
+    restarts: list[tuple[int, int]]
+
+
 def _blocks_from_segments(program: ast.Program, memo: LineMemo
                           ) -> tuple[list[Block], dict[int, int], list[BlockEffects]]:
-    """The blocks (the exit block last), put together from the memo's line segments:
-    the fastest way after an edit, which changes few of them."""
-    cut = _Blocks()
-    parts: list[list[Part]] = []  # per block but the exit: its runs' effects
+    """The blocks (the exit block last), put together from the memo's line segments: the
+    fastest way after an edit. An edit inside a line changes that line alone, so the
+    walk restarts at the last restart point before it and stops at the first one after
+    it, taking the blocks on either side from the last check."""
+    walk = _walk_again(program.lines, memo) if memo.last_walk else None
+    if walk is None:
+        walk = _walk_lines(program.lines, 0, [], [], memo, None)
+    memo.last_walk = walk
+    memo.forget_all_but(program.lines)
+    blocks: list[Block] = []
+    labels: dict[int, int] = {}
+    for index, cut in enumerate(walk.cuts):
+        blocks.append(Block(index, cut.statements, cut.labels, [], [], cut.opaque))
+        for label in cut.labels:
+            if label.number is not None:
+                labels.setdefault(label.number, index)
+    return blocks, labels, memo.block_effects([cut.parts for cut in walk.cuts[:-1]])
+
+
+def _walk_again(lines: tuple[ast.Line, ...], memo: LineMemo) -> _Walk | None:
+    """The walk over `lines`, reusing the memo's last walk around what changed."""
+    last = memo.last_walk
+    assert last is not None
+    old = last.lines
+    shortest = min(len(old), len(lines))
+    same_start = 0
+    while same_start < shortest and old[same_start] is lines[same_start]:
+        same_start += 1
+    same_end = 0
+    while (same_end < shortest - same_start
+           and old[len(old) - 1 - same_end] is lines[len(lines) - 1 - same_end]):
+        same_end += 1
+    restart = bisect.bisect_right(last.restarts, (same_start, len(last.cuts))) - 1
+    if restart < 0:
+        return None
+    start, cuts_before = last.restarts[restart]
+    return _walk_lines(lines, start, last.cuts[:cuts_before], last.restarts[:restart],
+                       memo, (last, len(lines) - same_end))
+
+
+def _walk_lines(lines: tuple[ast.Line, ...], start: int, cuts: list[_Cut],
+                restarts: list[tuple[int, int]], memo: LineMemo,
+                resume: tuple[_Walk, int] | None) -> _Walk:
+    """Cut `lines` from `start` on into blocks, after `cuts`. With `resume` (the last
+    walk, and where the lines it also had begin), stop at the first restart point in
+    that common end that the last walk shares, and take the rest from it."""
     statements: list[ast.Statement] | None = None  # the open block's, None when closed
-    effects: list[Part] = []  # the open block's parts
-    for line, segments in memo.segments_of(program.lines):
+    parts: list[Part] = []  # the open block's
+    pending: list[ast.LabelDef] = []  # labels seen since the last statement
+    shift = 0 if resume is None else len(lines) - len(resume[0].lines)
+    old_restarts = {} if resume is None else dict(resume[0].restarts)
+    for number, (line, segments) in enumerate(
+            zip(lines[start:], memo.segments_of(lines[start:]), strict=True), start=start):
+        if statements is None and not pending:
+            if resume is not None and number >= resume[1] and number - shift in old_restarts:
+                return _resumed(lines, cuts, restarts, resume[0], number - shift)
+            restarts.append((number, len(cuts)))
         if line.label is not None:
             statements = None
-            cut.pending.append(line.label)
+            pending.append(line.label)
         if not line.ok:
-            cut.open(opaque=True)
-            parts.append([])
+            cuts.append(_Cut([], pending, True, []))
+            pending = []
             statements = None
             continue
         for run, summary, closes in segments:
             if statements is None:
-                statements = cut.open().statements
-                effects = []
-                parts.append(effects)
+                statements, parts = [], []
+                cuts.append(_Cut(statements, pending, False, parts))
+                pending = []
             if summary is not None:
-                effects.append((len(statements), summary))
+                parts.append((len(statements), summary))
             statements += run
             if closes:
                 statements = None
-    cut.open()
-    return cut.blocks, cut.labels, memo.block_effects(parts)
+    cuts.append(_Cut([], pending, False, []))
+    return _Walk(lines, cuts, restarts)
+
+
+def _resumed(lines: tuple[ast.Line, ...], cuts: list[_Cut], restarts: list[tuple[int, int]],
+             last: _Walk, old_line: int) -> _Walk:
+    """The walk so far, completed with the last walk's blocks from its restart point at
+    `old_line` on (a line both walks share, at the same distance from the end)."""
+    shift = len(lines) - len(last.lines)
+    position = bisect.bisect_left(last.restarts, (old_line, -1))
+    old_cuts_before = last.restarts[position][1]
+    added = len(cuts) - old_cuts_before
+    cuts += last.cuts[old_cuts_before:]
+    restarts += [(line + shift, count + added) for line, count in last.restarts[position:]]
+    return _Walk(lines, cuts, restarts)

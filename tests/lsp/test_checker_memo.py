@@ -69,6 +69,12 @@ def test_the_memo_never_changes_a_result_after_edits(
         warm = check_program(program, document.memo)
         assert sorted(warm, key=sort_key) == sorted(check_program(program), key=sort_key)
         assert shape(build_cfg(program, document.memo)) == shape(build_cfg(program))
+        # The walk that reused the last one keeps the same books as a walk afresh (and
+        # so does not grow with the number of edits).
+        fresh = LineMemo()
+        build_cfg(program, fresh)
+        assert document.memo.last_walk is not None and fresh.last_walk is not None
+        assert document.memo.last_walk.restarts == fresh.last_walk.restarts
 
 
 @settings(max_examples=150, deadline=None)
