@@ -33,25 +33,37 @@ _SELECTING = frozenset(name for name, builtin in BUILTINS.items() if builtin.has
 
 def label_def(lexemes: Sequence[Lexeme], line: int, index: int = 0) -> ast.LabelDef:
     text, column = lexemes[index]
-    digits = text[1:]
     return ast.LabelDef(ast.Span(line, column + 1, line, column + 1 + len(text)), text,
-                        int(digits) if len(digits) == 2 else None)
+                        _label_number(text))
+
+
+def _label_number(text: str) -> int | None:
+    """The number of `:NN` or `#NN`; None unless exactly two digits follow."""
+    digits = text[1:]
+    return int(digits) if len(digits) == 2 else None
 
 
 def _label_ref(index: int) -> Builder[ast.LabelRef]:
     def build(lexemes: Sequence[Lexeme], line: int) -> ast.LabelRef:
         text, column = lexemes[index]
-        digits = text[1:]
         return ast.LabelRef(ast.Span(line, column + 1, line, column + 1 + len(text)), text,
-                            int(digits) if len(digits) == 2 else None)
+                            _label_number(text))
+    return build
+
+
+Letter = TypeVar("Letter", ast.Var, ast.Selector)
+
+
+def _letter(node: type[Letter], index: int) -> Builder[Letter]:
+    """A variable, or the selector letter of `(CAM P c)` and `(ULT A)`."""
+    def build(lexemes: Sequence[Lexeme], line: int) -> Letter:
+        text, column = lexemes[index]
+        return node(ast.Span(line, column + 1, line, column + 2), text)
     return build
 
 
 def _var(index: int) -> Builder[ast.Var]:
-    def build(lexemes: Sequence[Lexeme], line: int) -> ast.Var:
-        text, column = lexemes[index]
-        return ast.Var(ast.Span(line, column + 1, line, column + 2), text)
-    return build
+    return _letter(ast.Var, index)
 
 
 def _number(index: int) -> Builder[ast.Const]:
@@ -69,13 +81,6 @@ def _hex(index: int) -> Builder[ast.Const]:
         value = int(text[1:], 16)
         return ast.Const(ast.Span(line, column + 1, line, column + 1 + len(text)),
                          value - 0x10000 if value >= 0x8000 else value, text, True)
-    return build
-
-
-def _selector(index: int) -> Builder[ast.Selector]:
-    def build(lexemes: Sequence[Lexeme], line: int) -> ast.Selector:
-        text, column = lexemes[index]
-        return ast.Selector(ast.Span(line, column + 1, line, column + 2), text)
     return build
 
 
@@ -193,8 +198,8 @@ def call(kinds: Kinds, children: list[Child]) -> Builder[ast.Call]:
     args = [_LEAVES[kinds[index]](index) for index in arg_indices]
     # `(CAM P c)`: a letter first selects a form; whether this call is a CAM or an ULT is
     # in the mnemonic's text, which the kinds do not tell, so the builder decides.
-    selector = (_selector(arg_indices[0]) if arg_indices and kinds[arg_indices[0]] == "VAR"
-                else None)
+    first_is_letter = bool(arg_indices) and kinds[arg_indices[0]] == "VAR"
+    selector = _letter(ast.Selector, arg_indices[0]) if first_is_letter else None
 
     def build(lexemes: Sequence[Lexeme], number: int) -> ast.Call:
         mnemonic, column = lexemes[mnemonic_index]
