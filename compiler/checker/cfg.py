@@ -104,8 +104,9 @@ class LineMemo:
     identity: the language server keeps the AST of an unchanged line, and tells the memo
     when it relocates one (a move changes no segment). Each entry holds its line, so an
     id cannot be reused while it is in the memo; once most entries are of lines no longer
-    in the program, a check drops them. It never changes a result, only how soon it
-    comes."""
+    in the program, a check drops them. It also keeps the last check's cut of the program
+    into blocks (`last_walk`), which the next check reuses around what changed. It never
+    changes a result, only how soon it comes."""
 
     def __init__(self) -> None:
         self._entries: dict[int, tuple[ast.Line, Segments]] = {}
