@@ -24,7 +24,7 @@ from rl1.compiler import catalogue, checker
 from rl1.compiler.collector import collector_paused
 from rl1.compiler.diagnostics import Diagnostic, Severity, sort_key
 
-from .document import MAX_ANALYSED_CHARACTERS, Document
+from .document import MAX_ANALYSED_CHARACTERS, MAX_ANALYSED_LINE, Document
 from .positions import Columns
 
 log = logging.getLogger(__name__)
@@ -103,10 +103,15 @@ def notice(message: str) -> types.Diagnostic:
 
 
 def too_large_notice(document: Document) -> types.Diagnostic:
-    return notice(
-        f"this document has {document.size:,} characters; rl1-lsp analyses documents of up "
-        f"to {MAX_ANALYSED_CHARACTERS:,}, so it shows no diagnostics and answers no requests "
-        "for it. Check it with `rl1c check FILE`.")
+    if document.size > MAX_ANALYSED_CHARACTERS:
+        what = (f"this document has {document.size:,} characters; rl1-lsp analyses "
+                f"documents of up to {MAX_ANALYSED_CHARACTERS:,}")
+    else:
+        number, length = document.longest_line()
+        what = (f"line {number} of this document has {length:,} characters; rl1-lsp "
+                f"analyses documents whose lines have up to {MAX_ANALYSED_LINE:,}")
+    return notice(f"{what}, so it shows no diagnostics and answers no requests for it. "
+                  "Check it with `rl1c check FILE`.")
 
 
 CHECKER_FAILED = notice(

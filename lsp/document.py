@@ -33,6 +33,10 @@ MAX_ANALYSED_CHARACTERS = 2_000_000
 """Beyond this a document is kept in sync but not analysed. An RL/I program of 10,000
 lines is about 200,000 characters; parsing tens of megabytes would stall the server."""
 
+MAX_ANALYSED_LINE = 20_000
+"""Nor is a document with a line longer than this (the paper's lines are under 80
+characters): a line is parsed whole at each edit, and a megabyte line takes seconds."""
+
 
 @dataclass(slots=True)
 class CachedLine:
@@ -70,6 +74,7 @@ class Document:
         # the others are ready, so preparing the program after a small edit skips them.
         self._stale_low, self._stale_high = 0, len(self._lines)
         self._size = len(text)
+        self._long_lines = sum(len(line) > MAX_ANALYSED_LINE for line in texts)
         self._program: ast.Program | None = None
         self._derived: dict[Callable[[Document], object], object] = {}
         self.memo = LineMemo()  # the whole-program checker's facts about kept lines
@@ -83,7 +88,12 @@ class Document:
 
     @property
     def too_large(self) -> bool:
-        return self._size > MAX_ANALYSED_CHARACTERS
+        return self._size > MAX_ANALYSED_CHARACTERS or self._long_lines > 0
+
+    def longest_line(self) -> tuple[int, int]:
+        """The 1-based number and the length of the document's longest line."""
+        length, index = max((len(line.text), -index) for index, line in enumerate(self._lines))
+        return 1 - index, length
 
     @property
     def size(self) -> int:
@@ -156,6 +166,8 @@ class Document:
         middle = [CachedLine(text) for text in texts[same_start : len(texts) - same_end]]
         kept_end = old[len(old) - same_end :] if same_end else []
         removed = sum(len(line.text) for line in old) + sum(map(len, self._endings[low:high]))
+        self._long_lines += (sum(len(text) > MAX_ANALYSED_LINE for text in texts)
+                             - sum(len(line.text) > MAX_ANALYSED_LINE for line in old))
         self._lines[low:high] = old[:same_start] + middle + kept_end
         self._endings[low:high] = endings
         # Lines below the window moved when it changed size: they need relocating.

@@ -10,7 +10,7 @@ from rl1.compiler.checker import check_line
 from rl1.compiler.diagnostics import sort_key
 from rl1.compiler.parser import parse_program
 from rl1.compiler.strategies import lines
-from rl1.lsp.document import Document
+from rl1.lsp.document import MAX_ANALYSED_LINE, Document
 from rl1.lsp.positions import UTF8, UTF16, UTF32, Columns
 from rl1.lsp.tokens import TokenHistory, encode
 
@@ -134,3 +134,20 @@ def test_semantic_token_deltas_rebuild_the_new_tokens(
     for change in delta.edits:
         data[change.start : change.start + change.delete_count] = list(change.data or [])
     assert data == encode(document, columns)
+
+
+def test_a_document_with_an_overlong_line_is_too_large_until_the_line_is_shortened() -> None:
+    columns = Columns()
+    long = "A" * (MAX_ANALYSED_LINE + 1)
+    document = Document("file:///t.rob", f"B=1\n{long}\n(END)\n", 1)
+    assert document.too_large and document.longest_line() == (2, len(long))
+    document.apply(types.TextDocumentContentChangePartial(   # a second one, then both go
+        range=types.Range(types.Position(0, 0), types.Position(0, 0)), text=long + "\n"),
+        columns)
+    document.apply(types.TextDocumentContentChangePartial(   # the second shortened
+        range=types.Range(types.Position(2, 3), types.Position(2, len(long))), text=""),
+        columns)
+    assert document.too_large and document.longest_line() == (1, len(long))
+    document.apply(types.TextDocumentContentChangePartial(
+        range=types.Range(types.Position(0, 0), types.Position(2, 0)), text=""), columns)
+    assert not document.too_large and document.text() == "AAA\n(END)\n"

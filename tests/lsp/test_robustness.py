@@ -19,6 +19,8 @@ from lsprotocol import types
 from pygls.exceptions import JsonRpcException
 from pytest_lsp import ClientServerConfig
 
+from rl1.lsp.document import MAX_ANALYSED_LINE
+
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
 UNKNOWN = types.TextDocumentIdentifier("file:///never/opened.rob")
@@ -74,14 +76,32 @@ async def test_a_ten_megabyte_document_is_refused_clearly_and_quickly(client: Cl
 
 
 async def test_a_long_line_with_a_japanese_comment_is_not_quadratic(client: Client) -> None:
-    text = "A=1;" * 50_000 + "'日本語😀\n"
+    text = "A=1;" * 4_990 + "'日本語😀\n"  # just within MAX_ANALYSED_LINE
+    assert len(text) <= MAX_ANALYSED_LINE
     async with asyncio.timeout(TIMEOUT):
         uri, _ = await client.opened(text)
         tokens = await client.text_document_semantic_tokens_full_async(
             types.SemanticTokensParams(types.TextDocumentIdentifier(uri)))
     assert tokens is not None
-    # the comment: 2 after the last `1` (column 199,998), 6 UTF-16 units long
+    # the comment: 2 after the last `1` (column 19,958), 6 UTF-16 units long
     assert list(tokens.data[-5:]) == [0, 2, 6, 7, 0]
+
+
+async def test_a_megabyte_line_is_refused_clearly_and_the_fix_brings_analysis_back(
+        client: Client) -> None:
+    text = "A=1\n" + "B=2;" * 250_000 + "\n(END)\n"
+    async with asyncio.timeout(TIMEOUT):
+        uri, diagnostics = await client.opened(text)
+    (notice,) = diagnostics
+    assert "line 2 " in notice.message and "1,000,000 characters" in notice.message
+    assert "rl1c check" in notice.message
+    client.change(uri, 2, ((1, 0, 1, 1_000_000), "B=2"))
+    async with asyncio.timeout(TIMEOUT):
+        fixed = await client.diagnostics_of(uri, 2)
+    assert not any("characters" in d.message for d in fixed)
+    hover = await client.text_document_hover_async(types.HoverParams(
+        types.TextDocumentIdentifier(uri), types.Position(1, 0)))
+    assert hover is not None
 
 
 async def test_edits_outside_the_document_are_clamped(client: Client) -> None:
