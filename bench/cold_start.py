@@ -30,7 +30,7 @@ def main() -> None:
     rl1c = str(Path(sys.executable).with_name("rl1c"))
     check = [rl1c, "check", str(ROOT / "examples" / "sample.rob")]
     baseline = [sys.executable, "-c", "pass"]
-    run_seconds(check)  # fills the parser cache and the OS page cache
+    run_seconds(check)  # warms the OS page cache and the .pyc files
     checks, passes = [], []
     for _ in range(options.runs):
         checks.append(run_seconds(check))
