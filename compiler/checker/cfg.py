@@ -190,56 +190,13 @@ def _structure(program: ast.Program, memo: LineMemo | None) -> ControlFlowGraph:
     return ControlFlowGraph(blocks, labels)
 
 
-class _Blocks:
-    """The blocks being cut from a program, in source order, and the labels naming them."""
-
-    def __init__(self) -> None:
-        self.blocks: list[Block] = []
-        self.labels: dict[int, int] = {}  # label number -> its first definition's block
-        self.pending: list[ast.LabelDef] = []  # labels seen since the last statement
-
-    def open(self, opaque: bool = False) -> Block:
-        block = Block(len(self.blocks), [], self.pending, [], [], opaque)
-        for label in self.pending:
-            if label.number is not None:
-                self.labels.setdefault(label.number, block.index)
-        self.pending = []
-        self.blocks.append(block)
-        return block
-
-
-def _blocks(program: ast.Program) -> tuple[list[Block], dict[int, int], list[BlockEffects]]:
-    """The blocks (the exit block last), summarized one block at a time: the fastest
-    way from scratch."""
-    cut = _Blocks()
-    statements: list[ast.Statement] | None = None  # the open block's, None when closed
-    for line in program.lines:
-        if line.label is not None:
-            statements = None
-            cut.pending.append(line.label)
-        if not line.ok:
-            cut.open(opaque=True)
-            statements = None
-            continue
-        for statement in line.statements:
-            if statements is None:
-                statements = cut.open().statements
-            statements.append(statement)
-            if isinstance(statement, _JUMPS) or is_end(statement):
-                statements = None
-    cut.open()
-    summaries = [summarize(block.statements) or BlockEffects.nothing()
-                 for block in cut.blocks[:-1]]
-    return cut.blocks, cut.labels, summaries
-
-
 class _Cut(NamedTuple):
     """A block as the walk over the lines cut it, before any edge is known."""
 
     statements: list[ast.Statement]
     labels: list[ast.LabelDef]
     opaque: bool
-    parts: list[Part]  # its runs' effects (none for the exit block)
+    parts: list[Part]  # its runs' effects, when cut from the memo's segments (else none)
 
 
 class _Walk(NamedTuple):
@@ -250,6 +207,34 @@ class _Walk(NamedTuple):
     lines: tuple[ast.Line, ...]
     cuts: list[_Cut]
     restarts: list[tuple[int, int]]
+
+
+def _blocks(program: ast.Program) -> tuple[list[Block], dict[int, int], list[BlockEffects]]:
+    """The blocks (the exit block last), summarized one block at a time: the fastest
+    way from scratch."""
+    cuts: list[_Cut] = []
+    statements: list[ast.Statement] | None = None  # the open block's, None when closed
+    pending: list[ast.LabelDef] = []  # labels seen since the last statement
+    for line in program.lines:
+        if line.label is not None:
+            statements = None
+            pending.append(line.label)
+        if not line.ok:
+            cuts.append(_Cut([], pending, True, []))
+            pending = []
+            statements = None
+            continue
+        for statement in line.statements:
+            if statements is None:
+                statements = []
+                cuts.append(_Cut(statements, pending, False, []))
+                pending = []
+            statements.append(statement)
+            if isinstance(statement, _JUMPS) or is_end(statement):
+                statements = None
+    cuts.append(_Cut([], pending, False, []))
+    summaries = [summarize(cut.statements) or BlockEffects.nothing() for cut in cuts[:-1]]
+    return *_assembled(cuts), summaries
 
 
 def _blocks_from_segments(program: ast.Program, memo: LineMemo
@@ -263,14 +248,19 @@ def _blocks_from_segments(program: ast.Program, memo: LineMemo
         walk = _walk_lines(program.lines, 0, [], [], memo, None)
     memo.last_walk = walk
     memo.forget_all_but(program.lines)
+    return *_assembled(walk.cuts), memo.block_effects([cut.parts for cut in walk.cuts[:-1]])
+
+
+def _assembled(cuts: list[_Cut]) -> tuple[list[Block], dict[int, int]]:
+    """The blocks the cuts stand for, and the block each label's first definition names."""
     blocks: list[Block] = []
     labels: dict[int, int] = {}
-    for index, cut in enumerate(walk.cuts):
+    for index, cut in enumerate(cuts):
         blocks.append(Block(index, cut.statements, cut.labels, [], [], cut.opaque))
         for label in cut.labels:
             if label.number is not None:
                 labels.setdefault(label.number, index)
-    return blocks, labels, memo.block_effects([cut.parts for cut in walk.cuts[:-1]])
+    return blocks, labels
 
 
 def _walk_again(lines: tuple[ast.Line, ...], memo: LineMemo) -> _Walk | None:
@@ -304,12 +294,15 @@ def _walk_lines(lines: tuple[ast.Line, ...], start: int, cuts: list[_Cut],
     parts: list[Part] = []  # the open block's
     pending: list[ast.LabelDef] = []  # labels seen since the last statement
     shift = 0 if resume is None else len(lines) - len(resume[0].lines)
-    old_restarts = {} if resume is None else dict(resume[0].restarts)
+    # the last walk's restart points: line -> its position among them
+    old_restarts = {} if resume is None else {
+        line: position for position, (line, _) in enumerate(resume[0].restarts)}
     for number, (line, segments) in enumerate(
             zip(lines[start:], memo.segments_of(lines[start:]), strict=True), start=start):
         if statements is None and not pending:
             if resume is not None and number >= resume[1] and number - shift in old_restarts:
-                return _resumed(lines, cuts, restarts, resume[0], number - shift)
+                return _resumed(lines, cuts, restarts, resume[0],
+                                old_restarts[number - shift])
             restarts.append((number, len(cuts)))
         if line.label is not None:
             statements = None
@@ -334,11 +327,11 @@ def _walk_lines(lines: tuple[ast.Line, ...], start: int, cuts: list[_Cut],
 
 
 def _resumed(lines: tuple[ast.Line, ...], cuts: list[_Cut], restarts: list[tuple[int, int]],
-             last: _Walk, old_line: int) -> _Walk:
-    """The walk so far, completed with the last walk's blocks from its restart point at
-    `old_line` on (a line both walks share, at the same distance from the end)."""
+             last: _Walk, position: int) -> _Walk:
+    """The walk so far, completed with the last walk's blocks from its restart point
+    `last.restarts[position]` on (at a line both walks share, at the same distance from
+    the end)."""
     shift = len(lines) - len(last.lines)
-    position = bisect.bisect_left(last.restarts, (old_line, -1))
     old_cuts_before = last.restarts[position][1]
     added = len(cuts) - old_cuts_before
     cuts += last.cuts[old_cuts_before:]
