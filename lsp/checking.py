@@ -4,9 +4,9 @@ are published.
 A change is checked at once when it comes alone, as a keystroke does; a change that
 follows the last one within a few milliseconds (a paste, a multi-cursor edit, a burst
 from a script) is part of a burst, whose check waits a little so that the burst is
-checked once. The check yields to the event loop while it parses, so requests are answered in
-the meantime, and it gives up as soon as a newer version arrives: diagnostics are never
-published for a stale version.
+checked once. The check yields to the event loop while it parses, so requests are
+answered in the meantime, and it gives up as soon as a newer version arrives:
+diagnostics are never published for a stale version.
 """
 
 from __future__ import annotations
