@@ -79,7 +79,7 @@ def shape(node: object) -> object:
     """A node as nested tuples without its spans: equal shapes mean the same program."""
     if isinstance(node, ast.Node):
         return (type(node).__name__, *(
-            shape(getattr(node, name)) for name in node.__struct_fields__
+            shape(getattr(node, name)) for name in node.fields
             if not isinstance(getattr(node, name), ast.Span)
         ))
     if isinstance(node, tuple):

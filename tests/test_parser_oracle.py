@@ -83,13 +83,13 @@ class _Reference(lark.Transformer):  # type: ignore[type-arg]
         op, item = items
         operand = self._leaf(item)
         return ast.BinaryStep(self._cover(self._span(op), operand.span),
-                              cast(ast.BinaryOperator, str(op)),
+                              cast("ast.BinaryOperator", str(op)),
                               self._span(op), operand)
 
     def incdec(self, items: list[lark.Token]) -> ast.IncDec:
         var = ast.Var(self._span(items[0]), str(items[0]))
         return ast.IncDec(self._cover(var.span, self._span(items[1])), var,
-                          cast(ast.Step, str(items[1])))
+                          cast("ast.Step", str(items[1])))
 
     def _label_ref(self, token: lark.Token) -> ast.LabelRef:
         digits = token[1:]
@@ -105,7 +105,7 @@ class _Reference(lark.Transformer):  # type: ignore[type-arg]
         label = self._label_ref(target)
         return ast.CondJump(self._cover(self._span(qmark), label.span),
                             ast.Var(self._span(var), str(var)),
-                            cast(ast.Relation, str(relation)), label)
+                            cast("ast.Relation", str(relation)), label)
 
     def call(self, items: list[lark.Token]) -> ast.Call:
         lpar, mnemonic, *args, rpar = items
