@@ -12,21 +12,26 @@ texts and columns.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from typing import Any, TypeVar, cast
-
 from . import ast
 from .builtins import BUILTINS
-from .scanner import Kinds, Lexeme
 
-Node = TypeVar("Node", covariant=True)
-Builder = Callable[[Sequence[Lexeme], int], Node]
-"""Builds a node from a line's lexemes and its line number."""
+TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
+if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+    from typing import Any, TypeVar
 
-Child = int | Builder[Any]
-"""What a rule receives for each symbol: a token's index, or a sub-rule's builder."""
+    from .scanner import Kinds, Lexeme
 
-ParsedLine = tuple[ast.LabelDef | None, tuple[ast.Statement, ...]]
+    Node = TypeVar("Node", covariant=True)
+    Builder = Callable[[Sequence[Lexeme], int], Node]
+    """Builds a node from a line's lexemes and its line number."""
+
+    Child = int | Builder[Any]
+    """What a rule receives for each symbol: a token's index, or a sub-rule's builder."""
+
+    ParsedLine = tuple[ast.LabelDef | None, tuple[ast.Statement, ...]]
+
+    Letter = TypeVar("Letter", ast.Var, ast.Selector)
 
 _SELECTING = frozenset(name for name, builtin in BUILTINS.items() if builtin.has_selector)
 
@@ -49,9 +54,6 @@ def _label_ref(index: int) -> Builder[ast.LabelRef]:
         return ast.LabelRef(ast.Span(line, column + 1, line, column + 1 + len(text)), text,
                             _label_number(text))
     return build
-
-
-Letter = TypeVar("Letter", ast.Var, ast.Selector)
 
 
 def _letter(node: type[Letter], index: int) -> Builder[Letter]:
@@ -194,7 +196,7 @@ def call(kinds: Kinds, children: list[Child]) -> Builder[ast.Call]:
     lpar_index, mnemonic_index, *arg_children, rpar_index = children
     assert isinstance(lpar_index, int) and isinstance(mnemonic_index, int)
     assert isinstance(rpar_index, int)
-    arg_indices = cast(list[int], arg_children)  # the grammar's arguments are single tokens
+    arg_indices: list[int] = arg_children  # type: ignore[assignment]  # single tokens, by the grammar
     args = [_LEAVES[kinds[index]](index) for index in arg_indices]
     # `(CAM P c)`: a letter first selects a form; whether this call is a CAM or an ULT is
     # in the mnemonic's text, which the kinds do not tell, so the builder decides.

@@ -9,19 +9,24 @@ W07xx safety. The long explanation of CODE is explanations/CODE.md, printed by
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
 from .diagnostics import Severity
+from .record import Record
 
 _EXPLANATIONS = Path(__file__).with_name("explanations")
 
 
-@dataclass(frozen=True, slots=True)
-class CodeInfo:
+class CodeInfo(Record):
+    __slots__ = ("code", "severity", "title")
     code: str
     severity: Severity
     title: str
+
+    def __init__(self, code: str, severity: Severity, title: str) -> None:
+        self.code = code
+        self.severity = severity
+        self.title = title
 
     def explanation(self) -> str:
         return (_EXPLANATIONS / f"{self.code}.md").read_text(encoding="utf-8")

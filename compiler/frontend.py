@@ -2,18 +2,21 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from .ast import Program
 from .checker import check
 from .diagnostics import Diagnostic, sort_key
 from .parser import parse_program
+from .record import Record
 
 
-@dataclass(frozen=True, slots=True)
-class Analysis:
+class Analysis(Record):
+    __slots__ = ("program", "diagnostics")
     program: Program
     diagnostics: list[Diagnostic]
+
+    def __init__(self, program: Program, diagnostics: list[Diagnostic]) -> None:
+        self.program = program
+        self.diagnostics = diagnostics
 
     @property
     def has_errors(self) -> bool:

@@ -17,8 +17,11 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
-from .ast import BinaryOperator, Relation, Step
 from .builtins import BUILTINS, HANDLER_LABELS, VARIABLES
+
+TYPE_CHECKING = False
+if TYPE_CHECKING:
+    from .ast import BinaryOperator, Relation, Step
 
 BlockId = str
 """`Lnn` for the block a source label `:nn` starts, `Bn` for the others."""

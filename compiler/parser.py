@@ -17,10 +17,9 @@ from __future__ import annotations
 
 import functools
 import unicodedata
-from typing import Any
 
 from . import ast
-from .builders import ACTIONS, Builder, Child, ParsedLine, label_def
+from .builders import ACTIONS, label_def
 from .builtins import BUILTINS
 from .collector import collector_paused
 from .diagnostics import Diagnostic, Severity
@@ -28,6 +27,12 @@ from .lalr_tables import ACTIONS as TABLE
 from .lalr_tables import RULES, START
 from .scanner import Kinds, Lexeme, scan
 from .source import split_lines
+
+TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
+if TYPE_CHECKING:
+    from typing import Any
+
+    from .builders import Builder, Child, ParsedLine
 
 # What each terminal is called in "expected ..." messages.
 TERMINAL_NAMES = {
@@ -54,7 +59,9 @@ class Rejection:
         self.expected = expected
 
 
-Plan = Builder[ParsedLine] | Rejection
+if TYPE_CHECKING:
+    Plan = Builder[ParsedLine] | Rejection
+    """What a line of some kinds parses to: the builder of its AST, or why it is rejected."""
 
 
 def make_plan(kinds: Kinds) -> Plan:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import TypeVar, cast
 
 from lsprotocol import types
@@ -53,14 +53,14 @@ def _split(text: str) -> tuple[list[str], list[str]]:
 
 def _move_diagnostic(diagnostic: Diagnostic, line: int) -> Diagnostic:
     """A one-line diagnostic moved, with its fixes and related spans, to `line`."""
-    return replace(
-        diagnostic,
-        span=diagnostic.span.on_line(line),
-        fixes=tuple(
+    return Diagnostic(
+        diagnostic.code, diagnostic.severity, diagnostic.message,
+        diagnostic.span.on_line(line), diagnostic.help,
+        tuple(
             Fix(fix.title, tuple(Edit(edit.span.on_line(line), edit.text) for edit in fix.edits))
             for fix in diagnostic.fixes
         ),
-        related=tuple(Related(r.span.on_line(line), r.message) for r in diagnostic.related),
+        tuple(Related(r.span.on_line(line), r.message) for r in diagnostic.related),
     )
 
 

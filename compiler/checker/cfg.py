@@ -30,10 +30,9 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import NamedTuple
 
 from .. import ast
+from ..record import Record
 from . import device
 from .effects import BlockEffects, Segment, combine, line_segments, relocated, summarize
 
@@ -41,26 +40,44 @@ Segments = tuple[Segment, ...]
 Part = tuple[int, BlockEffects]  # a run's effects, and where in its block the run starts
 
 
-@dataclass(slots=True)
-class HandlerEdge:
+class HandlerEdge(Record):
     """A lost guidance line may jump to `:label` from the event point of statement
     `index` of the block (the first such in the block): right after its calls, before an
     assignment stores its value, or right after its jump."""
 
+    __slots__ = ("label", "index", "target")
     label: int
     index: int
     target: int | None  # the handler's block; None when the program does not define it
 
+    def __init__(self, label: int, index: int, target: int | None) -> None:
+        self.label = label
+        self.index = index
+        self.target = target
 
-@dataclass(slots=True)
-class Block:
+
+class Block(Record):
+    """A basic block. The graph's construction fills in its edges and effects."""
+
+    __slots__ = ("index", "statements", "labels", "successors", "handlers", "opaque",
+                 "effects")
     index: int
-    statements: list[ast.Statement] = field(default_factory=list)
-    labels: list[ast.LabelDef] = field(default_factory=list)  # the labels naming it
-    successors: list[int] = field(default_factory=list)
-    handlers: list[HandlerEdge] = field(default_factory=list)
-    opaque: bool = False  # stands for a line with a syntax error
-    effects: BlockEffects = field(default_factory=BlockEffects.nothing)
+    statements: list[ast.Statement]
+    labels: list[ast.LabelDef]  # the labels naming it
+    successors: list[int]
+    handlers: list[HandlerEdge]
+    opaque: bool  # stands for a line with a syntax error
+    effects: BlockEffects
+
+    def __init__(self, index: int, statements: list[ast.Statement],
+                 labels: list[ast.LabelDef], opaque: bool) -> None:
+        self.index = index
+        self.statements = statements
+        self.labels = labels
+        self.successors = []
+        self.handlers = []
+        self.opaque = opaque
+        self.effects = BlockEffects.nothing()
 
     @property
     def jump(self) -> ast.Goto | ast.CondJump | None:
@@ -74,14 +91,20 @@ class Block:
         return bool(self.statements) and is_end(self.statements[-1])
 
 
-@dataclass(slots=True)
-class ControlFlowGraph:
+class ControlFlowGraph(Record):
+    __slots__ = ("blocks", "labels", "device_on_entry", "entry")
     blocks: list[Block]
     labels: dict[int, int]  # label number -> the block its first definition names
     # device.py's state on entry to each block (tracing modes and motion that may be in
-    # effect); 0 for a block no path reaches
-    device_on_entry: list[int] = field(default_factory=list)
-    entry: int = 0
+    # effect); 0 for a block no path reaches; filled in by device.py
+    device_on_entry: list[int]
+    entry: int
+
+    def __init__(self, blocks: list[Block], labels: dict[int, int]) -> None:
+        self.blocks = blocks
+        self.labels = labels
+        self.device_on_entry = []
+        self.entry = 0
 
     @property
     def exit(self) -> int:
@@ -190,23 +213,38 @@ def _structure(program: ast.Program, memo: LineMemo | None) -> ControlFlowGraph:
     return ControlFlowGraph(blocks, labels)
 
 
-class _Cut(NamedTuple):
+class _Cut(Record):
     """A block as the walk over the lines cut it, before any edge is known."""
 
+    __slots__ = ("statements", "labels", "opaque", "parts")
     statements: list[ast.Statement]
     labels: list[ast.LabelDef]
     opaque: bool
     parts: list[Part]  # its runs' effects, when cut from the memo's segments (else none)
 
+    def __init__(self, statements: list[ast.Statement], labels: list[ast.LabelDef],
+                 opaque: bool, parts: list[Part]) -> None:
+        self.statements = statements
+        self.labels = labels
+        self.opaque = opaque
+        self.parts = parts
 
-class _Walk(NamedTuple):
+
+class _Walk(Record):
     """How a check cut its program into blocks: the lines, the blocks (the exit block
     last), and the lines before which no block was open and no label waited for one,
     where a walk may start afresh, each with the number of blocks cut before it."""
 
+    __slots__ = ("lines", "cuts", "restarts")
     lines: tuple[ast.Line, ...]
     cuts: list[_Cut]
     restarts: list[tuple[int, int]]
+
+    def __init__(self, lines: tuple[ast.Line, ...], cuts: list[_Cut],
+                 restarts: list[tuple[int, int]]) -> None:
+        self.lines = lines
+        self.cuts = cuts
+        self.restarts = restarts
 
 
 def _blocks(program: ast.Program) -> tuple[list[Block], dict[int, int], list[BlockEffects]]:
@@ -256,7 +294,7 @@ def _assembled(cuts: list[_Cut]) -> tuple[list[Block], dict[int, int]]:
     blocks: list[Block] = []
     labels: dict[int, int] = {}
     for index, cut in enumerate(cuts):
-        blocks.append(Block(index, cut.statements, cut.labels, [], [], cut.opaque))
+        blocks.append(Block(index, cut.statements, cut.labels, cut.opaque))
         for label in cut.labels:
             if label.number is not None:
                 labels.setdefault(label.number, index)

@@ -13,27 +13,32 @@ taken to do what any of their forms does: the summary never resolves selectors.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
-from typing import NamedTuple
 
 from .. import ast
 from ..builtins import BUILTINS, RESERVED_VARIABLES
+from ..record import Record
 from . import device
 
 RESERVED_BIT = {name: 1 << index for index, name in enumerate(RESERVED_VARIABLES)}
 ALL_RESERVED = (1 << len(RESERVED_VARIABLES)) - 1
 
 
-@dataclass(slots=True, eq=False)  # shared, never changed: equal only to itself (a memo key)
 class BlockEffects:
-    operations: list[device.Operation]  # the calls that change the device state
-    # The first event point, where a pending lost line is taken: the first statement
-    # that makes a call (right after it, before an assignment stores) or jumps.
-    first_event: int | None
-    reads: int  # reserved variables read anywhere in the block (RESERVED_BIT bits)
-    # (statement index, reserved variables its calls write, those its store writes)
-    writes: list[tuple[int, int, int]]
-    observes: bool
+    """What a block (or a run of statements) does. Shared, never changed, and equal only
+    to itself: a memo key."""
+
+    __slots__ = ("operations", "first_event", "reads", "writes", "observes")
+
+    def __init__(self, operations: list[device.Operation], first_event: int | None,
+                 reads: int, writes: list[tuple[int, int, int]], observes: bool) -> None:
+        self.operations = operations  # the calls that change the device state
+        # The first event point, where a pending lost line is taken: the first statement
+        # that makes a call (right after it, before an assignment stores) or jumps.
+        self.first_event = first_event
+        self.reads = reads  # reserved variables read anywhere in the block (RESERVED_BIT bits)
+        # (statement index, reserved variables its calls write, those its store writes)
+        self.writes = writes
+        self.observes = observes
 
     @staticmethod
     def nothing() -> BlockEffects:
@@ -46,10 +51,16 @@ class BlockEffects:
 Segment = tuple[tuple[ast.Statement, ...], BlockEffects | None, bool]
 
 
-class _CallFacts(NamedTuple):
+class _CallFacts(Record):
+    __slots__ = ("writes", "observes", "device")
     writes: int
     observes: bool
     device: bool  # whether device.operation may find something in it
+
+    def __init__(self, writes: int, observes: bool, device: bool) -> None:
+        self.writes = writes
+        self.observes = observes
+        self.device = device
 
 
 def _facts_of(name: str) -> _CallFacts:

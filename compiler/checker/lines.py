@@ -7,8 +7,6 @@ line it is given. Lines with a syntax error are skipped: the parser has said why
 
 from __future__ import annotations
 
-import difflib
-
 from .. import ast
 from ..builtins import BUILTINS, RESERVED_VARIABLES, Builtin, Form, writers_of
 from ..diagnostics import Diagnostic, Edit, Fix, Severity
@@ -176,6 +174,8 @@ def _wide_constants(args: tuple[ast.Arg, ...], found: list[Diagnostic]) -> None:
 
 
 def _unknown_function(call: ast.Call) -> Diagnostic:
+    import difflib  # only for a misspelt name: it costs 2 ms of every start
+
     name = call.mnemonic.upper()
     close = difflib.get_close_matches(name, list(BUILTINS), n=1)
     message = f"`{call.mnemonic}` is not a built-in function"
