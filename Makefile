@@ -12,6 +12,9 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	# pip byte-compiles what it installs, but an editable install leaves rl1 to its
+	# first run, which cannot write bytecode where PYTHONDONTWRITEBYTECODE is set.
+	$(BIN)/python -m compileall -q compiler vm lsp
 	touch $(STAMP)
 
 demo: $(STAMP)

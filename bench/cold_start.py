@@ -4,7 +4,7 @@ same machine load, and reports medians.
 
 It first byte-compiles the project's modules, as pip does for a package it installs:
 an editable install leaves that to the first run, which cannot do it where
-PYTHONDONTWRITEBYTECODE is set (as on our CI machines), so every start would compile
+PYTHONDONTWRITEBYTECODE is set (as on our development machine), so every start would compile
 all of rl1 again.
 
     .venv/bin/python bench/cold_start.py [--runs 15]
