@@ -35,6 +35,12 @@ def test_a_bad_tcp_address_is_a_usage_error(value: str) -> None:
     assert "HOST:PORT" in failed.stderr and "Traceback" not in failed.stderr
 
 
+def test_stdio_and_tcp_together_are_a_usage_error() -> None:
+    failed = run("--stdio", "--tcp", "127.0.0.1:2087")
+    assert failed.returncode == 2
+    assert "choose one of --stdio and --tcp" in failed.stderr
+
+
 def free_port() -> int:
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
