@@ -4,21 +4,23 @@ Each action is a thin wrapper: parse options, call the stage that does the work,
 outcome to an exit status. Exit statuses: 0 success, 1 the input has errors,
 2 a usage problem or an unreadable file, 3 an internal error (a bug in rl1c).
 
-To add a command: one function decorated `@main.command()`; read inputs with
-`read_input`, report diagnostics with `emit` (or render.report), end with `ctx.exit`.
+To add a command: a function returning the exit status, decorated `@command(name,
+*arguments)` with the arguments it takes as keywords; its docstring is its help, the
+first line its summary in `rl1c --help`. Read inputs with `read_input`, report
+diagnostics with `emit` (or render.report), and end early by raising `Failure` (a message
+for standard error and a status) or `UsageError`.
+
+The command line is built on the standard library's argparse rather than click:
+`rl1c check` must start within twice the time of `python -c pass`
+(bench/cold_start.py), and importing click alone takes that whole budget (30 ms).
 """
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
-import traceback
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-import click
-
-from rl1.vm.faults import DEFAULT_BUDGET
 
 from .ast import Span
 from .diagnostics import Diagnostic, Severity
@@ -27,71 +29,111 @@ from .render import (
     EXIT_ERRORS,
     EXIT_USAGE,
     FORMATS,
-    ColorChoice,
     FileDiagnostics,
-    Format,
     exit_status,
     report,
     use_color,
 )
 from .source import MAX_SOURCE_BYTES, Source, SourceError, decode, read_source
 
+TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
 if TYPE_CHECKING:
+    from collections.abc import Callable, Sequence
+    from typing import Any, TypeVar
+
     from rl1.vm.runner import Engine
 
     from .driver import Emit
+    from .render import ColorChoice, Format
+
+    Run = TypeVar("Run", bound=Callable[..., int])
+    Argument = tuple[tuple[str, ...], dict[str, Any]]
 
 # Each command imports the stages it runs when it runs, so that `rl1c check` starts
 # without loading the back end, the VM or the assembler (bench/cold_start.py). For the
-# same reason these option choices are spelled here; tests/test_cli_imports.py holds
-# them equal to driver.EMITS and runner.ENGINES.
+# same reason these option values are spelled here; tests/test_cli_imports.py holds
+# them equal to driver.EMITS, runner.ENGINES and faults.DEFAULT_BUDGET.
 EMIT_CHOICES = ("ilc", "ir")
 ENGINE_CHOICES = ("vm", "ast")
+DEFAULT_BUDGET = 10_000_000
 
 EXIT_INTERNAL = 3
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report a program stopped by Ctrl-C
 
 STDIN_NAME = "<stdin>"
 
-
-class _Toolchain(click.Group):
-    """The `rl1c` group: `rl1c FILE ...` means `rl1c compile FILE ...`, so compiling
-    needs no verb; and an unexpected exception ends in a short message, not a traceback."""
-
-    def resolve_command(
-        self, ctx: click.Context, args: list[str]
-    ) -> tuple[str | None, click.Command | None, list[str]]:
-        if args and args[0] not in self.commands and (args[0] == "-"  # standard input
-                                                      or not args[0].startswith("-")):
-            args = ["compile", *args]
-        return super().resolve_command(ctx, args)
-
-    def invoke(self, ctx: click.Context) -> object:
-        try:
-            return super().invoke(ctx)
-        except (click.exceptions.Exit, click.ClickException, click.Abort, BrokenPipeError):
-            raise  # click turns these into their messages and exit statuses
-        except Exception as error:
-            # A traceback tells a robot programmer nothing they can act on and reads as
-            # if their program were at fault; a distinct status (3) lets scripts and CI
-            # tell a bug in rl1c from a program with errors (1) or a usage problem (2).
-            # RL1C_BACKTRACE=1 shows the traceback to whoever debugs rl1c.
-            if os.environ.get("RL1C_BACKTRACE"):
-                traceback.print_exc()
-            summary = f"{type(error).__name__}: {error}"
-            click.echo(
-                f"rl1c: internal error: {summary[:300]}\n"
-                "This is a bug in rl1c, not in your program. Please report it with the "
-                "command line and the input file (RL1C_BACKTRACE=1 shows the details).",
-                err=True,
-            )
-            ctx.exit(EXIT_INTERNAL)
+DESCRIPTION = """The RL/I toolchain. `rl1c FILE.rob -o FILE.ilc` compiles; the commands
+below check, format, explain, disassemble, assemble and run programs."""
 
 
-@click.group(cls=_Toolchain, context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(package_name="rl1", prog_name="rl1c")
-def main() -> None:
-    """The RL/I toolchain. `rl1c FILE.rob -o FILE.ilc` compiles; the commands below
-    check, format, explain, disassemble, assemble and run programs."""
+class UsageError(Exception):
+    """The command line asks for something impossible; shown with the command's usage,
+    exit status 2."""
+
+
+class Failure(Exception):
+    """Ends a command: `message` goes to standard error, `status` is the exit status."""
+
+    def __init__(self, message: str, status: int = EXIT_USAGE) -> None:
+        super().__init__(message)
+        self.status = status
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Runs the command line `argv` (default: the process's arguments); the exit status.
+    Asking for help or the version, or a malformed command line, ends in SystemExit."""
+    _escape_unprintable_output()
+    args = _with_verb(sys.argv[1:] if argv is None else argv)
+    if not args or args[0] not in _COMMANDS:
+        return _toolchain(args)
+    function, arguments = _COMMANDS[args[0]]
+    # The parser of this command only: building every command's would take 4 ms.
+    command_parser = _parser(f"rl1c {args[0]}", function.__doc__)
+    for names, settings in arguments:
+        command_parser.add_argument(*names, **settings)
+    # Intermixed: options may come between files, `rl1c check a.rob --format json b.rob`.
+    options = vars(command_parser.parse_intermixed_args(args[1:]))
+    try:
+        status = function(**options)
+        sys.stdout.flush()  # a closed pipe shows here, not when the process exits
+        return status
+    except UsageError as error:
+        command_parser.print_usage(sys.stderr)
+        print(f"{command_parser.prog}: error: {error}", file=sys.stderr)
+        return EXIT_USAGE
+    except Failure as failure:
+        print(failure, file=sys.stderr)
+        return failure.status
+    except BrokenPipeError:
+        # The reader stopped early (`rl1c dis x.ilc | head`): end quietly. What is left in
+        # the buffer goes to /dev/null, or Python would fail again flushing it at exit.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_ERRORS
+    except KeyboardInterrupt:
+        print("rl1c: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Exception as error:
+        return _internal_error(error)
+
+
+def _internal_error(error: Exception) -> int:
+    # A traceback tells a robot programmer nothing they can act on and reads as if their
+    # program were at fault; a distinct status (3) lets scripts and CI tell a bug in rl1c
+    # from a program with errors (1) or a usage problem (2). RL1C_BACKTRACE=1 shows the
+    # traceback to whoever debugs rl1c.
+    if os.environ.get("RL1C_BACKTRACE"):
+        import traceback
+
+        traceback.print_exception(error)
+    summary = f"{type(error).__name__}: {error}"
+    print(f"rl1c: internal error: {summary[:300]}\n"
+          "This is a bug in rl1c, not in your program. Please report it with the command "
+          "line and the input file (RL1C_BACKTRACE=1 shows the details).", file=sys.stderr)
+    return EXIT_INTERNAL
+
+
+def _escape_unprintable_output() -> None:
     # A terminal that cannot show a character (a Japanese comment in a Latin-1 locale)
     # gets an escape for it instead of a failure.
     for stream in (sys.stdout, sys.stderr):
@@ -100,15 +142,91 @@ def main() -> None:
             reconfigure(errors="backslashreplace")
 
 
+def _with_verb(args: list[str]) -> list[str]:
+    """`rl1c FILE ...` means `rl1c compile FILE ...`: compiling needs no verb."""
+    if args and args[0] not in _COMMANDS and (args[0] == "-"  # standard input
+                                              or not args[0].startswith("-")):
+        return ["compile", *args]
+    return args
+
+
+# Declaring commands ---------------------------------------------------------------------
+
+_COMMANDS: dict[str, tuple[Callable[..., int], Sequence[Argument]]] = {}
+
+
+def command(name: str, *arguments: Argument) -> Callable[[Run], Run]:
+    """Makes the decorated function the command `name`, called with `arguments` (made by
+    `argument`) as keywords."""
+    def register(function: Run) -> Run:
+        _COMMANDS[name] = (function, arguments)
+        return function
+    return register
+
+
+def argument(*names: str, **settings: Any) -> Argument:
+    """An argument of a command, as argparse's `add_argument` takes it."""
+    return names, settings
+
+
+def _toolchain(args: list[str]) -> int:
+    """`rl1c` without a command: --help, --version, or a usage problem (no arguments at
+    all is one: the help goes to standard error)."""
+    parser = _parser("rl1c", DESCRIPTION)
+    parser.add_argument("--version", action=_ShowVersion, help="show the version and exit")
+    commands = parser.add_subparsers(title="commands", metavar="COMMAND")
+    for name, (function, _) in _COMMANDS.items():
+        commands.add_parser(name, help=(function.__doc__ or "").partition("\n")[0])
+    if not args:
+        parser.print_help(sys.stderr)
+        return EXIT_USAGE
+    parser.parse_args(args)  # --help and --version end the process, and errors
+    parser.error("expected a command, or a file to compile (see rl1c --help)")
+
+
+def _parser(prog: str, description: str | None) -> argparse.ArgumentParser:
+    # No abbreviated options (`--form` for `--format`): adding an option could break them.
+    return argparse.ArgumentParser(prog=prog, description=description, allow_abbrev=False)
+
+
+class _ShowVersion(argparse.Action):
+    """`--version`, looked up only when asked: importlib.metadata costs milliseconds."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, help: str) -> None:
+        super().__init__(option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS,
+                         nargs=0, help=help)
+
+    def __call__(self, parser: argparse.ArgumentParser, namespace: argparse.Namespace,
+                 values: str | Sequence[Any] | None, option_string: str | None = None,
+                 ) -> None:
+        from importlib.metadata import version
+
+        print(f"{parser.prog}, version {version('rl1')}")
+        parser.exit()
+
+
+def _at_least_one(text: str) -> int:
+    """An argparse type: a whole number, at least 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number of at least 1, got {text!r}")
+    return value
+
+
 # Shared by the commands that report diagnostics.
-format_option = click.option(
-    "--format", "output_format", type=click.Choice(FORMATS), default="human",
-    show_default=True, help="human: text for people; json or sarif: for tools.",
+REPORT_OPTIONS = (
+    argument("--format", dest="output_format", choices=FORMATS, default="human",
+             help="human: text for people; json or sarif: for tools (default: %(default)s)"),
+    argument("--color", choices=COLOR_CHOICES, default="auto",
+             help="colour the human format; auto: only on a terminal, and not if NO_COLOR "
+                  "is set (default: %(default)s)"),
 )
-color_option = click.option(
-    "--color", "color", type=click.Choice(COLOR_CHOICES), default="auto", show_default=True,
-    help="Colour the human format; auto: only on a terminal, and not if NO_COLOR is set.",
-)
+
+
+# Inputs and outputs ---------------------------------------------------------------------
 
 
 def read_input(name: str) -> Source | FileDiagnostics:
@@ -131,21 +249,56 @@ def emit(files: list[FileDiagnostics], output_format: Format, color: ColorChoice
          action: str, *, err: bool = False) -> int:
     """Print the diagnostics of `files` on standard output (`err`: standard error);
     the exit status they call for."""
-    colored = output_format == "human" and use_color(color, sys.stderr if err else sys.stdout)
-    click.echo(report(files, output_format, color=colored, action=action), nl=False,
-               err=err, color=colored)
+    stream = sys.stderr if err else sys.stdout
+    colored = output_format == "human" and use_color(color, stream)
+    stream.write(report(files, output_format, color=colored, action=action))
     return exit_status(files)
 
 
-@main.command()
-@click.argument("files", nargs=-1, required=True)
-@format_option
-@color_option
-@click.pass_context
-def check(ctx: click.Context, files: tuple[str, ...], output_format: Format,
-          color: ColorChoice) -> None:
-    """Check RL/I programs (`-` reads standard input) and report every problem found.
-    Exit status: 0 no errors (warnings allowed), 1 errors, 2 an unreadable file."""
+def write_stdout_bytes(data: bytes) -> None:
+    sys.stdout.flush()  # what was printed as text comes first
+    sys.stdout.buffer.write(data)
+    sys.stdout.buffer.flush()
+
+
+def write_file(target: str, data: bytes) -> None:
+    """Writes `target` atomically; a Failure (exit status 2) saying why it cannot be."""
+    from .atomic import write_atomically
+
+    try:
+        write_atomically(target, data)
+    except OSError as error:
+        raise Failure(f"error: cannot write `{target}`: {error.strerror or error}") from None
+
+
+MAX_ILC_BYTES = 16 * 1024 * 1024  # far more than any .ilc file holds
+
+
+def read_ilc(file: str) -> bytes:
+    """The bytes of an .ilc file; a Failure with exit status 2 when it cannot be read, 1
+    when it is too large to be one (without reading a huge file whole)."""
+    try:
+        with open(file, "rb") as stream:
+            data = stream.read(MAX_ILC_BYTES + 1)
+    except OSError as error:
+        raise Failure(f"error: cannot read `{file}`: {error.strerror or error}") from None
+    if len(data) > MAX_ILC_BYTES:
+        raise Failure(f"error: `{file}` is larger than {MAX_ILC_BYTES} bytes: not an .ilc "
+                      "file", EXIT_ERRORS)
+    return data
+
+
+# The commands -------------------------------------------------------------------------
+
+
+@command("check", argument("files", nargs="+", metavar="FILE",
+                           help="an RL/I program; `-` is standard input"),
+         *REPORT_OPTIONS)
+def check(files: list[str], output_format: Format, color: ColorChoice) -> int:
+    """Check RL/I programs and report every problem found.
+
+    `-` reads standard input. Exit status: 0 no errors (warnings allowed), 1 errors,
+    2 an unreadable file."""
     from .frontend import analyze
 
     checked: list[FileDiagnostics] = []
@@ -156,188 +309,164 @@ def check(ctx: click.Context, files: tuple[str, ...], output_format: Format,
                                            analyze(source.text).diagnostics))
         else:
             checked.append(source)
-    ctx.exit(emit(checked, output_format, color, "check"))
+    return emit(checked, output_format, color, "check")
 
 
-@main.command("compile")
-@click.argument("file")
-@click.option("-o", "--output", metavar="PATH",
-              help="Where to write; `-` is standard output. Default: FILE.ilc beside the "
-                   "source (standard output with --emit ir).")
-@click.option("-s", "--strip", is_flag=True,
-              help="Leave out the debug section (the map from code to source lines).")
-@click.option("--emit", "emit_kind", type=click.Choice(EMIT_CHOICES), default="ilc",
-              show_default=True, help="ilc: the .ilc file; ir: the IR as text.")
-@click.option("-O", "optimize", default="0", metavar="LEVEL",
-              help="Optimization level; only -O0 (none) exists so far.")
-@format_option
-@color_option
-@click.pass_context
-def compile_program(ctx: click.Context, file: str, output: str | None, strip: bool,
-                    emit_kind: Emit, optimize: str, output_format: Format,
-                    color: ColorChoice) -> None:
-    """Compile an RL/I program (`-` reads standard input): `rl1c FILE.rob -o FILE.ilc`.
-    Diagnostics go to standard error; nothing is written when the program has errors.
-    Exit status: 0 compiled (warnings allowed), 1 errors, 2 an unreadable input or an
-    output that cannot be written."""
-    from .atomic import write_atomically
+@command(
+    "compile",
+    argument("file", metavar="FILE", help="the RL/I program; `-` is standard input"),
+    argument("-o", "--output", metavar="PATH",
+             help="where to write; `-` is standard output. Default: FILE.ilc beside the "
+                  "source (standard output with --emit ir)"),
+    argument("-s", "--strip", action="store_true",
+             help="leave out the debug section (the map from code to source lines)"),
+    argument("--emit", dest="emit_kind", choices=EMIT_CHOICES, default="ilc",
+             help="ilc: the .ilc file; ir: the IR as text (default: %(default)s)"),
+    argument("-O", dest="optimize", default="0", metavar="LEVEL",
+             help="optimization level; only -O0 (none) exists so far"),
+    *REPORT_OPTIONS,
+)
+def compile_program(file: str, output: str | None, strip: bool, emit_kind: Emit,
+                    optimize: str, output_format: Format, color: ColorChoice) -> int:
+    """Compile an RL/I program: `rl1c FILE.rob -o FILE.ilc`.
+
+    `-` reads standard input. Diagnostics go to standard error; nothing is written when
+    the program has errors. Exit status: 0 compiled (warnings allowed), 1 errors,
+    2 an unreadable input or an output that cannot be written."""
     from .driver import OPTIMIZATION_LEVELS, compile_text
 
     if optimize not in {str(level) for level in OPTIMIZATION_LEVELS}:
-        raise click.BadParameter(f"`-O{optimize}`: only -O0 (no optimization) exists so far",
-                                 param_hint="-O")
+        raise UsageError(f"argument -O: `-O{optimize}`: only -O0 (no optimization) exists "
+                         "so far")
     if strip and emit_kind == "ir":
-        raise click.UsageError("--strip drops the debug section of an .ilc file; "
-                               "it has no meaning with --emit ir")
+        raise UsageError("--strip drops the debug section of an .ilc file; "
+                         "it has no meaning with --emit ir")
     target = output or ("-" if emit_kind == "ir" else _default_output(file))
     source = read_input(file)
     if not isinstance(source, Source):
-        ctx.exit(emit([source], output_format, color, "compile", err=True))
+        return emit([source], output_format, color, "compile", err=True)
     if target != "-" and file != "-" and os.path.exists(target) \
             and os.path.samefile(file, target):
-        raise click.UsageError(f"the output `{target}` is the source file itself: "
-                               "give another path with -o")
+        raise UsageError(f"the output `{target}` is the source file itself: "
+                         "give another path with -o")
     compilation = compile_text(source.text, Path(source.name).name, emit=emit_kind,
                                strip_debug=strip)
     status = emit([FileDiagnostics(source.name, source.text, compilation.diagnostics)],
                   output_format, color, "compile", err=True)
     if compilation.output is None:
-        ctx.exit(status)
-    if target == "-":
-        stdout = sys.stdout.buffer
-        if emit_kind == "ilc" and stdout.isatty():
-            raise click.UsageError("an .ilc file is binary and standard output is a "
-                                   "terminal: redirect it, or give -o FILE.ilc")
-        stdout.write(compilation.output)
-        stdout.flush()
-        return
-    try:
-        write_atomically(target, compilation.output)
-    except OSError as error:
-        click.echo(f"error: cannot write `{target}`: {error.strerror or error}", err=True)
-        ctx.exit(EXIT_USAGE)
+        return status
+    if target != "-":
+        write_file(target, compilation.output)
+    elif emit_kind == "ilc" and sys.stdout.isatty():
+        raise UsageError("an .ilc file is binary and standard output is a "
+                         "terminal: redirect it, or give -o FILE.ilc")
+    else:
+        write_stdout_bytes(compilation.output)
+    return status
 
 
 def _default_output(source: str) -> str:
     if source == "-":
-        raise click.UsageError("reading standard input there is no file name to name the "
-                               "output after: give -o FILE.ilc (or -o - for standard output)")
+        raise UsageError("reading standard input there is no file name to name the "
+                         "output after: give -o FILE.ilc (or -o - for standard output)")
     return str(Path(source).with_suffix(".ilc"))
 
 
-@main.command()
-@click.argument("code", required=False)
-@click.option("--list", "list_codes", is_flag=True, help="List every code with its title.")
-@click.pass_context
-def explain(ctx: click.Context, code: str | None, list_codes: bool) -> None:
+@command(
+    "explain",
+    argument("code", nargs="?", metavar="CODE", help="a diagnostic code, such as E0101"),
+    argument("--list", dest="list_codes", action="store_true",
+             help="list every code with its title"),
+)
+def explain(code: str | None, list_codes: bool) -> int:
     """Explain a diagnostic code in depth, with examples: `rl1c explain E0101`."""
     from .catalogue import CODES
 
     if list_codes == (code is not None):
-        raise click.UsageError("give a code, as in `rl1c explain E0101`, or --list")
+        raise UsageError("give a code, as in `rl1c explain E0101`, or --list")
     if code is None:
         for entry in CODES.values():
-            click.echo(f"{entry.code}  {entry.title}")
-        return
+            print(f"{entry.code}  {entry.title}")
+        return 0
     info = CODES.get(code.strip().upper())
     if info is None:
-        click.echo(f"error: `{code}` is not a diagnostic code of rl1c\n"
-                   "  = help: `rl1c explain --list` lists every code with its title",
-                   err=True)
-        ctx.exit(EXIT_USAGE)
-    click.echo(info.explanation(), nl=False)
+        raise Failure(f"error: `{code}` is not a diagnostic code of rl1c\n"
+                      "  = help: `rl1c explain --list` lists every code with its title")
+    sys.stdout.write(info.explanation())
+    return 0
 
 
-MAX_ILC_BYTES = 16 * 1024 * 1024  # far more than any .ilc file holds
+@command("dis", argument("file", metavar="FILE", help="the .ilc file"))
+def dis(file: str) -> int:
+    """Disassemble an .ilc file into .ils text on standard output.
 
-
-def read_ilc(ctx: click.Context, file: str) -> bytes:
-    """The bytes of an .ilc file; exits 2 when it cannot be read, 1 when it is too large
-    to be one (without reading a huge file whole)."""
-    try:
-        with open(file, "rb") as stream:
-            data = stream.read(MAX_ILC_BYTES + 1)
-    except OSError as error:
-        click.echo(f"error: cannot read `{file}`: {error.strerror or error}", err=True)
-        ctx.exit(EXIT_USAGE)
-    if len(data) > MAX_ILC_BYTES:
-        click.echo(f"error: `{file}` is larger than {MAX_ILC_BYTES} bytes: not an .ilc file",
-                   err=True)
-        ctx.exit(EXIT_ERRORS)
-    return data
-
-
-@main.command()
-@click.argument("file")
-@click.pass_context
-def dis(ctx: click.Context, file: str) -> None:
-    """Disassemble an .ilc file into .ils text on standard output, with the program's
-    source lines when its source file is found (beside the .ilc, or by the recorded name).
-    Exit status: 0 done, 1 the file is not valid intermediate code, 2 an unreadable file."""
+    The program's source lines are shown when its source file is found (beside the .ilc,
+    or by the recorded name). Exit status: 0 done, 1 the file is not valid intermediate
+    code, 2 an unreadable file."""
     from rl1.vm.verifier import VerifyError
 
     from .disasm import disassemble, source_beside
 
-    data = read_ilc(ctx, file)
+    data = read_ilc(file)
     try:
         text = disassemble(data, file, source_beside(file))
     except VerifyError as error:
-        click.echo(f"error: {file}: byte {error.offset}: {error.message}", err=True)
-        ctx.exit(EXIT_ERRORS)
-    click.echo(text, nl=False)
+        raise Failure(f"error: {file}: byte {error.offset}: {error.message}",
+                      EXIT_ERRORS) from None
+    sys.stdout.write(text)
+    return 0
 
 
-@main.command("asm")
-@click.argument("file")
-@click.option("-o", "--output", metavar="PATH",
-              help="Where to write the .ilc file; `-` is standard output. "
-                   "Default: FILE.ilc beside the .ils file.")
-@click.pass_context
-def assemble_file(ctx: click.Context, file: str, output: str | None) -> None:
-    """Assemble .ils text (as `rl1c dis` prints it) into an .ilc file; the result must
-    pass the verifier. Exit status: 0 written, 1 errors in the text (nothing is written),
-    2 an unreadable input or an output that cannot be written."""
+@command(
+    "asm",
+    argument("file", metavar="FILE", help="the .ils file"),
+    argument("-o", "--output", metavar="PATH",
+             help="where to write the .ilc file; `-` is standard output. "
+                  "Default: FILE.ilc beside the .ils file"),
+)
+def assemble_file(file: str, output: str | None) -> int:
+    """Assemble .ils text (as `rl1c dis` prints it) into an .ilc file.
+
+    The result must pass the verifier. Exit status: 0 written, 1 errors in the text
+    (nothing is written), 2 an unreadable input or an output that cannot be written."""
     from .asm import AsmError, assemble
-    from .atomic import write_atomically
 
     try:
         source = read_source(file)
     except SourceError as error:
-        click.echo(f"error: {error}", err=True)
-        ctx.exit(EXIT_USAGE)
+        raise Failure(f"error: {error}") from None
     target = output or str(Path(file).with_suffix(".ilc"))
     if target != "-" and os.path.exists(target) and os.path.samefile(file, target):
-        raise click.UsageError(f"the output `{target}` is the input file itself: "
-                               "give another path with -o")
+        raise UsageError(f"the output `{target}` is the input file itself: "
+                         "give another path with -o")
     try:
         data = assemble(source.text)
     except AsmError as error:
-        for problem in error.problems:
-            click.echo(f"{file}:{problem.line}:{problem.column}: error: {problem.message}",
-                       err=True)
-        ctx.exit(EXIT_ERRORS)
+        raise Failure("\n".join(f"{file}:{problem.line}:{problem.column}: error: "
+                                f"{problem.message}" for problem in error.problems),
+                      EXIT_ERRORS) from None
     if target == "-":
-        sys.stdout.buffer.write(data)
-        return
-    try:
-        write_atomically(target, data)
-    except OSError as error:
-        click.echo(f"error: cannot write `{target}`: {error.strerror or error}", err=True)
-        ctx.exit(EXIT_USAGE)
+        write_stdout_bytes(data)
+    else:
+        write_file(target, data)
+    return 0
 
 
-@main.command("fmt")
-@click.argument("files", nargs=-1, required=True)
-@click.option("--check", is_flag=True,
-              help="Change nothing; list the files formatting would change (exit status 1).")
-@click.option("--diff", is_flag=True,
-              help="Change nothing; print what formatting would change as a unified diff.")
-@click.pass_context
-def fmt(ctx: click.Context, files: tuple[str, ...], check: bool, diff: bool) -> None:
-    """Put RL/I programs in the canonical layout (spec/language.md, section 11), rewriting
-    each file in place in its own encoding; `-` formats standard input to standard output.
-    Exit status: 0 done, 1 (--check) a file would change, 2 a file cannot be read or
-    written."""
+@command(
+    "fmt",
+    argument("files", nargs="+", metavar="FILE",
+             help="an RL/I program; `-` is standard input"),
+    argument("--check", action="store_true",
+             help="change nothing; list the files formatting would change (exit status 1)"),
+    argument("--diff", action="store_true",
+             help="change nothing; print what formatting would change as a unified diff"),
+)
+def fmt(files: list[str], check: bool, diff: bool) -> int:
+    """Put RL/I programs in the canonical layout (spec/language.md, section 11).
+
+    Each file is rewritten in place in its own encoding; `-` formats standard input to
+    standard output. Exit status: 0 done, 1 (--check) a file would change, 2 a file cannot
+    be read or written."""
     from . import formatter
 
     status = 0
@@ -350,43 +479,45 @@ def fmt(ctx: click.Context, files: tuple[str, ...], check: bool, diff: bool) -> 
         formatted = formatter.format_text(source.text)
         changed = formatted != source.text
         if diff and changed:
-            click.echo(formatter.unified_diff(source.name, source.text, formatted), nl=False)
+            sys.stdout.write(formatter.unified_diff(source.name, source.text, formatted))
         if check and changed:
-            click.echo(source.name)
+            print(source.name)
             status = max(status, EXIT_ERRORS)
         if check or diff:
             continue
         if name == "-":
-            sys.stdout.buffer.write(formatter.encode_like(source, formatted, bom=False))
+            write_stdout_bytes(formatter.encode_like(source, formatted, bom=False))
         elif changed:
             try:
                 formatter.rewrite(source, formatted)
             except OSError as error:
-                click.echo(f"error: cannot write `{name}`: {error.strerror or error}", err=True)
+                print(f"error: cannot write `{name}`: {error.strerror or error}",
+                      file=sys.stderr)
                 status = EXIT_USAGE
-    ctx.exit(status)
+    return status
 
 
-@main.command()
-@click.argument("file")
-@click.option("--sensors", metavar="FILE",
-              help="Sensor script for the scripted device (JSON, or TOML if FILE ends in "
-                   ".toml). Without one every sensor reads 0 and the line is never lost.")
-@click.option("--format", "run_format", type=click.Choice(("text", "json")), default="text",
-              show_default=True, help="text: for people; json: one object for tools.")
-@click.option("--budget", type=click.IntRange(min=1), default=DEFAULT_BUDGET,
-              show_default=True,
-              help="Instructions (statements with --engine ast) before the watchdog stops "
-                   "a runaway program.")
-@click.option("--engine", type=click.Choice(ENGINE_CHOICES), default="vm", show_default=True,
-              help="vm: compile, then run on the reference VM; ast: interpret the source.")
-@click.pass_context
-def run(ctx: click.Context, file: str, sensors: str | None, run_format: str, budget: int,
-        engine: Engine) -> None:
-    """Run a program (.rob source, or a compiled .ilc file) on the scripted device; print
-    the device's trace and the final variables. Exit status: 0 the program ended; 1 it
-    has errors (or the .ilc file is not valid); 2 a usage problem or an unreadable file
-    (sensor scripts included); faults: 10 argument out of range, 11 missing handler,
+@command(
+    "run",
+    argument("file", metavar="FILE", help="an RL/I program (.rob) or a compiled .ilc file"),
+    argument("--sensors", metavar="FILE",
+             help="sensor script for the scripted device (JSON, or TOML if FILE ends in "
+                  ".toml). Without one every sensor reads 0 and the line is never lost"),
+    argument("--format", dest="run_format", choices=("text", "json"), default="text",
+             help="text: for people; json: one object for tools (default: %(default)s)"),
+    argument("--budget", type=_at_least_one, default=DEFAULT_BUDGET, metavar="N",
+             help="instructions (statements with --engine ast) before the watchdog stops "
+                  "a runaway program (default: %(default)s)"),
+    argument("--engine", choices=ENGINE_CHOICES, default="vm",
+             help="vm: compile, then run on the reference VM; ast: interpret the source "
+                  "(default: %(default)s)"),
+)
+def run(file: str, sensors: str | None, run_format: str, budget: int, engine: Engine) -> int:
+    """Run a program (.rob source, or a compiled .ilc file) on the scripted device.
+
+    Prints the device's trace and the final variables. Exit status: 0 the program ended;
+    1 it has errors (or the .ilc file is not valid); 2 a usage problem or an unreadable
+    file (sensor scripts included); faults: 10 argument out of range, 11 missing handler,
     12 budget exhausted, 13 device error."""
     from rl1.vm.faults import RunResult
     from rl1.vm.report import render_json, render_text
@@ -397,27 +528,26 @@ def run(ctx: click.Context, file: str, sensors: str | None, run_format: str, bud
     try:
         device = ScriptedDevice(load_script(sensors) if sensors is not None else Script())
     except ScriptError as error:
-        click.echo(f"error: {error}", err=True)
-        ctx.exit(EXIT_USAGE)
+        raise Failure(f"error: {error}") from None
     if file.lower().endswith(".ilc"):
         if engine == "ast":
-            raise click.UsageError("--engine ast interprets RL/I source; an .ilc file runs "
-                                   "on the VM: leave out --engine, or run the .rob file")
-        data = read_ilc(ctx, file)
+            raise UsageError("--engine ast interprets RL/I source; an .ilc file runs "
+                             "on the VM: leave out --engine, or run the .rob file")
+        data = read_ilc(file)
         try:
             result = run_ilc(data, device, budget)
         except VerifyError as error:
-            click.echo(f"error: {file}: byte {error.offset}: {error.message}", err=True)
-            ctx.exit(EXIT_ERRORS)
+            raise Failure(f"error: {file}: byte {error.offset}: {error.message}",
+                          EXIT_ERRORS) from None
     else:
         source = read_input(file)
         if not isinstance(source, Source):
-            ctx.exit(emit([source], "human", "auto", "run", err=True))
+            return emit([source], "human", "auto", "run", err=True)
         outcome = run_source(source.text, Path(source.name).name, device, engine, budget)
         if not isinstance(outcome, RunResult):
-            ctx.exit(emit([FileDiagnostics(source.name, source.text, outcome)], "human",
-                          "auto", "run", err=True))
+            return emit([FileDiagnostics(source.name, source.text, outcome)], "human",
+                        "auto", "run", err=True)
         result = outcome
     render = render_json if run_format == "json" else render_text
-    click.echo(render(result, device.trace), nl=False)
-    ctx.exit(result.fault.kind.exit_status if result.fault is not None else 0)
+    sys.stdout.write(render(result, device.trace))
+    return result.fault.kind.exit_status if result.fault is not None else 0

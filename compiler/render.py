@@ -7,24 +7,28 @@ until here; nothing else turns them into text.
 
 from __future__ import annotations
 
-import json
 import os
 import unicodedata
-from collections.abc import Sequence
 from pathlib import Path
-from typing import IO, Any, Literal, NamedTuple
 from urllib.parse import quote
 
-import click
-
-from .ast import Span
 from .catalogue import CODES
-from .diagnostics import Diagnostic, Fix, Severity, sort_key
+from .diagnostics import Severity, sort_key
+from .record import Record
 from .source import split_lines
 
-Format = Literal["human", "json", "sarif"]
+TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+    from typing import IO, Any, Literal
+
+    from .ast import Span
+    from .diagnostics import Diagnostic, Fix
+
+    Format = Literal["human", "json", "sarif"]
+    ColorChoice = Literal["auto", "always", "never"]
+
 FORMATS: tuple[Format, ...] = ("human", "json", "sarif")
-ColorChoice = Literal["auto", "always", "never"]
 COLOR_CHOICES: tuple[ColorChoice, ...] = ("auto", "always", "never")
 
 # Exit statuses of a command that reports diagnostics.
@@ -41,14 +45,19 @@ SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
 _SARIF_LEVELS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
 
 
-class FileDiagnostics(NamedTuple):
+class FileDiagnostics(Record):
     """The diagnostics of one source file. `text` is None when the file could not be
     read; its diagnostics then say why (E0100) and have no place in the text."""
 
+    __slots__ = ("name", "text", "diagnostics")
     name: str
     text: str | None
     diagnostics: Sequence[Diagnostic]
 
+    def __init__(self, name: str, text: str | None, diagnostics: Sequence[Diagnostic]) -> None:
+        self.name = name
+        self.text = text
+        self.diagnostics = diagnostics
 
 
 def _tool_version() -> str:
@@ -56,6 +65,7 @@ def _tool_version() -> str:
     from importlib.metadata import version
 
     return version("rl1")
+
 
 def report(
     files: Sequence[FileDiagnostics],
@@ -97,14 +107,17 @@ def _ordered(diagnostics: Sequence[Diagnostic]) -> list[Diagnostic]:
 
 # Human ------------------------------------------------------------------------------
 
-_STYLES: dict[str, dict[str, Any]] = {
-    "error": {"fg": "red", "bold": True},
-    "warning": {"fg": "yellow", "bold": True},
-    "info": {"fg": "cyan", "bold": True},
-    "note": {"fg": "green", "bold": True},
-    "help": {"fg": "cyan", "bold": True},
-    "gutter": {"fg": "blue", "bold": True},
-    "message": {"bold": True},
+# ANSI SGR escapes: a colour, then bold; _RESET ends both.
+_RED, _GREEN, _YELLOW, _BLUE, _CYAN = (f"\x1b[{code}m" for code in (31, 32, 33, 34, 36))
+_BOLD, _RESET = "\x1b[1m", "\x1b[0m"
+_STYLES = {
+    "error": _RED + _BOLD,
+    "warning": _YELLOW + _BOLD,
+    "info": _CYAN + _BOLD,
+    "note": _GREEN + _BOLD,
+    "help": _CYAN + _BOLD,
+    "gutter": _BLUE + _BOLD,
+    "message": _BOLD,
 }
 
 
@@ -184,7 +197,7 @@ class _HumanRenderer:
         self.lines = split_lines(file.text) if file.text is not None else []
 
     def paint(self, text: str, role: str) -> str:
-        return click.style(text, **_STYLES[role]) if self.color else text
+        return f"{_STYLES[role]}{text}{_RESET}" if self.color else text
 
     def render(self, action: str) -> str:
         blocks = [self.diagnostic(d) for d in _ordered(self.file.diagnostics)]
@@ -286,8 +299,15 @@ def _json_report(files: Sequence[FileDiagnostics]) -> str:
         for file in files
         for d in _ordered(file.diagnostics)
     ]
+    return _json_text(items)
+
+
+def _json_text(value: object) -> str:
+    # Imported here, as the human format needs no JSON: `json` costs 2 ms of every start.
+    import json
+
     # ASCII only: valid JSON whatever the encoding of the stream it is written to.
-    return json.dumps(items, indent=2, ensure_ascii=True) + "\n"
+    return json.dumps(value, indent=2, ensure_ascii=True) + "\n"
 
 
 def _json_span(span: Span) -> dict[str, int]:
@@ -323,7 +343,7 @@ def _sarif_report(files: Sequence[FileDiagnostics]) -> str:
             "results": results,
         }],
     }
-    return json.dumps(log, indent=2, ensure_ascii=True) + "\n"
+    return _json_text(log)
 
 
 def _sarif_rule(code: str) -> dict[str, Any]:

@@ -6,14 +6,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner
+from cli_run import rl1c
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from ilc_testing import images
 
 from rl1.compiler.asm import AsmError, assemble
 from rl1.compiler.builtins import Feature
-from rl1.compiler.cli import main
 from rl1.compiler.disasm import disassemble
 from rl1.compiler.driver import compile_text
 from rl1.vm import ilc
@@ -142,16 +141,14 @@ def test_check_false_assembles_a_file_the_verifier_refuses() -> None:
 def test_dis_then_asm_on_the_command_line(tmp_path: Path) -> None:
     (tmp_path / "count.rob").write_text("A=5\n' count down\n:10 A--; ?A>#10\n")
     (tmp_path / "count.ilc").write_bytes(assemble(HAND_WRITTEN))
-    runner = CliRunner()
-    shown = runner.invoke(main, ["dis", str(tmp_path / "count.ilc")])
+    shown = rl1c("dis", tmp_path / "count.ilc")
     assert shown.exit_code == 0
     assert ";    3 | :10 A--; ?A>#10" in shown.output  # found beside the .ilc
     (tmp_path / "count.ils").write_text(shown.output)
-    built = runner.invoke(main, ["asm", str(tmp_path / "count.ils"), "-o",
-                                 str(tmp_path / "again.ilc")])
+    built = rl1c("asm", tmp_path / "count.ils", "-o", tmp_path / "again.ilc")
     assert built.exit_code == 0
     assert (tmp_path / "again.ilc").read_bytes() == (tmp_path / "count.ilc").read_bytes()
-    default = runner.invoke(main, ["asm", str(tmp_path / "count.ils")])
+    default = rl1c("asm", tmp_path / "count.ils")
     assert default.exit_code == 0  # FILE.ilc beside the .ils by default
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "again.ilc", "count.ilc", "count.ils", "count.rob"]  # no temporary file left
@@ -160,25 +157,23 @@ def test_dis_then_asm_on_the_command_line(tmp_path: Path) -> None:
 def test_asm_reports_errors_with_file_line_column_and_writes_nothing(tmp_path: Path) -> None:
     source = tmp_path / "bad.ils"
     source.write_text("LDI 5\nFOO\n")
-    result = CliRunner().invoke(main, ["asm", str(source), "-o", str(tmp_path / "bad.ilc")])
+    result = rl1c("asm", source, "-o", tmp_path / "bad.ilc")
     assert result.exit_code == 1
     assert f"{source}:2:1: error: unknown instruction FOO" in result.output
     assert not (tmp_path / "bad.ilc").exists()
 
 
 def test_unreadable_files_exit_2(tmp_path: Path) -> None:
-    runner = CliRunner()
-    assert runner.invoke(main, ["dis", str(tmp_path / "none.ilc")]).exit_code == 2
-    assert runner.invoke(main, ["asm", str(tmp_path / "none.ils")]).exit_code == 2
+    assert rl1c("dis", tmp_path / "none.ilc").exit_code == 2
+    assert rl1c("asm", tmp_path / "none.ils").exit_code == 2
     (tmp_path / "ok.ils").write_text("END\n")
-    unwritable = runner.invoke(main, ["asm", str(tmp_path / "ok.ils"), "-o",
-                                      str(tmp_path / "no" / "dir.ilc")])
+    unwritable = rl1c("asm", tmp_path / "ok.ils", "-o", tmp_path / "no" / "dir.ilc")
     assert unwritable.exit_code == 2
     assert "cannot write" in unwritable.output
 
 
 def test_dis_refuses_an_invalid_file_with_its_offset(tmp_path: Path) -> None:
     (tmp_path / "x.ilc").write_bytes(b"RLIX" + assemble("END")[4:])
-    result = CliRunner().invoke(main, ["dis", str(tmp_path / "x.ilc")])
+    result = rl1c("dis", tmp_path / "x.ilc")
     assert result.exit_code == 1
     assert "byte 0: not an .ilc file" in result.output

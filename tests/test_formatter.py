@@ -13,11 +13,11 @@ import re
 from pathlib import Path
 
 import pytest
-from click.testing import CliRunner, Result
+from cli_run import Result, rl1c
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rl1.compiler import ast, cli, formatter
+from rl1.compiler import ast, formatter
 from rl1.compiler.formatter import format_line, format_lines, format_text
 from rl1.compiler.parser import parse_program
 from rl1.compiler.source import split_lines
@@ -212,8 +212,8 @@ def test_line_ends_and_blank_lines(text: str, formatted: str) -> None:
 # rl1c fmt -----------------------------------------------------------------------------
 
 
-def run(*args: str, stdin: bytes | None = None) -> Result:
-    return CliRunner().invoke(cli.main, ["fmt", *args], input=stdin)
+def run(*args: str, stdin: bytes = b"") -> Result:
+    return rl1c("fmt", *args, stdin=stdin)
 
 
 def write(tmp_path: Path, data: bytes, name: str = "prog.rob") -> Path:

@@ -6,17 +6,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from click.testing import CliRunner, Result
+from cli_run import rl1c
 
 from rl1.compiler.builtins import VARIABLES
-from rl1.compiler.cli import main
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
 SAMPLE, SENSORS = EXAMPLES / "sample.rob", EXAMPLES / "sample.sensors.json"
-
-
-def rl1c(*args: str | Path) -> Result:
-    return CliRunner().invoke(main, [str(arg) for arg in args])
 
 
 def report(*args: str | Path) -> tuple[int, dict[str, Any]]:
