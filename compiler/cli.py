@@ -186,7 +186,30 @@ def _toolchain(args: list[str]) -> int:
 
 def _parser(prog: str, description: str | None) -> argparse.ArgumentParser:
     # No abbreviated options (`--form` for `--format`): adding an option could break them.
-    return argparse.ArgumentParser(prog=prog, description=description, allow_abbrev=False)
+    return argparse.ArgumentParser(prog=prog, description=description, allow_abbrev=False,
+                                   formatter_class=_HelpFormatter)
+
+
+class _HelpFormatter(argparse.HelpFormatter):
+    """argparse's help layout, given the terminal's width. Left to find it, argparse
+    imports shutil (and with it bz2, lzma and zlib: 3 ms of every start), because it
+    makes a formatter for every argument added, to check its metavar."""
+
+    def __init__(self, prog: str) -> None:
+        super().__init__(prog, width=_terminal_columns() - 2)  # argparse's own margin
+
+
+def _terminal_columns() -> int:
+    """The width `shutil.get_terminal_size()` finds: $COLUMNS, else standard output's
+    terminal, else 80."""
+    try:
+        return int(os.environ["COLUMNS"])
+    except (KeyError, ValueError):
+        pass
+    try:
+        return os.get_terminal_size(sys.__stdout__.fileno()).columns  # type: ignore[union-attr]
+    except (AttributeError, ValueError, OSError):
+        return 80
 
 
 class _ShowVersion(argparse.Action):

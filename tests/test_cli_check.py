@@ -148,6 +148,14 @@ def test_version_and_help() -> None:
     assert check_help.exit_code == 0 and "--format {human,json,sarif}" in check_help.stdout
 
 
+@pytest.mark.parametrize("columns", [60, 80, 120])
+def test_help_fits_the_terminal_width(columns: int) -> None:
+    """The width comes from $COLUMNS, as shutil would find it (cli.py avoids shutil)."""
+    lines = rl1c("check", "--help", env={"COLUMNS": str(columns)}).stdout.splitlines()
+    assert max(len(line) for line in lines) <= columns - 2
+    assert max(len(line) for line in lines) > columns - 20  # the width is used, not fixed
+
+
 # Unreadable files: E0100 in the chosen format, exit 2 ---------------------------------
 
 

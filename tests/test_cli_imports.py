@@ -15,9 +15,10 @@ SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 
 # What `rl1c check` must not load: each costs milliseconds of a start whose whole budget
 # is about 30 ms (bench/cold_start.py). json is for --format json or sarif, traceback for
-# an internal error, importlib.metadata for --version, difflib for a misspelt name.
+# an internal error, importlib.metadata for --version, difflib for a misspelt name;
+# shutil is what argparse would import to find the terminal's width.
 COSTLY = {"click", "lark", "msgspec", "typing", "dataclasses", "inspect", "json",
-          "traceback", "importlib.metadata", "difflib"}
+          "traceback", "importlib.metadata", "difflib", "shutil"}
 
 
 def test_option_values_are_the_stages_own() -> None:
