@@ -19,6 +19,7 @@ from lsprotocol import types
 
 from rl1.compiler import ast
 from rl1.compiler.checker import LineMemo, check_line
+from rl1.compiler.collector import collector_paused
 from rl1.compiler.diagnostics import Diagnostic, Edit, Fix, Related
 from rl1.compiler.parser import parse_line
 from rl1.compiler.source import LINE_BREAK
@@ -196,10 +197,11 @@ class Document:
         """Parse or relocate lines `first`..`last` (1-based, inclusive) now, so that a
         caller can spread the work of a large change between other tasks."""
         low, high = max(first, self._stale_low + 1), min(last, self._stale_high)
-        for number in range(low, high + 1):
-            cached = self._lines[number - 1]
-            if cached.parsed is None or cached.parsed.number != number:
-                self.line(number)
+        with collector_paused():
+            for number in range(low, high + 1):
+                cached = self._lines[number - 1]
+                if cached.parsed is None or cached.parsed.number != number:
+                    self.line(number)
         if low <= high and low == self._stale_low + 1:
             self._stale_low = high  # the stale window now starts below what was done
         if self._stale_low >= self._stale_high:
