@@ -25,7 +25,7 @@ def main() -> None:
     parser.add_argument("source", nargs="?", type=Path, default=SAMPLE)
     path: Path = parser.parse_args().source
     size = path.stat().st_size
-    text = read_source(path).text
+    text = read_source(str(path)).text
     statements = sum(1 for _ in parse_program(text)[0].statements())
     stripped, full = (compile_text(text, path.name, strip_debug=strip).output
                       for strip in (True, False))

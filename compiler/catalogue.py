@@ -9,12 +9,12 @@ W07xx safety. The long explanation of CODE is explanations/CODE.md, printed by
 
 from __future__ import annotations
 
-from pathlib import Path
+import os
 
 from .diagnostics import Severity
 from .record import Record
 
-_EXPLANATIONS = Path(__file__).with_name("explanations")
+_EXPLANATIONS = os.path.join(os.path.dirname(__file__), "explanations")
 
 
 class CodeInfo(Record):
@@ -29,7 +29,8 @@ class CodeInfo(Record):
         self.title = title
 
     def explanation(self) -> str:
-        return (_EXPLANATIONS / f"{self.code}.md").read_text(encoding="utf-8")
+        with open(os.path.join(_EXPLANATIONS, f"{self.code}.md"), encoding="utf-8") as file:
+            return file.read()
 
 
 def _entries(*rows: tuple[str, Severity, str]) -> dict[str, CodeInfo]:

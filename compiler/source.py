@@ -6,8 +6,8 @@ with LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them.
 
 from __future__ import annotations
 
+import os
 import re
-from pathlib import Path
 
 from .record import Record
 
@@ -69,16 +69,16 @@ def decode(data: bytes, name: str = "<input>") -> Source:
             ) from None
 
 
-def read_source(path: str | Path) -> Source:
+def read_source(path: str) -> Source:
     """Read and decode a source file, turning every OS failure into a SourceError."""
-    return decode(read_bounded(Path(path), MAX_SOURCE_BYTES, "an RL/I source file"), str(path))
+    return decode(read_bounded(path, MAX_SOURCE_BYTES, "an RL/I source file"), path)
 
 
-def read_bounded(path: Path, limit: int, what: str) -> bytes:
+def read_bounded(path: str | os.PathLike[str], limit: int, what: str) -> bytes:
     """The bytes of the input file `path`, `what` it should be; SourceError when it cannot
     be read or holds more than `limit` bytes (found without reading a huge file whole)."""
     try:
-        with path.open("rb") as stream:
+        with open(path, "rb") as stream:
             data = stream.read(limit + 1)
     except FileNotFoundError:
         raise SourceError(f"{path}: no such file") from None
