@@ -5,9 +5,9 @@ same machine load, and reports medians.
 `python3` is the interpreter running this script, the virtual environment's, as in a
 shell where .venv is activated: both processes start the same interpreter with the same
 site-packages. In the editable development install that start-up already imports re,
-enum and pathlib (for setuptools' import hook), which `rl1c check` needs too; after a
-regular `pip install` both start faster and rl1c pays for those modules itself, so the
-ratio there is larger (see the issue's closing notes for the figures).
+enum and pathlib (for setuptools' import hook), and `rl1c check` needs the first two;
+after a regular `pip install` both start faster and rl1c pays for re and enum itself,
+so the ratio there is larger (see the issue's closing notes for the figures).
 
 It first byte-compiles the project's modules, as pip does for a package it installs:
 an editable install leaves that to the first run, which cannot do it where
