@@ -298,6 +298,17 @@ def test_an_internal_error_is_a_short_message_and_exit_3(
     assert "in broken\n" in debugging.stderr and "This is a bug in rl1c" in debugging.stderr
 
 
+def test_ctrl_c_ends_with_a_short_message_and_the_shells_status(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def interrupted(text: str) -> Analysis:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(frontend, "analyze", interrupted)
+    result = run("check", write(tmp_path, "A=1\n"))
+    assert (result.exit_code, result.stdout, result.stderr) == (130, "", "rl1c: interrupted\n")
+
+
 def test_a_reader_that_stops_early_ends_the_output_quietly() -> None:
     # `rl1c fmt - <x.rob | head -1` when head is gone before rl1c writes: the reader's end
     # of the pipe is closed before rl1c has its input, so its first write fails.
