@@ -298,9 +298,7 @@ def relocate(node: Node, line: int) -> Node:
     plan = _RELOCATION_PLANS.get(cls) or _relocation_plan(cls)
     values: list[Any] = list(node.values())
     for index in plan.spans:
-        span = values[index]
-        values[index] = Span(line, span.column, line + span.end_line - span.line,
-                             span.end_column)
+        values[index] = values[index].on_line(line)
     for index in plan.nodes:
         if values[index] is not None:
             values[index] = relocate(values[index], line)

@@ -4,10 +4,12 @@
 (bench/cold_start.py), and importing `dataclasses` alone would spend a third of that
 budget, mostly in `inspect`. So a record class lists its fields in `__slots__` and assigns
 each in `__init__`, taking them in that order (a base class's fields first), as
-pycparser's AST nodes do. This base gives it the rest of what a frozen dataclass has:
-equality and hashing by value, and a readable `repr`.
+pycparser's AST nodes do. This base gives it the rest of what a dataclass has:
+equality and hashing by the fields' values, and a readable `repr`.
 
-Records are values: never assign to a field after `__init__`.
+Most records are values, never changed after `__init__` (the AST, diagnostics); the
+checker's graph fills in its blocks as it builds them. A record used as a dict key or
+a set member must not change afterwards.
 """
 
 from __future__ import annotations
@@ -35,9 +37,11 @@ class Record:
         # an inserted line (ast.relocate) through `values`.
         if len(cls.fields) > 1:
             cls._get_values = attrgetter(*cls.fields)
+        elif cls.fields:  # attrgetter of one name returns the value, not a tuple
+            get_only = attrgetter(cls.fields[0])
+            cls._get_values = lambda record: (get_only(record),)
         else:
-            get_one = attrgetter(*cls.fields) if cls.fields else None
-            cls._get_values = lambda record: (get_one(record),) if get_one else ()
+            cls._get_values = lambda record: ()
 
     def values(self) -> tuple[object, ...]:
         """The fields' values, in the order of `fields`."""
