@@ -14,7 +14,7 @@ import random
 
 from timing import best_time
 
-from rl1.compiler.frontend import analyze
+from rl1.compiler.analysis import analyze
 
 
 def rl1_program(lines: int, seed: int = 1997) -> str:

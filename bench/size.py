@@ -12,9 +12,9 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from rl1.compiler.driver import compile_text
-from rl1.compiler.parser import parse_program
-from rl1.compiler.source import read_source
+from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.frontend.parser import parse_program
+from rl1.compiler.frontend.source import read_source
 from rl1.vm import ilc
 
 SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"

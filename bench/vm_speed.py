@@ -13,7 +13,7 @@ import argparse
 
 from timing import best_time
 
-from rl1.compiler.driver import compile_text
+from rl1.compiler.backend.driver import compile_text
 from rl1.vm.machine import Machine
 from rl1.vm.scripted import ScriptedDevice
 from rl1.vm.verifier import verify

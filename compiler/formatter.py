@@ -11,11 +11,11 @@ from __future__ import annotations
 import difflib
 import os
 
-from . import ast
-from .atomic import write_atomically
-from .diagnostics import Edit
-from .parser import parse_line
-from .source import LINE_BREAK, Source, split_lines
+from .files import write_atomically
+from .frontend import ast
+from .frontend.diagnostics import Edit
+from .frontend.parser import parse_line
+from .frontend.source import LINE_BREAK, Source, split_lines
 
 _UTF8_BOM = b"\xef\xbb\xbf"
 

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 from hypothesis import strategies as st
 
-from .builtins import BUILTINS, HANDLER_LABELS, RESERVED_VARIABLES, VARIABLES, Form
+from rl1.vm.language import BUILTINS, HANDLER_LABELS, RESERVED_VARIABLES, VARIABLES, Form
 
 Tokens = tuple[str, ...]
 

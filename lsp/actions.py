@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 from lsprotocol import types
 
-from rl1.compiler.diagnostics import Diagnostic, Edit, Fix
+from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix
 
 from .checking import to_lsp
 from .document import Document

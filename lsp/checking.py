@@ -20,9 +20,10 @@ from pathlib import Path
 
 from lsprotocol import types
 
-from rl1.compiler import catalogue, checker
-from rl1.compiler.collector import collector_paused
-from rl1.compiler.diagnostics import Diagnostic, Severity, sort_key
+from rl1.compiler import checker
+from rl1.compiler.frontend.collector import collector_paused
+from rl1.compiler.frontend.diagnostics import Diagnostic, Severity, sort_key
+from rl1.compiler.reporting import catalogue
 
 from .document import MAX_ANALYSED_CHARACTERS, MAX_ANALYSED_LINE, Document
 from .positions import Columns

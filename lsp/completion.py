@@ -7,7 +7,7 @@ import re
 
 from lsprotocol import types
 
-from rl1.compiler.builtins import BUILTINS, RESERVED_VARIABLES, VARIABLES, Builtin, Form, writers_of
+from rl1.vm.language import BUILTINS, RESERVED_VARIABLES, VARIABLES, Builtin, Form, writers_of
 
 from .document import Document
 from .hover import describe_builtin, describe_form, signature

@@ -17,12 +17,12 @@ from typing import TypeVar, cast
 
 from lsprotocol import types
 
-from rl1.compiler import ast
 from rl1.compiler.checker import LineMemo, check_line
-from rl1.compiler.collector import collector_paused
-from rl1.compiler.diagnostics import Diagnostic, Edit, Fix, Related
-from rl1.compiler.parser import parse_line
-from rl1.compiler.source import LINE_BREAK
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.collector import collector_paused
+from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Related
+from rl1.compiler.frontend.parser import parse_line
+from rl1.compiler.frontend.source import LINE_BREAK
 
 from .positions import Columns, span_range
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from lsprotocol import types
 
-from rl1.compiler import ast
-from rl1.compiler.builtins import (
+from rl1.compiler.frontend import ast
+from rl1.vm.language import (
     BUILTINS,
     HANDLER_LABELS,
     RESERVED_VARIABLES,

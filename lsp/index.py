@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections import defaultdict
 from dataclasses import dataclass
 
-from rl1.compiler import ast
+from rl1.compiler.frontend import ast
 
 from .document import Document
 

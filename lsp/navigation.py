@@ -9,8 +9,8 @@ from collections import defaultdict
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException
 
-from rl1.compiler import ast
-from rl1.compiler.builtins import HANDLER_LABELS
+from rl1.compiler.frontend import ast
+from rl1.vm.language import HANDLER_LABELS
 
 from .document import Document
 from .index import Token, label_number, labels, token_at, token_span

@@ -12,7 +12,7 @@ import re
 
 from lsprotocol import types
 
-from rl1.compiler.ast import Span
+from rl1.compiler.frontend.ast import Span
 
 UTF8, UTF16, UTF32 = "utf-8", "utf-16", "utf-32"
 _NON_ASCII = re.compile(r"[^\x00-\x7f]")

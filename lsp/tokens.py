@@ -7,8 +7,8 @@ import itertools
 
 from lsprotocol import types
 
-from rl1.compiler import ast
-from rl1.compiler.builtins import BUILTINS, RESERVED_VARIABLES
+from rl1.compiler.frontend import ast
+from rl1.vm.language import BUILTINS, RESERVED_VARIABLES
 
 from .document import Document
 from .positions import Columns

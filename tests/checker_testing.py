@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from rl1.compiler.ast import Span
-from rl1.compiler.diagnostics import Diagnostic, Fix
-from rl1.compiler.frontend import analyze
+from rl1.compiler.analysis import analyze
+from rl1.compiler.frontend.ast import Span
+from rl1.compiler.frontend.diagnostics import Diagnostic, Fix
 
 
 def found(source: str, code: str) -> list[Diagnostic]:

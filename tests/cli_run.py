@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 import pytest
 
-from rl1.compiler import cli
+from rl1.compiler.cli import main as cli
 
 if TYPE_CHECKING:
     from _typeshed import ReadableBuffer

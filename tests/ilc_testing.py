@@ -9,8 +9,8 @@ import zlib
 
 from hypothesis import strategies as st
 
-from rl1.compiler.builtins import BUILTINS, HANDLER_LABELS, VARIABLES, Feature
 from rl1.vm import ilc, isa
+from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES, Feature
 
 
 def with_crc(data: bytes | bytearray) -> bytes:

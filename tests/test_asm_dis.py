@@ -11,11 +11,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from ilc_testing import images
 
-from rl1.compiler.asm import AsmError, assemble
-from rl1.compiler.builtins import Feature
-from rl1.compiler.disasm import disassemble
-from rl1.compiler.driver import compile_text
+from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.ils.asm import AsmError, assemble
+from rl1.compiler.ils.disasm import disassemble
 from rl1.vm import ilc
+from rl1.vm.language import Feature
 from rl1.vm.verifier import verify
 
 HAND_WRITTEN = """\

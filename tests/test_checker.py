@@ -8,11 +8,11 @@ from pathlib import Path
 import pytest
 from checker_testing import apply, codes, found, one, span
 
-from rl1.compiler import ast
-from rl1.compiler.catalogue import CODES
+from rl1.compiler.analysis import analyze
 from rl1.compiler.checker import build_cfg, check_line
-from rl1.compiler.frontend import analyze
-from rl1.compiler.parser import parse_line, parse_program
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.parser import parse_line, parse_program
+from rl1.compiler.reporting.catalogue import CODES
 
 SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 CHECKER_CODES = ["E0201", "E0202", "E0203", "E0204", "W0205", "W0301", "W0401", "W0402",

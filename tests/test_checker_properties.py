@@ -9,13 +9,13 @@ import re
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from rl1.compiler.analysis import analyze
 from rl1.compiler.checker import check, check_line
 from rl1.compiler.checker.lines import check_line as per_line_rule
-from rl1.compiler.frontend import analyze
-from rl1.compiler.parser import parse_program
+from rl1.compiler.frontend.parser import parse_program
+from rl1.compiler.interpreter import interpret
 from rl1.compiler.strategies import programs
 from rl1.vm.faults import FaultKind
-from rl1.vm.interpreter import interpret
 from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
 
 PER_LINE_CODES = {"E0201", "E0202", "W0402", "E0501", "W0502", "E0503", "E0504", "E0505",

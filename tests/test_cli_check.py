@@ -20,11 +20,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from sarif_structure import sarif_problems
 
-from rl1.compiler import frontend
-from rl1.compiler.ast import Span
-from rl1.compiler.catalogue import CODES
-from rl1.compiler.diagnostics import Diagnostic, Severity
-from rl1.compiler.frontend import Analysis, analyze
+from rl1.compiler import analysis
+from rl1.compiler.analysis import Analysis, analyze
+from rl1.compiler.frontend.ast import Span
+from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
+from rl1.compiler.reporting.catalogue import CODES
 
 ROOT = Path(__file__).parent.parent
 SAMPLE = ROOT / "examples" / "sample.rob"
@@ -72,7 +72,7 @@ def test_warnings_alone_exit_0(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) 
         program = analyze(text).program
         return Analysis(program, [Diagnostic("W0601", Severity.WARNING, "odd", Span(1, 1, 1, 2))])
 
-    monkeypatch.setattr(frontend, "analyze", only_a_warning)
+    monkeypatch.setattr(analysis, "analyze", only_a_warning)
     result = run("check", write(tmp_path, "A=1\n"))
     assert result.exit_code == 0
     assert "warning[W0601]: odd" in result.stdout
@@ -285,7 +285,7 @@ def test_an_internal_error_is_a_short_message_and_exit_3(
     def broken(text: str) -> Analysis:
         raise KeyError("no such rule")
 
-    monkeypatch.setattr(frontend, "analyze", broken)
+    monkeypatch.setattr(analysis, "analyze", broken)
     monkeypatch.delenv("RL1C_BACKTRACE", raising=False)
     result = run("check", write(tmp_path, "A=1\n"))
     assert result.exit_code == 3
@@ -304,7 +304,7 @@ def test_ctrl_c_ends_with_a_short_message_and_the_shells_status(
     def interrupted(text: str) -> Analysis:
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(frontend, "analyze", interrupted)
+    monkeypatch.setattr(analysis, "analyze", interrupted)
     result = run("check", write(tmp_path, "A=1\n"))
     assert (result.exit_code, result.stdout, result.stderr) == (130, "", "rl1c: interrupted\n")
 

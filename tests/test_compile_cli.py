@@ -8,14 +8,14 @@ from pathlib import Path
 import pytest
 from cli_run import rl1c
 
-from rl1.compiler import driver
-from rl1.compiler.ast import Span
-from rl1.compiler.atomic import write_atomically
-from rl1.compiler.diagnostics import Diagnostic, Severity
-from rl1.compiler.frontend import Analysis
-from rl1.compiler.ir import format_program
-from rl1.compiler.lower import lower
-from rl1.compiler.parser import parse_program
+from rl1.compiler.analysis import Analysis
+from rl1.compiler.backend import driver
+from rl1.compiler.backend.ir import format_program
+from rl1.compiler.backend.lower import lower
+from rl1.compiler.files import write_atomically
+from rl1.compiler.frontend.ast import Span
+from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
+from rl1.compiler.frontend.parser import parse_program
 from rl1.vm import ilc
 from rl1.vm.verifier import verify
 

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rl1.compiler.builtins import BUILTINS
+from rl1.compiler.cli.run import load_script
 from rl1.vm.device import (
     BINDINGS,
     DeviceError,
@@ -18,6 +18,7 @@ from rl1.vm.device import (
     Odometry,
     perform,
 )
+from rl1.vm.language import BUILTINS
 from rl1.vm.scripted import (
     LossAt,
     LossDuring,
@@ -25,7 +26,6 @@ from rl1.vm.scripted import (
     ScriptedDevice,
     ScriptError,
     TraceEntry,
-    load_script,
     parse_script,
 )
 

@@ -17,8 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from rl1.compiler.builtins import BUILTINS, HANDLER_LABELS, RESERVED_VARIABLES
-from rl1.compiler.scanner import scan
+from rl1.compiler.frontend.scanner import scan
+from rl1.vm.language import BUILTINS, HANDLER_LABELS, RESERVED_VARIABLES
 
 EDITORS = Path(__file__).parent.parent / "editors"
 EXPECTED = sorted((EDITORS / "vscode" / "test" / "expected").glob("*.tokens"))

@@ -17,10 +17,11 @@ from cli_run import Result, rl1c
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rl1.compiler import ast, formatter
+from rl1.compiler import formatter
 from rl1.compiler.formatter import format_line, format_lines, format_text
-from rl1.compiler.parser import parse_program
-from rl1.compiler.source import split_lines
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.parser import parse_program
+from rl1.compiler.frontend.source import split_lines
 from rl1.compiler.strategies import lines, programs
 
 SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"

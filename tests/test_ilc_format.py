@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from ilc_testing import images, with_crc
 
-from rl1.compiler.builtins import Feature
 from rl1.vm import ilc
+from rl1.vm.language import Feature
 
 LDI_5_END = bytes([0x02, 0x05, 0x00, 0x00])  # LDI 5; END
 SAMPLE = ilc.Image(LDI_5_END, {97: 3}, frozenset({Feature.MOTION, Feature.IO}),

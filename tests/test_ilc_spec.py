@@ -9,9 +9,9 @@ import re
 import struct
 from pathlib import Path
 
-from rl1.compiler.builtins import Feature
-from rl1.compiler.driver import compile_text
+from rl1.compiler.backend.driver import compile_text
 from rl1.vm import ilc, isa, isa_table
+from rl1.vm.language import Feature
 
 SPEC = (Path(__file__).parent.parent / "spec" / "ilc.md").read_text(encoding="utf-8")
 

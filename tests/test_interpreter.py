@@ -6,11 +6,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from semantics_model import operate
 
-from rl1.compiler.frontend import analyze
-from rl1.compiler.parser import parse_program
+from rl1.compiler.analysis import analyze
+from rl1.compiler.frontend.parser import parse_program
+from rl1.compiler.interpreter import NotRunnable, interpret
 from rl1.vm.device import ImageReading, Odometry
 from rl1.vm.faults import FaultKind, RunResult
-from rl1.vm.interpreter import NotRunnable, interpret
 from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
 
 

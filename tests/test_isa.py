@@ -3,8 +3,8 @@
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rl1.compiler.builtins import BUILTINS
 from rl1.vm import isa
+from rl1.vm.language import BUILTINS
 
 
 def test_every_builtin_form_has_exactly_one_opcode() -> None:

@@ -5,10 +5,22 @@ from pathlib import Path
 
 import pytest
 
-from rl1.compiler import ir
-from rl1.compiler.ir import Branch, Call, End, Imm, Jump, Load, Operate, R, StepVar, Store, Var
-from rl1.compiler.lower import LoweringError, lower
-from rl1.compiler.parser import parse_program
+from rl1.compiler.backend import ir
+from rl1.compiler.backend.ir import (
+    Branch,
+    Call,
+    End,
+    Imm,
+    Jump,
+    Load,
+    Operate,
+    R,
+    StepVar,
+    Store,
+    Var,
+)
+from rl1.compiler.backend.lower import LoweringError, lower
+from rl1.compiler.frontend.parser import parse_program
 
 SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 

@@ -13,16 +13,17 @@ from hypothesis import strategies as st
 from ilc_testing import images
 from semantics_model import int16, operate
 
-from rl1.compiler.builtins import BUILTINS, VARIABLES
-from rl1.compiler.driver import compile_text
-from rl1.compiler.frontend import analyze
+from rl1.compiler.analysis import analyze
+from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.cli.run import load_script
+from rl1.compiler.interpreter import interpret
 from rl1.compiler.strategies import checked_programs
 from rl1.vm import ilc, isa
 from rl1.vm.device import DeviceError, FuzzyReading, ImageReading, LineLost, Odometry
 from rl1.vm.faults import FaultKind, RunResult
-from rl1.vm.interpreter import interpret
+from rl1.vm.language import BUILTINS, VARIABLES
 from rl1.vm.machine import Machine
-from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice, load_script
+from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
 from rl1.vm.verifier import VerifiedProgram, verify
 
 EXAMPLES = Path(__file__).parent.parent / "examples"

@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
-from rl1.compiler import ast
-from rl1.compiler.parser import parse_line, parse_program
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.parser import parse_line, parse_program
 
 SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 

@@ -1,9 +1,9 @@
 """The parser against lark's own LALR parser.
 
 The parser runs lark's tables through its own loop, once per sequence of token kinds,
-and replays the outcome for every line with those kinds (compiler/parser.py). Here lark
+and replays the outcome for every line with those kinds (compiler/frontend/parser.py). Here lark
 parses the same tokens itself, with a tree builder written independently of
-compiler/builders.py; both must build the same AST, or reject the line at the same
+compiler/frontend/builders.py; both must build the same AST, or reject the line at the same
 token expecting the same terminals.
 """
 
@@ -18,16 +18,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from lark.lexer import Lexer
 
-from rl1.compiler import ast
-from rl1.compiler.builtins import BUILTINS
-from rl1.compiler.make_tables import GRAMMAR, TABLES, generate
-from rl1.compiler.parser import make_plan, parse_line
-from rl1.compiler.scanner import scan
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.make_tables import GRAMMAR, TABLES, generate
+from rl1.compiler.frontend.parser import make_plan, parse_line
+from rl1.compiler.frontend.scanner import scan
 from rl1.compiler.strategies import lines
+from rl1.vm.language import BUILTINS
 
 
 class _ScannerTokens(Lexer):
-    """Hands lark the tokens of compiler/scanner.py."""
+    """Hands lark the tokens of compiler/frontend/scanner.py."""
 
     def __init__(self, lexer_conf: object) -> None:
         pass
@@ -181,5 +181,5 @@ def test_a_cached_plan_builds_the_same_line_as_a_fresh_one() -> None:
 
 def test_the_committed_tables_are_lark_s_analysis_of_the_grammar() -> None:
     assert TABLES.read_text(encoding="utf-8") == generate(), (
-        "grammar.lark changed: run `python -m rl1.compiler.make_tables`"
+        "grammar.lark changed: run `python -m rl1.compiler.frontend.make_tables`"
     )

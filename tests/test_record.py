@@ -5,8 +5,8 @@ from __future__ import annotations
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rl1.compiler import ast
-from rl1.compiler.record import Record
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.record import Record
 
 
 class Pair(Record):

@@ -12,10 +12,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from sarif_structure import sarif_problems
 
-from rl1.compiler.ast import Span
-from rl1.compiler.catalogue import CODES
-from rl1.compiler.diagnostics import Diagnostic, Edit, Fix, Related, Severity
-from rl1.compiler.render import (
+from rl1.compiler.frontend.ast import Span
+from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Related, Severity
+from rl1.compiler.reporting.catalogue import CODES
+from rl1.compiler.reporting.render import (
     SNIPPET_WIDTH,
     FileDiagnostics,
     artifact_uri,

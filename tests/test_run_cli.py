@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 from cli_run import rl1c
 
-from rl1.compiler.builtins import VARIABLES
+from rl1.vm.language import VARIABLES
 
 EXAMPLES = Path(__file__).parent.parent / "examples"
 SAMPLE, SENSORS = EXAMPLES / "sample.rob", EXAMPLES / "sample.sensors.json"

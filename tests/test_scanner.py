@@ -2,7 +2,7 @@
 
 The reference below follows the spec's wording step by step: at each position the first
 alternative of the table in 3.1 that matches, then the three context rules of 3.2, then
-3.3's test of a hex constant. compiler/scanner.py gets there faster (one `findall`,
+3.3's test of a hex constant. compiler/frontend/scanner.py gets there faster (one `findall`,
 kinds decided by the first character); both must cut every line the same way.
 """
 
@@ -13,7 +13,7 @@ import re
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rl1.compiler.scanner import WHITESPACE, Kinds, Lexeme, scan
+from rl1.compiler.frontend.scanner import WHITESPACE, Kinds, Lexeme, scan
 from rl1.compiler.strategies import lines
 
 _TABLE_3_1 = re.compile(r"""

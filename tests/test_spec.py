@@ -1,21 +1,21 @@
 """spec/language.md agrees with the code it describes: the built-in table with
-builtins.py, the EBNF with grammar.lark, and the token examples with the scanner."""
+vm/language.py, the EBNF with grammar.lark, and the token examples with the scanner."""
 
 import re
 from pathlib import Path
 
 import pytest
 
-from rl1.compiler import ast
-from rl1.compiler.builtins import BUILTINS, Feature
-from rl1.compiler.catalogue import CODES
-from rl1.compiler.codegen import generate
-from rl1.compiler.lower import lower
-from rl1.compiler.make_tables import GRAMMAR
-from rl1.compiler.parser import parse_line, parse_program
-from rl1.compiler.scanner import scan
+from rl1.compiler.backend.codegen import generate
+from rl1.compiler.backend.lower import lower
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.make_tables import GRAMMAR
+from rl1.compiler.frontend.parser import parse_line, parse_program
+from rl1.compiler.frontend.scanner import scan
+from rl1.compiler.interpreter import interpret
+from rl1.compiler.reporting.catalogue import CODES
 from rl1.vm import ilc, machine
-from rl1.vm.interpreter import interpret
+from rl1.vm.language import BUILTINS, Feature
 from rl1.vm.scripted import ScriptedDevice
 from rl1.vm.verifier import verify
 
@@ -42,7 +42,7 @@ def _number(text: str) -> int:
 
 
 def _row_of_form(mnemonic: str, selector: str | None) -> list[str]:
-    """How builtins.py says a form's row should read, in the spec's notation."""
+    """How vm/language.py says a form's row should read, in the spec's notation."""
     builtin = BUILTINS[mnemonic]
     form = builtin.form(selector)
     assert form is not None

@@ -8,13 +8,13 @@ from collections.abc import Callable
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rl1.compiler import ast
-from rl1.compiler.builtins import BUILTINS
-from rl1.compiler.frontend import analyze
-from rl1.compiler.parser import parse_line, parse_program
+from rl1.compiler.analysis import analyze
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.parser import parse_line, parse_program
+from rl1.compiler.interpreter import interpret
 from rl1.compiler.strategies import OPERATORS, checked_programs, lines, programs
 from rl1.vm.device import FuzzyReading, ImageReading, Odometry
-from rl1.vm.interpreter import interpret
+from rl1.vm.language import BUILTINS
 from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
 
 ALL_FORMS = {f"call {b.mnemonic} {form.selector}" for b in BUILTINS.values()

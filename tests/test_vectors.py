@@ -16,10 +16,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rl1.compiler.builtins import VARIABLES
-from rl1.compiler.driver import compile_text
+from rl1.compiler.backend.driver import compile_text
 from rl1.vm import ilc, isa
 from rl1.vm.faults import FaultKind
+from rl1.vm.language import VARIABLES
 from rl1.vm.verifier import verify
 
 VECTOR_DIR = Path(__file__).resolve().parent.parent / "spec" / "vectors"

@@ -10,8 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from ilc_testing import images, with_crc
 
-from rl1.compiler.builtins import BUILTINS, Feature
 from rl1.vm import ilc, isa, machine
+from rl1.vm.language import BUILTINS, Feature
 from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
 from rl1.vm.verifier import VerifiedProgram, VerifyError, verify
 

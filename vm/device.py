@@ -5,7 +5,7 @@ range-checks the arguments, calls the method, and stores what a sensing method r
 into R and the reserved variables; the device never touches program state.
 
 Time belongs to the device. Waiting methods (`wait`, `move_distance`, and the other
-built-ins that `builtins.Builtin.waits` marks) return when the device's clock says the
+built-ins that `language.Builtin.waits` marks) return when the device's clock says the
 command is done; `move` returns at once.
 
 Division of work for a lost guidance line (Table 4):
@@ -72,7 +72,7 @@ class FuzzyReading:
 
 
 class Device(Protocol):
-    """A vehicle. Arguments arrive already range-checked against builtins.py; values
+    """A vehicle. Arguments arrive already range-checked against language.py; values
     returned must be 16-bit signed integers. Any method may raise DeviceError."""
 
     # Motion and steering (Table 2)

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Any
 
-from rl1.compiler.builtins import VARIABLES
+from .language import VARIABLES
 
 DEFAULT_BUDGET = 10_000_000
 """Steps a run may take before the watchdog ends it: VM instructions, or interpreter

@@ -16,7 +16,7 @@ import struct
 import zlib
 from dataclasses import dataclass
 
-from rl1.compiler.builtins import HANDLER_LABELS, Feature
+from .language import HANDLER_LABELS, Feature
 
 MAGIC = b"RLIC"
 VERSION_MAJOR, VERSION_MINOR = 1, 0

@@ -20,7 +20,7 @@ import struct
 from dataclasses import dataclass
 from enum import Enum
 
-from rl1.compiler.builtins import BUILTINS, Form
+from .language import BUILTINS, Form
 
 
 class Operand(Enum):

@@ -40,11 +40,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from rl1.compiler.builtins import VARIABLES, Param
-
 from . import isa
 from .device import Device, DeviceError, LineLost, form_name, perform
 from .faults import DEFAULT_BUDGET, Fault, FaultKind, RunResult
+from .language import VARIABLES, Param
 from .verifier import VerifiedProgram
 
 R_CELL = len(VARIABLES)

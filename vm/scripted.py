@@ -28,7 +28,7 @@ tracing mode does with it.
 The motion model (device time in integer milliseconds, starting at 0):
 - TIM t waits t x 100 ms; MVI l,r,cm moves the centre at |l+r|/2 x 5 cm/s (a wheel speed
   unit is 5 cm/s), so it takes ceil(|cm| x 400 / |l+r|) ms; ROT a takes |a| x 10 ms;
-  every other built-in that waits (builtins.Builtin.waits) takes 100 ms; the rest 0 ms.
+  every other built-in that waits (language.Builtin.waits) takes 100 ms; the rest 0 ms.
 - A loss interrupts only TIM and MVI (they return at the loss's time); any other call
   completes first, and the loss reaches the program after it.
 """
@@ -42,17 +42,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
 
-from rl1.compiler.builtins import BUILTINS
-from rl1.compiler.source import SourceError, read_bounded
-
-from .device import (
-    DeviceError,
-    FuzzyReading,
-    ImageReading,
-    LineLost,
-    MotionCommand,
-    Odometry,
-)
+from .device import DeviceError, FuzzyReading, ImageReading, LineLost, MotionCommand, Odometry
+from .language import BUILTINS
 
 T = TypeVar("T")
 
@@ -110,19 +101,15 @@ class TraceEntry:
 
 # Loading and validating scripts --------------------------------------------------------
 
-MAX_SCRIPT_BYTES = 16 * 2**20
 _INT16 = (-32768, 32767)
 _LIST_KEYS = ("IMG", "KYO", "CAM R", "ULT A", "ULT B", "ULT C", "ULT D", "FZI")
 _KEYS = (*_LIST_KEYS, "INP", "line_lost", "comment")
 
 
-def load_script(path: str | Path) -> Script:
-    """Read and validate a sensor script; ScriptError says what is wrong and where."""
-    path = Path(path)
-    try:
-        data = read_bounded(path, MAX_SCRIPT_BYTES, "a sensor script")
-    except SourceError as error:
-        raise ScriptError(str(error)) from None
+def decode_script(data: bytes, name: str) -> Script:
+    """Decode and validate the bytes of a sensor script, TOML when `name` ends in .toml
+    and JSON otherwise; ScriptError says what is wrong and where."""
+    path = Path(name)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as error:

@@ -13,10 +13,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from rl1.compiler.builtins import BUILTINS, HANDLER_LABELS, VARIABLES
-
 from . import isa
 from .ilc import Container, IlcFormatError, Image, read
+from .language import BUILTINS, HANDLER_LABELS, VARIABLES
 
 
 class VerifyError(IlcFormatError):

@@ -3,9 +3,10 @@ the control-flow graph (cfg.py) and the data-flow analyses on it."""
 
 from __future__ import annotations
 
-from ..ast import Program
-from ..collector import collector_paused
-from ..diagnostics import Diagnostic
+from rl1.compiler.frontend.ast import Program
+from rl1.compiler.frontend.collector import collector_paused
+from rl1.compiler.frontend.diagnostics import Diagnostic
+
 from .cfg import ControlFlowGraph, LineMemo, build_cfg
 from .handlers import check_handlers
 from .labels import check_labels

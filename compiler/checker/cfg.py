@@ -31,8 +31,9 @@ from __future__ import annotations
 import bisect
 from collections.abc import Sequence
 
-from .. import ast
-from ..record import Record
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.record import Record
+
 from . import device
 from .effects import BlockEffects, Segment, combine, line_segments, relocated, summarize
 

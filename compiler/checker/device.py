@@ -24,7 +24,8 @@ non-zero MOV in effect) and RUNNING (an MVI in progress).
 
 from __future__ import annotations
 
-from .. import ast
+from rl1.compiler.frontend import ast
+
 from . import dataflow
 
 TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)

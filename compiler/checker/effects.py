@@ -5,7 +5,7 @@ that change the device state (device.py), the reserved variables read and writte
 "Observing" is the checker's word for a call through which a program can see the world
 change or let device time pass: a call that returns a reading or writes reserved
 variables (KYO, IMG, CAM R, ULT, INP, FZI), or one the device takes time over (`waits`
-in builtins.py: MVI, TIM, ORG, STR, STL, STX, ROT, IMG, CAM, ULT). A loop without one
+in vm/language.py: MVI, TIM, ORG, STR, STL, STX, ROT, IMG, CAM, ULT). A loop without one
 spins at the speed of the interpreter, blind. For `(CAM ...)` and `(ULT ...)` a call is
 taken to do what any of their forms does: the summary never resolves selectors.
 """
@@ -14,9 +14,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from .. import ast
-from ..builtins import BUILTINS, RESERVED_VARIABLES
-from ..record import Record
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.record import Record
+from rl1.vm.language import BUILTINS, RESERVED_VARIABLES
+
 from . import device
 
 RESERVED_BIT = {name: 1 << index for index, name in enumerate(RESERVED_VARIABLES)}

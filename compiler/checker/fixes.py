@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from .. import ast
-from ..diagnostics import Edit
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Edit
 
 
 def append_line(program: ast.Program, text: str) -> Edit:

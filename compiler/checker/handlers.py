@@ -8,8 +8,9 @@ needs `:96`, not `:97`. This is a warning, not an error: the paper's own Listing
 
 from __future__ import annotations
 
-from .. import ast
-from ..diagnostics import Diagnostic, Fix, Severity
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity
+
 from .cfg import ControlFlowGraph
 from .fixes import append_line
 

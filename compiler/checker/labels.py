@@ -8,9 +8,10 @@ unused labels are not reported: they are likely cascades of that error.
 
 from __future__ import annotations
 
-from .. import ast
-from ..builtins import HANDLER_LABELS
-from ..diagnostics import Diagnostic, Edit, Fix, Related, Severity
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Related, Severity
+from rl1.vm.language import HANDLER_LABELS
+
 from .cfg import ControlFlowGraph
 
 

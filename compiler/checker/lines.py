@@ -7,9 +7,9 @@ line it is given. Lines with a syntax error are skipped: the parser has said why
 
 from __future__ import annotations
 
-from .. import ast
-from ..builtins import BUILTINS, RESERVED_VARIABLES, Builtin, Form, writers_of
-from ..diagnostics import Diagnostic, Edit, Fix, Severity
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Severity
+from rl1.vm.language import BUILTINS, RESERVED_VARIABLES, Builtin, Form, writers_of
 
 E, W = Severity.ERROR, Severity.WARNING
 INT16_LOW, INT16_HIGH = -0x8000, 0x7FFF

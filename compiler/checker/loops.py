@@ -11,8 +11,9 @@ nested blind loops are reported once, on their last backward jump.
 
 from __future__ import annotations
 
-from .. import ast
-from ..diagnostics import Diagnostic, Related, Severity
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Diagnostic, Related, Severity
+
 from .cfg import Block, ControlFlowGraph
 from .scc import cycles
 

@@ -8,8 +8,9 @@ to its label.
 
 from __future__ import annotations
 
-from .. import ast
-from ..diagnostics import Diagnostic, Fix, Severity
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity
+
 from .cfg import Block, ControlFlowGraph
 from .fixes import append_line
 

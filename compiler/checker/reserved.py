@@ -2,7 +2,7 @@
 
 A must-be-set analysis, run as its complement so that the shared solver can join by `|`:
 the state is the set of reserved variables that may still be unset (hold their initial
-0). A call writes its reserved variables (builtins.py), an assignment or `V++` writes its
+0). A call writes its reserved variables (vm/language.py), an assignment or `V++` writes its
 target (W0402 has already warned about that), and a line with a syntax error is assumed
 to write them all.
 """
@@ -11,9 +11,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from .. import ast
-from ..builtins import writers_of
-from ..diagnostics import Diagnostic, Severity
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
+from rl1.vm.language import writers_of
+
 from . import dataflow
 from .cfg import ControlFlowGraph
 from .effects import ALL_RESERVED, RESERVED_BIT, reserved_writes

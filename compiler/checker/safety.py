@@ -4,8 +4,9 @@ vehicle driving with nothing in control."""
 
 from __future__ import annotations
 
-from .. import ast
-from ..diagnostics import Diagnostic, Edit, Fix, Severity
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Severity
+
 from . import device
 from .cfg import ControlFlowGraph
 from .fixes import append_line

@@ -29,8 +29,8 @@ from oracle import (
     render,
 )
 
-from rl1.compiler.builtins import BUILTINS, Param
 from rl1.vm import isa
+from rl1.vm.language import BUILTINS, Param
 
 EXAMPLES = Path(__file__).resolve().parent.parent.parent / "examples"
 DEFAULT_BUDGET = 100_000

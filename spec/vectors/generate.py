@@ -24,12 +24,12 @@ from typing import Any
 
 from cases import Case, TraceItem, all_cases
 
-from rl1.compiler.atomic import write_atomically
-from rl1.compiler.builtins import VARIABLES
-from rl1.compiler.driver import compile_text
-from rl1.compiler.frontend import analyze
+from rl1.compiler.analysis import analyze
+from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.files import write_atomically
+from rl1.compiler.interpreter import interpret
 from rl1.vm.faults import FaultKind, RunResult
-from rl1.vm.interpreter import interpret
+from rl1.vm.language import VARIABLES
 from rl1.vm.machine import run
 from rl1.vm.scripted import ScriptedDevice, parse_script
 from rl1.vm.verifier import verify

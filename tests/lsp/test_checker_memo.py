@@ -8,8 +8,8 @@ from hypothesis import strategies as st
 from lsprotocol import types
 
 from rl1.compiler.checker import ControlFlowGraph, LineMemo, build_cfg, check_program
-from rl1.compiler.diagnostics import sort_key
-from rl1.compiler.parser import parse_program
+from rl1.compiler.frontend.diagnostics import sort_key
+from rl1.compiler.frontend.parser import parse_program
 from rl1.compiler.strategies import lines, programs
 from rl1.lsp.document import Document
 from rl1.lsp.positions import Columns

@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from lsprotocol import types
 
-from rl1.compiler.frontend import analyze
+from rl1.compiler.analysis import analyze
 from rl1.compiler.strategies import lines
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")

@@ -7,8 +7,8 @@ from hypothesis import strategies as st
 from lsprotocol import types
 
 from rl1.compiler.checker import check_line
-from rl1.compiler.diagnostics import sort_key
-from rl1.compiler.parser import parse_program
+from rl1.compiler.frontend.diagnostics import sort_key
+from rl1.compiler.frontend.parser import parse_program
 from rl1.compiler.strategies import lines
 from rl1.lsp.document import MAX_ANALYSED_LINE, Document
 from rl1.lsp.positions import UTF8, UTF16, UTF32, Columns

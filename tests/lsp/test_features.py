@@ -7,8 +7,8 @@ from conftest import Client, position_of
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException
 
-from rl1.compiler.builtins import BUILTINS, VARIABLES
 from rl1.compiler.formatter import format_text
+from rl1.vm.language import BUILTINS, VARIABLES
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 

@@ -13,11 +13,11 @@ import json
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from rl1.compiler.files import SourceError
+from rl1.compiler.frontend.source import read_source
 from rl1.vm import ilc, isa
+from rl1.vm.language import HANDLER_LABELS, VARIABLES, Feature
 from rl1.vm.verifier import verify
-
-from .builtins import HANDLER_LABELS, VARIABLES, Feature
-from .source import SourceError, read_source
 
 SourceLookup = Callable[[str], Sequence[str] | None]
 

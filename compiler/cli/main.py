@@ -21,9 +21,11 @@ import argparse
 import os
 import sys
 
-from .ast import Span
-from .diagnostics import Diagnostic, Severity
-from .render import (
+from rl1.compiler.files import SourceError
+from rl1.compiler.frontend.ast import Span
+from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
+from rl1.compiler.frontend.source import MAX_SOURCE_BYTES, Source, decode, read_source
+from rl1.compiler.reporting.render import (
     COLOR_CHOICES,
     EXIT_ERRORS,
     EXIT_USAGE,
@@ -33,17 +35,16 @@ from .render import (
     report,
     use_color,
 )
-from .source import MAX_SOURCE_BYTES, Source, SourceError, decode, read_source
 
 TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
 if TYPE_CHECKING:
     from collections.abc import Callable, Sequence
     from typing import Any, TypeVar
 
-    from rl1.vm.runner import Engine
+    from rl1.compiler.backend.driver import Emit
+    from rl1.compiler.reporting.render import ColorChoice, Format
 
-    from .driver import Emit
-    from .render import ColorChoice, Format
+    from .run import Engine
 
     Run = TypeVar("Run", bound=Callable[..., int])
     Argument = tuple[tuple[str, ...], dict[str, Any]]
@@ -285,7 +286,7 @@ def write_stdout_bytes(data: bytes) -> None:
 
 def write_file(target: str, data: bytes) -> None:
     """Writes `target` atomically; a Failure (exit status 2) saying why it cannot be."""
-    from .atomic import write_atomically
+    from rl1.compiler.files import write_atomically
 
     try:
         write_atomically(target, data)
@@ -321,7 +322,7 @@ def check(files: list[str], output_format: Format, color: ColorChoice) -> int:
 
     `-` reads standard input. Exit status: 0 no errors (warnings allowed), 1 errors,
     2 an unreadable file."""
-    from .frontend import analyze
+    from rl1.compiler.analysis import analyze
 
     checked: list[FileDiagnostics] = []
     for name in files:
@@ -355,7 +356,7 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: Emit,
     `-` reads standard input. Diagnostics go to standard error; nothing is written when
     the program has errors. Exit status: 0 compiled (warnings allowed), 1 errors,
     2 an unreadable input or an output that cannot be written."""
-    from .driver import OPTIMIZATION_LEVELS, compile_text
+    from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
 
     if optimize not in {str(level) for level in OPTIMIZATION_LEVELS}:
         raise UsageError(f"argument -O: `-O{optimize}`: only -O0 (no optimization) exists "
@@ -408,7 +409,7 @@ def _with_suffix(path: str, suffix: str) -> str:
 )
 def explain(code: str | None, list_codes: bool) -> int:
     """Explain a diagnostic code in depth, with examples: `rl1c explain E0101`."""
-    from .catalogue import CODES
+    from rl1.compiler.reporting.catalogue import CODES
 
     if list_codes == (code is not None):
         raise UsageError("give a code, as in `rl1c explain E0101`, or --list")
@@ -431,9 +432,8 @@ def dis(file: str) -> int:
     The program's source lines are shown when its source file is found (beside the .ilc,
     or by the recorded name). Exit status: 0 done, 1 the file is not valid intermediate
     code, 2 an unreadable file."""
+    from rl1.compiler.ils.disasm import disassemble, source_beside
     from rl1.vm.verifier import VerifyError
-
-    from .disasm import disassemble, source_beside
 
     data = read_ilc(file)
     try:
@@ -457,7 +457,7 @@ def assemble_file(file: str, output: str | None) -> int:
 
     The result must pass the verifier. Exit status: 0 written, 1 errors in the text
     (nothing is written), 2 an unreadable input or an output that cannot be written."""
-    from .asm import AsmError, assemble
+    from rl1.compiler.ils.asm import AsmError, assemble
 
     try:
         source = read_source(file)
@@ -495,7 +495,7 @@ def fmt(files: list[str], check: bool, diff: bool) -> int:
     Each file is rewritten in place in its own encoding; `-` formats standard input to
     standard output. Exit status: 0 done, 1 (--check) a file would change, 2 a file cannot
     be read or written."""
-    from . import formatter
+    from rl1.compiler import formatter
 
     status = 0
     for name in files:
@@ -548,10 +548,11 @@ def run(file: str, sensors: str | None, run_format: str, budget: int, engine: En
     file (sensor scripts included); faults: 10 argument out of range, 11 missing handler,
     12 budget exhausted, 13 device error."""
     from rl1.vm.faults import RunResult
-    from rl1.vm.report import render_json, render_text
-    from rl1.vm.runner import run_ilc, run_source
-    from rl1.vm.scripted import Script, ScriptedDevice, ScriptError, load_script
+    from rl1.vm.scripted import Script, ScriptedDevice, ScriptError
     from rl1.vm.verifier import VerifyError
+
+    from .run import load_script, run_ilc, run_source
+    from .run_report import render_json, render_text
 
     try:
         device = ScriptedDevice(load_script(sensors) if sensors is not None else Script())

@@ -10,11 +10,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Literal
 
+from rl1.compiler.analysis import analyze
+from rl1.compiler.frontend.diagnostics import Diagnostic, sort_key
 from rl1.vm import ilc
 
 from .codegen import CodegenError, generate
-from .diagnostics import Diagnostic, sort_key
-from .frontend import analyze
 from .ir import format_program
 from .lower import lower
 

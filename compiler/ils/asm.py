@@ -18,11 +18,10 @@ import json
 import re
 from dataclasses import dataclass, field
 
+from rl1.compiler.frontend.source import split_lines
 from rl1.vm import ilc, isa
+from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES, Feature
 from rl1.vm.verifier import VerifyError, verify
-
-from .builtins import BUILTINS, HANDLER_LABELS, VARIABLES, Feature
-from .source import split_lines
 
 
 @dataclass(frozen=True, slots=True)

@@ -18,9 +18,10 @@ from __future__ import annotations
 import functools
 import unicodedata
 
+from rl1.vm.language import BUILTINS
+
 from . import ast
 from .builders import ACTIONS, label_def
-from .builtins import BUILTINS
 from .collector import collector_paused
 from .diagnostics import Diagnostic, Severity
 from .lalr_tables import ACTIONS as TABLE

@@ -8,9 +8,8 @@ renders the same facts for people; keep the two in step.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from enum import Enum
-
-from .record import Record
 
 
 class Feature(Enum):
@@ -25,64 +24,41 @@ class Feature(Enum):
     FUZZY = 6
 
 
-class Param(Record):
-    __slots__ = ("name", "low", "high", "meaning")
+@dataclass(frozen=True, slots=True)
+class Param:
     name: str
     low: int
     high: int
     meaning: str
 
-    def __init__(self, name: str, low: int, high: int, meaning: str) -> None:
-        self.name = name
-        self.low = low
-        self.high = high
-        self.meaning = meaning
-
     def describe(self) -> str:
         return f"{self.name}: {self.meaning}, {self.low}..{self.high}"
 
 
-class Form(Record):
+@dataclass(frozen=True, slots=True)
+class Form:
     """One way to call a built-in. Most have a single form with `selector` None;
     `(CAM ...)` and `(ULT ...)` have one form per selector letter."""
 
-    __slots__ = ("selector", "params", "summary", "result", "writes")
     selector: str | None
     params: tuple[Param, ...]
     summary: str
-    result: str | None  # what the call returns, None if it returns nothing
-    writes: tuple[str, ...]  # reserved variables the call sets
-
-    def __init__(self, selector: str | None, params: tuple[Param, ...], summary: str,
-                 result: str | None = None, writes: tuple[str, ...] = ()) -> None:
-        self.selector = selector
-        self.params = params
-        self.summary = summary
-        self.result = result
-        self.writes = writes
+    result: str | None = None  # what the call returns, None if it returns nothing
+    writes: tuple[str, ...] = ()  # reserved variables the call sets
 
     @property
     def returns_value(self) -> bool:
         return self.result is not None
 
 
-class Builtin(Record):
-    __slots__ = ("mnemonic", "name", "group", "feature", "waits", "forms")
+@dataclass(frozen=True, slots=True)
+class Builtin:
     mnemonic: str
     name: str  # the paper's expansion of the mnemonic
     group: str  # "motion" (Table 2), "sensing" (Table 3) or "control" (Table 1)
     feature: Feature | None
     waits: bool  # True when the call takes device time before the next statement runs
     forms: tuple[Form, ...]
-
-    def __init__(self, mnemonic: str, name: str, group: str, feature: Feature | None,
-                 waits: bool, forms: tuple[Form, ...]) -> None:
-        self.mnemonic = mnemonic
-        self.name = name
-        self.group = group
-        self.feature = feature
-        self.waits = waits
-        self.forms = forms
 
     @property
     def has_selector(self) -> bool:

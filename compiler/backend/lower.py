@@ -9,8 +9,10 @@ statement after it, and falling off the end of the program ends it.
 
 from __future__ import annotations
 
-from . import ast, ir
-from .builtins import HANDLER_LABELS
+from rl1.compiler.frontend import ast
+from rl1.vm.language import HANDLER_LABELS
+
+from . import ir
 
 
 class LoweringError(Exception):

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from .ast import Program
 from .checker import check
-from .diagnostics import Diagnostic, sort_key
-from .parser import parse_program
-from .record import Record
+from .frontend.ast import Program
+from .frontend.diagnostics import Diagnostic, sort_key
+from .frontend.parser import parse_program
+from .frontend.record import Record
 
 
 class Analysis(Record):

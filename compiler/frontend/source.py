@@ -6,19 +6,15 @@ with LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them.
 
 from __future__ import annotations
 
-import os
 import re
+
+from rl1.compiler.files import SourceError, read_bounded
 
 from .record import Record
 
 MAX_SOURCE_BYTES = 64 * 1024 * 1024
 LINE_BREAK = re.compile(r"\r\n|\r|\n")
 """A line end: LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them."""
-
-
-class SourceError(Exception):
-    """An input file that cannot be read, or not as RL/I text; the message says why and
-    what to do."""
 
 
 class Source(Record):
@@ -72,22 +68,3 @@ def decode(data: bytes, name: str = "<input>") -> Source:
 def read_source(path: str) -> Source:
     """Read and decode a source file, turning every OS failure into a SourceError."""
     return decode(read_bounded(path, MAX_SOURCE_BYTES, "an RL/I source file"), path)
-
-
-def read_bounded(path: str | os.PathLike[str], limit: int, what: str) -> bytes:
-    """The bytes of the input file `path`, `what` it should be; SourceError when it cannot
-    be read or holds more than `limit` bytes (found without reading a huge file whole)."""
-    try:
-        with open(path, "rb") as stream:
-            data = stream.read(limit + 1)
-    except FileNotFoundError:
-        raise SourceError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise SourceError(f"{path} is a directory, not {what}") from None
-    except PermissionError:
-        raise SourceError(f"{path}: permission denied") from None
-    except OSError as error:
-        raise SourceError(f"{path}: cannot read ({error.strerror or error})") from None
-    if len(data) > limit:
-        raise SourceError(f"{path} is larger than {limit // 2**20} MiB, the limit for {what}")
-    return data

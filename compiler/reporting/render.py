@@ -10,18 +10,19 @@ from __future__ import annotations
 import os
 import unicodedata
 
+from rl1.compiler.frontend.diagnostics import Severity, sort_key
+from rl1.compiler.frontend.record import Record
+from rl1.compiler.frontend.source import split_lines
+
 from .catalogue import CODES
-from .diagnostics import Severity, sort_key
-from .record import Record
-from .source import split_lines
 
 TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
 if TYPE_CHECKING:
     from collections.abc import Sequence
     from typing import IO, Any, Literal
 
-    from .ast import Span
-    from .diagnostics import Diagnostic, Fix
+    from rl1.compiler.frontend.ast import Span
+    from rl1.compiler.frontend.diagnostics import Diagnostic, Fix
 
     Format = Literal["human", "json", "sarif"]
     ColorChoice = Literal["auto", "always", "never"]

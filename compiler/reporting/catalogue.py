@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import os
 
-from .diagnostics import Severity
-from .record import Record
+from rl1.compiler.frontend.diagnostics import Severity
+from rl1.compiler.frontend.record import Record
 
 _EXPLANATIONS = os.path.join(os.path.dirname(__file__), "explanations")
 

@@ -12,8 +12,9 @@ texts and columns.
 
 from __future__ import annotations
 
+from rl1.vm.language import BUILTINS
+
 from . import ast
-from .builtins import BUILTINS
 
 TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
 if TYPE_CHECKING:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 
-from .faults import RunResult
-from .scripted import TraceEntry
+from rl1.vm.faults import RunResult
+from rl1.vm.scripted import TraceEntry
 
 
 def render_json(result: RunResult, trace: Sequence[TraceEntry]) -> str:

@@ -17,11 +17,11 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 
-from .builtins import BUILTINS, HANDLER_LABELS, VARIABLES
+from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES
 
 TYPE_CHECKING = False
 if TYPE_CHECKING:
-    from .ast import BinaryOperator, Relation, Step
+    from rl1.compiler.frontend.ast import BinaryOperator, Relation, Step
 
 BlockId = str
 """`Lnn` for the block a source label `:nn` starts, `Bn` for the others."""

@@ -14,11 +14,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from rl1.compiler import ast
-from rl1.compiler.builtins import BUILTINS, VARIABLES, Form
+from rl1.vm.device import Device, DeviceError, form_name, perform
+from rl1.vm.faults import DEFAULT_BUDGET, Fault, FaultKind, RunResult
+from rl1.vm.language import BUILTINS, VARIABLES, Form
 
-from .device import Device, DeviceError, form_name, perform
-from .faults import DEFAULT_BUDGET, Fault, FaultKind, RunResult
+from .frontend import ast
 
 # Table 4: where a lost line sends the program, by (tracing mode, command in effect).
 _HANDLERS = {(2, "MOV"): 98, (2, "MVI"): 99, (3, "MOV"): 96, (3, "MVI"): 97}

@@ -10,12 +10,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from rl1.compiler.frontend.ast import Span
+from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.vm import ilc, isa
+from rl1.vm.language import BUILTINS, VARIABLES
 
 from . import ir
-from .ast import Span
-from .builtins import BUILTINS, VARIABLES
-from .diagnostics import Diagnostic, Severity
 
 VARIABLE_INDEX = {name: index for index, name in enumerate(VARIABLES)}
 

@@ -7,17 +7,21 @@ their traces and final variables can be compared.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Literal
 
-from rl1.compiler.diagnostics import Diagnostic
-from rl1.compiler.driver import compile_text
-from rl1.compiler.frontend import analyze
+from rl1.compiler.analysis import analyze
+from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.files import SourceError, read_bounded
+from rl1.compiler.frontend.diagnostics import Diagnostic
+from rl1.compiler.interpreter import interpret
+from rl1.vm.device import Device
+from rl1.vm.faults import DEFAULT_BUDGET, RunResult
+from rl1.vm.machine import Machine
+from rl1.vm.scripted import Script, ScriptError, decode_script
+from rl1.vm.verifier import verify
 
-from .device import Device
-from .faults import DEFAULT_BUDGET, RunResult
-from .interpreter import interpret
-from .machine import Machine
-from .verifier import verify
+MAX_SCRIPT_BYTES = 16 * 2**20
 
 Engine = Literal["vm", "ast"]
 ENGINES: tuple[Engine, ...] = ("vm", "ast")
@@ -42,3 +46,12 @@ def run_ilc(data: bytes, device: Device, budget: int = DEFAULT_BUDGET) -> RunRes
     """Run the bytes of an .ilc file on the VM; verifier.VerifyError if they are not
     valid intermediate code."""
     return Machine(verify(data), device, budget).run()
+
+
+def load_script(path: str | Path) -> Script:
+    """Read and validate a sensor script; ScriptError says what is wrong and where."""
+    try:
+        data = read_bounded(path, MAX_SCRIPT_BYTES, "a sensor script")
+    except SourceError as error:
+        raise ScriptError(str(error)) from None
+    return decode_script(data, str(path))

@@ -1,0 +1,1 @@
+"""The `rl1c` command line: thin wrappers over the stages."""
