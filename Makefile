@@ -36,7 +36,7 @@ typecheck: $(STAMP)
 	ln -s ../../vm .typecheck/rl1/vm
 	ln -s ../../lsp .typecheck/rl1/lsp
 	MYPYPATH=.typecheck $(BIN)/mypy -p rl1.compiler -p rl1.vm -p rl1.lsp
-	MYPYPATH=.typecheck:spec/vectors $(BIN)/mypy tests $(wildcard bench/*.py) spec/vectors
+	MYPYPATH=.typecheck:spec/vectors:tests $(BIN)/mypy tests $(wildcard bench/*.py) spec/vectors
 
 pytest: $(STAMP)
 	$(BIN)/pytest -n 2

@@ -13,13 +13,14 @@ from conftest import TIMEOUT, Client
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from lsprotocol import types
+from support import SAMPLE
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.strategies import lines
 
 pytestmark = pytest.mark.asyncio(loop_scope="module")
 
-SAMPLE = (Path(__file__).parents[2] / "examples" / "sample.rob").read_text(encoding="utf-8")
+SAMPLE_TEXT = SAMPLE.read_text(encoding="utf-8")
 
 
 def expected(text: str) -> list[tuple[str, int, int, str]]:
@@ -41,8 +42,8 @@ def published(diagnostics: Sequence[types.Diagnostic]) -> list[tuple[str, int, i
 
 
 async def test_sample_program_diagnostics_match_the_compiler(client: Client) -> None:
-    _, diagnostics = await client.opened(SAMPLE)
-    assert published(diagnostics) == expected(SAMPLE)
+    _, diagnostics = await client.opened(SAMPLE_TEXT)
+    assert published(diagnostics) == expected(SAMPLE_TEXT)
 
 
 async def test_syntax_error_is_published_with_code_severity_range_and_explanation(

@@ -6,10 +6,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from cli_run import rl1c
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from ilc_testing import images
+from support import SAMPLE
+from support.cli import rl1c
+from support.ilc import images
 
 from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.ils.asm import AsmError, assemble
@@ -48,7 +49,6 @@ def test_assembling_the_disassembly_gives_the_same_bytes(
     assert assemble(text) == data
 
 
-SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 
 
 @pytest.mark.parametrize("strip", [False, True])

@@ -8,7 +8,7 @@ import struct
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from ilc_testing import images, with_crc
+from support.ilc import images, with_crc
 
 from rl1.vm import ilc, isa, machine
 from rl1.vm.language import BUILTINS, Feature

@@ -9,12 +9,12 @@ from __future__ import annotations
 import json
 import re
 import sys
-from pathlib import Path
 from typing import Any
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import ROOT
 
 from rl1.compiler.backend.driver import compile_text
 from rl1.vm import ilc, isa
@@ -22,7 +22,7 @@ from rl1.vm.faults import FaultKind
 from rl1.vm.language import VARIABLES
 from rl1.vm.verifier import verify
 
-VECTOR_DIR = Path(__file__).resolve().parent.parent / "spec" / "vectors"
+VECTOR_DIR = ROOT / "spec" / "vectors"
 sys.path.insert(0, str(VECTOR_DIR))
 
 import cases  # noqa: E402  (spec/vectors is not a package: its modules need the path)

@@ -16,11 +16,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from support import ROOT
 
 from rl1.compiler.frontend.scanner import scan
 from rl1.vm.language import BUILTINS, HANDLER_LABELS, RESERVED_VARIABLES
 
-EDITORS = Path(__file__).parent.parent / "editors"
+EDITORS = ROOT / "editors"
 EXPECTED = sorted((EDITORS / "vscode" / "test" / "expected").glob("*.tokens"))
 
 _LINE_HEADER = re.compile(r"(\d+): (.*)")

@@ -5,7 +5,7 @@ code, a program that raises it (with its span) and a close one that does not."""
 from __future__ import annotations
 
 import pytest
-from checker_testing import apply, codes, found, one, span
+from support.checker import apply, codes, found, one, span
 
 # Lost-line handlers (W0301) -------------------------------------------------------------
 

@@ -3,10 +3,9 @@ code, a program that raises it (with its span) and a close one that does not."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
-from checker_testing import apply, codes, found, one, span
+from support import SAMPLE
+from support.checker import apply, codes, found, one, span
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.checker import build_cfg, check_line
@@ -14,7 +13,6 @@ from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.parser import parse_line, parse_program
 from rl1.compiler.reporting.catalogue import CODES
 
-SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 CHECKER_CODES = ["E0201", "E0202", "E0203", "E0204", "W0205", "W0301", "W0401", "W0402",
                  "E0501", "W0502", "E0503", "E0504", "E0505", "E0506", "E0507", "E0508",
                  "W0601", "W0602", "W0603", "W0604", "W0701"]

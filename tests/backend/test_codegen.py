@@ -1,11 +1,11 @@
 """Code generation: the bytes of each construct, jump layout, handler table, features,
 the line map and the code size limit; every valid program compiles to a verified file."""
 
-from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import SAMPLE
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend import ir
@@ -20,8 +20,6 @@ from rl1.vm.faults import FaultKind, RunResult
 from rl1.vm.language import BUILTINS, VARIABLES, Feature
 from rl1.vm.scripted import Script, ScriptedDevice, TraceEntry
 from rl1.vm.verifier import verify
-
-SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 
 
 def compile_text(text: str) -> ilc.Image:

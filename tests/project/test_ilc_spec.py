@@ -7,13 +7,14 @@ from __future__ import annotations
 import dataclasses
 import re
 import struct
-from pathlib import Path
+
+from support import ROOT
 
 from rl1.compiler.backend.driver import compile_text
 from rl1.vm import ilc, isa, isa_table
 from rl1.vm.language import Feature
 
-SPEC = (Path(__file__).parent.parent / "spec" / "ilc.md").read_text(encoding="utf-8")
+SPEC = (ROOT / "spec" / "ilc.md").read_text(encoding="utf-8")
 
 
 def table_after(heading: str) -> list[list[str]]:

@@ -15,10 +15,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from cli_run import Result, rl1c
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from sarif_structure import sarif_problems
+from support import ROOT, TEST_DATA
+from support.cli import Result, rl1c
+from support.sarif import sarif_problems
 
 from rl1.compiler import analysis
 from rl1.compiler.analysis import Analysis, analyze
@@ -26,9 +27,8 @@ from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.compiler.reporting.catalogue import CODES
 
-ROOT = Path(__file__).parent.parent
 SAMPLE = ROOT / "examples" / "sample.rob"
-CP932_COMMENTS = Path(__file__).parent / "data" / "cp932_comments.rob"
+CP932_COMMENTS = TEST_DATA / "cp932_comments.rob"
 
 
 def run(*args: str, stdin: bytes = b"") -> Result:

@@ -13,9 +13,10 @@ import re
 from pathlib import Path
 
 import pytest
-from cli_run import Result, rl1c
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import SAMPLE, TEST_DATA
+from support.cli import Result, rl1c
 
 from rl1.compiler import formatter
 from rl1.compiler.formatter import format_line, format_lines, format_text
@@ -24,8 +25,7 @@ from rl1.compiler.frontend.parser import parse_program
 from rl1.compiler.frontend.source import split_lines
 from rl1.compiler.strategies import lines, programs
 
-SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
-CP932_COMMENTS = Path(__file__).parent / "data" / "cp932_comments.rob"
+CP932_COMMENTS = TEST_DATA / "cp932_comments.rob"
 
 # Listing 1 in the canonical layout, written out by hand from the rules of section 11:
 # indentation removed (lines 9, 22-24) and trailing `;` dropped (lines 10, 27-29, 39).

@@ -1,9 +1,9 @@
 """Lowering to IR: the instruction sequence of each construct, blocks and edges, the
 IR's invariants and its printed form."""
 
-from pathlib import Path
 
 import pytest
+from support import SAMPLE
 
 from rl1.compiler.backend import ir
 from rl1.compiler.backend.ir import (
@@ -21,8 +21,6 @@ from rl1.compiler.backend.ir import (
 )
 from rl1.compiler.backend.lower import LoweringError, lower
 from rl1.compiler.frontend.parser import parse_program
-
-SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 
 
 def lower_text(text: str) -> ir.Program:

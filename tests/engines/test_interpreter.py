@@ -4,7 +4,7 @@ tracing mode, and every kind of fault."""
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from semantics_model import operate
+from support.semantics import operate
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.frontend.parser import parse_program

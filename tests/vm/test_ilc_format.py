@@ -7,7 +7,7 @@ import struct
 
 import pytest
 from hypothesis import given, settings
-from ilc_testing import images, with_crc
+from support.ilc import images, with_crc
 
 from rl1.vm import ilc
 from rl1.vm.language import Feature

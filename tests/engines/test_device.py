@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import SAMPLE_SENSORS
 
 from rl1.compiler.cli.run import load_script
 from rl1.vm.device import (
@@ -28,8 +29,6 @@ from rl1.vm.scripted import (
     TraceEntry,
     parse_script,
 )
-
-SAMPLE_SENSORS = Path(__file__).parent.parent / "examples" / "sample.sensors.json"
 
 
 def calls(device: ScriptedDevice) -> list[tuple[int, str, tuple[int, ...]]]:

@@ -5,13 +5,13 @@ programs, the same traces, variables and faults as the AST interpreter."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from ilc_testing import images
-from semantics_model import int16, operate
+from support import EXAMPLES
+from support.ilc import images
+from support.semantics import int16, operate
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import compile_text
@@ -25,8 +25,6 @@ from rl1.vm.language import BUILTINS, VARIABLES
 from rl1.vm.machine import Machine
 from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
 from rl1.vm.verifier import VerifiedProgram, verify
-
-EXAMPLES = Path(__file__).parent.parent / "examples"
 
 
 @dataclass(frozen=True)

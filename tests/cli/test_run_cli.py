@@ -6,12 +6,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from cli_run import rl1c
+from support import SAMPLE, SAMPLE_SENSORS
+from support.cli import rl1c
 
 from rl1.vm.language import VARIABLES
 
-EXAMPLES = Path(__file__).parent.parent / "examples"
-SAMPLE, SENSORS = EXAMPLES / "sample.rob", EXAMPLES / "sample.sensors.json"
+SENSORS = SAMPLE_SENSORS
 
 
 def report(*args: str | Path) -> tuple[int, dict[str, Any]]:

@@ -1,11 +1,10 @@
 """The parser: spans, left-to-right expressions, selectors and syntax errors."""
 
-from pathlib import Path
+
+from support import SAMPLE
 
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.parser import parse_line, parse_program
-
-SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 
 
 def test_sample_parses_without_syntax_errors() -> None:

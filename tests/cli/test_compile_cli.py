@@ -6,7 +6,8 @@ import shutil
 from pathlib import Path
 
 import pytest
-from cli_run import rl1c
+from support import SAMPLE
+from support.cli import rl1c
 
 from rl1.compiler.analysis import Analysis
 from rl1.compiler.backend import driver
@@ -19,7 +20,6 @@ from rl1.compiler.frontend.parser import parse_program
 from rl1.vm import ilc
 from rl1.vm.verifier import verify
 
-SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 BROKEN = "A=1\nB=(MOV 1\nC=2\n"
 
 

@@ -2,9 +2,9 @@
 vm/language.py, the EBNF with grammar.lark, and the token examples with the scanner."""
 
 import re
-from pathlib import Path
 
 import pytest
+from support import ROOT
 
 from rl1.compiler.backend.codegen import generate
 from rl1.compiler.backend.lower import lower
@@ -19,7 +19,7 @@ from rl1.vm.language import BUILTINS, Feature
 from rl1.vm.scripted import ScriptedDevice
 from rl1.vm.verifier import verify
 
-SPEC = (Path(__file__).parent.parent / "spec" / "language.md").read_text(encoding="utf-8")
+SPEC = (ROOT / "spec" / "language.md").read_text(encoding="utf-8")
 NONE = "—"
 
 

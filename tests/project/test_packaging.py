@@ -6,7 +6,8 @@ shows up in a wheel; these checks catch that without building one."""
 import tomllib
 from pathlib import Path
 
-ROOT = Path(__file__).parent.parent
+from support import ROOT
+
 CONFIG = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["setuptools"]
 
 

@@ -4,16 +4,14 @@ the stages' own."""
 import subprocess
 import sys
 from importlib.metadata import version
-from pathlib import Path
 
 import pytest
+from support import SAMPLE
 
 from rl1.compiler.backend import driver
 from rl1.compiler.cli import main as cli
 from rl1.compiler.cli import run as runner
 from rl1.vm import faults
-
-SAMPLE = Path(__file__).parent.parent / "examples" / "sample.rob"
 
 # What `rl1c check` must not load: heavy packages that only other commands need (lark
 # builds the parser's tables offline, numpy is for the simulator, hypothesis for the
