@@ -15,15 +15,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from rl1.vm.device import Device, DeviceError, form_name, perform
-from rl1.vm.faults import DEFAULT_BUDGET, Fault, FaultKind, RunResult
-from rl1.vm.language import BUILTINS, VARIABLES, Form
+from rl1.vm.faults import DEFAULT_BUDGET, Fault, FaultKind, RunResult, missing_handler_message
+from rl1.vm.language import BUILTINS, VARIABLE_INDEX, VARIABLES, Form, lost_line_handler
 
 from .frontend import ast
-
-# Table 4: where a lost line sends the program, by (tracing mode, command in effect).
-_HANDLERS = {(2, "MOV"): 98, (2, "MVI"): 99, (3, "MOV"): 96, (3, "MVI"): 97}
-
-_INDEX = {name: index for index, name in enumerate(VARIABLES)}
 
 
 class NotRunnable(Exception):
@@ -206,15 +201,15 @@ class Interpreter:
             value = self._operand(statement.first)
             for step in statement.rest:
                 value = apply(step.op, value, self._operand(step.operand))
-            self.variables[_INDEX[statement.target.name]] = value
+            self.variables[VARIABLE_INDEX[statement.target.name]] = value
         elif isinstance(statement, ast.IncDec):
-            index = _INDEX[statement.target.name]
+            index = VARIABLE_INDEX[statement.target.name]
             delta = 1 if statement.step == "++" else -1
             self.variables[index] = wrap(self.variables[index] + delta)
         elif isinstance(statement, ast.Goto):
             return self._jump(statement.target)
         elif isinstance(statement, ast.CondJump):
-            value = self.variables[_INDEX[statement.var.name]]
+            value = self.variables[VARIABLE_INDEX[statement.var.name]]
             if _holds(statement.relation, value):
                 return self._jump(statement.target)
         else:
@@ -236,7 +231,7 @@ class Interpreter:
 
     def _operand(self, operand: ast.Operand) -> int:
         if isinstance(operand, ast.Var):
-            return self.variables[_INDEX[operand.name]]
+            return self.variables[VARIABLE_INDEX[operand.name]]
         if isinstance(operand, ast.Const):
             return constant(operand)
         result = self._call(operand)
@@ -260,7 +255,7 @@ class Interpreter:
         except DeviceError as error:
             raise _Faulted(FaultKind.DEVICE, str(error)) from None
         for name, value in zip(resolved.spec.writes, outcome.writes, strict=True):
-            self.variables[_INDEX[name]] = value
+            self.variables[VARIABLE_INDEX[name]] = value
         self._take_event()
         return outcome.result
 
@@ -272,12 +267,10 @@ class Interpreter:
             raise _Faulted(FaultKind.DEVICE, str(error)) from None
         if event is None:
             return
-        label = _HANDLERS.get((event.mode, event.command))
+        label = lost_line_handler(event.mode, event.command)
         if label is None:
             return
         if label not in self.labels:
             raise _Faulted(FaultKind.MISSING_HANDLER,
-                           f"the line was lost during {event.command} in tracing mode "
-                           f"{event.mode}, which jumps to :{label}, but the program has "
-                           f"no label :{label}")
+                           missing_handler_message(event.mode, event.command, label))
         raise _Jump(self.labels[label])

@@ -43,7 +43,7 @@ class Fault:
 
 @dataclass(frozen=True, slots=True)
 class RunResult:
-    """The final variables (53, in builtins.VARIABLES order) and the fault that ended
+    """The final variables (53, in language.VARIABLES order) and the fault that ended
     the run, None when it ended normally."""
 
     variables: tuple[int, ...]
@@ -51,3 +51,9 @@ class RunResult:
 
     def named(self) -> dict[str, int]:
         return dict(zip(VARIABLES, self.variables, strict=True))
+
+
+def missing_handler_message(mode: int, command: str, label: int) -> str:
+    """What a MISSING_HANDLER fault says, whichever engine meets it."""
+    return (f"the line was lost during {command} in tracing mode {mode}, which jumps to "
+            f":{label}, but the program has no label :{label}")

@@ -1,6 +1,9 @@
-"""The built-in functions of RL/I (the paper's Tables 2 and 3) as data.
+"""The facts of RL/I that every stage shares, each written once: the variables and their
+index, the built-in functions (the paper's Tables 2 and 3), and where a lost guidance
+line jumps (Table 4).
 
-One table serves every stage: the checker (arity, kinds, ranges), the code generator
+This module is the bottom layer of the project: it imports nothing of rl1. The
+built-in table serves every stage: the checker (arity, kinds, ranges), the code generator
 (opcodes and device features), the VMs (which reserved variables a call writes) and the
 language server (hover, completion, signature help, inlay hints). spec/language.md
 renders the same facts for people; keep the two in step.
@@ -160,9 +163,40 @@ BUILTINS: dict[str, Builtin] = {
 RESERVED_VARIABLES = "stuvwxyz"
 VARIABLES = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz@"
 """The 53 variables in their index order (the .ilc variable index)."""
+VARIABLE_INDEX: dict[str, int] = {name: index for index, name in enumerate(VARIABLES)}
 
-HANDLER_LABELS = range(96, 100)
+
+@dataclass(frozen=True, slots=True)
+class LostLineRule:
+    """One row of Table 4: a line lost in tracing `mode` while `command` (MOV or MVI)
+    is in effect jumps to `label`; `stops` tells whether the command stops first (mode 2)
+    or goes on (mode 3, an MVI then running on in the background)."""
+
+    mode: int
+    command: str
+    label: int
+    stops: bool
+
+
+LOST_LINE_RULES = (
+    LostLineRule(2, "MOV", 98, stops=True),
+    LostLineRule(2, "MVI", 99, stops=True),
+    LostLineRule(3, "MOV", 96, stops=False),
+    LostLineRule(3, "MVI", 97, stops=False),
+)
+"""Table 4. Mode 0 does not trace, mode 1 drives straight until it finds the line again:
+neither jumps."""
+
+_HANDLER_BY_EVENT = {(rule.mode, rule.command): rule.label for rule in LOST_LINE_RULES}
+
+HANDLER_LABELS = range(min(_HANDLER_BY_EVENT.values()), max(_HANDLER_BY_EVENT.values()) + 1)
 """`:96`-`:99`: where a lost guidance line sends the program (Table 4)."""
+
+
+def lost_line_handler(mode: int, command: str) -> int | None:
+    """The label a line lost in tracing `mode` during `command` jumps to; None for no
+    jump."""
+    return _HANDLER_BY_EVENT.get((mode, command))
 
 
 def writers_of(variable: str) -> list[tuple[Builtin, Form]]:

@@ -1,7 +1,7 @@
 """The reference VM: what every instruction of a verified .ilc program means.
 
 Later implementations (a C VM on the vehicle) must behave as this one does.
-State: 53 variables (builtins.VARIABLES order, all 0 at start), the accumulator, the
+State: 53 variables (language.VARIABLES order, all 0 at start), the accumulator, the
 result register R (the value of the last value-returning call, 0 at start) and the
 program counter. Every value is a 16-bit two's complement integer and every result
 wraps; shift counts are signed (see `_shift_left`).
@@ -9,7 +9,7 @@ wraps; shift counts are signed (see `_shift_left`).
 Execution: the instruction at the program counter runs; running off the end of the code
 is (END). A lost-line event (device.py) is taken between instructions: right after each
 call instruction and after each jump taken. Its handler is the label Table 4 names for
-the event's tracing mode and command: 2 MOV :98, 2 MVI :99, 3 MOV :96, 3 MVI :97.
+the event's tracing mode and command (language.LOST_LINE_RULES).
 
 Faults end the run after the device is stopped: a variable argument outside its range,
 a lost line whose handler the program lacks, the watchdog's instruction budget used up,
@@ -42,15 +42,11 @@ from dataclasses import dataclass
 
 from . import isa
 from .device import Device, DeviceError, LineLost, form_name, perform
-from .faults import DEFAULT_BUDGET, Fault, FaultKind, RunResult
-from .language import VARIABLES, Param
+from .faults import DEFAULT_BUDGET, Fault, FaultKind, RunResult, missing_handler_message
+from .language import VARIABLE_INDEX, VARIABLES, Param, lost_line_handler
 from .verifier import VerifiedProgram
 
 R_CELL = len(VARIABLES)
-_INDEX = {name: index for index, name in enumerate(VARIABLES)}
-
-# Table 4: the handler label by (tracing mode, command in effect).
-HANDLERS = {(2, "MOV"): 98, (2, "MVI"): 99, (3, "MOV"): 96, (3, "MVI"): 97}
 
 # The operations of the dispatch loop (not opcodes: decoding folds operand kinds).
 (LOAD, STORE, ADD, SUB, AND, OR, XOR, SHL, SHR, INC, DEC,
@@ -167,7 +163,7 @@ class Machine:
         form = info.form
         assert info.builtin is not None
         self.sites.append(_CallSite(info.builtin, form.params, instruction.args,
-                                    tuple(_INDEX[name] for name in form.writes),
+                                    tuple(VARIABLE_INDEX[name] for name in form.writes),
                                     form.returns_value))
         return (CALL, len(self.sites) - 1, 0)
 
@@ -321,15 +317,13 @@ class Machine:
         when there is no event or its mode calls for no jump."""
         if event is None:
             return resume
-        label = HANDLERS.get((event.mode, event.command))
+        label = lost_line_handler(event.mode, event.command)
         if label is None:
             return resume
         handler = self.handlers.get(label)
         if handler is None:
             raise _Faulted(FaultKind.MISSING_HANDLER,
-                           f"the line was lost during {event.command} in tracing mode "
-                           f"{event.mode}, which jumps to :{label}, but the program has "
-                           f"no label :{label}")
+                           missing_handler_message(event.mode, event.command, label))
         return handler
 
     def _fault(self, fault: _Faulted, index: int) -> Fault:

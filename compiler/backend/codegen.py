@@ -13,14 +13,9 @@ from dataclasses import dataclass
 from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.vm import ilc, isa
-from rl1.vm.language import BUILTINS, VARIABLES
+from rl1.vm.language import BUILTINS, VARIABLE_INDEX
 
 from . import ir
-
-VARIABLE_INDEX = {name: index for index, name in enumerate(VARIABLES)}
-
-
-MAX_DEBUG_LINE = 0xFFFF  # the line map records u16 line numbers
 
 
 class CodegenError(Exception):
@@ -55,7 +50,7 @@ def generate(program: ir.Program, source_name: str, *, debug: bool = True) -> il
         for op in ops:
             if offset + op.info.length > ilc.MAX_CODE_SIZE:
                 raise CodegenError(_too_large(op.line))
-            if debug and op.line > MAX_DEBUG_LINE:
+            if debug and op.line > ilc.MAX_LINE:
                 raise CodegenError(_line_too_far(op.line))
             offset += op.info.length
     code = bytearray()
@@ -92,7 +87,7 @@ def _line_too_far(line: int) -> Diagnostic:
     return Diagnostic(
         "E0191", Severity.ERROR,
         f"line {line} holds code, but the .ilc debug section records line numbers up to "
-        f"{MAX_DEBUG_LINE} only",
+        f"{ilc.MAX_LINE} only",
         Span(line, 1, line, 1),
         help="compile with -s to leave the debug section out, or remove blank and "
              "comment lines before this one",

@@ -106,7 +106,7 @@ class _Lowerer:
             self.finish(ir.Branch(ir.Var(statement.var.name), statement.relation,
                                   taken, fall_through, line))
             self.open_block()
-        elif statement.call.mnemonic.upper() == "END":
+        elif statement.call.is_end:
             if statement.call.args:
                 raise LoweringError(f"line {line}: `(END)` takes no arguments")
             self.finish(ir.End(line))

@@ -89,7 +89,7 @@ class Block(Record):
     @property
     def ends(self) -> bool:
         """Whether the block ends with `(END)`."""
-        return bool(self.statements) and is_end(self.statements[-1])
+        return bool(self.statements) and ast.is_end(self.statements[-1])
 
 
 class ControlFlowGraph(Record):
@@ -116,10 +116,6 @@ class ControlFlowGraph(Record):
 
 
 _JUMPS = (ast.Goto, ast.CondJump)
-
-
-def is_end(statement: ast.Statement) -> bool:
-    return isinstance(statement, ast.CallStmt) and statement.call.mnemonic.upper() == "END"
 
 
 class LineMemo:
@@ -209,7 +205,7 @@ def _structure(program: ast.Program, memo: LineMemo | None) -> ControlFlowGraph:
                 block.successors = list(found)
             else:
                 block.successors = [following, *(index for index in found if index != following)]
-        elif last is None or not is_end(last):
+        elif last is None or not ast.is_end(last):
             block.successors = [following]
     return ControlFlowGraph(blocks, labels)
 
@@ -269,7 +265,7 @@ def _blocks(program: ast.Program) -> tuple[list[Block], dict[int, int], list[Blo
                 cuts.append(_Cut(statements, pending, False, []))
                 pending = []
             statements.append(statement)
-            if isinstance(statement, _JUMPS) or is_end(statement):
+            if isinstance(statement, _JUMPS) or ast.is_end(statement):
                 statements = None
     cuts.append(_Cut([], pending, False, []))
     summaries = [summarize(cut.statements) or BlockEffects.nothing() for cut in cuts[:-1]]

@@ -9,11 +9,11 @@ The model (spec/language.md 7.5 and 7.7):
   moves it, with variables may do either; `(MVI ...)` runs to its distance and leaves
   the vehicle stopped (at once with a constant 0 cm); `(FRE)` and `(HLD)` stop it;
 - a line lost while a MOV drives or an MVI runs becomes a pending event, taken at the
-  next event point: right after a call, or after a jump. Mode 2 stops the vehicle and
-  jumps to :98 (MOV) or :99 (MVI); mode 3 jumps to :96 (MOV) or :97 (MVI, which goes on
-  in the background, still an MVI in progress). The event may have been recorded at any
-  moment since the previous event point, so each event point looks at the states before
-  and after its call.
+  next event point: right after a call, or after a jump, and jumps where Table 4
+  (language.LOST_LINE_RULES) says. Mode 2 stops the vehicle first; in mode 3 the motion
+  goes on (an MVI in the background, still an MVI in progress). The event may have been
+  recorded at any moment since the previous event point, so each event point looks at
+  the states before and after its call.
 A call with the wrong number of arguments or an out-of-range constant (already an error)
 changes nothing, and a line that could not be parsed is assumed to leave tracing off and
 the vehicle stopped, so that neither cascades into warnings.
@@ -25,6 +25,7 @@ non-zero MOV in effect) and RUNNING (an MVI in progress).
 from __future__ import annotations
 
 from rl1.compiler.frontend import ast
+from rl1.vm.language import LOST_LINE_RULES
 
 from . import dataflow
 
@@ -38,8 +39,7 @@ MOVING = 1 << 5
 RUNNING = 1 << 6
 MOTION = STOPPED | MOVING | RUNNING
 START = 1 << 0 | STOPPED
-MODE_2 = 1 << 2
-MODE_3 = 1 << 3
+JUMPING_MODES = sum({1 << rule.mode for rule in LOST_LINE_RULES})  # modes 2 and 3
 
 # What a call does to the device state: (kind, value), and where in its block.
 _SET_MODES, _SET_MOTION, _MVI, _END = range(4)
@@ -125,18 +125,21 @@ def _lost_line(recorded: tuple[int, ...], now: int, from_mvi: bool, index: int,
             under_mov |= seen
         if seen & RUNNING:
             under_mvi |= seen
-    if not (under_mov | under_mvi) & (MODE_2 | MODE_3):
+    if not (under_mov | under_mvi) & JUMPING_MODES:
         return
     modes = now & ALL_MODES
-    for label, modes_then, mode, entry in (
-        (96, under_mov, MODE_3, now),
-        (97, under_mvi, MODE_3, modes | RUNNING if from_mvi else now),
-        (98, under_mov, MODE_2, modes | STOPPED),
-        (99, under_mvi, MODE_2, modes | STOPPED),
-    ):
-        if modes_then & mode:
-            first, entries = triggers.get(label, (index, 0))
-            triggers[label] = (first, entries | entry)
+    for rule in LOST_LINE_RULES:
+        modes_then = under_mvi if rule.command == "MVI" else under_mov
+        if not modes_then & 1 << rule.mode:
+            continue
+        if rule.stops:
+            entry = modes | STOPPED
+        elif rule.command == "MVI" and from_mvi:
+            entry = modes | RUNNING  # the MVI that lost the line runs on in the background
+        else:
+            entry = now
+        first, entries = triggers.get(rule.label, (index, 0))
+        triggers[rule.label] = (first, entries | entry)
 
 
 def trace(graph: ControlFlowGraph) -> tuple[list[int], list[Triggers]]:

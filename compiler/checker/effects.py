@@ -139,8 +139,7 @@ def line_segments(statements: tuple[ast.Statement, ...]) -> tuple[Segment, ...]:
     segments: list[Segment] = []
     start = 0
     for index, statement in enumerate(statements):
-        if isinstance(statement, ast.Goto | ast.CondJump) or (
-                isinstance(statement, ast.CallStmt) and _is_end(statement.call)):
+        if isinstance(statement, ast.Goto | ast.CondJump) or ast.is_end(statement):
             run = statements[start : index + 1]
             segments.append((run, summarize(run), True))
             start = index + 1
@@ -148,10 +147,6 @@ def line_segments(statements: tuple[ast.Statement, ...]) -> tuple[Segment, ...]:
         run = statements[start:]
         segments.append((run, summarize(run), False))
     return tuple(segments)
-
-
-def _is_end(call: ast.Call) -> bool:
-    return call.mnemonic.upper() == "END"
 
 
 def _summary(operations: list[device.Operation], first_event: int | None, reads: int,

@@ -10,20 +10,24 @@ from __future__ import annotations
 
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity
+from rl1.vm.language import LOST_LINE_RULES
 
 from .cfg import ControlFlowGraph
 from .fixes import append_line
 
 HANDLER = "(MOV 0,0); (END)"  # what the fix's handler does: stop, then end
 
+_DURING = {"MOV": "while `(MOV)` drives", "MVI": "during `(MVI)`"}
+_THEN = {  # (stops, command): what the lost line does besides the jump
+    (True, "MOV"): "stops the vehicle and jumps to `:{label}`",
+    (True, "MVI"): "aborts it and jumps to `:{label}`",
+    (False, "MOV"): "jumps to `:{label}`, the vehicle still moving",
+    (False, "MVI"): "jumps to `:{label}`, the motion going on in the background",
+}
 _WHEN = {
-    96: "in tracing mode 3, a lost line while `(MOV)` drives jumps to `:96`, the vehicle "
-        "still moving",
-    97: "in tracing mode 3, a lost line during `(MVI)` jumps to `:97`, the motion going on "
-        "in the background",
-    98: "in tracing mode 2, a lost line while `(MOV)` drives stops the vehicle and jumps "
-        "to `:98`",
-    99: "in tracing mode 2, a lost line during `(MVI)` aborts it and jumps to `:99`",
+    rule.label: f"in tracing mode {rule.mode}, a lost line {_DURING[rule.command]} "
+                + _THEN[rule.stops, rule.command].format(label=rule.label)
+    for rule in LOST_LINE_RULES
 }
 
 

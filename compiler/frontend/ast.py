@@ -125,6 +125,11 @@ class Call(Node):
         self.mnemonic_span = mnemonic_span
         self.args = args
 
+    @property
+    def is_end(self) -> bool:
+        """Whether this is `(END)`, in any case."""
+        return self.mnemonic.upper() == "END"
+
 
 Operand = Var | Const | Call
 
@@ -226,6 +231,11 @@ class CallStmt(Node):
 
 
 Statement = Assign | IncDec | Goto | CondJump | CallStmt
+
+
+def is_end(statement: Statement) -> bool:
+    """Whether `statement` is `(END)`."""
+    return isinstance(statement, CallStmt) and statement.call.is_end
 
 
 # Lines and programs -----------------------------------------------------------------
