@@ -27,6 +27,7 @@ test: lint typecheck vscode-test pytest
 
 lint: $(STAMP)
 	$(BIN)/ruff check compiler vm lsp tests bench spec/vectors
+	$(BIN)/lint-imports --no-cache
 
 # mypy cannot follow setuptools' editable-install mapping of rl1.compiler onto
 # compiler/, so it checks a tree of symlinks with the installed names.

@@ -2,21 +2,18 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from .checker import check
 from .frontend.ast import Program
 from .frontend.diagnostics import Diagnostic, sort_key
 from .frontend.parser import parse_program
-from .frontend.record import Record
 
 
-class Analysis(Record):
-    __slots__ = ("program", "diagnostics")
+@dataclass(frozen=True, slots=True)
+class Analysis:
     program: Program
     diagnostics: list[Diagnostic]
-
-    def __init__(self, program: Program, diagnostics: list[Diagnostic]) -> None:
-        self.program = program
-        self.diagnostics = diagnostics
 
     @property
     def has_errors(self) -> bool:

@@ -12,27 +12,24 @@ texts and columns.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+from typing import Any, TypeVar
+
 from rl1.vm.language import BUILTINS
 
 from . import ast
+from .scanner import Kinds, Lexeme
 
-TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
-if TYPE_CHECKING:
-    from collections.abc import Callable, Sequence
-    from typing import Any, TypeVar
+Node = TypeVar("Node", covariant=True)
+Builder = Callable[[Sequence[Lexeme], int], Node]
+"""Builds a node from a line's lexemes and its line number."""
 
-    from .scanner import Kinds, Lexeme
+Child = int | Builder[Any]
+"""What a rule receives for each symbol: a token's index, or a sub-rule's builder."""
 
-    Node = TypeVar("Node", covariant=True)
-    Builder = Callable[[Sequence[Lexeme], int], Node]
-    """Builds a node from a line's lexemes and its line number."""
+ParsedLine = tuple[ast.LabelDef | None, tuple[ast.Statement, ...]]
 
-    Child = int | Builder[Any]
-    """What a rule receives for each symbol: a token's index, or a sub-rule's builder."""
-
-    ParsedLine = tuple[ast.LabelDef | None, tuple[ast.Statement, ...]]
-
-    Letter = TypeVar("Letter", ast.Var, ast.Selector)
+Letter = TypeVar("Letter", ast.Var, ast.Selector)
 
 _SELECTING = frozenset(name for name, builtin in BUILTINS.items() if builtin.has_selector)
 

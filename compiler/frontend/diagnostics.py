@@ -6,10 +6,10 @@ The catalogue of codes (titles and the long explanations of `rl1c explain`) live
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from enum import Enum
 
 from .ast import Span
-from .record import Record
 
 
 class Severity(Enum):
@@ -18,62 +18,39 @@ class Severity(Enum):
     INFO = "info"
 
 
-class Edit(Record):
+@dataclass(frozen=True, slots=True)
+class Edit:
     """Replace the text of `span` with `text` (an empty span inserts)."""
 
-    __slots__ = ("span", "text")
     span: Span
     text: str
 
-    def __init__(self, span: Span, text: str) -> None:
-        self.span = span
-        self.text = text
 
-
-class Fix(Record):
+@dataclass(frozen=True, slots=True)
+class Fix:
     """A machine-applicable fix: the editor's quick fix, the help line's suggestion."""
 
-    __slots__ = ("title", "edits")
     title: str
     edits: tuple[Edit, ...]
 
-    def __init__(self, title: str, edits: tuple[Edit, ...]) -> None:
-        self.title = title
-        self.edits = edits
 
-
-class Related(Record):
+@dataclass(frozen=True, slots=True)
+class Related:
     """Another place that explains a diagnostic (the first definition of a label...)."""
 
-    __slots__ = ("span", "message")
     span: Span
     message: str
 
-    def __init__(self, span: Span, message: str) -> None:
-        self.span = span
-        self.message = message
 
-
-class Diagnostic(Record):
-    __slots__ = ("code", "severity", "message", "span", "help", "fixes", "related")
+@dataclass(frozen=True, slots=True)
+class Diagnostic:
     code: str
     severity: Severity
     message: str
     span: Span
-    help: str | None
-    fixes: tuple[Fix, ...]
-    related: tuple[Related, ...]
-
-    def __init__(self, code: str, severity: Severity, message: str, span: Span,
-                 help: str | None = None, fixes: tuple[Fix, ...] = (),
-                 related: tuple[Related, ...] = ()) -> None:
-        self.code = code
-        self.severity = severity
-        self.message = message
-        self.span = span
-        self.help = help
-        self.fixes = fixes
-        self.related = related
+    help: str | None = None
+    fixes: tuple[Fix, ...] = ()
+    related: tuple[Related, ...] = ()
 
     @property
     def is_error(self) -> bool:

@@ -17,23 +17,19 @@ from __future__ import annotations
 
 import functools
 import unicodedata
+from dataclasses import dataclass
+from typing import Any
 
 from rl1.vm.language import BUILTINS
 
 from . import ast
-from .builders import ACTIONS, label_def
+from .builders import ACTIONS, Builder, Child, ParsedLine, label_def
 from .collector import collector_paused
 from .diagnostics import Diagnostic, Severity
 from .lalr_tables import ACTIONS as TABLE
 from .lalr_tables import RULES, START
 from .scanner import Kinds, Lexeme, scan
 from .source import split_lines
-
-TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
-if TYPE_CHECKING:
-    from typing import Any
-
-    from .builders import Builder, Child, ParsedLine
 
 # What each terminal is called in "expected ..." messages.
 TERMINAL_NAMES = {
@@ -49,20 +45,17 @@ _LONGEST_CACHED_PLAN = 64
 huge line's plan could fill the cache."""
 
 
+@dataclass(frozen=True, slots=True)
 class Rejection:
     """The outcome of a line the grammar rejects: the index of the token the automaton
     could not take (None: the end of the line) and the terminals it expected there."""
 
-    __slots__ = ("expected", "index")
-
-    def __init__(self, index: int | None, expected: frozenset[str]) -> None:
-        self.index = index
-        self.expected = expected
+    index: int | None
+    expected: frozenset[str]
 
 
-if TYPE_CHECKING:
-    Plan = Builder[ParsedLine] | Rejection
-    """What a line of some kinds parses to: the builder of its AST, or why it is rejected."""
+Plan = Builder[ParsedLine] | Rejection
+"""What a line of some kinds parses to: the builder of its AST, or why it is rejected."""
 
 
 def make_plan(kinds: Kinds) -> Plan:

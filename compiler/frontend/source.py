@@ -7,26 +7,20 @@ with LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them.
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 
 from rl1.compiler.files import SourceError, read_bounded
-
-from .record import Record
 
 MAX_SOURCE_BYTES = 64 * 1024 * 1024
 LINE_BREAK = re.compile(r"\r\n|\r|\n")
 """A line end: LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them."""
 
 
-class Source(Record):
-    __slots__ = ("name", "text", "encoding")
+@dataclass(frozen=True, slots=True)
+class Source:
     name: str
     text: str
     encoding: str  # "utf-8" or "cp932"
-
-    def __init__(self, name: str, text: str, encoding: str) -> None:
-        self.name = name
-        self.text = text
-        self.encoding = encoding
 
     @property
     def lines(self) -> list[str]:

@@ -10,23 +10,18 @@ W07xx safety. The long explanation of CODE is explanations/CODE.md, printed by
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 
 from rl1.compiler.frontend.diagnostics import Severity
-from rl1.compiler.frontend.record import Record
 
 _EXPLANATIONS = os.path.join(os.path.dirname(__file__), "explanations")
 
 
-class CodeInfo(Record):
-    __slots__ = ("code", "severity", "title")
+@dataclass(frozen=True, slots=True)
+class CodeInfo:
     code: str
     severity: Severity
     title: str
-
-    def __init__(self, code: str, severity: Severity, title: str) -> None:
-        self.code = code
-        self.severity = severity
-        self.title = title
 
     def explanation(self) -> str:
         with open(os.path.join(_EXPLANATIONS, f"{self.code}.md"), encoding="utf-8") as file:

@@ -9,23 +9,18 @@ from __future__ import annotations
 
 import os
 import unicodedata
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import IO, Any, Literal
 
-from rl1.compiler.frontend.diagnostics import Severity, sort_key
-from rl1.compiler.frontend.record import Record
+from rl1.compiler.frontend.ast import Span
+from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity, sort_key
 from rl1.compiler.frontend.source import split_lines
 
 from .catalogue import CODES
 
-TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
-if TYPE_CHECKING:
-    from collections.abc import Sequence
-    from typing import IO, Any, Literal
-
-    from rl1.compiler.frontend.ast import Span
-    from rl1.compiler.frontend.diagnostics import Diagnostic, Fix
-
-    Format = Literal["human", "json", "sarif"]
-    ColorChoice = Literal["auto", "always", "never"]
+Format = Literal["human", "json", "sarif"]
+ColorChoice = Literal["auto", "always", "never"]
 
 FORMATS: tuple[Format, ...] = ("human", "json", "sarif")
 COLOR_CHOICES: tuple[ColorChoice, ...] = ("auto", "always", "never")
@@ -44,19 +39,14 @@ SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
 _SARIF_LEVELS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
 
 
-class FileDiagnostics(Record):
+@dataclass(frozen=True, slots=True)
+class FileDiagnostics:
     """The diagnostics of one source file. `text` is None when the file could not be
     read; its diagnostics then say why (E0100) and have no place in the text."""
 
-    __slots__ = ("name", "text", "diagnostics")
     name: str
     text: str | None
     diagnostics: Sequence[Diagnostic]
-
-    def __init__(self, name: str, text: str | None, diagnostics: Sequence[Diagnostic]) -> None:
-        self.name = name
-        self.text = text
-        self.diagnostics = diagnostics
 
 
 def _tool_version() -> str:
