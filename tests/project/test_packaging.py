@@ -3,7 +3,11 @@
 An editable install maps whole folders, so a package missing from pyproject.toml only
 shows up in a wheel; these checks catch that without building one."""
 
+import shutil
+import subprocess
+import sys
 import tomllib
+import zipfile
 from pathlib import Path
 
 from support import ROOT
@@ -32,3 +36,25 @@ def test_data_files_the_code_reads_are_package_data() -> None:
     assert "*.lark" in CONFIG["package-data"]["rl1.compiler.frontend"]
     assert "*.md" in CONFIG["package-data"]["rl1.compiler.reporting.explanations"]
     assert list((ROOT / "compiler" / "reporting" / "explanations").glob("*.md"))
+
+
+def test_a_wheel_builds_without_warnings_and_holds_the_data(tmp_path: Path) -> None:
+    """`pip install .` builds this wheel: setuptools warns of a data folder that is not
+    a listed package ("would be ignored"), and a missing data file breaks `rl1c explain`."""
+    for name in ("pyproject.toml", "README.md", "LICENSE"):
+        shutil.copy(ROOT / name, tmp_path / name)
+    for top in CONFIG["package-dir"].values():
+        shutil.copytree(ROOT / top, tmp_path / top,
+                        ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    built = subprocess.run([sys.executable, "-m", "pip", "wheel", ".", "--no-deps",
+                            "--quiet", "-w", "dist"],
+                           cwd=tmp_path, capture_output=True, text=True, check=False)
+    assert built.returncode == 0, built.stderr
+    assert "warning" not in (built.stdout + built.stderr).lower()
+    (wheel,) = (tmp_path / "dist").glob("rl1-*.whl")
+    names = set(zipfile.ZipFile(wheel).namelist())
+    explanations = {f"rl1/compiler/reporting/explanations/{md.name}"
+                    for md in (ROOT / "compiler" / "reporting" / "explanations").glob("*.md")}
+    assert explanations <= names
+    assert "rl1/compiler/frontend/grammar.lark" in names
+    assert "rl1/compiler/frontend/lalr_tables.py" in names
