@@ -199,6 +199,23 @@ def lost_line_handler(mode: int, command: str) -> int | None:
     return _HANDLER_BY_EVENT.get((mode, command))
 
 
+_SIGNIFICANT_DIGITS = 18
+TOO_LONG = 10**_SIGNIFICANT_DIGITS
+"""What a decimal number of more significant digits stands for: out of every range that
+RL/I, the .ils text or a sensor script accepts."""
+
+
+def decimal_value(text: str) -> int:
+    """The value of a decimal integer written as `text` (an optional sign, then digits).
+    A number too long to fit anything is taken as TOO_LONG with its sign, so that it gets
+    the same out-of-range message as `99999` instead of costing time (or Python's limit
+    on converting long digit strings) to convert."""
+    digits = text.lstrip("+-").lstrip("0")
+    if len(digits) > _SIGNIFICANT_DIGITS:
+        return -TOO_LONG if text.startswith("-") else TOO_LONG
+    return int(text)
+
+
 def writers_of(variable: str) -> list[tuple[Builtin, Form]]:
     """The built-in forms that set a reserved variable."""
     return [(b, form) for b in BUILTINS.values() for form in b.forms if variable in form.writes]

@@ -43,7 +43,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from .device import DeviceError, FuzzyReading, ImageReading, LineLost, MotionCommand, Odometry
-from .language import BUILTINS
+from .language import BUILTINS, TOO_LONG, decimal_value
 
 T = TypeVar("T")
 
@@ -121,9 +121,12 @@ def decode_script(data: bytes, name: str) -> Script:
             raise ScriptError(f"{path}: invalid TOML: {error}") from None
         except RecursionError:
             raise ScriptError(f"{path}: invalid TOML: nested too deeply") from None
+        except ValueError:  # tomllib converts every integer, however long
+            raise ScriptError(f"{path}: a number is far too long to be a reading; "
+                              "readings are 16-bit") from None
     else:
         try:
-            document = json.loads(text)
+            document = json.loads(text, parse_int=decimal_value)
         except json.JSONDecodeError as error:
             raise ScriptError(f"{path}:{error.lineno}:{error.colno}: invalid JSON: "
                               f"{error.msg}") from None
@@ -191,6 +194,9 @@ def _list(value: object, where: str) -> list[object]:
 def _int(value: object, where: str, low: int, high: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int):
         raise ScriptError(f"{where}: expected an integer in {low}..{high}, found {_kind(value)}")
+    if abs(value) >= TOO_LONG:
+        raise ScriptError(f"{where}: a number of more than {len(str(TOO_LONG)) - 1} digits "
+                          f"is far outside {low}..{high}")
     if not low <= value <= high:
         raise ScriptError(f"{where}: {value} is outside {low}..{high}")
     return value
@@ -220,7 +226,7 @@ def _ports(value: object, where: str) -> dict[int, tuple[int, ...]]:
         if not (key.isascii() and key.isdigit()):
             raise ScriptError(f"{where}.{key}: a port is a decimal number "
                               f"{port_range.low}..{port_range.high}")
-        port = _int(int(key), f"{where}.{key}", port_range.low, port_range.high)
+        port = _int(decimal_value(key), f"{where}.{key}", port_range.low, port_range.high)
         ports[port] = tuple(_int(item, f"{where}.{key}[{i}]", 0, 255)
                             for i, item in enumerate(_list(readings, f"{where}.{key}")))
     return ports

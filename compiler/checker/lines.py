@@ -50,7 +50,7 @@ def _malformed_label(text: str, span: ast.Span, what: str, sigil: str) -> Diagno
     fixes: tuple[Fix, ...] = ()
     if not digits:
         help_text = f"write two digits after `{sigil}`, e.g. `{sigil}10`"
-    elif int(digits) < 100:
+    elif len(digits.lstrip("0")) <= 2:
         fixed = f"{sigil}{int(digits):02d}"
         help_text = f"write `{fixed}`"
         fixes = (Fix(f"write `{fixed}`", (Edit(span, fixed),)),)

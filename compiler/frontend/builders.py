@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
 
-from rl1.vm.language import BUILTINS
+from rl1.vm.language import BUILTINS, decimal_value
 
 from . import ast
 from .scanner import Kinds, Lexeme
@@ -70,7 +70,7 @@ def _number(index: int) -> Builder[ast.Const]:
     def build(lexemes: Sequence[Lexeme], line: int) -> ast.Const:
         text, column = lexemes[index]
         return ast.Const(ast.Span(line, column + 1, line, column + 1 + len(text)),
-                         int(text), text, False)
+                         decimal_value(text), text, False)
     return build
 
 

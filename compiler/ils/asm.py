@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 from rl1.compiler.frontend.source import split_lines
 from rl1.vm import ilc, isa
-from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES, Feature
+from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES, Feature, decimal_value
 from rl1.vm.verifier import VerifyError, verify
 
 
@@ -121,11 +121,11 @@ def _number(token: _Token, low: int, high: int, what: str) -> int:
     if token.kind != "number":
         raise _LineError(token.column, f"expected {what}, found {token.text or 'nothing'!r}")
     if token.text.startswith("$"):
-        value = int(token.text[1:], 16)
+        value = int(token.text[1:], 16)  # linear in its length, unlike a decimal
         if value <= 0xFFFF and low < 0 and value >= 0x8000:
             value -= 0x10000
     else:
-        value = int(token.text)
+        value = decimal_value(token.text)
     if not low <= value <= high:
         raise _LineError(token.column, f"{what} {token.text} is out of range {low}..{high}")
     return value
