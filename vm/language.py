@@ -200,7 +200,7 @@ def lost_line_handler(mode: int, command: str) -> int | None:
 
 
 _SIGNIFICANT_DIGITS = 18
-TOO_LONG = 10**_SIGNIFICANT_DIGITS
+TOO_LONG: int = 10**_SIGNIFICANT_DIGITS
 """What a decimal number of more significant digits stands for: out of every range that
 RL/I, the .ils text or a sensor script accepts."""
 
