@@ -35,6 +35,7 @@ The motion model (device time in integer milliseconds, starting at 0):
 
 from __future__ import annotations
 
+import bisect
 import json
 import math
 import tomllib
@@ -270,10 +271,16 @@ class ScriptedDevice:
         self._motion: _Motion | None = None
         self._calls = {"MOV": 0, "MVI": 0}
         self.pending: LineLost | None = None
+        # Each loss is looked up by bisection, so that a run costs time linear in its
+        # script, however many losses it holds.
         self._losses_at = sorted(loss.time for loss in self.script.losses
                                  if isinstance(loss, LossAt))
-        self._losses_during = [loss for loss in self.script.losses
-                               if isinstance(loss, LossDuring)]
+        self._losses_during: dict[tuple[str, int], list[int]] = {}
+        for loss in self.script.losses:
+            if isinstance(loss, LossDuring):
+                self._losses_during.setdefault((loss.command, loss.nth), []).append(loss.after)
+        for afters in self._losses_during.values():
+            afters.sort()
         self._read_counts: dict[str, int] = {}
 
     # Bookkeeping
@@ -290,14 +297,16 @@ class ScriptedDevice:
 
     def _next_loss(self, until: int) -> int | None:
         """The time of the next loss that could matter in (time, until]."""
-        while self._losses_at and self._losses_at[0] <= self.time:
-            self._losses_at.pop(0)
-        times = [t for t in self._losses_at[:1] if t <= until]
+        times = []
+        at = bisect.bisect_right(self._losses_at, self.time)
+        if at < len(self._losses_at) and self._losses_at[at] <= until:
+            times.append(self._losses_at[at])
         motion = self._motion
         if motion is not None:
-            times += [motion.start + loss.after for loss in self._losses_during
-                      if (loss.command, loss.nth) == (motion.command, motion.nth)
-                      and self.time < motion.start + loss.after <= until]
+            afters = self._losses_during.get((motion.command, motion.nth), [])
+            during = bisect.bisect_right(afters, self.time - motion.start)
+            if during < len(afters) and motion.start + afters[during] <= until:
+                times.append(motion.start + afters[during])
         return min(times, default=None)
 
     def _advance(self, duration: int, interruptible: bool) -> None:

@@ -311,3 +311,26 @@ class _Faulty(ScriptedDevice):
 def test_a_value_outside_16_bits_from_a_device_is_its_error() -> None:
     with pytest.raises(DeviceError, match=r"\(ULT C\) returned 40000"):
         perform(_Faulty(), ("ULT", "C"), ())
+
+
+@given(at=st.lists(st.integers(1, 30_000), max_size=60),
+       during=st.lists(st.tuples(st.integers(1, 3), st.integers(1, 12_000)), max_size=60))
+@settings(deadline=None)
+def test_in_mode_1_every_scheduled_loss_under_motion_is_traced_once_in_time_order(
+        at: list[int], during: list[tuple[int, int]]) -> None:
+    """Three MOVs of 10 s each, in mode 1: each loss scheduled while one drives appears in
+    the trace once, at its time, whatever the order and overlap of the script's entries."""
+    losses = (*[LossAt(time) for time in at],
+              *[LossDuring("MOV", nth, after) for nth, after in during])
+    device = ScriptedDevice(Script(losses=losses))
+    device.set_tracing(1)
+    starts = []
+    for _ in range(3):
+        starts.append(device.time)
+        device.move(3, 3)
+        device.wait(100)
+    expected = {time for time in at if time <= 30_000}
+    expected |= {starts[nth - 1] + after for nth, after in during
+                 if after <= 10_000 and starts[nth - 1] + after <= 30_000}
+    traced = [entry.time for entry in device.trace if entry.call == "LINE LOST"]
+    assert traced == sorted(expected)
