@@ -9,6 +9,7 @@ waits, reads the odometer and counts, so losses fall both into waits and between
 
 from __future__ import annotations
 
+import functools
 import json
 
 from timing import best_time
@@ -39,7 +40,7 @@ def main() -> None:
     previous = None
     for losses in (2_500, 5_000, 10_000, 20_000):
         data = script_of(losses)
-        seconds = best_time(lambda data=data: run(data), 3)
+        seconds = best_time(functools.partial(run, data), 3)
         megabytes = len(data) / 2**20
         growth = "" if previous is None else f", x{seconds / previous:.2f} for twice the size"
         print(f"{2 * losses:>6} losses, {megabytes:.2f} MB: {seconds * 1000:7.1f} ms "

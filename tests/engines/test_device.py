@@ -320,8 +320,9 @@ def test_in_mode_1_every_scheduled_loss_under_motion_is_traced_once_in_time_orde
         at: list[int], during: list[tuple[int, int]]) -> None:
     """Three MOVs of 10 s each, in mode 1: each loss scheduled while one drives appears in
     the trace once, at its time, whatever the order and overlap of the script's entries."""
-    losses = (*[LossAt(time) for time in at],
-              *[LossDuring("MOV", nth, after) for nth, after in during])
+    losses: tuple[LossAt | LossDuring, ...] = (*[LossAt(time) for time in at],
+                                                *[LossDuring("MOV", nth, after)
+                                                  for nth, after in during])
     device = ScriptedDevice(Script(losses=losses))
     device.set_tracing(1)
     starts = []
