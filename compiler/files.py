@@ -11,7 +11,6 @@ from __future__ import annotations
 import contextlib
 import os
 import stat
-import tempfile
 from pathlib import Path
 
 
@@ -41,6 +40,10 @@ def read_bounded(path: str | os.PathLike[str], limit: int, what: str) -> bytes:
 
 def write_atomically(path: str | Path, data: bytes) -> None:
     """Replace the file at `path` with `data`; OSError if that cannot be done."""
+    # Imported here: tempfile (with shutil and the compression modules it loads) costs
+    # rl1c check, which reads files but writes none, 3 ms of every start.
+    import tempfile
+
     path = Path(path)
     mode = _mode_for(path)
     descriptor, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.",

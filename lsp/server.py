@@ -8,12 +8,12 @@ honoured exactly.
 
 from __future__ import annotations
 
-import argparse
 import logging
 from collections.abc import Callable, Generator
 from importlib.metadata import version
 from typing import Any
 
+import click
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException
 from pygls.lsp.server import LanguageServer
@@ -210,39 +210,39 @@ def create_server() -> Rl1Server:
     return server
 
 
-def main(argv: list[str] | None = None) -> None:
-    """The `rl1-lsp` command line (default: the process's arguments); serves until the
-    client leaves. Help, the version and a malformed command line end in SystemExit."""
-    parser = argparse.ArgumentParser(
-        prog=NAME, allow_abbrev=False,
-        description="The RL/I language server: diagnostics, hover, completion, navigation, "
-                    "renaming of labels, formatting and quick fixes for .rob files in any "
-                    "LSP editor.")
-    parser.add_argument("--version", action="version", version=f"{NAME}, version {version('rl1')}",
-                        help="show the version and exit")
-    parser.add_argument("--stdio", action="store_true",
-                        help="talk LSP over standard input and output (the default)")
-    parser.add_argument("--tcp", metavar="HOST:PORT", type=_host_port,
-                        help="listen for one client on a TCP port instead")
-    parser.add_argument("--log-level", choices=("debug", "info", "warning", "error"),
-                        default="warning", help="what to log on standard error "
-                                                "(default: %(default)s)")
-    options = parser.parse_args(argv)
-    if options.tcp is not None and options.stdio:
-        parser.error("choose one of --stdio and --tcp")
-    logging.basicConfig(level=options.log_level.upper(),
-                        format="rl1-lsp %(levelname)s: %(message)s")
+@click.command(NAME, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="rl1", prog_name=NAME)
+@click.option("--stdio", is_flag=True,
+              help="talk LSP over standard input and output (the default)")
+@click.option("--tcp", metavar="HOST:PORT", callback=lambda ctx, param, value: _host_port(value),
+              help="listen for one client on a TCP port instead")
+@click.option("--log-level", type=click.Choice(["debug", "info", "warning", "error"]),
+              default="warning", show_default=True, help="what to log on standard error")
+def command(stdio: bool, tcp: tuple[str, int] | None, log_level: str) -> None:
+    """The RL/I language server: diagnostics, hover, completion, navigation, renaming of
+    labels, formatting and quick fixes for .rob files in any LSP editor."""
+    if tcp is not None and stdio:
+        raise click.UsageError("--stdio and --tcp exclude each other: choose one of --stdio "
+                               "and --tcp")
+    logging.basicConfig(level=log_level.upper(), format="rl1-lsp %(levelname)s: %(message)s")
     server = create_server()
-    if options.tcp is None:
+    if tcp is None:
         server.start_io()
     else:
-        server.start_tcp(*options.tcp)
+        server.start_tcp(*tcp)
 
 
-def _host_port(text: str) -> tuple[str, int]:
-    """An argparse type: `HOST:PORT`."""
+def main(argv: list[str] | None = None) -> None:
+    """The `rl1-lsp` command line (default: the process's arguments); serves until the
+    client leaves, then exits. Help, the version and a malformed command line exit too."""
+    command.main(argv, prog_name=NAME)  # the name, also under `python -m rl1.lsp`
+
+
+def _host_port(text: str | None) -> tuple[str, int] | None:
+    """The value of --tcp: `HOST:PORT`."""
+    if text is None:
+        return None
     host, _, port = text.rpartition(":")
     if not host or not port.isdigit() or not 0 < int(port) < 65536:
-        raise argparse.ArgumentTypeError(
-            f"expected HOST:PORT such as 127.0.0.1:2087, got {text!r}")
+        raise click.BadParameter(f"expected HOST:PORT such as 127.0.0.1:2087, got {text!r}")
     return host, int(port)

@@ -9,7 +9,7 @@ import pytest
 from support import SAMPLE
 
 from rl1.compiler.backend import driver
-from rl1.compiler.cli import main as cli
+from rl1.compiler.cli import build as cli
 from rl1.compiler.cli import run as runner
 from rl1.vm import faults
 
@@ -33,8 +33,8 @@ def modules_loaded_by(argv: list[str]) -> tuple[int, set[str]]:
         "import sys\n"
         f"for name in {sorted(COSTLY)!r}:\n"
         "    sys.modules.pop(name, None)\n"
-        "from rl1.compiler.cli.main import main\n"
-        f"status = main({argv!r})\n"
+        "from rl1.compiler.cli.main import rl1c\n"
+        f"status = rl1c.main({argv!r}, standalone_mode=False)\n"
         "print(status, *sys.modules)\n"
     )
     result = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True,
@@ -70,6 +70,7 @@ def test_json_is_loaded_for_the_json_format_only() -> None:
 
 
 def test_version_reads_the_installed_metadata_when_asked() -> None:
-    shown = subprocess.run([sys.executable, "-c", "from rl1.compiler.cli.main import main; "
-                            "main(['--version'])"], capture_output=True, text=True, check=False)
+    shown = subprocess.run([sys.executable, "-c", "from rl1.compiler.cli.main import rl1c; "
+                            "rl1c.main(['--version'])"], capture_output=True, text=True,
+                           check=False)
     assert (shown.returncode, shown.stdout) == (0, f"rl1c, version {version('rl1')}\n")

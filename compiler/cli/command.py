@@ -1,0 +1,164 @@
+"""What every `rl1c` command shares: the click command class that turns what a command
+returns or raises into the exit status, the parameter types with their messages, and the
+options of the commands that report diagnostics.
+
+A command is a function returning its exit status, decorated `@click.command(cls=Command)`
+with its parameters; its docstring is its help, the first line its summary in
+`rl1c --help`. It ends early by raising `Failure` (a message for standard error and a
+status) or `click.UsageError` (shown with the command's usage, status 2).
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING, Any, TypeVar
+
+import click
+
+from rl1.compiler.reporting.render import COLOR_CHOICES, EXIT_ERRORS, EXIT_USAGE, FORMATS
+
+if TYPE_CHECKING:
+    from click.shell_completion import CompletionItem
+
+EXIT_INTERNAL = 3
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as shells report a program stopped by Ctrl-C
+
+CONTEXT_SETTINGS: dict[str, Any] = {"help_option_names": ["-h", "--help"]}
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+
+class Failure(Exception):
+    """Ends a command: `message` goes to standard error, `status` is the exit status."""
+
+    def __init__(self, message: str, status: int = EXIT_USAGE) -> None:
+        super().__init__(message)
+        self.status = status
+
+
+class Context(click.Context):
+    """Makes the help as wide as the terminal ($COLUMNS, else the terminal's width, as
+    shutil finds it): click would stop at 80 columns, and at exactly 80 under CliRunner."""
+
+    def make_formatter(self) -> click.HelpFormatter:
+        return click.HelpFormatter(width=max(shutil.get_terminal_size().columns - 2, 50))
+
+
+def write_usage(command: click.Command, ctx: click.Context,
+                formatter: click.HelpFormatter) -> None:
+    """The usage line as `usage: rl1c check [OPTIONS] FILE...`, lower case as in the
+    error messages that follow it."""
+    formatter.write_usage(ctx.command_path, " ".join(command.collect_usage_pieces(ctx)),
+                          prefix="usage: ")
+
+
+class Command(click.Command):
+    """An `rl1c` command: its callback returns the exit status. Failures, a closed
+    output pipe, Ctrl-C and bugs become a message on standard error and a status here,
+    before click's own handling (which would print a blank line on Ctrl-C)."""
+
+    context_class = Context
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("context_settings", CONTEXT_SETTINGS)
+        super().__init__(*args, **kwargs)
+
+    def format_usage(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        write_usage(self, ctx, formatter)
+
+    def invoke(self, ctx: click.Context) -> int:
+        try:
+            status: int = super().invoke(ctx)
+            sys.stdout.flush()  # a closed pipe shows here, not when the process exits
+            return status
+        except (click.ClickException, click.exceptions.Exit):
+            raise  # usage errors are shown by the group, with the usage
+        except Failure as failure:
+            print(failure, file=sys.stderr)
+            return failure.status
+        except BrokenPipeError:
+            # The reader stopped early (`rl1c dis x.ilc | head`): end quietly. What is
+            # left in the buffer goes to /dev/null, or Python would fail again flushing
+            # it at exit.
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            return EXIT_ERRORS
+        except KeyboardInterrupt:
+            return interrupted()
+        except Exception as error:
+            return internal_error(error)
+
+
+def interrupted() -> int:
+    print("rl1c: interrupted", file=sys.stderr)
+    return EXIT_INTERRUPTED
+
+
+def internal_error(error: Exception) -> int:
+    """Reports a bug in rl1c; its exit status (3)."""
+    # A traceback tells a robot programmer nothing they can act on and reads as if their
+    # program were at fault; a distinct status (3) lets scripts and CI tell a bug in rl1c
+    # from a program with errors (1) or a usage problem (2). RL1C_BACKTRACE=1 shows the
+    # traceback to whoever debugs rl1c.
+    if os.environ.get("RL1C_BACKTRACE"):
+        import traceback
+
+        traceback.print_exception(error)
+    summary = f"{type(error).__name__}: {error}"
+    print(f"rl1c: internal error: {summary[:300]}\n"
+          "This is a bug in rl1c, not in your program. Please report it with the command "
+          "line and the input file (RL1C_BACKTRACE=1 shows the details).", file=sys.stderr)
+    return EXIT_INTERNAL
+
+
+# Parameter types ----------------------------------------------------------------------
+
+
+def choice_option(*names: str, choices: Sequence[str], help: str,
+                  **settings: Any) -> Callable[[F], F]:
+    """An option taking one of `choices`, shown as `--format {human,json,sarif}`, with
+    the message `invalid choice: 'xml' (choose from human, json, sarif)`; the choices
+    complete in the shell."""
+    def one_of(ctx: click.Context, param: click.Parameter, value: str) -> str:
+        if value not in choices:
+            raise click.BadParameter(
+                f"invalid choice: {value!r} (choose from {', '.join(choices)})", ctx, param)
+        return value
+
+    def complete(ctx: click.Context, param: click.Parameter,
+                 incomplete: str) -> list[CompletionItem]:
+        from click.shell_completion import CompletionItem
+
+        return [CompletionItem(choice) for choice in choices if choice.startswith(incomplete)]
+
+    return click.option(*names, callback=one_of, shell_complete=complete,
+                        metavar="{" + ",".join(choices) + "}", show_default=True, help=help,
+                        **settings)
+
+
+def at_least_one(ctx: click.Context, param: click.Parameter, value: str) -> int:
+    """An option's callback: a whole number, at least 1."""
+    try:
+        number = int(value)
+    except ValueError:
+        number = 0
+    if number < 1:
+        raise click.BadParameter(f"expected a whole number of at least 1, got {value!r}",
+                                 ctx, param)
+    return number
+
+
+# A path as given: the stages read it and report what is wrong in their own terms (E0100
+# for a source file), so click checks nothing; it completes file names in the shell.
+PATH = click.Path(readable=False, allow_dash=True)
+
+# Shared by the commands that report diagnostics.
+format_option = choice_option(
+    "--format", "output_format", choices=FORMATS, default="human",
+    help="human: text for people; json or sarif: for tools")
+color_option = choice_option(
+    "--color", choices=COLOR_CHOICES, default="auto",
+    help="colour the human format; auto: only on a terminal, and not if NO_COLOR is set")
