@@ -11,7 +11,6 @@ status) or `click.UsageError` (shown with the command's usage, status 2).
 from __future__ import annotations
 
 import os
-import shutil
 import sys
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, Any, TypeVar
@@ -44,6 +43,8 @@ class Context(click.Context):
     shutil finds it): click would stop at 80 columns, and at exactly 80 under CliRunner."""
 
     def make_formatter(self) -> click.HelpFormatter:
+        import shutil  # with bz2 and lzma, 2 ms of every start; only help needs it
+
         return click.HelpFormatter(width=max(shutil.get_terminal_size().columns - 2, 50))
 
 
