@@ -24,6 +24,7 @@ VERSION_MAJOR, VERSION_MINOR = 1, 0
 # magic, major, minor, flags, crc, header size, then the size of each section in order.
 # The debug section's size is a u32: one entry per instruction can pass 64 KiB.
 HEADER = struct.Struct("<4sBBHIHHHHI")
+FLAGS_OFFSET = 6
 CRC_OFFSET = 8  # the CRC-32 field; it counts as zero while the CRC is computed
 HANDLER_SIZE = 2 * len(HANDLER_LABELS)
 FEATURE_SIZE = 2
@@ -70,6 +71,7 @@ class Image:
     handlers: dict[int, int]  # handler label 96..99 -> code offset; absent labels left out
     features: frozenset[Feature]
     debug: DebugInfo | None = None
+    flags: int = 0  # the header's flag bits, kept so that a file reads back as it was
 
 
 @dataclass(frozen=True)
@@ -131,7 +133,9 @@ def encode(image: Image) -> bytes:
     handlers = _encode_handlers(image.handlers, len(image.code))
     features = struct.pack("<H", sum(1 << feature.value for feature in image.features))
     debug = b"" if image.debug is None else _encode_debug(image.debug)
-    header = HEADER.pack(MAGIC, VERSION_MAJOR, VERSION_MINOR, 0, 0, HEADER.size,
+    if not 0 <= image.flags <= 0xFFFF:
+        raise ValueError(f"flags 0x{image.flags:X} do not fit the 16-bit field")
+    header = HEADER.pack(MAGIC, VERSION_MAJOR, VERSION_MINOR, image.flags, 0, HEADER.size,
                          len(image.code), len(handlers), len(features), len(debug))
     data = bytearray(header + image.code + handlers + features + debug)
     struct.pack_into("<I", data, CRC_OFFSET, crc_of(bytes(data)))
@@ -199,13 +203,14 @@ def read(data: bytes) -> Container:
                              "the file is damaged, compile it again")
     unknown_required = header.flags & REQUIRED_FLAGS & ~KNOWN_FLAGS
     if unknown_required:
-        raise IlcFormatError(6, f"unknown required flag bits 0x{unknown_required:04X}: "
+        raise IlcFormatError(FLAGS_OFFSET, f"unknown required flag bits 0x{unknown_required:04X}: "
                              "the file needs a newer reader")
     code = data[header.code_start:header.handler_start]
     handlers = _decode_handlers(data, header)
     features = _decode_features(data, header.feature_start)
     debug, entry_offsets = (None, ()) if header.debug_size == 0 else _decode_debug(data, header)
-    return Container(header, Image(code, handlers, features, debug), entry_offsets)
+    return Container(header, Image(code, handlers, features, debug, header.flags),
+                     entry_offsets)
 
 
 def read_header(data: bytes) -> Header:

@@ -148,6 +148,7 @@ class _Assembler:
     fixups: list[tuple[int, _Token, int]] = field(default_factory=list)  # (pos, label, line)
     handler_targets: dict[int, tuple[_Token, int]] = field(default_factory=dict)
     features: frozenset[Feature] | None = None
+    flags: int | None = None
     source_name: str | None = None
     current_line: int | None = None
     entries: list[tuple[int, int]] = field(default_factory=list)
@@ -158,6 +159,7 @@ class _Assembler:
     handler_origins: dict[int, tuple[int, int]] = field(default_factory=dict)
     entry_origins: list[tuple[int, int]] = field(default_factory=list)
     features_origin: tuple[int, int] = (1, 1)
+    flags_origin: tuple[int, int] = (1, 1)
     line_origin: tuple[int, int] = (1, 1)
 
     def line(self, number: int, text: str) -> None:
@@ -205,6 +207,11 @@ class _Assembler:
                 names.append(cursor.next())
             self.features = frozenset(self.feature(name) for name in names)
             self.features_origin = position
+        elif token.text == ".flags":
+            if self.flags is not None:
+                raise _LineError(token.column, ".flags is given twice")
+            self.flags = _number(cursor.next(), 0, 0xFFFF, "flags")
+            self.flags_origin = position
         elif token.text == ".handler":
             label = _number(cursor.next(), HANDLER_LABELS.start, HANDLER_LABELS.stop - 1,
                             "handler label")
@@ -226,7 +233,7 @@ class _Assembler:
             self.line_directive(token, cursor, position)
         else:
             raise _LineError(token.column, f"unknown directive {token.text}: the directives "
-                                           "are .features, .handler, .source and .line")
+                                           "are .features, .flags, .handler, .source and .line")
 
     @staticmethod
     def feature(token: _Token) -> Feature:
@@ -347,7 +354,7 @@ class _Assembler:
         debug = None if self.source_name is None else ilc.DebugInfo(self.source_name,
                                                                      tuple(self.entries))
         features = self.features if self.features is not None else self.needed_features()
-        return ilc.Image(bytes(self.code), handlers, features, debug)
+        return ilc.Image(bytes(self.code), handlers, features, debug, self.flags or 0)
 
     def needed_features(self) -> frozenset[Feature]:
         needed = set()
@@ -360,6 +367,8 @@ class _Assembler:
 
     def origin_of(self, data: bytes, offset: int) -> tuple[int, int]:
         """The text position of what put file byte `offset` in the assembled file."""
+        if offset == ilc.FLAGS_OFFSET:
+            return self.flags_origin
         container = ilc.read(data)
         header = container.header
         if header.code_start <= offset < header.handler_start:

@@ -35,6 +35,8 @@ def disassemble(data: bytes, name: str, find_source: SourceLookup = lambda _: No
     image = program.image
     source_lines = None if image.debug is None else find_source(image.debug.source_name)
     out = [*_header_comments(header, name, len(data)), _features(image.features)]
+    if image.flags:
+        out.append(f".flags ${image.flags:04X}")
     out += [f".handler {label} "
             + (label_name(image.handlers[label]) if label in image.handlers else "none")
             for label in HANDLER_LABELS]

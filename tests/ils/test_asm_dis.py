@@ -49,6 +49,19 @@ def test_assembling_the_disassembly_gives_the_same_bytes(
     assert assemble(text) == data
 
 
+def test_optional_flags_survive_dis_and_asm_and_unknown_required_ones_are_refused() -> None:
+    data = assemble(".flags $8100\nEND\n")
+    assert ilc.read_header(data).flags == 0x8100
+    text = disassemble(data, "x.ilc")
+    assert ".flags $8100" in text.splitlines()
+    assert assemble(text) == data
+    with pytest.raises(AsmError) as refused:
+        assemble("END\n.flags 1\n")
+    (problem,) = refused.value.problems
+    assert (problem.line, problem.column) == (2, 1)
+    assert "unknown required flag bits 0x0001" in problem.message
+
+
 
 
 @pytest.mark.parametrize("strip", [False, True])

@@ -3,6 +3,7 @@ rules, and every refusal of `decode` with the file offset it points at."""
 
 from __future__ import annotations
 
+import dataclasses
 import struct
 
 import pytest
@@ -46,7 +47,7 @@ def test_decode_inverts_encode(image: ilc.Image) -> None:
     data = ilc.encode(image)
     assert ilc.decode(data) == image
     stripped = ilc.decode(ilc.encode(ilc.strip_debug(image)))
-    assert stripped == ilc.Image(image.code, image.handlers, image.features, None)
+    assert stripped == ilc.Image(image.code, image.handlers, image.features, None, image.flags)
 
 
 def test_strip_debug_leaves_an_empty_debug_section() -> None:
@@ -86,11 +87,13 @@ def test_a_newer_major_version_is_refused() -> None:
     assert "version 2.0 is not supported" in error.message
 
 
-def test_an_unknown_required_flag_is_refused_an_optional_one_ignored() -> None:
+def test_an_unknown_required_flag_is_refused_an_optional_one_kept() -> None:
     data = ilc.encode(SAMPLE)
     error = refusal(patched(data, 6, "<H", 0x0004))
     assert (error.offset, "required flag" in error.message) == (6, True)
-    assert ilc.decode(patched(data, 6, "<H", 0x0100)) == SAMPLE
+    flagged = patched(data, 6, "<H", 0x0100)
+    assert ilc.decode(flagged) == dataclasses.replace(SAMPLE, flags=0x0100)
+    assert ilc.encode(ilc.decode(flagged)) == flagged
 
 
 # --- refusals ------------------------------------------------------------------------
