@@ -10,6 +10,7 @@ status) or `click.UsageError` (shown with the command's usage, status 2).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
 from collections.abc import Callable, Sequence
@@ -80,17 +81,29 @@ class Command(click.Command):
         except Failure as failure:
             print(failure, file=sys.stderr)
             return failure.status
-        except BrokenPipeError:
-            # The reader stopped early (`rl1c dis x.ilc | head`): end quietly. What is
-            # left in the buffer goes to /dev/null, or Python would fail again flushing
-            # it at exit.
-            devnull = os.open(os.devnull, os.O_WRONLY)
-            os.dup2(devnull, sys.stdout.fileno())
-            return EXIT_ERRORS
+        except OSError as error:
+            if error.filename is not None:  # a file a command forgot to guard: a bug
+                return internal_error(error)
+            return output_failed(error)
         except KeyboardInterrupt:
             return interrupted()
         except Exception as error:
             return internal_error(error)
+
+
+def output_failed(error: OSError) -> int:
+    """Standard output could not be written. A closed pipe (`rl1c dis x.ilc | head`) ends
+    quietly with status 1; anything else (a full disk) is said in one line, status 2.
+    What is left in the buffer goes to /dev/null, or Python would fail again flushing it
+    at exit."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, sys.stdout.fileno())
+    if isinstance(error, BrokenPipeError):
+        return EXIT_ERRORS
+    with contextlib.suppress(OSError):  # standard error may be just as full
+        print(f"rl1c: error: cannot write the output: {error.strerror or error}; "
+              "free some space or write elsewhere", file=sys.stderr)
+    return EXIT_USAGE
 
 
 def interrupted() -> int:

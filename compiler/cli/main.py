@@ -24,7 +24,14 @@ import click
 from rl1.compiler.reporting.render import EXIT_USAGE
 
 from . import build, source
-from .command import CONTEXT_SETTINGS, Context, internal_error, interrupted, write_usage
+from .command import (
+    CONTEXT_SETTINGS,
+    Context,
+    internal_error,
+    interrupted,
+    output_failed,
+    write_usage,
+)
 
 # The commands, by the section of `rl1c --help` that lists them.
 SECTIONS: tuple[tuple[str, Sequence[click.Command]], ...] = (
@@ -101,6 +108,8 @@ class Toolchain(click.Group):
             status = error.exit_code
         except click.Abort:  # Ctrl-C while click reads the command line
             status = interrupted()
+        except OSError as error:  # writing --help or --version failed
+            status = output_failed(error) if error.filename is None else internal_error(error)
         except Exception as error:
             status = internal_error(error)
         if standalone_mode:
