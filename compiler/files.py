@@ -38,14 +38,39 @@ def read_bounded(path: str | os.PathLike[str], limit: int, what: str) -> bytes:
     return data
 
 
-def write_atomically(path: str | Path, data: bytes) -> None:
-    """Replace the file at `path` with `data`; OSError if that cannot be done."""
+class NotReplaceable(OSError):
+    """An output that must not be replaced: a read-only file, or something that is not a
+    regular file (a directory, a socket, a block device). The message says why."""
+
+
+def write_atomically(path: str | Path, data: bytes, *, force: bool = False) -> None:
+    """Put `data` at `path`; OSError (NotReplaceable among them) if that cannot be done.
+
+    A regular file is replaced all at once: the data goes to a temporary file beside it
+    that is then renamed over it, so no reader ever sees half of it and a failure leaves
+    the old file as it was. A symbolic link is followed, so the link stays a link. A FIFO
+    or a character device (`/dev/stdout`, `/dev/null`) is written as a stream, never
+    replaced. A read-only file is refused unless `force`: a rename ignores the file's
+    own mode, and so does root."""
     # Imported here: tempfile (with shutil and the compression modules it loads) costs
     # rl1c check, which reads files but writes none, 3 ms of every start.
     import tempfile
 
-    path = Path(path)
-    mode = _mode_for(path)
+    path = Path(os.path.realpath(path))
+    try:
+        status: os.stat_result | None = path.stat()
+    except FileNotFoundError:
+        status = None
+    if status is not None and not stat.S_ISREG(status.st_mode):
+        if stat.S_ISFIFO(status.st_mode) or stat.S_ISCHR(status.st_mode):
+            with open(path, "wb") as stream:
+                stream.write(data)
+            return
+        kind = "a directory" if stat.S_ISDIR(status.st_mode) else "not a regular file"
+        raise NotReplaceable(f"it is {kind}")
+    if status is not None and not force and _read_only(path, status):
+        raise NotReplaceable("it is read-only; give --force to replace it anyway")
+    mode = stat.S_IMODE(status.st_mode) if status is not None else _new_file_mode()
     descriptor, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.",
                                              suffix=".tmp")
     try:
@@ -61,12 +86,14 @@ def write_atomically(path: str | Path, data: bytes) -> None:
         raise
 
 
-def _mode_for(path: Path) -> int:
-    """A replaced file keeps its permissions; a new one gets the usual ones (mkstemp's
-    are owner-only)."""
-    try:
-        return stat.S_IMODE(path.stat().st_mode)
-    except FileNotFoundError:
-        umask = os.umask(0)
-        os.umask(umask)
-        return 0o666 & ~umask
+def _read_only(path: Path, status: os.stat_result) -> bool:
+    """No write permission bit at all (`chmod 444`), or none for this user."""
+    writable_bits = stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH
+    return not status.st_mode & writable_bits or not os.access(path, os.W_OK)
+
+
+def _new_file_mode() -> int:
+    """The usual permissions of a new file (mkstemp's are owner-only)."""
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask

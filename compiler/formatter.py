@@ -9,7 +9,6 @@ range formatting (`format_lines`) and the whole-document form (`format_text`) ag
 from __future__ import annotations
 
 import difflib
-import os
 
 from .files import write_atomically
 from .frontend import ast
@@ -124,11 +123,10 @@ def encode_like(source: Source, text: str, *, bom: bool) -> bytes:
     return (_UTF8_BOM if bom else b"") + text.encode(source.encoding)
 
 
-def rewrite(source: Source, text: str) -> None:
+def rewrite(source: Source, text: str, *, force: bool = False) -> None:
     """Replace the file `source` was read from with `text`, in the file's own encoding
-    (keeping a UTF-8 byte-order mark), atomically. A symbolic link is followed, so the
-    link stays a link. OSError if that cannot be done."""
-    path = os.path.realpath(source.name)
-    with open(path, "rb") as original:
+    (keeping a UTF-8 byte-order mark), as files.write_atomically does (a read-only file
+    only with `force`). OSError if that cannot be done."""
+    with open(source.name, "rb") as original:
         bom = original.read(len(_UTF8_BOM)) == _UTF8_BOM
-    write_atomically(path, encode_like(source, text, bom=bom))
+    write_atomically(source.name, encode_like(source, text, bom=bom), force=force)

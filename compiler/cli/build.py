@@ -26,6 +26,7 @@ from .command import (
     at_least_one,
     choice_option,
     color_option,
+    force_option,
     format_option,
 )
 from .streams import (
@@ -62,10 +63,12 @@ DEFAULT_BUDGET = 10_000_000
                help="ilc: the .ilc file; ir: the IR as text")
 @click.option("-O", "optimize", default="0", metavar="LEVEL",
               help="optimization level; only -O0 (none) exists so far")
+@force_option
 @format_option
 @color_option
 def compile_program(file: str, output: str | None, strip: bool, emit_kind: Emit,
-                    optimize: str, output_format: Format, color: ColorChoice) -> int:
+                    optimize: str, force: bool, output_format: Format,
+                    color: ColorChoice) -> int:
     """Compile an RL/I program: `rl1c FILE.rob -o FILE.ilc`.
 
     FILE is the RL/I program; `-` reads standard input. Diagnostics go to standard
@@ -94,7 +97,7 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: Emit,
     if compilation.output is None:
         return status
     if target != "-":
-        write_file(target, compilation.output)
+        write_file(target, compilation.output, force=force)
     elif emit_kind == "ilc" and sys.stdout.isatty():
         raise click.UsageError("an .ilc file is binary and standard output is a "
                                "terminal: redirect it, or give -o FILE.ilc")
@@ -193,7 +196,8 @@ def dis(file: str) -> int:
 @click.option("-o", "--output", metavar="PATH", type=PATH,
               help="where to write the .ilc file; `-` is standard output. "
                    "Default: FILE.ilc beside the .ils file")
-def assemble_file(file: str, output: str | None) -> int:
+@force_option
+def assemble_file(file: str, output: str | None, force: bool) -> int:
     """Assemble .ils text (as `rl1c dis` prints it) into an .ilc file.
 
     The result must pass the verifier. Exit status: 0 written, 1 errors in the text
@@ -217,7 +221,7 @@ def assemble_file(file: str, output: str | None) -> int:
     if target == "-":
         write_stdout_bytes(data)
     else:
-        write_file(target, data)
+        write_file(target, data, force=force)
     return 0
 
 

@@ -176,3 +176,9 @@ format_option = choice_option(
 color_option = choice_option(
     "--color", choices=COLOR_CHOICES, default="auto",
     help="colour the human format; auto: only on a terminal, and not if NO_COLOR is set")
+
+
+force_option = click.option(
+    "--force", is_flag=True,
+    help="replace an output file even when it is read-only (a device or a FIFO is "
+         "written to, never replaced)")

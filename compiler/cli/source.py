@@ -15,7 +15,7 @@ from rl1.compiler.frontend.source import Source
 from rl1.compiler.reporting.catalogue import CODES
 from rl1.compiler.reporting.render import EXIT_ERRORS, EXIT_USAGE, FileDiagnostics
 
-from .command import PATH, Command, Failure, color_option, format_option
+from .command import PATH, Command, Failure, color_option, force_option, format_option
 from .streams import emit, read_input, write_stdout_bytes
 
 if TYPE_CHECKING:  # names that exist for the type checker only
@@ -54,7 +54,8 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice) -> 
               help="change nothing; list the files formatting would change (exit status 1)")
 @click.option("--diff", is_flag=True,
               help="change nothing; print what formatting would change as a unified diff")
-def fmt(files: tuple[str, ...], check: bool, diff: bool) -> int:
+@force_option
+def fmt(files: tuple[str, ...], check: bool, diff: bool, force: bool) -> int:
     """Put RL/I programs in the canonical layout (spec/language.md, section 11).
 
     Each FILE is rewritten in place in its own encoding; `-` formats standard input to
@@ -82,7 +83,7 @@ def fmt(files: tuple[str, ...], check: bool, diff: bool) -> int:
             write_stdout_bytes(formatter.encode_like(source, formatted, bom=False))
         elif changed:
             try:
-                formatter.rewrite(source, formatted)
+                formatter.rewrite(source, formatted, force=force)
             except OSError as error:
                 print(f"error: cannot write `{name}`: {error.strerror or error}",
                       file=sys.stderr)

@@ -60,10 +60,11 @@ def write_stdout_bytes(data: bytes) -> None:
     sys.stdout.buffer.flush()
 
 
-def write_file(target: str, data: bytes) -> None:
-    """Writes `target` atomically; a Failure (exit status 2) saying why it cannot be."""
+def write_file(target: str, data: bytes, *, force: bool = False) -> None:
+    """Writes `target` as files.write_atomically does (a read-only file only with
+    `force`); a Failure (exit status 2) saying why it cannot be."""
     try:
-        write_atomically(target, data)
+        write_atomically(target, data, force=force)
     except OSError as error:
         raise Failure(f"error: cannot write `{target}`: {error.strerror or error}") from None
 

@@ -291,7 +291,7 @@ def test_fmt_keeps_a_byte_order_mark_and_follows_a_symbolic_link(tmp_path: Path)
 
 def test_fmt_reports_a_file_it_cannot_write(tmp_path: Path,
                                            monkeypatch: pytest.MonkeyPatch) -> None:
-    def disk_full(path: object, data: bytes) -> None:
+    def disk_full(path: object, data: bytes, *, force: bool = False) -> None:
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
     monkeypatch.setattr(formatter, "write_atomically", disk_full)
