@@ -156,7 +156,7 @@ async def main() -> None:
     await session.start()
     opened = await session.open(URI, text)
     editor = Editor(session, text)
-    middle = options.lines // 2
+    middle: int = options.lines // 2
 
     def plain_line() -> int:
         """A line near the middle that starts with a statement (no label, no indent)."""
@@ -190,7 +190,8 @@ async def main() -> None:
                for index in range(5)]
     await session.stop()
 
-    print(f"{options.lines} lines of Listing 1; didOpen -> first diagnostics {opened * 1000:.0f} ms")
+    print(f"{options.lines} lines of Listing 1; didOpen -> first diagnostics "
+          f"{opened * 1000:.0f} ms")
     print("didChange -> publishDiagnostics of that version:")
     for kind, seconds in times.items():
         summary(kind, seconds, goal=kind in ("line inserted at the top",
