@@ -85,19 +85,6 @@ def reserved_writes(call: ast.Call) -> int:
     return _facts(call).writes
 
 
-def relocated(segments: tuple[Segment, ...], statements: tuple[ast.Statement, ...]
-              ) -> tuple[Segment, ...]:
-    """The segments of a line moved elsewhere (ast.relocate), whose `statements` are
-    those of the segments' line, moved: only the statements change."""
-    moved: list[Segment] = []
-    start = 0
-    for segment in segments:
-        end = start + len(segment[0])
-        moved.append((statements[start:end], segment[1], segment[2]))
-        start = end
-    return tuple(moved)
-
-
 def combine(parts: list[tuple[int, BlockEffects]]) -> BlockEffects:
     """The effects of a block from those of its runs, each with the index in the block
     of its first statement. Summaries are shared, never changed, so one run's is reused

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from rl1.compiler.frontend import ast
 
 from .blocks import Part, Segments, Walk, cut, cut_again
-from .effects import BlockEffects, combine, line_segments, relocated
+from .effects import BlockEffects, combine, line_segments
 
 
 class LineMemo:
@@ -30,12 +30,6 @@ class LineMemo:
         self._entries: dict[int, tuple[ast.Line, Segments]] = {}
         self._blocks: dict[tuple[Part, ...], BlockEffects] = {}  # the last check's
         self.last_walk: Walk | None = None  # how the last check cut its program
-
-    def moved(self, old: ast.Line, new: ast.Line) -> None:
-        """`new` is `old` relocated (ast.relocate): it has the same segments."""
-        entry = self._entries.pop(id(old), None)
-        if entry is not None and entry[0] is old:
-            self._entries[id(new)] = (new, relocated(entry[1], new.statements))
 
     def cut(self, lines: tuple[ast.Line, ...]) -> tuple[Walk, list[BlockEffects]]:
         """The cut of `lines` into blocks, and the effects of each block but the exit."""
