@@ -14,6 +14,7 @@ lines both have, may take the rest of its blocks from that cut.
 from __future__ import annotations
 
 import bisect
+import operator
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
@@ -74,19 +75,21 @@ def cut_again(lines: tuple[ast.Line, ...], last: Walk, segments_of: SegmentsOf) 
     after the last one that `last` shares."""
     old = last.lines
     shortest = min(len(old), len(lines))
-    same_start = 0
-    while same_start < shortest and old[same_start] is lines[same_start]:
-        same_start += 1
-    same_end = 0
-    while (same_end < shortest - same_start
-           and old[len(old) - 1 - same_end] is lines[len(lines) - 1 - same_end]):
-        same_end += 1
+    same_start = _same_run(old, lines)
+    same_end = min(_same_run(old[::-1], lines[::-1]), shortest - same_start)
     restart = bisect.bisect_right(last.restarts, (same_start, len(last.cuts))) - 1
     if restart < 0:
         return cut(lines, segments_of)
     start, cuts_before = last.restarts[restart]
     return _cut(lines, start, last.cuts[:cuts_before], last.restarts[:restart], segments_of,
                 (last, len(lines) - same_end))
+
+
+def _same_run(old: tuple[ast.Line, ...], new: tuple[ast.Line, ...]) -> int:
+    """How many lines the two start with that are the same objects (compared in C: the
+    server's documents have 10,000 lines, and an edit changes one or two)."""
+    same = list(map(operator.is_, old, new))
+    return same.index(False) if False in same else len(same)
 
 
 def _cut(lines: tuple[ast.Line, ...], start: int, cuts: list[Cut],

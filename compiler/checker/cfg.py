@@ -38,8 +38,10 @@ def _with_edges(cuts: list[Cut], summaries: list[BlockEffects]) -> ControlFlowGr
     ordinary edges (everything but the handler edges)."""
     blocks: list[Block] = []
     labels: dict[int, int] = {}  # label number -> the block its first definition names
+    nothing = BlockEffects.nothing()  # never changed, so one does for all empty blocks
     for index, block_cut in enumerate(cuts):
-        blocks.append(Block(index, block_cut.statements, block_cut.labels, block_cut.opaque))
+        blocks.append(Block(index, block_cut.statements, block_cut.labels, block_cut.opaque,
+                            [], [], nothing))
         for label in block_cut.labels:
             if label.number is not None:
                 labels.setdefault(label.number, index)

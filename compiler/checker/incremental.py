@@ -11,7 +11,7 @@ comes.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 from rl1.compiler.frontend import ast
 
@@ -41,16 +41,15 @@ class LineMemo:
         self._forget_all_but(lines)
         return walk, self._block_effects([block.parts for block in walk.cuts[:-1]])
 
-    def segments_of(self, lines: Sequence[ast.Line]) -> list[Segments]:
-        """The segments of each line, computing those of lines not seen before."""
+    def segments_of(self, lines: Sequence[ast.Line]) -> Iterator[Segments]:
+        """The segments of each line, computing those of lines not seen before; lazily,
+        as the cutter stops as soon as it meets the last cut again."""
         entries = self._entries
-        found = []
         for line in lines:
             entry = entries.get(id(line))
             if entry is None or entry[0] is not line:
                 entry = entries[id(line)] = (line, line_segments(line.statements))
-            found.append(entry[1])
-        return found
+            yield entry[1]
 
     def _forget_all_but(self, lines: tuple[ast.Line, ...]) -> None:
         """Drop the entries of lines no longer in the program, once they are most."""
