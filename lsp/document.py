@@ -2,10 +2,11 @@
 
 RL/I is line-oriented, so an edit re-parses and re-checks (the checker's per-line rules)
 only the lines whose text it changes. A cached line keeps the AST it was parsed with and
-its diagnostics; when an edit above it moves it, it is
-relocated to its new line number the next time it is asked for (`ast.relocate`), which
-costs far less than parsing it again. Lines end with LF, CRLF or a lone CR, as LSP
-counts them; the last line has no ending and may be empty.
+its diagnostics, all of whose spans refer to the line's `ast.Row`: when an edit above
+inserts or deletes lines, the rows below are renumbered, which moves every node and
+diagnostic on them at the cost of one store per line. The lines keep their identity, so
+the checker's memo (incremental.py) knows them again. Lines end with LF, CRLF or a lone
+CR, as LSP counts them; the last line has no ending and may be empty.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from lsprotocol import types
 from rl1.compiler.checker import LineMemo, check_line
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.collector import collector_paused
-from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Related
+from rl1.compiler.frontend.diagnostics import Diagnostic
 from rl1.compiler.frontend.parser import parse_line
 from rl1.compiler.frontend.source import LINE_BREAK
 
@@ -42,8 +43,9 @@ characters): a line is parsed whole at each edit, and a megabyte line takes seco
 @dataclass(slots=True)
 class CachedLine:
     text: str
+    row: ast.Row  # the line's number, shared by the spans of `parsed` and `problems`
     parsed: ast.Line | None = None  # None until first asked for
-    problems: tuple[Diagnostic, ...] = ()  # the line's own diagnostics, numbered like `parsed`
+    problems: tuple[Diagnostic, ...] = ()  # the line's own diagnostics
 
 
 def _split(text: str) -> tuple[list[str], list[str]]:
@@ -52,27 +54,15 @@ def _split(text: str) -> tuple[list[str], list[str]]:
     return parts[0::2], [*parts[1::2], ""]
 
 
-def _move_diagnostic(diagnostic: Diagnostic, line: int) -> Diagnostic:
-    """A one-line diagnostic moved, with its fixes and related spans, to `line`."""
-    return Diagnostic(
-        diagnostic.code, diagnostic.severity, diagnostic.message,
-        diagnostic.span.on_line(line), diagnostic.help,
-        tuple(
-            Fix(fix.title, tuple(Edit(edit.span.on_line(line), edit.text) for edit in fix.edits))
-            for fix in diagnostic.fixes
-        ),
-        tuple(Related(r.span.on_line(line), r.message) for r in diagnostic.related),
-    )
-
-
 class Document:
     def __init__(self, uri: str, text: str, version: int) -> None:
         self.uri = uri
         self.version = version
         texts, self._endings = _split(text)
-        self._lines = [CachedLine(line) for line in texts]
-        # Lines [_stale_low, _stale_high) may be unparsed or numbered for another place;
-        # the others are ready, so preparing the program after a small edit skips them.
+        self._lines = [CachedLine(line, ast.Row(number))
+                       for number, line in enumerate(texts, start=1)]
+        # Lines [_stale_low, _stale_high) may be unparsed; the others are ready, so
+        # preparing the program after a small edit skips them.
         self._stale_low, self._stale_high = 0, len(self._lines)
         self._size = len(text)
         self._long_lines = sum(len(line) > MAX_ANALYSED_LINE for line in texts)
@@ -164,43 +154,51 @@ class Document:
         while (same_end < min(len(old), len(texts)) - same_start
                and old[-1 - same_end].text == texts[-1 - same_end]):
             same_end += 1
-        middle = [CachedLine(text) for text in texts[same_start : len(texts) - same_end]]
+        middle = [CachedLine(text, ast.Row(0))  # numbered below
+                  for text in texts[same_start : len(texts) - same_end]]
         kept_end = old[len(old) - same_end :] if same_end else []
         removed = sum(len(line.text) for line in old) + sum(map(len, self._endings[low:high]))
         self._long_lines += (sum(len(text) > MAX_ANALYSED_LINE for text in texts)
                              - sum(len(line.text) > MAX_ANALYSED_LINE for line in old))
         self._lines[low:high] = old[:same_start] + middle + kept_end
         self._endings[low:high] = endings
-        # Lines below the window moved when it changed size: they need relocating.
-        stale_high = low + len(texts) if len(texts) == high - low else len(self._lines)
-        self._stale_low = min(self._stale_low, low)
-        self._stale_high = min(max(self._stale_high, stale_high), len(self._lines))
+        # Number the new lines, and those below the window when it changed size.
+        renumber_to = low + len(texts) if len(texts) == high - low else len(self._lines)
+        for number in range(low + same_start, renumber_to):
+            self._lines[number].row.number = number + 1
+        # The window of unparsed lines: an earlier one moves with the lines below this
+        # edit, and takes in the new lines.
+        moved_by = len(texts) - (high - low)
+        if self._stale_low < self._stale_high:
+            if self._stale_low >= high:
+                self._stale_low += moved_by
+            else:
+                self._stale_low = min(self._stale_low, low)
+            if self._stale_high > low:
+                self._stale_high = max(self._stale_high + moved_by, low + len(texts))
+        if middle:
+            self._stale_low = min(self._stale_low, low + same_start)
+            self._stale_high = max(self._stale_high, low + same_start + len(middle))
+        self._stale_high = min(self._stale_high, len(self._lines))
         self._size += sum(map(len, texts)) + sum(map(len, endings)) - removed
 
     # Syntax -------------------------------------------------------------------------
 
     def line(self, number: int) -> ast.Line:
-        """The AST of 1-based line `number`, parsing or relocating it if need be."""
+        """The AST of 1-based line `number`, parsing it if need be."""
         cached = self._lines[number - 1]
         if cached.parsed is None:
-            cached.parsed, problems = parse_line(cached.text, number)
+            cached.parsed, problems = parse_line(cached.text, cached.row)
             cached.problems = (*problems, *check_line(cached.parsed))
-        elif cached.parsed.number != number:
-            moved = ast.relocate(cached.parsed, number)
-            assert isinstance(moved, ast.Line)
-            self.memo.moved(cached.parsed, moved)
-            cached.parsed = moved
-            cached.problems = tuple(_move_diagnostic(d, number) for d in cached.problems)
         return cached.parsed
 
     def prepare(self, first: int, last: int) -> None:
-        """Parse or relocate lines `first`..`last` (1-based, inclusive) now, so that a
-        caller can spread the work of a large change between other tasks."""
+        """Parse lines `first`..`last` (1-based, inclusive) now, so that a caller can
+        spread the work of a large change between other tasks."""
         low, high = max(first, self._stale_low + 1), min(last, self._stale_high)
         with collector_paused():
             for number in range(low, high + 1):
-                cached = self._lines[number - 1]
-                if cached.parsed is None or cached.parsed.number != number:
+                if self._lines[number - 1].parsed is None:
                     self.line(number)
         if low <= high and low == self._stale_low + 1:
             self._stale_low = high  # the stale window now starts below what was done
@@ -208,13 +206,13 @@ class Document:
             self._stale_low, self._stale_high = len(self._lines), 0
 
     def unprepared(self) -> range:
-        """The 1-based numbers of the lines an edit may have left unparsed or moved
-        (prepare() makes them ready); the others are ready already."""
+        """The 1-based numbers of the lines an edit may have left unparsed (prepare()
+        makes them ready); the others are ready already."""
         return range(self._stale_low + 1, min(self._stale_high, self.program_lines()) + 1)
 
     def problems(self) -> list[Diagnostic]:
         """The diagnostics of every line alone, in line order."""
-        self.program()  # parses and relocates what needs it
+        self.program()  # parses what needs it
         return [problem for cached in self._lines if cached.problems
                 for problem in cached.problems]
 

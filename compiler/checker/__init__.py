@@ -1,5 +1,5 @@
 """The static checker: the per-line rules (lines.py), then the whole-program rules over
-the control-flow graph (cfg.py) and the data-flow analyses on it."""
+the control-flow graph (graph.py, built by cfg.py) and the data-flow analyses on it."""
 
 from __future__ import annotations
 
@@ -7,8 +7,10 @@ from rl1.compiler.frontend.ast import Program
 from rl1.compiler.frontend.collector import collector_paused
 from rl1.compiler.frontend.diagnostics import Diagnostic
 
-from .cfg import ControlFlowGraph, LineMemo, build_cfg
+from .cfg import build_cfg
+from .graph import ControlFlowGraph
 from .handlers import check_handlers
+from .incremental import LineMemo
 from .labels import check_labels
 from .lines import check_line
 from .loops import check_loops

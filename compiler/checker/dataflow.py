@@ -10,9 +10,7 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Callable, Iterable
 
-TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
-if TYPE_CHECKING:
-    from .cfg import ControlFlowGraph
+from .graph import ControlFlowGraph
 
 # transfer(block index, state on entry) -> (state at its end, extra (block, state) edges)
 Transfer = Callable[[int, int], tuple[int, Iterable[tuple[int, int]]]]

@@ -1,6 +1,7 @@
 """What the vehicle may be doing at each point of a program: the tracing mode in effect
-and the motion. One forward data-flow over the CFG gives both, and from them the
-lost-line handler edges: where a lost guidance line can send the program.
+and the motion, as a bitset state, and what each call and each block does to it.
+handler_edges.py runs it as a forward data-flow over the CFG, which gives both, and from
+them the lost-line handler edges: where a lost guidance line can send the program.
 
 The model (spec/language.md 7.5 and 7.7):
 - the program starts in tracing mode 0 with the vehicle stopped; `(TRC m)` sets the
@@ -26,12 +27,6 @@ from __future__ import annotations
 
 from rl1.compiler.frontend import ast
 from rl1.vm.language import LOST_LINE_RULES
-
-from . import dataflow
-
-TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
-if TYPE_CHECKING:
-    from .cfg import ControlFlowGraph
 
 ALL_MODES = 0b1111
 STOPPED = 1 << 4
@@ -140,22 +135,3 @@ def _lost_line(recorded: tuple[int, ...], now: int, from_mvi: bool, index: int,
             entry = now
         first, entries = triggers.get(rule.label, (index, 0))
         triggers[rule.label] = (first, entries | entry)
-
-
-def trace(graph: ControlFlowGraph) -> tuple[list[int], list[Triggers]]:
-    """The state on entry to every block (0: unreachable) and, per block, the handlers a
-    lost line may jump to from it."""
-    blocks = graph.blocks
-    triggers: list[Triggers] = [{} for _ in blocks]
-
-    def transfer(index: int, state: int) -> tuple[int, list[tuple[int, int]]]:
-        block = blocks[index]
-        if block.opaque:
-            return START, []
-        # A block's last visit is with its final state, so its last triggers are final.
-        effects = block.effects
-        out, triggers[index] = run(effects.operations, effects.first_event, state)
-        return out, [(graph.labels[label], entry)
-                     for label, (_, entry) in triggers[index].items() if label in graph.labels]
-
-    return dataflow.solve(graph, START, transfer), triggers

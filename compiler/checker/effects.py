@@ -13,9 +13,9 @@ taken to do what any of their forms does: the summary never resolves selectors.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 from rl1.compiler.frontend import ast
-from rl1.compiler.frontend.record import Record
 from rl1.vm.language import BUILTINS, RESERVED_VARIABLES
 
 from . import device
@@ -24,22 +24,19 @@ RESERVED_BIT = {name: 1 << index for index, name in enumerate(RESERVED_VARIABLES
 ALL_RESERVED = (1 << len(RESERVED_VARIABLES)) - 1
 
 
+@dataclass(slots=True, eq=False)
 class BlockEffects:
     """What a block (or a run of statements) does. Shared, never changed, and equal only
-    to itself: a memo key."""
+    to itself: a memo key (incremental.py)."""
 
-    __slots__ = ("operations", "first_event", "reads", "writes", "observes")
-
-    def __init__(self, operations: list[device.Operation], first_event: int | None,
-                 reads: int, writes: list[tuple[int, int, int]], observes: bool) -> None:
-        self.operations = operations  # the calls that change the device state
-        # The first event point, where a pending lost line is taken: the first statement
-        # that makes a call (right after it, before an assignment stores) or jumps.
-        self.first_event = first_event
-        self.reads = reads  # reserved variables read anywhere in the block (RESERVED_BIT bits)
-        # (statement index, reserved variables its calls write, those its store writes)
-        self.writes = writes
-        self.observes = observes
+    operations: list[device.Operation]  # the calls that change the device state
+    # The first event point, where a pending lost line is taken: the first statement
+    # that makes a call (right after it, before an assignment stores) or jumps.
+    first_event: int | None
+    reads: int  # reserved variables read anywhere in the block (RESERVED_BIT bits)
+    # (statement index, reserved variables its calls write, those its store writes)
+    writes: list[tuple[int, int, int]]
+    observes: bool
 
     @staticmethod
     def nothing() -> BlockEffects:
@@ -52,16 +49,11 @@ class BlockEffects:
 Segment = tuple[tuple[ast.Statement, ...], BlockEffects | None, bool]
 
 
-class _CallFacts(Record):
-    __slots__ = ("writes", "observes", "device")
+@dataclass(frozen=True, slots=True)
+class _CallFacts:
     writes: int
     observes: bool
     device: bool  # whether device.operation may find something in it
-
-    def __init__(self, writes: int, observes: bool, device: bool) -> None:
-        self.writes = writes
-        self.observes = observes
-        self.device = device
 
 
 def _facts_of(name: str) -> _CallFacts:
@@ -93,19 +85,6 @@ def reserved_writes(call: ast.Call) -> int:
     return _facts(call).writes
 
 
-def relocated(segments: tuple[Segment, ...], statements: tuple[ast.Statement, ...]
-              ) -> tuple[Segment, ...]:
-    """The segments of a line moved elsewhere (ast.relocate), whose `statements` are
-    those of the segments' line, moved: only the statements change."""
-    moved: list[Segment] = []
-    start = 0
-    for segment in segments:
-        end = start + len(segment[0])
-        moved.append((statements[start:end], segment[1], segment[2]))
-        start = end
-    return tuple(moved)
-
-
 def combine(parts: list[tuple[int, BlockEffects]]) -> BlockEffects:
     """The effects of a block from those of its runs, each with the index in the block
     of its first statement. Summaries are shared, never changed, so one run's is reused
@@ -135,7 +114,7 @@ def combine(parts: list[tuple[int, BlockEffects]]) -> BlockEffects:
 def line_segments(statements: tuple[ast.Statement, ...]) -> tuple[Segment, ...]:
     """A line's statements cut after each jump and `(END)`, each run summarized. What a
     run does depends on its statements alone, not on the line's number, so the language
-    server keeps these across edits (cfg.LineMemo)."""
+    server keeps these across edits (incremental.LineMemo)."""
     segments: list[Segment] = []
     start = 0
     for index, statement in enumerate(statements):

@@ -12,8 +12,8 @@ from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity
 from rl1.vm.language import LOST_LINE_RULES
 
-from .cfg import ControlFlowGraph
 from .fixes import append_line
+from .graph import ControlFlowGraph
 
 HANDLER = "(MOV 0,0); (END)"  # what the fix's handler does: stop, then end
 

@@ -12,7 +12,7 @@ from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Related, Severity
 from rl1.vm.language import HANDLER_LABELS
 
-from .cfg import ControlFlowGraph
+from .graph import ControlFlowGraph
 
 
 def check_labels(graph: ControlFlowGraph) -> list[Diagnostic]:

@@ -162,7 +162,7 @@ def _arity(call: ast.Call, builtin: Builtin, form: Form, values: tuple[ast.Arg, 
     extra = values[expected].span.cover(values[-1].span)
     kept = values[expected - 1] if expected else (call.args[0] if form.selector else None)
     start = kept.span if kept is not None else call.mnemonic_span
-    removal = ast.Span(start.end_line, start.end_column, extra.end_line, extra.end_column)
+    removal = start.end_to_end_of(extra)  # on the line's row, so it moves with it
     return Diagnostic("E0503", E, message, extra, help=help_text,
                       fixes=(Fix("remove the extra arguments", (Edit(removal, ""),)),))
 

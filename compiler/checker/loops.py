@@ -14,7 +14,7 @@ from __future__ import annotations
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Related, Severity
 
-from .cfg import Block, ControlFlowGraph
+from .graph import Block, ControlFlowGraph
 from .scc import cycles
 
 HELP = ("read a sensor inside the loop (e.g. `A=(IMG)-180`, `(KYO)`, `A=(ULT A)`) or wait "

@@ -11,8 +11,8 @@ from __future__ import annotations
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity
 
-from .cfg import Block, ControlFlowGraph
 from .fixes import append_line
+from .graph import Block, ControlFlowGraph
 
 REMOVE_OR_LABEL = "remove it, or start its line with a label and jump there"
 

@@ -16,8 +16,8 @@ from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.vm.language import writers_of
 
 from . import dataflow
-from .cfg import ControlFlowGraph
 from .effects import ALL_RESERVED, RESERVED_BIT, reserved_writes
+from .graph import ControlFlowGraph
 
 OnRead = Callable[[ast.Var], None]
 

@@ -8,8 +8,8 @@ from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Severity
 
 from . import device
-from .cfg import ControlFlowGraph
 from .fixes import append_line
+from .graph import ControlFlowGraph
 from .reachability import fall_off_span
 
 HELP = ("`(END)` does not stop the motion a `(MOV)` started: stop the vehicle first with "

@@ -1,63 +1,123 @@
 """The RL/I abstract syntax tree: small value classes, separate from parsing.
 
-Every node carries a `Span`. Nodes are `Record`s (record.py), as pycparser's are plain
-classes: fields in `__slots__`, set once by `__init__`, compared and hashed by value; they
-are values, never changed after they are built. Lines are the unit of parsing (RL/I is
-line-oriented), so a `Line` can be re-parsed alone and moved to another line number with
-`relocate`. `walk` visits a tree in source order.
+Every node carries a `Span`. Nodes are dataclasses, values never changed after they are
+built. Lines are the unit of parsing (RL/I is line-oriented), so a `Line` can be parsed
+alone; its spans share one `Row`, the line's number, so that the language server moves
+a line (and every node and per-line diagnostic on it) by renumbering its row, without
+rebuilding anything. `walk` visits a tree in source order.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterator
-from types import UnionType
+from dataclasses import dataclass, fields
+from typing import Literal
 
-from .record import Record
-
-TYPE_CHECKING = False  # `typing` costs 4 ms of every start (record.py)
-if TYPE_CHECKING:
-    from typing import Any, Literal
-
-    BinaryOperator = Literal["+", "-", "&", "|", "^", "<", ">"]
-    Relation = Literal["=", ">", "<"]
-    Step = Literal["++", "--"]
+BinaryOperator = Literal["+", "-", "&", "|", "^", "<", ">"]
+Relation = Literal["=", ">", "<"]
+Step = Literal["++", "--"]
 
 
-class Span(Record):
+class Row:
+    """The number of a line that may move. Every span the parser makes on a line refers
+    to the line's row, so renumbering the row moves them all (the language server does
+    when an edit above inserts or deletes lines)."""
+
+    __slots__ = ("number",)
+
+    def __init__(self, number: int) -> None:
+        self.number = number
+
+    def __repr__(self) -> str:
+        return f"Row({self.number})"
+
+
+class Span:
     """A source range. Lines and columns are 1-based; columns count code points and
-    `end_column` is exclusive (one past the last character), as in SARIF."""
+    `end_column` is exclusive (one past the last character), as in SARIF.
 
-    __slots__ = ("line", "column", "end_line", "end_column")
-    line: int
-    column: int
-    end_line: int
-    end_column: int
+    `Span(line, column, end_line, end_column)` with numbers makes a span of its own;
+    with a `Row` for both lines it is a one-line span on that row, whose lines follow
+    the row. A hand-written class rather than a dataclass: it takes either form, its
+    lines are read through the row, and it is the parser's commonest object, built
+    faster by a plain `__init__` than by a frozen dataclass's. Compared and hashed by
+    the lines and columns it has now: a span on a row must not be a dict key while its
+    row may be renumbered."""
 
-    def __init__(self, line: int, column: int, end_line: int, end_column: int) -> None:
-        self.line = line
+    __slots__ = ("row", "column", "height", "end_column")
+
+    def __init__(self, line: int | Row, column: int, end_line: int | Row,
+                 end_column: int) -> None:
+        if isinstance(line, Row):
+            self.row = line
+            self.height = 0
+        else:
+            assert isinstance(end_line, int)
+            self.row = Row(line)
+            self.height = end_line - line
         self.column = column
-        self.end_line = end_line
         self.end_column = end_column
 
-    def on_line(self, line: int) -> Span:
-        return Span(line, self.column, line + self.end_line - self.line, self.end_column)
+    @property
+    def line(self) -> int:
+        return self.row.number
+
+    @property
+    def end_line(self) -> int:
+        return self.row.number + self.height
+
+    def _key(self) -> tuple[int, int, int, int]:
+        line = self.row.number
+        return line, self.column, line + self.height, self.end_column
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Span) and self._key() == other._key()
+
+    def __hash__(self) -> int:
+        return hash(self._key())
+
+    def __repr__(self) -> str:
+        line, column, end_line, end_column = self._key()
+        return (f"Span(line={line}, column={column}, end_line={end_line}, "
+                f"end_column={end_column})")
 
     def cover(self, other: Span) -> Span:
-        """The smallest span holding both."""
+        """The smallest span holding both (on their row, when they share one)."""
+        if self.row is other.row and self.height == other.height == 0:
+            return Span(self.row, min(self.column, other.column), self.row,
+                        max(self.end_column, other.end_column))
         start = min((self.line, self.column), (other.line, other.column))
         end = max((self.end_line, self.end_column), (other.end_line, other.end_column))
         return Span(start[0], start[1], end[0], end[1])
+
+    def end_to_end_of(self, other: Span) -> Span:
+        """From the end of this span to the end of `other` (on their row, when they
+        share one)."""
+        if self.row is other.row and self.height == other.height == 0:
+            return Span(self.row, self.end_column, self.row, other.end_column)
+        return Span(self.end_line, self.end_column, other.end_line, other.end_column)
 
     def contains(self, line: int, column: int) -> bool:
         return (self.line, self.column) <= (line, column) < (self.end_line, self.end_column)
 
 
-class Node(Record):
-    __slots__ = ("span",)
+_CHILD_FIELDS: dict[type, tuple[str, ...]] = {}
+
+
+@dataclass(slots=True, unsafe_hash=True)
+class Node:
+    """The base of every node. Nodes are never changed once built, but not frozen
+    dataclasses: a frozen dataclass's `__init__` takes more than twice as long, and the
+    parser builds about ten nodes per line (bench/parse_check.py)."""
+
     span: Span
 
     def children(self) -> Iterator[Node]:
-        for name in self.fields:
+        names = _CHILD_FIELDS.get(type(self))
+        if names is None:
+            names = _CHILD_FIELDS[type(self)] = tuple(
+                field.name for field in fields(self) if field.name != "span")
+        for name in names:
             value = getattr(self, name)
             if isinstance(value, Node):
                 yield value
@@ -68,62 +128,40 @@ class Node(Record):
 # Operands and arguments -------------------------------------------------------------
 
 
+@dataclass(slots=True, unsafe_hash=True)
 class Var(Node):
     """A one-letter variable: `A`-`Z`, `a`-`z` or `@`."""
 
-    __slots__ = ("name",)
     name: str
 
-    def __init__(self, span: Span, name: str) -> None:
-        self.span = span
-        self.name = name
 
-
+@dataclass(slots=True, unsafe_hash=True)
 class Const(Node):
     """A constant as written. `value` is the number written (a decimal may lie outside
     16 bits; the checker reports it); `hex` constants are 16-bit bit patterns."""
 
-    __slots__ = ("value", "text", "hex")
     value: int
     text: str
     hex: bool
 
-    def __init__(self, span: Span, value: int, text: str, hex: bool) -> None:
-        self.span = span
-        self.value = value
-        self.text = text
-        self.hex = hex
 
-
+@dataclass(slots=True, unsafe_hash=True)
 class Selector(Node):
     """The letter that selects a form of `(CAM ...)` or a sensor of `(ULT ...)`."""
 
-    __slots__ = ("letter",)
     letter: str
-
-    def __init__(self, span: Span, letter: str) -> None:
-        self.span = span
-        self.letter = letter
 
 
 Arg = Var | Const | Selector
 
 
+@dataclass(slots=True, unsafe_hash=True)
 class Call(Node):
     """A built-in function call `(MNEMONIC args)`; `mnemonic` is as written."""
 
-    __slots__ = ("mnemonic", "mnemonic_span", "args")
     mnemonic: str
     mnemonic_span: Span
     args: tuple[Arg, ...]
-
-    def __init__(
-        self, span: Span, mnemonic: str, mnemonic_span: Span, args: tuple[Arg, ...]
-    ) -> None:
-        self.span = span
-        self.mnemonic = mnemonic
-        self.mnemonic_span = mnemonic_span
-        self.args = args
 
     @property
     def is_end(self) -> bool:
@@ -137,97 +175,57 @@ Operand = Var | Const | Call
 # Statements -------------------------------------------------------------------------
 
 
+@dataclass(slots=True, unsafe_hash=True)
 class BinaryStep(Node):
     """One `op operand` of a left-to-right expression."""
 
-    __slots__ = ("op", "op_span", "operand")
     op: BinaryOperator
     op_span: Span
     operand: Operand
 
-    def __init__(
-        self, span: Span, op: BinaryOperator, op_span: Span, operand: Operand
-    ) -> None:
-        self.span = span
-        self.op = op
-        self.op_span = op_span
-        self.operand = operand
 
-
+@dataclass(slots=True, unsafe_hash=True)
 class Assign(Node):
     """`V=operand {op operand}`, evaluated strictly left to right."""
 
-    __slots__ = ("target", "first", "rest")
     target: Var
     first: Operand
     rest: tuple[BinaryStep, ...]
 
-    def __init__(
-        self, span: Span, target: Var, first: Operand, rest: tuple[BinaryStep, ...]
-    ) -> None:
-        self.span = span
-        self.target = target
-        self.first = first
-        self.rest = rest
 
-
+@dataclass(slots=True, unsafe_hash=True)
 class IncDec(Node):
     """`V++` or `V--`."""
 
-    __slots__ = ("target", "step")
     target: Var
     step: Step
 
-    def __init__(self, span: Span, target: Var, step: Step) -> None:
-        self.span = span
-        self.target = target
-        self.step = step
 
-
+@dataclass(slots=True, unsafe_hash=True)
 class LabelRef(Node):
     """`#NN` as written; `number` is None when the digits are not a valid label."""
 
-    __slots__ = ("text", "number")
     text: str
     number: int | None
 
-    def __init__(self, span: Span, text: str, number: int | None) -> None:
-        self.span = span
-        self.text = text
-        self.number = number
 
-
+@dataclass(slots=True, unsafe_hash=True)
 class Goto(Node):
-    __slots__ = ("target",)
     target: LabelRef
 
-    def __init__(self, span: Span, target: LabelRef) -> None:
-        self.span = span
-        self.target = target
 
-
+@dataclass(slots=True, unsafe_hash=True)
 class CondJump(Node):
     """`?V=#NN`, `?V>#NN`, `?V<#NN`: jump when V compares so with zero."""
 
-    __slots__ = ("var", "relation", "target")
     var: Var
     relation: Relation
     target: LabelRef
 
-    def __init__(self, span: Span, var: Var, relation: Relation, target: LabelRef) -> None:
-        self.span = span
-        self.var = var
-        self.relation = relation
-        self.target = target
 
-
+@dataclass(slots=True, unsafe_hash=True)
 class CallStmt(Node):
-    __slots__ = ("call",)
     call: Call
-
-    def __init__(self, span: Span, call: Call) -> None:
-        self.span = span
-        self.call = call
 
 
 Statement = Assign | IncDec | Goto | CondJump | CallStmt
@@ -241,128 +239,44 @@ def is_end(statement: Statement) -> bool:
 # Lines and programs -----------------------------------------------------------------
 
 
+@dataclass(slots=True, unsafe_hash=True)
 class LabelDef(Node):
     """`:NN` at the start of a line; `number` is None when not exactly two digits."""
 
-    __slots__ = ("text", "number")
     text: str
     number: int | None
 
-    def __init__(self, span: Span, text: str, number: int | None) -> None:
-        self.span = span
-        self.text = text
-        self.number = number
 
-
+@dataclass(slots=True, unsafe_hash=True)
 class Comment(Node):
     """`' text` to the end of the line; `text` excludes the quote."""
 
-    __slots__ = ("text",)
     text: str
 
-    def __init__(self, span: Span, text: str) -> None:
-        self.span = span
-        self.text = text
 
-
+@dataclass(slots=True, unsafe_hash=True)
 class Line(Node):
     """One source line. `ok` is False when the line has a syntax error; its
     statements are then empty and the parser's diagnostic says why."""
 
-    __slots__ = ("number", "label", "statements", "comment", "ok")
-    number: int
     label: LabelDef | None
     statements: tuple[Statement, ...]
     comment: Comment | None
-    ok: bool
+    ok: bool = True
 
-    def __init__(self, span: Span, number: int, label: LabelDef | None,
-                 statements: tuple[Statement, ...], comment: Comment | None,
-                 ok: bool = True) -> None:
-        self.span = span
-        self.number = number
-        self.label = label
-        self.statements = statements
-        self.comment = comment
-        self.ok = ok
+    @property
+    def number(self) -> int:
+        """The line's 1-based number, now (its row's)."""
+        return self.span.row.number
 
 
+@dataclass(slots=True, unsafe_hash=True)
 class Program(Node):
-    __slots__ = ("lines",)
     lines: tuple[Line, ...]
-
-    def __init__(self, span: Span, lines: tuple[Line, ...]) -> None:
-        self.span = span
-        self.lines = lines
 
     def statements(self) -> Iterator[Statement]:
         for line in self.lines:
             yield from line.statements
-
-
-def relocate(node: Node, line: int) -> Node:
-    """A copy of a one-line node (and its children) moved to `line`. The language
-    server moves every line below an inserted one, so this is built for speed: what to
-    do with each field is worked out once per class, and nodes are rebuilt positionally."""
-    cls = node.__class__
-    plan = _RELOCATION_PLANS.get(cls) or _relocation_plan(cls)
-    values: list[Any] = list(node.values())
-    for index in plan.spans:
-        values[index] = values[index].on_line(line)
-    for index in plan.nodes:
-        if values[index] is not None:
-            values[index] = relocate(values[index], line)
-    for index in plan.tuples:
-        values[index] = tuple([relocate(item, line) for item in values[index]])
-    if plan.number is not None:
-        values[plan.number] = line
-    return cls(*values)
-
-
-class _RelocationPlan(Record):
-    """The positions of a class's fields that hold a span, a node (or None), a tuple of
-    nodes, and the line number (Line's)."""
-
-    __slots__ = ("spans", "nodes", "tuples", "number")
-
-    def __init__(self, spans: tuple[int, ...], nodes: tuple[int, ...], tuples: tuple[int, ...],
-                 number: int | None) -> None:
-        self.spans = spans
-        self.nodes = nodes
-        self.tuples = tuples
-        self.number = number
-
-
-_RELOCATION_PLANS: dict[type, _RelocationPlan] = {}
-
-
-def _relocation_plan(cls: type[Node]) -> _RelocationPlan:
-    """Read from the field annotations, which `from __future__ import annotations` keeps
-    as the strings written above (`Span`, `tuple[Arg, ...]`, `LabelDef | None`...)."""
-    annotations: dict[str, str] = {}
-    for klass in reversed(cls.__mro__):
-        annotations.update(getattr(klass, "__annotations__", {}))
-    spans, nodes, tuples, number = [], [], [], None
-    for index, name in enumerate(cls.fields):
-        written = annotations[name]
-        if written == "Span":
-            spans.append(index)
-        elif written.startswith("tuple["):
-            tuples.append(index)
-        elif cls is Line and name == "number":
-            number = index
-        elif any(_holds_nodes(globals().get(option.strip())) for option in written.split("|")):
-            nodes.append(index)
-    plan = _RELOCATION_PLANS[cls] = _RelocationPlan(tuple(spans), tuple(nodes), tuple(tuples),
-                                                    number)
-    return plan
-
-
-def _holds_nodes(kind: object) -> bool:
-    """Whether `kind` (a class or a union like `Operand`) is or includes a Node class."""
-    if isinstance(kind, UnionType):
-        return any(_holds_nodes(option) for option in kind.__args__)
-    return isinstance(kind, type) and issubclass(kind, Node)
 
 
 def walk(node: Node) -> Iterator[Node]:

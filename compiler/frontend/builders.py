@@ -21,8 +21,8 @@ from . import ast
 from .scanner import Kinds, Lexeme
 
 Node = TypeVar("Node", covariant=True)
-Builder = Callable[[Sequence[Lexeme], int], Node]
-"""Builds a node from a line's lexemes and its line number."""
+Builder = Callable[[Sequence[Lexeme], ast.Row], Node]
+"""Builds a node from a line's lexemes and its row (the line number its spans share)."""
 
 Child = int | Builder[Any]
 """What a rule receives for each symbol: a token's index, or a sub-rule's builder."""
@@ -34,7 +34,7 @@ Letter = TypeVar("Letter", ast.Var, ast.Selector)
 _SELECTING = frozenset(name for name, builtin in BUILTINS.items() if builtin.has_selector)
 
 
-def label_def(lexemes: Sequence[Lexeme], line: int, index: int = 0) -> ast.LabelDef:
+def label_def(lexemes: Sequence[Lexeme], line: ast.Row, index: int = 0) -> ast.LabelDef:
     text, column = lexemes[index]
     return ast.LabelDef(ast.Span(line, column + 1, line, column + 1 + len(text)), text,
                         _label_number(text))
@@ -47,7 +47,7 @@ def _label_number(text: str) -> int | None:
 
 
 def _label_ref(index: int) -> Builder[ast.LabelRef]:
-    def build(lexemes: Sequence[Lexeme], line: int) -> ast.LabelRef:
+    def build(lexemes: Sequence[Lexeme], line: ast.Row) -> ast.LabelRef:
         text, column = lexemes[index]
         return ast.LabelRef(ast.Span(line, column + 1, line, column + 1 + len(text)), text,
                             _label_number(text))
@@ -56,7 +56,7 @@ def _label_ref(index: int) -> Builder[ast.LabelRef]:
 
 def _letter(node: type[Letter], index: int) -> Builder[Letter]:
     """A variable, or the selector letter of `(CAM P c)` and `(ULT A)`."""
-    def build(lexemes: Sequence[Lexeme], line: int) -> Letter:
+    def build(lexemes: Sequence[Lexeme], line: ast.Row) -> Letter:
         text, column = lexemes[index]
         return node(ast.Span(line, column + 1, line, column + 2), text)
     return build
@@ -67,7 +67,7 @@ def _var(index: int) -> Builder[ast.Var]:
 
 
 def _number(index: int) -> Builder[ast.Const]:
-    def build(lexemes: Sequence[Lexeme], line: int) -> ast.Const:
+    def build(lexemes: Sequence[Lexeme], line: ast.Row) -> ast.Const:
         text, column = lexemes[index]
         return ast.Const(ast.Span(line, column + 1, line, column + 1 + len(text)),
                          decimal_value(text), text, False)
@@ -76,7 +76,7 @@ def _number(index: int) -> Builder[ast.Const]:
 
 def _hex(index: int) -> Builder[ast.Const]:
     """The scanner makes a HEX token only of a valid 16-bit pattern."""
-    def build(lexemes: Sequence[Lexeme], line: int) -> ast.Const:
+    def build(lexemes: Sequence[Lexeme], line: ast.Row) -> ast.Const:
         text, column = lexemes[index]
         value = int(text[1:], 16)
         return ast.Const(ast.Span(line, column + 1, line, column + 1 + len(text)),
@@ -100,11 +100,11 @@ def line(kinds: Kinds, children: list[Child]) -> Builder[ParsedLine]:
     if len(statements) == 1 and not has_label:  # the commonest line, made a little faster
         (only,) = statements
 
-        def build_one(lexemes: Sequence[Lexeme], number: int) -> ParsedLine:
+        def build_one(lexemes: Sequence[Lexeme], number: ast.Row) -> ParsedLine:
             return None, (only(lexemes, number),)
         return build_one
 
-    def build(lexemes: Sequence[Lexeme], number: int) -> ParsedLine:
+    def build(lexemes: Sequence[Lexeme], number: ast.Row) -> ParsedLine:
         return (label_def(lexemes, number) if has_label else None,
                 tuple([statement(lexemes, number) for statement in statements]))
     return build
@@ -117,7 +117,7 @@ def assign(kinds: Kinds, children: list[Child]) -> Builder[ast.Assign]:
     first = _operand(kinds, first_child)
     steps: list[Builder[ast.BinaryStep]] = step_children  # type: ignore[assignment]
 
-    def build(lexemes: Sequence[Lexeme], number: int) -> ast.Assign:
+    def build(lexemes: Sequence[Lexeme], number: ast.Row) -> ast.Assign:
         target_var = target(lexemes, number)
         first_operand = first(lexemes, number)
         rest = tuple([step(lexemes, number) for step in steps]) if steps else ()
@@ -132,7 +132,7 @@ def step(kinds: Kinds, children: list[Child]) -> Builder[ast.BinaryStep]:
     assert isinstance(op_index, int)
     operand = _operand(kinds, operand_child)
 
-    def build(lexemes: Sequence[Lexeme], number: int) -> ast.BinaryStep:
+    def build(lexemes: Sequence[Lexeme], number: ast.Row) -> ast.BinaryStep:
         op, column = lexemes[op_index]
         value = operand(lexemes, number)
         return ast.BinaryStep(ast.Span(number, column + 1, number, value.span.end_column),
@@ -146,7 +146,7 @@ def incdec(kinds: Kinds, children: list[Child]) -> Builder[ast.IncDec]:
     assert isinstance(var_index, int) and isinstance(step_index, int)
     target = _var(var_index)
 
-    def build(lexemes: Sequence[Lexeme], number: int) -> ast.IncDec:
+    def build(lexemes: Sequence[Lexeme], number: ast.Row) -> ast.IncDec:
         target_var = target(lexemes, number)
         column = lexemes[step_index][1]
         return ast.IncDec(ast.Span(number, target_var.span.column, number, column + 3),
@@ -159,7 +159,7 @@ def goto(kinds: Kinds, children: list[Child]) -> Builder[ast.Goto]:
     assert isinstance(target_index, int)
     target = _label_ref(target_index)
 
-    def build(lexemes: Sequence[Lexeme], number: int) -> ast.Goto:
+    def build(lexemes: Sequence[Lexeme], number: ast.Row) -> ast.Goto:
         label = target(lexemes, number)
         return ast.Goto(label.span, label)
     return build
@@ -171,7 +171,7 @@ def condjump(kinds: Kinds, children: list[Child]) -> Builder[ast.CondJump]:
     assert isinstance(relation_index, int) and isinstance(target_index, int)
     var, target = _var(var_index), _label_ref(target_index)
 
-    def build(lexemes: Sequence[Lexeme], number: int) -> ast.CondJump:
+    def build(lexemes: Sequence[Lexeme], number: ast.Row) -> ast.CondJump:
         label = target(lexemes, number)
         return ast.CondJump(
             ast.Span(number, lexemes[qmark_index][1] + 1, number, label.span.end_column),
@@ -184,7 +184,7 @@ def call_stmt(kinds: Kinds, children: list[Child]) -> Builder[ast.CallStmt]:
     (call_builder,) = children
     assert not isinstance(call_builder, int)
 
-    def build(lexemes: Sequence[Lexeme], number: int) -> ast.CallStmt:
+    def build(lexemes: Sequence[Lexeme], number: ast.Row) -> ast.CallStmt:
         call_node = call_builder(lexemes, number)
         return ast.CallStmt(call_node.span, call_node)
     return build
@@ -201,7 +201,7 @@ def call(kinds: Kinds, children: list[Child]) -> Builder[ast.Call]:
     first_is_letter = bool(arg_indices) and kinds[arg_indices[0]] == "VAR"
     selector = _letter(ast.Selector, arg_indices[0]) if first_is_letter else None
 
-    def build(lexemes: Sequence[Lexeme], number: int) -> ast.Call:
+    def build(lexemes: Sequence[Lexeme], number: ast.Row) -> ast.Call:
         mnemonic, column = lexemes[mnemonic_index]
         if selector is not None and mnemonic.upper() in _SELECTING:
             built: tuple[ast.Arg, ...] = (selector(lexemes, number),

@@ -117,16 +117,16 @@ def _plan(kinds: Kinds) -> Plan:
     return _cached_plan(kinds) if len(kinds) <= _LONGEST_CACHED_PLAN else make_plan(kinds)
 
 
-def _syntax_error(number: int, code: str, kinds: Kinds, lexemes: list[Lexeme],
+def _syntax_error(row: ast.Row, code: str, kinds: Kinds, lexemes: list[Lexeme],
                   rejection: Rejection) -> Diagnostic:
     if rejection.index is None:
         column = len(code.rstrip()) + 1
-        span = ast.Span(number, column, number, column + 1)
+        span = ast.Span(row, column, row, column + 1)
         kind, text = "$END", ""
     else:
         kind = kinds[rejection.index]
         text, start = lexemes[rejection.index]
-        span = ast.Span(number, start + 1, number, start + 1 + max(len(text), 1))
+        span = ast.Span(row, start + 1, row, start + 1 + max(len(text), 1))
     if kind == "BAD":
         return _bad_character(span, text)
     if kind == "WORD":
@@ -197,27 +197,29 @@ def _misused_word(span: ast.Span, word: str) -> Diagnostic:
     )
 
 
-def parse_line(text: str, number: int) -> tuple[ast.Line, list[Diagnostic]]:
-    """Parse one line of source (no line end) as line `number`."""
+def parse_line(text: str, line: int | ast.Row) -> tuple[ast.Line, list[Diagnostic]]:
+    """Parse one line of source (no line end) as line `line`: its number, or the row
+    that will hold its number as it moves (every span on the line refers to it)."""
+    row = line if isinstance(line, ast.Row) else ast.Row(line)
     code, quote, comment_text = text.partition("'")
     comment = None
     if quote:
-        comment = ast.Comment(ast.Span(number, len(code) + 1, number, len(text) + 1),
+        comment = ast.Comment(ast.Span(row, len(code) + 1, row, len(text) + 1),
                               comment_text)
-    span = ast.Span(number, 1, number, len(text) + 1)
+    span = ast.Span(row, 1, row, len(text) + 1)
     kinds, lexemes = scan(code)
     if not kinds:
-        return ast.Line(span, number, None, (), comment), []
+        return ast.Line(span, None, (), comment), []
     plan = _plan(kinds)
     if isinstance(plan, Rejection):
         # A broken line keeps its label, so that jumps to it still resolve and the
         # checker need not assume the worst about it.
-        label = label_def(lexemes, number) if kinds[0] == "LABEL" else None
-        return ast.Line(span, number, label, (), comment, ok=False), [
-            _syntax_error(number, code, kinds, lexemes, plan)
+        label = label_def(lexemes, row) if kinds[0] == "LABEL" else None
+        return ast.Line(span, label, (), comment, ok=False), [
+            _syntax_error(row, code, kinds, lexemes, plan)
         ]
-    label, statements = plan(lexemes, number)
-    return ast.Line(span, number, label, statements, comment), []
+    label, statements = plan(lexemes, row)
+    return ast.Line(span, label, statements, comment), []
 
 
 def parse_program(text: str) -> tuple[ast.Program, list[Diagnostic]]:

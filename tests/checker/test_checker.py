@@ -178,7 +178,7 @@ def test_selector_where_a_value_belongs() -> None:
     assert isinstance(statement, ast.CallStmt)
     call = statement.call
     letter = ast.Selector(call.args[1].span, "B")
-    odd = ast.Line(line.span, 1, None, (ast.CallStmt(call.span, ast.Call(
+    odd = ast.Line(line.span, None, (ast.CallStmt(call.span, ast.Call(
         call.span, call.mnemonic, call.mnemonic_span, (call.args[0], letter))),), None)
     [diagnostic] = check_line(odd)
     assert (diagnostic.code, diagnostic.span) == ("E0504", span(1, 8, 9))
@@ -236,10 +236,12 @@ def test_calls_with_a_result_are_operands() -> None:
 
 
 def test_per_line_results_depend_on_the_line_alone() -> None:
-    line, _ = parse_line("(mov 13,0); x=1; #5", 7)
-    moved = ast.relocate(line, 9)
-    assert isinstance(moved, ast.Line)
-    assert [d.span.on_line(9) for d in check_line(line)] == [d.span for d in check_line(moved)]
+    row = ast.Row(7)
+    line, _ = parse_line("(mov 13,0); x=1; #5", row)
+    found = check_line(line)
+    row.number = 9  # the line moves, and its diagnostics with it
+    assert found == check_line(parse_line("(mov 13,0); x=1; #5", 9)[0])
+    assert {d.span.line for d in found} == {9}
 
 
 # The control-flow graph ---------------------------------------------------------------

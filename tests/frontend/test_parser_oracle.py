@@ -141,7 +141,7 @@ def _our_outcome(code: str) -> object:
     kinds, lexemes = scan(code)
     plan = make_plan(kinds)
     if callable(plan):
-        return plan(lexemes, 1)
+        return plan(lexemes, ast.Row(1))
     at = None if plan.index is None else lexemes[plan.index][1]
     return ("rejected", at, plan.expected)
 

@@ -45,7 +45,6 @@ def test_fields_are_the_slots_base_first() -> None:
     assert Labelled(1, 2, "x").values() == (1, 2, "x")
     assert Single(5).values() == (5,)
     assert Empty().values() == ()
-    assert ast.Var.fields == ("span", "name")
 
 
 @given(values, values, values, values)
@@ -61,7 +60,8 @@ def test_a_record_equals_only_records_of_its_own_class() -> None:
     assert Pair(1, 2) != (1, 2)
     assert Empty() == Empty() and Empty() != Single(None)
     span = ast.Span(1, 1, 1, 2)
-    assert ast.Var(span, "A") != ast.Selector(span, "A")  # same values, other meaning
+    selector: object = ast.Selector(span, "A")
+    assert ast.Var(span, "A") != selector  # same values, other meaning
 
 
 def test_repr_names_every_field() -> None:

@@ -1,0 +1,88 @@
+"""The control-flow graph of a whole program: basic blocks of statements and the edges
+between them, for the checker's data-flow rules (and for any later pass that wants it).
+
+A block is entered only at its first statement. A new block starts at every labelled
+line, after every `#NN`, `?V..#NN` and `(END)`, and around every line the parser could
+not read (blocks.py cuts them). Blocks are numbered in source order. Edges:
+- to the next block (fall-through), unless the block ends with `#NN` or `(END)`;
+- `#NN` and `?V..#NN` to the block that `:NN` names (its first definition);
+- `(END)`: none;
+- the last block falls through to `exit`, an empty block standing for the end of the
+  program (falling off the end behaves as `(END)`); a label with no code after it names
+  `exit` too;
+- lost-line handler edges (`Block.handlers`) to `:96`-`:99`, found by handler_edges.py.
+A line with a syntax error becomes an opaque block: it may have held any statement, so
+it may continue to the next block, to any labelled block or to the end, and a jump to a
+label the program does not define may land on it.
+
+Each block also carries a summary of what its statements do (effects.py), computed once
+for all the data-flow rules, and the graph the device state on entry to each block,
+which says which blocks some path reaches.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from rl1.compiler.frontend import ast
+
+from .effects import BlockEffects
+
+JUMPS = (ast.Goto, ast.CondJump)
+
+
+def closes_block(statement: ast.Statement) -> bool:
+    """Whether a block ends after `statement`: a jump or `(END)`."""
+    return isinstance(statement, JUMPS) or ast.is_end(statement)
+
+
+@dataclass(frozen=True, slots=True)
+class HandlerEdge:
+    """A lost guidance line may jump to `:label` from the event point of statement
+    `index` of the block (the first such in the block): right after its calls, before an
+    assignment stores its value, or right after its jump."""
+
+    label: int
+    index: int
+    target: int | None  # the handler's block; None when the program does not define it
+
+
+@dataclass(slots=True)
+class Block:
+    """A basic block. The graph's construction fills in its edges and effects."""
+
+    index: int
+    statements: list[ast.Statement]
+    labels: list[ast.LabelDef]  # the labels naming it
+    opaque: bool  # stands for a line with a syntax error
+    successors: list[int] = field(default_factory=list)
+    handlers: list[HandlerEdge] = field(default_factory=list)
+    effects: BlockEffects = field(default_factory=BlockEffects.nothing)
+
+    @property
+    def jump(self) -> ast.Goto | ast.CondJump | None:
+        """The `#NN` or `?V..#NN` that ends the block, if one does."""
+        last = self.statements[-1] if self.statements else None
+        return last if isinstance(last, JUMPS) else None
+
+    @property
+    def ends(self) -> bool:
+        """Whether the block ends with `(END)`."""
+        return bool(self.statements) and ast.is_end(self.statements[-1])
+
+
+@dataclass(slots=True)
+class ControlFlowGraph:
+    blocks: list[Block]
+    labels: dict[int, int]  # label number -> the block its first definition names
+    # handler_edges.py's device state on entry to each block (tracing modes and motion
+    # that may be in effect); 0 for a block no path reaches
+    device_on_entry: list[int] = field(default_factory=list)
+    entry: int = 0
+
+    @property
+    def exit(self) -> int:
+        return len(self.blocks) - 1
+
+    def reachable(self, index: int) -> bool:
+        return self.device_on_entry[index] != 0
