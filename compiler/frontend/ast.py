@@ -44,7 +44,7 @@ class Span:
     the lines and columns it has now: a span on a row must not be a dict key while its
     row may be renumbered."""
 
-    __slots__ = ("row", "column", "height", "end_column")
+    __slots__ = ("column", "end_column", "height", "row")
 
     def __init__(self, line: int | Row, column: int, end_line: int | Row,
                  end_column: int) -> None:
