@@ -2,8 +2,9 @@
 index, the built-in functions (the paper's Tables 2 and 3), and where a lost guidance
 line jumps (Table 4).
 
-This module is the bottom layer of the project: it imports nothing of rl1. The
-built-in table serves every stage: the checker (arity, kinds, ranges), the code generator
+This module is the bottom layer of the project: it imports nothing of rl1. Its rows
+are frozen singletons, compared by identity (`eq=False`), which also spares generating
+equality and hashing for them at every start. The built-in table serves every stage: the checker (arity, kinds, ranges), the code generator
 (opcodes and device features), the VMs (which reserved variables a call writes) and the
 language server (hover, completion, signature help, inlay hints). spec/language.md
 renders the same facts for people; keep the two in step.
@@ -27,8 +28,10 @@ class Feature(Enum):
     FUZZY = 6
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class Param:
+    """One parameter of a built-in: its name, range and meaning."""
+
     name: str
     low: int
     high: int
@@ -38,7 +41,7 @@ class Param:
         return f"{self.name}: {self.meaning}, {self.low}..{self.high}"
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class Form:
     """One way to call a built-in. Most have a single form with `selector` None;
     `(CAM ...)` and `(ULT ...)` have one form per selector letter."""
@@ -54,8 +57,10 @@ class Form:
         return self.result is not None
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class Builtin:
+    """A built-in function (a row of Table 2 or 3) and the forms it is called in."""
+
     mnemonic: str
     name: str  # the paper's expansion of the mnemonic
     group: str  # "motion" (Table 2), "sensing" (Table 3) or "control" (Table 1)
@@ -166,7 +171,7 @@ VARIABLES = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz@"
 VARIABLE_INDEX: dict[str, int] = {name: index for index, name in enumerate(VARIABLES)}
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class LostLineRule:
     """One row of Table 4: a line lost in tracing `mode` while `command` (MOV or MVI)
     is in effect jumps to `label`; `stops` tells whether the command stops first (mode 2)

@@ -9,8 +9,9 @@ rebuilding anything. `walk` visits a tree in source order.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, fields
+from operator import attrgetter
 from typing import Literal
 
 BinaryOperator = Literal["+", "-", "&", "|", "^", "<", ">"]
@@ -101,23 +102,37 @@ class Span:
         return (self.line, self.column) <= (line, column) < (self.end_line, self.end_column)
 
 
-_CHILD_FIELDS: dict[type, tuple[str, ...]] = {}
-
-
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class Node:
     """The base of every node. Nodes are never changed once built, but not frozen
     dataclasses: a frozen dataclass's `__init__` takes more than twice as long, and the
-    parser builds about ten nodes per line (bench/parse_check.py)."""
+    parser builds about ten nodes per line (bench/parse_check.py).
+
+    Each node class is a dataclass for its fields and `__init__` alone; equality,
+    hashing and `repr` by the fields' values are written once, here. Generating them for
+    each of the 16 classes, as `@dataclass` does by default, costs 0.15 ms a class at
+    every start of `rl1c check` (bench/cold_start.py)."""
 
     span: Span
 
+    def _values(self) -> tuple[object, ...]:
+        return _layout(type(self)).values(self)
+
+    def __eq__(self, other: object) -> bool:
+        return (isinstance(other, Node) and type(other) is type(self)
+                and self._values() == other._values())
+
+    def __hash__(self) -> int:
+        return hash((type(self), self._values()))
+
+    def __repr__(self) -> str:
+        shown = ", ".join(f"{name}={value!r}"
+                          for name, value in zip(_layout(type(self)).names, self._values(),
+                                                 strict=True))
+        return f"{type(self).__name__}({shown})"
+
     def children(self) -> Iterator[Node]:
-        names = _CHILD_FIELDS.get(type(self))
-        if names is None:
-            names = _CHILD_FIELDS[type(self)] = tuple(
-                field.name for field in fields(self) if field.name != "span")
-        for name in names:
+        for name in _layout(type(self)).child_names:
             value = getattr(self, name)
             if isinstance(value, Node):
                 yield value
@@ -125,17 +140,42 @@ class Node:
                 yield from (item for item in value if isinstance(item, Node))
 
 
+class _Layout:
+    """What the base needs to know of a node class: its fields' names, the names of
+    those that may hold child nodes, and a getter of all their values."""
+
+    __slots__ = ("child_names", "names", "values")
+
+    def __init__(self, node_class: type[Node]) -> None:
+        self.names = tuple(field.name for field in fields(node_class))
+        self.child_names = tuple(name for name in self.names if name != "span")
+        get = attrgetter(*self.names)
+        # attrgetter of one name gives the value alone, not a tuple.
+        self.values: Callable[[Node], tuple[object, ...]] = (
+            (lambda node: (get(node),)) if len(self.names) == 1 else get)
+
+
+_LAYOUTS: dict[type, _Layout] = {}
+
+
+def _layout(node_class: type[Node]) -> _Layout:
+    layout = _LAYOUTS.get(node_class)
+    if layout is None:
+        layout = _LAYOUTS[node_class] = _Layout(node_class)
+    return layout
+
+
 # Operands and arguments -------------------------------------------------------------
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class Var(Node):
     """A one-letter variable: `A`-`Z`, `a`-`z` or `@`."""
 
     name: str
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class Const(Node):
     """A constant as written. `value` is the number written (a decimal may lie outside
     16 bits; the checker reports it); `hex` constants are 16-bit bit patterns."""
@@ -145,7 +185,7 @@ class Const(Node):
     hex: bool
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class Selector(Node):
     """The letter that selects a form of `(CAM ...)` or a sensor of `(ULT ...)`."""
 
@@ -155,7 +195,7 @@ class Selector(Node):
 Arg = Var | Const | Selector
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class Call(Node):
     """A built-in function call `(MNEMONIC args)`; `mnemonic` is as written."""
 
@@ -175,7 +215,7 @@ Operand = Var | Const | Call
 # Statements -------------------------------------------------------------------------
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class BinaryStep(Node):
     """One `op operand` of a left-to-right expression."""
 
@@ -184,7 +224,7 @@ class BinaryStep(Node):
     operand: Operand
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class Assign(Node):
     """`V=operand {op operand}`, evaluated strictly left to right."""
 
@@ -193,7 +233,7 @@ class Assign(Node):
     rest: tuple[BinaryStep, ...]
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class IncDec(Node):
     """`V++` or `V--`."""
 
@@ -201,7 +241,7 @@ class IncDec(Node):
     step: Step
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class LabelRef(Node):
     """`#NN` as written; `number` is None when the digits are not a valid label."""
 
@@ -209,12 +249,12 @@ class LabelRef(Node):
     number: int | None
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class Goto(Node):
     target: LabelRef
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class CondJump(Node):
     """`?V=#NN`, `?V>#NN`, `?V<#NN`: jump when V compares so with zero."""
 
@@ -223,7 +263,7 @@ class CondJump(Node):
     target: LabelRef
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class CallStmt(Node):
     call: Call
 
@@ -239,7 +279,7 @@ def is_end(statement: Statement) -> bool:
 # Lines and programs -----------------------------------------------------------------
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class LabelDef(Node):
     """`:NN` at the start of a line; `number` is None when not exactly two digits."""
 
@@ -247,14 +287,14 @@ class LabelDef(Node):
     number: int | None
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class Comment(Node):
     """`' text` to the end of the line; `text` excludes the quote."""
 
     text: str
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class Line(Node):
     """One source line. `ok` is False when the line has a syntax error; its
     statements are then empty and the parser's diagnostic says why."""
@@ -270,7 +310,7 @@ class Line(Node):
         return self.span.row.number
 
 
-@dataclass(slots=True, unsafe_hash=True)
+@dataclass(slots=True, eq=False, repr=False)
 class Program(Node):
     lines: tuple[Line, ...]
 
