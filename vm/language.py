@@ -4,10 +4,11 @@ line jumps (Table 4).
 
 This module is the bottom layer of the project: it imports nothing of rl1. Its rows
 are frozen singletons, compared by identity (`eq=False`), which also spares generating
-equality and hashing for them at every start. The built-in table serves every stage: the checker (arity, kinds, ranges), the code generator
-(opcodes and device features), the VMs (which reserved variables a call writes) and the
-language server (hover, completion, signature help, inlay hints). spec/language.md
-renders the same facts for people; keep the two in step.
+equality and hashing for them at every start. The built-in table serves every stage:
+the checker (arity, kinds, ranges), the code generator (opcodes and device features),
+the VMs (which reserved variables a call writes) and the language server (hover,
+completion, signature help, inlay hints). spec/language.md renders the same facts for
+people; keep the two in step.
 """
 
 from __future__ import annotations
