@@ -172,18 +172,26 @@ def run(file: str, sensors: str | None, run_format: str, budget: int, engine: En
 
 @click.command(cls=Command)
 @click.argument("file", metavar="FILE", type=PATH)
-def dis(file: str) -> int:
+@click.option("--source", "source_file", metavar="FILE.rob", type=PATH,
+              help="the program's source, to show its lines; default: the file the .ilc "
+                   "records, when it is in the .ilc file's folder")
+def dis(file: str, source_file: str | None) -> int:
     """Disassemble an .ilc file into .ils text on standard output.
 
-    The program's source lines are shown when its source file is found (beside the .ilc,
-    or by the recorded name). Exit status: 0 done, 1 the file is not valid intermediate
-    code, 2 an unreadable file."""
-    from rl1.compiler.ils.disasm import disassemble, source_beside
+    The program's source lines are shown when its source file is found: the one --source
+    names, or the one the .ilc records if it is in the .ilc file's folder (a recorded
+    name that is absolute or leads out of the folder is not followed). Exit status: 0
+    done, 1 the file is not valid intermediate code, 2 an unreadable file."""
+    from rl1.compiler.ils.disasm import disassemble, named_source, source_beside
     from rl1.vm.verifier import VerifyError
 
     data = read_ilc(file)
     try:
-        text = disassemble(data, file, source_beside(file))
+        find_source = source_beside(file) if source_file is None else named_source(source_file)
+    except SourceError as error:
+        raise Failure(f"error: {error}") from None
+    try:
+        text = disassemble(data, file, find_source)
     except VerifyError as error:
         raise Failure(f"error: {file}: byte {error.offset}: {error.message}",
                       EXIT_ERRORS) from None

@@ -10,8 +10,9 @@ comments, like `objdump -S`.
 from __future__ import annotations
 
 import json
+import stat
 from collections.abc import Callable, Sequence
-from pathlib import Path
+from pathlib import Path, PurePath
 
 from rl1.compiler.files import SourceError
 from rl1.compiler.frontend.source import read_source
@@ -108,16 +109,29 @@ def _features(features: frozenset[Feature]) -> str:
 
 
 def source_beside(ilc_path: str) -> SourceLookup:
-    """Finds a source file by the name the compiler recorded: next to the .ilc file
-    first (where a build usually leaves it), then as the name says (from the current
-    directory if relative). A missing or unreadable source just means no source lines."""
+    """Finds a source file by the name the compiler recorded, in the .ilc file's folder
+    only (where a build usually leaves it): a name that is absolute or climbs out of the
+    folder is not followed, since a hand-made file could name any file on the machine,
+    and only a regular file is read (a FIFO would hang `dis`). A missing or unreadable
+    source just means no source lines."""
     def find(source_name: str) -> Sequence[str] | None:
+        recorded = PurePath(source_name)
+        if recorded.is_absolute() or ".." in recorded.parts or not recorded.name:
+            return None
         directory = Path(ilc_path).parent
-        for candidate in (directory / Path(source_name).name, directory / source_name,
-                          Path(source_name)):
+        for candidate in dict.fromkeys((directory / recorded.name, directory / recorded)):
             try:
+                if not stat.S_ISREG(candidate.stat().st_mode):
+                    continue
                 return read_source(str(candidate)).lines
-            except (SourceError, ValueError):  # ValueError: a NUL in the name
+            except (OSError, SourceError, ValueError):  # ValueError: a NUL in the name
                 continue
         return None
     return find
+
+
+def named_source(path: str) -> SourceLookup:
+    """The source the user named (`rl1c dis --source FILE`), whatever the .ilc records;
+    SourceError when it cannot be read."""
+    lines = read_source(path).lines
+    return lambda _: lines

@@ -3,6 +3,8 @@ line and column, and the `rl1c dis` / `rl1c asm` commands."""
 
 from __future__ import annotations
 
+import json
+import os
 from pathlib import Path
 
 import pytest
@@ -190,3 +192,38 @@ def test_dis_refuses_an_invalid_file_with_its_offset(tmp_path: Path) -> None:
     result = rl1c("dis", tmp_path / "x.ilc")
     assert result.exit_code == 1
     assert "byte 0: not an .ilc file" in result.output
+
+
+def _ilc_naming(tmp_path: Path, source_name: str) -> Path:
+    target = tmp_path / "named.ilc"
+    target.write_bytes(assemble(f".source {json.dumps(source_name)}\n.line 1\nLDI 1\nEND\n"))
+    return target
+
+
+@pytest.mark.parametrize("name", ["/etc/passwd", "../secret.rob", "sub/../../secret.rob"])
+def test_dis_does_not_follow_a_recorded_name_out_of_its_folder(tmp_path: Path,
+                                                                name: str) -> None:
+    (tmp_path / "secret.rob").write_text("SECRET=1\n", encoding="utf-8")
+    folder = tmp_path / "build"
+    folder.mkdir()
+    shown = rl1c("dis", _ilc_naming(folder, name))
+    assert shown.exit_code == 0
+    assert "SECRET" not in shown.stdout and "root:" not in shown.stdout
+    assert "        .line 1" in shown.stdout
+
+
+def test_dis_reads_no_fifo_the_file_names(tmp_path: Path) -> None:
+    os.mkfifo(tmp_path / "hang.rob")
+    shown = rl1c("dis", _ilc_naming(tmp_path, "hang.rob"))  # would block if opened
+    assert shown.exit_code == 0 and "        .line 1" in shown.stdout
+
+
+def test_dis_source_option_names_the_source_whatever_the_file_records(tmp_path: Path) -> None:
+    elsewhere = tmp_path / "src" / "p.rob"
+    elsewhere.parent.mkdir()
+    elsewhere.write_text("A=1\n", encoding="utf-8")
+    target = _ilc_naming(tmp_path, "/etc/passwd")
+    shown = rl1c("dis", target, "--source", elsewhere)
+    assert shown.exit_code == 0 and ";    1 | A=1" in shown.stdout
+    missing = rl1c("dis", target, "--source", tmp_path / "none.rob")
+    assert missing.exit_code == 2 and "none.rob: no such file" in missing.stderr
