@@ -40,6 +40,10 @@ TERMINAL_NAMES = {
     "$END": "the end of the line",
 }
 
+MAX_LINE_LENGTH = 20_000
+"""The longest code part of a line that is read (E0106 beyond): a line's memory grows
+with its tokens, so a megabyte line is refused before any is made."""
+
 _LONGEST_CACHED_PLAN = 64
 """Lines of more tokens than this are planned afresh each time: they are rare, and one
 huge line's plan could fill the cache."""
@@ -207,6 +211,8 @@ def parse_line(text: str, line: int | ast.Row) -> tuple[ast.Line, list[Diagnosti
         comment = ast.Comment(ast.Span(row, len(code) + 1, row, len(text) + 1),
                               comment_text)
     span = ast.Span(row, 1, row, len(text) + 1)
+    if len(code) > MAX_LINE_LENGTH:
+        return ast.Line(span, None, (), comment, ok=False), [_too_long(row, code)]
     kinds, lexemes = scan(code)
     if not kinds:
         return ast.Line(span, None, (), comment), []
@@ -220,6 +226,16 @@ def parse_line(text: str, line: int | ast.Row) -> tuple[ast.Line, list[Diagnosti
         ]
     label, statements = plan(lexemes, row)
     return ast.Line(span, label, statements, comment), []
+
+
+def _too_long(row: ast.Row, code: str) -> Diagnostic:
+    return Diagnostic(
+        "E0106", Severity.ERROR,
+        f"this line has {len(code):,} characters of code; RL/I reads lines of up to "
+        f"{MAX_LINE_LENGTH:,}", ast.Span(row, 1, row, len(code) + 1),
+        help="put the statements on lines of their own (a comment after `'` may be as "
+             "long as you like)",
+    )
 
 
 def parse_program(text: str) -> tuple[ast.Program, list[Diagnostic]]:

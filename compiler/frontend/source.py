@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 from rl1.compiler.files import SourceError, read_bounded
 
-MAX_SOURCE_BYTES = 64 * 1024 * 1024
+MAX_SOURCE_BYTES = 8 * 1024 * 1024  # checking takes about 100 bytes a source byte
 LINE_BREAK = re.compile(r"\r\n|\r|\n")
 """A line end: LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them."""
 

@@ -41,6 +41,7 @@ CODES: dict[str, CodeInfo] = _entries(
     ("E0103", E, "a word that is not a variable"),
     ("E0104", E, "label not at the start of a line"),
     ("E0105", E, "malformed hex constant"),
+    ("E0106", E, "line too long"),
     ("E0190", E, "compiled code too large for .ilc"),
     ("E0191", E, "code past line 65535 with a debug section"),
     ("E0201", E, "label not exactly two digits"),

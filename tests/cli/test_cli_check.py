@@ -224,9 +224,17 @@ def test_a_megabyte_line_is_checked_and_shown_briefly(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("code", ["A=1" + "+1" * 250_000, "B=2;" * 250_000])
-def test_a_megabyte_line_of_code_is_parsed_in_one_pass(tmp_path: Path, code: str) -> None:
-    # Quadratic time on such a line (copying a growing list at every step) would make
-    # this test run for hours rather than seconds.
+def test_a_megabyte_line_of_code_is_refused_before_it_is_scanned(tmp_path: Path,
+                                                                  code: str) -> None:
+    # Checking it would take a gigabyte (language.md 3.4): E0106, and nothing else.
+    result = run("check", write(tmp_path, code + "\n(END)\n"), "--format", "json")
+    assert result.exit_code == 1
+    assert [(d["code"], d["line"]) for d in json.loads(result.stdout)] == [("E0106", 1)]
+
+
+@pytest.mark.parametrize("code", ["A=10" + "+1" * 9_998, "B=2;" * 5_000])
+def test_a_line_of_the_longest_length_read_is_checked(tmp_path: Path, code: str) -> None:
+    assert len(code) == 20_000
     result = run("check", write(tmp_path, code + "\n(END)\n"), "--format", "json")
     assert result.exit_code == 0
     assert "E01" not in result.stdout

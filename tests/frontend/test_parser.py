@@ -64,7 +64,7 @@ def test_multi_letter_word_and_bare_mnemonic_get_specific_messages() -> None:
 
 
 def test_messages_quote_an_excerpt_of_a_huge_token_but_span_all_of_it() -> None:
-    word = "AB" * 50_000
+    word = "AB" * 9_000
     _, [diagnostic] = parse_line(word + "=1", 1)
     assert diagnostic.code == "E0103"
     assert len(diagnostic.message) < 100
@@ -91,3 +91,12 @@ def test_a_line_with_a_syntax_error_keeps_its_label() -> None:
     assert diagnostic.code == "E0101" and not broken.ok
     assert broken.label == ast.LabelDef(ast.Span(2, 1, 2, 4), ":10", 10)
     assert broken.statements == ()
+
+
+def test_a_line_of_more_code_than_is_read_is_e0106_and_nothing_else() -> None:
+    line, [diagnostic] = parse_line("A=1;" * 5_000 + "B", 7)
+    assert (diagnostic.code, diagnostic.span.line) == ("E0106", 7)
+    assert "20,001 characters" in diagnostic.message
+    assert line.statements == () and not line.ok
+    long_comment, diagnostics = parse_line("A=1 '" + "x" * 100_000, 1)
+    assert diagnostics == [] and len(long_comment.statements) == 1
