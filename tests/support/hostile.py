@@ -1,0 +1,131 @@
+"""Hostile inputs for every `rl1c` command, and what each must still do.
+
+Shared by tests/cli/test_hostile_inputs.py (a bounded run in the test command) and
+bench/hostile_fuzz.py (a campaign as long as asked). `source_attack` and `ilc_attack`
+run the commands in-process on one input and return the problems found: an internal
+error, an exit status the command does not document, output written by a command that
+failed, a traceback on any stream.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from hypothesis import strategies as st
+
+from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.strategies import programs
+
+from . import EXAMPLES, ROOT
+from .cli import Result, rl1c
+from .ilc import with_crc
+
+# The exit statuses each command documents (README, the commands table).
+STATUSES = {
+    "check": {0, 1, 2},
+    "fmt": {0, 1, 2},
+    "compile": {0, 1, 2},
+    "run": {0, 1, 2, 10, 11, 12, 13},
+    "dis": {0, 1, 2},
+    "asm": {0, 1, 2},
+}
+BUDGET = "20000"  # instructions: a runaway input ends quickly
+
+
+def _mutated(text: bytes, draw: st.DrawFn) -> bytes:
+    data = bytearray(text)
+    for _ in range(draw(st.integers(1, 8))):
+        if not data:
+            data += draw(st.binary(min_size=1, max_size=8))
+            continue
+        at = draw(st.integers(0, len(data) - 1))
+        action = draw(st.sampled_from(["flip", "insert", "delete", "replace", "cut"]))
+        if action == "flip":
+            data[at] ^= 1 << draw(st.integers(0, 7))
+        elif action == "insert":
+            data[at:at] = draw(st.binary(min_size=1, max_size=16))
+        elif action == "delete":
+            del data[at:at + draw(st.integers(1, 16))]
+        elif action == "replace":
+            data[at] = draw(st.integers(0, 255))
+        else:
+            del data[at:]
+    return bytes(data)
+
+
+@st.composite
+def hostile_sources(draw: st.DrawFn) -> bytes:
+    """Arbitrary bytes, generated programs, and programs mutated byte by byte."""
+    kind = draw(st.sampled_from(["bytes", "program", "mutated"]))
+    if kind == "bytes":
+        return draw(st.binary(max_size=400))
+    program = draw(programs(max_lines=12)).encode("utf-8")
+    return program if kind == "program" else _mutated(program, draw)
+
+
+def _seed_ilc_files() -> list[bytes]:
+    sample = (EXAMPLES / "sample.rob").read_text(encoding="utf-8")
+    compiled = [compile_text(sample, "sample.rob", strip_debug=strip).output
+                for strip in (False, True)]
+    vectors = [bytes.fromhex(vector[key])
+               for group in sorted((ROOT / "spec" / "vectors").glob("*.json"))
+               for vector in json.loads(group.read_text(encoding="utf-8"))["vectors"]
+               for key in ("ilc", "ilc_stripped")]
+    return [data for data in compiled if data is not None] + vectors
+
+
+SEED_ILC_FILES = _seed_ilc_files()
+
+
+@st.composite
+def hostile_ilc_files(draw: st.DrawFn) -> bytes:
+    """Valid .ilc files (the sample's, the vectors') mutated, mostly with the CRC fixed
+    so that the mutation reaches the verifier rather than stopping at the checksum."""
+    data = _mutated(draw(st.sampled_from(SEED_ILC_FILES)), draw)
+    return with_crc(data) if len(data) >= 12 and draw(st.integers(0, 4)) else data
+
+
+def _problems(command: str, result: Result, written: Path | None) -> list[str]:
+    found = []
+    if result.exit_code not in STATUSES[command]:
+        found.append(f"{command}: exit status {result.exit_code}")
+    if b"internal error" in result.output_bytes or b"Traceback" in result.output_bytes:
+        found.append(f"{command}: {result.output_bytes[-300:]!r}")
+    if written is not None and result.exit_code != 0 and written.exists():
+        found.append(f"{command}: failed with status {result.exit_code} but wrote {written}")
+    return found
+
+
+def source_attack(data: bytes, folder: Path) -> list[str]:
+    """Every command that reads RL/I source, on `data`."""
+    source, output = folder / "hostile.rob", folder / "hostile.ilc"
+    source.write_bytes(data)
+    output.unlink(missing_ok=True)
+    found = _problems("check", rl1c("check", source), None)
+    found += _problems("check", rl1c("check", "--format", "sarif", "-", stdin=data), None)
+    found += _problems("fmt", rl1c("fmt", "--diff", source), None)
+    found += _problems("fmt", rl1c("fmt", "-", stdin=data), None)
+    found += _problems("compile", rl1c(source, "-o", output), output)
+    for engine in ("vm", "ast"):
+        found += _problems("run", rl1c("run", source, "--engine", engine, "--budget", BUDGET),
+                           None)
+    return found
+
+
+def ilc_attack(data: bytes, folder: Path) -> list[str]:
+    """The commands that read .ilc files, on `data`; `asm` on what `dis` printed must
+    give the same bytes back."""
+    binary, text, again = folder / "hostile.ilc", folder / "hostile.ils", folder / "again.ilc"
+    binary.write_bytes(data)
+    again.unlink(missing_ok=True)
+    found = _problems("run", rl1c("run", binary, "--budget", BUDGET), None)
+    shown = rl1c("dis", binary)
+    found += _problems("dis", shown, None)
+    if shown.exit_code == 0 and data[4:6] == bytes([1, 0]):  # the round trip is for 1.0
+        text.write_text(shown.stdout, encoding="utf-8")
+        built = rl1c("asm", text, "-o", again)
+        found += _problems("asm", built, again)
+        if built.exit_code != 0 or again.read_bytes() != data:
+            found.append(f"asm(dis(x)) != x: {built.output_bytes[-300:]!r}")
+    return found
