@@ -21,6 +21,9 @@ from .graph import JUMPS, Block, ControlFlowGraph
 from .handler_edges import add_handler_edges
 from .incremental import LineMemo
 
+_LABELS = operator.attrgetter("labels")
+_OPAQUE = operator.attrgetter("opaque")
+
 
 def build_cfg(program: ast.Program, memo: LineMemo | None = None) -> ControlFlowGraph:
     """The graph of `program`; `memo` may hold what an earlier check found out about
@@ -47,18 +50,18 @@ def _with_edges(cuts: list[Cut], summaries: list[BlockEffects], last_cuts: list[
     memo built from `last_cuts`: when the blocks keep their numbers, the labels and the
     opaque blocks, a block cut the same keeps its edges, so its Block is taken over
     (edited in place: the memo's last graph is not kept by anyone else)."""
+    # the few labelled and opaque blocks among thousands, found in C
+    labelled = list(itertools.compress(range(len(cuts)), map(_LABELS, cuts)))
+    opaque = list(itertools.compress(range(len(cuts)), map(_OPAQUE, cuts)))
     labels: dict[int, int] = {}  # label number -> the block its first definition names
-    opaque: list[int] = []
-    for index, block_cut in enumerate(cuts):
-        if block_cut.opaque:
-            opaque.append(index)
-        for label in block_cut.labels:
+    for index in labelled:
+        for label in cuts[index].labels:
             if label.number is not None:
                 labels.setdefault(label.number, index)
     exit_index = len(cuts) - 1
     nothing = BlockEffects.nothing()  # never changed, so one does for all empty blocks
     if (previous is None or len(last_cuts) != len(cuts) or previous.labels != labels
-            or [block.index for block in previous.blocks if block.opaque] != opaque):
+            or previous.opaque != opaque):
         blocks = [Block(index, block_cut.statements, block_cut.labels, block_cut.opaque,
                         [], [], nothing) for index, block_cut in enumerate(cuts)]
         changed: Iterable[int] = range(len(cuts) - 1)
@@ -72,7 +75,7 @@ def _with_edges(cuts: list[Cut], summaries: list[BlockEffects], last_cuts: list[
                                   block_cut.opaque, [], [], nothing)
         if changed and changed[-1] == exit_index:
             changed.pop()  # the exit block has no effects nor edges
-    labelled = sorted(set(labels.values()))
+    named = sorted(set(labels.values()))
     for index in changed:
         block = blocks[index]
         summary = summaries[index]
@@ -80,8 +83,9 @@ def _with_edges(cuts: list[Cut], summaries: list[BlockEffects], last_cuts: list[
         following = block.index + 1
         last = block.statements[-1] if block.statements else None
         if block.opaque:
-            block.successors = list(dict.fromkeys([following, *labelled, exit_index]))
+            block.successors = list(dict.fromkeys([following, *named, exit_index]))
         elif isinstance(last, JUMPS):
+            block.jump = last
             number = last.target.number
             target = labels.get(number) if number is not None else None
             found = opaque if target is None else [target]
@@ -91,4 +95,4 @@ def _with_edges(cuts: list[Cut], summaries: list[BlockEffects], last_cuts: list[
                 block.successors = [following, *(other for other in found if other != following)]
         elif last is None or not ast.is_end(last):
             block.successors = [following]
-    return ControlFlowGraph(blocks, labels)
+    return ControlFlowGraph(blocks, labels, labelled, opaque)
