@@ -36,6 +36,9 @@ class Cut:
     labels: list[ast.LabelDef]
     opaque: bool
     parts: list[Part]  # the effects of its runs that do something (summarized segments only)
+    # what the whole block does, once the incremental memo has combined its parts; a cut
+    # reused by the next walk keeps it
+    effects: BlockEffects | None = None
 
 
 @dataclass(slots=True)
@@ -102,15 +105,15 @@ def _cut(lines: tuple[ast.Line, ...], start: int, cuts: list[Cut],
     parts: list[Part] = []  # the open block's
     pending: list[ast.LabelDef] = []  # labels seen since the last statement
     shift = 0 if resume is None else len(lines) - len(resume[0].lines)
-    # the last walk's restart points: line -> its position among them
-    old_restarts = {} if resume is None else {
-        line: position for position, (line, _) in enumerate(resume[0].restarts)}
+    old_restarts = [] if resume is None else resume[0].restarts  # sorted by line
     for number, (line, segments) in enumerate(
             zip(lines[start:], segments_of(lines[start:]), strict=True), start=start):
         if statements is None and not pending:
-            if resume is not None and number >= resume[1] and number - shift in old_restarts:
-                return _resumed(lines, cuts, restarts, resume[0],
-                                old_restarts[number - shift])
+            if resume is not None and number >= resume[1]:
+                # found by bisection: a dict of them all would cost the whole program
+                position = bisect.bisect_left(old_restarts, (number - shift, 0))
+                if position < len(old_restarts) and old_restarts[position][0] == number - shift:
+                    return _resumed(lines, cuts, restarts, resume[0], position)
             restarts.append((number, len(cuts)))
         if line.label is not None:
             statements = None
@@ -143,5 +146,8 @@ def _resumed(lines: tuple[ast.Line, ...], cuts: list[Cut], restarts: list[tuple[
     old_cuts_before = last.restarts[position][1]
     added = len(cuts) - old_cuts_before
     cuts += last.cuts[old_cuts_before:]
-    restarts += [(line + shift, count + added) for line, count in last.restarts[position:]]
+    if shift == 0 and added == 0:
+        restarts += last.restarts[position:]
+    else:
+        restarts += [(line + shift, count + added) for line, count in last.restarts[position:]]
     return Walk(lines, cuts, restarts)

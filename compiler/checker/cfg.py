@@ -9,6 +9,10 @@ summarizes and cuts again only what it changed.
 
 from __future__ import annotations
 
+import itertools
+import operator
+from collections.abc import Iterable
+
 from rl1.compiler.frontend import ast
 
 from .blocks import Cut, cut, runs_of
@@ -16,6 +20,9 @@ from .effects import BlockEffects, summarize
 from .graph import JUMPS, Block, ControlFlowGraph
 from .handler_edges import add_handler_edges
 from .incremental import LineMemo
+
+_LABELS = operator.attrgetter("labels")
+_OPAQUE = operator.attrgetter("opaque")
 
 
 def build_cfg(program: ast.Program, memo: LineMemo | None = None) -> ControlFlowGraph:
@@ -28,40 +35,64 @@ def build_cfg(program: ast.Program, memo: LineMemo | None = None) -> ControlFlow
     else:
         walk, summaries = memo.cut(program.lines)
         cuts = walk.cuts
-    graph = _with_edges(cuts, summaries)
+    previous = memo.last_graph if memo is not None else None
+    graph = _with_edges(cuts, summaries, *(previous or ([], None)))
+    if memo is not None:
+        memo.last_graph = (cuts, graph)
     add_handler_edges(graph)
     return graph
 
 
-def _with_edges(cuts: list[Cut], summaries: list[BlockEffects]) -> ControlFlowGraph:
+def _with_edges(cuts: list[Cut], summaries: list[BlockEffects], last_cuts: list[Cut],
+                previous: ControlFlowGraph | None) -> ControlFlowGraph:
     """The blocks the cuts stand for (the exit block last), with their effects and
-    ordinary edges (everything but the handler edges)."""
-    blocks: list[Block] = []
+    ordinary edges (everything but the handler edges). `previous` is the graph the same
+    memo built from `last_cuts`: when the blocks keep their numbers, the labels and the
+    opaque blocks, a block cut the same keeps its edges, so its Block is taken over
+    (edited in place: the memo's last graph is not kept by anyone else)."""
+    # the few labelled and opaque blocks among thousands, found in C
+    labelled = list(itertools.compress(range(len(cuts)), map(_LABELS, cuts)))
+    opaque = list(itertools.compress(range(len(cuts)), map(_OPAQUE, cuts)))
     labels: dict[int, int] = {}  # label number -> the block its first definition names
-    nothing = BlockEffects.nothing()  # never changed, so one does for all empty blocks
-    for index, block_cut in enumerate(cuts):
-        blocks.append(Block(index, block_cut.statements, block_cut.labels, block_cut.opaque,
-                            [], [], nothing))
-        for label in block_cut.labels:
+    for index in labelled:
+        for label in cuts[index].labels:
             if label.number is not None:
                 labels.setdefault(label.number, index)
-    exit_index = len(blocks) - 1
-    opaque = [block.index for block in blocks if block.opaque]
-    labelled = sorted(set(labels.values()))
-    for block, summary in zip(blocks[:-1], summaries, strict=True):
+    exit_index = len(cuts) - 1
+    nothing = BlockEffects.nothing()  # never changed, so one does for all empty blocks
+    if (previous is None or len(last_cuts) != len(cuts) or previous.labels != labels
+            or previous.opaque != opaque):
+        blocks = [Block(index, block_cut.statements, block_cut.labels, block_cut.opaque,
+                        [], [], nothing) for index, block_cut in enumerate(cuts)]
+        changed: Iterable[int] = range(len(cuts) - 1)
+    else:
+        blocks = previous.blocks
+        # the blocks whose cut is new, found in C: an edit changes one or two of thousands
+        changed = list(itertools.compress(range(len(cuts)), map(operator.is_not, cuts, last_cuts)))
+        for index in changed:
+            block_cut = cuts[index]
+            blocks[index] = Block(index, block_cut.statements, block_cut.labels,
+                                  block_cut.opaque, [], [], nothing)
+        if changed and changed[-1] == exit_index:
+            changed.pop()  # the exit block has no effects nor edges
+    named = sorted(set(labels.values()))
+    for index in changed:
+        block = blocks[index]
+        summary = summaries[index]
         block.effects = summary
         following = block.index + 1
         last = block.statements[-1] if block.statements else None
         if block.opaque:
-            block.successors = list(dict.fromkeys([following, *labelled, exit_index]))
+            block.successors = list(dict.fromkeys([following, *named, exit_index]))
         elif isinstance(last, JUMPS):
+            block.jump = last
             number = last.target.number
             target = labels.get(number) if number is not None else None
             found = opaque if target is None else [target]
             if isinstance(last, ast.Goto):
                 block.successors = list(found)
             else:
-                block.successors = [following, *(index for index in found if index != following)]
+                block.successors = [following, *(other for other in found if other != following)]
         elif last is None or not ast.is_end(last):
             block.successors = [following]
-    return ControlFlowGraph(blocks, labels)
+    return ControlFlowGraph(blocks, labels, labelled, opaque)

@@ -58,12 +58,9 @@ class Block:
     successors: list[int] = field(default_factory=list)
     handlers: list[HandlerEdge] = field(default_factory=list)
     effects: BlockEffects = field(default_factory=BlockEffects.nothing)
-
-    @property
-    def jump(self) -> ast.Goto | ast.CondJump | None:
-        """The `#NN` or `?V..#NN` that ends the block, if one does."""
-        last = self.statements[-1] if self.statements else None
-        return last if isinstance(last, JUMPS) else None
+    # the `#NN` or `?V..#NN` that ends the block, if one does: a field, not a property,
+    # so that the rules gather the jumps of thousands of blocks in C (attrgetter)
+    jump: ast.Goto | ast.CondJump | None = None
 
     @property
     def ends(self) -> bool:
@@ -75,6 +72,8 @@ class Block:
 class ControlFlowGraph:
     blocks: list[Block]
     labels: dict[int, int]  # label number -> the block its first definition names
+    labelled: list[int] = field(default_factory=list)  # the blocks labels name, in order
+    opaque: list[int] = field(default_factory=list)  # the opaque blocks, in order
     # handler_edges.py's device state on entry to each block (tracing modes and motion
     # that may be in effect); 0 for a block no path reaches
     device_on_entry: list[int] = field(default_factory=list)

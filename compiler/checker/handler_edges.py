@@ -13,9 +13,9 @@ def add_handler_edges(graph: ControlFlowGraph) -> None:
     """Fill in the graph's device state on entry to each block and its handler edges."""
     graph.device_on_entry, triggers = trace(graph)
     for block, found in zip(graph.blocks, triggers, strict=True):
-        if found:
-            block.handlers = [HandlerEdge(label, index, graph.labels.get(label))
-                              for label, (index, _) in sorted(found.items())]
+        # a block the incremental check took over may hold the last check's edges
+        block.handlers = [HandlerEdge(label, index, graph.labels.get(label))
+                          for label, (index, _) in sorted(found.items())] if found else []
 
 
 def trace(graph: ControlFlowGraph) -> tuple[list[int], list[device.Triggers]]:

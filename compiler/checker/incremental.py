@@ -12,11 +12,13 @@ comes.
 from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
+from typing import cast
 
 from rl1.compiler.frontend import ast
 
-from .blocks import Part, Segments, Walk, cut, cut_again
+from .blocks import Cut, Segments, Walk, cut, cut_again
 from .effects import BlockEffects, combine, line_segments
+from .graph import ControlFlowGraph
 
 
 class LineMemo:
@@ -28,8 +30,9 @@ class LineMemo:
 
     def __init__(self) -> None:
         self._entries: dict[int, tuple[ast.Line, Segments]] = {}
-        self._blocks: dict[tuple[Part, ...], BlockEffects] = {}  # the last check's
         self.last_walk: Walk | None = None  # how the last check cut its program
+        # the last check's cuts and graph, whose blocks cfg.py reuses for the cuts it shares
+        self.last_graph: tuple[list[Cut], ControlFlowGraph] | None = None
 
     def cut(self, lines: tuple[ast.Line, ...]) -> tuple[Walk, list[BlockEffects]]:
         """The cut of `lines` into blocks, and the effects of each block but the exit."""
@@ -39,7 +42,7 @@ class LineMemo:
             walk = cut_again(lines, self.last_walk, self.segments_of)
         self.last_walk = walk
         self._forget_all_but(lines)
-        return walk, self._block_effects([block.parts for block in walk.cuts[:-1]])
+        return walk, _block_effects(walk.cuts[:-1])
 
     def segments_of(self, lines: Sequence[ast.Line]) -> Iterator[Segments]:
         """The segments of each line, computing those of lines not seen before; lazily,
@@ -58,18 +61,11 @@ class LineMemo:
             self._entries = {id(entry[0]): entry for entry in kept
                              if entry is not None}
 
-    def _block_effects(self, parts: list[list[Part]]) -> list[BlockEffects]:
-        """`effects.combine` of each block's parts, reusing the last check's for a block
-        made of the same runs (summaries are compared by identity)."""
-        known = self._blocks
-        kept: dict[tuple[Part, ...], BlockEffects] = {}
-        found = []
-        for block_parts in parts:
-            key = tuple(block_parts)
-            effects = known.get(key)
-            if effects is None:
-                effects = combine(block_parts)
-            kept[key] = effects
-            found.append(effects)
-        self._blocks = kept
-        return found
+
+def _block_effects(cuts: list[Cut]) -> list[BlockEffects]:
+    """`effects.combine` of each cut's parts, kept on the cut: a cut the walk took over
+    from the last one has them already."""
+    for block_cut in cuts:
+        if block_cut.effects is None:
+            block_cut.effects = combine(block_cut.parts)
+    return [cast(BlockEffects, block_cut.effects) for block_cut in cuts]

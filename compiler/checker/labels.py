@@ -8,6 +8,8 @@ unused labels are not reported: they are likely cascades of that error.
 
 from __future__ import annotations
 
+import operator
+
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Related, Severity
 from rl1.vm.language import HANDLER_LABELS
@@ -18,8 +20,8 @@ from .graph import ControlFlowGraph
 def check_labels(graph: ControlFlowGraph) -> list[Diagnostic]:
     found: list[Diagnostic] = []
     first: dict[int, ast.LabelDef] = {}
-    for block in graph.blocks:
-        for label in block.labels:
+    for index in graph.labelled:
+        for label in graph.blocks[index].labels:
             if label.number is None:
                 continue
             if label.number in first:
@@ -27,14 +29,14 @@ def check_labels(graph: ControlFlowGraph) -> list[Diagnostic]:
             else:
                 first[label.number] = label
 
-    jumps = [block.jump for block in graph.blocks]
-    targets = {jump.target.number for jump in jumps if jump is not None}
-    blind = any(block.opaque and not block.labels for block in graph.blocks)
+    jumps = list(filter(None, map(operator.attrgetter("jump"), graph.blocks)))
+    targets = {jump.target.number for jump in jumps}
+    blind = any(not graph.blocks[index].labels for index in graph.opaque)
     if not blind:
         found.extend(_undefined(jump.target, first) for jump in jumps
-                     if jump is not None and jump.target.number is not None
+                     if jump.target.number is not None
                      and jump.target.number not in first)
-    if not any(block.opaque for block in graph.blocks):
+    if not graph.opaque:
         found.extend(_unused(graph, number, label) for number, label in first.items()
                      if number not in targets and number not in HANDLER_LABELS)
     return found

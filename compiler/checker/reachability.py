@@ -20,8 +20,8 @@ REMOVE_OR_LABEL = "remove it, or start its line with a label and jump there"
 def check_reachability(program: ast.Program, graph: ControlFlowGraph) -> list[Diagnostic]:
     found: list[Diagnostic] = []
     run: list[Block] = []
-    for block in graph.blocks:
-        if not graph.reachable(block.index):
+    for block, entry in zip(graph.blocks, graph.device_on_entry, strict=True):
+        if not entry:
             run.append(block)
         elif run:
             found.extend(_unreachable(graph, run))
@@ -33,10 +33,13 @@ def check_reachability(program: ast.Program, graph: ControlFlowGraph) -> list[Di
 
 
 def _unreachable(graph: ControlFlowGraph, run: list[Block]) -> list[Diagnostic]:
-    statements = [statement for block in run for statement in block.statements]
-    if not statements:
+    # the first and last statements only: a run may be most of the program
+    first_statement = next((block.statements[0] for block in run if block.statements), None)
+    last_statement = next((block.statements[-1] for block in reversed(run)
+                           if block.statements), None)
+    if first_statement is None or last_statement is None:
         return []  # only lines with syntax errors
-    span = statements[0].span.cover(statements[-1].span)
+    span = first_statement.span.cover(last_statement.span)
     first = run[0]
     before = graph.blocks[first.index - 1].statements[-1:]  # the entry block is reachable
     if first.labels:

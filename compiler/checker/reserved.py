@@ -9,6 +9,7 @@ to write them all.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable
 
 from rl1.compiler.frontend import ast
@@ -24,23 +25,18 @@ OnRead = Callable[[ast.Var], None]
 
 def check_reserved(graph: ControlFlowGraph) -> list[Diagnostic]:
     blocks = graph.blocks
-    # "May be unset" only shrinks, so a block's effect is `state & keep`, and a handler
-    # edge's is `state & keep` up to its statement.
-    keep = [ALL_RESERVED] * len(blocks)
-    keep_until: list[list[tuple[int, int]]] = [[] for _ in blocks]
-    for block in blocks:
-        if block.opaque:
-            keep[block.index] = 0
-            continue
-        writes = block.effects.writes
-        for edge in block.handlers:
-            if edge.target is not None:
-                keep_until[block.index].append((edge.target, _kept(writes, edge.index)))
-        keep[block.index] = _kept(writes, len(block.statements))  # past the last statement
 
+    # "May be unset" only shrinks, so a block's effect is `state & keep`, and a handler
+    # edge's is `state & keep` up to its statement. Computed as the solver visits a
+    # block: blocks no path reaches cost nothing.
     def transfer(index: int, state: int) -> tuple[int, list[tuple[int, int]]]:
-        return state & keep[index], [(target, state & kept)
-                                     for target, kept in keep_until[index]]
+        block = blocks[index]
+        if block.opaque:
+            return 0, []
+        writes = block.effects.writes
+        return state & _kept(writes, len(block.statements)), [
+            (edge.target, state & _kept(writes, edge.index))
+            for edge in block.handlers if edge.target is not None]
 
     states = dataflow.solve(graph, ALL_RESERVED, transfer)
     found: list[Diagnostic] = []
@@ -48,9 +44,10 @@ def check_reserved(graph: ControlFlowGraph) -> list[Diagnostic]:
     def report(var: ast.Var) -> None:
         found.append(_unset(var))
 
-    for block in blocks:
-        state = states[block.index]
-        if state & block.effects.reads and graph.reachable(block.index):
+    for index in itertools.compress(range(len(blocks)), states):  # in C: most states are 0
+        block = blocks[index]
+        state = states[index]
+        if state & block.effects.reads and graph.reachable(index):
             for statement in block.statements:
                 state = _walk(statement, state, report)
     return found

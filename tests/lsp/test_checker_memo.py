@@ -95,3 +95,21 @@ def test_the_memo_forgets_replaced_lines_and_still_agrees() -> None:
     for program in (short, long, short):  # the long program's lines are dropped, then back
         assert check_program(program, memo) == check_program(program)
         assert shape(build_cfg(program, memo)) == shape(build_cfg(program))
+
+
+@settings(max_examples=100, deadline=None)
+@given(text=st.lists(LINE, max_size=15).map("\n".join),
+       edits=st.lists(line_edits(), min_size=1, max_size=8))
+def test_blocks_taken_over_from_the_last_graph_agree_with_new_ones(
+        text: str, edits: list[tuple[str, int, str]]) -> None:
+    """The memo's graph reuses the Blocks of cuts an edit did not touch: their jumps,
+    and the graph's lists of labelled and opaque blocks, are those of a fresh graph."""
+    columns = Columns()
+    document = Document("file:///t.rob", text, 1)
+    build_cfg(document.program(), document.memo)
+    for edit in edits:
+        apply(document, edit, columns)
+        warm, fresh = build_cfg(document.program(), document.memo), build_cfg(document.program())
+        assert [block.jump for block in warm.blocks] == [block.jump for block in fresh.blocks]
+        assert [block.index for block in warm.blocks] == list(range(len(fresh.blocks)))
+        assert (warm.labelled, warm.opaque) == (fresh.labelled, fresh.opaque)
