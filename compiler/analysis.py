@@ -10,7 +10,7 @@ from .frontend.diagnostics import Diagnostic, sort_key
 from .frontend.parser import parse_program
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class Analysis:
     program: Program
     diagnostics: list[Diagnostic]

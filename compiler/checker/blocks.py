@@ -28,7 +28,7 @@ Part = tuple[int, BlockEffects]  # a run's effects, and where in its block the r
 SegmentsOf = Callable[[Sequence[ast.Line]], Iterable[Segments]]
 
 
-@dataclass(slots=True)
+@dataclass(slots=True, eq=False)
 class Cut:
     """A block as the cutter cut it."""
 
@@ -41,7 +41,7 @@ class Cut:
     effects: BlockEffects | None = None
 
 
-@dataclass(slots=True)
+@dataclass(slots=True, eq=False)
 class Walk:
     """How a program was cut: its lines, the blocks (the exit block last), and the
     restart points, each as (line index, number of blocks cut before it)."""

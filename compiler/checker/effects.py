@@ -49,7 +49,7 @@ class BlockEffects:
 Segment = tuple[tuple[ast.Statement, ...], BlockEffects | None, bool]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class _CallFacts:
     writes: int
     observes: bool

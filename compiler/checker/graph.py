@@ -47,7 +47,7 @@ class HandlerEdge:
     target: int | None  # the handler's block; None when the program does not define it
 
 
-@dataclass(slots=True)
+@dataclass(slots=True, eq=False)
 class Block:
     """A basic block. The graph's construction fills in its edges and effects."""
 
@@ -68,7 +68,7 @@ class Block:
         return bool(self.statements) and ast.is_end(self.statements[-1])
 
 
-@dataclass(slots=True)
+@dataclass(slots=True, eq=False)
 class ControlFlowGraph:
     blocks: list[Block]
     labels: dict[int, int]  # label number -> the block its first definition names

@@ -49,7 +49,7 @@ _LONGEST_CACHED_PLAN = 64
 huge line's plan could fill the cache."""
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class Rejection:
     """The outcome of a line the grammar rejects: the index of the token the automaton
     could not take (None: the end of the line) and the terminals it expected there."""

@@ -17,7 +17,7 @@ from rl1.compiler.frontend.diagnostics import Severity
 _EXPLANATIONS = os.path.join(os.path.dirname(__file__), "explanations")
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(frozen=True, slots=True, eq=False)
 class CodeInfo:
     code: str
     severity: Severity
