@@ -22,7 +22,7 @@ from rl1.compiler.checker import LineMemo, check_line
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.collector import collector_paused
 from rl1.compiler.frontend.diagnostics import Diagnostic
-from rl1.compiler.frontend.parser import parse_line
+from rl1.compiler.frontend.parser import MAX_LINE_LENGTH, parse_line
 from rl1.compiler.frontend.source import LINE_BREAK
 
 from .positions import Columns, span_range
@@ -35,9 +35,9 @@ MAX_ANALYSED_CHARACTERS = 2_000_000
 """Beyond this a document is kept in sync but not analysed. An RL/I program of 10,000
 lines is about 200,000 characters; parsing tens of megabytes would stall the server."""
 
-MAX_ANALYSED_LINE = 20_000
+MAX_ANALYSED_LINE = MAX_LINE_LENGTH
 """Nor is a document with a line longer than this (the paper's lines are under 80
-characters): a line is parsed whole at each edit, and a megabyte line takes seconds."""
+characters), the longest line of code `rl1c check` reads (language.md 3.4)."""
 
 
 @dataclass(slots=True)
