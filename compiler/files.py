@@ -1,9 +1,9 @@
 """Reading input files within a size bound, and writing output files all at once.
 
 Every OS failure of a read becomes a SourceError whose message says what to do. A write
-goes to a temporary file in the target's directory (the same file system, so
-the rename is atomic), which then replaces the target. On any failure the temporary file
-is removed and the target, if it existed, is left as it was.
+replaces a regular file through a temporary file renamed over it, so that a failure
+leaves the old file as it was; it never replaces what is not a regular file, nor a
+read-only file unless forced (`write_atomically`).
 """
 
 from __future__ import annotations
