@@ -16,12 +16,9 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
+from rl1.compiler.frontend.ast import BinaryOperator, Relation, Step
 from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES
-
-if TYPE_CHECKING:  # until ast.py defines these aliases at run time
-    from rl1.compiler.frontend.ast import BinaryOperator, Relation, Step
 
 BlockId = str
 """`Lnn` for the block a source label `:nn` starts, `Bn` for the others."""

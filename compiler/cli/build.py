@@ -17,7 +17,7 @@ import click
 
 from rl1.compiler.files import SourceError
 from rl1.compiler.frontend.source import Source, read_source
-from rl1.compiler.reporting.render import EXIT_ERRORS, FileDiagnostics
+from rl1.compiler.reporting.render import EXIT_ERRORS, ColorChoice, FileDiagnostics, Format
 
 from .command import (
     PATH,
@@ -39,9 +39,8 @@ from .streams import (
     write_stdout_bytes,
 )
 
-if TYPE_CHECKING:  # names that exist for the type checker only
+if TYPE_CHECKING:  # the back end and the engines load only for the command that runs them
     from rl1.compiler.backend.driver import Emit
-    from rl1.compiler.reporting.render import ColorChoice, Format
 
     from .run import Engine
 

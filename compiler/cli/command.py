@@ -20,7 +20,7 @@ import click
 
 from rl1.compiler.reporting.render import COLOR_CHOICES, EXIT_ERRORS, EXIT_USAGE, FORMATS
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # click's completion module loads only when a shell asks
     from click.shell_completion import CompletionItem
 
 EXIT_INTERNAL = 3

@@ -13,15 +13,19 @@ import click
 
 from rl1.compiler.frontend.source import Source
 from rl1.compiler.reporting.catalogue import CODES
-from rl1.compiler.reporting.render import EXIT_ERRORS, EXIT_USAGE, FileDiagnostics
+from rl1.compiler.reporting.render import (
+    EXIT_ERRORS,
+    EXIT_USAGE,
+    ColorChoice,
+    FileDiagnostics,
+    Format,
+)
 
 from .command import PATH, Command, Failure, color_option, force_option, format_option
 from .streams import emit, read_input, write_stdout_bytes
 
-if TYPE_CHECKING:  # names that exist for the type checker only
+if TYPE_CHECKING:  # click's completion module loads only when a shell asks
     from click.shell_completion import CompletionItem
-
-    from rl1.compiler.reporting.render import ColorChoice, Format
 
 SECTION = "RL/I programs"
 

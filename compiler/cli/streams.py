@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import os
 import sys
-from typing import TYPE_CHECKING
 
 from rl1.compiler.files import SourceError, write_atomically
 from rl1.compiler.frontend.ast import Span
@@ -13,16 +12,15 @@ from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.compiler.frontend.source import MAX_SOURCE_BYTES, Source, decode, read_source
 from rl1.compiler.reporting.render import (
     EXIT_ERRORS,
+    ColorChoice,
     FileDiagnostics,
+    Format,
     exit_status,
     report,
     use_color,
 )
 
 from .command import Failure
-
-if TYPE_CHECKING:  # names that exist for the type checker only
-    from rl1.compiler.reporting.render import ColorChoice, Format
 
 STDIN_NAME = "<stdin>"
 MAX_ILC_BYTES = 16 * 1024 * 1024  # far more than any .ilc file holds
