@@ -141,15 +141,24 @@ class DiagnosticsScheduler:
         self._tasks: dict[str, asyncio.Task[None]] = {}
         self._results: dict[str, Checked] = {}
         self._last_change: dict[str, float] = {}
+        self._waiting: dict[str, Document] = {}  # checks that have not started yet
 
     def schedule(self, document: Document) -> None:
-        self.cancel(document.uri)
+        """Check the document's current version soon. A change that joins a burst
+        leaves the burst's waiting check in place, which checks whatever version is
+        current when the burst ends: a task per change would cost more than the edit."""
+        uri = document.uri
+        self._results.pop(uri, None)
         loop = asyncio.get_running_loop()
         now = loop.time()
-        wait = wait_before_check(self._last_change.get(document.uri), now)
-        self._last_change[document.uri] = now
-        task = loop.create_task(self._run(document, document.version, wait))
-        self._tasks[document.uri] = task
+        wait = wait_before_check(self._last_change.get(uri), now)
+        self._last_change[uri] = now
+        if wait and self._waiting.get(uri) is document:
+            return
+        self.cancel(uri)
+        self._waiting[uri] = document
+        task = loop.create_task(self._run(document, wait))
+        self._tasks[uri] = task
         task.add_done_callback(self._finished)
 
     def cancel(self, uri: str) -> None:
@@ -157,6 +166,7 @@ class DiagnosticsScheduler:
         if task is not None:
             task.cancel()
         self._results.pop(uri, None)
+        self._waiting.pop(uri, None)
 
     def close(self, uri: str) -> None:
         """Forget a closed document and clear its diagnostics in the client."""
@@ -176,8 +186,13 @@ class DiagnosticsScheduler:
             self._results[document.uri] = checked
         return checked
 
-    async def _run(self, document: Document, version: int, wait: float) -> None:
+    async def _run(self, document: Document, wait: float) -> None:
         await asyncio.sleep(wait)
+        loop = asyncio.get_running_loop()
+        while wait and (quiet := loop.time() - self._last_change[document.uri]) < BURST_SECONDS:
+            await asyncio.sleep(BURST_SECONDS - quiet)  # the burst goes on
+        del self._waiting[document.uri]
+        version = document.version
         if document.too_large:
             self._send(document, version, [too_large_notice(document)])
             return

@@ -8,19 +8,30 @@ honoured exactly.
 
 from __future__ import annotations
 
+import asyncio
+import json
 import logging
+import sys
 from collections.abc import Callable, Generator
+from functools import partial
 from importlib.metadata import version
-from typing import Any
+from threading import Event
+from typing import Any, BinaryIO
 
 import click
 from lsprotocol import types
-from pygls.exceptions import JsonRpcException
+from pygls.exceptions import (
+    JsonRpcException,
+    JsonRpcInvalidRequest,
+    JsonRpcParseError,
+    JsonRpcServerNotInitialized,
+)
+from pygls.io_ import StdoutWriter
 from pygls.lsp.server import LanguageServer
 from pygls.protocol import LanguageServerProtocol
 from pygls.protocol.language_server import lsp_method
 
-from . import actions, checking, completion, formatting, hints, hover, navigation, tokens
+from . import actions, checking, completion, formatting, framing, hints, hover, navigation, tokens
 from .document import Document
 from .positions import UTF16, Columns
 
@@ -29,8 +40,88 @@ NAME = "rl1-lsp"
 
 class Rl1Protocol(LanguageServerProtocol):
     """Passes document synchronisation straight to the server's handlers, leaving
-    pygls' own copy of the documents out, and answers requests whose parameters do not
-    fit the protocol (pygls only logs them, leaving the client waiting forever)."""
+    pygls' own copy of the documents out, and answers what pygls leaves unanswered,
+    which leaves the client waiting forever: requests whose parameters do not fit the
+    protocol, malformed JSON, JSON that is no message, and requests out of the
+    session's order (before `initialize`, after `shutdown`)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        self.initialize_received = False  # before pygls' __init__, which reads `ready`
+        super().__init__(*args, **kwargs)
+
+    def receive(self, body: bytes) -> None:
+        """Handle one message's body, as read by framing.read_messages."""
+        try:
+            data = json.loads(body)
+        except ValueError as error:  # JSONDecodeError and UnicodeDecodeError
+            self._refuse(None, JsonRpcParseError(
+                f"the message is not JSON in UTF-8 ({error}): send a JSON-RPC message"))
+            return
+        if not isinstance(data, dict) or "jsonrpc" not in data:  # JSON, but no message
+            msg_id = data.get("id") if isinstance(data, dict) else None
+            self._refuse(msg_id if isinstance(msg_id, int | str) else None, JsonRpcInvalidRequest(
+                "not a JSON-RPC 2.0 message: send an object with \"jsonrpc\": \"2.0\""))
+            return
+        try:
+            message = self.structure_message(data)
+        except JsonRpcException as error:  # answered by structure_message if a request
+            logging.warning("a message that does not fit LSP: %s", error)
+            return
+        try:
+            if type(message) is types.DidChangeTextDocumentNotification and self.ready:
+                # The one message a burst repeats a thousand times: pygls' dispatch
+                # costs five times the edit itself.
+                self.fm.features[types.TEXT_DOCUMENT_DID_CHANGE](message.params)
+            else:
+                self.handle_message(message)
+        except Exception as error:  # as pygls' reader does: log, tell the client, go on
+            logging.exception("handling a message failed")
+            self._server._report_server_error(error, JsonRpcException)
+
+    @property
+    def ready(self) -> bool:
+        """Between `initialize` and `shutdown`: notifications are handled."""
+        return self.initialize_received and not self._shutdown
+
+    def handle_message(self, message: Any) -> None:
+        method = getattr(message, "method", None)
+        if method is not None and hasattr(message, "id"):  # a request
+            if self._shutdown:
+                self._refuse(message.id, JsonRpcInvalidRequest(
+                    f"{method} after shutdown: the server only accepts exit now"))
+                return
+            if method == types.INITIALIZE and self.initialize_received:
+                self._refuse(message.id, JsonRpcInvalidRequest(
+                    "initialize was already received: send it once per session"))
+                return
+            if method != types.INITIALIZE and not self.initialize_received:
+                self._refuse(message.id, JsonRpcServerNotInitialized(
+                    f"{method} before initialize: send initialize first"))
+                return
+            self.initialize_received = True
+        elif method not in (None, types.EXIT) and not self.initialize_received:
+            logging.warning("%s before initialize: dropped, as LSP asks", method)
+            return
+        super().handle_message(message)
+
+    def _handle_notification(self, method_name: str, params: Any) -> None:
+        # pygls files the future of a notification's handler under a fresh id that no
+        # response ever removes: one entry per didChange, megabytes per burst of edits.
+        outstanding = set(self._request_futures)
+        super()._handle_notification(method_name, params)
+        for msg_id in self._request_futures.keys() - outstanding:
+            future = self._request_futures[msg_id]
+            if future.done():
+                del self._request_futures[msg_id]
+            else:
+                future.add_done_callback(partial(self._forget_future, msg_id))
+
+    def _forget_future(self, msg_id: int | str, _: object) -> None:
+        self._request_futures.pop(msg_id, None)
+
+    def _refuse(self, msg_id: int | str | None, error: JsonRpcException) -> None:
+        logging.warning("%s", error.message)
+        self._send_response(msg_id, error=error.to_response_error())  # type: ignore[arg-type]
 
     def structure_message(self, data: dict[str, Any]) -> Any:
         try:
@@ -71,6 +162,21 @@ class Rl1Server(LanguageServer):
         self.checks = checking.DiagnosticsScheduler(
             self.text_document_publish_diagnostics, lambda: self.columns)
         self.token_history = tokens.TokenHistory()
+
+    def start_io(self, stdin: BinaryIO | None = None, stdout: BinaryIO | None = None) -> None:
+        """Serve over standard input and output, with framing.py's reader in place of
+        pygls' (the rest as pygls' own start_io). LSP's `exit` ends the process with
+        the status LSP gives it."""
+        self._stop_event = Event()
+        self.protocol.set_writer(StdoutWriter(stdout or sys.stdout.buffer))
+        fd = (stdin or sys.stdin.buffer).fileno()
+        assert isinstance(self.protocol, Rl1Protocol)
+        try:
+            asyncio.run(framing.read_messages(fd, self.protocol.receive, self._stop_event))
+        except BrokenPipeError:
+            logging.error("the client closed its end of the connection: exiting")
+        finally:
+            self.shutdown()  # type: ignore[no-untyped-call]  # pygls has no hints here
 
     def document(self, uri: str) -> Document | None:
         """An open document the server analyses; None for unknown or huge ones."""

@@ -1,0 +1,137 @@
+"""The base protocol's framing on standard input: `Content-Length` headers, each
+message's body, and what to do when a client breaks them.
+
+pygls' reader trusts its client: a huge `Content-Length` is read in one allocation
+(MemoryError), and a header it does not recognise leaves it waiting for a header that
+never comes. This reader bounds every read (a header line, a message), accepts LF as
+well as CRLF line ends, and after broken framing skips to the next `Content-Length`
+header, saying on standard error what it skipped.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import os
+import re
+import threading
+from collections.abc import Callable
+
+log = logging.getLogger(__name__)
+
+MAX_MESSAGE = 64 * 2**20
+"""The largest body accepted, in bytes: 6 times the largest document analysed, which
+JSON's escapes may double or so."""
+MAX_HEADER_LINE = 4096  # header lines are short: a longer one is not a header
+CHUNK = 2**16  # bytes read at a time
+
+_MARKER = b"content-length:"
+_HEADER = re.compile(re.escape(_MARKER), re.IGNORECASE)
+_LENGTH = re.compile(rb"content-length:[ \t]*(\d+)[ \t]*", re.IGNORECASE)
+_FIELD = re.compile(rb"[!-9;-~]+:.*")  # any other header, such as Content-Type
+
+
+class Framer:
+    """Splits the bytes read into message bodies, without ever holding more than one
+    message (up to `limit` bytes) and one chunk."""
+
+    def __init__(self, limit: int = MAX_MESSAGE) -> None:
+        self.limit = limit
+        self.problems: list[str] = []  # what was skipped since last taken
+        self._buffer = bytearray()
+        self._length: int | None = None  # the Content-Length of the headers read so far
+        self._body: int | None = None  # the headers are read: a body this long follows
+        self._lost = False  # skipping up to the next Content-Length header
+
+    def feed(self, data: bytes) -> list[bytes]:
+        """The bodies of the messages completed by `data`."""
+        self._buffer += data
+        bodies = []
+        while (body := self._next()) is not None:
+            bodies.append(body)
+        return bodies
+
+    def _next(self) -> bytes | None:
+        buffer = self._buffer
+        while True:
+            if self._body is not None:
+                if len(buffer) < self._body:
+                    return None
+                body = bytes(buffer[:self._body])
+                del buffer[:self._body]
+                self._body = None
+                return body
+            if self._lost:
+                found = _HEADER.search(buffer)
+                if found is None:  # keep what may be the start of a header
+                    del buffer[:max(0, len(buffer) - len(_MARKER) + 1)]
+                    return None
+                del buffer[:found.start()]
+                self._lost = False
+            end = buffer.find(b"\n", 0, MAX_HEADER_LINE)
+            if end < 0:
+                if len(buffer) < MAX_HEADER_LINE:
+                    return None
+                self._skip(f"a header line longer than {MAX_HEADER_LINE:,} bytes", 1)
+                continue
+            line = bytes(buffer[:end]).rstrip(b"\r").strip(b" \t")
+            if not line:  # the end of the headers
+                if self._length is None:
+                    self._skip("a message without a valid Content-Length header", end + 1)
+                    continue
+                self._body, self._length = self._length, None
+            elif (length := _LENGTH.fullmatch(line)) is not None:
+                if int(length[1]) > self.limit:
+                    self._skip(f"a message of {int(length[1]):,} bytes, over the limit of "
+                               f"{self.limit:,}", end + 1)
+                    continue
+                self._length = int(length[1])
+            elif _HEADER.match(line):
+                self._skip(f"a Content-Length that is no number of bytes: {line[:60]!r}",
+                           end + 1)
+                continue
+            elif not _FIELD.fullmatch(line):  # perhaps the rest of a body: skip a byte
+                self._skip(f"a line that is no header: {line[:60]!r}", 1)
+                continue
+            del buffer[:end + 1]
+
+    def _skip(self, problem: str, drop: int) -> None:
+        del self._buffer[:drop]
+        self._length = None
+        self._lost = True
+        self.problems.append(problem)
+
+
+async def read_messages(fd: int, handle: Callable[[bytes], None],
+                        stop: threading.Event) -> None:
+    """Hands each message body read from file descriptor `fd` to `handle`, until the
+    end of the input or `stop`."""
+    loop = asyncio.get_running_loop()
+    chunks: asyncio.Queue[bytes] = asyncio.Queue(maxsize=4)
+
+    def read() -> None:
+        # A daemon thread with os.read: a blocked read neither holds a lock nor delays
+        # the exit that LSP's `exit` asks for.
+        while True:
+            chunk = os.read(fd, CHUNK)
+            put = chunks.put(chunk)
+            try:
+                asyncio.run_coroutine_threadsafe(put, loop).result()
+            except RuntimeError:  # the loop has ended: the server is exiting
+                put.close()
+                return
+            if not chunk:
+                return
+
+    threading.Thread(target=read, name="rl1-lsp stdin", daemon=True).start()
+    framer = Framer()
+    while not stop.is_set():
+        chunk = await chunks.get()
+        if not chunk:
+            return
+        for body in framer.feed(chunk):
+            handle(body)
+        for problem in framer.problems:
+            log.warning("skipped %s; reading on from the next Content-Length header. "
+                        "The client is breaking LSP's framing: please report it", problem)
+        framer.problems.clear()

@@ -1,0 +1,212 @@
+"""The JSON-RPC and LSP rules over the server's real standard input and output: broken
+framing is skipped up to the next valid header, a message has a bounded size, errors
+carry the codes JSON-RPC and LSP give them, and the session's start and end follow
+LSP; after a burst of edits, the last diagnostics published are the last version's."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import time
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+from raw import INITIALIZE, INITIALIZED, RawServer, frame, notification, request
+
+from rl1.lsp.server import create_server
+
+PARSE_ERROR = -32700
+INVALID_REQUEST = -32600
+SERVER_NOT_INITIALIZED = -32002
+
+HOVER_NOWHERE = {"textDocument": {"uri": "file:///never/opened.rob"},
+                 "position": {"line": 0, "character": 0}}
+
+
+@pytest.fixture
+def server() -> Iterator[RawServer]:
+    running = RawServer()
+    yield running
+    running.kill()
+
+
+def hover(msg_id: int) -> bytes:
+    return frame(request(msg_id, "textDocument/hover", HOVER_NOWHERE))
+
+
+def answered(server: RawServer, msg_id: int) -> None:
+    """The server answers a request sent now, with a result."""
+    server.send(hover(msg_id))
+    assert "error" not in server.reply(msg_id)
+
+
+# Framing --------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("header", [
+    b"Content-Length: 99999999999999\r\n\r\n",
+    b"Content-Length: 67108865\r\n\r\n",  # one byte more than the limit
+    b"Content-Type: application/vscode-jsonrpc\r\n\r\n",  # no Content-Length
+    b"Content-Length: -5\r\n\r\n",
+    b"Content-Length: abc\r\n\r\n",
+    b"Content-Length: 12 34\r\n\r\n",
+    b"x" * 100_000 + b"\r\n\r\n",  # a header line longer than any header
+])
+def test_a_message_with_a_broken_header_is_skipped_up_to_the_next_one(
+        server: RawServer, header: bytes) -> None:
+    server.start()
+    server.send(frame(request(2, "textDocument/hover", HOVER_NOWHERE), header))
+    answered(server, 3)
+    answered(server, 4)
+    server.send(frame(request(5, "shutdown")) + frame(notification("exit")))
+    assert server.reply(5)["result"] is None
+    status, stderr = server.finish()
+    assert status == 0
+    assert "skipped" in stderr
+
+
+def test_line_feeds_alone_frame_messages_too(server: RawServer) -> None:
+    server.start()
+    body = json.dumps(request(2, "textDocument/hover", HOVER_NOWHERE)).encode()
+    server.send(b"Content-Length: %d\n\n" % len(body) + body)
+    assert server.reply(2)["result"] is None
+    answered(server, 3)
+
+
+def test_a_header_split_across_writes_is_read_whole(server: RawServer) -> None:
+    server.start()
+    data = hover(2) + hover(3)
+    for start in range(0, len(data), 7):
+        server.send(data[start:start + 7])
+        time.sleep(0.001)
+    assert server.reply(2)["result"] is None
+    assert server.reply(3)["result"] is None
+
+
+# JSON-RPC errors ------------------------------------------------------------------------
+
+@pytest.mark.parametrize("body", [b'{"jsonrpc": "2.0", "id": 2, "method": ', b"\xff\xfe{}",
+                                  b""])
+def test_malformed_json_is_a_parse_error(server: RawServer, body: bytes) -> None:
+    server.start()
+    server.send(frame(body))
+    reply = server.reply(None)
+    assert reply["error"]["code"] == PARSE_ERROR
+    answered(server, 3)
+
+
+@pytest.mark.parametrize("body", [b"[]", b"42", b'"hover"', b'{"id": 2, "method": "shutdown"}'])
+def test_json_that_is_no_message_is_an_invalid_request(server: RawServer, body: bytes) -> None:
+    server.start()
+    server.send(frame(body))
+    msg_id = 2 if b'"id"' in body else None
+    assert server.error_code(msg_id) == INVALID_REQUEST
+    answered(server, 3)
+
+
+# The session: initialize first, shutdown, exit --------------------------------------------
+
+def test_a_request_before_initialize_is_refused(server: RawServer) -> None:
+    server.send(hover(7))
+    assert server.error_code(7) == SERVER_NOT_INITIALIZED
+    server.send(frame(notification("textDocument/didOpen", {"textDocument": {
+        "uri": "file:///early.rob", "languageId": "rl1", "version": 1, "text": "A=("}})))
+    server.start()  # the notification before initialize was dropped: nothing published
+    answered(server, 8)
+    assert server.messages.empty()
+
+
+def test_after_shutdown_requests_are_invalid_and_exit_succeeds(server: RawServer) -> None:
+    server.start()
+    server.send(frame(request(2, "shutdown")))
+    assert server.reply(2)["result"] is None
+    server.send(hover(3))
+    assert server.error_code(3) == INVALID_REQUEST
+    server.send(frame(notification("exit")))
+    status, stderr = server.finish()
+    assert status == 0
+    assert "hover after shutdown" in stderr and "Traceback" not in stderr
+
+
+def test_exit_without_shutdown_fails(server: RawServer) -> None:
+    server.start()
+    server.send(frame(notification("exit")))
+    status, _ = server.finish()
+    assert status == 1
+
+
+def test_exit_before_initialize_fails(server: RawServer) -> None:
+    server.send(frame(notification("exit")))
+    status, _ = server.finish()
+    assert status == 1
+
+
+def test_initialize_twice_is_an_invalid_request(server: RawServer) -> None:
+    server.start()
+    server.send(frame({**INITIALIZE, "id": 2}))
+    assert server.error_code(2) == INVALID_REQUEST
+    server.send(frame(INITIALIZED))
+    answered(server, 3)
+
+
+# Bursts ---------------------------------------------------------------------------------
+
+def test_after_a_burst_the_last_diagnostics_published_are_the_last_versions(
+        server: RawServer) -> None:
+    server.start()
+    lines = [f"A=B+{n % 100}" for n in range(2_000)]
+    uri = "file:///burst.rob"
+    server.send(frame(notification("textDocument/didOpen", {"textDocument": {
+        "uri": uri, "languageId": "rl1", "version": 1, "text": "\n".join(lines)}})))
+    burst = bytearray()
+    last = 301
+    for version in range(2, last + 1):
+        line = version * 7 % len(lines)
+        text = "A=(" if version % 3 else "B=A+1"  # errors come and go
+        burst += frame(notification("textDocument/didChange", {
+            "textDocument": {"uri": uri, "version": version},
+            "contentChanges": [{"range": {"start": {"line": line, "character": 0},
+                                          "end": {"line": line,
+                                                  "character": len(lines[line])}},
+                                "text": text}]}))
+        lines[line] = text
+    server.send(bytes(burst))
+    published: list[dict[str, Any]] = []
+    while not published or published[-1]["version"] != last:
+        message = server.next()
+        if message.get("method") == "textDocument/publishDiagnostics":
+            published.append(message["params"])
+    # a fresh document with the final text: what the last version's diagnostics are
+    server.send(frame(notification("textDocument/didOpen", {"textDocument": {
+        "uri": "file:///final.rob", "languageId": "rl1", "version": 1,
+        "text": "\n".join(lines)}})))
+    while (message := server.next()).get("params", {}).get("uri") != "file:///final.rob":
+        published.append(message["params"])
+    assert [p["version"] for p in published].index(last) == len(published) - 1
+    assert published[-1]["diagnostics"] == message["params"]["diagnostics"]
+    assert len(published[-1]["diagnostics"]) == lines.count("A=(")
+
+
+def test_handled_notifications_leave_nothing_behind() -> None:
+    """pygls keeps each notification handler's future under an id no response removes:
+    the server must drop them, or every edit costs memory for the whole session."""
+    server = create_server()
+    protocol = server.protocol
+    protocol._send_data = lambda data: None  # type: ignore[method-assign]
+
+    def receive(message: dict[str, Any]) -> None:
+        protocol.receive(json.dumps(message).encode())  # type: ignore[attr-defined]
+
+    async def session() -> int:
+        receive(INITIALIZE)
+        receive(INITIALIZED)
+        receive(notification("textDocument/didOpen", {"textDocument": {
+            "uri": "file:///a.rob", "languageId": "rl1", "version": 1, "text": "A=1\n"}}))
+        for version in range(2, 202):
+            receive(notification("textDocument/didChange", {
+                "textDocument": {"uri": "file:///a.rob", "version": version},
+                "contentChanges": [{"text": f"A={version}\n"}]}))
+        await asyncio.sleep(0.1)
+        return len(protocol._request_futures)
+
+    assert asyncio.run(session()) == 0
