@@ -1,4 +1,5 @@
-"""The .ilc container: a fixed header, then the code, handler, features and debug sections.
+"""The .ilc container: a fixed header, then the code, handler, features and debug
+sections, and (from version 1.1) the digest of the source the debug section describes.
 
 spec/ilc.md describes the format to the byte; this module is its executable form.
 `decode` checks the container only (magic, version, flags, section lengths, CRC, the
@@ -12,6 +13,7 @@ u16 lengths, sections in a fixed order, little-endian, no alignment, nothing to 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import struct
 import zlib
 from dataclasses import dataclass
@@ -19,7 +21,9 @@ from dataclasses import dataclass
 from .language import HANDLER_LABELS, Feature
 
 MAGIC = b"RLIC"
-VERSION_MAJOR, VERSION_MINOR = 1, 0
+VERSION_MAJOR, VERSION_MINOR = 1, 1
+DIGEST_MINOR = 1  # the first minor version with the source digest section
+DIGEST_SIZE = 16  # the first 16 bytes of SHA-256
 
 # magic, major, minor, flags, crc, header size, then the size of each section in order.
 # The debug section's size is a u32: one entry per instruction can pass 64 KiB.
@@ -54,6 +58,8 @@ class IlcFormatError(Exception):
 class DebugInfo:
     source_name: str
     lines: tuple[tuple[int, int], ...]  # (code offset, source line), one per instruction
+    # source_digest(text) of the source compiled; None in a version 1.0 file
+    source_digest: bytes | None = None
 
     def line_at(self, offset: int) -> int | None:
         """The source line of the instruction at or before code `offset`."""
@@ -63,6 +69,12 @@ class DebugInfo:
                 break
             line = source_line
         return line
+
+
+def source_digest(text: str) -> bytes:
+    """The digest that tells a source from any edited copy: the first 16 bytes of the
+    SHA-256 of its text in UTF-8 (as decoded: encoding and BOM do not matter)."""
+    return hashlib.sha256(text.encode("utf-8", "surrogatepass")).digest()[:DIGEST_SIZE]
 
 
 @dataclass(frozen=True)
@@ -103,8 +115,18 @@ class Header:
         return self.feature_start + self.feature_size
 
     @property
-    def end(self) -> int:
+    def digest_start(self) -> int:
         return self.debug_start + self.debug_size
+
+    @property
+    def digest_size(self) -> int:
+        """The source digest follows a debug section from version 1.1 on."""
+        return DIGEST_SIZE if self.minor >= DIGEST_MINOR and self.debug_size else 0
+
+    @property
+    def end(self) -> int:
+        """Where the sections this reader knows end."""
+        return self.digest_start + self.digest_size
 
 
 @dataclass(frozen=True)
@@ -133,11 +155,17 @@ def encode(image: Image) -> bytes:
     handlers = _encode_handlers(image.handlers, len(image.code))
     features = struct.pack("<H", sum(1 << feature.value for feature in image.features))
     debug = b"" if image.debug is None else _encode_debug(image.debug)
+    digest = b"" if image.debug is None or image.debug.source_digest is None \
+        else image.debug.source_digest
+    if digest and len(digest) != DIGEST_SIZE:
+        raise ValueError(f"a source digest is {DIGEST_SIZE} bytes, not {len(digest)}")
     if not 0 <= image.flags <= 0xFFFF:
         raise ValueError(f"flags 0x{image.flags:X} do not fit the 16-bit field")
-    header = HEADER.pack(MAGIC, VERSION_MAJOR, VERSION_MINOR, image.flags, 0, HEADER.size,
+    # A file without a digest is written as 1.0, so that every 1.0 reader reads it.
+    minor = DIGEST_MINOR if digest else 0
+    header = HEADER.pack(MAGIC, VERSION_MAJOR, minor, image.flags, 0, HEADER.size,
                          len(image.code), len(handlers), len(features), len(debug))
-    data = bytearray(header + image.code + handlers + features + debug)
+    data = bytearray(header + image.code + handlers + features + debug + digest)
     struct.pack_into("<I", data, CRC_OFFSET, crc_of(bytes(data)))
     return bytes(data)
 
@@ -272,7 +300,7 @@ def _decode_features(data: bytes, position: int) -> frozenset[Feature]:
 
 
 def _decode_debug(data: bytes, header: Header) -> tuple[DebugInfo, tuple[int, ...]]:
-    reader = _Reader(data, header.debug_start, header.end, "debug section")
+    reader = _Reader(data, header.debug_start, header.digest_start, "debug section")
     name_bytes = reader.take(reader.byte())
     try:
         name = name_bytes.decode("utf-8")
@@ -294,10 +322,11 @@ def _decode_debug(data: bytes, header: Header) -> tuple[DebugInfo, tuple[int, ..
                                  f"of range: offsets are u16, lines 1..{MAX_LINE}")
         lines.append((offset, line))
         starts.append(start)
-    if reader.position != header.end:
-        raise IlcFormatError(reader.position, f"{header.end - reader.position} bytes left "
-                             "over at the end of the debug section")
-    return DebugInfo(name, tuple(lines)), tuple(starts)
+    if reader.position != header.digest_start:
+        raise IlcFormatError(reader.position, f"{header.digest_start - reader.position} "
+                             "bytes left over at the end of the debug section")
+    digest = data[header.digest_start:header.end] if header.digest_size else None
+    return DebugInfo(name, tuple(lines), digest), tuple(starts)
 
 
 class _Reader:

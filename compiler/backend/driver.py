@@ -7,7 +7,7 @@ and writing the output are the CLI's job.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 from rl1.compiler.analysis import analyze
@@ -45,4 +45,7 @@ def compile_text(text: str, source_name: str, *, emit: Emit = "ilc",
     except CodegenError as refused:
         diagnostics = sorted([*analysis.diagnostics, refused.diagnostic], key=sort_key)
         return Compilation(diagnostics, None)
+    if image.debug is not None:  # so that `dis` can tell this source from an edited one
+        debug = replace(image.debug, source_digest=ilc.source_digest(text))
+        image = replace(image, debug=debug)
     return Compilation(analysis.diagnostics, ilc.encode(image))

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import click
 
 from rl1.compiler.files import SourceError
-from rl1.compiler.frontend.source import Source, read_source
+from rl1.compiler.frontend.source import Source
 from rl1.compiler.reporting.render import EXIT_ERRORS, ColorChoice, FileDiagnostics, Format
 
 from .command import (
@@ -75,6 +75,7 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: Emit,
     (warnings allowed), 1 errors, 2 an unreadable input or an output that cannot be
     written."""
     from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
+    from rl1.compiler.ils.sources import recorded_name
 
     if optimize not in {str(level) for level in OPTIMIZATION_LEVELS}:
         raise click.UsageError(f"argument -O: `-O{optimize}`: only -O0 (no optimization) "
@@ -89,8 +90,8 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: Emit,
     if same_file(file, target):
         raise click.UsageError(f"the output `{target}` is the source file itself: "
                                "give another path with -o")
-    compilation = compile_text(source.text, os.path.basename(source.name), emit=emit_kind,
-                               strip_debug=strip)
+    compilation = compile_text(source.text, recorded_name(source.name, target),
+                               emit=emit_kind, strip_debug=strip)
     status = emit([FileDiagnostics(source.name, source.text, compilation.diagnostics)],
                   output_format, color, "compile", err=True)
     if compilation.output is None:
@@ -175,26 +176,31 @@ def run(file: str, sensors: str | None, run_format: str, budget: int, engine: En
               help="the program's source, to show its lines; default: the file the .ilc "
                    "records, when it is in the .ilc file's folder")
 def dis(file: str, source_file: str | None) -> int:
-    """Disassemble an .ilc file into .ils text on standard output.
+    """Disassemble an .ilc file (`-`: standard input) into .ils text on standard output.
 
-    The program's source lines are shown when its source file is found: the one --source
-    names, or the one the .ilc records if it is in the .ilc file's folder (a recorded
-    name that is absolute or leads out of the folder is not followed). Exit status: 0
-    done, 1 the file is not valid intermediate code, 2 an unreadable file."""
-    from rl1.compiler.ils.disasm import disassemble, named_source, source_beside
-    from rl1.vm.verifier import VerifyError
+    The program's source lines are shown when its source file is found (the one
+    --source names, or the path the .ilc records, from the .ilc file's folder; a name
+    that is absolute or leads out of the folder is not followed) and is the source that
+    was compiled (its digest matches). Why no lines are shown is said on standard
+    error. Exit status: 0 done, 1 the file is not valid intermediate code, 2 an
+    unreadable file."""
+    from rl1.compiler.ils.disasm import disassemble
+    from rl1.compiler.ils.sources import find_source
+    from rl1.vm.verifier import VerifyError, verify
 
     data = read_ilc(file)
     try:
-        find_source = source_beside(file) if source_file is None else named_source(source_file)
-    except SourceError as error:
-        raise Failure(f"error: {error}") from None
-    try:
-        text = disassemble(data, file, find_source)
+        debug = verify(data).image.debug  # an invalid file is refused before any source is read
     except VerifyError as error:
         raise Failure(f"error: {file}: byte {error.offset}: {error.message}",
                       EXIT_ERRORS) from None
-    sys.stdout.write(text)
+    try:
+        found = find_source(debug, file, source_file)
+    except SourceError as error:
+        raise Failure(f"error: cannot read the source given with --source: {error}") from None
+    if found.note is not None:
+        click.echo(found.note, err=True)
+    sys.stdout.write(disassemble(data, file, found.lines))
     return 0
 
 
@@ -205,24 +211,23 @@ def dis(file: str, source_file: str | None) -> int:
                    "Default: FILE.ilc beside the .ils file")
 @force_option
 def assemble_file(file: str, output: str | None, force: bool) -> int:
-    """Assemble .ils text (as `rl1c dis` prints it) into an .ilc file.
+    """Assemble .ils text (as `rl1c dis` prints it; `-`: standard input) into an .ilc file.
 
     The result must pass the verifier. Exit status: 0 written, 1 errors in the text
     (nothing is written), 2 an unreadable input or an output that cannot be written."""
     from rl1.compiler.ils.asm import AsmError, assemble
 
-    try:
-        source = read_source(file)
-    except SourceError as error:
-        raise Failure(f"error: {error}") from None
-    target = output or with_suffix(file, ".ilc")
+    source = read_input(file)
+    if not isinstance(source, Source):
+        raise Failure(f"error: {source.diagnostics[0].message}")
+    target = output or _default_output(file)
     if same_file(file, target):
         raise click.UsageError(f"the output `{target}` is the input file itself: "
                                "give another path with -o")
     try:
         data = assemble(source.text)
     except AsmError as error:
-        raise Failure("\n".join(f"{file}:{problem.line}:{problem.column}: error: "
+        raise Failure("\n".join(f"{source.name}:{problem.line}:{problem.column}: error: "
                                 f"{problem.message}" for problem in error.problems),
                       EXIT_ERRORS) from None
     if target == "-":

@@ -68,15 +68,20 @@ def write_file(target: str, data: bytes, *, force: bool = False) -> None:
 
 
 def read_ilc(file: str) -> bytes:
-    """The bytes of an .ilc file; a Failure with exit status 2 when it cannot be read, 1
-    when it is too large to be one (without reading a huge file whole)."""
+    """The bytes of an .ilc file (`-` is standard input); a Failure with exit status 2
+    when it cannot be read, 1 when it is too large to be one (without reading a huge
+    file whole)."""
+    name = STDIN_NAME if file == "-" else file
     try:
-        with open(file, "rb") as stream:
-            data = stream.read(MAX_ILC_BYTES + 1)
+        if file == "-":
+            data = sys.stdin.buffer.read(MAX_ILC_BYTES + 1)
+        else:
+            with open(file, "rb") as stream:
+                data = stream.read(MAX_ILC_BYTES + 1)
     except OSError as error:
-        raise Failure(f"error: cannot read `{file}`: {error.strerror or error}") from None
+        raise Failure(f"error: cannot read `{name}`: {error.strerror or error}") from None
     if len(data) > MAX_ILC_BYTES:
-        raise Failure(f"error: `{file}` is larger than {MAX_ILC_BYTES} bytes: not an .ilc "
+        raise Failure(f"error: `{name}` is larger than {MAX_ILC_BYTES} bytes: not an .ilc "
                       "file", EXIT_ERRORS)
     return data
 

@@ -150,6 +150,7 @@ class _Assembler:
     features: frozenset[Feature] | None = None
     flags: int | None = None
     source_name: str | None = None
+    source_digest: bytes | None = None
     current_line: int | None = None
     entries: list[tuple[int, int]] = field(default_factory=list)
     problems: list[Problem] = field(default_factory=list)
@@ -229,11 +230,30 @@ class _Assembler:
             except json.JSONDecodeError as error:
                 raise _LineError(name.column + error.pos, f"bad string: {error.msg} "
                                                           "(strings use JSON escapes)") from None
+        elif token.text == ".digest":
+            self.digest_directive(token, cursor)
         elif token.text == ".line":
             self.line_directive(token, cursor, position)
         else:
             raise _LineError(token.column, f"unknown directive {token.text}: the directives "
-                                           "are .features, .flags, .handler, .source and .line")
+                                           "are .features, .flags, .handler, .source, .digest "
+                                           "and .line")
+
+    def digest_directive(self, token: _Token, cursor: _Cursor) -> None:
+        if self.source_name is None:
+            raise _LineError(token.column, '.digest needs a .source "FILE.rob" directive '
+                                           "before it: it is the digest of that source")
+        if self.source_digest is not None:
+            raise _LineError(token.column, ".digest is given twice")
+        text = cursor.expect("string", "the digest in quotes, as `rl1c dis` prints it")
+        try:
+            digest = bytes.fromhex(json.loads(text.text))
+        except (ValueError, TypeError):
+            digest = b""
+        if len(digest) != ilc.DIGEST_SIZE:
+            raise _LineError(text.column, f"a source digest is {ilc.DIGEST_SIZE} bytes: "
+                                          f"{2 * ilc.DIGEST_SIZE} hexadecimal digits in quotes")
+        self.source_digest = digest
 
     @staticmethod
     def feature(token: _Token) -> Feature:
@@ -351,8 +371,8 @@ class _Assembler:
                                              f"{len(self.code)}-byte code"))
         if self.problems:
             raise AsmError(self.problems)
-        debug = None if self.source_name is None else ilc.DebugInfo(self.source_name,
-                                                                     tuple(self.entries))
+        debug = None if self.source_name is None else ilc.DebugInfo(
+            self.source_name, tuple(self.entries), self.source_digest)
         features = self.features if self.features is not None else self.needed_features()
         return ilc.Image(bytes(self.code), handlers, features, debug, self.flags or 0)
 

@@ -1,40 +1,35 @@
 """`rl1c dis`: an .ilc file as .ils text, which `rl1c asm` reads back to the same bytes.
 
 The header and the section layout are shown as comments (the assembler derives them);
-the features, the handler table, the source name and the line map are directives; each
-instruction shows its code offset. Jump and handler targets get labels named after
-their offsets (`L0042`). With the program's source at hand, its lines are interleaved as
-comments, like `objdump -S`.
+the features, the handler table, the source name and digest and the line map are
+directives; each instruction shows its code offset. Jump and handler targets get labels
+named after their offsets (`L0042`). With the program's source at hand, its lines are
+interleaved as comments, like `objdump -S`.
 """
 
 from __future__ import annotations
 
 import json
-import stat
-from collections.abc import Callable, Sequence
-from pathlib import Path, PurePath
+from collections.abc import Sequence
 
-from rl1.compiler.files import SourceError
-from rl1.compiler.frontend.source import read_source
 from rl1.vm import ilc, isa
 from rl1.vm.language import HANDLER_LABELS, VARIABLES, Feature
 from rl1.vm.verifier import verify
-
-SourceLookup = Callable[[str], Sequence[str] | None]
 
 
 def label_name(offset: int) -> str:
     return f"L{offset:04d}"
 
 
-def disassemble(data: bytes, name: str, find_source: SourceLookup = lambda _: None) -> str:
+def disassemble(data: bytes, name: str, source_lines: Sequence[str] | None = None) -> str:
     """The .ils text of the .ilc bytes `data` (read from file `name`), with the lines of
-    the source that `find_source` finds for the debug section's source name. VerifyError
-    if the file does not verify: only verified code has known instruction boundaries."""
+    its source interleaved when given (sources.find_source finds them). VerifyError if
+    the file does not verify: only verified code has known instruction boundaries."""
     program = verify(data)
     header = ilc.read_header(data)
     image = program.image
-    source_lines = None if image.debug is None else find_source(image.debug.source_name)
+    if image.debug is None:
+        source_lines = None
     out = [*_header_comments(header, name, len(data)), _features(image.features)]
     if image.flags:
         out.append(f".flags ${image.flags:04X}")
@@ -44,6 +39,8 @@ def disassemble(data: bytes, name: str, find_source: SourceLookup = lambda _: No
     entries: dict[int, int] = {}
     if image.debug is not None:
         out.append(f".source {json.dumps(image.debug.source_name, ensure_ascii=False)}")
+        if image.debug.source_digest is not None:
+            out.append(f'.digest "{image.debug.source_digest.hex()}"')
         entries = dict(image.debug.lines)
     targets = set(image.handlers.values()) | {
         instruction.operands[-1] for instruction in program.instructions
@@ -106,32 +103,3 @@ def _header_comments(header: ilc.Header, name: str, size: int) -> list[str]:
 def _features(features: frozenset[Feature]) -> str:
     names = [feature.name for feature in sorted(features, key=lambda f: f.value)]
     return " ".join([".features", *names])
-
-
-def source_beside(ilc_path: str) -> SourceLookup:
-    """Finds a source file by the name the compiler recorded, in the .ilc file's folder
-    only (where a build usually leaves it): a name that is absolute or climbs out of the
-    folder is not followed, since a hand-made file could name any file on the machine,
-    and only a regular file is read (a FIFO would hang `dis`). A missing or unreadable
-    source just means no source lines."""
-    def find(source_name: str) -> Sequence[str] | None:
-        recorded = PurePath(source_name)
-        if recorded.is_absolute() or ".." in recorded.parts or not recorded.name:
-            return None
-        directory = Path(ilc_path).parent
-        for candidate in dict.fromkeys((directory / recorded.name, directory / recorded)):
-            try:
-                if not stat.S_ISREG(candidate.stat().st_mode):
-                    continue
-                return read_source(str(candidate)).lines
-            except (OSError, SourceError, ValueError):  # ValueError: a NUL in the name
-                continue
-        return None
-    return find
-
-
-def named_source(path: str) -> SourceLookup:
-    """The source the user named (`rl1c dis --source FILE`), whatever the .ilc records;
-    SourceError when it cannot be read."""
-    lines = read_source(path).lines
-    return lambda _: lines

@@ -47,7 +47,7 @@ def test_assembling_the_disassembly_gives_the_same_bytes(
     image: ilc.Image, source: list[str] | None,
 ) -> None:
     data = ilc.encode(image)
-    text = disassemble(data, "x.ilc", lambda _: source)
+    text = disassemble(data, "x.ilc", source)
     assert assemble(text) == data
 
 
@@ -71,7 +71,7 @@ def test_listing_1_compiled_survives_dis_and_asm(strip: bool) -> None:
     text = SAMPLE.read_text(encoding="utf-8")
     data = compile_text(text, "sample.rob", strip_debug=strip).output
     assert data is not None
-    shown = disassemble(data, "sample.ilc", lambda _: text.splitlines())
+    shown = disassemble(data, "sample.ilc", text.splitlines())
     assert assemble(shown) == data
     assert ("; 4 | :10 A=(IMG)-180; ?A<#10" in " ".join(shown.split())) != strip
 
@@ -95,7 +95,7 @@ def test_a_hand_written_program_assembles_to_what_it_says() -> None:
 def test_the_disassembly_shows_the_header_tables_offsets_and_source() -> None:
     data = assemble(HAND_WRITTEN)
     source = ["A=5", "' count down", ":10 A--; ?A>#10", "(MOV A,-3)"]
-    text = disassemble(data, "count.ilc", lambda name: source if name == "count.rob" else None)
+    text = disassemble(data, "count.ilc", source)
     assert f"CRC-32 0x{ilc.read_header(data).crc:08X}, {len(data)} bytes" in text
     assert ".features MOTION ULTRASONIC\n.handler 96 L0005\n.handler 97 none\n" in text
     # The source lines up to an instruction's line come before it, as comments.
@@ -125,6 +125,10 @@ def test_the_disassembly_shows_the_header_tables_offsets_and_source() -> None:
     (".handler 95 none", 1, 10, "handler label 95 is out of range 96..99"),
     ("END\n.handler 96 5", 2, 13, "handler :96 at 5 is outside the 1-byte code"),
     (".bogus", 1, 1, "unknown directive .bogus"),
+    ('.digest "00"', 1, 1, ".digest needs a .source"),
+    ('.source "a"\n.digest "00"', 2, 9, "a source digest is 16 bytes"),
+    ('.source "a"\n.digest "' + "0g" * 16 + '"', 2, 9, "32 hexadecimal digits"),
+    ('.source "a"\n.digest "' + "00" * 16 + '"\n.digest "00"', 3, 1, "given twice"),
     ("LDI 1 # 2", 1, 7, "unexpected character '#'"),
     # Refusals of the verifier, reported at the operand that caused them.
     ("LDI 0\nJMP 1", 2, 5, "jump target 1 is in the middle of the instruction at 0"),
@@ -158,8 +162,9 @@ def test_dis_then_asm_on_the_command_line(tmp_path: Path) -> None:
     (tmp_path / "count.ilc").write_bytes(assemble(HAND_WRITTEN))
     shown = rl1c("dis", tmp_path / "count.ilc")
     assert shown.exit_code == 0
-    assert ";    3 | :10 A--; ?A>#10" in shown.output  # found beside the .ilc
-    (tmp_path / "count.ils").write_text(shown.output)
+    assert ";    3 | :10 A--; ?A>#10" in shown.stdout  # found beside the .ilc
+    assert "no source digest (format 1.0)" in shown.stderr  # so not checked
+    (tmp_path / "count.ils").write_text(shown.stdout)
     built = rl1c("asm", tmp_path / "count.ils", "-o", tmp_path / "again.ilc")
     assert built.exit_code == 0
     assert (tmp_path / "again.ilc").read_bytes() == (tmp_path / "count.ilc").read_bytes()
@@ -210,6 +215,45 @@ def test_dis_does_not_follow_a_recorded_name_out_of_its_folder(tmp_path: Path,
     assert shown.exit_code == 0
     assert "SECRET" not in shown.stdout and "root:" not in shown.stdout
     assert "        .line 1" in shown.stdout
+    assert "outside its folder" in shown.stderr and "--source" in shown.stderr
+
+
+def test_the_readme_first_session_shows_the_source(tmp_path: Path,
+                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+    """`rl1c examples/sample.rob -o sample.ilc; rl1c dis sample.ilc`, as README says."""
+    (tmp_path / "examples").mkdir()
+    (tmp_path / "examples" / "sample.rob").write_bytes(SAMPLE.read_bytes())
+    monkeypatch.chdir(tmp_path)
+    assert rl1c("examples/sample.rob", "-o", "sample.ilc").exit_code == 0
+    debug = ilc.decode(Path("sample.ilc").read_bytes()).debug
+    assert debug is not None and debug.source_name == "examples/sample.rob"
+    shown = rl1c("dis", "sample.ilc")
+    assert (shown.exit_code, shown.stderr) == (0, "")
+    assert "| :10 A=(IMG)-180; ?A<#10" in shown.stdout
+
+
+def test_a_source_edited_since_compiling_is_not_interleaved(tmp_path: Path) -> None:
+    source = tmp_path / "p.rob"
+    source.write_text("A=1\nB=2\n(END)\n", encoding="utf-8")
+    assert rl1c(source, "-o", tmp_path / "p.ilc").exit_code == 0
+    assert "| B=2" in rl1c("dis", tmp_path / "p.ilc").stdout
+    source.write_text("' a comment moves every line\nA=1\nB=2\n(END)\n", encoding="utf-8")
+    for shown in (rl1c("dis", tmp_path / "p.ilc"),
+                  rl1c("dis", tmp_path / "p.ilc", "--source", source)):
+        assert shown.exit_code == 0 and " | " not in shown.stdout
+        assert "p.rob is not the source" in shown.stderr and "compile it again" in shown.stderr
+
+
+def test_dis_says_when_the_source_is_missing_or_stripped(tmp_path: Path) -> None:
+    source = tmp_path / "p.rob"
+    source.write_text("A=1\n(END)\n", encoding="utf-8")
+    assert rl1c(source, "-o", tmp_path / "p.ilc").exit_code == 0
+    assert rl1c(source, "-s", "-o", tmp_path / "stripped.ilc").exit_code == 0
+    source.unlink()
+    missing = rl1c("dis", tmp_path / "p.ilc")
+    assert missing.exit_code == 0 and "was not found" in missing.stderr
+    stripped = rl1c("dis", tmp_path / "stripped.ilc")
+    assert stripped.exit_code == 0 and "no debug section" in stripped.stderr
 
 
 def test_dis_reads_no_fifo_the_file_names(tmp_path: Path) -> None:
@@ -227,3 +271,17 @@ def test_dis_source_option_names_the_source_whatever_the_file_records(tmp_path: 
     assert shown.exit_code == 0 and ";    1 | A=1" in shown.stdout
     missing = rl1c("dis", target, "--source", tmp_path / "none.rob")
     assert missing.exit_code == 2 and "none.rob: no such file" in missing.stderr
+
+
+def test_dis_and_asm_read_standard_input(tmp_path: Path) -> None:
+    data = assemble(HAND_WRITTEN)
+    shown = rl1c("dis", "-", stdin=data)
+    assert shown.exit_code == 0 and "  0000  LDI 5" in shown.stdout
+    assert "standard input has no folder" in shown.stderr
+    built = rl1c("asm", "-", "-o", tmp_path / "again.ilc", stdin=shown.stdout.encode())
+    assert built.exit_code == 0
+    assert (tmp_path / "again.ilc").read_bytes() == data
+    nowhere = rl1c("asm", "-", stdin=b"END\n")
+    assert nowhere.exit_code == 2 and "give -o FILE.ilc" in nowhere.stderr
+    bad = rl1c("asm", "-", "-o", "-", stdin=b"FOO\n")
+    assert bad.exit_code == 1 and "<stdin>:1:1: error: unknown instruction FOO" in bad.stderr

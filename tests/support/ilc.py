@@ -61,7 +61,8 @@ def debug_infos(draw: st.DrawFn, offsets: list[int]) -> ilc.DebugInfo:
         lines.append((offset, line))
         # Mostly small steps; sometimes large ones, for the multi-byte numbers.
         line = min(ilc.MAX_LINE, line + draw(st.integers(0, 3) | st.integers(0, 40000)))
-    return ilc.DebugInfo(name, tuple(lines))
+    digest = draw(st.none() | st.binary(min_size=ilc.DIGEST_SIZE, max_size=ilc.DIGEST_SIZE))
+    return ilc.DebugInfo(name, tuple(lines), digest)
 
 
 @st.composite

@@ -14,8 +14,11 @@ from rl1.vm import ilc
 from rl1.vm.language import Feature
 
 LDI_5_END = bytes([0x02, 0x05, 0x00, 0x00])  # LDI 5; END
-SAMPLE = ilc.Image(LDI_5_END, {97: 3}, frozenset({Feature.MOTION, Feature.IO}),
-                   ilc.DebugInfo("a.rob", ((0, 2), (3, 130))))
+SAMPLE_DEBUG = ilc.DebugInfo("a.rob", ((0, 2), (3, 130)))
+SAMPLE = ilc.Image(LDI_5_END, {97: 3}, frozenset({Feature.MOTION, Feature.IO}), SAMPLE_DEBUG)
+DIGEST = ilc.source_digest("A=5\n")
+DIGESTED = dataclasses.replace(SAMPLE, debug=dataclasses.replace(SAMPLE_DEBUG,
+                                                                 source_digest=DIGEST))
 
 
 def patched(data: bytes, offset: int, fmt: str, value: int) -> bytes:
@@ -65,13 +68,37 @@ def test_line_at_takes_the_entry_at_or_before_an_offset() -> None:
 # --- versioning ----------------------------------------------------------------------
 
 def test_a_newer_minor_version_is_read_ignoring_what_it_adds() -> None:
-    data = ilc.encode(SAMPLE)
+    data = ilc.encode(DIGESTED)
     header_end = 24
-    # A 1.1 file: two more header bytes, and 3 bytes of a new section after the last.
+    # A 1.2 file: two more header bytes, and 3 bytes of a new section after the last.
     grown = bytearray(data[:header_end] + b"\xAA\xBB" + data[header_end:] + b"new")
-    grown[5] = 1
+    grown[5] = ilc.VERSION_MINOR + 1
     struct.pack_into("<H", grown, 12, header_end + 2)
-    assert ilc.decode(with_crc(grown)) == SAMPLE
+    assert ilc.decode(with_crc(grown)) == DIGESTED
+
+
+def test_a_source_digest_makes_a_1_1_file_and_follows_the_debug_section() -> None:
+    plain, digested = ilc.encode(SAMPLE), ilc.encode(DIGESTED)
+    assert (plain[5], digested[5]) == (0, 1)
+    assert digested[24:] == plain[24:] + DIGEST
+    assert ilc.decode(digested) == DIGESTED
+    assert ilc.read_header(digested).end == len(digested)
+
+
+def test_a_1_1_file_cut_in_its_digest_is_refused() -> None:
+    data = ilc.encode(DIGESTED)
+    error = refusal(with_crc(bytearray(data[:-1])))
+    assert "truncated" in error.message
+
+
+def test_a_1_1_file_without_debug_has_no_digest() -> None:
+    data = patched(ilc.encode(ilc.strip_debug(SAMPLE)), 5, "<B", 1)
+    assert ilc.decode(data) == ilc.strip_debug(SAMPLE)
+
+
+def test_the_digest_tells_edited_text_and_ignores_the_encoding() -> None:
+    assert ilc.source_digest("A=1\n") != ilc.source_digest("A=1 \n")
+    assert len(ilc.source_digest("")) == ilc.DIGEST_SIZE
 
 
 def test_the_same_minor_version_with_extra_bytes_is_refused() -> None:
