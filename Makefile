@@ -8,20 +8,29 @@ STAMP := $(VENV)/.installed
 
 .PHONY: demo test lint typecheck pytest clean vscode-test vscode-package
 
+# pip byte-compiles what it installs, but an editable install leaves rl1 to its first
+# run, which cannot write bytecode where PYTHONDONTWRITEBYTECODE is set: compileall.
+# setuptools' "Editable installation" notice (mind folders named like the package) is
+# for pip's own users, not for ours, so it is filtered out.
 $(STAMP): pyproject.toml
-	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[dev]'
-	# pip byte-compiles what it installs, but an editable install leaves rl1 to its
-	# first run, which cannot write bytecode where PYTHONDONTWRITEBYTECODE is set.
-	$(BIN)/python -m compileall -q compiler vm lsp
-	touch $(STAMP)
+	@echo 'Setting up .venv: the rl1 package and its development tools (a minute or two, once)'
+	@$(PYTHON) -m venv $(VENV)
+	@$(BIN)/python -m pip install --quiet --upgrade pip
+	@PYTHONWARNINGS='ignore:Editable installation' $(BIN)/python -m pip install --quiet -e '.[dev]'
+	@$(BIN)/python -m compileall -q compiler vm lsp
+	@touch $(STAMP)
 
+# What a user reads: each command as they would type it with .venv activated, then its
+# output. Compiling checks first, so the checker's warnings are printed once, here.
 demo: $(STAMP)
-	$(BIN)/rl1c check examples/sample.rob
-	mkdir -p build
-	$(BIN)/rl1c examples/sample.rob -o build/sample.ilc
-	$(BIN)/rl1c run build/sample.ilc --sensors examples/sample.sensors.json
+	@mkdir -p build
+	@echo '$$ rl1c examples/sample.rob -o build/sample.ilc'
+	@$(BIN)/rl1c examples/sample.rob -o build/sample.ilc
+	@echo
+	@echo '$$ rl1c run build/sample.ilc --sensors examples/sample.sensors.json'
+	@$(BIN)/rl1c run build/sample.ilc --sensors examples/sample.sensors.json
+	@echo
+	@echo 'Next: `. .venv/bin/activate`, then the first session in README.md.'
 
 test: lint typecheck vscode-test pytest
 
