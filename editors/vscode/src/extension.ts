@@ -1,18 +1,56 @@
 // The VS Code side of RL/I: highlighting comes from the TextMate grammar alone; this
-// starts the `rl1-lsp` language server for diagnostics, hover and completion.
+// starts the `rl1-lsp` language server for diagnostics, hover and completion, and runs
+// `rl1c` for the commands Check, Compile, Run and Show disassembly and the `rl1` tasks.
 
+import * as path from 'node:path';
 import * as vscode from 'vscode';
 import { LanguageClient, LanguageClientOptions, ServerOptions } from 'vscode-languageclient/node';
+import {
+  CommandId,
+  COMMANDS,
+  disassemble,
+  Rl1cError,
+  rl1cPath,
+  TASK_TYPE,
+  TaskCommand,
+  taskCommandLine,
+  TaskError,
+  taskRequest,
+} from './rl1cCommand';
 import { DEFAULT_SERVER, serverCommand, SettingError } from './serverCommand';
+
+const DISASSEMBLY_SCHEME = 'rl1-dis';
 
 let client: LanguageClient | undefined;
 let output: vscode.LogOutputChannel | undefined;
+
+// Typed by CommandId, so that tsc refuses a command of package.json without a handler.
+const HANDLERS: Record<CommandId, () => Promise<void>> = {
+  'rl1.restartServer': restart,
+  'rl1.check': () => runTask('check'),
+  'rl1.compile': () => runTask('compile'),
+  'rl1.run': runWithSensors,
+  'rl1.showDisassembly': showDisassembly,
+};
+
+// The .ils text of each open disassembly view, by the view's URI.
+const disassemblies = new Map<string, string>();
+const disassemblyChanged = new vscode.EventEmitter<vscode.Uri>();
 
 export async function activate(context: vscode.ExtensionContext): Promise<void> {
   output = vscode.window.createOutputChannel('RL/I', { log: true });
   context.subscriptions.push(
     output,
-    vscode.commands.registerCommand('rl1.restartServer', restart),
+    ...COMMANDS.map((id) => vscode.commands.registerCommand(id, HANDLERS[id])),
+    vscode.workspace.registerTextDocumentContentProvider(DISASSEMBLY_SCHEME, {
+      onDidChange: disassemblyChanged.event,
+      provideTextDocumentContent: (uri) => disassemblies.get(uri.toString()) ?? '',
+    }),
+    vscode.workspace.onDidCloseTextDocument((document) => disassemblies.delete(document.uri.toString())),
+    vscode.tasks.registerTaskProvider(TASK_TYPE, {
+      provideTasks: () => providedTasks(),
+      resolveTask: (task) => resolvedTask(task),
+    }),
     vscode.workspace.onDidChangeConfiguration((change) => {
       if (change.affectsConfiguration('rl1.server')) {
         void restart();
@@ -69,7 +107,7 @@ async function start(): Promise<void> {
     const reason = error instanceof Error ? error.message : String(error);
     const where =
       server.command === DEFAULT_SERVER
-        ? `install the rl1 Python package (\`pip install -e .\` in the rl1 project) so that ` +
+        ? `install the rl1 Python package (\`pipx install /path/to/rl1\`) so that ` +
           `${DEFAULT_SERVER} is on PATH, or set rl1.server.path to its full path`
         : 'check rl1.server.path';
     void offerSettings(
@@ -79,9 +117,121 @@ async function start(): Promise<void> {
   }
 }
 
+/** Tells the user what went wrong in a command or task; only a bad setting offers the settings. */
+function report(error: unknown): void {
+  if (error instanceof SettingError) {
+    void offerSettings(`RL/I: ${error.message}.`);
+  } else if (error instanceof TaskError || error instanceof Rl1cError) {
+    void vscode.window.showErrorMessage(`RL/I: ${error.message}.`);
+  } else {
+    throw error;
+  }
+}
+
 async function offerSettings(message: string): Promise<void> {
   const choice = await vscode.window.showErrorMessage(message, 'Open Settings');
   if (choice === 'Open Settings') {
-    await vscode.commands.executeCommand('workbench.action.openSettings', 'rl1.server');
+    await vscode.commands.executeCommand('workbench.action.openSettings', 'rl1.');
   }
+}
+
+function rl1c(): string {
+  const folder = vscode.workspace.workspaceFolders?.[0]?.uri.fsPath;
+  const server = vscode.workspace.getConfiguration('rl1.server');
+  return rl1cPath(
+    vscode.workspace.getConfiguration('rl1.rl1c').get('path'),
+    serverCommand(server.get('path'), server.get('args'), folder).command,
+    folder,
+  );
+}
+
+/** The RL/I file in the active editor, saved so that rl1c reads what the user sees. */
+async function currentFile(): Promise<string | undefined> {
+  const document = vscode.window.activeTextEditor?.document;
+  if (document === undefined || document.languageId !== 'rl1' || document.uri.scheme !== 'file') {
+    void vscode.window.showErrorMessage('RL/I: open an RL/I file (.rob) saved on disk first.');
+    return undefined;
+  }
+  if (document.isDirty && !(await document.save())) {
+    void vscode.window.showErrorMessage(`RL/I: ${path.basename(document.fileName)} could not be saved.`);
+    return undefined;
+  }
+  return document.fileName;
+}
+
+/** A task for a definition, or undefined after telling the user what is wrong with it. */
+function buildTask(definition: vscode.TaskDefinition, scope: vscode.TaskScope | vscode.WorkspaceFolder): vscode.Task | undefined {
+  try {
+    const request = taskRequest(definition, vscode.window.activeTextEditor?.document.fileName);
+    const line = taskCommandLine(rl1c(), request);
+    return new vscode.Task(
+      definition,
+      scope,
+      `${request.command} ${path.basename(request.file)}`,
+      'rl1c',
+      new vscode.ProcessExecution(line.command, line.args),
+      request.command === 'check' ? ['$rl1c'] : [],
+    );
+  } catch (error) {
+    report(error);
+    return undefined;
+  }
+}
+
+function providedTasks(): vscode.Task[] {
+  const document = vscode.window.activeTextEditor?.document;
+  if (document?.languageId !== 'rl1' || document.uri.scheme !== 'file') {
+    return [];
+  }
+  const scope = vscode.workspace.getWorkspaceFolder(document.uri) ?? vscode.TaskScope.Workspace;
+  return (['check', 'compile'] as const)
+    .map((command) => buildTask({ type: TASK_TYPE, command, file: document.fileName }, scope))
+    .filter((task): task is vscode.Task => task !== undefined);
+}
+
+function resolvedTask(task: vscode.Task): vscode.Task | undefined {
+  return buildTask(task.definition, task.scope ?? vscode.TaskScope.Workspace);
+}
+
+async function runTask(command: TaskCommand, extra: Record<string, string> = {}): Promise<void> {
+  const file = await currentFile();
+  if (file === undefined) {
+    return;
+  }
+  const scope = vscode.workspace.getWorkspaceFolder(vscode.Uri.file(file)) ?? vscode.TaskScope.Workspace;
+  const task = buildTask({ type: TASK_TYPE, command, file, ...extra }, scope);
+  if (task !== undefined) {
+    await vscode.tasks.executeTask(task);
+  }
+}
+
+async function runWithSensors(): Promise<void> {
+  const document = vscode.window.activeTextEditor?.document;
+  const picked = await vscode.window.showOpenDialog({
+    title: 'RL/I: the sensor script to run with',
+    openLabel: 'Run with this script',
+    defaultUri: document !== undefined ? vscode.Uri.file(path.dirname(document.fileName)) : undefined,
+    filters: { 'Sensor scripts': ['json', 'toml'] },
+  });
+  if (picked?.[0] !== undefined) {
+    await runTask('run', { sensors: picked[0].fsPath });
+  }
+}
+
+async function showDisassembly(): Promise<void> {
+  const file = await currentFile();
+  if (file === undefined) {
+    return;
+  }
+  let text;
+  try {
+    text = await disassemble(rl1c(), file);
+  } catch (error) {
+    report(error);
+    return;
+  }
+  const uri = vscode.Uri.from({ scheme: DISASSEMBLY_SCHEME, path: `${file}.ils` });
+  disassemblies.set(uri.toString(), text);
+  disassemblyChanged.fire(uri);
+  await vscode.window.showTextDocument(uri, { preview: false, viewColumn: vscode.ViewColumn.Beside });
 }

@@ -6,7 +6,8 @@ import * as path from 'node:path';
 
 export const DEFAULT_SERVER = 'rl1-lsp';
 
-export interface ServerCommand {
+/** A program and its arguments, run without a shell. */
+export interface CommandLine {
   command: string;
   args: string[];
 }
@@ -23,7 +24,7 @@ export function serverCommand(
   pathSetting: unknown,
   argsSetting: unknown,
   workspaceFolder: string | undefined,
-): ServerCommand {
+): CommandLine {
   if (pathSetting !== undefined && pathSetting !== null && typeof pathSetting !== 'string') {
     throw new SettingError(
       `rl1.server.path must be a string such as "${DEFAULT_SERVER}", not ${JSON.stringify(pathSetting)}`,
@@ -37,7 +38,7 @@ export function serverCommand(
   }
   const written = (pathSetting ?? '').trim();
   return {
-    command: written === '' ? DEFAULT_SERVER : expand(written, workspaceFolder),
+    command: written === '' ? DEFAULT_SERVER : expand('rl1.server.path', written, workspaceFolder),
     args: argsSetting ?? [],
   };
 }
@@ -46,12 +47,13 @@ function isStringArray(value: unknown): value is string[] {
   return Array.isArray(value) && value.every((item) => typeof item === 'string');
 }
 
-function expand(written: string, workspaceFolder: string | undefined): string {
+/** A path setting with `~/` and `${workspaceFolder}` expanded; `setting` names it in errors. */
+export function expand(setting: string, written: string, workspaceFolder: string | undefined): string {
   let expanded = written;
   if (expanded.includes('${workspaceFolder}')) {
     if (workspaceFolder === undefined) {
       throw new SettingError(
-        `rl1.server.path "${written}" uses \${workspaceFolder}, but no folder is open: ` +
+        `${setting} "${written}" uses \${workspaceFolder}, but no folder is open: ` +
           'open the project folder, or write the full path',
       );
     }
