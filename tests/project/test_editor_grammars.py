@@ -5,13 +5,17 @@ Listing 1 and the edge cases (the extension's `npm test` keeps them true to the 
 Here every token the compiler's scanner finds must appear there at the same column,
 with the same text and a scope of the matching class, so that highlighting splits every
 line as the compiler does (`A=B--5` is B minus -5, `C--` a decrement). The editors'
-lists of built-in functions must be the compiler's.
+lists of built-in functions must be the compiler's, and Neovim's syntax file (run in
+Neovim or Vim when one is installed) colours each class.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import re
+import shutil
+import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -167,3 +171,129 @@ def test_the_emacs_mode_knows_exactly_the_builtins() -> None:
     found = re.search(r"\(defconst rl1-mnemonics\s+'\(([^)]*)\)", source)
     assert found is not None
     assert set(re.findall(r'"([A-Z]+)"', found[1])) == set(BUILTINS)
+
+
+def _neovim_mnemonics() -> set[str]:
+    source = (EDITORS / "nvim" / "syntax" / "rl1.vim").read_text(encoding="utf-8")
+    found = re.search(r"^let s:builtins = '([A-Z ]*)'$", source, re.MULTILINE)
+    assert found is not None, "syntax/rl1.vim: no `let s:builtins = '...'` line"
+    return set(found[1].split())
+
+
+def test_the_neovim_syntax_knows_exactly_the_builtins() -> None:
+    assert _neovim_mnemonics() == set(BUILTINS)
+
+
+# Each token of these lines, by its first column, with the syntax group that should
+# colour it.
+_VIM_CASES = {
+    ":10 (mov 3,3); A=$FF+#20 ' (MOV) 日本": {
+        1: "rl1Label", 6: "rl1Builtin", 10: "rl1Number", 11: "rl1Delimiter", 16: "rl1Variable",
+        17: "rl1Operator", 18: "rl1Number", 22: "rl1Jump", 26: "rl1Comment", 29: "rl1Comment"},
+    "?x=#96; B=C++": {1: "rl1Conditional", 2: "rl1Reserved", 3: "rl1Operator", 4: "rl1Jump",
+                      9: "rl1Variable", 12: "rl1Operator"},
+    ":97 (CAM P 5); (ult Q); (ULT a)": {
+        1: "rl1Handler", 6: "rl1Builtin", 10: "rl1Selector", 12: "rl1Number",
+        17: "rl1Builtin", 21: "rl1Error", 30: "rl1Selector"},
+    "(FOO 1); ABC=:5; E=$12345; #1 日": {2: "rl1Error", 10: "rl1Error", 14: "rl1Error",
+                                          20: "rl1Error", 28: "rl1Error", 31: "rl1Error"},
+    " :96 A=1": {2: "rl1Handler", 6: "rl1Variable"},
+}
+_VIM = shutil.which("nvim") or shutil.which("vim")
+# Writes the file type, then for each line the syntax group of each character (by byte),
+# space-separated.
+_DUMP_GROUPS = """
+let rows = [&filetype]
+for l in range(1, line('$'))
+  call add(rows, join(map(range(1, col([l, '$']) - 1), 'synIDattr(synID(l, v:val, 1), "name")')))
+endfor
+call writefile(rows, 'groups.txt')
+"""
+
+
+def _run_vim(folder: Path, *commands: str, path: str | None = None) -> None:
+    """Run `commands` in Neovim (or Vim) in `folder`, with no user configuration and
+    editors/nvim on the runtime path."""
+    assert _VIM is not None
+    arguments = [argument for command in (*commands, "qa!") for argument in ("-c", command)]
+    environment = {**os.environ, "PATH": path or os.environ["PATH"]}
+    subprocess.run([_VIM, "-N", "-u", "NONE", "-i", "NONE", "-es",
+                    "--cmd", f"set runtimepath^={EDITORS / 'nvim'}", *arguments],
+                   cwd=folder, env=environment, check=True, timeout=60)
+
+
+def _vim_groups(lines: list[str], folder: Path) -> list[list[str]]:
+    """The syntax group of each character of `lines` as Neovim (or Vim) colours them in a
+    `.rob` file, found by the file type detection of editors/nvim."""
+    (folder / "case.rob").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    (folder / "dump.vim").write_text(_DUMP_GROUPS, encoding="utf-8")
+    _run_vim(folder, "filetype on", "syntax on", "edit case.rob", "source dump.vim")
+    filetype, *rows = (folder / "groups.txt").read_text(encoding="utf-8").splitlines()
+    assert filetype == "rl1", f"{_VIM} took case.rob for {filetype!r}, not rl1"
+    groups = []
+    for line, row in zip(lines, rows, strict=True):
+        by_byte = row.split(" ")
+        # Columns count characters; Vim counts bytes.
+        starts = [len(line[:i].encode()) for i in range(len(line))]
+        groups.append([by_byte[start] for start in starts])
+    return groups
+
+
+@pytest.mark.skipif(_VIM is None, reason="neither nvim nor vim is installed")
+def test_the_neovim_syntax_colours_each_class(tmp_path: Path) -> None:
+    lines = list(_VIM_CASES)
+    for line, groups in zip(lines, _vim_groups(lines, tmp_path), strict=True):
+        for column, wanted in _VIM_CASES[line].items():
+            assert groups[column - 1] == wanted, (
+                f"{line!r} column {column} ({line[column - 1]!r}): {groups[column - 1]!r}, "
+                f"not {wanted}")
+
+
+@pytest.mark.skipif(_VIM is None, reason="neither nvim nor vim is installed")
+def test_the_neovim_syntax_colours_every_builtin_in_any_case(tmp_path: Path) -> None:
+    lines = [f"({name} 1); ({name.lower()} 1)" for name in sorted(BUILTINS)] + ["(XYZ 1)"]
+    groups = _vim_groups(lines, tmp_path)
+    for line, row in zip(lines[:-1], groups, strict=False):
+        second = line.index("(", 1) + 1
+        assert row[1] == row[second] == "rl1Builtin", line
+    assert groups[-1][1] == "rl1Error"
+
+
+# A stand-in for rl1c: records its arguments, prints concise lines and a summary.
+_FAKE_RL1C = """#!/bin/sh
+echo "$@" > arguments.txt
+echo 'case.rob:12:5: warning[W0301]: a lost line can jump to `:97`: add it'
+echo 'case.rob:3:17: error[E0100]: unexpected `*`'
+echo '2 files checked: 1 error, 1 warning'
+exit 1
+"""
+# Writes makeprg, then each valid quickfix entry as line|column|type|text.
+_DUMP_QUICKFIX = """
+compiler rl1c
+let rows = [&makeprg]
+silent make
+for item in filter(getqflist(), 'v:val.valid')
+  call add(rows, join([item.lnum, item.col, item.type, item.text], '|'))
+endfor
+call writefile(rows, 'quickfix.txt')
+"""
+
+
+@pytest.mark.skipif(_VIM is None or shutil.which("sh") is None,
+                    reason="neither nvim nor vim is installed, or no sh")
+def test_the_neovim_compiler_file_fills_the_quickfix_list_from_concise_lines(
+        tmp_path: Path) -> None:
+    fake = tmp_path / "bin" / "rl1c"
+    fake.parent.mkdir()
+    fake.write_text(_FAKE_RL1C, encoding="utf-8")
+    fake.chmod(0o755)
+    (tmp_path / "case.rob").write_text("A=1\n", encoding="utf-8")
+    (tmp_path / "dump.vim").write_text(_DUMP_QUICKFIX, encoding="utf-8")
+    _run_vim(tmp_path, "edit case.rob", "source dump.vim",
+             path=f"{fake.parent}{os.pathsep}{os.environ['PATH']}")
+    makeprg, *entries = (tmp_path / "quickfix.txt").read_text(encoding="utf-8").splitlines()
+    assert makeprg == "rl1c check --format concise %:S"
+    assert (tmp_path / "arguments.txt").read_text(encoding="utf-8").split() == [
+        "check", "--format", "concise", "case.rob"]
+    assert entries == ["12|5|w|[W0301]: a lost line can jump to `:97`: add it",
+                       "3|17|e|[E0100]: unexpected `*`"]

@@ -21,13 +21,17 @@ end
 function M.setup(opts)
   local config = vim.tbl_deep_extend('force', M.defaults, opts or {})
   if vim.fn.has('nvim-0.8') == 0 then
-    vim.notify('rl1: the language server needs Neovim 0.8 or newer', vim.log.levels.WARN)
+    vim.notify(
+      'rl1: the language server needs Neovim 0.8 or newer; until then, highlighting works '
+        .. 'and :compiler rl1c, then :make, checks the current file',
+      vim.log.levels.WARN
+    )
     return
   end
   if vim.fn.executable(config.cmd[1]) == 0 then
     vim.notify(
-      ('rl1: %s was not found: install the rl1 Python package (pip install -e . in the rl1 '
-        .. "project) or pass its full path: require('rl1').setup({ cmd = { '/path/to/rl1-lsp' } })")
+      ('rl1: %s was not found: install the rl1 Python package (pipx install /path/to/rl1) '
+        .. "or pass its full path: require('rl1').setup({ cmd = { '/path/to/rl1-lsp' } })")
         :format(config.cmd[1]),
       vim.log.levels.WARN
     )
