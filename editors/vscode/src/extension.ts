@@ -33,8 +33,8 @@ const HANDLERS: Record<CommandId, () => Promise<void>> = {
   'rl1.showDisassembly': showDisassembly,
 };
 
-// The .ils text of each open disassembly view, by the view's URI.
-const disassemblies = new Map<string, string>();
+// A disassembly view's URI is its source's path with `.ils` added, in this scheme.
+const DISASSEMBLY_SUFFIX = '.ils';
 const disassemblyChanged = new vscode.EventEmitter<vscode.Uri>();
 
 export async function activate(context: vscode.ExtensionContext): Promise<void> {
@@ -44,9 +44,15 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
     ...COMMANDS.map((id) => vscode.commands.registerCommand(id, HANDLERS[id])),
     vscode.workspace.registerTextDocumentContentProvider(DISASSEMBLY_SCHEME, {
       onDidChange: disassemblyChanged.event,
-      provideTextDocumentContent: (uri) => disassemblies.get(uri.toString()) ?? '',
+      provideTextDocumentContent: disassembly,
     }),
-    vscode.workspace.onDidCloseTextDocument((document) => disassemblies.delete(document.uri.toString())),
+    // An open disassembly follows its source from save to save.
+    vscode.workspace.onDidSaveTextDocument((saved) => {
+      const view = disassemblyUri(saved.fileName);
+      if (vscode.workspace.textDocuments.some((document) => document.uri.toString() === view.toString())) {
+        disassemblyChanged.fire(view);
+      }
+    }),
     vscode.tasks.registerTaskProvider(TASK_TYPE, {
       provideTasks: () => providedTasks(),
       resolveTask: (task) => resolvedTask(task),
@@ -117,11 +123,11 @@ async function start(): Promise<void> {
   }
 }
 
-/** Tells the user what went wrong in a command or task; only a bad setting offers the settings. */
+/** Tells the user what is wrong with a task or a setting; a setting's message offers the settings. */
 function report(error: unknown): void {
   if (error instanceof SettingError) {
     void offerSettings(`RL/I: ${error.message}.`);
-  } else if (error instanceof TaskError || error instanceof Rl1cError) {
+  } else if (error instanceof TaskError) {
     void vscode.window.showErrorMessage(`RL/I: ${error.message}.`);
   } else {
     throw error;
@@ -193,28 +199,34 @@ function resolvedTask(task: vscode.Task): vscode.Task | undefined {
   return buildTask(task.definition, task.scope ?? vscode.TaskScope.Workspace);
 }
 
-async function runTask(command: TaskCommand, extra: Record<string, string> = {}): Promise<void> {
+async function runTask(command: TaskCommand): Promise<void> {
   const file = await currentFile();
-  if (file === undefined) {
-    return;
-  }
-  const scope = vscode.workspace.getWorkspaceFolder(vscode.Uri.file(file)) ?? vscode.TaskScope.Workspace;
-  const task = buildTask({ type: TASK_TYPE, command, file, ...extra }, scope);
-  if (task !== undefined) {
-    await vscode.tasks.executeTask(task);
+  if (file !== undefined) {
+    await startTask({ type: TASK_TYPE, command, file });
   }
 }
 
 async function runWithSensors(): Promise<void> {
-  const document = vscode.window.activeTextEditor?.document;
+  const file = await currentFile();
+  if (file === undefined) {
+    return;
+  }
   const picked = await vscode.window.showOpenDialog({
     title: 'RL/I: the sensor script to run with',
     openLabel: 'Run with this script',
-    defaultUri: document !== undefined ? vscode.Uri.file(path.dirname(document.fileName)) : undefined,
+    defaultUri: vscode.Uri.file(path.dirname(file)),
     filters: { 'Sensor scripts': ['json', 'toml'] },
   });
   if (picked?.[0] !== undefined) {
-    await runTask('run', { sensors: picked[0].fsPath });
+    await startTask({ type: TASK_TYPE, command: 'run', file, sensors: picked[0].fsPath });
+  }
+}
+
+async function startTask(definition: vscode.TaskDefinition & { file: string }): Promise<void> {
+  const scope = vscode.workspace.getWorkspaceFolder(vscode.Uri.file(definition.file)) ?? vscode.TaskScope.Workspace;
+  const task = buildTask(definition, scope);
+  if (task !== undefined) {
+    await vscode.tasks.executeTask(task);
   }
 }
 
@@ -223,15 +235,24 @@ async function showDisassembly(): Promise<void> {
   if (file === undefined) {
     return;
   }
-  let text;
+  const view = disassemblyUri(file);
+  disassemblyChanged.fire(view); // an open view is brought up to date
+  await vscode.window.showTextDocument(view, { preview: false, viewColumn: vscode.ViewColumn.Beside });
+}
+
+function disassemblyUri(source: string): vscode.Uri {
+  return vscode.Uri.file(source + DISASSEMBLY_SUFFIX).with({ scheme: DISASSEMBLY_SCHEME });
+}
+
+/** The view's text: what `rl1c dis` shows, or, as an .ils comment, why there is none. */
+async function disassembly(view: vscode.Uri): Promise<string> {
+  const source = view.with({ scheme: 'file' }).fsPath.slice(0, -DISASSEMBLY_SUFFIX.length);
   try {
-    text = await disassemble(rl1c(), file);
+    return await disassemble(rl1c(), source);
   } catch (error) {
-    report(error);
-    return;
+    if (error instanceof Rl1cError || error instanceof SettingError) {
+      return `; RL/I: ${error.message}.\n`;
+    }
+    throw error;
   }
-  const uri = vscode.Uri.from({ scheme: DISASSEMBLY_SCHEME, path: `${file}.ils` });
-  disassemblies.set(uri.toString(), text);
-  disassemblyChanged.fire(uri);
-  await vscode.window.showTextDocument(uri, { preview: false, viewColumn: vscode.ViewColumn.Beside });
 }

@@ -5,7 +5,7 @@ import * as assert from 'node:assert/strict';
 import * as fs from 'node:fs';
 import * as path from 'node:path';
 import { test } from 'node:test';
-import { registered } from './fakeVscode';
+import { ProcessExecution, registered, Task } from './fakeVscode';
 import { activate } from '../extension';
 import { COMMANDS, TASK_COMMANDS, TASK_TYPE } from '../rl1cCommand';
 import { PACKAGE_ROOT } from './textmate';
@@ -18,16 +18,34 @@ test('activating registers a handler for every command package.json declares, an
   const declared = contributes.commands.map((command: { command: string }) => command.command);
   assert.deepEqual([...registered.commands.keys()].sort(), [...declared].sort());
   assert.deepEqual([...COMMANDS].sort(), [...declared].sort());
-  assert.deepEqual(registered.taskTypes, [TASK_TYPE]);
+  assert.deepEqual([...registered.taskProviders.keys()], [TASK_TYPE]);
 });
 
 test('the commands that act on a file say so when no RL/I file is open', async () => {
   await activated;
-  for (const id of ['rl1.check', 'rl1.compile', 'rl1.showDisassembly']) {
+  for (const id of ['rl1.check', 'rl1.compile', 'rl1.run', 'rl1.showDisassembly']) {
     registered.errors.length = 0;
     await registered.commands.get(id)?.();
     assert.deepEqual(registered.errors, ['RL/I: open an RL/I file (.rob) saved on disk first.'], id);
   }
+});
+
+test('a check task from tasks.json runs rl1c check --format concise under the $rl1c matcher', async () => {
+  await activated;
+  const provider = registered.taskProviders.get(TASK_TYPE);
+  const task = provider?.resolveTask({ definition: { type: TASK_TYPE, command: 'check', file: '/r/a.rob' } });
+  assert.ok(task instanceof Task);
+  assert.deepEqual(task.execution, new ProcessExecution('rl1c', ['check', '--format', 'concise', '/r/a.rob']));
+  assert.deepEqual(task.problemMatchers, ['$rl1c']);
+  assert.equal(task.name, 'check a.rob');
+});
+
+test('a run task without a sensor script is refused with what to write', async () => {
+  await activated;
+  registered.errors.length = 0;
+  const provider = registered.taskProviders.get(TASK_TYPE);
+  assert.equal(provider?.resolveTask({ definition: { type: TASK_TYPE, command: 'run', file: '/r/a.rob' } }), undefined);
+  assert.match(registered.errors.join('\n'), /the rl1 "run" task needs "sensors"/);
 });
 
 test('the task type declares the commands the task provider runs', () => {

@@ -5,9 +5,13 @@ import Module = require('node:module');
 
 type Handler = (...args: unknown[]) => unknown;
 
+export interface TaskProvider {
+  resolveTask(task: { definition: Record<string, unknown>; scope?: unknown }): unknown;
+}
+
 export const registered = {
   commands: new Map<string, Handler>(),
-  taskTypes: [] as string[],
+  taskProviders: new Map<string, TaskProvider>(),
   schemes: [] as string[],
   errors: [] as string[],
 };
@@ -19,8 +23,30 @@ class EventEmitter {
   fire(): void {}
 }
 
+/** vscode.Task and vscode.ProcessExecution keep their constructor's arguments. */
+export class Task {
+  constructor(
+    readonly definition: unknown,
+    readonly scope: unknown,
+    readonly name: string,
+    readonly source: string,
+    readonly execution: ProcessExecution,
+    readonly problemMatchers: string[],
+  ) {}
+}
+
+export class ProcessExecution {
+  constructor(
+    readonly process: string,
+    readonly args: string[],
+  ) {}
+}
+
 const vscode = {
   EventEmitter,
+  Task,
+  ProcessExecution,
+  TaskScope: { Workspace: 2 },
   window: {
     activeTextEditor: undefined,
     createOutputChannel: () => disposable,
@@ -39,15 +65,15 @@ const vscode = {
     workspaceFolders: undefined,
     getConfiguration: () => ({ get: () => undefined }),
     onDidChangeConfiguration: () => disposable,
-    onDidCloseTextDocument: () => disposable,
+    onDidSaveTextDocument: () => disposable,
     registerTextDocumentContentProvider: (scheme: string) => {
       registered.schemes.push(scheme);
       return disposable;
     },
   },
   tasks: {
-    registerTaskProvider: (type: string) => {
-      registered.taskTypes.push(type);
+    registerTaskProvider: (type: string, provider: TaskProvider) => {
+      registered.taskProviders.set(type, provider);
       return disposable;
     },
   },
