@@ -17,7 +17,7 @@ from rl1.compiler.frontend.diagnostics import Diagnostic
 from rl1.compiler.interpreter import interpret
 from rl1.vm.device import Device
 from rl1.vm.faults import DEFAULT_BUDGET, RunResult
-from rl1.vm.machine import Machine
+from rl1.vm.machine import run
 from rl1.vm.scripted import Script, ScriptError, decode_script
 from rl1.vm.verifier import verify
 
@@ -39,13 +39,13 @@ def run_source(text: str, source_name: str, device: Device, engine: Engine = "vm
     compilation = compile_text(text, source_name)
     if compilation.output is None:
         return compilation.diagnostics
-    return Machine(verify(compilation.output), device, budget).run()
+    return run(verify(compilation.output), device, budget)
 
 
 def run_ilc(data: bytes, device: Device, budget: int = DEFAULT_BUDGET) -> RunResult:
     """Run the bytes of an .ilc file on the VM; verifier.VerifyError if they are not
     valid intermediate code."""
-    return Machine(verify(data), device, budget).run()
+    return run(verify(data), device, budget)
 
 
 def load_script(path: str | Path) -> Script:
