@@ -10,7 +10,8 @@ returns, in order, and when the guidance line is lost:
       "ULT A": [150, ...],          (also "ULT B", "ULT C", "ULT D")
       "INP": {"3": [1, 0], ...},    (per input port, the port number in decimal)
       "FZI": [{"s": 1, "t": -2}, ...],
-      "line_lost": [{"time": 2500}, {"during": "MVI", "nth": 1, "after": 300}],
+      "line_lost": [{"time": 2500}, {"during": "MVI", "nth": 1, "after": 300},
+                    {"instruction": 40}],
       "comment": "free text, ignored"
     }
 
@@ -21,7 +22,11 @@ repeats; a call with no list reads zeros. Values are 16-bit signed integers (INP
 Line losses: `{"time": T}` at device time T ms; `{"during": "MOV"|"MVI", "nth": N,
 "after": A}` A ms (default 1) after the N-th MOV or MVI call of the run (counting every
 call, MOV 0,0 included) started, if that command is still in effect then. A loss at the
-very moment an MVI covers its distance is too late for it. A loss matters only while
+very moment an MVI covers its distance is too late for it. `{"instruction": N}`: right
+after the VM has run N instructions, between two instructions, as a vehicle's device
+posts a loss from an interrupt; the device cannot see instructions, so whoever steps the
+VM calls `lose_line` then (vm/drive.py), and an engine that counts no instructions (the
+AST interpreter) cannot run such a script. A loss matters only while
 motion is in effect (a non-zero MOV, or an MVI in progress); see device.py for what each
 tracing mode does with it.
 
@@ -74,6 +79,13 @@ class LossDuring:
 
 
 @dataclass(frozen=True, slots=True)
+class LossAfter:
+    """The line is lost right after the VM's `instruction`-th instruction."""
+
+    instruction: int
+
+
+@dataclass(frozen=True, slots=True)
 class Script:
     images: tuple[ImageReading, ...] = ()
     odometry: tuple[Odometry, ...] = ()
@@ -81,7 +93,13 @@ class Script:
     ultrasonic: dict[str, tuple[int, ...]] = field(default_factory=dict)
     ports: dict[int, tuple[int, ...]] = field(default_factory=dict)
     fuzzy: tuple[FuzzyReading, ...] = ()
-    losses: tuple[LossAt | LossDuring, ...] = ()
+    losses: tuple[LossAt | LossDuring | LossAfter, ...] = ()
+
+    @property
+    def instruction_losses(self) -> tuple[int, ...]:
+        """The instruction counts after which the line is lost, in order."""
+        return tuple(sorted(loss.instruction for loss in self.losses
+                            if isinstance(loss, LossAfter)))
 
 
 @dataclass(frozen=True, slots=True)
@@ -233,16 +251,18 @@ def _ports(value: object, where: str) -> dict[int, tuple[int, ...]]:
     return ports
 
 
-def _loss(value: object, where: str) -> LossAt | LossDuring:
+def _loss(value: object, where: str) -> LossAt | LossDuring | LossAfter:
     if isinstance(value, dict) and set(value) == {"time"}:
         return LossAt(_int(value["time"], f"{where}.time", 1, 2**31 - 1))
+    if isinstance(value, dict) and set(value) == {"instruction"}:
+        return LossAfter(_int(value["instruction"], f"{where}.instruction", 0, 2**31 - 1))
     if isinstance(value, dict) and set(value) in ({"during", "nth"}, {"during", "nth", "after"}):
         command = value["during"]
         if command not in ("MOV", "MVI"):
             raise ScriptError(f'{where}.during: expected "MOV" or "MVI", found {_kind(command)}')
         return LossDuring(command, _int(value["nth"], f"{where}.nth", 1, 2**31 - 1),
                           _int(value.get("after", 1), f"{where}.after", 1, 2**31 - 1))
-    raise ScriptError(f'{where}: expected {{"time": MS}} or '
+    raise ScriptError(f'{where}: expected {{"time": MS}}, {{"instruction": N}} or '
                       f'{{"during": "MOV"|"MVI", "nth": N, "after": MS}}, found {_kind(value)}')
 
 
@@ -326,10 +346,10 @@ class ScriptedDevice:
                 self.time = until
                 return
             self.time = loss
-            if self._lose_line() and interruptible:
+            if self.lose_line() and interruptible:
                 return
 
-    def _lose_line(self) -> bool:
+    def lose_line(self) -> bool:
         """The line is lost now; True if the program is to hear of it."""
         motion = self._motion
         if motion is None or self.mode == 0:

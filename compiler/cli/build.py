@@ -158,8 +158,11 @@ def run(file: str, sensors: str | None, run_format: str, budget: int, engine: En
         source = read_input(file)
         if not isinstance(source, Source):
             return emit([source], "human", "auto", "run", err=True)
-        outcome = run_source(source.text, os.path.basename(source.name), device, engine,
-                             budget)
+        try:
+            outcome = run_source(source.text, os.path.basename(source.name), device, engine,
+                                 budget)
+        except ScriptError as error:
+            raise Failure(f"error: {error}") from None
         if not isinstance(outcome, RunResult):
             return emit([FileDiagnostics(source.name, source.text, outcome)], "human",
                         "auto", "run", err=True)

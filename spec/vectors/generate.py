@@ -5,8 +5,9 @@
                                                         differs from what would be written
 
 Each case is compiled with and without its debug section, both files are verified and
-run on the VM, and the source is run on the AST interpreter, each run on a fresh
-scripted device. All runs must agree (the stripped file knows no fault line), and agree
+stepped on the VM (vm/drive.py), and the source is run on the AST interpreter (unless
+the script loses the line after instruction counts, which only the VM counts), each run
+on a fresh scripted device. All runs must agree (the stripped file knows no fault line), and agree
 with what the case expects (its variables, status, fault line and trace, worked out
 from the spec; see cases.py and oracle.py). If any case fails, no file is written.
 """
@@ -28,14 +29,16 @@ from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.files import write_atomically
 from rl1.compiler.interpreter import interpret
+from rl1.vm.drive import drive
 from rl1.vm.faults import FaultKind, RunResult
+from rl1.vm.hardware import Blocking
 from rl1.vm.language import VARIABLES
-from rl1.vm.machine import run
+from rl1.vm.machine import Machine
 from rl1.vm.scripted import ScriptedDevice, parse_script
 from rl1.vm.verifier import verify
 
 HERE = Path(__file__).resolve().parent
-FORMAT = 1  # the version of the vector format (README.md); a change of layout bumps it
+FORMAT = 2  # the version of the vector format (README.md); a change of layout bumps it
 EXIT_STATUS = {kind.code: kind.exit_status for kind in FaultKind} | {"ok": 0}
 
 Record = tuple[int, str, tuple[int, ...], tuple[int, ...]]  # time, call, args, result
@@ -49,25 +52,35 @@ class Outcome:
     fault_line: int | None
     variables: tuple[int, ...]
     trace: tuple[Record, ...]
+    executed: int | None = None  # instructions the VM ran; None for the interpreter
 
 
 class VectorError(Exception):
     """A case that cannot become a vector: it does not compile, or a run disagrees."""
 
 
-def _outcome(result: RunResult, device: ScriptedDevice) -> Outcome:
+def _outcome(result: RunResult, device: ScriptedDevice, executed: int | None = None
+             ) -> Outcome:
     fault = result.fault
     trace = tuple((entry.time, entry.call, entry.args, entry.result or ())
                   for entry in device.trace)
     if fault is None:
-        return Outcome("ok", None, result.variables, trace)
-    return Outcome(fault.kind.code, fault.line, result.variables, trace)
+        return Outcome("ok", None, result.variables, trace, executed)
+    return Outcome(fault.kind.code, fault.line, result.variables, trace, executed)
 
 
-def run_vm(data: bytes, sensors: Mapping[str, Any], budget: int) -> Outcome:
-    """Verify an .ilc file and run it on the VM with the sensor script."""
+def run_vm(data: bytes, sensors: Mapping[str, Any], budget: int,
+           machine: type[Machine] = Machine) -> Outcome:
+    """Verify an .ilc file and step it on the VM (or on `machine`, a variant of it) with
+    the sensor script."""
     device = ScriptedDevice(parse_script(dict(sensors), "sensors"))
-    return _outcome(run(verify(data), device, budget), device)
+    vm = machine(verify(data), Blocking(device), budget)
+    return _outcome(drive(vm, device), device, vm.executed)
+
+
+def interpretable(sensors: Mapping[str, Any]) -> bool:
+    """Whether the interpreter can run with the script: no loss after an instruction."""
+    return not parse_script(dict(sensors), "sensors").instruction_losses
 
 
 def run_interpreter(source: str, sensors: Mapping[str, Any], budget: int) -> Outcome:
@@ -108,6 +121,8 @@ def difference(expected: Outcome, actual: Outcome) -> str | None:
             return f"trace entry {index} is {got}, expected {want}"
     if len(expected.trace) != len(actual.trace):
         return f"the trace has {len(actual.trace)} entries, expected {len(expected.trace)}"
+    if None not in (expected.executed, actual.executed) and expected.executed != actual.executed:
+        return f"{actual.executed} instructions executed, expected {expected.executed}"
     return None
 
 
@@ -116,7 +131,8 @@ def _check_expectations(case: Case, outcome: Outcome) -> None:
     if unknown:
         raise VectorError(f"{case.name}: the case names no variable {sorted(unknown)}")
     expected = Outcome(case.status, case.fault_line or None,
-                       tuple(case.variables.get(name, 0) for name in VARIABLES), ())
+                       tuple(case.variables.get(name, 0) for name in VARIABLES), (),
+                       case.executed)
     problem = difference(expected, replace(outcome, trace=()))
     if problem is None and case.trace is not None:
         problem = _trace_difference(case.trace, outcome.trace)
@@ -144,9 +160,10 @@ def build(case: Case) -> dict[str, Any]:
     others = {
         "the VM on the stripped file": (run_vm(stripped, case.sensors, case.budget),
                                         replace(outcome, fault_line=None)),
-        "the AST interpreter": (run_interpreter(case.source, case.sensors, case.budget),
-                                outcome),
     }
+    if interpretable(case.sensors):
+        others["the AST interpreter"] = (
+            run_interpreter(case.source, case.sensors, case.budget), outcome)
     for engine, (other, reference) in others.items():
         problem = difference(reference, other)
         if problem is not None:
@@ -164,6 +181,7 @@ def build(case: Case) -> dict[str, Any]:
         "status": outcome.status,
         "exit_status": EXIT_STATUS[outcome.status],
         "fault_line": outcome.fault_line or 0,
+        "executed": outcome.executed,
         "variables": list(outcome.variables),
         "trace": [{"time": time, "call": call, "args": list(args), "result": list(result)}
                   for time, call, args, result in outcome.trace],

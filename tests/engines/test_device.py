@@ -86,7 +86,8 @@ def test_the_sample_sensor_script_is_valid() -> None:
     ({"line_lost": [{"time": 0}]}, "s.json:line_lost[0].time: 0 is outside 1.."),
     ({"line_lost": [{"during": "TIM", "nth": 1}]},
      's.json:line_lost[0].during: expected "MOV" or "MVI"'),
-    ({"line_lost": [{"at": 5}]}, 's.json:line_lost[0]: expected {"time": MS} or'),
+    ({"line_lost": [{"at": 5}]},
+     's.json:line_lost[0]: expected {"time": MS}, {"instruction": N} or'),
     ({"comment": 5}, "s.json:comment: expected a string"),
 ])
 def test_bad_scripts_are_refused_with_file_key_and_reason(

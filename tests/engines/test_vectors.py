@@ -50,7 +50,7 @@ def expected(vector: dict[str, Any], *, stripped: bool = False) -> Outcome:
     line = None if stripped or vector["status"] == "ok" else vector["fault_line"]
     return Outcome(vector["status"], line, tuple(vector["variables"]), tuple(
         (entry["time"], entry["call"], tuple(entry["args"]), tuple(entry["result"]))
-        for entry in vector["trace"]))
+        for entry in vector["trace"]), vector["executed"])
 
 
 def instructions(data: bytes) -> list[isa.Instruction]:
@@ -100,6 +100,8 @@ def test_the_vm_on_the_bytes_gives_the_outcome(vector: dict[str, Any]) -> None:
 
 @each_vector
 def test_the_interpreter_on_the_source_gives_the_outcome(vector: dict[str, Any]) -> None:
+    if not generate.interpretable(vector["sensors"]):
+        pytest.skip("the script loses the line after instruction counts: VM only")
     outcome = generate.run_interpreter(vector["source"], vector["sensors"], vector["budget"])
     assert generate.difference(expected(vector), outcome) is None
 
