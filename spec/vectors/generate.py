@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from cases import Case, TraceItem, all_cases
+from files import FileCase, all_file_cases
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import compile_text
@@ -35,7 +36,7 @@ from rl1.vm.hardware import Blocking
 from rl1.vm.language import VARIABLES
 from rl1.vm.machine import Machine
 from rl1.vm.scripted import ScriptedDevice, parse_script
-from rl1.vm.verifier import verify
+from rl1.vm.verifier import VerifyError, verify
 
 HERE = Path(__file__).resolve().parent
 FORMAT = 2  # the version of the vector format (README.md); a change of layout bumps it
@@ -206,8 +207,47 @@ def render_group(group: str, vectors: list[dict[str, Any]]) -> str:
     return text
 
 
-def generate(cases: Sequence[Case]) -> dict[Path, str]:
-    """The text of every vector file, by path; VectorError if a case fails."""
+# What the message of a refusal by each rule of spec/ilc.md section 10 says: how the
+# generator knows which rule refused a file (the C loader reports the rule's number).
+RULE_MESSAGES = {
+    1: "truncated|not an .ilc file", 2: "format version", 3: "truncated", 4: "header size",
+    5: "section must be", 6: "truncated: the header's section sizes", 7: "unexpected bytes",
+    8: "CRC-32 mismatch", 9: "required flag", 10: "points at code offset",
+    11: "unknown feature bits", 12: "debug|line entry (repeats|\\(offset)|UTF-8|left over",
+    13: "unknown opcode", 14: "needs \\d+ bytes", 15: "variable index|argument mask|out of range",
+    16: "needs the device feature", 17: "jump target", 18: "handler :\\d+ at code offset",
+    19: "line entry for code offset",
+}
+
+
+def build_file(case: FileCase) -> dict[str, Any]:
+    """The verifier vector of one file, after the verifier does what the case says."""
+    try:
+        verify(case.data)
+    except VerifyError as error:
+        rule = case.rule
+        if rule is None or error.offset != case.offset or not re.search(
+                RULE_MESSAGES[rule], error.message):
+            raise VectorError(f"{case.name}: refused at {error.offset} ({error.message}), "
+                              f"expected rule {rule} at {case.offset}") from None
+        return case.vector()
+    if case.rule is not None:
+        raise VectorError(f"{case.name}: accepted, expected rule {case.rule} at {case.offset}")
+    return case.vector()
+
+
+def render_files(vectors: list[dict[str, Any]]) -> str:
+    """verifier.json: one file vector a line."""
+    lines = ",\n".join("    " + json.dumps(vector) for vector in vectors)
+    text = (f'{{\n  "format": {FORMAT},\n  "group": "verifier",\n  "files": [\n{lines}\n'
+            "  ]\n}\n")
+    assert text.isascii() and json.loads(text)["files"] == vectors
+    return text
+
+
+def generate(cases: Sequence[Case], file_cases: Sequence[FileCase] = ()) -> dict[Path, str]:
+    """The text of every vector file, by path; VectorError if a case fails. The verifier
+    vectors are written only when `file_cases` are given."""
     groups: dict[str, list[dict[str, Any]]] = {}
     names: set[str] = set()
     for case in cases:
@@ -215,8 +255,11 @@ def generate(cases: Sequence[Case]) -> dict[Path, str]:
             raise VectorError(f"{case.name}: two cases have this name")
         names.add(case.name)
         groups.setdefault(case.group, []).append(build(case))
-    return {HERE / f"{group}.json": render_group(group, vectors)
-            for group, vectors in groups.items()}
+    files = {HERE / f"{group}.json": render_group(group, vectors)
+             for group, vectors in groups.items()}
+    if file_cases:
+        files[HERE / "verifier.json"] = render_files([build_file(c) for c in file_cases])
+    return files
 
 
 def stale_files(files: Mapping[Path, str]) -> list[str]:
@@ -240,7 +283,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     arguments = parser.parse_args(argv)
     cases = all_cases()
     try:
-        files = generate(cases)
+        files = generate(cases, all_file_cases())
     except VectorError as error:
         print(f"error: {error}", file=sys.stderr)
         return 1
