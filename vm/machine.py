@@ -259,6 +259,7 @@ class Machine:
     def _execute(self, limit: int) -> State:
         code, expressions, budget, reach = self.code, self.expressions, self.budget, self.reach
         cells, sites = self.cells, self.sites
+        last = len(self.program.instructions)  # the END that running off the end runs
         hardware = self.hardware
         take, divert = hardware.take_event, self._divert
         acc, pc = self.acc, self.pc  # acc modulo 2**16: see the module's docstring
@@ -387,6 +388,7 @@ class Machine:
                     self.acc, self.pc, self.executed = acc, pc, executed + pc - start
                     return State.RUNNING
                 else:  # END
+                    pc = min(pc, last)  # running off the end is no instruction
                     self.acc, self.pc, self.executed = acc, pc, executed + pc - start
                     self.state = State.ENDED
                     ended = hardware.end()

@@ -12,6 +12,8 @@ returns, in order, and when the guidance line is lost:
       "FZI": [{"s": 1, "t": -2}, ...],
       "line_lost": [{"time": 2500}, {"during": "MVI", "nth": 1, "after": 300},
                     {"instruction": 40}],
+      "fail": {"ULT A": 2, ...},     (the 2nd ULT A call of the run fails)
+      "stop_fails": true,
       "comment": "free text, ignored"
     }
 
@@ -29,6 +31,11 @@ VM calls `lose_line` then (vm/drive.py), and an engine that counts no instructio
 AST interpreter) cannot run such a script. A loss matters only while
 motion is in effect (a non-zero MOV, or an MVI in progress); see device.py for what each
 tracing mode does with it.
+
+Failures: a call named in "fail" (a form as the trace writes it: "TIM", "CAM R") fails
+the N-th time it arrives: the device records it, then raises DeviceError at once, before
+any device time passes. With "stop_fails" the device records STOP, then raises
+DeviceError: the engine's stop after a fault fails.
 
 The motion model (device time in integer milliseconds, starting at 0):
 - TIM t waits t x 100 ms; MVI l,r,cm moves the centre at |l+r|/2 x 5 cm/s (a wheel speed
@@ -48,7 +55,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
 
-from .device import DeviceError, FuzzyReading, ImageReading, LineLost, MotionCommand, Odometry
+from .device import (
+    DeviceError,
+    FuzzyReading,
+    ImageReading,
+    LineLost,
+    MotionCommand,
+    Odometry,
+    form_name,
+)
 from .language import BUILTINS, TOO_LONG, decimal_value
 
 T = TypeVar("T")
@@ -94,6 +109,8 @@ class Script:
     ports: dict[int, tuple[int, ...]] = field(default_factory=dict)
     fuzzy: tuple[FuzzyReading, ...] = ()
     losses: tuple[LossAt | LossDuring | LossAfter, ...] = ()
+    failures: dict[str, int] = field(default_factory=dict)  # a form -> the call that fails
+    stop_fails: bool = False
 
     @property
     def instruction_losses(self) -> tuple[int, ...]:
@@ -122,7 +139,7 @@ class TraceEntry:
 
 _INT16 = (-32768, 32767)
 _LIST_KEYS = ("IMG", "KYO", "CAM R", "ULT A", "ULT B", "ULT C", "ULT D", "FZI")
-_KEYS = (*_LIST_KEYS, "INP", "line_lost", "comment")
+_KEYS = (*_LIST_KEYS, "INP", "line_lost", "fail", "stop_fails", "comment")
 
 
 def decode_script(data: bytes, name: str) -> Script:
@@ -165,6 +182,8 @@ def parse_script(document: object, name: str = "<script>") -> Script:
                               + ", ".join(f'"{k}"' for k in _KEYS))
     if not isinstance(document.get("comment", ""), str):
         raise ScriptError(f"{name}:comment: expected a string")
+    if not isinstance(document.get("stop_fails", False), bool):
+        raise ScriptError(f"{name}:stop_fails: expected true or false")
 
     def readings(key: str) -> list[object]:
         return _list(document[key], f"{name}:{key}") if key in document else []
@@ -186,6 +205,8 @@ def parse_script(document: object, name: str = "<script>") -> Script:
                     for i, item in enumerate(readings("FZI"))),
         losses=tuple(_loss(item, f"{name}:line_lost[{i}]")
                      for i, item in enumerate(readings("line_lost"))),
+        failures=_failures(document.get("fail", {}), f"{name}:fail"),
+        stop_fails=document.get("stop_fails", False),
     )
 
 
@@ -251,6 +272,21 @@ def _ports(value: object, where: str) -> dict[int, tuple[int, ...]]:
     return ports
 
 
+FORMS = frozenset(form_name((mnemonic, form.selector)) for mnemonic, builtin in BUILTINS.items()
+                  if mnemonic != "END" for form in builtin.forms)
+
+
+def _failures(value: object, where: str) -> dict[str, int]:
+    if not isinstance(value, dict):
+        raise ScriptError(f'{where}: expected an object from a call to the one that fails, '
+                          f'e.g. {{"TIM": 2}}, found {_kind(value)}')
+    for call in value:
+        if call not in FORMS:
+            raise ScriptError(f"{where}.{call}: not a built-in form; expected one of "
+                              + ", ".join(sorted(FORMS)))
+    return {call: _int(nth, f"{where}.{call}", 1, 2**31 - 1) for call, nth in value.items()}
+
+
 def _loss(value: object, where: str) -> LossAt | LossDuring | LossAfter:
     if isinstance(value, dict) and set(value) == {"time"}:
         return LossAt(_int(value["time"], f"{where}.time", 1, 2**31 - 1))
@@ -302,11 +338,17 @@ class ScriptedDevice:
         for afters in self._losses_during.values():
             afters.sort()
         self._read_counts: dict[str, int] = {}
+        self._arrivals: dict[str, int] = {}  # calls of each form so far, for "fail"
 
     # Bookkeeping
 
     def _record(self, call: str, *args: int, result: tuple[int, ...] | None = None) -> None:
         self.trace.append(TraceEntry(self.time, call, args, result))
+        arrived = self._arrivals.get(call, 0) + 1
+        self._arrivals[call] = arrived
+        if self.script.failures.get(call) == arrived:
+            raise DeviceError(f"({call}) failed: the sensor script says its call "
+                              f"{arrived} fails")
 
     def _next(self, key: str, readings: tuple[T, ...], nothing: T) -> T:
         count = self._read_counts.get(key, 0)
@@ -489,6 +531,8 @@ class ScriptedDevice:
 
     def stop(self) -> None:
         self._stopped("STOP")
+        if self.script.stop_fails:
+            raise DeviceError("the sensor script says stopping fails")
 
     def poll_event(self) -> LineLost | None:
         event, self.pending = self.pending, None

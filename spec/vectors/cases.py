@@ -51,11 +51,12 @@ class Case:
     fault_line: int = 0
     trace: tuple[TraceItem, ...] | None = None  # the expected trace, when the case fixes it
     executed: int | None = None  # the VM's instruction count, when the case fixes it
+    language: str = "rl1"  # "ils": `source` is intermediate code written by hand (.ils)
 
 
 def all_cases() -> list[Case]:
     return [*arithmetic(), *shifts(), *control(), *calls(), *tracing(), *events(), *faults(),
-            *sample()]
+            *sample(), *intermediate()]
 
 
 def _straight(group: str, name: str, covers: str, program: Straight) -> Case:
@@ -640,6 +641,18 @@ def faults() -> Iterator[Case]:
                "and out of range is a budget fault",
                "a++\n" * 13 + "(MOV a,0)\n", {"a": 13}, budget=13, status="budget",
                fault_line=14, trace=((0, "STOP", ()),), executed=14)
+    yield Case(group, "failing-call", "the device fails the 2nd (ULT A), a built-in that "
+               "takes device time: a device error at that call, after the vehicle is "
+               "stopped; the first reading was written",
+               "(MOV 1,1)\nA=(ULT A)\nB=(ULT A)\n", {"A": 7}, status="device-error",
+               fault_line=3, sensors={"ULT A": [7], "fail": {"ULT A": 2}},
+               trace=((0, "MOV", (1, 1)), (0, "ULT A", ()), (100, "ULT A", ()),
+                      (100, "STOP", ())),
+               executed=5)
+    yield Case(group, "failing-stop", "the stop after a fault fails: the fault reported is "
+               "still the one that caused the stop (argument-range), not a device error",
+               "a=13\n(MOV a,0)\n", {"a": 13}, status="argument-range", fault_line=2,
+               sensors={"stop_fails": True}, trace=((0, "STOP", ()),), executed=3)
     yield Case(group, "device-error", "the device refuses an MVI whose centre would not "
                "move: a device error, after the vehicle is stopped",
                "(MOV 2,2)\n(MVI 3,-3,10)\n", {}, status="device-error", fault_line=2,
@@ -648,6 +661,42 @@ def faults() -> Iterator[Case]:
                "variables", "a=-5; b=5; c=-1900\n\n(MVI a,b,c)\n",
                {"a": -5, "b": 5, "c": -1900}, status="device-error", fault_line=3,
                trace=((0, "MVI", (-5, 5, -1900)), (0, "STOP", ())))
+
+
+# --- intermediate code written by hand ------------------------------------------------------
+
+
+def intermediate() -> Iterator[Case]:
+    """What the compiler never writes, but a VM must run as section 9 of spec/ilc.md says."""
+    group = "ils"
+    yield Case(group, "ils-off-the-end", "code with no final END: running past the last "
+               "instruction ends the program", "  LDI 5\n  STV A\n", {"A": 5},
+               language="ils", executed=2)
+    yield Case(group, "ils-empty-code", "an empty code section: the program begins and "
+               "ends having run no instruction", "", {}, language="ils", executed=0)
+    yield Case(group, "ils-ldr-before-any-call", "R is 0 before any call returns a value",
+               "  LDR\n  STV A\n  LDI 7\n  ADDR\n  STV B\n", {"B": 7}, language="ils",
+               executed=5)
+    yield Case(group, "ils-r-kept-by-calls-without-result",
+               "FZI, TIM and MOV return nothing: R still holds IMG's area for SHLR",
+               "  IMG\n  FZI\n  TIM 1\n  MOV 0, 0\n  LDI 1\n  SHLR\n  STV A\n",
+               {"A": 8, "w": 3, "s": -1, "t": 20},
+               sensors={"IMG": [{"area": 3, "x": 0, "y": 0, "z": 0}],
+                        "FZI": [{"s": -1, "t": 20}]},
+               language="ils", executed=7)
+    yield Case(group, "ils-jump-into-a-statement", "a jump into the middle of a "
+               "load-operate-store run continues with the accumulator as it is",
+               "  LDI 100\n  JMP L1\n  LDI 10\nL1:\n  ADDI 5\n  STV A\n  END\n", {"A": 105},
+               language="ils", executed=5)
+    yield Case(group, "ils-budget-at-a-conditional-jump-to-a-handler",
+               "the budget fault comes at a conditional jump taken even with an event "
+               "pending there: the watchdog is checked before the event point",
+               ".handler 96 H\n  TRC 3\n  MOV 1, 1\n  INC A\nL:\n  JGT A, L\nH:\n  END\n",
+               {"A": 1}, budget=3, status="budget", fault_line=1,
+               sensors={"line_lost": [{"instruction": 3}]},
+               trace=((0, "TRC", (3,)), (0, "MOV", (1, 1)), (0, "LINE LOST", (3,)),
+                      (0, "STOP", ())),
+               language="ils", executed=4)
 
 
 # --- Listing 1 ---------------------------------------------------------------------------

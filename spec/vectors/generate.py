@@ -29,7 +29,9 @@ from files import FileCase, all_file_cases
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.files import write_atomically
+from rl1.compiler.ils.asm import AsmError, assemble
 from rl1.compiler.interpreter import interpret
+from rl1.vm import ilc
 from rl1.vm.drive import drive
 from rl1.vm.faults import FaultKind, RunResult
 from rl1.vm.hardware import Blocking
@@ -91,7 +93,15 @@ def run_interpreter(source: str, sensors: Mapping[str, Any], budget: int) -> Out
 
 
 def compile_both(case: Case) -> tuple[bytes, bytes]:
-    """The case's .ilc file with its debug section, and without."""
+    """The case's .ilc file with its debug section, and without; for intermediate code
+    written by hand, the assembled file and the same stripped."""
+    if case.language == "ils":
+        try:
+            full = assemble(f".source {json.dumps(source_name(case))}\n.line 1\n"
+                            + case.source)
+        except AsmError as error:
+            raise VectorError(f"{case.name}: the .ils text does not assemble: {error}") from None
+        return full, ilc.encode(ilc.strip_debug(ilc.decode(full)))
     files = []
     for strip in (False, True):
         compilation = compile_text(case.source, source_name(case), strip_debug=strip)
@@ -104,7 +114,7 @@ def compile_both(case: Case) -> tuple[bytes, bytes]:
 
 
 def source_name(case: Case) -> str:
-    return case.name + ".rob"
+    return case.name + (".ils" if case.language == "ils" else ".rob")
 
 
 def difference(expected: Outcome, actual: Outcome) -> str | None:
@@ -162,7 +172,7 @@ def build(case: Case) -> dict[str, Any]:
         "the VM on the stripped file": (run_vm(stripped, case.sensors, case.budget),
                                         replace(outcome, fault_line=None)),
     }
-    if interpretable(case.sensors):
+    if case.language == "rl1" and interpretable(case.sensors):
         others["the AST interpreter"] = (
             run_interpreter(case.source, case.sensors, case.budget), outcome)
     for engine, (other, reference) in others.items():
@@ -236,6 +246,67 @@ def build_file(case: FileCase) -> dict[str, Any]:
     return case.vector()
 
 
+def _word(call: str) -> str:
+    """A call's name as one word of the text form: "CAM A" is "CAM_A"."""
+    return call.replace(" ", "_")
+
+
+def _sensor_lines(sensors: Mapping[str, Any]) -> list[str]:
+    """The sensor script as lines of the text form, each list in its order."""
+    fields = {"IMG": ("area", "x", "y", "z"), "KYO": ("centre", "right", "left"),
+              "FZI": ("s", "t")}
+    lines = []
+    for key, readings in sensors.items():
+        if key in fields:
+            lines += [f"sensor {key} " + " ".join(str(r[f]) for f in fields[key])
+                      for r in readings]
+        elif key in ("CAM R", "ULT A", "ULT B", "ULT C", "ULT D"):
+            lines += [f"sensor {_word(key)} {value}" for value in readings]
+        elif key == "INP":
+            lines += [f"sensor INP {port} {value}" for port, values in readings.items()
+                      for value in values]
+        elif key == "line_lost":
+            for loss in readings:
+                if "during" in loss:
+                    lines.append(f"loss during {loss['during']} {loss['nth']} "
+                                 f"{loss.get('after', 1)}")
+                else:
+                    (kind, value), = loss.items()
+                    lines.append(f"loss {kind} {value}")
+        elif key == "fail":
+            lines += [f"fail {_word(call)} {nth}" for call, nth in readings.items()]
+        elif key == "stop_fails" and readings:
+            lines.append("stop_fails")
+    return lines
+
+
+def render_text(group: str, vectors: list[dict[str, Any]]) -> str:
+    """GROUP.txt: the same vectors as GROUP.json, a line per fact (README.md, "The text
+    form"), for a C runner without a JSON reader."""
+    lines = [f"rl1-vectors {FORMAT} {group}"]
+    for vector in vectors:
+        lines += [f"vector {vector['name']}", f"budget {vector['budget']}",
+                  f"ilc {vector['ilc']}", f"ilc_stripped {vector['ilc_stripped']}",
+                  *_sensor_lines(vector["sensors"]),
+                  f"status {vector['status']} {vector['exit_status']} {vector['fault_line']}",
+                  f"executed {vector['executed']}",
+                  "variables " + " ".join(map(str, vector["variables"]))]
+        lines += [f"trace {e['time']} {_word(e['call'])} {len(e['args'])} "
+                  + " ".join(map(str, [*e["args"], len(e["result"]), *e["result"]]))
+                  for e in vector["trace"]]
+        lines.append("end")
+    return "\n".join(lines) + "\n"
+
+
+def render_files_text(vectors: list[dict[str, Any]]) -> str:
+    """verifier.txt: a line per file: name, hex, then accepted, or refused, rule, offset."""
+    lines = [f"rl1-vectors {FORMAT} verifier"]
+    lines += [f"file {v['name']} {v['ilc']} "
+              + ("accepted" if v["accepted"] else f"refused {v['rule']} {v['offset']}")
+              for v in vectors]
+    return "\n".join(lines) + "\n"
+
+
 def render_files(vectors: list[dict[str, Any]]) -> str:
     """verifier.json: one file vector a line."""
     lines = ",\n".join("    " + json.dumps(vector) for vector in vectors)
@@ -255,10 +326,14 @@ def generate(cases: Sequence[Case], file_cases: Sequence[FileCase] = ()) -> dict
             raise VectorError(f"{case.name}: two cases have this name")
         names.add(case.name)
         groups.setdefault(case.group, []).append(build(case))
-    files = {HERE / f"{group}.json": render_group(group, vectors)
-             for group, vectors in groups.items()}
+    files = {}
+    for group, vectors in groups.items():
+        files[HERE / f"{group}.json"] = render_group(group, vectors)
+        files[HERE / f"{group}.txt"] = render_text(group, vectors)
     if file_cases:
-        files[HERE / "verifier.json"] = render_files([build_file(c) for c in file_cases])
+        file_vectors = [build_file(case) for case in file_cases]
+        files[HERE / "verifier.json"] = render_files(file_vectors)
+        files[HERE / "verifier.txt"] = render_files_text(file_vectors)
     return files
 
 
@@ -266,7 +341,7 @@ def stale_files(files: Mapping[Path, str]) -> list[str]:
     """The vector files on disk that differ from `files`, are missing, or are not made
     by the generator at all."""
     stale = []
-    for path in sorted({*files, *HERE.glob("*.json")}):
+    for path in sorted({*files, *HERE.glob("*.json"), *HERE.glob("*.txt")}):
         want = files.get(path)
         have = path.read_text(encoding="utf-8") if path.exists() else None
         if want != have:
