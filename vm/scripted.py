@@ -24,7 +24,8 @@ repeats; a call with no list reads zeros. Values are 16-bit signed integers (INP
 Line losses: `{"time": T}` at device time T ms; `{"during": "MOV"|"MVI", "nth": N,
 "after": A}` A ms (default 1) after the N-th MOV or MVI call of the run (counting every
 call, MOV 0,0 included) started, if that command is still in effect then. A loss at the
-very moment an MVI covers its distance is too late for it. `{"instruction": N}`: right
+very moment an MVI covers its distance is too late for it; losses at the same
+millisecond are one loss. `{"instruction": N}`: right
 after the VM has run N instructions, between two instructions, as a vehicle's device
 posts a loss from an interrupt; the device cannot see instructions, so whoever steps the
 VM calls `lose_line` then (vm/drive.py), and an engine that counts no instructions (the

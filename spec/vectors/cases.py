@@ -511,8 +511,8 @@ def events() -> Iterator[Case]:
                trace=((0, "TRC", (3,)), (0, "MOV", (1, 1)), (0, "TIM", (10,)),
                       (1000, "LINE LOST", (3,))))
     yield Case(group, "two-losses-in-one-millisecond",
-               "two losses at the same time: the first becomes the event and ends the TIM "
-               "early; the second is not queued",
+               "two losses at the same millisecond are one loss: one LINE LOST, one event, "
+               "which ends the TIM early",
                "(TRC 3)\n(MOV 1,1)\n(TIM 10)\nA++\n" + EVENT_HANDLERS,
                {"H": 96}, sensors={"line_lost": [{"time": 500}, {"time": 500}]},
                trace=((0, "TRC", (3,)), (0, "MOV", (1, 1)), (0, "TIM", (10,)),
