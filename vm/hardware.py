@@ -8,7 +8,8 @@ implements (spec/ilc.md, section 12). A built-in that takes device time
 one-slot mailbox: `pending` looks at it, `take_event` empties it.
 
 `Blocking` adapts a blocking `Device` (device.py): it carries out the whole built-in
-when it is started, so its first poll answers done.
+when it is started, so its first poll answers done, or the error the device raised
+meanwhile.
 """
 
 from __future__ import annotations
@@ -89,8 +90,9 @@ class Blocking:
         return self._perform(form, args)
 
     def start(self, form: FormKey, args: tuple[int, ...]) -> Answer:
+        # Whatever happened while the device did its work is what the poll answers.
         self._started = self._perform(form, args)
-        return OK if self._started.status is Status.OK else self._started
+        return OK
 
     def poll(self) -> Answer:
         return self._started

@@ -34,8 +34,9 @@ motion is in effect (a non-zero MOV, or an MVI in progress); see device.py for w
 tracing mode does with it.
 
 Failures: a call named in "fail" (a form as the trace writes it: "TIM", "CAM R") fails
-the N-th time it arrives: the device records it, then raises DeviceError at once, before
-any device time passes. With "stop_fails" the device records STOP, then raises
+the N-th time it arrives: the device records it, then raises DeviceError, at once for a
+built-in that takes no device time, at the end of its device time for one that does (as
+a poll that answers an error). With "stop_fails" the device records STOP, then raises
 DeviceError: the engine's stop after a fault fails.
 
 The motion model (device time in integer milliseconds, starting at 0):
@@ -340,6 +341,7 @@ class ScriptedDevice:
             afters.sort()
         self._read_counts: dict[str, int] = {}
         self._arrivals: dict[str, int] = {}  # calls of each form so far, for "fail"
+        self._failing: str | None = None  # why the waiting built-in under way fails
 
     # Bookkeeping
 
@@ -348,8 +350,10 @@ class ScriptedDevice:
         arrived = self._arrivals.get(call, 0) + 1
         self._arrivals[call] = arrived
         if self.script.failures.get(call) == arrived:
-            raise DeviceError(f"({call}) failed: the sensor script says its call "
-                              f"{arrived} fails")
+            failure = f"({call}) failed: the sensor script says its call {arrived} fails"
+            if not BUILTINS[call.split()[0]].waits:
+                raise DeviceError(failure)
+            self._failing = failure  # at the end of its device time
 
     def _next(self, key: str, readings: tuple[T, ...], nothing: T) -> T:
         count = self._read_counts.get(key, 0)
@@ -373,6 +377,14 @@ class ScriptedDevice:
         return min(times, default=None)
 
     def _advance(self, duration: int, interruptible: bool) -> None:
+        """Let the device time of a waiting built-in pass; then it fails, if the script
+        says so (a failing poll)."""
+        self._pass_time(duration, interruptible)
+        failing, self._failing = self._failing, None
+        if failing is not None:
+            raise DeviceError(failing)
+
+    def _pass_time(self, duration: int, interruptible: bool) -> None:
         """Let `duration` ms of device time pass, meeting motion ends and line losses in
         time order; an interruptible wait ends at the first loss the program must hear."""
         until = self.time + duration
@@ -431,6 +443,7 @@ class ScriptedDevice:
         self._record("MVI", left, right, cm)
         if cm == 0:
             self._motion = None
+            self._advance(0, interruptible=True)  # no time passes, but it may fail
             return
         if left + right == 0:
             raise DeviceError(f"(MVI {left},{right},{cm}) would never end: with wheel speeds "

@@ -641,13 +641,14 @@ def faults() -> Iterator[Case]:
                "and out of range is a budget fault",
                "a++\n" * 13 + "(MOV a,0)\n", {"a": 13}, budget=13, status="budget",
                fault_line=14, trace=((0, "STOP", ()),), executed=14)
-    yield Case(group, "failing-call", "the device fails the 2nd (ULT A), a built-in that "
-               "takes device time: a device error at that call, after the vehicle is "
-               "stopped; the first reading was written",
+    yield Case(group, "failing-poll", "the device fails the 2nd (ULT A), a built-in that "
+               "takes device time, at the end of that time (its poll answers an error): a "
+               "device error at that call, after the vehicle is stopped; the first reading "
+               "was written",
                "(MOV 1,1)\nA=(ULT A)\nB=(ULT A)\n", {"A": 7}, status="device-error",
                fault_line=3, sensors={"ULT A": [7], "fail": {"ULT A": 2}},
                trace=((0, "MOV", (1, 1)), (0, "ULT A", ()), (100, "ULT A", ()),
-                      (100, "STOP", ())),
+                      (200, "STOP", ())),
                executed=5)
     yield Case(group, "failing-stop", "the stop after a fault fails: the fault reported is "
                "still the one that caused the stop (argument-range), not a device error",

@@ -352,4 +352,4 @@ def test_a_scripted_failure_refuses_the_nth_call_and_a_failing_stop_records_firs
     with pytest.raises(DeviceError, match="stopping fails"):
         device.stop()
     assert [entry.call for entry in device.trace] == ["ULT A"] * 3 + ["STOP"]
-    assert device.time == 200  # the failing call took no time
+    assert device.time == 300  # the failing call took its time, then failed
