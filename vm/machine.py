@@ -245,6 +245,10 @@ class Machine:
             answer = self.hardware.begin()
             if answer.status is not Status.OK:
                 return self._faulted(_Faulted(FaultKind.DEVICE, answer.message), None)
+            try:
+                self.hardware.take_event()  # a loss from before the program is not its own
+            except DeviceError as error:
+                return self._faulted(_Faulted(FaultKind.DEVICE, str(error)), None)
         return self._execute(limit)
 
     def run(self) -> RunResult:

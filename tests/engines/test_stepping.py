@@ -75,10 +75,11 @@ def test_a_step_of_zero_runs_nothing_and_an_ended_run_stays_ended() -> None:
 class Fake:
     """Hardware that logs every callback: each poll answers BUSY `busy` times after a
     start, then done with the next of `readings`; the callbacks named in `failing`
-    answer ERROR."""
+    answer ERROR; during the callback `post_at` the device posts `event`."""
 
     busy: int = 0
     readings: list[Outcome] = field(default_factory=list)
+    post_at: str = ""  # the callback during which the device posts `event`
     failing: set[str] = field(default_factory=set)  # callbacks that answer ERROR
     log: list[str] = field(default_factory=list)
     event: LineLost | None = None
@@ -86,6 +87,8 @@ class Fake:
 
     def _answer(self, name: str, outcome: Outcome = NOTHING) -> Answer:
         self.log.append(name)
+        if name == self.post_at:
+            self.pending_event = self.event
         if name in self.failing:
             return Answer(Status.ERROR, message=f"{name} failed")
         return Answer(Status.OK, outcome)
@@ -114,12 +117,14 @@ class Fake:
     def end(self) -> Answer:
         return self._answer("end")
 
+    pending_event: LineLost | None = None  # in the mailbox
+
     @property
     def pending(self) -> LineLost | None:
-        return self.event
+        return self.pending_event
 
     def take_event(self) -> LineLost | None:
-        event, self.event = self.event, None
+        event, self.pending_event = self.pending_event, None
         return event
 
 
@@ -188,15 +193,25 @@ def test_readings_out_of_their_documented_range_are_device_faults() -> None:
 
 
 def test_an_event_pending_at_the_end_is_dropped_and_end_does_not_stop() -> None:
-    fake = Fake(event=LineLost("MOV", 2))
-    result = Machine(assemble(op("INC", v("A")), op("END"), op("INC", v("B")),
-                              handlers={98: 2}), fake).run()
-    assert result.fault is None and result.named()["B"] == 0
-    assert fake.log == ["begin", "end"] and fake.event is not None
+    device = ScriptedDevice()
+    machine = Machine(assemble(op("INC", v("A")), op("END"), op("INC", v("B")),
+                               handlers={98: 2}), Blocking(device))
+    assert machine.step(1) is State.RUNNING
+    device.pending = LineLost("MOV", 2)
+    assert machine.step(5) is State.ENDED
+    assert machine.result is not None and machine.result.named()["B"] == 0
+    assert device.pending is not None and device.trace == []
+
+
+def test_a_loss_posted_before_the_program_begins_is_dropped() -> None:
+    fake = Fake(event=LineLost("MOV", 3), post_at="begin")
+    result = Machine(assemble(call("KYC"), op("INC", v("A")), op("END"),
+                              op("INC", v("H")), handlers={96: 3}), fake).run()
+    assert (result.named()["A"], result.named()["H"]) == (1, 0)
 
 
 def test_an_event_is_taken_after_a_call_that_takes_no_time_and_at_a_taken_jump() -> None:
-    fake = Fake(event=LineLost("MOV", 3))
+    fake = Fake(event=LineLost("MOV", 3), post_at="call KYC")
     result = Machine(assemble(call("KYC"), op("INC", v("A")), op("END"),
                               op("INC", v("H")), handlers={96: 3}), fake).run()
     assert (result.named()["A"], result.named()["H"]) == (0, 1)
