@@ -397,7 +397,8 @@ class Machine:
                     self.state = State.ENDED
                     ended = hardware.end()
                     if ended.status is not Status.OK:
-                        return self._faulted(_Faulted(FaultKind.DEVICE, ended.message), pc - 1)
+                        return self._faulted(_Faulted(FaultKind.DEVICE, ended.message), pc - 1,
+                                             ended=True)
                     self.result = RunResult(tuple(cells[:R_CELL]))
                     return State.ENDED
         except (_Faulted, DeviceError) as error:
@@ -485,14 +486,15 @@ class Machine:
                            missing_handler_message(event.mode, event.command, label))
         return handler
 
-    def _faulted(self, fault: _Faulted, index: int | None) -> State:
+    def _faulted(self, fault: _Faulted, index: int | None, ended: bool = False) -> State:
         """Stop the vehicle, describe the fault at instruction `index` (None: before
-        the first), and tell the device the program is over."""
+        the first), and tell the device the program is over unless `ended` did."""
         message = fault.message
         stopped = self.hardware.stop()
         if stopped.status is not Status.OK:
             message += f"; stopping the vehicle failed too: {stopped.message}"
-        self.hardware.end()  # the fault is reported whatever the end answers
+        if not ended:
+            self.hardware.end()  # the fault is reported whatever the end answers
         self.state = State.FAULTED
         line = None if index is None else self._line_of(index)
         self.result = RunResult(tuple(self.cells[:R_CELL]), Fault(fault.kind, message, line))

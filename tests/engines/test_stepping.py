@@ -223,3 +223,10 @@ def test_an_event_is_taken_after_a_call_that_takes_no_time_and_at_a_taken_jump()
     assert machine.step(1) is State.RUNNING and machine.pc == 1  # INC A takes no event
     assert machine.step(1) is State.RUNNING and machine.pc == 2  # the JMP took it
     assert commands(device) == [] and machine.cells[v("A")] == 2
+
+
+def test_a_failing_end_is_a_device_fault_at_the_end_and_end_is_not_called_twice() -> None:
+    fake = Fake(failing={"end"})
+    kind, message, line = _fault_of(fake, op("INC", v("A")), op("END"))
+    assert (kind, message, line) == (FaultKind.DEVICE, "end failed", 2)
+    assert fake.log == ["begin", "end", "stop"]
