@@ -14,6 +14,7 @@ import argparse
 from timing import best_time
 
 from rl1.compiler.backend.driver import compile_text
+from rl1.vm.hardware import Blocking
 from rl1.vm.machine import Machine
 from rl1.vm.scripted import ScriptedDevice
 from rl1.vm.verifier import verify
@@ -54,7 +55,7 @@ def main() -> None:
     assert compilation.output is not None, compilation.diagnostics
     program = verify(compilation.output)
 
-    counted = Machine(program, ScriptedDevice())
+    counted = Machine(program, Blocking(ScriptedDevice()))
     result = counted.run()
     assert result.fault is None, result.fault
     named = result.named()
@@ -62,7 +63,7 @@ def main() -> None:
     assert (named["A"], named["B"], named["C"]) == expected, (named, expected)
     instructions = counted.executed
 
-    vm_time = best_time(lambda: Machine(program, ScriptedDevice()).run(), options.repeat)
+    vm_time = best_time(lambda: Machine(program, Blocking(ScriptedDevice())).run(), options.repeat)
     python_time = best_time(python_equivalent, options.repeat)
     print(f"instructions per run:     {instructions:,}")
     print(f"VM:                       {vm_time * 1000:8.1f} ms, "

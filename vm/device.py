@@ -28,6 +28,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
+from .language import BUILTINS
+
 MotionCommand = Literal["MOV", "MVI"]
 
 
@@ -126,12 +128,12 @@ class Outcome:
     writes: tuple[int, ...] = ()
 
 
-_NOTHING = Outcome(None)
+NOTHING = Outcome(None)
 
 
 def _effect(action: Callable[[], None]) -> Outcome:
     action()
-    return _NOTHING
+    return NOTHING
 
 
 def _value(value: int) -> Outcome:
@@ -150,11 +152,14 @@ def _fuzzy(reading: FuzzyReading) -> Outcome:
     return Outcome(None, (reading.s, reading.t))
 
 
+FormKey = tuple[str, str | None]
+"""A built-in form as (mnemonic, selector): ("MOV", None), ("CAM", "A")."""
+
 Binding = Callable[[Device, tuple[int, ...]], Outcome]
 
 # Each built-in form (mnemonic, selector) bound to its Device method. Both engines call
 # devices through this one table, so a form means the same device action in both.
-BINDINGS: dict[tuple[str, str | None], Binding] = {
+BINDINGS: dict[FormKey, Binding] = {
     ("FRE", None): lambda d, a: _effect(d.free),
     ("HLD", None): lambda d, a: _effect(d.hold),
     ("ORG", None): lambda d, a: _effect(d.steering_origin),
@@ -188,18 +193,31 @@ BINDINGS: dict[tuple[str, str | None], Binding] = {
 }
 
 
-def form_name(form: tuple[str, str | None]) -> str:
+def form_name(form: FormKey) -> str:
     """How a form is written in messages and traces: "MOV", "CAM A"."""
     mnemonic, selector = form
     return mnemonic if selector is None else f"{mnemonic} {selector}"
 
 
-def perform(device: Device, form: tuple[str, str | None], args: tuple[int, ...]) -> Outcome:
-    """Carry out one built-in call on `device`. A value outside 16 bits coming back
-    from the device is the device's fault: DeviceError."""
-    outcome = BINDINGS[form](device, args)
-    for value in (outcome.result, *outcome.writes):
-        if value is not None and not (isinstance(value, int) and -32768 <= value <= 32767):
+def checked(form: FormKey, outcome: Outcome) -> Outcome:
+    """`outcome` if every value in it is one the form can give: a 16-bit signed integer,
+    within the form's documented result range (language.Form.result_range: INP 0..255,
+    CAM R 0..784); DeviceError otherwise, since a value outside it is the device's fault."""
+    mnemonic, selector = form
+    spec = BUILTINS[mnemonic].form(selector)
+    assert spec is not None
+    low, high = spec.result_range
+    if outcome.result is not None and not (
+            isinstance(outcome.result, int) and low <= outcome.result <= high):
+        raise DeviceError(f"({form_name(form)}) returned {outcome.result!r}, outside "
+                          f"its range {low}..{high}")
+    for value in outcome.writes:
+        if not (isinstance(value, int) and -32768 <= value <= 32767):
             raise DeviceError(f"({form_name(form)}) returned {value!r}, "
                               "which is not a 16-bit signed integer")
     return outcome
+
+
+def perform(device: Device, form: FormKey, args: tuple[int, ...]) -> Outcome:
+    """Carry out one built-in call on `device`, checking what comes back (`checked`)."""
+    return checked(form, BINDINGS[form](device, args))

@@ -20,6 +20,11 @@ runs (every loop takes a jump); since they count different steps, they stop a ru
 program at different points."""
 
 
+MAX_BUDGET = 2**31 - 1
+"""The largest budget: a run passes its budget by less than 65536 instructions (spec/ilc.md,
+section 9), so a 32-bit counter never wraps."""
+
+
 class FaultKind(Enum):
     ARGUMENT_RANGE = ("argument-range", 10)  # a variable argument outside its range
     MISSING_HANDLER = ("missing-handler", 11)  # a lost line jumps to an undefined :96-:99

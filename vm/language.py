@@ -52,6 +52,7 @@ class Form:
     summary: str
     result: str | None = None  # what the call returns, None if it returns nothing
     writes: tuple[str, ...] = ()  # reserved variables the call sets
+    result_range: tuple[int, int] = (-32768, 32767)  # what the device may return
 
     @property
     def returns_value(self) -> bool:
@@ -81,8 +82,9 @@ WHEEL_SPEED = "wheel speed"
 
 
 def _one(summary: str, *params: Param, result: str | None = None,
-         writes: tuple[str, ...] = ()) -> tuple[Form, ...]:
-    return (Form(None, params, summary, result, writes),)
+         writes: tuple[str, ...] = (), result_range: tuple[int, int] = (-32768, 32767)
+         ) -> tuple[Form, ...]:
+    return (Form(None, params, summary, result, writes, result_range),)
 
 
 BUILTINS: dict[str, Builtin] = {
@@ -142,7 +144,7 @@ BUILTINS: dict[str, Builtin] = {
             Form("P", (Param("pulse", 0, 784, "pan pulse position"),),
                  "Pan the camera to a pulse position."),
             Form("R", (), "Read the camera's pan position.",
-                 result="pan pulse position (0..784)"),
+                 result="pan pulse position (0..784)", result_range=(0, 784)),
         )),
         Builtin("ULT", "Ultra", "sensing", Feature.ULTRASONIC, True, tuple(
             Form(letter, (), f"Ultrasonic range reading from sensor {letter}.",
@@ -153,7 +155,7 @@ BUILTINS: dict[str, Builtin] = {
                 _one("Switch the lighting off or on.", Param("on", 0, 1, "0 off, 1 on"))),
         Builtin("INP", "Input", "sensing", Feature.IO, False,
                 _one("Read an input port.", Param("port", 0, 0x7D, "input port"),
-                     result="the port's data (0..255)")),
+                     result="the port's data (0..255)", result_range=(0, 255))),
         Builtin("OUT", "Output", "sensing", Feature.IO, False,
                 _one("Write data to an output port.", Param("port", 0, 0x7D, "output port"),
                      Param("data", 0, 255, "data byte"))),

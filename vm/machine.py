@@ -7,9 +7,14 @@ program counter. Every value is a 16-bit two's complement integer and every resu
 wraps; shift counts are signed (see `_shift_left`).
 
 Execution: the instruction at the program counter runs; running off the end of the code
-is (END). A lost-line event (device.py) is taken between instructions: right after each
+is (END). A lost-line event (hardware.py) is taken at two points only: right after each
 call instruction and after each jump taken. Its handler is the label Table 4 names for
 the event's tracing mode and command (language.LOST_LINE_RULES).
+
+Stepping (spec/ilc.md, section 12): `step(n)` runs at most n instructions and returns
+the State: RUNNING, WAITING (a built-in taking device time was started and has not
+answered done), ENDED or FAULTED; `run` steps to the end. The VM drives the vehicle
+through `hardware.Hardware`: a built-in that takes device time is started, then polled.
 
 Faults end the run after the device is stopped: a variable argument outside its range,
 a lost line whose handler the program lacks, the watchdog's instruction budget used up,
@@ -32,25 +37,43 @@ How this implementation is fast enough (bench/vm_speed.py) without hiding the me
   (none comes from the compiler) runs the single instructions, which stay in place.
 - Instructions are counted by index arithmetic when control leaves a straight run (a
   jump taken, a handler entered, the end), not one by one.
-- A jump looks at the device's `pending` event and calls `poll_event` only when there
+- So a step's limit is not counted down either: where a straight run could pass it, a
+  HALT is put in the code at the exact index (`_bound`), and taken out when the run
+  leaves; a run that cannot reach the limit costs one comparison at its start.
+- A jump looks at the hardware's `pending` event and calls `take_event` only when there
   is one.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import Enum
 
 from . import isa
-from .device import Device, DeviceError, LineLost, form_name, perform
+from .device import Device, DeviceError, FormKey, LineLost, checked, form_name
 from .faults import DEFAULT_BUDGET, Fault, FaultKind, RunResult, missing_handler_message
-from .language import VARIABLE_INDEX, VARIABLES, Param, lost_line_handler
+from .hardware import Answer, Blocking, Hardware, Status
+from .language import BUILTINS, VARIABLE_INDEX, VARIABLES, Param, lost_line_handler
 from .verifier import VerifiedProgram
 
 R_CELL = len(VARIABLES)
 
+SLICE = 1 << 20
+"""Instructions per step when `run` steps a program to its end."""
+
 # The operations of the dispatch loop (not opcodes: decoding folds operand kinds).
 (LOAD, STORE, ADD, SUB, AND, OR, XOR, SHL, SHR, INC, DEC,
- JUMP, JUMP_ZERO, JUMP_POSITIVE, JUMP_NEGATIVE, CALL, END, EXPRESSION) = range(18)
+ JUMP, JUMP_ZERO, JUMP_POSITIVE, JUMP_NEGATIVE, CALL, END, EXPRESSION, HALT) = range(19)
+_BOUNDARIES = (JUMP, END)  # where a straight run of instructions surely stops
+
+
+class State(Enum):
+    """Where a run stands after a step (RL1_RUNNING ... RL1_FAULTED in C)."""
+
+    RUNNING = 0  # the step ran its limit; step again
+    WAITING = 1  # a built-in is taking device time; step again to poll it
+    ENDED = 2  # (END), or past the last instruction: `result` holds the variables
+    FAULTED = 3  # `result` holds the variables and the fault (kind, message, line)
 
 _ALU = (ADD, SUB, AND, OR, XOR, SHL, SHR)  # in isa.ALU_OPERATORS order
 _ALU_BASES = (isa.ALU_RESULT, isa.ALU_IMM, isa.ALU_VAR)  # highest first
@@ -63,11 +86,12 @@ class _CallSite:
     """A call instruction, decoded: its form, its arguments (cell index or constant),
     and the cells its results go to."""
 
-    form: tuple[str, str | None]
+    form: FormKey
     params: tuple[Param, ...]
     args: tuple[isa.Arg, ...]
     writes: tuple[int, ...]
     returns_value: bool
+    waits: bool  # started and polled, rather than called
 
 
 @dataclass(frozen=True, slots=True)
@@ -110,21 +134,35 @@ def _shift_right(value: int, count: int) -> int:
 
 
 class Machine:
-    def __init__(self, program: VerifiedProgram, device: Device,
+    """One run of a verified program on `hardware`, stepped (`step`) or to its end
+    (`run`). Its resumable state: the cells (the variables, R), acc, pc (an instruction
+    index), the instructions executed, and the call in progress (`waiting`)."""
+
+    def __init__(self, program: VerifiedProgram, hardware: Hardware,
                  budget: int = DEFAULT_BUDGET) -> None:
         self.program = program
-        self.device = device
+        self.hardware = hardware
         self.budget = budget
         self.cells: list[int] = [0] * (R_CELL + 1)
         self._immediates: dict[int, int] = {}
         self.sites: list[_CallSite] = []
         self.code = [self._decode(instruction) for instruction in program.instructions]
         self.code.append((END, 0, 0))  # running off the end is (END)
+        self.plain = self.code[:]  # every instruction alone, before EXPRESSION steps
         self.expressions: list[_Expression] = []
+        self.fused_at = [-1] * len(self.code)  # the EXPRESSION whose run holds an index
         self._group_expressions()
+        self.reach = self._reaches()
+        self._saved: list[tuple[int, tuple[int, int, int]]] = []  # what a HALT replaced
         self.handlers = {label: program.index_of[offset]
                          for label, offset in program.image.handlers.items()}
-        self.executed = 0  # instructions the last run executed
+        self.acc = 0
+        self.pc = 0
+        self.executed = 0  # instructions run so far, the one that faulted included
+        self.waiting: _CallSite | None = None
+        self.state = State.RUNNING
+        self.result: RunResult | None = None  # once ENDED or FAULTED
+        self._begun = False
 
     # Decoding
 
@@ -164,7 +202,7 @@ class Machine:
         assert info.builtin is not None
         self.sites.append(_CallSite(info.builtin, form.params, instruction.args,
                                     tuple(VARIABLE_INDEX[name] for name in form.writes),
-                                    form.returns_value))
+                                    form.returns_value, BUILTINS[info.builtin[0]].waits))
         return (CALL, len(self.sites) - 1, 0)
 
     def _group_expressions(self) -> None:
@@ -181,20 +219,65 @@ class Machine:
                 steps = tuple((step[0], step[1]) for step in code[index + 1:end])
                 self.expressions.append(_Expression(a, steps, code[end][1]))
                 code[index] = (EXPRESSION, len(self.expressions) - 1, end + 1)
+                self.fused_at[index + 1:end + 1] = [index] * (end - index)
+
+    def _reaches(self) -> list[int]:
+        """For each index, how many instructions a straight run from it runs at most:
+        up to and including the next JMP or END (a conditional jump or a handler may
+        leave earlier). A step whose limit is further away needs no HALT."""
+        reach = [0] * len(self.plain)
+        following = 0
+        for index in range(len(self.plain) - 1, -1, -1):
+            following = 1 if self.plain[index][0] in _BOUNDARIES else following + 1
+            reach[index] = following
+        return reach
+
+    # Stepping
+
+    def step(self, limit: int) -> State:
+        """Run at most `limit` instructions (0 or more) and say where the run stands.
+        A call in progress is polled first, once; a call that starts taking device time
+        ends the step (WAITING) unless its first poll already answers done."""
+        if self.state in (State.ENDED, State.FAULTED):
+            return self.state
+        if not self._begun:
+            self._begun = True
+            answer = self.hardware.begin()
+            if answer.status is not Status.OK:
+                return self._faulted(_Faulted(FaultKind.DEVICE, answer.message), None)
+            try:
+                self.hardware.take_event()  # a loss from before the program is not its own
+            except DeviceError as error:
+                return self._faulted(_Faulted(FaultKind.DEVICE, str(error)), None)
+        return self._execute(limit)
+
+    def run(self) -> RunResult:
+        """Step until (END) or a fault: how a host without other work runs a program."""
+        while self.step(SLICE) in (State.RUNNING, State.WAITING):
+            pass
+        assert self.result is not None
+        return self.result
 
     # The dispatch loop
 
-    def run(self) -> RunResult:
-        """Run from the first instruction until (END) or a fault."""
-        code, expressions, budget = self.code, self.expressions, self.budget
-        cells = self.cells[:]
-        device = self.device
-        poll, divert = device.poll_event, self._divert
-        acc = 0  # modulo 2**16: see the module's docstring
-        pc = 0
-        start = 0  # where the current straight run of instructions began
-        executed = 0  # instructions run before `start`
+    def _execute(self, limit: int) -> State:
+        code, expressions, budget, reach = self.code, self.expressions, self.budget, self.reach
+        cells, sites = self.cells, self.sites
+        last = len(self.program.instructions)  # the END that running off the end runs
+        hardware = self.hardware
+        take, divert = hardware.take_event, self._divert
+        acc, pc = self.acc, self.pc  # acc modulo 2**16: see the module's docstring
+        start = pc  # where the current straight run of instructions began
+        executed = self.executed  # instructions run before `start`
+        stop_at = executed + limit
         try:
+            if self.waiting is not None:
+                if not self._finish(self.waiting, hardware.poll()):
+                    return State.WAITING
+                self.waiting = None
+                self.state = State.RUNNING
+                pc = start = divert(take(), pc)
+            check = self._bound(pc, executed, stop_at)
             while True:
                 op, a, b = code[pc]
                 pc += 1
@@ -227,37 +310,63 @@ class Machine:
                 elif op == JUMP_POSITIVE:
                     if cells[a] > 0:
                         # A jump taken: count the straight run it ends, check the budget,
-                        # take a pending event. The other jumps do the same.
+                        # take a pending event, bound the next run by the step's limit.
+                        # The other jumps do the same.
                         executed += pc - start
+                        start = pc
                         if executed > budget:
                             break
-                        pc = start = b if device.pending is None else divert(poll(), b)
+                        pc = start = b if hardware.pending is None else divert(take(), b)
+                        if executed + reach[pc] > check:
+                            check = self._bound(pc, executed, stop_at)
                 elif op == JUMP_ZERO:
                     if cells[a] == 0:
                         executed += pc - start
+                        start = pc
                         if executed > budget:
                             break
-                        pc = start = b if device.pending is None else divert(poll(), b)
+                        pc = start = b if hardware.pending is None else divert(take(), b)
+                        if executed + reach[pc] > check:
+                            check = self._bound(pc, executed, stop_at)
                 elif op == JUMP_NEGATIVE:
                     if cells[a] < 0:
                         executed += pc - start
+                        start = pc
                         if executed > budget:
                             break
-                        pc = start = b if device.pending is None else divert(poll(), b)
+                        pc = start = b if hardware.pending is None else divert(take(), b)
+                        if executed + reach[pc] > check:
+                            check = self._bound(pc, executed, stop_at)
                 elif op == JUMP:
                     executed += pc - start
+                    start = pc
                     if executed > budget:
                         break
-                    pc = start = b if device.pending is None else divert(poll(), b)
+                    pc = start = b if hardware.pending is None else divert(take(), b)
+                    if executed + reach[pc] > check:
+                        check = self._bound(pc, executed, stop_at)
                 elif op == CALL:
+                    site = sites[a]
                     if executed + pc - start > budget:
                         executed += pc - start
                         break
-                    self._call(self.sites[a], cells)
-                    event = poll()
+                    args = self._arguments(site, cells)
+                    if site.waits:
+                        started = hardware.start(site.form, args)
+                        if started.status is not Status.OK:
+                            raise DeviceError(started.message)
+                        if not self._finish(site, hardware.poll()):
+                            self.state, self.waiting = State.WAITING, site
+                            self.acc, self.pc, self.executed = acc, pc, executed + pc - start
+                            return State.WAITING
+                    else:
+                        self._finish(site, hardware.call(site.form, args))
+                    event = take()
                     if event is not None:
                         executed += pc - start
+                        start = pc
                         pc = start = divert(event, pc)
+                        check = self._bound(pc, executed, stop_at)
                 elif op == LOAD:
                     acc = cells[a]
                 elif op == STORE:
@@ -278,24 +387,64 @@ class Machine:
                     count = cells[a]
                     acc = _wrap(acc)
                     acc = acc >> count if 0 <= count < 16 else _shift_right(acc, count)
+                elif op == HALT:  # the step's limit: stop before this instruction
+                    pc -= 1
+                    self.acc, self.pc, self.executed = acc, pc, executed + pc - start
+                    return State.RUNNING
                 else:  # END
-                    self.executed = executed + pc - start
-                    return RunResult(tuple(cells[:R_CELL]))
+                    pc = min(pc, last)  # running off the end is no instruction
+                    self.acc, self.pc, self.executed = acc, pc, executed + pc - start
+                    self.state = State.ENDED
+                    ended = hardware.end()
+                    if ended.status is not Status.OK:
+                        return self._faulted(_Faulted(FaultKind.DEVICE, ended.message), pc - 1,
+                                             ended=True)
+                    self.result = RunResult(tuple(cells[:R_CELL]))
+                    return State.ENDED
         except (_Faulted, DeviceError) as error:
             # pc has already moved past the instruction that faulted.
-            self.executed = executed + pc - start
+            self.acc, self.pc, self.executed = acc, pc, executed + pc - start
             fault = (error if isinstance(error, _Faulted)
                      else _Faulted(FaultKind.DEVICE, str(error)))
-            return RunResult(tuple(cells[:R_CELL]), self._fault(fault, pc - 1))
-        self.executed = executed
+            return self._faulted(fault, pc - 1)
+        finally:
+            self._unbound()
+        self.acc, self.pc, self.executed = acc, pc, executed
         watchdog = _Faulted(FaultKind.BUDGET, f"the program ran more than {budget} "
                             "instructions without ending (raise the budget if it should "
                             "run longer)")
-        return RunResult(tuple(cells[:R_CELL]), self._fault(watchdog, pc - 1))
+        return self._faulted(watchdog, pc - 1)
+
+    # The step's limit: a HALT put in the code where the step must stop
+
+    def _bound(self, pc: int, executed: int, stop_at: int) -> int:
+        """Bound the straight run starting at `pc`, with `executed` instructions run, by
+        the step's limit `stop_at`: if the run could pass it, put a HALT where the limit
+        falls. What the next run start compares with: `stop_at`, or -1 while a HALT is
+        in place (so that the next run start moves it)."""
+        self._unbound()
+        left = stop_at - executed
+        if self.reach[pc] <= left:
+            return stop_at
+        halt = pc + left
+        fused = self.fused_at[halt]
+        if fused >= 0:  # the halt falls inside an EXPRESSION: run its instructions singly
+            self._saved.append((fused, self.code[fused]))
+            self.code[fused] = self.plain[fused]
+        self._saved.append((halt, self.code[halt]))
+        self.code[halt] = (HALT, 0, 0)
+        return -1
+
+    def _unbound(self) -> None:
+        while self._saved:
+            index, instruction = self._saved.pop()
+            self.code[index] = instruction
 
     # The slow paths: calls, events and faults
 
-    def _call(self, site: _CallSite, cells: list[int]) -> None:
+    def _arguments(self, site: _CallSite, cells: list[int]) -> tuple[int, ...]:
+        """The call's argument values, left to right; a variable's value outside its
+        parameter's range is a fault."""
         values = []
         for param, arg in zip(site.params, site.args, strict=True):
             value = cells[arg.value] if arg.is_var else arg.value
@@ -305,12 +454,23 @@ class Machine:
                                f"{value} (the value of {VARIABLES[arg.value]}), outside "
                                f"{param.low}..{param.high}")
             values.append(value)
-        outcome = perform(self.device, site.form, tuple(values))
+        return tuple(values)
+
+    def _finish(self, site: _CallSite, answer: Answer) -> bool:
+        """Take a call's answer: False while BUSY; done, write what it read (checked
+        first): the reserved variables, then R."""
+        if answer.status is Status.BUSY:
+            return False
+        if answer.status is not Status.OK:
+            raise DeviceError(answer.message)
+        outcome = checked(site.form, answer.outcome)
+        cells = self.cells
         for cell, value in zip(site.writes, outcome.writes, strict=True):
             cells[cell] = value
         if site.returns_value:
             assert outcome.result is not None
             cells[R_CELL] = outcome.result
+        return True
 
     def _divert(self, event: LineLost | None, resume: int) -> int:
         """Where a lost-line event sends the program: its handler's index, or `resume`
@@ -326,14 +486,19 @@ class Machine:
                            missing_handler_message(event.mode, event.command, label))
         return handler
 
-    def _fault(self, fault: _Faulted, index: int) -> Fault:
-        """Stop the vehicle, then describe the fault at instruction `index`."""
+    def _faulted(self, fault: _Faulted, index: int | None, ended: bool = False) -> State:
+        """Stop the vehicle, describe the fault at instruction `index` (None: before
+        the first), and tell the device the program is over unless `ended` did."""
         message = fault.message
-        try:
-            self.device.stop()
-        except DeviceError as error:
-            message += f"; stopping the vehicle failed too: {error}"
-        return Fault(fault.kind, message, self._line_of(index))
+        stopped = self.hardware.stop()
+        if stopped.status is not Status.OK:
+            message += f"; stopping the vehicle failed too: {stopped.message}"
+        if not ended:
+            self.hardware.end()  # the fault is reported whatever the end answers
+        self.state = State.FAULTED
+        line = None if index is None else self._line_of(index)
+        self.result = RunResult(tuple(self.cells[:R_CELL]), Fault(fault.kind, message, line))
+        return State.FAULTED
 
     def _line_of(self, index: int) -> int | None:
         debug = self.program.image.debug
@@ -345,5 +510,5 @@ class Machine:
 
 
 def run(program: VerifiedProgram, device: Device, budget: int = DEFAULT_BUDGET) -> RunResult:
-    """Run a verified program on `device`."""
-    return Machine(program, device, budget).run()
+    """Run a verified program on a blocking `device`."""
+    return Machine(program, Blocking(device), budget).run()

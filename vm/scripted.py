@@ -10,7 +10,10 @@ returns, in order, and when the guidance line is lost:
       "ULT A": [150, ...],          (also "ULT B", "ULT C", "ULT D")
       "INP": {"3": [1, 0], ...},    (per input port, the port number in decimal)
       "FZI": [{"s": 1, "t": -2}, ...],
-      "line_lost": [{"time": 2500}, {"during": "MVI", "nth": 1, "after": 300}],
+      "line_lost": [{"time": 2500}, {"during": "MVI", "nth": 1, "after": 300},
+                    {"instruction": 40}],
+      "fail": {"ULT A": 2, ...},     (the 2nd ULT A call of the run fails)
+      "stop_fails": true,
       "comment": "free text, ignored"
     }
 
@@ -21,9 +24,20 @@ repeats; a call with no list reads zeros. Values are 16-bit signed integers (INP
 Line losses: `{"time": T}` at device time T ms; `{"during": "MOV"|"MVI", "nth": N,
 "after": A}` A ms (default 1) after the N-th MOV or MVI call of the run (counting every
 call, MOV 0,0 included) started, if that command is still in effect then. A loss at the
-very moment an MVI covers its distance is too late for it. A loss matters only while
+very moment an MVI covers its distance is too late for it; losses at the same
+millisecond are one loss. `{"instruction": N}`: right
+after the VM has run N instructions, between two instructions, as a vehicle's device
+posts a loss from an interrupt; the device cannot see instructions, so whoever steps the
+VM calls `lose_line` then (vm/drive.py), and an engine that counts no instructions (the
+AST interpreter) cannot run such a script. A loss matters only while
 motion is in effect (a non-zero MOV, or an MVI in progress); see device.py for what each
 tracing mode does with it.
+
+Failures: a call named in "fail" (a form as the trace writes it: "TIM", "CAM R") fails
+the N-th time it arrives: the device records it, then raises DeviceError, at once for a
+built-in that takes no device time, at the end of its device time for one that does (as
+a poll that answers an error). With "stop_fails" the device records STOP, then raises
+DeviceError: the engine's stop after a fault fails.
 
 The motion model (device time in integer milliseconds, starting at 0):
 - TIM t waits t x 100 ms; MVI l,r,cm moves the centre at |l+r|/2 x 5 cm/s (a wheel speed
@@ -43,7 +57,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
 
-from .device import DeviceError, FuzzyReading, ImageReading, LineLost, MotionCommand, Odometry
+from .device import (
+    DeviceError,
+    FuzzyReading,
+    ImageReading,
+    LineLost,
+    MotionCommand,
+    Odometry,
+    form_name,
+)
 from .language import BUILTINS, TOO_LONG, decimal_value
 
 T = TypeVar("T")
@@ -74,6 +96,13 @@ class LossDuring:
 
 
 @dataclass(frozen=True, slots=True)
+class LossAfter:
+    """The line is lost right after the VM's `instruction`-th instruction."""
+
+    instruction: int
+
+
+@dataclass(frozen=True, slots=True)
 class Script:
     images: tuple[ImageReading, ...] = ()
     odometry: tuple[Odometry, ...] = ()
@@ -81,7 +110,15 @@ class Script:
     ultrasonic: dict[str, tuple[int, ...]] = field(default_factory=dict)
     ports: dict[int, tuple[int, ...]] = field(default_factory=dict)
     fuzzy: tuple[FuzzyReading, ...] = ()
-    losses: tuple[LossAt | LossDuring, ...] = ()
+    losses: tuple[LossAt | LossDuring | LossAfter, ...] = ()
+    failures: dict[str, int] = field(default_factory=dict)  # a form -> the call that fails
+    stop_fails: bool = False
+
+    @property
+    def instruction_losses(self) -> tuple[int, ...]:
+        """The instruction counts after which the line is lost, in order."""
+        return tuple(sorted(loss.instruction for loss in self.losses
+                            if isinstance(loss, LossAfter)))
 
 
 @dataclass(frozen=True, slots=True)
@@ -104,7 +141,7 @@ class TraceEntry:
 
 _INT16 = (-32768, 32767)
 _LIST_KEYS = ("IMG", "KYO", "CAM R", "ULT A", "ULT B", "ULT C", "ULT D", "FZI")
-_KEYS = (*_LIST_KEYS, "INP", "line_lost", "comment")
+_KEYS = (*_LIST_KEYS, "INP", "line_lost", "fail", "stop_fails", "comment")
 
 
 def decode_script(data: bytes, name: str) -> Script:
@@ -147,6 +184,8 @@ def parse_script(document: object, name: str = "<script>") -> Script:
                               + ", ".join(f'"{k}"' for k in _KEYS))
     if not isinstance(document.get("comment", ""), str):
         raise ScriptError(f"{name}:comment: expected a string")
+    if not isinstance(document.get("stop_fails", False), bool):
+        raise ScriptError(f"{name}:stop_fails: expected true or false")
 
     def readings(key: str) -> list[object]:
         return _list(document[key], f"{name}:{key}") if key in document else []
@@ -168,6 +207,8 @@ def parse_script(document: object, name: str = "<script>") -> Script:
                     for i, item in enumerate(readings("FZI"))),
         losses=tuple(_loss(item, f"{name}:line_lost[{i}]")
                      for i, item in enumerate(readings("line_lost"))),
+        failures=_failures(document.get("fail", {}), f"{name}:fail"),
+        stop_fails=document.get("stop_fails", False),
     )
 
 
@@ -233,16 +274,33 @@ def _ports(value: object, where: str) -> dict[int, tuple[int, ...]]:
     return ports
 
 
-def _loss(value: object, where: str) -> LossAt | LossDuring:
+FORMS = frozenset(form_name((mnemonic, form.selector)) for mnemonic, builtin in BUILTINS.items()
+                  if mnemonic != "END" for form in builtin.forms)
+
+
+def _failures(value: object, where: str) -> dict[str, int]:
+    if not isinstance(value, dict):
+        raise ScriptError(f'{where}: expected an object from a call to the one that fails, '
+                          f'e.g. {{"TIM": 2}}, found {_kind(value)}')
+    for call in value:
+        if call not in FORMS:
+            raise ScriptError(f"{where}.{call}: not a built-in form; expected one of "
+                              + ", ".join(sorted(FORMS)))
+    return {call: _int(nth, f"{where}.{call}", 1, 2**31 - 1) for call, nth in value.items()}
+
+
+def _loss(value: object, where: str) -> LossAt | LossDuring | LossAfter:
     if isinstance(value, dict) and set(value) == {"time"}:
         return LossAt(_int(value["time"], f"{where}.time", 1, 2**31 - 1))
+    if isinstance(value, dict) and set(value) == {"instruction"}:
+        return LossAfter(_int(value["instruction"], f"{where}.instruction", 0, 2**31 - 1))
     if isinstance(value, dict) and set(value) in ({"during", "nth"}, {"during", "nth", "after"}):
         command = value["during"]
         if command not in ("MOV", "MVI"):
             raise ScriptError(f'{where}.during: expected "MOV" or "MVI", found {_kind(command)}')
         return LossDuring(command, _int(value["nth"], f"{where}.nth", 1, 2**31 - 1),
                           _int(value.get("after", 1), f"{where}.after", 1, 2**31 - 1))
-    raise ScriptError(f'{where}: expected {{"time": MS}} or '
+    raise ScriptError(f'{where}: expected {{"time": MS}}, {{"instruction": N}} or '
                       f'{{"during": "MOV"|"MVI", "nth": N, "after": MS}}, found {_kind(value)}')
 
 
@@ -282,11 +340,20 @@ class ScriptedDevice:
         for afters in self._losses_during.values():
             afters.sort()
         self._read_counts: dict[str, int] = {}
+        self._arrivals: dict[str, int] = {}  # calls of each form so far, for "fail"
+        self._failing: str | None = None  # why the waiting built-in under way fails
 
     # Bookkeeping
 
     def _record(self, call: str, *args: int, result: tuple[int, ...] | None = None) -> None:
         self.trace.append(TraceEntry(self.time, call, args, result))
+        arrived = self._arrivals.get(call, 0) + 1
+        self._arrivals[call] = arrived
+        if self.script.failures.get(call) == arrived:
+            failure = f"({call}) failed: the sensor script says its call {arrived} fails"
+            if not BUILTINS[call.split()[0]].waits:
+                raise DeviceError(failure)
+            self._failing = failure  # at the end of its device time
 
     def _next(self, key: str, readings: tuple[T, ...], nothing: T) -> T:
         count = self._read_counts.get(key, 0)
@@ -310,6 +377,14 @@ class ScriptedDevice:
         return min(times, default=None)
 
     def _advance(self, duration: int, interruptible: bool) -> None:
+        """Let the device time of a waiting built-in pass; then it fails, if the script
+        says so (a failing poll)."""
+        self._pass_time(duration, interruptible)
+        failing, self._failing = self._failing, None
+        if failing is not None:
+            raise DeviceError(failing)
+
+    def _pass_time(self, duration: int, interruptible: bool) -> None:
         """Let `duration` ms of device time pass, meeting motion ends and line losses in
         time order; an interruptible wait ends at the first loss the program must hear."""
         until = self.time + duration
@@ -326,10 +401,10 @@ class ScriptedDevice:
                 self.time = until
                 return
             self.time = loss
-            if self._lose_line() and interruptible:
+            if self.lose_line() and interruptible:
                 return
 
-    def _lose_line(self) -> bool:
+    def lose_line(self) -> bool:
         """The line is lost now; True if the program is to hear of it."""
         motion = self._motion
         if motion is None or self.mode == 0:
@@ -368,6 +443,7 @@ class ScriptedDevice:
         self._record("MVI", left, right, cm)
         if cm == 0:
             self._motion = None
+            self._advance(0, interruptible=True)  # no time passes, but it may fail
             return
         if left + right == 0:
             raise DeviceError(f"(MVI {left},{right},{cm}) would never end: with wheel speeds "
@@ -469,6 +545,8 @@ class ScriptedDevice:
 
     def stop(self) -> None:
         self._stopped("STOP")
+        if self.script.stop_fails:
+            raise DeviceError("the sensor script says stopping fails")
 
     def poll_event(self) -> LineLost | None:
         event, self.pending = self.pending, None

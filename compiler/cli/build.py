@@ -23,7 +23,7 @@ from .command import (
     PATH,
     Command,
     Failure,
-    at_least_one,
+    a_budget,
     choice_option,
     color_option,
     force_option,
@@ -121,7 +121,7 @@ def _default_output(source: str) -> str:
                    ".toml). Without one every sensor reads 0 and the line is never lost")
 @choice_option("--format", "run_format", choices=("text", "json"), default="text",
                help="text: for people; json: one object for tools")
-@click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=at_least_one,
+@click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget,
               metavar="N", show_default=True,
               help="instructions (statements with --engine ast) before the watchdog stops "
                    "a runaway program")
@@ -159,8 +159,11 @@ def run(file: str, sensors: str | None, run_format: str, budget: int, engine: En
         source = read_input(file)
         if not isinstance(source, Source):
             return emit([source], "human", "auto", "run", err=True)
-        outcome = run_source(source.text, os.path.basename(source.name), device, engine,
-                             budget)
+        try:
+            outcome = run_source(source.text, os.path.basename(source.name), device, engine,
+                                 budget)
+        except ScriptError as error:
+            raise Failure(f"error: {error}") from None
         if not isinstance(outcome, RunResult):
             return emit([FileDiagnostics(source.name, source.text, outcome)], "human",
                         "auto", "run", err=True)

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import click
 
 from rl1.compiler.reporting.render import COLOR_CHOICES, EXIT_ERRORS, EXIT_USAGE, FORMATS
+from rl1.vm.faults import MAX_BUDGET
 
 if TYPE_CHECKING:  # click's completion module loads only when a shell asks
     from click.shell_completion import CompletionItem
@@ -153,15 +154,15 @@ def choice_option(*names: str, choices: Sequence[str], help: str,
                         **settings)
 
 
-def at_least_one(ctx: click.Context, param: click.Parameter, value: str) -> int:
-    """An option's callback: a whole number, at least 1."""
+def a_budget(ctx: click.Context, param: click.Parameter, value: str) -> int:
+    """An option's callback: a watchdog budget, a whole number in 1..MAX_BUDGET."""
     try:
         number = int(value)
     except ValueError:
         number = 0
-    if number < 1:
-        raise click.BadParameter(f"expected a whole number of at least 1, got {value!r}",
-                                 ctx, param)
+    if not 1 <= number <= MAX_BUDGET:
+        raise click.BadParameter(f"expected a whole number from 1 to {MAX_BUDGET}, "
+                                 f"got {value!r}", ctx, param)
     return number
 
 

@@ -1,8 +1,10 @@
 """Running a program by either engine: the stage behind `rl1c run`.
 
 A .rob program is interpreted (engine "ast") or compiled in memory and run on the VM
-(engine "vm"); an .ilc file runs on the VM only. Both engines drive the same Device, so
-their traces and final variables can be compared.
+(engine "vm"); an .ilc file runs on the VM only. Both engines drive the same scripted
+device, so their traces and final variables can be compared. The VM runs in steps
+(vm/drive.py), which is also how a script's losses after instruction N are made; the
+interpreter counts no instructions, so it refuses such a script.
 """
 
 from __future__ import annotations
@@ -15,11 +17,12 @@ from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.frontend.diagnostics import Diagnostic
 from rl1.compiler.interpreter import interpret
-from rl1.vm.device import Device
+from rl1.vm.drive import drive
 from rl1.vm.faults import DEFAULT_BUDGET, RunResult
+from rl1.vm.hardware import Blocking
 from rl1.vm.machine import Machine
-from rl1.vm.scripted import Script, ScriptError, decode_script
-from rl1.vm.verifier import verify
+from rl1.vm.scripted import Script, ScriptedDevice, ScriptError, decode_script
+from rl1.vm.verifier import VerifiedProgram, verify
 
 MAX_SCRIPT_BYTES = 16 * 2**20
 
@@ -27,11 +30,15 @@ Engine = Literal["vm", "ast"]
 ENGINES: tuple[Engine, ...] = ("vm", "ast")
 
 
-def run_source(text: str, source_name: str, device: Device, engine: Engine = "vm",
+def run_source(text: str, source_name: str, device: ScriptedDevice, engine: Engine = "vm",
                budget: int = DEFAULT_BUDGET) -> RunResult | list[Diagnostic]:
     """Run RL/I source by `engine`; the diagnostics instead when it has errors. For the
-    VM the compiled bytes go through the verifier, as a file read from disk would."""
+    VM the compiled bytes go through the verifier, as a file read from disk would.
+    ScriptError when the interpreter is given losses after instruction counts."""
     if engine == "ast":
+        if device.script.instruction_losses:
+            raise ScriptError("the sensor script loses the line after instruction counts, "
+                              "which only the VM counts: run it with --engine vm")
         analysis = analyze(text)
         if analysis.has_errors:
             return analysis.diagnostics
@@ -39,13 +46,19 @@ def run_source(text: str, source_name: str, device: Device, engine: Engine = "vm
     compilation = compile_text(text, source_name)
     if compilation.output is None:
         return compilation.diagnostics
-    return Machine(verify(compilation.output), device, budget).run()
+    return run_program(verify(compilation.output), device, budget)
 
 
-def run_ilc(data: bytes, device: Device, budget: int = DEFAULT_BUDGET) -> RunResult:
+def run_ilc(data: bytes, device: ScriptedDevice, budget: int = DEFAULT_BUDGET) -> RunResult:
     """Run the bytes of an .ilc file on the VM; verifier.VerifyError if they are not
     valid intermediate code."""
-    return Machine(verify(data), device, budget).run()
+    return run_program(verify(data), device, budget)
+
+
+def run_program(program: VerifiedProgram, device: ScriptedDevice,
+                budget: int = DEFAULT_BUDGET) -> RunResult:
+    """Step a verified program on the VM to its end."""
+    return drive(Machine(program, Blocking(device), budget), device)
 
 
 def load_script(path: str | Path) -> Script:

@@ -50,10 +50,13 @@ class Case:
     status: str = "ok"  # "ok" or a fault code (vm/faults.py)
     fault_line: int = 0
     trace: tuple[TraceItem, ...] | None = None  # the expected trace, when the case fixes it
+    executed: int | None = None  # the VM's instruction count, when the case fixes it
+    language: str = "rl1"  # "ils": `source` is intermediate code written by hand (.ils)
 
 
 def all_cases() -> list[Case]:
-    return [*arithmetic(), *shifts(), *control(), *calls(), *tracing(), *faults(), *sample()]
+    return [*arithmetic(), *shifts(), *control(), *calls(), *tracing(), *events(), *faults(),
+            *sample(), *intermediate()]
 
 
 def _straight(group: str, name: str, covers: str, program: Straight) -> Case:
@@ -191,6 +194,23 @@ def shifts() -> Iterator[Case]:
             yield _straight("shifts", f"shift-{word}-{label}-by-variables",
                             f"the same counts held in a variable (SH{word[0].upper()}V)",
                             Straight(statements))
+    yield _shifts_by_results()
+
+
+def _shifts_by_results() -> Case:
+    """Counts a C VM reads from R, not from V or an immediate: negative, 16 and more, and
+    -32768 (spec/language.md 7.2: a negative count shifts the other way)."""
+    return Case("shifts", "shift-counts-from-results",
+                "`<` and `>` by a call's result (SHLR, SHRR): (IMG) areas -1, -2, 16, 16, "
+                "-32768, -32768 and (KYO) centres -3, 16 as counts",
+                "A=1<(IMG)\nB=$100<(IMG)\nC=3<(IMG)\nD=$4000>(IMG)\nE=1>(IMG)\nF=-8<(IMG)\n"
+                "G=$80>(KYO)\nH=-2<(KYO)\n",
+                {"A": 0, "B": 64, "C": 0, "D": 0, "E": 0, "F": -1, "G": 1024, "H": 0,
+                 "w": -32768},
+                sensors={"IMG": [{"area": area, "x": 0, "y": 0, "z": 0}
+                                 for area in (-1, -2, 16, 16, -32768, -32768)],
+                         "KYO": [{"centre": -3, "right": 0, "left": 0},
+                                 {"centre": 16, "right": 0, "left": 0}]})
 
 
 # --- control -----------------------------------------------------------------------------
@@ -450,6 +470,78 @@ def tracing() -> Iterator[Case]:
                       (1800, "MOV", (0, 0))))
 
 
+# --- events: losses between instructions, and what a wait does with them ----------------
+
+EVENT_HANDLERS = "(END)\n:96 H=96; (END)\n:98 H=98; (END)\n"
+
+
+def events() -> Iterator[Case]:
+    group = "events"
+    for name, jump, mode, covers in (
+            ("event-at-a-jump", "#20", 3, "a loss posted between instructions is taken at "
+             "the next jump taken (#NN), before its target runs"),
+            ("event-at-a-conditional-jump", "?A>#20", 2, "the same at a conditional jump "
+             "whose condition holds; mode 2 stops the MOV")):
+        yield Case(group, name, covers,
+                   f"(TRC {mode})\n(MOV 1,1)\nA++\n{jump}\nB++\n:20 C++\n" + EVENT_HANDLERS,
+                   {"A": 1, "H": 102 - 2 * mode}, sensors={"line_lost": [{"instruction": 3}]},
+                   trace=((0, "TRC", (mode,)), (0, "MOV", (1, 1)),
+                          (0, "LINE LOST", (mode,))),
+                   executed=7)
+    yield Case(group, "event-waits-for-an-event-point",
+               "straight code and a conditional jump not taken take no event; a call that "
+               "takes no device time (KYC) does, right after it",
+               "(TRC 3)\n(MOV 1,1)\nA++\n?B>#20\nB++\n(KYC)\n:20 C++\n" + EVENT_HANDLERS,
+               {"A": 1, "B": 1, "H": 96}, sensors={"line_lost": [{"instruction": 2}]},
+               trace=((0, "TRC", (3,)), (0, "MOV", (1, 1)), (0, "LINE LOST", (3,)),
+                      (0, "KYC", ())),
+               executed=9)
+    yield Case(group, "event-pending-at-the-end",
+               "(END) is no event point: an event still pending when the program ends is "
+               "never taken, and the MOV keeps going",
+               "(TRC 3)\n(MOV 1,1)\nA++\n" + EVENT_HANDLERS,
+               {"A": 1}, sensors={"line_lost": [{"instruction": 3}]},
+               trace=((0, "TRC", (3,)), (0, "MOV", (1, 1)), (0, "LINE LOST", (3,))),
+               executed=4)
+    yield Case(group, "event-at-the-end-of-a-wait",
+               "a loss at the very millisecond a TIM ends: the TIM ends, the event is taken "
+               "right after it",
+               "(TRC 3)\n(MOV 1,1)\n(TIM 10)\nA++\n" + EVENT_HANDLERS,
+               {"H": 96}, sensors={"line_lost": [{"time": 1000}]},
+               trace=((0, "TRC", (3,)), (0, "MOV", (1, 1)), (0, "TIM", (10,)),
+                      (1000, "LINE LOST", (3,))))
+    yield Case(group, "two-losses-in-one-millisecond",
+               "two losses at the same millisecond are one loss: one LINE LOST, one event, "
+               "which ends the TIM early",
+               "(TRC 3)\n(MOV 1,1)\n(TIM 10)\nA++\n" + EVENT_HANDLERS,
+               {"H": 96}, sensors={"line_lost": [{"time": 500}, {"time": 500}]},
+               trace=((0, "TRC", (3,)), (0, "MOV", (1, 1)), (0, "TIM", (10,)),
+                      (500, "LINE LOST", (3,))))
+    yield Case(group, "mode-2-during-a-background-mvi",
+               "an MVI running in the background after a mode-3 loss (:97) is stopped by a "
+               "mode-2 loss, which jumps to :99 and ends the TIM early",
+               "(TRC 3)\n(MVI 2,2,100)\n(END)\n:97 (TRC 2); (TIM 50); (END)\n"
+               ":99 H=99; (TIM 10); (END)\n",
+               {"H": 99}, sensors={"line_lost": [{"during": "MVI", "nth": 1, "after": 1000},
+                                                 {"during": "MVI", "nth": 1, "after": 3000}]},
+               trace=((0, "TRC", (3,)), (0, "MVI", (2, 2, 100)), (1000, "LINE LOST", (3,)),
+                      (1000, "TRC", (2,)), (1000, "TIM", (50,)), (3000, "LINE LOST", (2,)),
+                      (3000, "TIM", (10,))))
+    for command in ("MOV 1,1", "FRE"):
+        yield Case(group, f"{command.split()[0].lower()}-replaces-a-background-mvi",
+                   f"({command}) in the :97 handler replaces the MVI running in the "
+                   "background: a later loss timed during that MVI is nothing",
+                   f"(TRC 3)\n(MVI 2,2,100)\n(END)\n:97 G++; ({command}); (TIM 50); (END)\n"
+                   ":96 H=96; (END)\n",
+                   {"G": 1}, sensors={"line_lost": [
+                       {"during": "MVI", "nth": 1, "after": 1000},
+                       {"during": "MVI", "nth": 1, "after": 3000}]},
+                   trace=((0, "TRC", (3,)), (0, "MVI", (2, 2, 100)),
+                          (1000, "LINE LOST", (3,)),
+                          (1000, "FRE", ()) if command == "FRE" else (1000, "MOV", (1, 1)),
+                          (1000, "TIM", (50,))))
+
+
 # --- faults ------------------------------------------------------------------------------
 
 FAULT_PREFIX = "' the fault's line is counted from the top\n(MOV 2,2)\n"
@@ -531,6 +623,37 @@ def faults() -> Iterator[Case]:
                "the call does not reach the device", "A++\nB++\n(MOV 1,1)\n(END)\n",
                {"A": 1, "B": 1}, budget=2, status="budget", fault_line=3,
                trace=((0, "STOP", ()),))
+    yield Case(group, "budget-at-a-conditional-jump",
+               "a loop closed by a conditional jump meets the watchdog there: the 501st "
+               "?A<#10 brings the count to 2 x 501 = 1002 > 1001",
+               ":10 A--; ?A<#10\n", {"A": -501}, budget=1001, status="budget",
+               fault_line=1, trace=((0, "STOP", ()),), executed=1002)
+    yield Case(group, "budget-not-counting-a-handler-jump",
+               "a handler jump is no instruction: TRC, MOV, TIM, then at :96 A++ and the "
+               "#10 taken make 5 instructions, within a budget of 5",
+               "(TRC 3)\n(MOV 1,1)\n(TIM 10)\n(END)\n:10 B=1; (END)\n:96 A++; #10\n",
+               {"A": 1, "B": 1}, budget=5, sensors={"line_lost": [{"time": 500}]},
+               trace=((0, "TRC", (3,)), (0, "MOV", (1, 1)), (0, "TIM", (10,)),
+                      (500, "LINE LOST", (3,))),
+               executed=8)
+    yield Case(group, "budget-before-the-range-check",
+               "the watchdog is checked before a call's arguments: a call both over budget "
+               "and out of range is a budget fault",
+               "a++\n" * 13 + "(MOV a,0)\n", {"a": 13}, budget=13, status="budget",
+               fault_line=14, trace=((0, "STOP", ()),), executed=14)
+    yield Case(group, "failing-poll", "the device fails the 2nd (ULT A), a built-in that "
+               "takes device time, at the end of that time (its poll answers an error): a "
+               "device error at that call, after the vehicle is stopped; the first reading "
+               "was written",
+               "(MOV 1,1)\nA=(ULT A)\nB=(ULT A)\n", {"A": 7}, status="device-error",
+               fault_line=3, sensors={"ULT A": [7], "fail": {"ULT A": 2}},
+               trace=((0, "MOV", (1, 1)), (0, "ULT A", ()), (100, "ULT A", ()),
+                      (200, "STOP", ())),
+               executed=5)
+    yield Case(group, "failing-stop", "the stop after a fault fails: the fault reported is "
+               "still the one that caused the stop (argument-range), not a device error",
+               "a=13\n(MOV a,0)\n", {"a": 13}, status="argument-range", fault_line=2,
+               sensors={"stop_fails": True}, trace=((0, "STOP", ()),), executed=3)
     yield Case(group, "device-error", "the device refuses an MVI whose centre would not "
                "move: a device error, after the vehicle is stopped",
                "(MOV 2,2)\n(MVI 3,-3,10)\n", {}, status="device-error", fault_line=2,
@@ -539,6 +662,42 @@ def faults() -> Iterator[Case]:
                "variables", "a=-5; b=5; c=-1900\n\n(MVI a,b,c)\n",
                {"a": -5, "b": 5, "c": -1900}, status="device-error", fault_line=3,
                trace=((0, "MVI", (-5, 5, -1900)), (0, "STOP", ())))
+
+
+# --- intermediate code written by hand ------------------------------------------------------
+
+
+def intermediate() -> Iterator[Case]:
+    """What the compiler never writes, but a VM must run as section 9 of spec/ilc.md says."""
+    group = "ils"
+    yield Case(group, "ils-off-the-end", "code with no final END: running past the last "
+               "instruction ends the program", "  LDI 5\n  STV A\n", {"A": 5},
+               language="ils", executed=2)
+    yield Case(group, "ils-empty-code", "an empty code section: the program begins and "
+               "ends having run no instruction", "", {}, language="ils", executed=0)
+    yield Case(group, "ils-ldr-before-any-call", "R is 0 before any call returns a value",
+               "  LDR\n  STV A\n  LDI 7\n  ADDR\n  STV B\n", {"B": 7}, language="ils",
+               executed=5)
+    yield Case(group, "ils-r-kept-by-calls-without-result",
+               "FZI, TIM and MOV return nothing: R still holds IMG's area for SHLR",
+               "  IMG\n  FZI\n  TIM 1\n  MOV 0, 0\n  LDI 1\n  SHLR\n  STV A\n",
+               {"A": 8, "w": 3, "s": -1, "t": 20},
+               sensors={"IMG": [{"area": 3, "x": 0, "y": 0, "z": 0}],
+                        "FZI": [{"s": -1, "t": 20}]},
+               language="ils", executed=7)
+    yield Case(group, "ils-jump-into-a-statement", "a jump into the middle of a "
+               "load-operate-store run continues with the accumulator as it is",
+               "  LDI 100\n  JMP L1\n  LDI 10\nL1:\n  ADDI 5\n  STV A\n  END\n", {"A": 105},
+               language="ils", executed=5)
+    yield Case(group, "ils-budget-at-a-conditional-jump-to-a-handler",
+               "the budget fault comes at a conditional jump taken even with an event "
+               "pending there: the watchdog is checked before the event point",
+               ".handler 96 H\n  TRC 3\n  MOV 1, 1\n  INC A\nL:\n  JGT A, L\nH:\n  END\n",
+               {"A": 1}, budget=3, status="budget", fault_line=1,
+               sensors={"line_lost": [{"instruction": 3}]},
+               trace=((0, "TRC", (3,)), (0, "MOV", (1, 1)), (0, "LINE LOST", (3,)),
+                      (0, "STOP", ())),
+               language="ils", executed=4)
 
 
 # --- Listing 1 ---------------------------------------------------------------------------

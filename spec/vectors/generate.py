@@ -5,8 +5,9 @@
                                                         differs from what would be written
 
 Each case is compiled with and without its debug section, both files are verified and
-run on the VM, and the source is run on the AST interpreter, each run on a fresh
-scripted device. All runs must agree (the stripped file knows no fault line), and agree
+stepped on the VM (vm/drive.py), and the source is run on the AST interpreter (unless
+the script loses the line after instruction counts, which only the VM counts), each run
+on a fresh scripted device. All runs must agree (the stripped file knows no fault line), and agree
 with what the case expects (its variables, status, fault line and trace, worked out
 from the spec; see cases.py and oracle.py). If any case fails, no file is written.
 """
@@ -23,19 +24,24 @@ from pathlib import Path
 from typing import Any
 
 from cases import Case, TraceItem, all_cases
+from files import FileCase, all_file_cases
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.files import write_atomically
+from rl1.compiler.ils.asm import AsmError, assemble
 from rl1.compiler.interpreter import interpret
+from rl1.vm import ilc
+from rl1.vm.drive import drive
 from rl1.vm.faults import FaultKind, RunResult
+from rl1.vm.hardware import Blocking
 from rl1.vm.language import VARIABLES
-from rl1.vm.machine import run
+from rl1.vm.machine import Machine
 from rl1.vm.scripted import ScriptedDevice, parse_script
-from rl1.vm.verifier import verify
+from rl1.vm.verifier import VerifyError, verify
 
 HERE = Path(__file__).resolve().parent
-FORMAT = 1  # the version of the vector format (README.md); a change of layout bumps it
+FORMAT = 2  # the version of the vector format (README.md); a change of layout bumps it
 EXIT_STATUS = {kind.code: kind.exit_status for kind in FaultKind} | {"ok": 0}
 
 Record = tuple[int, str, tuple[int, ...], tuple[int, ...]]  # time, call, args, result
@@ -49,25 +55,35 @@ class Outcome:
     fault_line: int | None
     variables: tuple[int, ...]
     trace: tuple[Record, ...]
+    executed: int | None = None  # instructions the VM ran; None for the interpreter
 
 
 class VectorError(Exception):
     """A case that cannot become a vector: it does not compile, or a run disagrees."""
 
 
-def _outcome(result: RunResult, device: ScriptedDevice) -> Outcome:
+def _outcome(result: RunResult, device: ScriptedDevice, executed: int | None = None
+             ) -> Outcome:
     fault = result.fault
     trace = tuple((entry.time, entry.call, entry.args, entry.result or ())
                   for entry in device.trace)
     if fault is None:
-        return Outcome("ok", None, result.variables, trace)
-    return Outcome(fault.kind.code, fault.line, result.variables, trace)
+        return Outcome("ok", None, result.variables, trace, executed)
+    return Outcome(fault.kind.code, fault.line, result.variables, trace, executed)
 
 
-def run_vm(data: bytes, sensors: Mapping[str, Any], budget: int) -> Outcome:
-    """Verify an .ilc file and run it on the VM with the sensor script."""
+def run_vm(data: bytes, sensors: Mapping[str, Any], budget: int,
+           machine: type[Machine] = Machine) -> Outcome:
+    """Verify an .ilc file and step it on the VM (or on `machine`, a variant of it) with
+    the sensor script."""
     device = ScriptedDevice(parse_script(dict(sensors), "sensors"))
-    return _outcome(run(verify(data), device, budget), device)
+    vm = machine(verify(data), Blocking(device), budget)
+    return _outcome(drive(vm, device), device, vm.executed)
+
+
+def interpretable(sensors: Mapping[str, Any]) -> bool:
+    """Whether the interpreter can run with the script: no loss after an instruction."""
+    return not parse_script(dict(sensors), "sensors").instruction_losses
 
 
 def run_interpreter(source: str, sensors: Mapping[str, Any], budget: int) -> Outcome:
@@ -77,7 +93,15 @@ def run_interpreter(source: str, sensors: Mapping[str, Any], budget: int) -> Out
 
 
 def compile_both(case: Case) -> tuple[bytes, bytes]:
-    """The case's .ilc file with its debug section, and without."""
+    """The case's .ilc file with its debug section, and without; for intermediate code
+    written by hand, the assembled file and the same stripped."""
+    if case.language == "ils":
+        try:
+            full = assemble(f".source {json.dumps(source_name(case))}\n.line 1\n"
+                            + case.source)
+        except AsmError as error:
+            raise VectorError(f"{case.name}: the .ils text does not assemble: {error}") from None
+        return full, ilc.encode(ilc.strip_debug(ilc.decode(full)))
     files = []
     for strip in (False, True):
         compilation = compile_text(case.source, source_name(case), strip_debug=strip)
@@ -90,7 +114,7 @@ def compile_both(case: Case) -> tuple[bytes, bytes]:
 
 
 def source_name(case: Case) -> str:
-    return case.name + ".rob"
+    return case.name + (".ils" if case.language == "ils" else ".rob")
 
 
 def difference(expected: Outcome, actual: Outcome) -> str | None:
@@ -108,6 +132,8 @@ def difference(expected: Outcome, actual: Outcome) -> str | None:
             return f"trace entry {index} is {got}, expected {want}"
     if len(expected.trace) != len(actual.trace):
         return f"the trace has {len(actual.trace)} entries, expected {len(expected.trace)}"
+    if None not in (expected.executed, actual.executed) and expected.executed != actual.executed:
+        return f"{actual.executed} instructions executed, expected {expected.executed}"
     return None
 
 
@@ -116,7 +142,8 @@ def _check_expectations(case: Case, outcome: Outcome) -> None:
     if unknown:
         raise VectorError(f"{case.name}: the case names no variable {sorted(unknown)}")
     expected = Outcome(case.status, case.fault_line or None,
-                       tuple(case.variables.get(name, 0) for name in VARIABLES), ())
+                       tuple(case.variables.get(name, 0) for name in VARIABLES), (),
+                       case.executed)
     problem = difference(expected, replace(outcome, trace=()))
     if problem is None and case.trace is not None:
         problem = _trace_difference(case.trace, outcome.trace)
@@ -144,9 +171,10 @@ def build(case: Case) -> dict[str, Any]:
     others = {
         "the VM on the stripped file": (run_vm(stripped, case.sensors, case.budget),
                                         replace(outcome, fault_line=None)),
-        "the AST interpreter": (run_interpreter(case.source, case.sensors, case.budget),
-                                outcome),
     }
+    if case.language == "rl1" and interpretable(case.sensors):
+        others["the AST interpreter"] = (
+            run_interpreter(case.source, case.sensors, case.budget), outcome)
     for engine, (other, reference) in others.items():
         problem = difference(reference, other)
         if problem is not None:
@@ -164,6 +192,7 @@ def build(case: Case) -> dict[str, Any]:
         "status": outcome.status,
         "exit_status": EXIT_STATUS[outcome.status],
         "fault_line": outcome.fault_line or 0,
+        "executed": outcome.executed,
         "variables": list(outcome.variables),
         "trace": [{"time": time, "call": call, "args": list(args), "result": list(result)}
                   for time, call, args, result in outcome.trace],
@@ -188,8 +217,108 @@ def render_group(group: str, vectors: list[dict[str, Any]]) -> str:
     return text
 
 
-def generate(cases: Sequence[Case]) -> dict[Path, str]:
-    """The text of every vector file, by path; VectorError if a case fails."""
+# What the message of a refusal by each rule of spec/ilc.md section 10 says: how the
+# generator knows which rule refused a file (the C loader reports the rule's number).
+RULE_MESSAGES = {
+    1: "truncated|not an .ilc file", 2: "format version", 3: "truncated", 4: "header size",
+    5: "section must be", 6: "truncated: the header's section sizes", 7: "unexpected bytes",
+    8: "CRC-32 mismatch", 9: "required flag", 10: "points at code offset",
+    11: "unknown feature bits", 12: "debug|line entry (repeats|\\(offset)|UTF-8|left over",
+    13: "unknown opcode", 14: "needs \\d+ bytes", 15: "variable index|argument mask|out of range",
+    16: "needs the device feature", 17: "jump target", 18: "handler :\\d+ at code offset",
+    19: "line entry for code offset",
+}
+
+
+def build_file(case: FileCase) -> dict[str, Any]:
+    """The verifier vector of one file, after the verifier does what the case says."""
+    try:
+        verify(case.data)
+    except VerifyError as error:
+        rule = case.rule
+        if rule is None or error.offset != case.offset or not re.search(
+                RULE_MESSAGES[rule], error.message):
+            raise VectorError(f"{case.name}: refused at {error.offset} ({error.message}), "
+                              f"expected rule {rule} at {case.offset}") from None
+        return case.vector()
+    if case.rule is not None:
+        raise VectorError(f"{case.name}: accepted, expected rule {case.rule} at {case.offset}")
+    return case.vector()
+
+
+def _word(call: str) -> str:
+    """A call's name as one word of the text form: "CAM A" is "CAM_A"."""
+    return call.replace(" ", "_")
+
+
+def _sensor_lines(sensors: Mapping[str, Any]) -> list[str]:
+    """The sensor script as lines of the text form, each list in its order."""
+    fields = {"IMG": ("area", "x", "y", "z"), "KYO": ("centre", "right", "left"),
+              "FZI": ("s", "t")}
+    lines = []
+    for key, readings in sensors.items():
+        if key in fields:
+            lines += [f"sensor {key} " + " ".join(str(r[f]) for f in fields[key])
+                      for r in readings]
+        elif key in ("CAM R", "ULT A", "ULT B", "ULT C", "ULT D"):
+            lines += [f"sensor {_word(key)} {value}" for value in readings]
+        elif key == "INP":
+            lines += [f"sensor INP {port} {value}" for port, values in readings.items()
+                      for value in values]
+        elif key == "line_lost":
+            for loss in readings:
+                if "during" in loss:
+                    lines.append(f"loss during {loss['during']} {loss['nth']} "
+                                 f"{loss.get('after', 1)}")
+                else:
+                    (kind, value), = loss.items()
+                    lines.append(f"loss {kind} {value}")
+        elif key == "fail":
+            lines += [f"fail {_word(call)} {nth}" for call, nth in readings.items()]
+        elif key == "stop_fails" and readings:
+            lines.append("stop_fails")
+    return lines
+
+
+def render_text(group: str, vectors: list[dict[str, Any]]) -> str:
+    """GROUP.txt: the same vectors as GROUP.json, a line per fact (README.md, "The text
+    form"), for a C runner without a JSON reader."""
+    lines = [f"rl1-vectors {FORMAT} {group}"]
+    for vector in vectors:
+        lines += [f"vector {vector['name']}", f"budget {vector['budget']}",
+                  f"ilc {vector['ilc']}", f"ilc_stripped {vector['ilc_stripped']}",
+                  *_sensor_lines(vector["sensors"]),
+                  f"status {vector['status']} {vector['exit_status']} {vector['fault_line']}",
+                  f"executed {vector['executed']}",
+                  "variables " + " ".join(map(str, vector["variables"]))]
+        lines += [f"trace {e['time']} {_word(e['call'])} {len(e['args'])} "
+                  + " ".join(map(str, [*e["args"], len(e["result"]), *e["result"]]))
+                  for e in vector["trace"]]
+        lines.append("end")
+    return "\n".join(lines) + "\n"
+
+
+def render_files_text(vectors: list[dict[str, Any]]) -> str:
+    """verifier.txt: a line per file: name, hex, then accepted, or refused, rule, offset."""
+    lines = [f"rl1-vectors {FORMAT} verifier"]
+    lines += [f"file {v['name']} {v['ilc']} "
+              + ("accepted" if v["accepted"] else f"refused {v['rule']} {v['offset']}")
+              for v in vectors]
+    return "\n".join(lines) + "\n"
+
+
+def render_files(vectors: list[dict[str, Any]]) -> str:
+    """verifier.json: one file vector a line."""
+    lines = ",\n".join("    " + json.dumps(vector) for vector in vectors)
+    text = (f'{{\n  "format": {FORMAT},\n  "group": "verifier",\n  "files": [\n{lines}\n'
+            "  ]\n}\n")
+    assert text.isascii() and json.loads(text)["files"] == vectors
+    return text
+
+
+def generate(cases: Sequence[Case], file_cases: Sequence[FileCase] = ()) -> dict[Path, str]:
+    """The text of every vector file, by path; VectorError if a case fails. The verifier
+    vectors are written only when `file_cases` are given."""
     groups: dict[str, list[dict[str, Any]]] = {}
     names: set[str] = set()
     for case in cases:
@@ -197,15 +326,22 @@ def generate(cases: Sequence[Case]) -> dict[Path, str]:
             raise VectorError(f"{case.name}: two cases have this name")
         names.add(case.name)
         groups.setdefault(case.group, []).append(build(case))
-    return {HERE / f"{group}.json": render_group(group, vectors)
-            for group, vectors in groups.items()}
+    files = {}
+    for group, vectors in groups.items():
+        files[HERE / f"{group}.json"] = render_group(group, vectors)
+        files[HERE / f"{group}.txt"] = render_text(group, vectors)
+    if file_cases:
+        file_vectors = [build_file(case) for case in file_cases]
+        files[HERE / "verifier.json"] = render_files(file_vectors)
+        files[HERE / "verifier.txt"] = render_files_text(file_vectors)
+    return files
 
 
 def stale_files(files: Mapping[Path, str]) -> list[str]:
     """The vector files on disk that differ from `files`, are missing, or are not made
     by the generator at all."""
     stale = []
-    for path in sorted({*files, *HERE.glob("*.json")}):
+    for path in sorted({*files, *HERE.glob("*.json"), *HERE.glob("*.txt")}):
         want = files.get(path)
         have = path.read_text(encoding="utf-8") if path.exists() else None
         if want != have:
@@ -222,7 +358,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     arguments = parser.parse_args(argv)
     cases = all_cases()
     try:
-        files = generate(cases)
+        files = generate(cases, all_file_cases())
     except VectorError as error:
         print(f"error: {error}", file=sys.stderr)
         return 1

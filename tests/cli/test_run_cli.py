@@ -110,6 +110,7 @@ def test_bad_inputs_are_reported_without_a_traceback(tmp_path: Path) -> None:
         (("run", tmp_path / "none.ilc"), 2, "cannot read"),
         (("run", compiled, "--engine", "ast"), 2, "an .ilc file runs on the VM"),
         (("run", SAMPLE, "--budget", "0"), 2, "--budget"),
+        (("run", SAMPLE, "--budget", str(2**31)), 2, "from 1 to 2147483647"),
     ]
     for args, status, message in cases:
         result = rl1c(*args)

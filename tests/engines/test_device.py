@@ -86,8 +86,13 @@ def test_the_sample_sensor_script_is_valid() -> None:
     ({"line_lost": [{"time": 0}]}, "s.json:line_lost[0].time: 0 is outside 1.."),
     ({"line_lost": [{"during": "TIM", "nth": 1}]},
      's.json:line_lost[0].during: expected "MOV" or "MVI"'),
-    ({"line_lost": [{"at": 5}]}, 's.json:line_lost[0]: expected {"time": MS} or'),
+    ({"line_lost": [{"at": 5}]},
+     's.json:line_lost[0]: expected {"time": MS}, {"instruction": N} or'),
     ({"comment": 5}, "s.json:comment: expected a string"),
+    ({"fail": ["TIM"]}, "s.json:fail: expected an object from a call"),
+    ({"fail": {"CAM X": 1}}, "s.json:fail.CAM X: not a built-in form"),
+    ({"fail": {"TIM": 0}}, "s.json:fail.TIM: 0 is outside 1.."),
+    ({"stop_fails": 1}, "s.json:stop_fails: expected true or false"),
 ])
 def test_bad_scripts_are_refused_with_file_key_and_reason(
     tmp_path: Path, document: object, message: str,
@@ -335,3 +340,16 @@ def test_in_mode_1_every_scheduled_loss_under_motion_is_traced_once_in_time_orde
                  if after <= 10_000 and starts[nth - 1] + after <= 30_000}
     traced = [entry.time for entry in device.trace if entry.call == "LINE LOST"]
     assert traced == sorted(expected)
+
+
+def test_a_scripted_failure_refuses_the_nth_call_and_a_failing_stop_records_first() -> None:
+    device = ScriptedDevice(parse_script({"fail": {"ULT A": 2}, "stop_fails": True}))
+    device.ultrasonic("A")
+    with pytest.raises(DeviceError, match=r"\(ULT A\) failed: the sensor script says its "
+                       "call 2 fails"):
+        device.ultrasonic("A")
+    device.ultrasonic("A")  # only the 2nd
+    with pytest.raises(DeviceError, match="stopping fails"):
+        device.stop()
+    assert [entry.call for entry in device.trace] == ["ULT A"] * 3 + ["STOP"]
+    assert device.time == 300  # the failing call took its time, then failed

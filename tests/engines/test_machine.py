@@ -21,6 +21,7 @@ from rl1.compiler.strategies import checked_programs
 from rl1.vm import ilc, isa
 from rl1.vm.device import DeviceError, FuzzyReading, ImageReading, LineLost, Odometry
 from rl1.vm.faults import FaultKind, RunResult
+from rl1.vm.hardware import Blocking
 from rl1.vm.language import BUILTINS, VARIABLES
 from rl1.vm.machine import Machine
 from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
@@ -72,7 +73,7 @@ def assemble(*ops: Op, handlers: dict[int, int] | None = None, debug: bool = Tru
 def execute(program: VerifiedProgram, script: Script | None = None, budget: int = 10_000
             ) -> tuple[RunResult, ScriptedDevice]:
     device = ScriptedDevice(script)
-    return Machine(program, device, budget).run(), device
+    return Machine(program, Blocking(device), budget).run(), device
 
 
 def commands(device: ScriptedDevice) -> list[str]:
@@ -232,7 +233,7 @@ def test_an_event_after_a_jump_is_taken_there() -> None:
     program = assemble(call("MOV", 1, 1), op("INC", v("C")), op("JMP", To(1)),
                        op("LDI", 96), op("STV", v("H")), handlers={96: 3})
     device = Asynchronous()
-    result = Machine(program, device).run()
+    result = Machine(program, Blocking(device)).run()
     assert (result.named()["C"], result.named()["H"]) == (2, 96)
 
 
@@ -259,7 +260,7 @@ def test_a_missing_handler_is_a_fault() -> None:
 
 
 def test_the_watchdog_looks_at_taken_jumps_and_before_calls() -> None:
-    loop = Machine(assemble(op("INC", v("A")), op("JMP", To(0))), ScriptedDevice(), 5)
+    loop = Machine(assemble(op("INC", v("A")), op("JMP", To(0))), Blocking(ScriptedDevice()), 5)
     result = loop.run()
     assert result.fault is not None
     assert (result.fault.kind, result.fault.line) == (FaultKind.BUDGET, 2)
@@ -288,7 +289,7 @@ def test_a_failing_poll_or_stop_is_reported() -> None:
         def stop(self) -> None:
             raise DeviceError("no answer")
 
-    result = Machine(assemble(call("FRE")), Broken()).run()
+    result = Machine(assemble(call("FRE")), Blocking(Broken())).run()
     assert result.fault is not None and result.fault.kind is FaultKind.DEVICE
     assert result.fault.message == ("the serial link dropped; stopping the vehicle failed "
                                     "too: no answer")
@@ -302,7 +303,7 @@ def test_any_verified_image_runs_to_an_end_or_a_fault(
 ) -> None:
     device = ScriptedDevice(Script(ultrasonic={"A": (5,)}, losses=tuple(losses)))
     device.set_tracing(mode)
-    result = Machine(verify(ilc.encode(image)), device, 500).run()
+    result = Machine(verify(ilc.encode(image)), Blocking(device), 500).run()
     assert len(result.variables) == len(VARIABLES)
     assert all(-32768 <= value <= 32767 for value in result.variables)
 
@@ -339,7 +340,7 @@ def both(text: str, script: Script) -> tuple[tuple[RunResult, ScriptedDevice],
     assert compiled.output is not None
     interpreted_device, vm_device = ScriptedDevice(script), ScriptedDevice(script)
     interpreted = interpret(analysis.program, interpreted_device)
-    ran = Machine(verify(compiled.output), vm_device).run()
+    ran = Machine(verify(compiled.output), Blocking(vm_device)).run()
     return (interpreted, interpreted_device), (ran, vm_device)
 
 

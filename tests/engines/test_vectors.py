@@ -20,7 +20,7 @@ from rl1.compiler.backend.driver import compile_text
 from rl1.vm import ilc, isa
 from rl1.vm.faults import FaultKind
 from rl1.vm.language import VARIABLES
-from rl1.vm.verifier import verify
+from rl1.vm.verifier import VerifyError, verify
 
 VECTOR_DIR = ROOT / "spec" / "vectors"
 sys.path.insert(0, str(VECTOR_DIR))
@@ -28,20 +28,23 @@ sys.path.insert(0, str(VECTOR_DIR))
 import cases  # noqa: E402  (spec/vectors is not a package: its modules need the path)
 import generate  # noqa: E402
 import oracle  # noqa: E402
+from files import all_file_cases  # noqa: E402
 from generate import Outcome, VectorError  # noqa: E402
 
 
-def _load() -> list[dict[str, Any]]:
+def _load(key: str) -> list[dict[str, Any]]:
+    """The runs ("vectors") or the verifier's files ("files") of every vector file."""
     vectors = []
     for path in sorted(VECTOR_DIR.glob("*.json")):
         document = json.loads(path.read_text(encoding="ascii"))
         assert document["format"] == generate.FORMAT, path
         assert document["group"] == path.stem, path
-        vectors += document["vectors"]
+        vectors += document.get(key, [])
     return vectors
 
 
-VECTORS = _load()
+VECTORS = _load("vectors")
+FILES = _load("files")
 BY_NAME = {vector["name"]: vector for vector in VECTORS}
 each_vector = pytest.mark.parametrize("vector", VECTORS, ids=[v["name"] for v in VECTORS])
 
@@ -50,7 +53,7 @@ def expected(vector: dict[str, Any], *, stripped: bool = False) -> Outcome:
     line = None if stripped or vector["status"] == "ok" else vector["fault_line"]
     return Outcome(vector["status"], line, tuple(vector["variables"]), tuple(
         (entry["time"], entry["call"], tuple(entry["args"]), tuple(entry["result"]))
-        for entry in vector["trace"]))
+        for entry in vector["trace"]), vector["executed"])
 
 
 def instructions(data: bytes) -> list[isa.Instruction]:
@@ -69,13 +72,25 @@ def test_the_readme_counts_the_vectors_of_each_file() -> None:
     readme = (VECTOR_DIR / "README.md").read_text(encoding="utf-8")
     listed = {name: int(count) for name, count
               in re.findall(r"^\| `(\w+)\.json` \| (\d+) \|", readme, re.MULTILINE)}
-    actual = {path.stem: len(json.loads(path.read_text(encoding="ascii"))["vectors"])
-              for path in VECTOR_DIR.glob("*.json")}
+    documents = {path.stem: json.loads(path.read_text(encoding="ascii"))
+                 for path in VECTOR_DIR.glob("*.json")}
+    actual = {stem: len(document.get("vectors", document.get("files")))
+              for stem, document in documents.items()}
     assert listed == actual
+
+
+def hand_written(vector: dict[str, Any]) -> bool:
+    """Whether the vector's source is intermediate code written by hand (.ils)."""
+    return bool(vector["source_name"].endswith(".ils"))
 
 
 @each_vector
 def test_the_compiler_writes_the_bytes(vector: dict[str, Any]) -> None:
+    if hand_written(vector):
+        case = cases.Case("ils", vector["name"], "", vector["source"], {}, language="ils")
+        full, stripped = generate.compile_both(case)
+        assert (full.hex(), stripped.hex()) == (vector["ilc"], vector["ilc_stripped"])
+        return
     for key, strip in (("ilc", False), ("ilc_stripped", True)):
         compilation = compile_text(vector["source"], vector["source_name"], strip_debug=strip)
         assert compilation.output is not None, compilation.diagnostics
@@ -100,6 +115,8 @@ def test_the_vm_on_the_bytes_gives_the_outcome(vector: dict[str, Any]) -> None:
 
 @each_vector
 def test_the_interpreter_on_the_source_gives_the_outcome(vector: dict[str, Any]) -> None:
+    if hand_written(vector) or not generate.interpretable(vector["sensors"]):
+        pytest.skip("intermediate code, or losses after instruction counts: VM only")
     outcome = generate.run_interpreter(vector["source"], vector["sensors"], vector["budget"])
     assert generate.difference(expected(vector), outcome) is None
 
@@ -112,7 +129,23 @@ def test_the_fields_are_consistent(vector: dict[str, Any]) -> None:
     assert len(vector["variables"]) == len(VARIABLES)
     assert all(-32768 <= value <= 32767 for value in vector["variables"])
     assert re.fullmatch("[a-z0-9-]+", vector["name"])
-    assert vector["source_name"] == vector["name"] + ".rob"
+    assert vector["source_name"] in (vector["name"] + ".rob", vector["name"] + ".ils")
+
+
+@pytest.mark.parametrize("vector", FILES, ids=[f["name"] for f in FILES])
+def test_the_verifier_does_what_each_file_vector_says(vector: dict[str, Any]) -> None:
+    data = bytes.fromhex(vector["ilc"])
+    if vector["accepted"]:
+        verify(data)
+        return
+    with pytest.raises(VerifyError) as refusal:
+        verify(data)
+    assert refusal.value.offset == vector["offset"]
+    assert re.search(generate.RULE_MESSAGES[vector["rule"]], refusal.value.message)
+
+
+def test_every_rule_of_the_verifier_has_a_file_vector() -> None:
+    assert {f["rule"] for f in FILES if not f["accepted"]} == set(generate.RULE_MESSAGES)
 
 
 # --- coverage --------------------------------------------------------------------------
@@ -204,7 +237,7 @@ def test_every_handler_is_taken_and_missed() -> None:
 
 
 def test_the_files_are_what_the_generator_writes() -> None:
-    files = generate.generate(cases.all_cases())
+    files = generate.generate(cases.all_cases(), all_file_cases())
     stale = generate.stale_files(files)
     assert stale == [], ("run `.venv/bin/python spec/vectors/generate.py` and review the "
                          f"diff: {stale}")

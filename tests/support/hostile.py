@@ -68,11 +68,13 @@ def _seed_ilc_files() -> list[bytes]:
     sample = (EXAMPLES / "sample.rob").read_text(encoding="utf-8")
     compiled = [compile_text(sample, "sample.rob", strip_debug=strip).output
                 for strip in (False, True)]
-    vectors = [bytes.fromhex(vector[key])
-               for group in sorted((ROOT / "spec" / "vectors").glob("*.json"))
-               for vector in json.loads(group.read_text(encoding="utf-8"))["vectors"]
-               for key in ("ilc", "ilc_stripped")]
-    return [data for data in compiled if data is not None] + vectors
+    documents = [json.loads(group.read_text(encoding="utf-8"))
+                 for group in sorted((ROOT / "spec" / "vectors").glob("*.json"))]
+    vectors = [bytes.fromhex(vector[key]) for document in documents
+               for vector in document.get("vectors", []) for key in ("ilc", "ilc_stripped")]
+    verifier_files = [bytes.fromhex(file["ilc"]) for document in documents
+                      for file in document.get("files", [])]
+    return [data for data in compiled if data is not None] + vectors + verifier_files
 
 
 SEED_ILC_FILES = _seed_ilc_files()

@@ -1,0 +1,137 @@
+/* rl1_hardware.h: the RL/I VM's hardware interface and step call, for C firmware.
+ *
+ * Normative: spec/ilc.md, section 12, says what each declaration means; this header is
+ * its exact C shape, and vm/hardware.py and vm/machine.py are the Python reference.
+ * C99; no allocation; nothing here blocks.
+ */
+#ifndef RL1_HARDWARE_H
+#define RL1_HARDWARE_H
+
+#include <stdint.h>
+
+/* ---- What every callback answers --------------------------------------------------- */
+
+typedef enum {
+    RL1_OK = 0,    /* done (a poll or a call: `out` holds what a sensing built-in read) */
+    RL1_BUSY = 1,  /* only from poll: the built-in is still taking device time */
+    RL1_ERROR = 2  /* the device failed or refused: a device-error fault */
+} rl1_status;
+
+/* What a built-in gives back when it is done. The VM reads only the fields the form
+ * has (spec/ilc.md 8.3: "writes", and "R = result"), and checks each against its
+ * documented range before writing anything (12.5). */
+typedef struct {
+    int16_t result;     /* R: KYO centre, IMG area, CAM R position, ULT distance, INP data */
+    int16_t writes[4];  /* the reserved variables in the order of the "writes" column:
+                           KYO u v; IMG w x y z; FZI s t */
+} rl1_reading;
+
+/* The vehicle. One dispatch per kind of callback; the built-in is named by its opcode
+ * (0x40..0x5D, spec/ilc.md 8.3: one opcode per form, CAM and ULT selectors included),
+ * `args` holds its arguments in parameter order, already range-checked (as many as the
+ * form's arity; NULL when it has none). */
+typedef struct {
+    void *ctx;  /* handed to every callback */
+    /* A program is about to run its first instruction (12.3). */
+    rl1_status (*begin)(void *ctx);
+    /* A built-in that takes no device time: FRE HLD MOV TRC KYC KYO SCN LMP INP OUT FZO
+     * FZI. Answers RL1_OK (with `out` filled for KYO, INP, FZI) or RL1_ERROR. */
+    rl1_status (*call)(void *ctx, uint8_t opcode, const int16_t *args, rl1_reading *out);
+    /* A built-in that takes device time: ORG MVI STR STL STX ROT TIM IMG CAM* ULT*.
+     * Answers RL1_OK (started) or RL1_ERROR; never RL1_BUSY. */
+    rl1_status (*start)(void *ctx, uint8_t opcode, const int16_t *args);
+    /* The started built-in: RL1_BUSY, RL1_OK (with `out` filled for IMG, CAM R, ULT) or
+     * RL1_ERROR. A TIM or MVI during which the device posted a lost line answers RL1_OK
+     * at its next poll (12.4). */
+    rl1_status (*poll)(void *ctx, rl1_reading *out);
+    /* Stop the vehicle now: a fault (12.5). */
+    rl1_status (*stop)(void *ctx);
+    /* The program is over: after (END), or after a fault and its stop (12.3). */
+    rl1_status (*end)(void *ctx);
+} rl1_hardware;
+
+/* ---- Lost lines: a one-slot mailbox, written from an interrupt ----------------------- */
+
+/* Single producer (the device, from an interrupt or a task), single consumer (the VM).
+ * Only the device writes `event` and `posted`, only the VM writes `taken`; every field is
+ * one byte, so each read and write is atomic on any microcontroller. On a multi-core or
+ * out-of-order processor, add a release barrier between the two writes of
+ * rl1_post_line_lost and an acquire barrier after its first read in rl1_take_line_lost. */
+typedef struct {
+    volatile uint8_t event;   /* RL1_EVENT(mode, command), valid while posted != taken */
+    volatile uint8_t posted;  /* counts posts, modulo 256 */
+    volatile uint8_t taken;   /* counts takes, modulo 256 */
+} rl1_mailbox;
+
+#define RL1_MOV 0
+#define RL1_MVI 1
+#define RL1_EVENT(mode, command) ((uint8_t)(((mode) << 1) | (command)))  /* mode 2 or 3 */
+#define RL1_EVENT_MODE(event) ((uint8_t)((event) >> 1))
+#define RL1_EVENT_COMMAND(event) ((uint8_t)((event) & 1))
+
+/* The device posts a line lost in tracing mode 2 or 3 while `command` was the motion in
+ * effect (modes 0 and 1 are the device's alone: nothing is posted). Returns 1 when
+ * posted, 0 when an event is already pending: that loss is dropped, not queued. */
+static inline int rl1_post_line_lost(rl1_mailbox *box, uint8_t mode, uint8_t command) {
+    if (box->posted != box->taken) return 0;
+    box->event = RL1_EVENT(mode, command);
+    box->posted = (uint8_t)(box->posted + 1);
+    return 1;
+}
+
+/* The VM takes the pending event, if any: 1 and *event set, or 0. */
+static inline int rl1_take_line_lost(rl1_mailbox *box, uint8_t *event) {
+    uint8_t posted = box->posted;
+    if (posted == box->taken) return 0;
+    *event = box->event;
+    box->taken = posted;
+    return 1;
+}
+
+/* ---- The VM's state and its step call ------------------------------------------------ */
+
+typedef enum {
+    RL1_RUNNING = 0,  /* the step ran its n instructions: step again */
+    RL1_WAITING = 1,  /* a built-in is taking device time: step again to poll it */
+    RL1_ENDED = 2,    /* (END), or past the last instruction */
+    RL1_FAULTED = 3   /* `fault` and `fault_pc` say what and where */
+} rl1_state;
+
+typedef enum {  /* the values are rl1c run's exit statuses */
+    RL1_FAULT_NONE = 0,
+    RL1_FAULT_ARGUMENT_RANGE = 10,
+    RL1_FAULT_MISSING_HANDLER = 11,
+    RL1_FAULT_BUDGET = 12,
+    RL1_FAULT_DEVICE = 13
+} rl1_fault;
+
+/* Everything a run needs to resume, and nothing else (about 140 bytes). Zero it, set
+ * the program, the budget and the hardware, then step. */
+typedef struct {
+    /* the verified program (spec/ilc.md 10), read only */
+    const uint8_t *code;
+    uint16_t code_size;
+    uint16_t handlers[4];       /* :96..:99, 0xFFFF absent */
+    uint32_t budget;            /* 1 .. 2^31 - 1 (12.6) */
+    const rl1_hardware *hw;
+    rl1_mailbox mailbox;        /* the device posts here */
+    /* the machine (spec/ilc.md 8.1) */
+    int16_t V[53];
+    int16_t acc;
+    int16_t R;
+    uint16_t pc;                /* code offset of the next instruction */
+    uint32_t executed;          /* instructions run, the one that faulted included */
+    /* the run */
+    uint8_t begun;              /* begin() has been called */
+    uint8_t waiting;            /* opcode of the call in progress, 0 for none */
+    rl1_state state;
+    rl1_fault fault;
+    uint16_t fault_pc;          /* code offset of the faulting instruction; 0xFFFF: before the first */
+    uint8_t stop_failed;        /* the stop after the fault answered RL1_ERROR */
+} rl1_vm;
+
+/* Run at most n instructions (n = 0: only poll a call in progress) and say where the
+ * run stands. Once RL1_ENDED or RL1_FAULTED, a step does nothing and says so again. */
+rl1_state rl1_step(rl1_vm *vm, uint32_t n);
+
+#endif /* RL1_HARDWARE_H */

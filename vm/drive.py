@@ -1,0 +1,27 @@
+"""Running a program on the scripted device, with the losses its script times by
+instruction count: what `rl1c run` and the test vectors do.
+
+The scripted device's clock moves only inside calls, so a loss "after instruction N"
+(scripted.LossAfter) is the stepper's to make: it steps the VM to exactly N instructions
+and loses the line there, between two instructions, as a vehicle's device posts a loss
+from an interrupt (spec/ilc.md, section 12.4).
+"""
+
+from __future__ import annotations
+
+from .faults import RunResult
+from .machine import Machine, State
+from .scripted import ScriptedDevice
+
+_GOING = (State.RUNNING, State.WAITING)
+
+
+def drive(machine: Machine, device: ScriptedDevice) -> RunResult:
+    """Run `machine`, whose hardware is `device`, to its end."""
+    for count in device.script.instruction_losses:
+        while machine.executed < count and machine.step(count - machine.executed) in _GOING:
+            pass
+        if machine.state not in _GOING:
+            break
+        device.lose_line()
+    return machine.run()
