@@ -7,7 +7,8 @@ from collections.abc import Sequence
 
 from lsprotocol import types
 
-from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix
+from rl1.compiler.frontend.diagnostics import Diagnostic, Fix
+from rl1.compiler.frontend.edits import compatible
 
 from .checking import to_lsp
 from .document import Document
@@ -57,16 +58,6 @@ def code_actions(document: Document, diagnostics: list[Diagnostic], requested: t
 def _fix_all(diagnostics: list[Diagnostic]) -> Fix:
     """The only fix of each diagnostic that has exactly one, skipping any whose edits
     overlap an earlier one's (an editor cannot apply overlapping edits)."""
-    taken: list[tuple[tuple[int, int], tuple[int, int]]] = []
-    edits: list[Edit] = []
-    for diagnostic in diagnostics:
-        if len(diagnostic.fixes) != 1:
-            continue
-        fix = diagnostic.fixes[0]
-        spans = [((e.span.line, e.span.column), (e.span.end_line, e.span.end_column))
-                 for e in fix.edits]
-        if any((s < te and ts < e) or s == ts for s, e in spans for ts, te in taken):
-            continue
-        taken += spans
-        edits += fix.edits
-    return Fix("Apply every fix the checker suggests", tuple(edits))
+    fixes = compatible(d.fixes[0] for d in diagnostics if len(d.fixes) == 1)
+    return Fix("Apply every fix the checker suggests",
+               tuple(edit for fix in fixes for edit in fix.edits))

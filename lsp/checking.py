@@ -53,15 +53,17 @@ class Checked:
 
 def diagnose(document: Document) -> Checked:
     """Every diagnostic of the document, as `rl1c check` reports them: each line's own
-    (cached), then the whole program's rules."""
+    (cached), then the whole program's rules, less what its comments allow."""
     found = document.problems()
     failed = False
+    program = document.program()
     try:
         with collector_paused():
-            found.extend(checker.check_program(document.program(), document.memo))
+            found.extend(checker.check_program(program, document.memo))
     except Exception:  # a checker bug must not cost the user the syntax errors
         log.exception("the whole-program checker failed on %s", document.uri)
         failed = True
+    found = checker.apply_suppressions(program, found)
     found.sort(key=sort_key)
     return Checked(document.version, found, failed)
 

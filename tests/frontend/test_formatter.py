@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from support import SAMPLE, TEST_DATA
 from support.cli import Result, rl1c
 
-from rl1.compiler import formatter
+from rl1.compiler.cli import streams
 from rl1.compiler.formatter import format_line, format_lines, format_text
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.parser import parse_program
@@ -248,7 +248,7 @@ def test_fmt_check_lists_what_would_change_and_changes_nothing(tmp_path: Path) -
 def test_fmt_diff_prints_a_unified_diff_and_changes_nothing(tmp_path: Path) -> None:
     messy = write(tmp_path, b"'ok\nA = 1\n")
     result = run("--diff", str(messy))
-    assert result.exit_code == 0
+    assert result.exit_code == 1  # as `ruff format --diff`: a change to make is a failure
     assert "-A = 1\n+A=1\n" in result.stdout
     assert result.stdout.startswith(f"--- {messy}\n+++ {messy} (formatted)\n")
     assert messy.read_bytes() == b"'ok\nA = 1\n"
@@ -295,7 +295,7 @@ def test_fmt_reports_a_file_it_cannot_write(tmp_path: Path,
     def disk_full(path: object, data: bytes, *, force: bool = False) -> None:
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    monkeypatch.setattr(formatter, "write_atomically", disk_full)
+    monkeypatch.setattr(streams, "write_atomically", disk_full)
     messy = write(tmp_path, b"A = 1\n")
     result = run(str(messy))
     assert result.exit_code == 2
