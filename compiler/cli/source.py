@@ -84,8 +84,8 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
         for item in source_files(files, "check"):
             inputs.append((item, given.over(project(item)) if isinstance(item, str) else given))
     except ProjectFileError as error:
-        raise Failure(f"error: {error}\n  = help: correct the file (its form is in "
-                      "README.md, section `rl1c check`), or move it aside") from None
+        raise Failure(f"error: {error}\n  = help: correct the file (README.md, \"Controlling "
+                      "`rl1c check`\", shows its form), or move it aside") from None
     if diff:
         return _fix_diff(inputs)
     checked: list[FileDiagnostics] = []
