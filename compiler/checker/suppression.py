@@ -8,6 +8,7 @@ reported (W0107), so that a misspelt code or a stale comment does not linger uns
 
 from __future__ import annotations
 
+import functools
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -15,15 +16,21 @@ from dataclasses import dataclass
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 
-# The catalogue is the reporting layer's; the checker knows a code's severity from its
-# letter, which catalogue.py's tests hold to every code.
-_CODE = re.compile(r"[EW][0-9]{4}")
-_DIRECTIVE = re.compile(r"(?:^|(?<=\s))rl1:[ \t]*(?P<kind>[\w-]*)(?P<codes>.*)")
-_CODE_SHAPED = re.compile(r"[ \t,]*(?P<word>[A-Za-z][0-9]+)(?![\w-])")
 MARK = "rl1:"
 """What a comment holds when it may be a directive: the quick test of every comment."""
 
 KINDS = ("allow", "allow-file")
+
+
+@functools.cache
+def _patterns() -> tuple[re.Pattern[str], re.Pattern[str], re.Pattern[str]]:
+    """The directive, a word shaped as a code, and a code; compiled when a comment first
+    holds `rl1:` (most programs have none, and every start of rl1c would pay)."""
+    return (re.compile(r"(?:^|(?<=\s))rl1:[ \t]*(?P<kind>[\w-]*)(?P<codes>.*)"),
+            re.compile(r"[ \t,]*(?P<word>[A-Za-z][0-9]+)(?![\w-])"),
+            # The catalogue is the reporting layer's; the checker knows a code's severity
+            # from its letter, which the catalogue's tests hold to every code.
+            re.compile(r"[EW][0-9]{4}"))
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -81,7 +88,8 @@ def _directives(program: ast.Program) -> tuple[list[Directive], list[Diagnostic]
         comment = line.comment
         if comment is None or MARK not in comment.text:
             continue
-        match = _DIRECTIVE.search(comment.text)
+        directive, code_shaped, _ = _patterns()
+        match = directive.search(comment.text)
         if match is None:
             continue
         whole = _span(comment, match.start(), match.end("kind"))
@@ -93,7 +101,7 @@ def _directives(program: ast.Program) -> tuple[list[Directive], list[Diagnostic]
             continue
         codes: list[tuple[str, ast.Span]] = []
         position = match.start("codes")
-        while shaped := _CODE_SHAPED.match(comment.text, position):
+        while shaped := code_shaped.match(comment.text, position):
             word, position = shaped["word"], shaped.end()
             code_span = _span(comment, shaped.start("word"), shaped.end("word"))
             problem = _code_problem(word.upper())
@@ -117,7 +125,7 @@ def _span(comment: ast.Comment, first: int, last: int) -> ast.Span:
 
 
 def _code_problem(code: str) -> str | None:
-    if not _CODE.fullmatch(code):
+    if not _patterns()[2].fullmatch(code):
         return f"`{code}` is not a diagnostic code (`rl1c explain --list` lists them)"
     if code.startswith("E"):
         return f"`{code}` is an error, and errors cannot be allowed: fix the program"

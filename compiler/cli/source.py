@@ -76,6 +76,9 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
     from rl1.compiler.reporting.project import ProjectFileError, project_selection
     from rl1.compiler.reporting.selection import Selection
 
+    if fix and not diff and "-" in files:
+        raise click.UsageError("--fix rewrites files, and standard input is none: give the "
+                               "file, or --diff to see the fixes")
     given = Selection(_codes("--select", select), _codes("--ignore", ignore),
                       warnings_as_errors)
     project = project_selection()

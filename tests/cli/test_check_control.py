@@ -227,9 +227,15 @@ def test_diff_shows_what_fix_would_change_and_changes_nothing(tmp_path: Path) ->
     assert (nothing.exit_code, nothing.stdout) == (0, "")
 
 
-def test_fix_reads_standard_input_and_changes_no_file() -> None:
+def test_diff_reads_standard_input_and_fix_refuses_it(tmp_path: Path,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
     result = check("--diff", "-", stdin=MOVING.encode())
     assert result.exit_code == 1 and "+(MOV 0,0); (END)" in result.stdout
+    refused = check("--fix", "-", stdin=MOVING.encode())
+    assert refused.exit_code == 2
+    assert "--fix rewrites files, and standard input is none" in refused.stderr
+    assert list(tmp_path.iterdir()) == []
 
 
 # rl1.toml --------------------------------------------------------------------------------
