@@ -54,7 +54,7 @@ def read_input(name: str) -> Source | FileDiagnostics:
 def source_files(names: Sequence[str], command: str) -> list[str | FileDiagnostics]:
     """The files `names` name: each file as given, and for a folder every `.rob` file
     below it (the extension in any case) in sorted order, leaving out hidden files and
-    folders (`.git`) and not following links to folders. A folder that cannot be listed
+    folders (`.git`), what is no regular file, and links to folders. A folder that cannot be listed
     is an E0100 report; one without a `.rob` file is said on standard error."""
     found: list[str | FileDiagnostics] = []
     for name in names:
@@ -65,8 +65,11 @@ def source_files(names: Sequence[str], command: str) -> list[str | FileDiagnosti
         unlisted: list[OSError] = []
         for folder, folders, files in os.walk(name, onerror=unlisted.append):
             folders[:] = sorted(f for f in folders if not f.startswith("."))
-            found += [os.path.join(folder, file) for file in sorted(files)
-                      if file.lower().endswith(SOURCE_SUFFIX) and not file.startswith(".")]
+            # Regular files only: reading a FIFO named x.rob would wait for ever.
+            found += [path for path in (os.path.join(folder, file) for file in sorted(files)
+                                        if file.lower().endswith(SOURCE_SUFFIX)
+                                        and not file.startswith("."))
+                      if os.path.isfile(path)]
         for error in unlisted:
             folder = str(error.filename or name)
             found.append(unreadable(folder, f"{folder}: cannot list this folder "

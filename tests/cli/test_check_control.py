@@ -89,9 +89,10 @@ def test_a_folder_checks_every_rob_file_below_it_in_order(tmp_path: Path) -> Non
     assert check(tmp_path).stdout.endswith("\n2 files checked: 1 error, 3 warnings\n")
 
 
-def test_a_link_to_a_folder_is_not_followed(tmp_path: Path) -> None:
+def test_a_link_to_a_folder_and_a_fifo_are_left_out(tmp_path: Path) -> None:
     write(tmp_path, "real/a.rob", CLEAN)
     (tmp_path / "real" / "loop").symlink_to(tmp_path / "real")
+    os.mkfifo(tmp_path / "real" / "pipe.rob")  # reading it would wait for a writer
     result = check(tmp_path / "real")
     assert result.stdout == "1 file checked: 0 errors, 0 warnings\n"
 
