@@ -102,15 +102,16 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
         text, diagnostics = source.text, None
         if fix:
             fixing = analysis.fix(source.text, keep=selection.reports)
-            if fixing.fixes:
-                try:
+            text, diagnostics = fixing.text, fixing.analysis.diagnostics
+            try:
+                if fixing.fixes:
                     write_back(source, fixing.text, force=force)
-                    text, diagnostics = fixing.text, fixing.analysis.diagnostics
                     fixed += fixing.fixes
-                except OSError as error:
-                    print(f"error: cannot write the fixes to `{source.name}`: "
-                          f"{error.strerror or error}", file=sys.stderr)
-                    status = EXIT_USAGE
+            except OSError as error:
+                print(f"error: cannot write the fixes to `{source.name}`: "
+                      f"{error.strerror or error}", file=sys.stderr)
+                status = EXIT_USAGE
+                text, diagnostics = source.text, None  # the file is as it was
         if diagnostics is None:
             diagnostics = analysis.analyze(text).diagnostics
         checked.append(FileDiagnostics(source.name, text, selection.apply(diagnostics)))
