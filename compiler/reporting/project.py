@@ -56,6 +56,8 @@ def load_project_file(path: str) -> Selection:
                                "UTF-8") from None
     except tomllib.TOMLDecodeError as error:
         raise ProjectFileError(f"{path}: not valid TOML: {error}") from None
+    except RecursionError:  # tomllib reads nested arrays recursively
+        raise ProjectFileError(f"{path}: arrays or tables nested too deeply to read") from None
     unknown = sorted(set(document) - {TABLE})
     if unknown:
         raise ProjectFileError(f"{path}: unknown table or key `{unknown[0]}`: rl1.toml has "

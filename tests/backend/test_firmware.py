@@ -118,6 +118,13 @@ def test_intel_hex_reads_back_as_the_same_bytes_at_the_base_address(data: bytes,
     assert hex_file.tobinstr(start=base, size=len(data)) == data
 
 
+@settings(deadline=None)
+@given(checked_programs(), st.integers(0, ADDRESS_SPACE - 0x10000))
+def test_a_compiled_program_reads_back_from_intel_hex(source: str, base: int) -> None:
+    data = ilc_of(source)
+    assert read_hex(intel_hex(data, base)).tobinstr(start=base, size=len(data)) == data
+
+
 def test_records_never_cross_a_64k_segment_and_the_file_ends_with_eof() -> None:
     text = intel_hex(bytes(range(40)), 0xFFF8)
     # Without the checksums, which the reader checks.

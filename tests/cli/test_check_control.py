@@ -279,6 +279,7 @@ def test_standard_input_takes_the_working_directorys_project_file(
     ('[check]\nignore = ["E0101"]\n', "`ignore` in `[check]`: `E0101` names only errors"),
     ("[check]\nwarnings-as-errors = 1\n", "must be true or false"),
     (b"[check]\n# \xff\n", "not UTF-8 text"),
+    ("x = " + "[" * 100_000 + "]" * 100_000 + "\n", "nested too deeply"),
 ])
 def test_a_bad_project_file_stops_the_check_with_where_and_why(
     tmp_path: Path, content: str | bytes, says: str,
