@@ -68,7 +68,7 @@ def diagnose(document: Document, projects: ProjectFiles | None = None) -> Checke
     except Exception:  # a checker bug must not cost the user the syntax errors
         log.exception("the whole-program checker failed on %s", document.uri)
         failed = True
-    found = checker.apply_suppressions(program, found)
+    found = checker.apply_suppressions(program, found, complete=not failed)
     selection = projects.selection(document.uri) if projects is not None else Selection()
     problem = None
     if isinstance(selection, ProjectFileError):

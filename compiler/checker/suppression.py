@@ -47,10 +47,11 @@ class Directive:
         return self.span.line
 
 
-def apply_suppressions(program: ast.Program,
-                       diagnostics: Iterable[Diagnostic]) -> list[Diagnostic]:
+def apply_suppressions(program: ast.Program, diagnostics: Iterable[Diagnostic], *,
+                       complete: bool = True) -> list[Diagnostic]:
     """`diagnostics` without the warnings that the program's comments allow, with a
-    W0107 for each directive, or code in one, that allows nothing."""
+    W0107 for each directive, or code in one, that allows nothing. When `diagnostics`
+    are not `complete` (a rule failed), a code they lack is not said to be unused."""
     diagnostics = list(diagnostics)
     directives, problems = _directives(program)
     if not directives and not problems:
@@ -72,7 +73,7 @@ def apply_suppressions(program: ast.Program,
             used.add((None, code))
         else:
             kept.append(diagnostic)
-    for directive in directives:
+    for directive in directives if complete else ():
         scope = None if directive.file_wide else directive.line
         for code, span in directive.codes:
             if (scope, code) not in used:
