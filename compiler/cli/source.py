@@ -60,10 +60,11 @@ SECTION = "RL/I programs"
 @click.option("--diff", is_flag=True,
               help="change nothing; print what --fix would change as a unified diff (exit "
                    "status 1 when it would change a file)")
+@click.option("--isolated", is_flag=True, help="read no rl1.toml: only the options given here")
 @force_option
 def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
           select: tuple[str, ...], ignore: tuple[str, ...], warnings_as_errors: bool | None,
-          fix: bool, diff: bool, force: bool) -> int:
+          fix: bool, diff: bool, isolated: bool, force: bool) -> int:
     """Check RL/I programs and report every problem found.
 
     PATH is an RL/I program, or a folder: every .rob file below it is checked; `-` reads
@@ -85,7 +86,10 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
     inputs: list[tuple[str | FileDiagnostics, Selection]] = []
     try:  # every rl1.toml is read before any file is checked: a bad one stops it all
         for item in source_files(files, "check"):
-            inputs.append((item, given.over(project(item)) if isinstance(item, str) else given))
+            selection = given
+            if isinstance(item, str) and not isolated:
+                selection = given.over(project(item))
+            inputs.append((item, selection))
     except ProjectFileError as error:
         raise Failure(f"error: {error}\n  = help: correct the file (README.md, \"Controlling "
                       "`rl1c check`\", shows its form), or move it aside") from None

@@ -262,6 +262,15 @@ def test_options_given_win_over_the_project_file(tmp_path: Path) -> None:
         ("W0701", "warning")]
 
 
+def test_isolated_reads_no_project_file(tmp_path: Path) -> None:
+    write(tmp_path, "rl1.toml", "[check\n")  # broken, and not even read
+    program = write(tmp_path, "a.rob", MOVING)
+    assert check(program).exit_code == 2
+    result = check("--isolated", "--format", "json", "--ignore", "W0603", program)
+    assert result.exit_code == 0
+    assert [code for _, code in codes_in(result)] == ["W0701"]
+
+
 def test_standard_input_takes_the_working_directorys_project_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
 ) -> None:
