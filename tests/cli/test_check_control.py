@@ -10,10 +10,14 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 from support import TEST_DATA
 from support.cli import Result, rl1c
 
-from rl1.compiler.analysis import analyze
+from rl1.compiler.analysis import analyze, fix
+from rl1.compiler.frontend.source import decode
+from rl1.compiler.strategies import programs
 
 # W0603 (no END) and W0701 (runs off its end moving), both on line 1, both with fixes.
 MOVING = "(MOV 3,3)\n"
@@ -195,6 +199,25 @@ def test_fix_keeps_a_cp932_file_in_cp932_and_a_byte_order_mark(tmp_path: Path) -
     assert check("--fix", "--select", "W05", cp932, bom).exit_code == 0
     assert cp932.read_bytes() == legacy.replace(b"(mov 3,3)", b"(MOV 3,3)")
     assert bom.read_bytes() == b"\xef\xbb\xbf(MOV 0,0) ' \xe3\x81\x82\n(END)\n"
+
+
+@settings(max_examples=60, deadline=None)
+@given(programs(), st.sampled_from(["utf-8", "utf-8-sig", "cp932"]))
+def test_fix_writes_what_fix_makes_in_the_files_own_encoding(
+    tmp_path_factory: pytest.TempPathFactory, text: str, encoding: str,
+) -> None:
+    try:
+        data = text.encode(encoding)
+    except UnicodeEncodeError:
+        assume(False)
+    before = decode(data)
+    path = tmp_path_factory.getbasetemp() / "fixed.rob"
+    path.write_bytes(data)
+    result = check("--fix", "--format", "json", path)
+    assert result.exit_code in (0, 1), result.output
+    after = decode(path.read_bytes())
+    assert after.text == fix(before.text).text
+    assert (after.encoding, after.bom) == (before.encoding, before.bom)
 
 
 def test_fix_makes_only_the_fixes_of_selected_warnings(tmp_path: Path) -> None:
