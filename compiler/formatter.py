@@ -8,15 +8,10 @@ range formatting (`format_lines`) and the whole-document form (`format_text`) ag
 
 from __future__ import annotations
 
-import difflib
-
-from .files import write_atomically
 from .frontend import ast
 from .frontend.diagnostics import Edit
 from .frontend.parser import parse_line
-from .frontend.source import LINE_BREAK, Source, split_lines
-
-_UTF8_BOM = b"\xef\xbb\xbf"
+from .frontend.source import LINE_BREAK, split_lines
 
 
 def format_line(text: str) -> str:
@@ -102,31 +97,3 @@ def _call(call: ast.Call) -> str:
         else:
             text += "," + written
     return text + ")"
-
-
-# Files -----------------------------------------------------------------------------------
-
-
-def unified_diff(name: str, before: str, after: str) -> str:
-    """What formatting changes, as a unified diff (line ends shown as LF)."""
-    return "".join(difflib.unified_diff(
-        [line + "\n" for line in split_lines(before)],
-        [line + "\n" for line in split_lines(after)],
-        fromfile=name, tofile=f"{name} (formatted)",
-    ))
-
-
-def encode_like(source: Source, text: str, *, bom: bool) -> bytes:
-    """`text` in the encoding `source` was read in. Formatting keeps every non-ASCII
-    character of the source (they are all in comments), so a CP932 source's characters
-    all have a CP932 encoding."""
-    return (_UTF8_BOM if bom else b"") + text.encode(source.encoding)
-
-
-def rewrite(source: Source, text: str, *, force: bool = False) -> None:
-    """Replace the file `source` was read from with `text`, in the file's own encoding
-    (keeping a UTF-8 byte-order mark), as files.write_atomically does (a read-only file
-    only with `force`). OSError if that cannot be done."""
-    with open(source.name, "rb") as original:
-        bom = original.read(len(_UTF8_BOM)) == _UTF8_BOM
-    write_atomically(source.name, encode_like(source, text, bom=bom), force=force)

@@ -1,5 +1,5 @@
-"""Code actions: the checker's fixes as quick fixes, and all of them at once as
-`source.fixAll`."""
+"""Code actions: the checker's fixes as quick fixes, a comment that allows a warning on
+its line, and all the fixes at once as `source.fixAll`."""
 
 from __future__ import annotations
 
@@ -7,7 +7,10 @@ from collections.abc import Sequence
 
 from lsprotocol import types
 
-from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix
+from rl1.compiler.checker.suppression import MARK
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Severity
+from rl1.compiler.frontend.edits import compatible
 
 from .checking import to_lsp
 from .document import Document
@@ -45,6 +48,12 @@ def code_actions(document: Document, diagnostics: list[Diagnostic], requested: t
                     edit=_edit(document, fix, columns),
                     is_preferred=len(diagnostic.fixes) == 1,
                 ))
+            allow = _allow(document, diagnostic)
+            if allow is not None:
+                actions.append(types.CodeAction(
+                    title=allow.title, kind=types.CodeActionKind.QuickFix,
+                    diagnostics=[to_lsp(diagnostic, document, columns)],
+                    edit=_edit(document, allow, columns)))
     if only is None or any(types.CodeActionKind.SourceFixAll.startswith(kind) for kind in only):
         fix_all = _fix_all(diagnostics)
         if fix_all.edits:
@@ -54,19 +63,26 @@ def code_actions(document: Document, diagnostics: list[Diagnostic], requested: t
     return actions
 
 
+def _allow(document: Document, diagnostic: Diagnostic) -> Fix | None:
+    """A comment that allows a warning on its line (spec/language.md, 2.5), when the
+    line has no directive yet (only a comment's first one counts)."""
+    number = diagnostic.span.line
+    if diagnostic.severity is not Severity.WARNING or diagnostic.code == "W0107" \
+            or not 1 <= number <= document.line_count:
+        return None
+    comment = document.line(number).comment
+    if comment is not None and MARK in comment.text:
+        return None
+    end = len(document.line_text(number)) + 1
+    lead = " " if comment is not None else " ' "  # into the comment, or a new one
+    return Fix(f"Allow {diagnostic.code} on this line (a `rl1: allow` comment)",
+               (Edit(ast.Span(number, end, number, end),
+                     f"{lead}rl1: allow {diagnostic.code}"),))
+
+
 def _fix_all(diagnostics: list[Diagnostic]) -> Fix:
     """The only fix of each diagnostic that has exactly one, skipping any whose edits
     overlap an earlier one's (an editor cannot apply overlapping edits)."""
-    taken: list[tuple[tuple[int, int], tuple[int, int]]] = []
-    edits: list[Edit] = []
-    for diagnostic in diagnostics:
-        if len(diagnostic.fixes) != 1:
-            continue
-        fix = diagnostic.fixes[0]
-        spans = [((e.span.line, e.span.column), (e.span.end_line, e.span.end_column))
-                 for e in fix.edits]
-        if any((s < te and ts < e) or s == ts for s, e in spans for ts, te in taken):
-            continue
-        taken += spans
-        edits += fix.edits
-    return Fix("Apply every fix the checker suggests", tuple(edits))
+    fixes = compatible(d.fixes[0] for d in diagnostics if len(d.fixes) == 1)
+    return Fix("Apply every fix the checker suggests",
+               tuple(edit for fix in fixes for edit in fix.edits))

@@ -24,9 +24,12 @@ from rl1.compiler import checker
 from rl1.compiler.frontend.collector import collector_paused
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity, sort_key
 from rl1.compiler.reporting import catalogue
+from rl1.compiler.reporting.project import ProjectFileError
+from rl1.compiler.reporting.selection import Selection
 
 from .document import MAX_ANALYSED_CHARACTERS, MAX_ANALYSED_LINE, Document
 from .positions import Columns
+from .project import ProjectFiles
 
 log = logging.getLogger(__name__)
 
@@ -49,21 +52,30 @@ class Checked:
     version: int
     diagnostics: list[Diagnostic]
     checker_failed: bool = False  # the whole-program rules crashed (logged)
+    project_error: str | None = None  # why the rl1.toml that applies cannot be used
 
 
-def diagnose(document: Document) -> Checked:
+def diagnose(document: Document, projects: ProjectFiles | None = None) -> Checked:
     """Every diagnostic of the document, as `rl1c check` reports them: each line's own
-    (cached), then the whole program's rules."""
+    (cached), then the whole program's rules, less what its comments allow, as the
+    nearest rl1.toml selects them."""
     found = document.problems()
     failed = False
+    program = document.program()
     try:
         with collector_paused():
-            found.extend(checker.check_program(document.program(), document.memo))
+            found.extend(checker.check_program(program, document.memo))
     except Exception:  # a checker bug must not cost the user the syntax errors
         log.exception("the whole-program checker failed on %s", document.uri)
         failed = True
+    found = checker.apply_suppressions(program, found, complete=not failed)
+    selection = projects.selection(document.uri) if projects is not None else Selection()
+    problem = None
+    if isinstance(selection, ProjectFileError):
+        problem, selection = str(selection), Selection()
+    found = selection.apply(found)
     found.sort(key=sort_key)
-    return Checked(document.version, found, failed)
+    return Checked(document.version, found, failed, problem)
 
 
 @cache
@@ -115,6 +127,11 @@ def too_large_notice(document: Document) -> types.Diagnostic:
                   "Check it with `rl1c check FILE`.")
 
 
+def project_notice(problem: str) -> types.Diagnostic:
+    return notice(f"rl1-lsp: {problem}. Until it is corrected, every diagnostic is shown "
+                  "as if there were no rl1.toml.")
+
+
 CHECKER_FAILED = notice(
     "rl1-lsp: the whole-program checker failed on this document (an internal error, "
     "logged on the server's standard error), so only syntax and per-line problems are "
@@ -142,6 +159,7 @@ class DiagnosticsScheduler:
         self._results: dict[str, Checked] = {}
         self._last_change: dict[str, float] = {}
         self._waiting: dict[str, Document] = {}  # checks that have not started yet
+        self._projects = ProjectFiles()
 
     def schedule(self, document: Document) -> None:
         """Check the document's current version soon. A change that joins a burst
@@ -182,7 +200,7 @@ class DiagnosticsScheduler:
     def _checked(self, document: Document) -> Checked:
         checked = self._results.get(document.uri)
         if checked is None or checked.version != document.version:
-            checked = diagnose(document)
+            checked = diagnose(document, self._projects)
             self._results[document.uri] = checked
         return checked
 
@@ -205,6 +223,8 @@ class DiagnosticsScheduler:
         columns = self._columns()
         checked = self._checked(document)
         found = [to_lsp(d, document, columns) for d in checked.diagnostics]
+        if checked.project_error is not None:
+            found.insert(0, project_notice(checked.project_error))
         self._send(document, version, [CHECKER_FAILED, *found] if checked.checker_failed else found)
 
     def _send(self, document: Document, version: int, diagnostics: list[types.Diagnostic]) -> None:

@@ -1,5 +1,7 @@
 """The static checker: the per-line rules (lines.py), then the whole-program rules over
-the control-flow graph (graph.py, built by cfg.py) and the data-flow analyses on it."""
+the control-flow graph (graph.py, built by cfg.py) and the data-flow analyses on it;
+`apply_suppressions` (suppression.py) then drops the warnings the program's comments
+allow."""
 
 from __future__ import annotations
 
@@ -17,8 +19,10 @@ from .loops import check_loops
 from .reachability import check_reachability
 from .reserved import check_reserved
 from .safety import check_safety
+from .suppression import apply_suppressions
 
-__all__ = ["ControlFlowGraph", "LineMemo", "build_cfg", "check", "check_line", "check_program"]
+__all__ = ["ControlFlowGraph", "LineMemo", "apply_suppressions", "build_cfg", "check",
+           "check_line", "check_program"]
 
 
 def check(program: Program) -> list[Diagnostic]:

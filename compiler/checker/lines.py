@@ -186,7 +186,8 @@ def _unknown_function(call: ast.Call) -> Diagnostic:
     return Diagnostic(
         "E0501", E, message, call.mnemonic_span,
         help=f"did you mean `{guess.mnemonic}`? {guess.forms[0].summary}",
-        fixes=(Fix(f"write `{guess.mnemonic}`", (Edit(call.mnemonic_span, guess.mnemonic),)),),
+        fixes=(Fix(f"write `{guess.mnemonic}`", (Edit(call.mnemonic_span, guess.mnemonic),),
+                   automatic=False),),
     )
 
 

@@ -3,13 +3,15 @@
 Unreachable code is reported once per run of consecutive blocks no path reaches: as code
 after `(END)` (W0602) when the run starts right after an `(END)` on the same straight
 line, otherwise as unreachable (W0601), saying why: it follows a jump, or no path jumps
-to its label.
+to its label. The code of a lost-line handler `:96`-`:99` is not reported: the device
+jumps there.
 """
 
 from __future__ import annotations
 
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity
+from rl1.vm.language import BUILTINS, HANDLER_LABELS
 
 from .fixes import append_line
 from .graph import Block, ControlFlowGraph
@@ -20,8 +22,9 @@ REMOVE_OR_LABEL = "remove it, or start its line with a label and jump there"
 def check_reachability(program: ast.Program, graph: ControlFlowGraph) -> list[Diagnostic]:
     found: list[Diagnostic] = []
     run: list[Block] = []
+    defensive = _handler_code(graph)
     for block, entry in zip(graph.blocks, graph.device_on_entry, strict=True):
-        if not entry:
+        if not entry and block.index not in defensive:
             run.append(block)
         elif run:
             found.extend(_unreachable(graph, run))
@@ -29,6 +32,20 @@ def check_reachability(program: ast.Program, graph: ControlFlowGraph) -> list[Di
     if run:
         found.extend(_unreachable(graph, run))
     found.extend(_no_end(program, graph))
+    return found
+
+
+def _handler_code(graph: ControlFlowGraph) -> set[int]:
+    """The blocks of handlers `:96`-`:99` that no lost line reaches as the program is:
+    a handler defined defensively is there for the device, which may lose the line in a
+    mode the checker did not foresee (or after an edit), so its code is not dead."""
+    stack = [graph.labels[label] for label in HANDLER_LABELS if label in graph.labels]
+    found: set[int] = set()
+    while stack:
+        index = stack.pop()
+        if index not in found and not graph.reachable(index):
+            found.add(index)
+            stack.extend(graph.blocks[index].successors)
     return found
 
 
@@ -62,6 +79,9 @@ def _no_end(program: ast.Program, graph: ControlFlowGraph) -> list[Diagnostic]:
     blocks = graph.blocks
     if not graph.reachable(graph.exit) or any(block.ends or block.opaque for block in blocks):
         return []
+    if any(isinstance(statement, ast.CallStmt) and statement.call.mnemonic.upper() not in BUILTINS
+           for statement in program.statements()):
+        return []  # a misspelt `(ENDD)` is reported as such (E0501): it may be the (END)
     span = fall_off_span(graph)
     if span is None:
         return []  # nothing runs at all

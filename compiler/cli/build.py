@@ -40,40 +40,66 @@ from .streams import (
 )
 
 if TYPE_CHECKING:  # the back end and the engines load only for the command that runs them
-    from rl1.compiler.backend.driver import Emit
-
     from .run import Engine
 
 SECTION = "Intermediate code"
 
-EMIT_CHOICES = ("ilc", "ir")
+# What --emit writes: the driver's own outputs, then the forms of the .ilc bytes
+# (driver.EMITS, firmware.FORMATS and the .ils text).
+EMIT_CHOICES = ("ilc", "ir", "c", "ihex", "ils")
+# The file each --emit kind is written to beside the source (None: standard output).
+EMIT_SUFFIXES = {"ilc": ".ilc", "ir": None, "c": ".c", "ihex": ".hex", "ils": ".ils"}
 ENGINE_CHOICES = ("vm", "ast")
 DEFAULT_BUDGET = 10_000_000
+
+
+def _address(ctx: click.Context, param: click.Parameter, value: str | None) -> int | None:
+    """An option's callback: an address from 0 to 0xFFFFFFFF, decimal or 0x hex."""
+    if value is None:
+        return None
+    try:
+        address = int(value, 16) if value.lower().startswith("0x") else int(value, 10)
+    except ValueError:
+        address = -1
+    if not 0 <= address <= 0xFFFF_FFFF:
+        raise click.BadParameter(f"expected an address from 0 to 0xFFFFFFFF, decimal or "
+                                 f"0x hex, got {value!r}", ctx, param)
+    return address
 
 
 @click.command("compile", cls=Command)
 @click.argument("file", metavar="FILE", type=PATH)
 @click.option("-o", "--output", metavar="PATH", type=PATH,
               help="where to write; `-` is standard output. Default: FILE.ilc beside the "
-                   "source (standard output with --emit ir)")
+                   "source (FILE.c, FILE.hex or FILE.ils with --emit c, ihex or ils; "
+                   "standard output with --emit ir)")
 @click.option("-s", "--strip", is_flag=True,
               help="leave out the debug section (the map from code to source lines)")
 @choice_option("--emit", "emit_kind", choices=EMIT_CHOICES, default="ilc",
-               help="ilc: the .ilc file; ir: the IR as text")
+               help="ilc: the .ilc file; ir: the IR as text; c: the .ilc bytes as a C99 "
+                    "array (FILE.c); ihex: the .ilc bytes as Intel HEX (FILE.hex); ils: "
+                    "the .ilc file as .ils text, as `rl1c dis` prints it (FILE.ils)")
+@click.option("--c-name", metavar="NAME",
+              help="with --emit c: the array's name (its length is NAME_len). "
+                   "Default: the file's name and _ilc, such as sample_ilc")
+@click.option("--base-address", metavar="ADDRESS", callback=_address,
+              help="with --emit ihex: the address of the first byte, decimal or 0x hex "
+                   "(default 0)")
 @click.option("-O", "optimize", default="0", metavar="LEVEL",
               help="optimization level; only -O0 (none) exists so far")
 @force_option
 @format_option
 @color_option
-def compile_program(file: str, output: str | None, strip: bool, emit_kind: Emit,
-                    optimize: str, force: bool, output_format: Format,
-                    color: ColorChoice) -> int:
+def compile_program(file: str, output: str | None, strip: bool, emit_kind: str,
+                    c_name: str | None, base_address: int | None, optimize: str,
+                    force: bool, output_format: Format, color: ColorChoice) -> int:
     """Compile an RL/I program: `rl1c FILE.rob -o FILE.ilc`.
 
-    FILE is the RL/I program; `-` reads standard input. Diagnostics go to standard
-    error; nothing is written when the program has errors. Exit status: 0 compiled
-    (warnings allowed), 1 errors, 2 an unreadable input or an output that cannot be
-    written."""
+    FILE is the RL/I program; `-` reads standard input. With --emit, the same code in
+    another form: a C array or Intel HEX for a firmware build, .ils text. Diagnostics go
+    to standard error; nothing is written when the program has errors. Exit status: 0
+    compiled (warnings allowed), 1 errors, 2 an unreadable input or an output that
+    cannot be written."""
     from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
     from rl1.compiler.ils.sources import recorded_name
 
@@ -83,7 +109,8 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: Emit,
     if strip and emit_kind == "ir":
         raise click.UsageError("--strip drops the debug section of an .ilc file; "
                                "it has no meaning with --emit ir")
-    target = output or ("-" if emit_kind == "ir" else _default_output(file))
+    _check_form_options(emit_kind, c_name, base_address)
+    target = output or _default_output(file, emit_kind)
     source = read_input(file)
     if not isinstance(source, Source):
         return emit([source], output_format, color, "compile", err=True)
@@ -91,27 +118,71 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: Emit,
         raise click.UsageError(f"the output `{target}` is the source file itself: "
                                "give another path with -o")
     compilation = compile_text(source.text, recorded_name(source.name, target),
-                               emit=emit_kind, strip_debug=strip)
+                               emit="ir" if emit_kind == "ir" else "ilc",
+                               strip_debug=strip)
     status = emit([FileDiagnostics(source.name, source.text, compilation.diagnostics)],
                   output_format, color, "compile", err=True)
     if compilation.output is None:
         return status
+    data = compilation.output
+    if emit_kind not in ("ilc", "ir"):
+        name = c_name or _c_name_for(file if file != "-" else target)
+        data = _ilc_form(emit_kind, data, source, name, base_address or 0)
     if target != "-":
-        write_file(target, compilation.output, force=force)
+        write_file(target, data, force=force)
     elif emit_kind == "ilc" and sys.stdout.isatty():
         raise click.UsageError("an .ilc file is binary and standard output is a "
                                "terminal: redirect it, or give -o FILE.ilc")
     else:
-        write_stdout_bytes(compilation.output)
+        write_stdout_bytes(data)
     return status
 
 
-def _default_output(source: str) -> str:
+def _check_form_options(emit_kind: str, c_name: str | None, base_address: int | None) -> None:
+    from rl1.compiler.backend.firmware import c_name_problem
+
+    if c_name is not None and emit_kind != "c":
+        raise click.UsageError("--c-name names the array of --emit c: give --emit c, or "
+                               "leave out --c-name")
+    if base_address is not None and emit_kind != "ihex":
+        raise click.UsageError("--base-address places the bytes of --emit ihex: give "
+                               "--emit ihex, or leave out --base-address")
+    problem = c_name_problem(c_name) if c_name is not None else None
+    if problem is not None:
+        raise click.UsageError(f"argument --c-name: {problem}")
+
+
+def _c_name_for(path: str) -> str:
+    from rl1.compiler.backend.firmware import c_name_for
+
+    return c_name_for(os.path.splitext(os.path.basename(path))[0] if path != "-" else "")
+
+
+def _ilc_form(emit_kind: str, data: bytes, source: Source, c_name: str, base: int) -> bytes:
+    """The .ilc bytes `data` of `source` in the form --emit asks for."""
+    from rl1.compiler.backend import firmware
+    from rl1.compiler.ils.disasm import disassemble
+
+    if emit_kind == "c":
+        return firmware.c_source(data, c_name, os.path.basename(source.name)).encode("ascii")
+    if emit_kind == "ihex":
+        try:
+            return firmware.intel_hex(data, base).encode("ascii")
+        except ValueError as error:
+            raise click.UsageError(f"argument --base-address: {error}") from None
+    name = with_suffix(os.path.basename(source.name), ".ilc")
+    return disassemble(data, name, source.lines).encode("utf-8")
+
+
+def _default_output(source: str, emit_kind: str) -> str:
+    suffix = EMIT_SUFFIXES[emit_kind]
+    if suffix is None:
+        return "-"
     if source == "-":
         raise click.UsageError("reading standard input there is no file name to name the "
-                               "output after: give -o FILE.ilc (or -o - for standard "
+                               f"output after: give -o FILE{suffix} (or -o - for standard "
                                "output)")
-    return with_suffix(source, ".ilc")
+    return with_suffix(source, suffix)
 
 
 @click.command(cls=Command)
@@ -223,7 +294,7 @@ def assemble_file(file: str, output: str | None, force: bool) -> int:
     source = read_input(file)
     if not isinstance(source, Source):
         raise Failure(f"error: {source.diagnostics[0].message}")
-    target = output or _default_output(file)
+    target = output or _default_output(file, "ilc")
     if same_file(file, target):
         raise click.UsageError(f"the output `{target}` is the input file itself: "
                                "give another path with -o")

@@ -173,7 +173,8 @@ PATH = click.Path(readable=False, allow_dash=True)
 # Shared by the commands that report diagnostics.
 format_option = choice_option(
     "--format", "output_format", choices=FORMATS, default="human",
-    help="human: text for people; json or sarif: for tools")
+    help="human: text for people; concise: one line a problem, file:line:col: "
+         "warning[CODE]: message (for problem matchers and grep); json or sarif: for tools")
 color_option = choice_option(
     "--color", choices=COLOR_CHOICES, default="auto",
     help="colour the human format; auto: only on a terminal, and not if NO_COLOR is set")

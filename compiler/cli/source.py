@@ -7,6 +7,7 @@ another one needs (`rl1c explain` no checker, `rl1c check` no formatter).
 from __future__ import annotations
 
 import sys
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import click
@@ -19,80 +20,206 @@ from rl1.compiler.reporting.render import (
     ColorChoice,
     FileDiagnostics,
     Format,
+    summary,
 )
 
 from .command import PATH, Command, Failure, color_option, force_option, format_option
-from .streams import emit, read_input, write_stdout_bytes
+from .streams import (
+    emit,
+    encode_like,
+    read_input,
+    source_files,
+    unified_diff,
+    write_back,
+    write_stdout_bytes,
+)
 
 if TYPE_CHECKING:  # click's completion module loads only when a shell asks
     from click.shell_completion import CompletionItem
+
+    from rl1.compiler.reporting.selection import Selection
 
 SECTION = "RL/I programs"
 
 
 @click.command(cls=Command)
-@click.argument("files", nargs=-1, required=True, metavar="FILE...", type=PATH)
+@click.argument("files", nargs=-1, required=True, metavar="PATH...", type=PATH)
 @format_option
 @color_option
-def check(files: tuple[str, ...], output_format: Format, color: ColorChoice) -> int:
+@click.option("--select", metavar="CODES", multiple=True,
+              help="report only these warnings: codes or their starts, separated by commas "
+                   "(W0601,W06; W is every warning). Errors are always reported")
+@click.option("--ignore", metavar="CODES", multiple=True,
+              help="never report these warnings (over --select)")
+@click.option("--warnings-as-errors/--no-warnings-as-errors", default=None,
+              help="report warnings as errors, so that any warning fails the check (exit "
+                   "status 1), as CI wants")
+@click.option("--fix", is_flag=True,
+              help="make the fixes the checker suggests in the files, then report what is "
+                   "left (a guess at a misspelt name is left for you to confirm)")
+@click.option("--diff", is_flag=True,
+              help="change nothing; print what --fix would change as a unified diff (exit "
+                   "status 1 when it would change a file)")
+@click.option("--isolated", is_flag=True, help="read no rl1.toml: only the options given here")
+@force_option
+def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
+          select: tuple[str, ...], ignore: tuple[str, ...], warnings_as_errors: bool | None,
+          fix: bool, diff: bool, isolated: bool, force: bool) -> int:
     """Check RL/I programs and report every problem found.
 
-    FILE is an RL/I program; `-` reads standard input. Exit status: 0 no errors
-    (warnings allowed), 1 errors, 2 an unreadable file."""
-    from rl1.compiler.analysis import analyze
+    PATH is an RL/I program, or a folder: every .rob file below it is checked; `-` reads
+    standard input. The nearest rl1.toml in the file's folder or above it may set
+    --select, --ignore and --warnings-as-errors for its project (a `[check]` table);
+    the options given here win. A comment `' rl1: allow W0601` allows a warning on its
+    line, `' rl1: allow-file W0601` in its file. Exit status: 0 no errors (warnings
+    allowed), 1 errors (--diff: a file would change), 2 an unreadable file or rl1.toml."""
+    from rl1.compiler import analysis
+    from rl1.compiler.reporting.project import ProjectFileError, project_selection
+    from rl1.compiler.reporting.selection import Selection
 
+    if fix and not diff and "-" in files:
+        raise click.UsageError("--fix rewrites files, and standard input is none: give the "
+                               "file, or --diff to see the fixes")
+    given = Selection(_codes("--select", select), _codes("--ignore", ignore),
+                      warnings_as_errors)
+    project = project_selection()
+    inputs: list[tuple[str | FileDiagnostics, Selection]] = []
+    try:  # every rl1.toml is read before any file is checked: a bad one stops it all
+        for item in source_files(files, "check"):
+            selection = given
+            if isinstance(item, str) and not isolated:
+                selection = given.over(project(item))
+            inputs.append((item, selection))
+    except ProjectFileError as error:
+        raise Failure(f"error: {error}\n  = help: correct the file (README.md, \"Controlling "
+                      "`rl1c check`\", shows its form), or move it aside") from None
+    if diff:
+        return _fix_diff(inputs)
     checked: list[FileDiagnostics] = []
-    for name in files:
-        source = read_input(name)
-        if isinstance(source, Source):
-            checked.append(FileDiagnostics(source.name, source.text,
-                                           analyze(source.text).diagnostics))
-        else:
+    fixed = 0
+    status = 0
+    for item, selection in inputs:
+        source = read_input(item) if isinstance(item, str) else item
+        if not isinstance(source, Source):
             checked.append(source)
-    return emit(checked, output_format, color, "check")
+            continue
+        text, diagnostics = source.text, None
+        if fix:
+            fixing = analysis.fix(source.text, keep=selection.reports)
+            text, diagnostics = fixing.text, fixing.analysis.diagnostics
+            try:
+                if fixing.fixes:
+                    write_back(source, fixing.text, force=force)
+                    fixed += fixing.fixes
+            except OSError as error:
+                print(f"error: cannot write the fixes to `{source.name}`: "
+                      f"{error.strerror or error}", file=sys.stderr)
+                status = EXIT_USAGE
+                text, diagnostics = source.text, None  # the file is as it was
+        if diagnostics is None:
+            diagnostics = analysis.analyze(text).diagnostics
+        checked.append(FileDiagnostics(source.name, text, selection.apply(diagnostics)))
+    status = max(status, emit(checked, output_format, color, "check"))
+    if output_format in ("human", "concise"):
+        sys.stdout.write(summary(checked, fixed))
+    return status
+
+
+def _codes(option: str, words: tuple[str, ...]) -> tuple[str, ...] | None:
+    from rl1.compiler.reporting.selection import SelectionError, parse_codes
+
+    if not words:
+        return None
+    try:
+        return parse_codes(words)
+    except SelectionError as error:
+        raise click.UsageError(f"argument {option}: {error}") from None
+
+
+def _fix_diff(inputs: Sequence[tuple[str | FileDiagnostics, Selection]]) -> int:
+    """`rl1c check --diff`: what --fix would change, as diffs; exit status 1 when it
+    would change a file, 2 when a file cannot be read."""
+    from rl1.compiler import analysis
+
+    changed = 0
+    fixes = 0
+    unreadable = False
+    for item, selection in inputs:
+        source = read_input(item) if isinstance(item, str) else item
+        if not isinstance(source, Source):
+            emit([source], "human", "auto", "check", err=True)
+            unreadable = True
+            continue
+        fixing = analysis.fix(source.text, keep=selection.reports)
+        if fixing.fixes:
+            sys.stdout.write(unified_diff(source.name, source.text, fixing.text, "fixed"))
+            changed += 1
+            fixes += fixing.fixes
+    print(f"--fix would make {_plural(fixes, 'fix', 'fixes')} in "
+          f"{_plural(changed, 'file')}", file=sys.stderr)
+    return EXIT_USAGE if unreadable else EXIT_ERRORS if changed else 0
 
 
 @click.command(cls=Command)
-@click.argument("files", nargs=-1, required=True, metavar="FILE...", type=PATH)
+@click.argument("files", nargs=-1, required=True, metavar="PATH...", type=PATH)
 @click.option("--check", is_flag=True,
               help="change nothing; list the files formatting would change (exit status 1)")
 @click.option("--diff", is_flag=True,
-              help="change nothing; print what formatting would change as a unified diff")
+              help="change nothing; print what formatting would change as a unified diff "
+                   "(exit status 1 when it would change a file)")
 @force_option
 def fmt(files: tuple[str, ...], check: bool, diff: bool, force: bool) -> int:
     """Put RL/I programs in the canonical layout (spec/language.md, section 11).
 
-    Each FILE is rewritten in place in its own encoding; `-` formats standard input to
-    standard output. Exit status: 0 done, 1 (--check) a file would change, 2 a file cannot
-    be read or written."""
+    PATH is an RL/I program, or a folder: every .rob file below it is formatted. Each
+    file is rewritten in place in its own encoding; `-` formats standard input to
+    standard output. A summary of what changed goes to standard error. Exit status: 0
+    done, 1 (--check, --diff) a file would change, 2 a file cannot be read or
+    written."""
     from rl1.compiler import formatter
 
-    status = 0
-    for name in files:
-        source = read_input(name)
+    changed = unchanged = failed = 0
+    for item in source_files(files, "fmt"):
+        source = read_input(item) if isinstance(item, str) else item
         if not isinstance(source, Source):
             emit([source], "human", "auto", "format", err=True)
-            status = EXIT_USAGE
+            failed += 1
             continue
         formatted = formatter.format_text(source.text)
-        changed = formatted != source.text
-        if diff and changed:
-            sys.stdout.write(formatter.unified_diff(source.name, source.text, formatted))
-        if check and changed:
+        if formatted == source.text:
+            unchanged += 1
+        else:
+            changed += 1
+        if diff and formatted != source.text:
+            sys.stdout.write(unified_diff(source.name, source.text, formatted, "formatted"))
+        if check and formatted != source.text:
             print(source.name)
-            status = max(status, EXIT_ERRORS)
         if check or diff:
             continue
-        if name == "-":
-            write_stdout_bytes(formatter.encode_like(source, formatted, bom=False))
-        elif changed:
+        if item == "-":
+            write_stdout_bytes(encode_like(source, formatted, bom=False))
+        elif formatted != source.text:
             try:
-                formatter.rewrite(source, formatted, force=force)
+                write_back(source, formatted, force=force)
             except OSError as error:
-                print(f"error: cannot write `{name}`: {error.strerror or error}",
+                print(f"error: cannot write `{source.name}`: {error.strerror or error}",
                       file=sys.stderr)
-                status = EXIT_USAGE
-    return status
+                changed -= 1
+                failed += 1
+    would = check or diff
+    counts = [_plural(changed, "file") + (" would be reformatted" if would else " reformatted"),
+              _plural(unchanged, "file") + (" already formatted" if would else
+                                            " left unchanged")]
+    if failed:
+        counts.append(_plural(failed, "file") + " could not be formatted")
+    print(", ".join(counts), file=sys.stderr)
+    if failed:
+        return EXIT_USAGE
+    return EXIT_ERRORS if would and changed else 0
+
+
+def _plural(count: int, noun: str, nouns: str | None = None) -> str:
+    return f"{count} {noun if count == 1 else nouns or noun + 's'}"
 
 
 def _complete_code(ctx: click.Context, param: click.Parameter,

@@ -1,15 +1,24 @@
-"""The inputs and outputs of the commands: source files and standard input, diagnostics
-on standard output or error, `.ilc` bytes, and files written atomically."""
+"""The inputs and outputs of the commands: source files (folders searched for them) and
+standard input, diagnostics on standard output or error, `.ilc` bytes, files written
+atomically, and source files written back in their own encoding or shown as a diff."""
 
 from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Sequence
 
 from rl1.compiler.files import SourceError, write_atomically
 from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
-from rl1.compiler.frontend.source import MAX_SOURCE_BYTES, Source, decode, read_source
+from rl1.compiler.frontend.source import (
+    MAX_SOURCE_BYTES,
+    UTF8_BOM,
+    Source,
+    decode,
+    read_source,
+    split_lines,
+)
 from rl1.compiler.reporting.render import (
     EXIT_ERRORS,
     ColorChoice,
@@ -23,6 +32,7 @@ from rl1.compiler.reporting.render import (
 from .command import Failure
 
 STDIN_NAME = "<stdin>"
+SOURCE_SUFFIX = ".rob"  # in any case: DOS wrote SAMPLE.ROB
 MAX_ILC_BYTES = 16 * 1024 * 1024  # far more than any .ilc file holds
 
 
@@ -38,8 +48,42 @@ def read_input(name: str) -> Source | FileDiagnostics:
                               "RL/I sources are limited to that size")
         return decode(data, STDIN_NAME)
     except SourceError as error:
-        unreadable = Diagnostic("E0100", Severity.ERROR, str(error), Span(1, 1, 1, 1))
-        return FileDiagnostics(STDIN_NAME if name == "-" else name, None, [unreadable])
+        return unreadable(STDIN_NAME if name == "-" else name, str(error))
+
+
+def source_files(names: Sequence[str], command: str) -> list[str | FileDiagnostics]:
+    """The files `names` name: each file as given, and for a folder every `.rob` file
+    below it (the extension in any case) in sorted order, leaving out hidden files and
+    folders (`.git`), what is no regular file, and links to folders. A folder that cannot be listed
+    is an E0100 report; one without a `.rob` file is said on standard error."""
+    found: list[str | FileDiagnostics] = []
+    for name in names:
+        if name == "-" or not os.path.isdir(name):
+            found.append(name)
+            continue
+        before = len(found)
+        unlisted: list[OSError] = []
+        for folder, folders, files in os.walk(name, onerror=unlisted.append):
+            folders[:] = sorted(f for f in folders if not f.startswith("."))
+            # Regular files only: reading a FIFO named x.rob would wait for ever.
+            found += [path for path in (os.path.join(folder, file) for file in sorted(files)
+                                        if file.lower().endswith(SOURCE_SUFFIX)
+                                        and not file.startswith("."))
+                      if os.path.isfile(path)]
+        for error in unlisted:
+            folder = str(error.filename or name)
+            found.append(unreadable(folder, f"{folder}: cannot list this folder "
+                                    f"({error.strerror or error}); check its permissions"))
+        if len(found) == before:
+            print(f"rl1c {command}: warning: no {SOURCE_SUFFIX} file under `{name}`",
+                  file=sys.stderr)
+    return found
+
+
+def unreadable(name: str, message: str) -> FileDiagnostics:
+    """The E0100 report of a file or folder that cannot be read."""
+    problem = Diagnostic("E0100", Severity.ERROR, message, Span(1, 1, 1, 1))
+    return FileDiagnostics(name, None, [problem])
 
 
 def emit(files: list[FileDiagnostics], output_format: Format, color: ColorChoice,
@@ -95,3 +139,29 @@ def same_file(first: str, second: str) -> bool:
     """Whether two paths (`-` is a standard stream) name one existing file."""
     return "-" not in (first, second) and os.path.exists(second) \
         and os.path.samefile(first, second)
+
+
+def encode_like(source: Source, text: str, *, bom: bool) -> bytes:
+    """`text` in the encoding `source` was read in. The commands that rewrite a source
+    (fmt, check --fix) keep every non-ASCII character of it (they are all in comments),
+    so a CP932 source's characters all have a CP932 encoding."""
+    return (UTF8_BOM if bom else b"") + text.encode(source.encoding)
+
+
+def write_back(source: Source, text: str, *, force: bool = False) -> None:
+    """Replace the file `source` was read from with `text`, in the file's own encoding
+    and with its byte-order mark if it had one, as files.write_atomically does (a
+    read-only file only with `force`). OSError if that cannot be done."""
+    write_atomically(source.name, encode_like(source, text, bom=source.bom), force=force)
+
+
+def unified_diff(name: str, before: str, after: str, change: str) -> str:
+    """What a command would change in file `name`, as a unified diff (line ends shown as
+    LF); `change` names the new side: `x.rob (formatted)`."""
+    import difflib  # only for a diff: 2 ms of every start
+
+    return "".join(difflib.unified_diff(
+        [line + "\n" for line in split_lines(before)],
+        [line + "\n" for line in split_lines(after)],
+        fromfile=name, tofile=f"{name} ({change})",
+    ))

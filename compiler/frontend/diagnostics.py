@@ -28,10 +28,13 @@ class Edit:
 
 @dataclass(frozen=True, slots=True)
 class Fix:
-    """A machine-applicable fix: the editor's quick fix, the help line's suggestion."""
+    """A machine-applicable fix: the editor's quick fix, the help line's suggestion.
+    `automatic` is False for a guess (a misspelt name's closest match), which
+    `rl1c check --fix` leaves for a person to confirm."""
 
     title: str
     edits: tuple[Edit, ...]
+    automatic: bool = True
 
 
 @dataclass(frozen=True, slots=True)

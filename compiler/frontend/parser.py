@@ -25,7 +25,7 @@ from rl1.vm.language import BUILTINS
 from . import ast
 from .builders import ACTIONS, Builder, Child, ParsedLine, label_def
 from .collector import collector_paused
-from .diagnostics import Diagnostic, Severity
+from .diagnostics import Diagnostic, Edit, Fix, Severity
 from .lalr_tables import ACTIONS as TABLE
 from .lalr_tables import RULES, START
 from .scanner import Kinds, Lexeme, scan
@@ -134,7 +134,7 @@ def _syntax_error(row: ast.Row, code: str, kinds: Kinds, lexemes: list[Lexeme],
     if kind == "BAD":
         return _bad_character(span, text)
     if kind == "WORD":
-        return _misused_word(span, text)
+        return _misused_word(row, span, kinds, lexemes, rejection.index)
     if kind == "BADHEX":
         return Diagnostic(
             "E0105", Severity.ERROR, f"`{_excerpt(text)}` is not a 16-bit hex constant", span,
@@ -148,10 +148,10 @@ def _syntax_error(row: ast.Row, code: str, kinds: Kinds, lexemes: list[Lexeme],
         )
     found = "the end of the line" if kind == "$END" else f"`{_excerpt(text)}`"
     expected = sorted({TERMINAL_NAMES.get(name, name) for name in rejection.expected})
+    help_text, fixes = _syntax_help(row, kinds, lexemes, rejection)
     return Diagnostic(
         "E0101", Severity.ERROR,
-        f"expected {_either(expected)}, found {found}", span,
-        help=_syntax_help(text, rejection.expected),
+        f"expected {_either(expected)}, found {found}", span, help=help_text, fixes=fixes,
     )
 
 
@@ -159,14 +159,43 @@ def _either(names: list[str]) -> str:
     return names[0] if len(names) == 1 else ", ".join(names[:-1]) + " or " + names[-1]
 
 
-def _syntax_help(found: str, expected: frozenset[str]) -> str | None:
+# The tokens a statement can start with, for "two statements without a `;`".
+_STARTS_STATEMENT = frozenset({"VAR", "LPAR", "LABELREF", "QMARK"})
+
+
+def _syntax_help(row: ast.Row, kinds: Kinds, lexemes: list[Lexeme],
+                 rejection: Rejection) -> tuple[str | None, tuple[Fix, ...]]:
+    """The help of an E0101, and its fix when the intent is plain."""
+    index, expected = rejection.index, rejection.expected
+    found = lexemes[index][0] if index is not None else ""
+    if found == "-" and "_COMMA" in expected and index is not None:
+        # `(MOV 3 -3)`: after an argument, ` -3` scans as a subtraction (3.2).
+        fixes: tuple[Fix, ...] = ()
+        if index + 1 < len(kinds) and kinds[index + 1] == "NUMBER" \
+                and lexemes[index + 1][1] == lexemes[index][1] + 1:
+            fixes = (Fix("write a comma before the negative number",
+                         (_between(row, lexemes, index, ","),)),)
+        return ("separate a negative argument with a comma, as in `(MOV 3,-3)`: after an "
+                "argument, ` -3` reads as a subtraction, which a call's arguments cannot "
+                "hold"), fixes
     if "VAR" in expected and "NUMBER" in expected and found.startswith("-"):
-        return "there is no unary minus on a variable: write `0-V` for the negative of V"
+        return "there is no unary minus on a variable: write `0-V` for the negative of V", ()
+    if "_SEMI" in expected and index is not None and kinds[index] in _STARTS_STATEMENT:
+        return ("statements on one line are separated by `;`, as in `A=1; B=2`",
+                (Fix("separate the statements with `;`",
+                     (_between(row, lexemes, index, "; "),)),))
     if expected == {"RPAR"} or ("RPAR" in expected and "_COMMA" in expected):
-        return "close the call with `)`"
+        return "close the call with `)`", ()
     if "LABELREF" in expected:
-        return "a jump target is `#` and two digits, e.g. `#10`"
-    return None
+        return "a jump target is `#` and two digits, e.g. `#10`", ()
+    return None, ()
+
+
+def _between(row: ast.Row, lexemes: list[Lexeme], index: int, text: str) -> Edit:
+    """Replace what lies between token `index` and the one before it with `text`."""
+    before, start = lexemes[index - 1]
+    end = start + len(before)
+    return Edit(ast.Span(row, end + 1, row, lexemes[index][1] + 1), text)
 
 
 def _bad_character(span: ast.Span, character: str) -> Diagnostic:
@@ -175,6 +204,14 @@ def _bad_character(span: ast.Span, character: str) -> Diagnostic:
         help_text = f"this is a full-width character: type the ASCII `{ascii_form}` instead"
     elif character == "\u3000":
         help_text = "this is a full-width space: type an ASCII space instead"
+    elif character in "*/%":
+        help_text = ("RL/I has no `*`, `/` or `%`: its operators are `+ - & | ^ < >`, where "
+                     "`<` and `>` shift, so `B<1` is B times 2 and `B>1` is B halved")
+    elif character.isascii() and character.isprintable():
+        help_text = (f"`{character}` has no meaning in RL/I code (its operators are "
+                     "`+ - & | ^ < >`); a comment starts with `'`")
+    elif character.isascii():
+        help_text = "a control character has no place in RL/I code: delete it"
     else:
         help_text = "RL/I code is ASCII; text in any script may follow `'` as a comment"
     name = unicodedata.name(character, f"U+{ord(character):04X}")
@@ -187,18 +224,49 @@ def _excerpt(text: str, limit: int = 24) -> str:
     return text if len(text) <= limit else text[: limit - 1] + "…"
 
 
-def _misused_word(span: ast.Span, word: str) -> Diagnostic:
-    if word.upper() in BUILTINS:
+# Words of other languages' jumps and conditions, and what RL/I writes instead.
+_JUMP_WORDS = frozenset({"GOTO", "GO", "JMP", "JUMP", "JP", "GOSUB"})
+_CONDITION_WORDS = frozenset({"IF", "THEN", "ELSE"})
+
+
+def _misused_word(row: ast.Row, span: ast.Span, kinds: Kinds, lexemes: list[Lexeme],
+                  index: int | None) -> Diagnostic:
+    word = lexemes[index][0] if index is not None else ""
+    upper = word.upper()
+    if upper in BUILTINS:
         return Diagnostic(
             "E0103", Severity.ERROR,
             f"`{word}` is a built-in function, which is called in parentheses", span,
-            help=f"write `({word.upper()} ...)`",
+            help=f"write `({upper} ...)`",
         )
+    message = f"`{_excerpt(word)}` is not a variable: variable names are one letter"
+    if upper in _JUMP_WORDS and index is not None:
+        return Diagnostic("E0103", Severity.ERROR, message, span,
+                          help="RL/I jumps with `#` and two digits: `#10` goes on at the "
+                               "line that starts with the label `:10`",
+                          fixes=_jump_fix(row, kinds, lexemes, index))
+    if upper in _CONDITION_WORDS:
+        return Diagnostic("E0103", Severity.ERROR, message, span,
+                          help="RL/I's only condition is the conditional jump: `?A=#10` "
+                               "jumps to `:10` when A is 0, `?A>#10` when A is positive, "
+                               "`?A<#10` when A is negative")
     return Diagnostic(
-        "E0103", Severity.ERROR,
-        f"`{_excerpt(word)}` is not a variable: variable names are one letter",
+        "E0103", Severity.ERROR, message,
         span, help="use one of A-Z, a-z or @; built-in functions are written `(NAME ...)`",
     )
+
+
+def _jump_fix(row: ast.Row, kinds: Kinds, lexemes: list[Lexeme], index: int
+              ) -> tuple[Fix, ...]:
+    """`GOTO 10` -> `#10`, when a label's number follows the word."""
+    if index + 1 >= len(kinds) or kinds[index + 1] != "NUMBER":
+        return ()
+    number, start = lexemes[index + 1]
+    if not number.isdigit() or int(number) > 99:
+        return ()
+    target = f"#{int(number):02d}"
+    span = ast.Span(row, lexemes[index][1] + 1, row, start + len(number) + 1)
+    return (Fix(f"write `{target}`", (Edit(span, target),)),)
 
 
 def parse_line(text: str, line: int | ast.Row) -> tuple[ast.Line, list[Diagnostic]]:

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from rl1.compiler.files import SourceError, read_bounded
 
 MAX_SOURCE_BYTES = 8 * 1024 * 1024  # checking takes about 100 bytes a source byte
+UTF8_BOM = b"\xef\xbb\xbf"
 LINE_BREAK = re.compile(r"\r\n|\r|\n")
 """A line end: LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them."""
 
@@ -21,6 +22,7 @@ class Source:
     name: str
     text: str
     encoding: str  # "utf-8" or "cp932"
+    bom: bool = False  # the UTF-8 byte-order mark the file started with, dropped from text
 
     @property
     def lines(self) -> list[str]:
@@ -44,10 +46,11 @@ def decode(data: bytes, name: str = "<input>") -> Source:
             f"{name} looks like a binary file (a NUL byte at offset {offset}); "
             "RL/I source is text: check that this is the .rob file you meant"
         )
-    if data.startswith(b"\xef\xbb\xbf"):
-        data = data[3:]
+    bom = data.startswith(UTF8_BOM)
+    if bom:
+        data = data[len(UTF8_BOM):]
     try:
-        return Source(name, data.decode("utf-8"), "utf-8")
+        return Source(name, data.decode("utf-8"), "utf-8", bom)
     except UnicodeDecodeError as utf8_error:
         try:
             return Source(name, data.decode("cp932"), "cp932")

@@ -42,6 +42,7 @@ CODES: dict[str, CodeInfo] = _entries(
     ("E0104", E, "label not at the start of a line"),
     ("E0105", E, "malformed hex constant"),
     ("E0106", E, "line too long"),
+    ("W0107", W, "suppression comment that allows nothing"),
     ("E0190", E, "compiled code too large for .ilc"),
     ("E0191", E, "code past line 65535 with a debug section"),
     ("E0201", E, "label not exactly two digits"),

@@ -1,8 +1,10 @@
-"""Renderers: diagnostics to text for people (rustc/Elm style), JSON, or SARIF 2.1.0.
+"""Renderers: diagnostics to text for people (rustc/Elm style), one line each
+(`file:line:col: warning[W0301]: message`, for editors' problem matchers and grep), JSON,
+or SARIF 2.1.0.
 
-`report` renders the diagnostics of several files in one of the three formats, and
-`exit_status` says how a command should end after reporting them. Diagnostics stay data
-until here; nothing else turns them into text.
+`report` renders the diagnostics of several files in one of the four formats, `summary`
+counts them in one line, and `exit_status` says how a command should end after reporting
+them. Diagnostics stay data until here; nothing else turns them into text.
 """
 
 from __future__ import annotations
@@ -19,10 +21,10 @@ from rl1.compiler.frontend.source import split_lines
 
 from .catalogue import CODES
 
-Format = Literal["human", "json", "sarif"]
+Format = Literal["human", "concise", "json", "sarif"]
 ColorChoice = Literal["auto", "always", "never"]
 
-FORMATS: tuple[Format, ...] = ("human", "json", "sarif")
+FORMATS: tuple[Format, ...] = ("human", "concise", "json", "sarif")
 COLOR_CHOICES: tuple[ColorChoice, ...] = ("auto", "always", "never")
 
 # Exit statuses of a command that reports diagnostics.
@@ -70,8 +72,21 @@ def report(
         return _json_report(files)
     if output_format == "sarif":
         return _sarif_report(files)
+    if output_format == "concise":
+        return "".join(concise_line(file, d) for file in files for d in _ordered(file.diagnostics))
     rendered = (_HumanRenderer(file, color).render(action) for file in files)
     return "\n".join(text for text in rendered if text)
+
+
+def summary(files: Sequence[FileDiagnostics], fixed: int = 0) -> str:
+    """One line that counts the files and what was found in them: "3 files checked:
+    0 errors, 1 warning" (a file that could not be read counts its E0100 error), and
+    the problems `fixed` before, if any."""
+    errors = sum(d.is_error for file in files for d in file.diagnostics)
+    warnings = sum(d.severity is Severity.WARNING for file in files for d in file.diagnostics)
+    made = f" ({_plural(fixed, 'problem')} fixed)" if fixed else ""
+    return (f"{_plural(len(files), 'file')} checked: {_plural(errors, 'error')}, "
+            f"{_plural(warnings, 'warning')}{made}\n")
 
 
 def exit_status(files: Sequence[FileDiagnostics]) -> int:
@@ -268,6 +283,17 @@ def _visible_lines(text: str) -> list[str]:
 
 def _plural(count: int, noun: str) -> str:
     return f"{count} {noun}" if count == 1 else f"{count} {noun}s"
+
+
+# Concise ----------------------------------------------------------------------------
+
+
+def concise_line(file: FileDiagnostics, diagnostic: Diagnostic) -> str:
+    """`file:line:col: warning[W0301]: message`, the help left out: the form of gcc and
+    ruff that problem matchers read. A file that could not be read is placed at 1:1."""
+    span = diagnostic.span
+    return (f"{_visible(file.name)}:{span.line}:{max(span.column, 1)}: "
+            f"{diagnostic.severity.value}[{diagnostic.code}]: {_visible(diagnostic.message)}\n")
 
 
 # JSON -------------------------------------------------------------------------------

@@ -123,6 +123,21 @@ def test_code_reached_by_a_jump_or_a_lost_line_is_reachable() -> None:
     assert found("(TRC 2); (MOV 3,3); (END)\n:98 (END)", "W0601") == []
 
 
+@pytest.mark.parametrize("source", [
+    "(MOV 0,0); (END)\n:96 (MOV 0,0); (END)\n",  # no tracing at all: defined defensively
+    "(TRC 2); (MVI 3,3,10); (END)\n:98 (FRE); (END)\n:99 (FRE); (END)\n",  # no MOV: :98 idle
+    "(END)\n:97 (HLD); #50\n:50 (FRE); (END)\n",  # the code a handler jumps to
+])
+def test_a_handler_no_lost_line_reaches_is_not_dead_code(source: str) -> None:
+    assert found(source, "W0601") == []
+    assert found(source, "W0205") == []
+
+
+def test_code_after_a_handlers_end_is_still_dead() -> None:
+    assert one("(END)\n:96 (FRE); (END); A=1\n", "W0602").span == span(2, 19, 22)
+    assert one("(END)\n:96 (FRE); (END)\n:40 A=1\n", "W0601").span == span(3, 5, 8)
+
+
 def test_code_after_end_on_the_same_straight_line() -> None:
     assert one("(MOV 0,0); (END); (FRE)", "W0602").span == span(1, 19, 24)
     assert one("(END)\nA=1\n", "W0602").span == span(2, 1, 4)
@@ -191,6 +206,12 @@ def test_nested_blind_loops_are_reported_once_on_the_last_backward_jump() -> Non
     assert diagnostic.span == span(2, 10, 13)
 
 
+def test_a_misspelt_end_is_no_missing_end() -> None:
+    # `(ENDD)` is E0501, with `(END)` as the guess; "no (END)" would only repeat it.
+    assert codes("A=1\n(ENDD)\n") == ["E0501"]
+    assert codes("A=1\n(FOO)\n") == ["E0501"]
+
+
 # Ending while moving (W0701) ------------------------------------------------------------
 
 
@@ -226,6 +247,20 @@ def test_ending_stopped(source: str) -> None:
 def test_mode_3_keeps_moving_into_the_handler() -> None:
     source = "(TRC 3); (MOV 3,3)\n:10 (IMG); #10\n:96 (END)"
     assert one(source, "W0701").span == span(3, 5, 10)
+
+
+def test_an_mvi_left_in_the_background_by_mode_3_is_still_moving_at_the_end() -> None:
+    source = "(TRC 3); (MVI 3,3,100)\n(END)\n:97 (END)\n"
+    diagnostic = one(source, "W0701")
+    assert diagnostic.span == span(3, 5, 10)
+    assert "`(MVI)` that a lost line left running in the background" in diagnostic.message
+    fixed = apply(source, diagnostic.fixes[0])
+    assert fixed.endswith(":97 (MOV 0,0); (END)\n")
+    assert found(fixed, "W0701") == []
+    assert one("(TRC 3); (MVI 3,3,100)\n(END)\n:97 A=1\n", "W0701").span == span(3, 5, 8)
+    # Mode 2 aborts the MVI before jumping to :99; without a handler W0301 says so.
+    assert found("(TRC 2); (MVI 3,3,100)\n(END)\n:99 (END)\n", "W0701") == []
+    assert codes("(TRC 3); (MVI 3,3,100)\n(END)\n") == ["W0301"]
 
 
 def test_a_variable_speed_may_be_moving() -> None:

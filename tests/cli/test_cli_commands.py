@@ -77,9 +77,9 @@ def test_command_names_complete_with_file_names() -> None:
 
 
 def test_options_and_their_choices_complete() -> None:
-    assert completions(["check"], "--fo") == [("--format", "plain")]
+    assert completions(["check"], "--fo") == [("--format", "plain"), ("--force", "plain")]
     assert completions(["check", "--format"], "") == [
-        ("human", "plain"), ("json", "plain"), ("sarif", "plain")]
+        ("human", "plain"), ("concise", "plain"), ("json", "plain"), ("sarif", "plain")]
     assert completions(["run", "x.rob", "--engine"], "a") == [("ast", "plain")]
     # `rl1c FILE.rob` is `rl1c compile FILE.rob`: its options complete too.
     assert ("--emit", "plain") in completions(["prog.rob"], "--")

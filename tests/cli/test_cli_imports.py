@@ -8,7 +8,7 @@ from importlib.metadata import version
 import pytest
 from support import SAMPLE
 
-from rl1.compiler.backend import driver
+from rl1.compiler.backend import driver, firmware
 from rl1.compiler.cli import build as cli
 from rl1.compiler.cli import run as runner
 from rl1.vm import faults
@@ -20,7 +20,8 @@ COSTLY = {"lark", "numpy", "hypothesis", "pygls", "lsprotocol"}
 
 
 def test_option_values_are_the_stages_own() -> None:
-    assert cli.EMIT_CHOICES == driver.EMITS
+    assert (*driver.EMITS, *firmware.FORMATS, "ils") == cli.EMIT_CHOICES
+    assert set(cli.EMIT_SUFFIXES) == set(cli.EMIT_CHOICES)
     assert cli.ENGINE_CHOICES == runner.ENGINES
     assert cli.DEFAULT_BUDGET == faults.DEFAULT_BUDGET
 

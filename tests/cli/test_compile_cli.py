@@ -6,17 +6,20 @@ import shutil
 from pathlib import Path
 
 import pytest
+from intelhex import IntelHex
 from support import SAMPLE
 from support.cli import rl1c
 
 from rl1.compiler.analysis import Analysis
 from rl1.compiler.backend import driver
+from rl1.compiler.backend.firmware import c_source
 from rl1.compiler.backend.ir import format_program
 from rl1.compiler.backend.lower import lower
 from rl1.compiler.files import write_atomically
 from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.compiler.frontend.parser import parse_program
+from rl1.compiler.ils.asm import assemble
 from rl1.vm import ilc
 from rl1.vm.verifier import verify
 
@@ -72,6 +75,54 @@ def test_emit_ir_prints_the_ir_or_writes_it_with_o(sample: Path, tmp_path: Path)
     assert not (tmp_path / "sample.ilc").exists()
 
 
+def test_emit_c_writes_the_ilc_bytes_as_a_c_array_beside_the_source(sample: Path) -> None:
+    assert rl1c(str(sample), "-o", str(sample.parent / "ref.ilc")).exit_code == 0
+    data = (sample.parent / "ref.ilc").read_bytes()
+    result = rl1c(str(sample), "--emit", "c")
+    assert result.exit_code == 0, result.stderr
+    assert c_source(data, "sample_ilc", "sample.rob") \
+        == (sample.parent / "sample.c").read_text(encoding="ascii")
+    named = rl1c(str(sample), "--emit", "c", "--c-name", "route", "-o", "-")
+    assert named.stdout == c_source(data, "route", "sample.rob")
+
+
+def test_emit_c_from_standard_input_is_named_after_the_output(tmp_path: Path) -> None:
+    result = rl1c("-", "--emit", "c", "-o", str(tmp_path / "line-2.c"), stdin=SAMPLE.read_bytes())
+    assert result.exit_code == 0, result.stderr
+    assert "const uint8_t line_2_ilc[" in (tmp_path / "line-2.c").read_text(encoding="ascii")
+    unnamed = rl1c("-", "--emit", "c", "-o", "-", stdin=SAMPLE.read_bytes())
+    assert "const uint8_t program_ilc[" in unnamed.stdout
+
+
+@pytest.mark.parametrize("address, base", [(None, 0), ("0x08004000", 0x08004000),
+                                           ("4096", 4096)])
+def test_emit_ihex_places_the_ilc_bytes_at_the_base_address(
+    sample: Path, address: str | None, base: int,
+) -> None:
+    assert rl1c(str(sample), "-o", str(sample.parent / "ref.ilc")).exit_code == 0
+    data = (sample.parent / "ref.ilc").read_bytes()
+    result = rl1c(str(sample), "--emit", "ihex",
+                  *(["--base-address", address] if address is not None else []))
+    assert result.exit_code == 0, result.stderr
+    hex_file = IntelHex()
+    hex_file.loadhex(str(sample.parent / "sample.hex"))
+    assert (hex_file.minaddr(), hex_file.maxaddr()) == (base, base + len(data) - 1)
+    assert hex_file.tobinstr(start=base, size=len(data)) == data
+
+
+def test_emit_ils_is_the_text_that_assembles_to_the_same_ilc(sample: Path) -> None:
+    assert rl1c(str(sample), "-o", str(sample.parent / "ref.ilc")).exit_code == 0
+    result = rl1c(str(sample), "--emit", "ils")
+    assert result.exit_code == 0, result.stderr
+    text = (sample.parent / "sample.ils").read_text(encoding="utf-8")
+    assert ";    3 | (SCN 0); (TRC 3); (MOV 3,3)" in text  # the source lines, interleaved
+    assert assemble(text) == (sample.parent / "ref.ilc").read_bytes()
+    stripped = rl1c(str(sample), "--emit", "ils", "-s", "-o", "-")
+    assert ".source" not in stripped.stdout
+    assert assemble(stripped.stdout) == ilc.encode(ilc.strip_debug(
+        ilc.decode((sample.parent / "ref.ilc").read_bytes())))
+
+
 def test_standard_input_and_output(tmp_path: Path) -> None:
     result = rl1c("-", "-o", "-", stdin=SAMPLE.read_bytes())
     assert result.exit_code == 0, result.stderr
@@ -79,6 +130,8 @@ def test_standard_input_and_output(tmp_path: Path) -> None:
     assert image.debug is not None and image.debug.source_name == "<stdin>"
     unnamed = rl1c("-", stdin=SAMPLE.read_bytes())
     assert unnamed.exit_code == 2 and "give -o FILE.ilc" in unnamed.stderr
+    unnamed_c = rl1c("-", "--emit", "c", stdin=SAMPLE.read_bytes())
+    assert unnamed_c.exit_code == 2 and "give -o FILE.c" in unnamed_c.stderr
 
 
 @pytest.mark.parametrize("args, message", [
@@ -86,6 +139,13 @@ def test_standard_input_and_output(tmp_path: Path) -> None:
     (["-O", "s"], "only -O0"),
     (["--emit", "ir", "-s"], "no meaning with --emit ir"),
     (["--emit", "asm"], "argument --emit: invalid choice: 'asm'"),
+    (["--c-name", "x"], "--c-name names the array of --emit c"),
+    (["--emit", "c", "--c-name", "2x"], "argument --c-name: `2x` is not a C identifier"),
+    (["--emit", "c", "--c-name", "int"], "`int` is a C keyword"),
+    (["--base-address", "0x100"], "--base-address places the bytes of --emit ihex"),
+    (["--emit", "ihex", "--base-address", "0x1_0000_0000"], "expected an address from 0"),
+    (["--emit", "ihex", "--base-address", "-1"], "expected an address from 0"),
+    (["--emit", "ihex", "--base-address", "0xFFFFFF00"], "reach past 4 GiB"),
 ])
 def test_bad_options_are_usage_errors_and_write_nothing(
     sample: Path, args: list[str], message: str,
@@ -106,7 +166,8 @@ def test_errors_refuse_to_write_and_are_printed_as_check_prints_them(tmp_path: P
     assert result.stdout == ""
     checked = rl1c("check", str(source), "--color", "never")
     assert checked.exit_code == 1
-    assert result.stderr == checked.stdout.replace("could not check", "could not compile")
+    assert result.stderr + "1 file checked: 1 error, 0 warnings\n" \
+        == checked.stdout.replace("could not check", "could not compile")
     assert "error[E0101]" in result.stderr
     assert output.read_bytes() == b"an older build"
     assert sorted(os.listdir(tmp_path)) == ["broken.ilc", "broken.rob"]

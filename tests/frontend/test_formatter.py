@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from support import SAMPLE, TEST_DATA
 from support.cli import Result, rl1c
 
-from rl1.compiler import formatter
+from rl1.compiler.cli import streams
 from rl1.compiler.formatter import format_line, format_lines, format_text
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.parser import parse_program
@@ -248,7 +248,7 @@ def test_fmt_check_lists_what_would_change_and_changes_nothing(tmp_path: Path) -
 def test_fmt_diff_prints_a_unified_diff_and_changes_nothing(tmp_path: Path) -> None:
     messy = write(tmp_path, b"'ok\nA = 1\n")
     result = run("--diff", str(messy))
-    assert result.exit_code == 0
+    assert result.exit_code == 1  # as `ruff format --diff`: a change to make is a failure
     assert "-A = 1\n+A=1\n" in result.stdout
     assert result.stdout.startswith(f"--- {messy}\n+++ {messy} (formatted)\n")
     assert messy.read_bytes() == b"'ok\nA = 1\n"
@@ -295,9 +295,37 @@ def test_fmt_reports_a_file_it_cannot_write(tmp_path: Path,
     def disk_full(path: object, data: bytes, *, force: bool = False) -> None:
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    monkeypatch.setattr(formatter, "write_atomically", disk_full)
+    monkeypatch.setattr(streams, "write_atomically", disk_full)
     messy = write(tmp_path, b"A = 1\n")
     result = run(str(messy))
     assert result.exit_code == 2
     assert f"cannot write `{messy}`: No space left on device" in result.stderr
     assert messy.read_bytes() == b"A = 1\n"
+
+
+def test_fmt_sums_up_what_it_changed_on_standard_error(tmp_path: Path) -> None:
+    messy = write(tmp_path, b"A = 1\n", "messy.rob")
+    tidy = write(tmp_path, b"A=1\n", "tidy.rob")
+    checked = run("--check", str(messy), str(tidy))
+    assert checked.stderr == "1 file would be reformatted, 1 file already formatted\n"
+    done = run(str(messy), str(tidy), str(tmp_path / "gone.rob"))
+    assert done.exit_code == 2
+    assert done.stderr.endswith(
+        "1 file reformatted, 1 file left unchanged, 1 file could not be formatted\n")
+    again = run(str(messy), str(tidy))
+    assert (again.exit_code, again.stderr) == (0, "0 files reformatted, 2 files left unchanged\n")
+
+
+def test_fmt_formats_every_rob_file_below_a_folder(tmp_path: Path) -> None:
+    first = write(tmp_path, b"A = 1\n", "a.rob")
+    (tmp_path / "sub").mkdir()
+    second = write(tmp_path, b"B = 2\n", "sub/B.ROB")
+    other = write(tmp_path, b"C = 3\n", "sub/notes.txt")
+    diff = run("--diff", str(tmp_path))
+    assert diff.exit_code == 1
+    assert [line for line in diff.stdout.splitlines() if line.startswith("---")] == [
+        f"--- {first}", f"--- {second}"]
+    assert run(str(tmp_path)).exit_code == 0
+    assert (first.read_bytes(), second.read_bytes(), other.read_bytes()) == (
+        b"A=1\n", b"B=2\n", b"C = 3\n")
+    assert run("--check", str(tmp_path)).exit_code == 0

@@ -1,9 +1,11 @@
 """The parser: spans, left-to-right expressions, selectors and syntax errors."""
 
 
+import pytest
 from support import SAMPLE
 
 from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Diagnostic
 from rl1.compiler.frontend.parser import parse_line, parse_program
 
 
@@ -100,3 +102,86 @@ def test_a_line_of_more_code_than_is_read_is_e0106_and_nothing_else() -> None:
     assert line.statements == () and not line.ok
     long_comment, diagnostics = parse_line("A=1 '" + "x" * 100_000, 1)
     assert diagnostics == [] and len(long_comment.statements) == 1
+
+
+def only(text: str) -> Diagnostic:
+    _, [diagnostic] = parse_line(text, 1)
+    return diagnostic
+
+
+def edited(text: str, diagnostic: Diagnostic) -> str:
+    """`text`, one line, with the edits of the diagnostic's only fix made."""
+    (fix,) = diagnostic.fixes
+    for edit in sorted(fix.edits, key=lambda e: e.span.column, reverse=True):
+        text = text[:edit.span.column - 1] + edit.text + text[edit.span.end_column - 1:]
+    return text
+
+
+@pytest.mark.parametrize("text", ["A = B * 2", "A=B/2", "A=B%4"])
+def test_multiplying_and_dividing_are_said_to_be_shifts(text: str) -> None:
+    diagnostic = only(text)
+    assert diagnostic.code == "E0102"
+    assert "RL/I has no `*`, `/` or `%`" in (diagnostic.help or "")
+    assert "ASCII" not in (diagnostic.help or "")
+
+
+@pytest.mark.parametrize("text, says", [
+    ("A=B!", "`!` has no meaning in RL/I code"),
+    ("A=\x01", "a control character"),
+    ("A=B＋1", "type the ASCII `+`"),
+    ("A=B→1", "RL/I code is ASCII"),
+])
+def test_other_characters_get_help_that_fits_them(text: str, says: str) -> None:
+    assert says in (only(text).help or "")
+
+
+@pytest.mark.parametrize("text, fixed", [
+    ("(MOV 3 -3)", "(MOV 3,-3)"),
+    ("(MOV A  -12)", "(MOV A,-12)"),
+    ("(CAM A -5)", "(CAM A,-5)"),
+])
+def test_a_negative_argument_after_a_space_needs_a_comma(text: str, fixed: str) -> None:
+    diagnostic = only(text)
+    assert diagnostic.code == "E0101"
+    assert "separate a negative argument with a comma" in (diagnostic.help or "")
+    assert "unary minus" not in (diagnostic.help or "")
+    assert edited(text, diagnostic) == fixed
+    assert parse_line(fixed, 1)[1] == []
+
+
+def test_a_spaced_minus_in_a_call_gets_the_comma_help_but_no_fix() -> None:
+    diagnostic = only("(MOV 3 - 3)")
+    assert "comma" in (diagnostic.help or "") and diagnostic.fixes == ()
+    assert "unary minus" in (only("A=-B").help or "")
+
+
+@pytest.mark.parametrize("text, fixed", [
+    ("A=1 B=2", "A=1; B=2"),
+    ("A=1 (MOV 3,3)", "A=1; (MOV 3,3)"),
+    ("(MOV 3,3) #10", "(MOV 3,3); #10"),
+    ("A=B+1 ?A=#10", "A=B+1; ?A=#10"),
+])
+def test_two_statements_without_a_semicolon_get_one(text: str, fixed: str) -> None:
+    diagnostic = only(text)
+    assert "statements on one line are separated by `;`" in (diagnostic.help or "")
+    assert edited(text, diagnostic) == fixed
+    assert parse_line(fixed, 1)[1] == []
+
+
+@pytest.mark.parametrize("text, fixed", [("GOTO 10", "#10"), ("goto 5", "#05"),
+                                         ("A=1; JMP 99", "A=1; #99")])
+def test_goto_is_said_to_be_a_hash_jump(text: str, fixed: str) -> None:
+    diagnostic = only(text)
+    assert diagnostic.code == "E0103"
+    assert "RL/I jumps with `#` and two digits" in (diagnostic.help or "")
+    assert edited(text, diagnostic) == fixed
+
+
+def test_goto_without_a_label_number_gets_the_help_without_a_fix() -> None:
+    for text in ("GOTO A", "GOTO 100", "GOTO"):
+        diagnostic = only(text)
+        assert "`#10`" in (diagnostic.help or "") and diagnostic.fixes == ()
+
+
+def test_if_is_said_to_be_a_conditional_jump() -> None:
+    assert "`?A=#10` jumps to `:10` when A is 0" in (only("IF A=0 GOTO 10").help or "")

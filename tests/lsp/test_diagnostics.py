@@ -75,6 +75,40 @@ async def test_edit_then_fix_republishes_for_each_version(client: Client) -> Non
     assert published(fixed) == expected("A=1\n(MOV 1,1)\n(END)\n")
 
 
+async def test_suppression_comments_work_as_in_rl1c_check(client: Client) -> None:
+    text = "(TRC 3); (MVI 3,3,100)\n(END)\n"
+    uri, diagnostics = await client.opened(text)
+    assert [d.code for d in diagnostics] == ["W0301"]
+    # Allowing it on its line, as the user types the comment, hides it.
+    client.change(uri, 2, ((0, 22, 0, 22), " ' rl1: allow W0301"))
+    allowed = await client.diagnostics_of(uri, 2)
+    assert allowed == []
+    assert published(allowed) == expected("(TRC 3); (MVI 3,3,100) ' rl1: allow W0301\n(END)\n")
+    # Moved to another line, the comment allows nothing there: both are shown.
+    client.change(uri, 3, ((0, 22, 0, 41), ""), ((1, 5, 1, 5), " ' rl1: allow W0301"))
+    moved = await client.diagnostics_of(uri, 3)
+    assert sorted(str(d.code) for d in moved) == ["W0107", "W0301"]
+    assert published(moved) == expected("(TRC 3); (MVI 3,3,100)\n(END) ' rl1: allow W0301\n")
+
+
+async def test_the_nearest_rl1_toml_selects_as_for_rl1c_check(client: Client,
+                                                              tmp_path: Path) -> None:
+    project = tmp_path / "rl1.toml"
+    project.write_text('[check]\nignore = ["W0603"]\nwarnings-as-errors = true\n',
+                       encoding="utf-8")
+    uri = (tmp_path / "sub" / "prog.rob").as_uri()
+    _, diagnostics = await client.opened("(MOV 3,3)\n", uri)
+    assert [(d.code, d.severity) for d in diagnostics] == [
+        ("W0701", types.DiagnosticSeverity.Error)]
+    # A broken rl1.toml is said, and the diagnostics are shown as without one.
+    project.write_text("[check]\nselct = 1\n", encoding="utf-8")
+    client.change(uri, 2, ((0, 9, 0, 9), " "))
+    shown = await client.diagnostics_of(uri, 2)
+    assert "unknown key `selct`" in shown[0].message and shown[0].code is None
+    assert [(d.code, d.severity) for d in shown[1:]] == [
+        ("W0603", types.DiagnosticSeverity.Warning), ("W0701", types.DiagnosticSeverity.Warning)]
+
+
 async def test_closing_a_document_clears_its_diagnostics(client: Client) -> None:
     uri, diagnostics = await client.opened("A=(\n")
     assert "E0101" in [d.code for d in diagnostics]

@@ -7,6 +7,7 @@ from conftest import Client, position_of
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException
 
+from rl1.compiler.analysis import analyze
 from rl1.compiler.formatter import format_text
 from rl1.vm.language import BUILTINS, VARIABLES
 
@@ -376,6 +377,26 @@ async def test_quick_fixes_come_from_the_checker(client: Client) -> None:
     assert handler[0].edit is not None and handler[0].edit.changes is not None
     (added,) = handler[0].edit.changes[uri]
     assert added.new_text.startswith("\n:97")
+
+
+@pytest.mark.parametrize("line, allowed", [
+    ("(TRC 3); (MVI 3,3,100)", "(TRC 3); (MVI 3,3,100) ' rl1: allow W0301"),
+    ("(TRC 3); (MVI 3,3,100) 'go", "(TRC 3); (MVI 3,3,100) 'go rl1: allow W0301"),
+])
+async def test_a_warning_can_be_allowed_on_its_line(client: Client, line: str,
+                                                    allowed: str) -> None:
+    text = line + "\n(END)\n"
+    uri = await open_program(client, text)
+    (allow,) = [a for a in await actions_at(client, uri, 0) if a.title.startswith("Allow")]
+    assert allow.title.startswith("Allow W0301 on this line")
+    assert allow.edit is not None and allow.edit.changes is not None
+    (edit,) = allow.edit.changes[uri]
+    assert edit.range.start == edit.range.end == types.Position(0, len(line))
+    assert line + edit.new_text == allowed
+    assert analyze(allowed + "\n(END)\n").diagnostics == []
+    # A line whose comment holds a directive already is not offered another.
+    directive = await open_program(client, line + " ' rl1: allow W0602\n(END)\n")
+    assert not [a for a in await actions_at(client, directive, 0) if a.title.startswith("Allow")]
 
 
 async def test_fix_all_applies_every_single_fix(client: Client) -> None:

@@ -212,3 +212,10 @@ async def test_failing_features_answer_errors_and_the_server_goes_on(faulty: Cli
     assert starts == [types.Position(0, 0), types.Position(0, 15)]
     faulty.change(uri, 2, ((1, 2, 1, 3), "1"))
     assert [d.code for d in await faulty.diagnostics_of(uri, 2)] == [None]
+
+
+async def test_a_failed_checker_does_not_make_allow_comments_look_unused(faulty: Client) -> None:
+    # W0701 comes from the whole-program rules, which failed: its comment is not W0107.
+    _, diagnostics = await faulty.opened("(MOV 3,3); (END) ' rl1: allow W0701\n")
+    assert "checker failed" in diagnostics[0].message
+    assert diagnostics[1:] == []

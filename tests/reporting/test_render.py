@@ -411,3 +411,11 @@ def test_colour_auto_means_a_terminal_without_no_color(monkeypatch: pytest.Monke
 def test_combining_marks_take_no_cell_and_a_trailing_wide_space_stays_visible() -> None:
     assert snippet_rows("e\u0301A=1", Span(1, 3, 1, 4)) == ["1 | e\u0301A=1", "  |  ^"]
     assert snippet_rows("(MOV\u3000", Span(1, 5, 1, 6)) == ["1 | (MOV\u3000", "  |     ^^"]
+
+
+def test_concise_is_one_line_per_diagnostic_with_control_characters_shown() -> None:
+    files = [FileDiagnostics("a.rob", "A\nB\n", [error_at(Span(2, 1, 2, 2), "late"),
+                                                error_at(Span(1, 3, 1, 4), "bell\x07")])]
+    assert report(files, "concise") == ("a.rob:1:3: error[E0101]: bell\u2407\n"
+                                        "a.rob:2:1: error[E0101]: late\n")
+    assert report([FileDiagnostics("a.rob", "A\n", [])], "concise") == ""

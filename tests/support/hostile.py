@@ -108,10 +108,17 @@ def source_attack(data: bytes, folder: Path) -> list[str]:
     found += _problems("check", rl1c("check", "--format", "sarif", "-", stdin=data), None)
     found += _problems("fmt", rl1c("fmt", "--diff", source), None)
     found += _problems("fmt", rl1c("fmt", "-", stdin=data), None)
+    found += _problems("check", rl1c("check", "--diff", "--format", "concise", "-",
+                                     stdin=data), None)
     found += _problems("compile", rl1c(source, "-o", output), output)
+    c_output = folder / "hostile.c"
+    c_output.unlink(missing_ok=True)
+    found += _problems("compile", rl1c(source, "--emit", "c", "-o", c_output), c_output)
     for engine in ("vm", "ast"):
         found += _problems("run", rl1c("run", source, "--engine", engine, "--budget", BUDGET),
                            None)
+    # Last, as it rewrites the source.
+    found += _problems("check", rl1c("check", "--fix", source), None)
     return found
 
 

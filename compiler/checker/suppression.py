@@ -1,0 +1,140 @@
+"""Suppression comments (spec/language.md, section 2.5): `' rl1: allow W0601` silences a
+warning on its own line, `' rl1: allow-file W0601` in the whole file.
+
+Only warnings can be allowed: an error stops compilation whatever a comment says. A
+directive that names no warning, or allows a warning that is not there, is itself
+reported (W0107), so that a misspelt code or a stale comment does not linger unseen.
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
+
+MARK = "rl1:"
+"""What a comment holds when it may be a directive: the quick test of every comment."""
+
+KINDS = ("allow", "allow-file")
+
+
+@functools.cache
+def _patterns() -> tuple[re.Pattern[str], re.Pattern[str], re.Pattern[str]]:
+    """The directive, a word shaped as a code, and a code; compiled when a comment first
+    holds `rl1:` (most programs have none, and every start of rl1c would pay)."""
+    return (re.compile(r"(?:^|(?<=\s))rl1:[ \t]*(?P<kind>[\w-]*)(?P<codes>.*)"),
+            re.compile(r"[ \t,]*(?P<word>[A-Za-z][0-9]+)(?![\w-])"),
+            # The catalogue is the reporting layer's; the checker knows a code's severity
+            # from its letter, which the catalogue's tests hold to every code.
+            re.compile(r"[EW][0-9]{4}"))
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Directive:
+    """One `rl1: allow` comment: its kind, the codes it names (as written, with their
+    spans) and where it is."""
+
+    file_wide: bool
+    codes: tuple[tuple[str, ast.Span], ...]
+    span: ast.Span
+
+    @property
+    def line(self) -> int:
+        return self.span.line
+
+
+def apply_suppressions(program: ast.Program, diagnostics: Iterable[Diagnostic], *,
+                       complete: bool = True) -> list[Diagnostic]:
+    """`diagnostics` without the warnings that the program's comments allow, with a
+    W0107 for each directive, or code in one, that allows nothing. When `diagnostics`
+    are not `complete` (a rule failed), a code they lack is not said to be unused."""
+    diagnostics = list(diagnostics)
+    directives, problems = _directives(program)
+    if not directives and not problems:
+        return diagnostics
+    file_wide = {code for d in directives if d.file_wide for code, _ in d.codes}
+    on_line: dict[int, set[str]] = {}
+    for directive in directives:
+        if not directive.file_wide:
+            on_line.setdefault(directive.line, set()).update(code for code, _ in directive.codes)
+    kept: list[Diagnostic] = []
+    used: set[tuple[int | None, str]] = set()  # (line, code); None for the whole file
+    for diagnostic in diagnostics:
+        code, line = diagnostic.code, diagnostic.span.line
+        if diagnostic.severity is not Severity.WARNING:
+            kept.append(diagnostic)
+        elif code in on_line.get(line, ()):
+            used.add((line, code))
+        elif code in file_wide:
+            used.add((None, code))
+        else:
+            kept.append(diagnostic)
+    for directive in directives if complete else ():
+        scope = None if directive.file_wide else directive.line
+        for code, span in directive.codes:
+            if (scope, code) not in used:
+                where = "in this file" if directive.file_wide else "on this line"
+                problems.append(_unused(f"no {code} is reported {where}", span))
+    return kept + problems
+
+
+def _directives(program: ast.Program) -> tuple[list[Directive], list[Diagnostic]]:
+    directives: list[Directive] = []
+    problems: list[Diagnostic] = []
+    for line in program.lines:
+        comment = line.comment
+        if comment is None or MARK not in comment.text:
+            continue
+        directive, code_shaped, _ = _patterns()
+        match = directive.search(comment.text)
+        if match is None:
+            continue
+        whole = _span(comment, match.start(), match.end("kind"))
+        kind = match["kind"]
+        if kind not in KINDS:
+            problems.append(_unused(
+                f"`rl1: {kind}` is not a directive: write `rl1: allow CODE` for this line "
+                "or `rl1: allow-file CODE` for the whole file", whole))
+            continue
+        codes: list[tuple[str, ast.Span]] = []
+        position = match.start("codes")
+        while shaped := code_shaped.match(comment.text, position):
+            word, position = shaped["word"], shaped.end()
+            code_span = _span(comment, shaped.start("word"), shaped.end("word"))
+            problem = _code_problem(word.upper())
+            if problem is None:
+                codes.append((word.upper(), code_span))
+            else:
+                problems.append(_unused(problem, code_span))
+        if codes:
+            directives.append(Directive(kind == "allow-file", tuple(codes), whole))
+        elif position == match.start("codes"):
+            problems.append(_unused(f"`rl1: {kind}` names no code: write the warning's code "
+                                    f"after it, as in `rl1: {kind} W0601`", whole))
+    return directives, problems
+
+
+def _span(comment: ast.Comment, first: int, last: int) -> ast.Span:
+    """The span of the comment's text from index `first` to `last`; the text starts one
+    column after the quote."""
+    start = comment.span.column + 1
+    return ast.Span(comment.span.row, start + first, comment.span.row, start + last)
+
+
+def _code_problem(code: str) -> str | None:
+    if not _patterns()[2].fullmatch(code):
+        return f"`{code}` is not a diagnostic code (`rl1c explain --list` lists them)"
+    if code.startswith("E"):
+        return f"`{code}` is an error, and errors cannot be allowed: fix the program"
+    return None
+
+
+def _unused(why: str, span: ast.Span) -> Diagnostic:
+    return Diagnostic("W0107", Severity.WARNING,
+                      f"this suppression comment allows nothing: {why}", span,
+                      help="an `rl1: allow` comment names warning codes, such as W0601, that "
+                           "are reported on its line (`rl1: allow-file`: in its file)")
