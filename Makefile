@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint typecheck pytest clean vscode-test vscode-package
+.PHONY: demo test lint typecheck pytest clean vscode-test vscode-package c-test
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -23,7 +23,13 @@ demo: $(STAMP)
 	$(BIN)/rl1c examples/sample.rob -o build/sample.ilc
 	$(BIN)/rl1c run build/sample.ilc --sensors examples/sample.sensors.json
 
-test: lint typecheck vscode-test pytest
+test: lint typecheck vscode-test c-test pytest
+
+# The C loader (vm/c/): the Debian packages it needs when missing (CI runs as root),
+# then its builds, sanitizers, cross builds and a bounded fuzzing run.
+c-test:
+	vm/c/install-tools
+	$(MAKE) -C vm/c test
 
 lint: $(STAMP)
 	$(BIN)/ruff check compiler vm lsp tests bench spec/vectors
@@ -60,3 +66,4 @@ vscode-package: vscode-test
 clean:
 	rm -rf $(VENV) .typecheck .mypy_cache .pytest_cache .ruff_cache .hypothesis
 	rm -rf $(VSCODE)/node_modules $(VSCODE)/out $(VSCODE)/rl1.vsix
+	$(MAKE) -C vm/c clean

@@ -3,12 +3,9 @@ points at, and that no damage to a valid file makes it fail in any other way."""
 
 from __future__ import annotations
 
-import struct
-
 import pytest
 from hypothesis import given, settings
-from hypothesis import strategies as st
-from support.ilc import images, with_crc
+from support.ilc import damaged, images
 
 from rl1.vm import ilc, isa, machine
 from rl1.vm.language import BUILTINS, Feature
@@ -158,35 +155,6 @@ def test_a_line_entry_must_start_an_instruction() -> None:
 
 
 # --- damage of every kind ------------------------------------------------------------
-
-HEADER_FIELDS = [(4, "<B"), (5, "<B"), (6, "<H"), (12, "<H"), (14, "<H"), (16, "<H"),
-                 (18, "<H"), (20, "<I")]
-
-
-@st.composite
-def damaged(draw: st.DrawFn) -> bytes:
-    data = bytearray(ilc.encode(draw(images())))
-    # Hypothesis favours small numbers: pick the region first, so that damage reaches
-    # the code, the tables and the debug section as often as the header.
-    header = ilc.read_header(bytes(data))
-    start = draw(st.sampled_from([0, CODE, header.handler_start, header.debug_start]))
-    position = draw(st.integers(min(start, len(data) - 1), len(data) - 1))
-    kind = draw(st.sampled_from(["flip", "overwrite", "truncate", "insert", "header"]))
-    if kind == "flip":
-        data[position] ^= 1 << draw(st.integers(0, 7))
-    elif kind == "overwrite":
-        data[position] = draw(st.integers(0, 255))
-    elif kind == "truncate":
-        del data[position:]
-    elif kind == "insert":
-        data[position:position] = draw(st.binary(min_size=1, max_size=8))
-    else:
-        offset, fmt = draw(st.sampled_from(HEADER_FIELDS))
-        limit = 1 << 8 * struct.calcsize(fmt)
-        struct.pack_into(fmt, data, offset, draw(st.integers(0, limit - 1) | st.integers(0, 40)))
-    # Fixing the CRC lets the damage reach the checks behind it.
-    return with_crc(data) if len(data) >= 12 and draw(st.booleans()) else bytes(data)
-
 
 # Lost lines early and often, so that runs take the handler paths too.
 LOSSES = Script(losses=(LossAt(0), LossDuring("MOV", 1, 0), LossDuring("MVI", 1, 0),
