@@ -27,9 +27,9 @@ test: lint typecheck vscode-test c-test pytest
 
 # The C loader (vm/c/): the Debian packages it needs when missing (CI runs as root),
 # then its builds, sanitizers, cross builds and a bounded fuzzing run.
-c-test:
+c-test: $(STAMP)
 	vm/c/install-tools
-	$(MAKE) -C vm/c test
+	$(MAKE) -C vm/c test RL1_PYTHON=$(CURDIR)/$(BIN)/python
 
 lint: $(STAMP)
 	$(BIN)/ruff check compiler vm lsp tests bench spec/vectors
@@ -43,7 +43,8 @@ typecheck: $(STAMP)
 	ln -s ../../vm .typecheck/rl1/vm
 	ln -s ../../lsp .typecheck/rl1/lsp
 	MYPYPATH=.typecheck $(BIN)/mypy -p rl1.compiler -p rl1.vm -p rl1.lsp
-	MYPYPATH=.typecheck:spec/vectors:tests $(BIN)/mypy tests $(wildcard bench/*.py) spec/vectors
+	MYPYPATH=.typecheck:spec/vectors:tests $(BIN)/mypy tests $(wildcard bench/*.py) spec/vectors \
+	    $(wildcard vm/c/test/*.py)
 
 pytest: $(STAMP)
 	$(BIN)/pytest -n 2

@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from support.ilc import damaged, images
 
 from rl1.vm import ilc, isa, machine
+from rl1.vm.ilc import Refusal
 from rl1.vm.language import BUILTINS, Feature
 from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
 from rl1.vm.verifier import VerifiedProgram, VerifyError, verify
@@ -72,28 +73,30 @@ def test_container_refusals_come_as_verify_errors() -> None:
     assert error.offset == 0
 
 
-@pytest.mark.parametrize(("code", "offset", "message"), [
-    (op("LDI", 0) + bytes([0x07]), CODE + 3, "code offset 3: unknown opcode 0x07"),
-    (op("LDI", 0)[:2], CODE, "LDI needs 3 bytes, only 2 remain"),
+@pytest.mark.parametrize(("code", "offset", "message", "kind"), [
+    (op("LDI", 0) + bytes([0x07]), CODE + 3, "code offset 3: unknown opcode 0x07",
+     Refusal.UNKNOWN_OPCODE),
+    (op("LDI", 0)[:2], CODE, "LDI needs 3 bytes, only 2 remain", Refusal.CUT_OFF),
     (op("LDI", 0) + op("MVI", args=(const(1), const(1), const(1)))[:5], CODE + 3,
-     "MVI needs 8 bytes, only 5 remain"),
-    (op("JMP", 3), CODE + 1, "jump target 3 is outside the 3-byte code"),
-    (op("JMP", 0xFFFF), CODE + 1, "jump target 65535 is outside"),
+     "MVI needs 8 bytes, only 5 remain", Refusal.CUT_OFF),
+    (op("JMP", 3), CODE + 1, "jump target 3 is outside the 3-byte code", Refusal.BAD_JUMP),
+    (op("JMP", 0xFFFF), CODE + 1, "jump target 65535 is outside", Refusal.BAD_JUMP),
     (op("LDI", 0) + op("JGT", 0, 1), CODE + 5, "target 1 is in the middle of the "
-                                               "instruction at 0"),
-    (op("LDV", 53), CODE + 1, "LDV: variable index 53 is out of range 0..52"),
-    (op("LDI", 0) + op("JZ", 255, 0), CODE + 4, "JZ: variable index 255"),
-    (op("MOV", args=(const(0), var(53))), CODE + 4, "MOV argument r: variable index 53"),
-    (op("MOV", args=(const(0), var(0x100))), CODE + 4, "variable index 256"),
+                                               "instruction at 0", Refusal.BAD_JUMP),
+    (op("LDV", 53), CODE + 1, "LDV: variable index 53 is out of range 0..52", Refusal.BAD_VARIABLE),
+    (op("LDI", 0) + op("JZ", 255, 0), CODE + 4, "JZ: variable index 255", Refusal.BAD_VARIABLE),
+    (op("MOV", args=(const(0), var(53))), CODE + 4, "MOV argument r: variable index 53",
+     Refusal.BAD_VARIABLE),
+    (op("MOV", args=(const(0), var(0x100))), CODE + 4, "variable index 256", Refusal.BAD_VARIABLE),
     (op("MOV", args=(const(13), const(0))), CODE + 2, "MOV argument l = 13 is out of "
-                                                      "range -12..12"),
+                                                      "range -12..12", Refusal.ARGUMENT_RANGE),
     (bytes([isa.BY_NAME["MOV"].opcode, 0x04, 0, 0, 0, 0]), CODE + 1,
-     "argument mask 0x04 marks arguments beyond its 2"),
+     "argument mask 0x04 marks arguments beyond its 2", Refusal.BAD_MASK),
 ])
-def test_bad_code_is_refused_at_the_offending_byte(code: bytes, offset: int,
-                                                   message: str) -> None:
+def test_bad_code_is_refused_at_the_offending_byte(code: bytes, offset: int, message: str,
+                                                   kind: Refusal) -> None:
     error = refusal(file_of(code))
-    assert error.offset == offset
+    assert (error.offset, error.refusal) == (offset, kind)
     assert message in error.message
 
 

@@ -13,6 +13,14 @@
  */
 #include "rl1vm.h"
 
+/* How a byte of the file is read: a plain load, unless the build says otherwise. AVR's
+ * flash is not in its data address space, so a file kept there is read with
+ * -DRL1_READ_BYTE(p)=pgm_read_byte(p) -include avr/pgmspace.h (vm/c/README.md). */
+#ifndef RL1_READ_BYTE
+#define RL1_READ_BYTE(p) (*(p))
+#endif
+#define BYTE(p) ((uint8_t)RL1_READ_BYTE(p))
+
 #define HEADER_SIZE 24u
 #define HANDLER_SIZE 8u
 #define FEATURE_SIZE 2u
@@ -40,13 +48,13 @@ static rl1_status fail(loader *ld, rl1_status status, uint32_t offset)
 
 static uint16_t u16_at(const uint8_t *p)
 {
-    return (uint16_t)(p[0] | ((unsigned)p[1] << 8));
+    return (uint16_t)(BYTE(p) | ((unsigned)BYTE(p + 1) << 8));
 }
 
 static uint32_t u32_at(const uint8_t *p)
 {
-    return (uint32_t)p[0] | ((uint32_t)p[1] << 8) | ((uint32_t)p[2] << 16)
-           | ((uint32_t)p[3] << 24);
+    return (uint32_t)BYTE(p) | ((uint32_t)BYTE(p + 1) << 8)
+           | ((uint32_t)BYTE(p + 2) << 16) | ((uint32_t)BYTE(p + 3) << 24);
 }
 
 /* An i16 operand's value; converting a u16 above 0x7FFF to int16_t would be
@@ -85,7 +93,7 @@ static uint32_t file_crc(const loader *ld)
     uint32_t i;
     for (i = 0; i < ld->size; i++) {
         /* The CRC field, bytes 8..11, counts as zero. */
-        crc = crc_byte(crc, (i >= 8u && i < 12u) ? 0u : ld->file[i]);
+        crc = crc_byte(crc, (i >= 8u && i < 12u) ? 0u : BYTE(ld->file + i));
     }
     return crc ^ UINT32_C(0xFFFFFFFF);
 }
@@ -203,7 +211,7 @@ static rl1_status leb128(loader *ld, uint32_t *pos, uint32_t end, uint32_t *valu
         if (*pos == end) {
             return fail(ld, RL1_DEBUG_CUT_OFF, *pos);
         }
-        byte = ld->file[(*pos)++];
+        byte = BYTE(ld->file + (*pos)++);
         *value |= (uint32_t)(byte & 0x7Fu) << (7u * n);
         if (!(byte & 0x80u)) {
             /* A last byte of 0 after another byte: not the shortest form. */
@@ -218,7 +226,7 @@ static rl1_status leb128(loader *ld, uint32_t *pos, uint32_t end, uint32_t *valu
 static rl1_status check_utf8(loader *ld, uint32_t pos, uint32_t end)
 {
     while (pos < end) {
-        uint8_t lead = ld->file[pos];
+        uint8_t lead = BYTE(ld->file + pos);
         uint8_t low = 0x80u, high = 0xBFu; /* the second byte's range (Unicode table 3-7) */
         uint32_t length, i;
         if (lead < 0x80u) {
@@ -242,7 +250,7 @@ static rl1_status check_utf8(loader *ld, uint32_t pos, uint32_t end)
             return fail(ld, RL1_DEBUG_NAME_UTF8, pos);
         }
         for (i = 1; i < length; i++) {
-            uint8_t byte = ld->file[pos + i];
+            uint8_t byte = BYTE(ld->file + pos + i);
             if (byte < (i == 1u ? low : 0x80u) || byte > (i == 1u ? high : 0xBFu)) {
                 return fail(ld, RL1_DEBUG_NAME_UTF8, pos);
             }
@@ -261,7 +269,7 @@ static rl1_status check_debug(loader *ld, rl1_program *program, uint32_t pos, ui
     if (end - pos < 1u) {
         return fail(ld, RL1_DEBUG_CUT_OFF, pos);
     }
-    program->source_name_size = ld->file[pos++];
+    program->source_name_size = BYTE(ld->file + pos++);
     if (end - pos < program->source_name_size) {
         return fail(ld, RL1_DEBUG_CUT_OFF, pos);
     }
@@ -314,16 +322,17 @@ static rl1_status check_container(loader *ld, rl1_program *program, uint32_t *co
     if (ld->size < 6u) {
         return fail(ld, RL1_TRUNCATED, ld->size);
     }
-    if (file[0] != 'R' || file[1] != 'L' || file[2] != 'I' || file[3] != 'C') {
+    if (BYTE(file) != 'R' || BYTE(file + 1) != 'L' || BYTE(file + 2) != 'I'
+        || BYTE(file + 3) != 'C') {
         return fail(ld, RL1_BAD_MAGIC, 0);
     }
-    if (file[4] != 1u) {
+    if (BYTE(file + 4) != 1u) {
         return fail(ld, RL1_BAD_MAJOR, 4);
     }
     if (ld->size < HEADER_SIZE) {
         return fail(ld, RL1_TRUNCATED, ld->size);
     }
-    minor = file[5];
+    minor = BYTE(file + 5);
     newer = minor > KNOWN_MINOR;
     header_size = u16_at(file + 12);
     if (header_size < HEADER_SIZE || (header_size != HEADER_SIZE && !newer)) {
@@ -400,7 +409,7 @@ static bool starts_instruction(const starts *s, uint16_t target)
         return ((unsigned)s->bitmap[target >> 3] >> (target & 7u)) & 1u;
     }
     while (pos < target) {
-        pos += op_length(s->program->code[pos], &shape);
+        pos += op_length(BYTE(s->program->code + pos), &shape);
     }
     return pos == target;
 }
@@ -413,7 +422,7 @@ static rl1_status check_variable(loader *ld, uint32_t index, uint32_t offset)
 /* A call's mask and arguments; `at` is the mask's file offset. */
 static rl1_status check_call(loader *ld, uint8_t op, uint8_t length, uint32_t at)
 {
-    uint8_t mask = ld->file[at], arity = (uint8_t)((length - 2u) / 2u), k;
+    uint8_t mask = BYTE(ld->file + at), arity = (uint8_t)((length - 2u) / 2u), k;
     rl1_status status = RL1_OK;
     if (mask >> arity) {
         return fail(ld, RL1_BAD_MASK, at);
@@ -436,7 +445,7 @@ static rl1_status check_instructions(loader *ld, const rl1_program *program, uin
 {
     uint32_t pos = 0;
     while (pos < program->code_size) {
-        uint8_t op = program->code[pos], length, feature;
+        uint8_t op = BYTE(program->code + pos), length, feature;
         uint32_t at = base + pos;
         enum shape shape;
         rl1_status status = RL1_OK;
@@ -448,7 +457,7 @@ static rl1_status check_instructions(loader *ld, const rl1_program *program, uin
             return fail(ld, RL1_CUT_OFF, at);
         }
         if (shape == VAR || shape == VAR_ADDR) {
-            status = check_variable(ld, ld->file[at + 1u], at + 1u);
+            status = check_variable(ld, BYTE(ld->file + at + 1u), at + 1u);
         } else if (shape == ARGS) {
             status = check_call(ld, op, length, at + 1u);
         }
@@ -476,7 +485,7 @@ static rl1_status check_targets(loader *ld, const rl1_program *program, uint32_t
     uint8_t i;
     while (pos < program->code_size) {
         enum shape shape;
-        uint8_t length = op_length(program->code[pos], &shape);
+        uint8_t length = op_length(BYTE(program->code + pos), &shape);
         at = base + pos + (shape == VAR_ADDR ? 2u : 1u); /* the target operand */
         if ((shape == ADDR || shape == VAR_ADDR)
             && !starts_instruction(s, u16_at(ld->file + at))) {
