@@ -2,7 +2,7 @@
 acceptance, the same refusal at the same file offset, and the same source line for
 every code offset, on every vector file, on every opcode and parameter bound, and on
 generated and damaged files. The C side checks jump targets two ways (a bitmap, and a
-rescan without memory); both must agree with Python.
+rescan without memory, for a bitmap too small or none); each must agree with Python.
 
 ctypes, not cffi: it is in the standard library, so the only build step is the shared
 library `make -C vm/c lib` makes; the two entry points take only scalars and a buffer.
@@ -30,6 +30,7 @@ from rl1.vm.verifier import VerifyError, verify
 
 C_DIR = ROOT / "vm" / "c"
 CODE = 24  # file offset of the code section in a 1.0 or 1.1 file
+MAX_BITMAP = 8192  # RL1_BITMAP_SIZE(65535)
 
 
 class Loader:
@@ -37,17 +38,19 @@ class Loader:
 
     def __init__(self, library: Path) -> None:
         self.lib = ctypes.CDLL(str(library))
-        self.lib.rl1_test_load.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_int,
+        self.lib.rl1_test_load.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_size_t,
                                            ctypes.POINTER(ctypes.c_uint32)]
         self.lib.rl1_test_load.restype = ctypes.c_int
         self.lib.rl1_test_line_at.argtypes = [ctypes.c_char_p, ctypes.c_uint32,
                                               ctypes.c_uint16]
         self.lib.rl1_test_line_at.restype = ctypes.c_uint16
 
-    def load(self, data: bytes, *, bitmap: bool) -> tuple[int, int]:
-        """(status, error offset); status 0 accepts, else an ilc.Refusal."""
+    def load(self, data: bytes, bitmap_size: int) -> tuple[int, int]:
+        """(status, error offset); status 0 accepts, else an ilc.Refusal. The bitmap has
+        `bitmap_size` bytes, at most MAX_BITMAP (ffi.c's); 0: none."""
+        assert 0 <= bitmap_size <= MAX_BITMAP
         offset = ctypes.c_uint32(0)
-        status = self.lib.rl1_test_load(data, len(data), int(bitmap), ctypes.byref(offset))
+        status = self.lib.rl1_test_load(data, len(data), bitmap_size, ctypes.byref(offset))
         return int(status), offset.value if status else 0
 
     def line_at(self, data: bytes, code_offset: int) -> int:
@@ -75,8 +78,10 @@ def python_verdict(data: bytes) -> tuple[int, int]:
 
 def assert_agree(c_loader: Loader, data: bytes) -> tuple[int, int]:
     expected = python_verdict(data)
-    assert c_loader.load(data, bitmap=True) == expected
-    assert c_loader.load(data, bitmap=False) == expected
+    # The bitmap the header's code size needs (RL1_BITMAP_SIZE), more, less, and none.
+    needed = (struct.unpack_from("<H", data, 14)[0] + 7) // 8 if len(data) >= 16 else 0
+    for size in {MAX_BITMAP, needed, max(needed - 1, 0), 0}:
+        assert c_loader.load(data, size) == expected, size
     return expected
 
 

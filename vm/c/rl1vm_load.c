@@ -266,9 +266,7 @@ static rl1_status check_debug(loader *ld, rl1_program *program, uint32_t pos, ui
     uint32_t offset = 0, line = 0, offset_delta, line_delta;
     uint16_t index, count;
     rl1_status status;
-    if (end - pos < 1u) {
-        return fail(ld, RL1_DEBUG_CUT_OFF, pos);
-    }
+    /* The name's size byte is there: a debug section of size 0 is no debug section. */
     program->source_name_size = BYTE(ld->file + pos++);
     if (end - pos < program->source_name_size) {
         return fail(ld, RL1_DEBUG_CUT_OFF, pos);
