@@ -29,6 +29,7 @@ static void check(const uint8_t *data, uint32_t size)
 {
     rl1_program program, rescanned;
     uint32_t offset, rescanned_offset, code_offset;
+    int i;
     rl1_status status = rl1_load(&program, data, size, bitmap, sizeof bitmap, &offset);
     rl1_status again = rl1_load(&rescanned, data, size, NULL, 0, &rescanned_offset);
     if (status != again || offset != rescanned_offset || offset > size) {
@@ -36,6 +37,18 @@ static void check(const uint8_t *data, uint32_t size)
     }
     if (status != RL1_OK) {
         return;
+    }
+    /* What the VM will rely on without checking: the sections inside the file, every
+     * handler inside the code. */
+    if (program.code + program.code_size > data + size
+        || (program.lines && program.lines > data + size)
+        || (program.digest && program.digest + 16 > data + size)) {
+        __builtin_trap();
+    }
+    for (i = 0; i < 4; i++) {
+        if (program.handlers[i] != RL1_ABSENT && program.handlers[i] >= program.code_size) {
+            __builtin_trap();
+        }
     }
     /* Lines never decrease along the code (spec/ilc.md 4.4); the first 256 offsets,
      * since each lookup walks the map. */
