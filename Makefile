@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint typecheck pytest clean vscode-test vscode-package
+.PHONY: demo test lint typecheck pytest clean vscode-test vscode-package c-test
 
 # pip byte-compiles what it installs, but an editable install leaves rl1 to its first
 # run, which cannot write bytecode where PYTHONDONTWRITEBYTECODE is set: compileall.
@@ -32,7 +32,13 @@ demo: $(STAMP)
 	@echo
 	@echo 'Next: `. .venv/bin/activate`, then the first session in README.md.'
 
-test: lint typecheck vscode-test pytest
+test: lint typecheck vscode-test c-test pytest
+
+# The C loader (vm/c/): the Debian packages it needs when missing (CI runs as root),
+# then its builds, sanitizers, cross builds and a bounded fuzzing run.
+c-test: $(STAMP)
+	vm/c/install-tools
+	$(MAKE) -C vm/c test RL1_PYTHON=$(CURDIR)/$(BIN)/python
 
 lint: $(STAMP)
 	$(BIN)/ruff check compiler vm lsp tests bench spec/vectors
@@ -45,8 +51,9 @@ typecheck: $(STAMP)
 	ln -s ../../compiler .typecheck/rl1/compiler
 	ln -s ../../vm .typecheck/rl1/vm
 	ln -s ../../lsp .typecheck/rl1/lsp
-	MYPYPATH=.typecheck $(BIN)/mypy -p rl1.compiler -p rl1.vm -p rl1.lsp
-	MYPYPATH=.typecheck:spec/vectors:tests $(BIN)/mypy tests $(wildcard bench/*.py) spec/vectors
+	MYPYPATH=.typecheck:spec/vectors $(BIN)/mypy -p rl1.compiler -p rl1.vm -p rl1.lsp
+	MYPYPATH=.typecheck:spec/vectors:tests $(BIN)/mypy tests $(wildcard bench/*.py) spec/vectors \
+	    $(wildcard vm/c/test/*.py)
 
 pytest: $(STAMP)
 	$(BIN)/pytest -n 2
@@ -69,3 +76,4 @@ vscode-package: vscode-test
 clean:
 	rm -rf $(VENV) .typecheck .mypy_cache .pytest_cache .ruff_cache .hypothesis
 	rm -rf $(VSCODE)/node_modules $(VSCODE)/out $(VSCODE)/rl1.vsix
+	$(MAKE) -C vm/c clean

@@ -17,6 +17,7 @@ import hashlib
 import struct
 import zlib
 from dataclasses import dataclass
+from enum import IntEnum
 
 from .language import HANDLER_LABELS, Feature
 
@@ -45,13 +46,47 @@ REQUIRED_FLAGS = 0x00FF
 KNOWN_FLAGS = 0x0000
 
 
-class IlcFormatError(Exception):
-    """A file that is not a valid .ilc container; `offset` is a byte offset in the file."""
+class Refusal(IntEnum):
+    """Why a file is refused: one kind per rule of spec/ilc.md section 10, in the order
+    the rules are checked. The C loader's `rl1_status` (vm/c/rl1vm.h) has the same names
+    (prefixed RL1_) and numbers, so that the two can be compared refusal for refusal."""
 
-    def __init__(self, offset: int, message: str) -> None:
+    TRUNCATED = 1  # the header or a section passes the file's end
+    BAD_MAGIC = 2
+    BAD_MAJOR = 3
+    BAD_HEADER_SIZE = 4
+    BAD_SECTION_SIZE = 5  # the handler table or the features section
+    EXTRA_BYTES = 6
+    BAD_CRC = 7
+    REQUIRED_FLAG = 8
+    HANDLER_OUTSIDE = 9  # a handler entry past the code
+    UNKNOWN_FEATURE = 10
+    DEBUG_CUT_OFF = 11  # a debug field passes the section's end
+    DEBUG_NAME_UTF8 = 12
+    DEBUG_NUMBER = 13  # a LEB128 number too long or not in its shortest form
+    DEBUG_ORDER = 14  # line entry offsets do not increase
+    DEBUG_RANGE = 15  # a line entry's offset or line out of range
+    DEBUG_LEFTOVER = 16
+    UNKNOWN_OPCODE = 17
+    CUT_OFF = 18  # an instruction cut off by the code's end
+    BAD_VARIABLE = 19
+    BAD_MASK = 20
+    ARGUMENT_RANGE = 21
+    MISSING_FEATURE = 22  # a call whose device feature the header does not list
+    BAD_JUMP = 23  # a jump target that does not start an instruction
+    BAD_HANDLER = 24  # likewise a handler entry
+    BAD_LINE_ENTRY = 25  # likewise a line entry
+
+
+class IlcFormatError(Exception):
+    """A file that is not a valid .ilc container; `offset` is a byte offset in the file,
+    `refusal` the rule it breaks."""
+
+    def __init__(self, offset: int, message: str, refusal: Refusal) -> None:
         super().__init__(f"byte {offset}: {message}")
         self.offset = offset
         self.message = message
+        self.refusal = refusal
 
 
 @dataclass(frozen=True)
@@ -228,11 +263,13 @@ def read(data: bytes) -> Container:
     if crc_of(data) != header.crc:
         raise IlcFormatError(CRC_OFFSET, f"CRC-32 mismatch: the header says "
                              f"0x{header.crc:08X}, the file's is 0x{crc_of(data):08X}; "
-                             "the file is damaged, compile it again")
+                             "the file is damaged, compile it again",
+                             Refusal.BAD_CRC)
     unknown_required = header.flags & REQUIRED_FLAGS & ~KNOWN_FLAGS
     if unknown_required:
         raise IlcFormatError(FLAGS_OFFSET, f"unknown required flag bits 0x{unknown_required:04X}: "
-                             "the file needs a newer reader")
+                             "the file needs a newer reader",
+                             Refusal.REQUIRED_FLAG)
     code = data[header.code_start:header.handler_start]
     handlers = _decode_handlers(data, header)
     features = _decode_features(data, header.feature_start)
@@ -245,34 +282,42 @@ def read_header(data: bytes) -> Header:
     """The header, with its section lengths checked against the file's size."""
     if len(data) < 6:
         raise IlcFormatError(len(data), f"truncated: {len(data)} bytes is too short "
-                             f"for an .ilc header ({HEADER.size} bytes)")
+                             f"for an .ilc header ({HEADER.size} bytes)",
+                             Refusal.TRUNCATED)
     if data[:4] != MAGIC:
         raise IlcFormatError(0, f"not an .ilc file: it starts with {data[:4]!r}, "
-                             f"not {MAGIC!r}")
+                             f"not {MAGIC!r}",
+                             Refusal.BAD_MAGIC)
     if data[4] != VERSION_MAJOR:
         raise IlcFormatError(4, f"format version {data[4]}.{data[5]} is not supported: "
-                             f"this reader reads version {VERSION_MAJOR}.x")
+                             f"this reader reads version {VERSION_MAJOR}.x",
+                             Refusal.BAD_MAJOR)
     if len(data) < HEADER.size:
         raise IlcFormatError(len(data), f"truncated: {len(data)} bytes is too short "
-                             f"for an .ilc header ({HEADER.size} bytes)")
+                             f"for an .ilc header ({HEADER.size} bytes)",
+                             Refusal.TRUNCATED)
     header = Header(*HEADER.unpack_from(data)[1:])
     newer = header.minor > VERSION_MINOR
     if header.header_size < HEADER.size or (header.header_size != HEADER.size and not newer):
         raise IlcFormatError(12, f"header size {header.header_size} is wrong: "
-                             f"version {header.major}.{header.minor} has {HEADER.size}")
+                             f"version {header.major}.{header.minor} has {HEADER.size}",
+                             Refusal.BAD_HEADER_SIZE)
     for field_offset, size, expected, what in ((16, header.handler_size, HANDLER_SIZE,
                                                 "handler table"),
                                                (18, header.feature_size, FEATURE_SIZE,
                                                 "features")):
         if size != expected:
             raise IlcFormatError(field_offset, f"the {what} section must be {expected} "
-                                 f"bytes, the header says {size}")
+                                 f"bytes, the header says {size}",
+                                 Refusal.BAD_SECTION_SIZE)
     if header.end > len(data):
         raise IlcFormatError(len(data), f"truncated: the header's section sizes add up "
-                             f"to {header.end} bytes, the file has {len(data)}")
+                             f"to {header.end} bytes, the file has {len(data)}",
+                             Refusal.TRUNCATED)
     if header.end < len(data) and not newer:
         raise IlcFormatError(header.end, f"{len(data) - header.end} unexpected bytes "
-                             "after the last section")
+                             "after the last section",
+                             Refusal.EXTRA_BYTES)
     return header
 
 
@@ -285,7 +330,8 @@ def _decode_handlers(data: bytes, header: Header) -> dict[int, int]:
             continue
         if offset >= header.code_size:
             raise IlcFormatError(position, f"handler :{label} points at code offset "
-                                 f"{offset}, outside the {header.code_size}-byte code")
+                                 f"{offset}, outside the {header.code_size}-byte code",
+                                 Refusal.HANDLER_OUTSIDE)
         handlers[label] = offset
     return handlers
 
@@ -295,7 +341,8 @@ def _decode_features(data: bytes, position: int) -> frozenset[Feature]:
     known = sum(1 << feature.value for feature in Feature)
     if mask & ~known:
         raise IlcFormatError(position, f"unknown feature bits 0x{mask & ~known:04X}: the "
-                             "program needs a device feature this reader does not know")
+                             "program needs a device feature this reader does not know",
+                             Refusal.UNKNOWN_FEATURE)
     return frozenset(feature for feature in Feature if mask >> feature.value & 1)
 
 
@@ -306,7 +353,8 @@ def _decode_debug(data: bytes, header: Header) -> tuple[DebugInfo, tuple[int, ..
         name = name_bytes.decode("utf-8")
     except UnicodeDecodeError as error:
         raise IlcFormatError(header.debug_start + 1 + error.start,
-                             "the debug source name is not UTF-8") from None
+                             "the debug source name is not UTF-8",
+                             Refusal.DEBUG_NAME_UTF8) from None
     count = reader.u16()
     lines: list[tuple[int, int]] = []
     starts: list[int] = []
@@ -315,16 +363,19 @@ def _decode_debug(data: bytes, header: Header) -> tuple[DebugInfo, tuple[int, ..
         start = reader.position
         offset_delta, line_delta = reader.varint(), reader.varint()
         if index and offset_delta == 0:
-            raise IlcFormatError(start, "line entry repeats the previous entry's code offset")
+            raise IlcFormatError(start, "line entry repeats the previous entry's code offset",
+                                 Refusal.DEBUG_ORDER)
         offset, line = offset + offset_delta, line + line_delta
         if offset > MAX_CODE_SIZE or line > MAX_LINE or line == 0:
             raise IlcFormatError(start, f"line entry (offset {offset}, line {line}) is out "
-                                 f"of range: offsets are u16, lines 1..{MAX_LINE}")
+                                 f"of range: offsets are u16, lines 1..{MAX_LINE}",
+                                 Refusal.DEBUG_RANGE)
         lines.append((offset, line))
         starts.append(start)
     if reader.position != header.digest_start:
         raise IlcFormatError(reader.position, f"{header.digest_start - reader.position} "
-                             "bytes left over at the end of the debug section")
+                             "bytes left over at the end of the debug section",
+                             Refusal.DEBUG_LEFTOVER)
     digest = data[header.digest_start:header.end] if header.digest_size else None
     return DebugInfo(name, tuple(lines), digest), tuple(starts)
 
@@ -338,7 +389,8 @@ class _Reader:
     def take(self, size: int) -> bytes:
         if self.position + size > self.end:
             raise IlcFormatError(self.position, f"the {self.what} ends in the middle of a "
-                                 f"field ({size} bytes needed, {self.end - self.position} left)")
+                                 f"field ({size} bytes needed, {self.end - self.position} left)",
+                                 Refusal.DEBUG_CUT_OFF)
         chunk = self.data[self.position:self.position + size]
         self.position += size
         return chunk
@@ -359,7 +411,9 @@ class _Reader:
                 if index and not byte:
                     # Only the shortest form is valid, so that every image has one encoding.
                     raise IlcFormatError(start, f"a number in the {self.what} is not in "
-                                         "its shortest form (a trailing zero byte)")
+                                         "its shortest form (a trailing zero byte)",
+                                         Refusal.DEBUG_NUMBER)
                 return value
         raise IlcFormatError(start, f"a number in the {self.what} is longer than "
-                             f"{MAX_VARINT_SIZE} bytes")
+                             f"{MAX_VARINT_SIZE} bytes",
+                             Refusal.DEBUG_NUMBER)

@@ -14,7 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from . import isa
-from .ilc import Container, IlcFormatError, Image, read
+from .ilc import Container, IlcFormatError, Image, Refusal, read
 from .language import BUILTINS, HANDLER_LABELS, VARIABLES
 
 
@@ -36,7 +36,7 @@ def verify(data: bytes) -> VerifiedProgram:
     try:
         container = read(data)
     except IlcFormatError as error:
-        raise VerifyError(error.offset, error.message) from None
+        raise VerifyError(error.offset, error.message, error.refusal) from None
     return _CodeVerifier(container).run()
 
 
@@ -49,8 +49,9 @@ class _CodeVerifier:
         self.index_of: dict[int, int] = {}
         self.jumps: list[tuple[int, int]] = []  # (code offset of the ADDR operand, target)
 
-    def fail(self, code_offset: int, message: str) -> VerifyError:
-        return VerifyError(self.base + code_offset, f"code offset {code_offset}: {message}")
+    def fail(self, code_offset: int, message: str, refusal: Refusal) -> VerifyError:
+        return VerifyError(self.base + code_offset, f"code offset {code_offset}: {message}",
+                           refusal)
 
     def run(self) -> VerifiedProgram:
         offset = 0
@@ -63,7 +64,8 @@ class _CodeVerifier:
         # Falling off the end is allowed: it behaves as (END) (spec/language.md).
         for position, target in self.jumps:
             if target not in self.index_of:
-                raise self.fail(position, f"jump target {target} is " + self.misplaced(target))
+                raise self.fail(position, f"jump target {target} is " + self.misplaced(target),
+                                Refusal.BAD_JUMP)
         self.check_handlers()
         self.check_line_map()
         return VerifiedProgram(self.container.image, tuple(self.instructions),
@@ -72,10 +74,12 @@ class _CodeVerifier:
     def decode(self, offset: int) -> isa.Instruction:
         info = isa.OPCODES.get(self.code[offset])
         if info is None:
-            raise self.fail(offset, f"unknown opcode 0x{self.code[offset]:02X}")
+            raise self.fail(offset, f"unknown opcode 0x{self.code[offset]:02X}",
+                            Refusal.UNKNOWN_OPCODE)
         if offset + info.length > len(self.code):
             raise self.fail(offset, f"{info.name} needs {info.length} bytes, only "
-                                    f"{len(self.code) - offset} remain in the code")
+                                    f"{len(self.code) - offset} remain in the code",
+                            Refusal.CUT_OFF)
         return isa.decode_at(self.code, offset)
 
     def check_operands(self, instruction: isa.Instruction) -> None:
@@ -99,7 +103,7 @@ class _CodeVerifier:
     def check_variable(self, position: int, index: int, where: str) -> None:
         if index >= len(VARIABLES):
             raise self.fail(position, f"{where}: variable index {index} is out of range "
-                                      f"0..{len(VARIABLES) - 1}")
+                                      f"0..{len(VARIABLES) - 1}", Refusal.BAD_VARIABLE)
 
     def check_call(self, instruction: isa.Instruction, mask_position: int) -> None:
         info = instruction.info
@@ -108,14 +112,16 @@ class _CodeVerifier:
         mask = self.code[mask_position]
         if mask >> info.arity:
             raise self.fail(mask_position, f"{info.name}: argument mask 0x{mask:02X} marks "
-                                           f"arguments beyond its {info.arity}")
+                                           f"arguments beyond its {info.arity}",
+                            Refusal.BAD_MASK)
         for index, (arg, param) in enumerate(zip(instruction.args, form.params, strict=True)):
             position = mask_position + 1 + 2 * index
             if arg.is_var:
                 self.check_variable(position, arg.value, f"{info.name} argument {param.name}")
             elif not param.low <= arg.value <= param.high:
                 raise self.fail(position, f"{info.name} argument {param.name} = {arg.value} "
-                                          f"is out of range {param.low}..{param.high}")
+                                          f"is out of range {param.low}..{param.high}",
+                                Refusal.ARGUMENT_RANGE)
 
     def check_feature(self, instruction: isa.Instruction) -> None:
         # The header's features are what a device checks before loading; a call outside
@@ -126,7 +132,8 @@ class _CodeVerifier:
         if feature is not None and feature not in self.container.image.features:
             raise self.fail(instruction.offset, f"{instruction.info.name} needs the device "
                                                 f"feature {feature.name}, which the "
-                                                "features section does not list")
+                                                "features section does not list",
+                            Refusal.MISSING_FEATURE)
 
     def misplaced(self, target: int) -> str:
         """Why code offset `target` is not an instruction boundary."""
@@ -142,7 +149,7 @@ class _CodeVerifier:
             if target is not None and target not in self.index_of:
                 raise VerifyError(header.handler_start + 2 * index,
                                   f"handler :{label} at code offset {target} is "
-                                  + self.misplaced(target))
+                                  + self.misplaced(target), Refusal.BAD_HANDLER)
 
     def check_line_map(self) -> None:
         debug = self.container.image.debug
@@ -152,4 +159,5 @@ class _CodeVerifier:
                                              self.container.line_entry_offsets, strict=True):
             if offset not in self.index_of:
                 raise VerifyError(position, f"line entry for code offset {offset} is "
-                                            + self.misplaced(offset))
+                                            + self.misplaced(offset),
+                                  Refusal.BAD_LINE_ENTRY)

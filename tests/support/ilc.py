@@ -1,6 +1,6 @@
 """Test helpers for .ilc files: Hypothesis strategies for valid images (random instruction
 sequences whose jumps, handlers and line entries all land on instruction boundaries, with
-in-range operands), and the CRC as the spec defines it."""
+in-range operands) and for damaged files, and the CRC as the spec defines it."""
 
 from __future__ import annotations
 
@@ -81,3 +81,35 @@ def images(draw: st.DrawFn, max_instructions: int = 25) -> ilc.Image:
     debug = draw(st.none() | debug_infos(offsets))
     optional_flags = draw(st.integers(0, 0xFF)) << 8  # a reader must accept unknown ones
     return ilc.Image(code, handlers, features, debug, optional_flags)
+
+
+# --- damage of every kind ------------------------------------------------------------
+
+HEADER_FIELDS = [(4, "<B"), (5, "<B"), (6, "<H"), (12, "<H"), (14, "<H"), (16, "<H"),
+                 (18, "<H"), (20, "<I")]
+
+
+@st.composite
+def damaged(draw: st.DrawFn) -> bytes:
+    data = bytearray(ilc.encode(draw(images())))
+    # Hypothesis favours small numbers: pick the region first, so that damage reaches
+    # the code, the tables and the debug section as often as the header.
+    header = ilc.read_header(bytes(data))
+    start = draw(st.sampled_from([0, header.code_start, header.handler_start,
+                                  header.debug_start]))
+    position = draw(st.integers(min(start, len(data) - 1), len(data) - 1))
+    kind = draw(st.sampled_from(["flip", "overwrite", "truncate", "insert", "header"]))
+    if kind == "flip":
+        data[position] ^= 1 << draw(st.integers(0, 7))
+    elif kind == "overwrite":
+        data[position] = draw(st.integers(0, 255))
+    elif kind == "truncate":
+        del data[position:]
+    elif kind == "insert":
+        data[position:position] = draw(st.binary(min_size=1, max_size=8))
+    else:
+        offset, fmt = draw(st.sampled_from(HEADER_FIELDS))
+        limit = 1 << 8 * struct.calcsize(fmt)
+        struct.pack_into(fmt, data, offset, draw(st.integers(0, limit - 1) | st.integers(0, 40)))
+    # Fixing the CRC lets the damage reach the checks behind it.
+    return with_crc(data) if len(data) >= 12 and draw(st.booleans()) else bytes(data)

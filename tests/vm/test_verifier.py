@@ -3,14 +3,12 @@ points at, and that no damage to a valid file makes it fail in any other way."""
 
 from __future__ import annotations
 
-import struct
-
 import pytest
 from hypothesis import given, settings
-from hypothesis import strategies as st
-from support.ilc import images, with_crc
+from support.ilc import damaged, images
 
 from rl1.vm import ilc, isa, machine
+from rl1.vm.ilc import Refusal
 from rl1.vm.language import BUILTINS, Feature
 from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
 from rl1.vm.verifier import VerifiedProgram, VerifyError, verify
@@ -75,28 +73,30 @@ def test_container_refusals_come_as_verify_errors() -> None:
     assert error.offset == 0
 
 
-@pytest.mark.parametrize(("code", "offset", "message"), [
-    (op("LDI", 0) + bytes([0x07]), CODE + 3, "code offset 3: unknown opcode 0x07"),
-    (op("LDI", 0)[:2], CODE, "LDI needs 3 bytes, only 2 remain"),
+@pytest.mark.parametrize(("code", "offset", "message", "kind"), [
+    (op("LDI", 0) + bytes([0x07]), CODE + 3, "code offset 3: unknown opcode 0x07",
+     Refusal.UNKNOWN_OPCODE),
+    (op("LDI", 0)[:2], CODE, "LDI needs 3 bytes, only 2 remain", Refusal.CUT_OFF),
     (op("LDI", 0) + op("MVI", args=(const(1), const(1), const(1)))[:5], CODE + 3,
-     "MVI needs 8 bytes, only 5 remain"),
-    (op("JMP", 3), CODE + 1, "jump target 3 is outside the 3-byte code"),
-    (op("JMP", 0xFFFF), CODE + 1, "jump target 65535 is outside"),
+     "MVI needs 8 bytes, only 5 remain", Refusal.CUT_OFF),
+    (op("JMP", 3), CODE + 1, "jump target 3 is outside the 3-byte code", Refusal.BAD_JUMP),
+    (op("JMP", 0xFFFF), CODE + 1, "jump target 65535 is outside", Refusal.BAD_JUMP),
     (op("LDI", 0) + op("JGT", 0, 1), CODE + 5, "target 1 is in the middle of the "
-                                               "instruction at 0"),
-    (op("LDV", 53), CODE + 1, "LDV: variable index 53 is out of range 0..52"),
-    (op("LDI", 0) + op("JZ", 255, 0), CODE + 4, "JZ: variable index 255"),
-    (op("MOV", args=(const(0), var(53))), CODE + 4, "MOV argument r: variable index 53"),
-    (op("MOV", args=(const(0), var(0x100))), CODE + 4, "variable index 256"),
+                                               "instruction at 0", Refusal.BAD_JUMP),
+    (op("LDV", 53), CODE + 1, "LDV: variable index 53 is out of range 0..52", Refusal.BAD_VARIABLE),
+    (op("LDI", 0) + op("JZ", 255, 0), CODE + 4, "JZ: variable index 255", Refusal.BAD_VARIABLE),
+    (op("MOV", args=(const(0), var(53))), CODE + 4, "MOV argument r: variable index 53",
+     Refusal.BAD_VARIABLE),
+    (op("MOV", args=(const(0), var(0x100))), CODE + 4, "variable index 256", Refusal.BAD_VARIABLE),
     (op("MOV", args=(const(13), const(0))), CODE + 2, "MOV argument l = 13 is out of "
-                                                      "range -12..12"),
+                                                      "range -12..12", Refusal.ARGUMENT_RANGE),
     (bytes([isa.BY_NAME["MOV"].opcode, 0x04, 0, 0, 0, 0]), CODE + 1,
-     "argument mask 0x04 marks arguments beyond its 2"),
+     "argument mask 0x04 marks arguments beyond its 2", Refusal.BAD_MASK),
 ])
-def test_bad_code_is_refused_at_the_offending_byte(code: bytes, offset: int,
-                                                   message: str) -> None:
+def test_bad_code_is_refused_at_the_offending_byte(code: bytes, offset: int, message: str,
+                                                   kind: Refusal) -> None:
     error = refusal(file_of(code))
-    assert error.offset == offset
+    assert (error.offset, error.refusal) == (offset, kind)
     assert message in error.message
 
 
@@ -158,35 +158,6 @@ def test_a_line_entry_must_start_an_instruction() -> None:
 
 
 # --- damage of every kind ------------------------------------------------------------
-
-HEADER_FIELDS = [(4, "<B"), (5, "<B"), (6, "<H"), (12, "<H"), (14, "<H"), (16, "<H"),
-                 (18, "<H"), (20, "<I")]
-
-
-@st.composite
-def damaged(draw: st.DrawFn) -> bytes:
-    data = bytearray(ilc.encode(draw(images())))
-    # Hypothesis favours small numbers: pick the region first, so that damage reaches
-    # the code, the tables and the debug section as often as the header.
-    header = ilc.read_header(bytes(data))
-    start = draw(st.sampled_from([0, CODE, header.handler_start, header.debug_start]))
-    position = draw(st.integers(min(start, len(data) - 1), len(data) - 1))
-    kind = draw(st.sampled_from(["flip", "overwrite", "truncate", "insert", "header"]))
-    if kind == "flip":
-        data[position] ^= 1 << draw(st.integers(0, 7))
-    elif kind == "overwrite":
-        data[position] = draw(st.integers(0, 255))
-    elif kind == "truncate":
-        del data[position:]
-    elif kind == "insert":
-        data[position:position] = draw(st.binary(min_size=1, max_size=8))
-    else:
-        offset, fmt = draw(st.sampled_from(HEADER_FIELDS))
-        limit = 1 << 8 * struct.calcsize(fmt)
-        struct.pack_into(fmt, data, offset, draw(st.integers(0, limit - 1) | st.integers(0, 40)))
-    # Fixing the CRC lets the damage reach the checks behind it.
-    return with_crc(data) if len(data) >= 12 and draw(st.booleans()) else bytes(data)
-
 
 # Lost lines early and often, so that runs take the handler paths too.
 LOSSES = Script(losses=(LossAt(0), LossDuring("MOV", 1, 0), LossDuring("MVI", 1, 0),

@@ -1,0 +1,91 @@
+/* rl1vm: the RL/I virtual machine for firmware, in C99 (freestanding).
+ *
+ * This header is the whole public interface. Today it holds the loader and verifier
+ * (rl1vm_load.c): every check of spec/ilc.md section 10, made on the file in place
+ * (in flash, say) before any of it runs, and the debug line lookup for fault reports.
+ * The VM itself (rl1vm.c) will follow the firmware contract of spec/ilc.md.
+ *
+ * No allocation, no recursion, no floating point, no static data: all state is in
+ * the caller's rl1_program. Sizes are u32 and every sum of them is checked before it
+ * is made, so no file, however damaged, makes the loader read outside it.
+ */
+#ifndef RL1VM_H
+#define RL1VM_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+/* Why a file is refused: one code per rule of spec/ilc.md section 10, in the order the
+ * rules are checked. vm/ilc.py's Refusal has the same names and numbers (a test holds
+ * them equal). The comment says where the error offset points. */
+typedef enum rl1_status {
+    RL1_OK = 0,
+    RL1_TRUNCATED = 1,          /* the header or a section passes the file's end: the end */
+    RL1_BAD_MAGIC = 2,          /* 0 */
+    RL1_BAD_MAJOR = 3,          /* 4: a major version other than 1 */
+    RL1_BAD_HEADER_SIZE = 4,    /* 12 */
+    RL1_BAD_SECTION_SIZE = 5,   /* 16 or 18: handler table not 8, features not 2 */
+    RL1_EXTRA_BYTES = 6,        /* the first byte after the last section */
+    RL1_BAD_CRC = 7,            /* 8 */
+    RL1_REQUIRED_FLAG = 8,      /* 6: a required flag bit this reader does not know */
+    RL1_HANDLER_OUTSIDE = 9,    /* the handler entry: not 0xFFFF and not below code_size */
+    RL1_UNKNOWN_FEATURE = 10,   /* the features section */
+    RL1_DEBUG_CUT_OFF = 11,     /* the debug field that passes the section's end */
+    RL1_DEBUG_NAME_UTF8 = 12,   /* the first byte of the name's first bad sequence */
+    RL1_DEBUG_NUMBER = 13,      /* a LEB128 number longer than 3 bytes or not shortest */
+    RL1_DEBUG_ORDER = 14,       /* the line entry: its offset does not increase */
+    RL1_DEBUG_RANGE = 15,       /* the line entry: offset past u16, line not 1..65535 */
+    RL1_DEBUG_LEFTOVER = 16,    /* the first byte after the last line entry */
+    RL1_UNKNOWN_OPCODE = 17,    /* the opcode */
+    RL1_CUT_OFF = 18,           /* the opcode of an instruction the code's end cuts */
+    RL1_BAD_VARIABLE = 19,      /* the operand: a variable index above 52 */
+    RL1_BAD_MASK = 20,          /* the mask: a bit at or above the call's arity */
+    RL1_ARGUMENT_RANGE = 21,    /* the argument: a constant outside its parameter's range */
+    RL1_MISSING_FEATURE = 22,   /* the opcode: a call whose feature the header omits */
+    RL1_BAD_JUMP = 23,          /* the target operand: not the start of an instruction */
+    RL1_BAD_HANDLER = 24,       /* the handler entry: not the start of an instruction */
+    RL1_BAD_LINE_ENTRY = 25     /* the line entry: not the start of an instruction */
+} rl1_status;
+
+/* A verified file, its sections found: everything the VM needs, pointing into the
+ * caller's file (which must stay in place while the program is used). */
+typedef struct rl1_program {
+    const uint8_t *code;        /* the code section */
+    const uint8_t *lines;       /* the first line entry; NULL without a debug section */
+    const uint8_t *source_name; /* UTF-8, not NUL-terminated; NULL without debug */
+    const uint8_t *digest;      /* the 16-byte source digest (1.1); NULL when absent */
+    uint16_t code_size;
+    uint16_t handlers[4];       /* code offsets of :96..:99; RL1_ABSENT when undefined */
+    uint16_t features;          /* bit n: the program needs device feature n */
+    uint16_t flags;
+    uint16_t line_count;
+    uint8_t source_name_size;
+} rl1_program;
+
+#define RL1_ABSENT 0xFFFFu     /* a handler table entry for a label not defined */
+
+/* The bytes of a jump-target bitmap for code of `code_size` bytes: one bit per code
+ * byte, so at most 8192 bytes for the largest code (65535 bytes). */
+#define RL1_BITMAP_SIZE(code_size) (((uint32_t)(code_size) + 7u) / 8u)
+
+/* Checks the `size` bytes at `file` (spec/ilc.md section 10) and, when they pass, fills
+ * *program. On a refusal returns its code, with the file offset it points at in
+ * *error_offset (*program is then undefined).
+ *
+ * Jump targets, handler entries and line entries must start instructions. With a
+ * `bitmap` of at least RL1_BITMAP_SIZE(code_size) bytes (scratch: the loader clears it,
+ * and it is free again on return), each such check is one bit, so loading is linear in
+ * the file's size. With a smaller one, or NULL, the loader uses no memory for it and
+ * rescans the code from its start for each target instead: at most code_size bytes of
+ * decoding per jump, handler and line entry (quadratic in the worst case: keep it for
+ * small programs or for targets with no RAM to spare). Both give the same answer. */
+rl1_status rl1_load(rl1_program *program, const uint8_t *file, uint32_t size,
+                    uint8_t *bitmap, size_t bitmap_size, uint32_t *error_offset);
+
+/* The source line of the instruction at `code_offset`: the line of the last line entry
+ * at or before it (spec/ilc.md 4.4); 0 when unknown (no debug section, or no entry at or
+ * before it). It walks the line map, so it costs one pass over it: for fault reports. */
+uint16_t rl1_line_at(const rl1_program *program, uint16_t code_offset);
+
+#endif

@@ -1,0 +1,566 @@
+/* The .ilc loader and verifier (spec/ilc.md sections 2-8 and 10).
+ *
+ * It makes the checks of vm/ilc.py and vm/verifier.py in their order, so that a file
+ * gets the same refusal at the same file offset from both: the container first (header,
+ * sizes, CRC, flags, handlers, features, debug section), then one pass over the code
+ * (each instruction's opcode, length, operands and feature), then every jump target,
+ * handler entry and line entry against the instruction starts.
+ *
+ * Portability: `int` may be 16 bits (AVR). So no uint8_t or uint16_t is shifted or
+ * added before it is widened to unsigned or uint32_t, signed values are never computed
+ * by overflow, and there is no table in static data (on AVR it would be copied to RAM):
+ * the instruction set is switch statements, which the compiler keeps in flash.
+ */
+#include "rl1vm.h"
+
+/* How a byte of the file is read: a plain load, unless the build says otherwise. AVR's
+ * flash is not in its data address space, so a file kept there is read with
+ * -DRL1_READ_BYTE(p)=pgm_read_byte(p) -include avr/pgmspace.h (vm/c/README.md). */
+#ifndef RL1_READ_BYTE
+#define RL1_READ_BYTE(p) (*(p))
+#endif
+#define BYTE(p) ((uint8_t)RL1_READ_BYTE(p))
+
+#define HEADER_SIZE 24u
+#define HANDLER_SIZE 8u
+#define FEATURE_SIZE 2u
+#define DIGEST_SIZE 16u
+#define DIGEST_MINOR 1u      /* the first minor version with a source digest */
+#define KNOWN_MINOR 1u       /* the newest minor version this reader knows */
+#define REQUIRED_FLAGS 0x00FFu
+#define KNOWN_FEATURES 0x007Fu
+#define VARIABLES 53u
+#define MAX_U16 0xFFFFu
+#define NO_FEATURE 0xFFu
+
+/* The file being checked, and where the refusal points. */
+typedef struct loader {
+    const uint8_t *file;
+    uint32_t size;
+    uint32_t error_offset;
+} loader;
+
+static rl1_status fail(loader *ld, rl1_status status, uint32_t offset)
+{
+    ld->error_offset = offset;
+    return status;
+}
+
+static uint16_t u16_at(const uint8_t *p)
+{
+    return (uint16_t)(BYTE(p) | ((unsigned)BYTE(p + 1) << 8));
+}
+
+static uint32_t u32_at(const uint8_t *p)
+{
+    return (uint32_t)BYTE(p) | ((uint32_t)BYTE(p + 1) << 8)
+           | ((uint32_t)BYTE(p + 2) << 16) | ((uint32_t)BYTE(p + 3) << 24);
+}
+
+/* An i16 operand's value; converting a u16 above 0x7FFF to int16_t would be
+ * implementation-defined. */
+static int32_t i16_at(const uint8_t *p)
+{
+    uint16_t u = u16_at(p);
+    return u < 0x8000u ? (int32_t)u : (int32_t)u - (int32_t)0x10000L;
+}
+
+/* Moves *pos over a field of `length` bytes if the file holds it. *pos never passes
+ * the file's size, so `size - *pos` cannot wrap and the sum cannot pass 32 bits. */
+static bool advance(const loader *ld, uint32_t *pos, uint32_t length)
+{
+    if (length > ld->size - *pos) {
+        return false;
+    }
+    *pos += length;
+    return true;
+}
+
+/* CRC-32 (zlib's): bit by bit, since a 1 KiB table would cost RAM on AVR. */
+static uint32_t crc_byte(uint32_t crc, uint8_t byte)
+{
+    uint8_t bit;
+    crc ^= byte;
+    for (bit = 0; bit < 8u; bit++) {
+        crc = (crc & 1u) ? (crc >> 1) ^ UINT32_C(0xEDB88320) : crc >> 1;
+    }
+    return crc;
+}
+
+static uint32_t file_crc(const loader *ld)
+{
+    uint32_t crc = UINT32_C(0xFFFFFFFF);
+    uint32_t i;
+    for (i = 0; i < ld->size; i++) {
+        /* The CRC field, bytes 8..11, counts as zero. */
+        crc = crc_byte(crc, (i >= 8u && i < 12u) ? 0u : BYTE(ld->file + i));
+    }
+    return crc ^ UINT32_C(0xFFFFFFFF);
+}
+
+/* --- the instruction set (spec/ilc.md 8.3) ----------------------------------------- */
+
+enum shape { NONE, VAR, IMM, ADDR, VAR_ADDR, ARGS };
+
+/* The operands of `op`, and 0 bytes for an opcode this version does not define. */
+static uint8_t op_length(uint8_t op, enum shape *shape)
+{
+    *shape = NONE;
+    if (op == 0x00u || op == 0x03u || (op >= 0x20u && op <= 0x26u)) {
+        return 1; /* END, LDR, the ...R arithmetic */
+    }
+    if ((op >= 0x01u && op <= 0x06u && op != 0x02u) || (op >= 0x10u && op <= 0x16u)) {
+        *shape = VAR; /* LDV, STV, INC, DEC, the ...V arithmetic */
+        return 2;
+    }
+    if (op == 0x02u || (op >= 0x18u && op <= 0x1Eu)) {
+        *shape = IMM; /* LDI, the ...I arithmetic */
+        return 3;
+    }
+    if (op == 0x30u) {
+        *shape = ADDR; /* JMP */
+        return 3;
+    }
+    if (op >= 0x31u && op <= 0x33u) {
+        *shape = VAR_ADDR; /* JZ, JGT, JLT */
+        return 4;
+    }
+    switch (op) {
+    case 0x43: /* MVI l, r, cm */
+        *shape = ARGS;
+        return 8;
+    case 0x44: case 0x5B: case 0x5C: /* MOV l, r; OUT port, data; FZO a, b */
+        *shape = ARGS;
+        return 6;
+    case 0x45: case 0x46: case 0x47: case 0x48: case 0x49: case 0x4A: case 0x4D:
+    case 0x52: case 0x53: case 0x59: case 0x5A:
+        /* STR, STL, STX, ROT, TRC, TIM, SCN, CAM A, CAM P, LMP, INP: one argument */
+        *shape = ARGS;
+        return 4;
+    default:
+        /* The calls without arguments, 0x40..0x5D, and nothing else. */
+        return (op >= 0x40u && op <= 0x5Du) ? 1u : 0u;
+    }
+}
+
+/* The device feature bit a call needs (spec/ilc.md 4.3); NO_FEATURE for END, TIM and
+ * the instructions that are not calls. */
+static uint8_t op_feature(uint8_t op)
+{
+    switch (op) {
+    case 0x40: case 0x41: case 0x43: case 0x44: case 0x48: case 0x49: case 0x4B:
+    case 0x4C:
+        return 0; /* MOTION: FRE, HLD, MVI, MOV, ROT, TRC, KYC, KYO */
+    case 0x42: case 0x45: case 0x46: case 0x47:
+        return 1; /* STEERING: ORG, STR, STL, STX */
+    case 0x4F: case 0x50: case 0x51: case 0x52: case 0x53: case 0x54:
+        return 2; /* CAMERA: every CAM form */
+    case 0x4D: case 0x4E: case 0x59:
+        return 3; /* VISION: SCN, IMG, LMP */
+    case 0x55: case 0x56: case 0x57: case 0x58:
+        return 4; /* ULTRASONIC: every ULT form */
+    case 0x5A: case 0x5B:
+        return 5; /* IO: INP, OUT */
+    case 0x5C: case 0x5D:
+        return 6; /* FUZZY: FZO, FZI */
+    default:
+        return NO_FEATURE;
+    }
+}
+
+/* Whether `value` lies in the range of parameter `index` of call `op`
+ * (spec/language.md section 8). */
+static bool in_range(uint8_t op, uint8_t index, int32_t value)
+{
+    int32_t low = -32768, high = 32767; /* FZO a, b */
+    switch (op) {
+    case 0x43: /* MVI l, r, cm */
+        low = index == 2u ? -1900 : -12;
+        high = index == 2u ? 1900 : 12;
+        break;
+    case 0x44: low = -12; high = 12; break;      /* MOV l, r */
+    case 0x45: case 0x46: case 0x52:
+        low = 0; high = 180; break;                /* STR, STL, CAM A: degrees */
+    case 0x47: low = -1800; high = 1800; break;  /* STX tenths */
+    case 0x48: low = -360; high = 360; break;    /* ROT deg */
+    case 0x49: low = 0; high = 3; break;         /* TRC mode */
+    case 0x4A: low = 1; high = 100; break;       /* TIM tenths */
+    case 0x4D: low = 0; high = 7; break;         /* SCN scene */
+    case 0x53: low = 0; high = 784; break;       /* CAM P pulse */
+    case 0x59: low = 0; high = 1; break;         /* LMP on */
+    case 0x5A: low = 0; high = 0x7D; break;      /* INP port */
+    case 0x5B:                                    /* OUT port, data */
+        low = 0;
+        high = index == 0u ? 0x7D : 255;
+        break;
+    default:
+        break;
+    }
+    return value >= low && value <= high;
+}
+
+/* --- the container (spec/ilc.md sections 2-7) -------------------------------------- */
+
+/* One number of the debug section (4.4): LEB128, at most 3 bytes, shortest form. */
+static rl1_status leb128(loader *ld, uint32_t *pos, uint32_t end, uint32_t *value)
+{
+    uint32_t start = *pos;
+    uint8_t n, byte;
+    *value = 0;
+    for (n = 0; n < 3u; n++) {
+        if (*pos == end) {
+            return fail(ld, RL1_DEBUG_CUT_OFF, *pos);
+        }
+        byte = BYTE(ld->file + (*pos)++);
+        *value |= (uint32_t)(byte & 0x7Fu) << (7u * n);
+        if (!(byte & 0x80u)) {
+            /* A last byte of 0 after another byte: not the shortest form. */
+            return (n > 0u && byte == 0u) ? fail(ld, RL1_DEBUG_NUMBER, start) : RL1_OK;
+        }
+    }
+    return fail(ld, RL1_DEBUG_NUMBER, start);
+}
+
+/* Strict UTF-8 (RFC 3629: no overlong form, no surrogate, nothing past U+10FFFF); the
+ * offset of the first bad sequence's lead byte, as Python's decoder reports it. */
+static rl1_status check_utf8(loader *ld, uint32_t pos, uint32_t end)
+{
+    while (pos < end) {
+        uint8_t lead = BYTE(ld->file + pos);
+        uint8_t low = 0x80u, high = 0xBFu; /* the second byte's range (Unicode table 3-7) */
+        uint32_t length, i;
+        if (lead < 0x80u) {
+            pos++;
+            continue;
+        }
+        if (lead >= 0xC2u && lead <= 0xDFu) {
+            length = 2;
+        } else if (lead >= 0xE0u && lead <= 0xEFu) {
+            length = 3;
+            low = lead == 0xE0u ? 0xA0u : 0x80u;
+            high = lead == 0xEDu ? 0x9Fu : 0xBFu;
+        } else if (lead >= 0xF0u && lead <= 0xF4u) {
+            length = 4;
+            low = lead == 0xF0u ? 0x90u : 0x80u;
+            high = lead == 0xF4u ? 0x8Fu : 0xBFu;
+        } else {
+            return fail(ld, RL1_DEBUG_NAME_UTF8, pos);
+        }
+        if (length > end - pos) {
+            return fail(ld, RL1_DEBUG_NAME_UTF8, pos);
+        }
+        for (i = 1; i < length; i++) {
+            uint8_t byte = BYTE(ld->file + pos + i);
+            if (byte < (i == 1u ? low : 0x80u) || byte > (i == 1u ? high : 0xBFu)) {
+                return fail(ld, RL1_DEBUG_NAME_UTF8, pos);
+            }
+        }
+        pos += length;
+    }
+    return RL1_OK;
+}
+
+/* The debug section from `pos` to `end` (4.4). */
+static rl1_status check_debug(loader *ld, rl1_program *program, uint32_t pos, uint32_t end)
+{
+    uint32_t offset = 0, line = 0, offset_delta, line_delta;
+    uint16_t index, count;
+    rl1_status status;
+    /* The name's size byte is there: a debug section of size 0 is no debug section. */
+    program->source_name_size = BYTE(ld->file + pos++);
+    if (end - pos < program->source_name_size) {
+        return fail(ld, RL1_DEBUG_CUT_OFF, pos);
+    }
+    status = check_utf8(ld, pos, pos + program->source_name_size);
+    if (status != RL1_OK) {
+        return status;
+    }
+    program->source_name = ld->file + pos;
+    pos += program->source_name_size;
+    if (end - pos < 2u) {
+        return fail(ld, RL1_DEBUG_CUT_OFF, pos);
+    }
+    count = u16_at(ld->file + pos);
+    pos += 2;
+    program->lines = ld->file + pos;
+    program->line_count = count;
+    for (index = 0; index < count; index++) {
+        uint32_t start = pos;
+        status = leb128(ld, &pos, end, &offset_delta);
+        if (status == RL1_OK) {
+            status = leb128(ld, &pos, end, &line_delta);
+        }
+        if (status != RL1_OK) {
+            return status;
+        }
+        if (index > 0u && offset_delta == 0u) {
+            return fail(ld, RL1_DEBUG_ORDER, start);
+        }
+        /* Both sums stay below 2^22: the previous values are u16, a delta below 2^21. */
+        offset += offset_delta;
+        line += line_delta;
+        if (offset > MAX_U16 || line > MAX_U16 || line == 0u) {
+            return fail(ld, RL1_DEBUG_RANGE, start);
+        }
+    }
+    if (pos != end) {
+        return fail(ld, RL1_DEBUG_LEFTOVER, pos);
+    }
+    return RL1_OK;
+}
+
+/* The header and every section but the code's contents (sections 2-7, and the first
+ * rows of section 10). Leaves in *code_start the code's file offset. */
+static rl1_status check_container(loader *ld, rl1_program *program, uint32_t *code_start)
+{
+    const uint8_t *file = ld->file;
+    uint32_t header_size, debug_size, pos, handler_start, debug_start, digest_size;
+    uint8_t minor, i;
+    bool newer;
+    if (ld->size < 6u) {
+        return fail(ld, RL1_TRUNCATED, ld->size);
+    }
+    if (BYTE(file) != 'R' || BYTE(file + 1) != 'L' || BYTE(file + 2) != 'I'
+        || BYTE(file + 3) != 'C') {
+        return fail(ld, RL1_BAD_MAGIC, 0);
+    }
+    if (BYTE(file + 4) != 1u) {
+        return fail(ld, RL1_BAD_MAJOR, 4);
+    }
+    if (ld->size < HEADER_SIZE) {
+        return fail(ld, RL1_TRUNCATED, ld->size);
+    }
+    minor = BYTE(file + 5);
+    newer = minor > KNOWN_MINOR;
+    header_size = u16_at(file + 12);
+    if (header_size < HEADER_SIZE || (header_size != HEADER_SIZE && !newer)) {
+        return fail(ld, RL1_BAD_HEADER_SIZE, 12);
+    }
+    if (u16_at(file + 16) != HANDLER_SIZE) {
+        return fail(ld, RL1_BAD_SECTION_SIZE, 16);
+    }
+    if (u16_at(file + 18) != FEATURE_SIZE) {
+        return fail(ld, RL1_BAD_SECTION_SIZE, 18);
+    }
+    program->code_size = u16_at(file + 14);
+    debug_size = u32_at(file + 20);
+    digest_size = (minor >= DIGEST_MINOR && debug_size != 0u) ? DIGEST_SIZE : 0u;
+    /* header, code, handlers and features, debug, digest: each must fit what is left,
+     * so that their sum, which can pass 32 bits, is never made unchecked. */
+    pos = 0;
+    if (!advance(ld, &pos, header_size) || !advance(ld, &pos, program->code_size)
+        || !advance(ld, &pos, HANDLER_SIZE + FEATURE_SIZE)
+        || !advance(ld, &pos, debug_size) || !advance(ld, &pos, digest_size)) {
+        return fail(ld, RL1_TRUNCATED, ld->size);
+    }
+    if (pos < ld->size && !newer) {
+        return fail(ld, RL1_EXTRA_BYTES, pos);
+    }
+    if (file_crc(ld) != u32_at(file + 8)) {
+        return fail(ld, RL1_BAD_CRC, 8);
+    }
+    program->flags = u16_at(file + 6);
+    if (program->flags & REQUIRED_FLAGS) { /* versions 1.0 and 1.1 define no flag */
+        return fail(ld, RL1_REQUIRED_FLAG, 6);
+    }
+    *code_start = header_size;
+    program->code = file + header_size;
+    handler_start = header_size + program->code_size;
+    for (i = 0; i < 4u; i++) {
+        uint16_t entry = u16_at(file + handler_start + 2u * i);
+        if (entry != RL1_ABSENT && entry >= program->code_size) {
+            return fail(ld, RL1_HANDLER_OUTSIDE, handler_start + 2u * i);
+        }
+        program->handlers[i] = entry;
+    }
+    program->features = u16_at(file + handler_start + HANDLER_SIZE);
+    if (program->features & ~KNOWN_FEATURES) {
+        return fail(ld, RL1_UNKNOWN_FEATURE, handler_start + HANDLER_SIZE);
+    }
+    debug_start = handler_start + HANDLER_SIZE + FEATURE_SIZE;
+    program->lines = NULL;
+    program->source_name = NULL;
+    program->source_name_size = 0;
+    program->line_count = 0;
+    program->digest = digest_size ? file + debug_start + debug_size : NULL;
+    return debug_size ? check_debug(ld, program, debug_start, debug_start + debug_size)
+                      : RL1_OK;
+}
+
+/* --- the code (section 8 and the rest of section 10) -------------------------------- */
+
+/* Where instructions start: the bitmap when there is one, else a walk from offset 0
+ * over code already checked to be whole instructions. */
+typedef struct starts {
+    const rl1_program *program;
+    uint8_t *bitmap; /* NULL: rescan */
+} starts;
+
+static bool starts_instruction(const starts *s, uint16_t target)
+{
+    uint32_t pos = 0;
+    enum shape shape;
+    if (target >= s->program->code_size) {
+        return false;
+    }
+    if (s->bitmap) {
+        return ((unsigned)s->bitmap[target >> 3] >> (target & 7u)) & 1u;
+    }
+    while (pos < target) {
+        pos += op_length(BYTE(s->program->code + pos), &shape);
+    }
+    return pos == target;
+}
+
+static rl1_status check_variable(loader *ld, uint32_t index, uint32_t offset)
+{
+    return index < VARIABLES ? RL1_OK : fail(ld, RL1_BAD_VARIABLE, offset);
+}
+
+/* A call's mask and arguments; `at` is the mask's file offset. */
+static rl1_status check_call(loader *ld, uint8_t op, uint8_t length, uint32_t at)
+{
+    uint8_t mask = BYTE(ld->file + at), arity = (uint8_t)((length - 2u) / 2u), k;
+    rl1_status status = RL1_OK;
+    if (mask >> arity) {
+        return fail(ld, RL1_BAD_MASK, at);
+    }
+    for (k = 0; k < arity && status == RL1_OK; k++) {
+        uint32_t field = at + 1u + 2u * k;
+        if (((unsigned)mask >> k) & 1u) {
+            status = check_variable(ld, u16_at(ld->file + field), field);
+        } else if (!in_range(op, k, i16_at(ld->file + field))) {
+            status = fail(ld, RL1_ARGUMENT_RANGE, field);
+        }
+    }
+    return status;
+}
+
+/* Pass 1: every instruction whole, known, with valid operands and its feature listed;
+ * marks the instruction starts in the bitmap. */
+static rl1_status check_instructions(loader *ld, const rl1_program *program, uint32_t base,
+                                     uint8_t *bitmap)
+{
+    uint32_t pos = 0;
+    while (pos < program->code_size) {
+        uint8_t op = BYTE(program->code + pos), length, feature;
+        uint32_t at = base + pos;
+        enum shape shape;
+        rl1_status status = RL1_OK;
+        length = op_length(op, &shape);
+        if (length == 0u) {
+            return fail(ld, RL1_UNKNOWN_OPCODE, at);
+        }
+        if (length > program->code_size - pos) {
+            return fail(ld, RL1_CUT_OFF, at);
+        }
+        if (shape == VAR || shape == VAR_ADDR) {
+            status = check_variable(ld, BYTE(ld->file + at + 1u), at + 1u);
+        } else if (shape == ARGS) {
+            status = check_call(ld, op, length, at + 1u);
+        }
+        if (status != RL1_OK) {
+            return status;
+        }
+        feature = op_feature(op);
+        if (feature != NO_FEATURE && !(((unsigned)program->features >> feature) & 1u)) {
+            return fail(ld, RL1_MISSING_FEATURE, at);
+        }
+        if (bitmap) {
+            bitmap[pos >> 3] = (uint8_t)(bitmap[pos >> 3] | (1u << (pos & 7u)));
+        }
+        pos += length;
+    }
+    return RL1_OK;
+}
+
+/* Pass 2: jump targets, in code order, then handler entries, then line entries. */
+static rl1_status check_targets(loader *ld, const rl1_program *program, uint32_t base,
+                                const starts *s)
+{
+    uint32_t pos = 0, at, entry, offset = 0, delta;
+    uint16_t index;
+    uint8_t i;
+    while (pos < program->code_size) {
+        enum shape shape;
+        uint8_t length = op_length(BYTE(program->code + pos), &shape);
+        at = base + pos + (shape == VAR_ADDR ? 2u : 1u); /* the target operand */
+        if ((shape == ADDR || shape == VAR_ADDR)
+            && !starts_instruction(s, u16_at(ld->file + at))) {
+            return fail(ld, RL1_BAD_JUMP, at);
+        }
+        pos += length;
+    }
+    for (i = 0; i < 4u; i++) {
+        if (program->handlers[i] != RL1_ABSENT
+            && !starts_instruction(s, program->handlers[i])) {
+            return fail(ld, RL1_BAD_HANDLER, base + program->code_size + 2u * i);
+        }
+    }
+    if (!program->lines) {
+        return RL1_OK;
+    }
+    entry = (uint32_t)(program->lines - ld->file);
+    for (index = 0; index < program->line_count; index++) {
+        at = entry;
+        /* The section is checked: these reads cannot fail. */
+        (void)leb128(ld, &entry, ld->size, &delta);
+        offset += delta;
+        (void)leb128(ld, &entry, ld->size, &delta);
+        if (!starts_instruction(s, (uint16_t)offset)) {
+            return fail(ld, RL1_BAD_LINE_ENTRY, at);
+        }
+    }
+    return RL1_OK;
+}
+
+rl1_status rl1_load(rl1_program *program, const uint8_t *file, uint32_t size,
+                    uint8_t *bitmap, size_t bitmap_size, uint32_t *error_offset)
+{
+    loader ld;
+    starts s;
+    uint32_t base = 0, i;
+    rl1_status status;
+    ld.file = file;
+    ld.size = size;
+    ld.error_offset = 0;
+    status = check_container(&ld, program, &base);
+    if (status == RL1_OK) {
+        s.program = program;
+        s.bitmap = (bitmap && bitmap_size >= RL1_BITMAP_SIZE(program->code_size)) ? bitmap
+                                                                                  : NULL;
+        for (i = 0; s.bitmap && i < RL1_BITMAP_SIZE(program->code_size); i++) {
+            s.bitmap[i] = 0;
+        }
+        status = check_instructions(&ld, program, base, s.bitmap);
+    }
+    if (status == RL1_OK) {
+        status = check_targets(&ld, program, base, &s);
+    }
+    *error_offset = ld.error_offset;
+    return status;
+}
+
+uint16_t rl1_line_at(const rl1_program *program, uint16_t code_offset)
+{
+    loader ld;
+    uint32_t pos = 0, offset = 0, line = 0, delta;
+    uint16_t index, found = 0;
+    if (!program->lines) {
+        return 0;
+    }
+    /* Reads the verified line map from its first entry; it cannot run past it. */
+    ld.file = program->lines;
+    ld.size = UINT32_C(0xFFFFFFFF);
+    for (index = 0; index < program->line_count; index++) {
+        (void)leb128(&ld, &pos, ld.size, &delta);
+        offset += delta;
+        (void)leb128(&ld, &pos, ld.size, &delta);
+        line += delta;
+        if (offset > code_offset) {
+            break;
+        }
+        found = (uint16_t)line;
+    }
+    return found;
+}

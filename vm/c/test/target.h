@@ -1,0 +1,30 @@
+/* The conformance run on an emulated target (make -C vm/c targets): the cases that
+ * target_cases.py generates, and what each target's start-up file provides. */
+#ifndef TARGET_H
+#define TARGET_H
+
+#include <stdint.h>
+
+#include "../rl1vm.h"
+
+#ifndef TARGET_FLASH
+#define TARGET_FLASH /* flash and data share one address space: nothing to say */
+#endif
+
+typedef struct target_case {
+    uint32_t start, size;   /* in target_blob */
+    uint32_t status, offset; /* what the Python verifier answers */
+} target_case;
+
+extern const uint8_t target_blob[];
+extern const target_case target_cases[];
+extern const uint16_t target_case_count;
+
+/* From the target's start-up file. */
+void target_print(const char *text);
+uint32_t target_case_field(const uint32_t *field); /* reads a case's field from flash */
+
+/* Runs every case; returns the number that differ from the host. */
+uint16_t target_run(void);
+
+#endif
