@@ -159,6 +159,8 @@ def moments(image: Mask, window: tuple[int, int, int, int]) -> Moments:
     mu20 = float(((xs - cx) ** 2).mean())
     mu02 = float(((ys - cy) ** 2).mean())
     mu11 = float(((xs - cx) * (ys - cy)).mean())
+    if abs(mu11) < 1e-9 * (mu20 + mu02):
+        mu11 = 0.0  # rounding noise would flip a vertical axis between -90 and 90
     return Moments(area, cx, cy, math.degrees(0.5 * math.atan2(2 * mu11, mu20 - mu02)))
 
 

@@ -224,7 +224,7 @@ class Simulator:
         if seen is not None:
             if self.lost:
                 self.lost = False
-                self._event("found", "line found")
+                self.note("found", "line found")
             vehicle = self.world.vehicle
             self._speeds = tracing.correct(motion.left, motion.right, seen, vehicle.k1,
                                            vehicle.k2)
@@ -233,14 +233,15 @@ class Simulator:
         if self.lost:
             return None
         self.lost = True
-        self._event("lost", f"line lost during {motion.command} in mode {self.mode}")
+        self.note("lost", f"line lost during {motion.command} in mode {self.mode}")
         if self.mode == 1:
             return None
         if self.mode == 2:
             self.halt()
         return motion.command
 
-    def _event(self, kind: str, text: str) -> None:
+    def note(self, kind: str, text: str) -> None:
+        """Record an event at the present time and pose, for the pictures."""
         self.events.append(Event(self.time, kind, text, self.pose))
 
     # Safety -------------------------------------------------------------------------------
@@ -270,5 +271,5 @@ class Simulator:
 
     def _stop(self, kind: str, message: str) -> None:
         self.halt()
-        self._event("fault", message)
+        self.note("fault", message)
         raise SafetyFault(kind, message, self.time, self.pose)
