@@ -9,6 +9,7 @@ on (width / 2, height / 2) exactly.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from itertools import pairwise
@@ -56,20 +57,38 @@ def focal(vehicle: Vehicle) -> float:
     return vehicle.image_width / 2 / math.tan(math.radians(vehicle.camera_fov) / 2)
 
 
-def rays(view: View, vehicle: Vehicle, window: tuple[int, int, int, int]) -> Floats:
-    """Unit ray directions for each pixel of `window`, shape (rows, columns, 3)."""
+@functools.lru_cache(maxsize=8)
+def _camera_rays(width: int, height: int, fov: float,
+                 window: tuple[int, int, int, int]) -> Floats:
+    """Unit ray directions for each pixel of `window` in the camera's frame (forward,
+    left, down), shape (rows, columns, 3): the same for every image of a camera."""
     x0, y0, x1, y1 = window
-    x1, y1 = min(x1, vehicle.image_width), min(y1, vehicle.image_height)
-    xs = np.arange(x0, x1) + 0.5 - vehicle.image_width / 2
-    ys = np.arange(y0, y1) + 0.5 - vehicle.image_height / 2
+    xs = np.arange(x0, min(x1, width)) + 0.5 - width / 2
+    ys = np.arange(y0, min(y1, height)) + 0.5 - height / 2
+    f = width / 2 / math.tan(math.radians(fov) / 2)
+    directions = np.empty((ys.size, xs.size, 3))
+    directions[..., 0] = f
+    directions[..., 1] = xs[None, :]  # x grows to the left
+    directions[..., 2] = ys[:, None]
+    result: Floats = directions / np.linalg.norm(directions, axis=2, keepdims=True)
+    result.setflags(write=False)
+    return result
+
+
+def _axes(view: View) -> Floats:
+    """The camera's forward, left and down unit vectors in the world, as rows."""
     cp, sp = math.cos(view.pitch), math.sin(view.pitch)
     cy, sy = math.cos(view.yaw), math.sin(view.yaw)
-    forward = np.array([cp * cy, cp * sy, sp]) * focal(vehicle)
-    left = np.array([-sy, cy, 0.0])  # x grows to the left
-    down = np.array([sp * cy, sp * sy, -cp])
-    directions = (forward[None, None, :] + xs[None, :, None] * left[None, None, :]
-                  + ys[:, None, None] * down[None, None, :])
-    result: Floats = directions / np.linalg.norm(directions, axis=2, keepdims=True)
+    return np.array([[cp * cy, cp * sy, sp], [-sy, cy, 0.0], [sp * cy, sp * sy, -cp]])
+
+
+def rays(view: View, vehicle: Vehicle, window: tuple[int, int, int, int]) -> Floats:
+    """Unit ray directions in the world for each pixel of `window`, shape
+    (rows, columns, 3)."""
+    x0, y0, x1, y1 = window
+    local = _camera_rays(vehicle.image_width, vehicle.image_height, vehicle.camera_fov,
+                         (0, 0, vehicle.image_width, vehicle.image_height))[y0:y1, x0:x1]
+    result: Floats = local @ _axes(view)
     return result
 
 
@@ -81,9 +100,12 @@ def _floor_points(view: View, directions: Floats) -> tuple[Floats, Floats, Mask]
 
 
 def _near_polyline(px: Floats, py: Floats, points: tuple[tuple[float, float], ...],
-                   half_width: float) -> Mask:
+                   half_width: float, box: tuple[float, float, float, float]) -> Mask:
     hit = np.zeros(px.shape, dtype=bool)
     for (ax, ay), (bx, by) in pairwise(points):
+        if (max(ax, bx) + half_width < box[0] or min(ax, bx) - half_width > box[2]
+                or max(ay, by) + half_width < box[1] or min(ay, by) - half_width > box[3]):
+            continue  # the piece is nowhere near what the camera sees
         dx, dy = bx - ax, by - ay
         length2 = dx * dx + dy * dy or 1.0
         t = np.clip(((px - ax) * dx + (py - ay) * dy) / length2, 0.0, 1.0)
@@ -107,19 +129,33 @@ def _seen(scene: Scene, kind: str, name: str) -> bool:
     return kind in scene.sees or name in scene.sees
 
 
-def render(world: World, scene: Scene, view: View) -> Mask:
-    """The binary image of `scene`'s window as the camera at `view` sees it: True where
-    a feature the scene sees is."""
-    directions = rays(view, world.vehicle, scene.window)
-    image = np.zeros(directions.shape[:2], dtype=bool)
-    floor_features = [line for line in world.lines if _seen(scene, "lines", line.name)]
+def _floor(world: World, scene: Scene, view: View, image: Mask) -> None:
+    """Set the pixels of `image` that see a line or mark of `scene` on the floor."""
+    lines = [line for line in world.lines if _seen(scene, "lines", line.name)]
     marks = [mark for mark in world.marks if _seen(scene, "marks", mark.name)]
-    if floor_features or marks:
-        px, py, down = _floor_points(view, directions)
-        for line in floor_features:
-            image |= down & _near_polyline(px, py, line.points, line.width / 2)
-        for mark in marks:
+    if not (lines or marks):
+        return
+    px, py, down = _floor_points(view, rays(view, world.vehicle, scene.window))
+    if not down.any():
+        return
+    box = (float(px[down].min()), float(py[down].min()),
+           float(px[down].max()), float(py[down].max()))
+    for line in lines:
+        image |= down & _near_polyline(px, py, line.points, line.width / 2, box)
+    for mark in marks:
+        xs, ys = [p[0] for p in mark.points], [p[1] for p in mark.points]
+        if max(xs) >= box[0] and min(xs) <= box[2] and max(ys) >= box[1] and min(ys) <= box[3]:
             image |= down & _in_polygon(px, py, mark.points)
+
+
+def _leds(world: World, scene: Scene, view: View, image: Mask) -> None:
+    """Set the pixels of `image` whose rays pass within an LED's radius of its centre;
+    only a box around each LED's projection is tested."""
+    vehicle = world.vehicle
+    axes = _axes(view)
+    f = focal(vehicle)
+    x0, y0 = scene.window[0], scene.window[1]
+    rows, columns = image.shape
     for stand in world.stands:
         if not _seen(scene, "markers", stand.name):
             continue
@@ -127,11 +163,34 @@ def render(world: World, scene: Scene, view: View) -> Mask:
         facing = math.radians(stand.facing)
         if (view.x - mx) * math.cos(facing) + (view.y - my) * math.sin(facing) <= 0:
             continue  # the camera is behind the marker's face
-        for height in (world.vehicle.camera_height, world.vehicle.camera_height - LED_SPACING):
+        for height in (vehicle.camera_height, vehicle.camera_height - LED_SPACING):
             centre = np.array([mx - view.x, my - view.y, height - view.z])
+            ahead, left, down = (float(v) for v in axes @ centre)
+            if ahead <= LED_RADIUS:
+                continue
+            u = vehicle.image_width / 2 + f * left / ahead - x0
+            v = vehicle.image_height / 2 + f * down / ahead - y0
+            reach = 2 * f * LED_RADIUS / ahead + 2  # generous: the box only saves work
+            c0, c1 = max(0, int(u - reach)), min(columns, int(u + reach) + 1)
+            r0, r1 = max(0, int(v - reach)), min(rows, int(v + reach) + 1)
+            if c0 >= c1 or r0 >= r1:
+                continue
+            window = (x0 + c0, y0 + r0, x0 + c1, y0 + r1)
+            directions = rays(view, vehicle, window)
             along = directions @ centre
             miss2 = float(centre @ centre) - along * along
-            image |= (along > 0) & (miss2 <= LED_RADIUS * LED_RADIUS)
+            image[r0:r1, c0:c1] |= (along > 0) & (miss2 <= LED_RADIUS * LED_RADIUS)
+
+
+def render(world: World, scene: Scene, view: View) -> Mask:
+    """The binary image of `scene`'s window as the camera at `view` sees it: True where
+    a feature the scene sees is."""
+    x0, y0, x1, y1 = scene.window
+    shape = (min(y1, world.vehicle.image_height) - y0, min(x1, world.vehicle.image_width) - x0)
+    image = np.zeros((max(shape[0], 0), max(shape[1], 0)), dtype=bool)
+    if image.size:
+        _floor(world, scene, view, image)
+        _leds(world, scene, view, image)
     return image
 
 
@@ -149,16 +208,18 @@ class Moments:
 def moments(image: Mask, window: tuple[int, int, int, int]) -> Moments:
     """The zeroth, first and second moments of a binary image whose top left pixel is
     (window[0], window[1])."""
-    rows, columns = np.nonzero(image)
-    area = int(rows.size)
+    # Sums over rows and columns by matrix products: cheaper than listing the pixels.
+    pixels = image.astype(np.float64)
+    column_counts, row_counts = pixels.sum(axis=0), pixels.sum(axis=1)
+    area = int(column_counts.sum())
     if area == 0:
         return Moments(0, 0.0, 0.0, 0.0)
-    xs = columns + window[0] + 0.5
-    ys = rows + window[1] + 0.5
-    cx, cy = float(xs.mean()), float(ys.mean())
-    mu20 = float(((xs - cx) ** 2).mean())
-    mu02 = float(((ys - cy) ** 2).mean())
-    mu11 = float(((xs - cx) * (ys - cy)).mean())
+    xs = np.arange(image.shape[1]) + window[0] + 0.5
+    ys = np.arange(image.shape[0]) + window[1] + 0.5
+    cx, cy = float(column_counts @ xs) / area, float(row_counts @ ys) / area
+    mu20 = float(column_counts @ (xs - cx) ** 2) / area
+    mu02 = float(row_counts @ (ys - cy) ** 2) / area
+    mu11 = float((ys - cy) @ (pixels @ (xs - cx))) / area
     if abs(mu11) < 1e-9 * (mu20 + mu02):
         mu11 = 0.0  # rounding noise would flip a vertical axis between -90 and 90
     return Moments(area, cx, cy, math.degrees(0.5 * math.atan2(2 * mu11, mu20 - mu02)))

@@ -75,12 +75,14 @@ class Simulator:
     _tick: int = 1  # the tracing timer's next tick
     _rng: np.random.Generator = field(init=False)
     _obstacles: list[tuple[str, list[Point], Point, float]] = field(init=False)
+    _lines: tracing.Segments = field(init=False)
 
     def __post_init__(self) -> None:
         x, y, heading = self.world.start
         self.pose = Pose(x, y, math.radians(heading))
         self.track.append((0.0, self.pose))
         self._rng = np.random.default_rng(self.seed)
+        self._lines = tracing.segments(self.world.lines)
         self._obstacles = []
         for name, points in [(f"stand {s.name}", s.corners()) for s in self.world.stands] + [
                 (f"obstacle {b.name}", list(b.points)) for b in self.world.blocks]:
@@ -148,7 +150,7 @@ class Simulator:
             return None
         cx, cy, slant = centre
         half = slant * math.tan(math.radians(self.world.vehicle.camera_fov) / 2)
-        return tracing.measure(self.world.lines, cx, cy, view.yaw, half)
+        return tracing.measure(self._lines, cx, cy, view.yaw, half)
 
     def range_to(self, sensor: str) -> float:
         vehicle = self.world.vehicle

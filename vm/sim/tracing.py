@@ -12,8 +12,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from itertools import pairwise
 
-from .geometry import segment_nearest
+import numpy as np
+import numpy.typing as npt
+
 from .world import Line
+
+Floats = npt.NDArray[np.float64]
 
 MAX_SPEED = 12  # wheel speed units: the range of MOV and MVI
 
@@ -27,25 +31,51 @@ class LineView:
     angle: float
 
 
-def measure(lines: Sequence[Line], cx: float, cy: float, direction: float,
+@dataclass(frozen=True, slots=True)
+class Segments:
+    """Every straight piece of the guidance lines, as arrays: start points, direction
+    vectors, squared lengths, half widths, angles. Built once per world, so that a
+    measurement at each timer tick is a few array operations."""
+
+    ax: Floats
+    ay: Floats
+    dx: Floats
+    dy: Floats
+    length2: Floats
+    half_width: Floats
+    angle: Floats
+
+
+def segments(lines: Sequence[Line]) -> Segments:
+    pieces = [(a, b, line.width / 2) for line in lines for a, b in pairwise(line.points)]
+    ax = np.array([a[0] for a, _, _ in pieces], dtype=float)
+    ay = np.array([a[1] for a, _, _ in pieces], dtype=float)
+    dx = np.array([b[0] - a[0] for a, b, _ in pieces], dtype=float)
+    dy = np.array([b[1] - a[1] for a, b, _ in pieces], dtype=float)
+    length2 = dx * dx + dy * dy
+    return Segments(ax, ay, dx, dy, np.where(length2 == 0, 1.0, length2),
+                    np.array([w for _, _, w in pieces], dtype=float), np.arctan2(dy, dx))
+
+
+def measure(pieces: Segments, cx: float, cy: float, direction: float,
             half_width: float) -> LineView | None:
     """The guidance line nearest to the view centre (cx, cy) of a view looking along
-    `direction` (radians) and `half_width` cm wide either side; None when no line is
-    within the view."""
-    best: tuple[float, float, float, float] | None = None  # distance, nx, ny, segment angle
-    for line in lines:
-        for a, b in pairwise(line.points):
-            nx, ny, distance = segment_nearest(cx, cy, a, b)
-            distance = max(0.0, distance - line.width / 2)
-            if best is None or distance < best[0]:
-                best = (distance, nx, ny, math.atan2(b[1] - a[1], b[0] - a[0]))
-    if best is None or best[0] > half_width:
+    `direction` (radians) and `half_width` cm wide either side; None when no line's
+    edge is within the view."""
+    if pieces.ax.size == 0:
         return None
-    _, nx, ny, segment = best
+    t = np.clip(((cx - pieces.ax) * pieces.dx + (cy - pieces.ay) * pieces.dy) / pieces.length2,
+                0.0, 1.0)
+    nx, ny = pieces.ax + t * pieces.dx, pieces.ay + t * pieces.dy
+    gaps = np.maximum(np.hypot(cx - nx, cy - ny) - pieces.half_width, 0.0)
+    nearest = int(np.argmin(gaps))
+    if gaps[nearest] > half_width:
+        return None
     # Offset to the right of the view direction; the line's direction is taken modulo
     # 180 degrees, the way that is nearer the view's.
-    offset = (nx - cx) * math.sin(direction) - (ny - cy) * math.cos(direction)
-    relative = (segment - direction + math.pi / 2) % math.pi - math.pi / 2
+    offset = ((float(nx[nearest]) - cx) * math.sin(direction)
+              - (float(ny[nearest]) - cy) * math.cos(direction))
+    relative = (float(pieces.angle[nearest]) - direction + math.pi / 2) % math.pi - math.pi / 2
     return LineView(offset, -relative)
 
 
