@@ -74,3 +74,11 @@ def test_an_ilc_file_runs_on_the_vm(tmp_path: Path) -> None:
     from_ilc = rl1c("sim", ilc, "--world", WORLD)
     assert from_ilc.exit_code == 0
     assert from_ilc.stdout == rl1c("sim", SAMPLE, "--world", WORLD).stdout
+
+
+def test_the_readme_picture_is_the_one_the_command_draws(tmp_path: Path) -> None:
+    svg = tmp_path / "sample.svg"
+    assert rl1c("sim", SAMPLE, "--world", WORLD, "--svg", svg).exit_code == 0
+    assert svg.read_text() == (EXAMPLES / "sample.svg").read_text(), (
+        "regenerate it: rl1c sim examples/sample.rob --world examples/sample.world.toml "
+        "--svg examples/sample.svg")

@@ -14,7 +14,7 @@ from .motion import Pose
 from .simulator import Event
 from .world import World
 
-OUTLINE_EVERY = 2.0  # s of simulated time between two outlines drawn on the path
+OUTLINE_EVERY = 40.0  # cm of travel (or, turning, its equivalent) between two outlines
 _COLOURS = {"lost": "#e67e00", "found": "#2a9d2a", "fault": "#d11", "end": "#1565c0"}
 
 
@@ -60,12 +60,14 @@ def svg(world: World, track: Sequence[tuple[float, Pose]], events: Sequence[Even
     body = _scene(world)
     body.append(f'<polyline points="{_points([(p.x, p.y) for _, p in track])}" fill="none" '
                 'stroke="#1565c0" stroke-width="1.5" stroke-dasharray="4 3"/>')
-    next_outline = 0.0
-    for time, pose in track:
-        if time >= next_outline:
+    drawn: Pose | None = None
+    for _, pose in track:
+        # The outline is drawn again once the vehicle has moved on: a halt draws none.
+        if drawn is None or math.hypot(pose.x - drawn.x, pose.y - drawn.y) + abs(
+                pose.heading - drawn.heading) * world.vehicle.length / 2 >= OUTLINE_EVERY:
             body.append(f'<polygon points="{_outline(world, pose)}" fill="none" '
                         'stroke="#1565c0" stroke-opacity="0.45"/>')
-            next_outline = time + OUTLINE_EVERY
+            drawn = pose
     if track:
         body.append(f'<polygon points="{_outline(world, track[-1][1])}" fill="#1565c0" '
                     'fill-opacity="0.25" stroke="#1565c0" stroke-width="2"/>')
