@@ -12,7 +12,8 @@ from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.frontend.source import Source
 from rl1.compiler.reporting.render import EXIT_ERRORS, FileDiagnostics
 
-from .command import PATH, Command, Failure, choice_option
+from .build import DEFAULT_BUDGET
+from .command import PATH, Command, Failure, at_least_one, choice_option
 from .streams import emit, read_ilc, read_input, write_file
 
 SECTION = "Simulation"
@@ -34,8 +35,12 @@ MAX_WORLD_BYTES = 4 * 2**20
               help="the seed of the sensor noise (the world sets the noise; off by default)")
 @choice_option("--engine", choices=("vm", "ast"), default="vm",
                help="vm: compile, then run on the reference VM; ast: interpret the source")
+@click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=at_least_one,
+              metavar="N", show_default=True,
+              help="instructions (statements with --engine ast) before the watchdog stops "
+                   "a runaway program")
 def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_format: str,
-        seed: int, engine: str) -> int:
+        seed: int, engine: str, budget: int) -> int:
     """Run a program (.rob source, or an .ilc file) on the simulated vehicle and world.
 
     Prints each call with the time and the vehicle's pose, how the run ended and the
@@ -63,7 +68,7 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
             raise click.UsageError("--engine ast interprets RL/I source; an .ilc file runs "
                                    "on the VM: leave out --engine, or run the .rob file")
         try:
-            result = run_ilc(read_ilc(file), device)
+            result = run_ilc(read_ilc(file), device, budget)
         except VerifyError as error:
             raise Failure(f"error: {file}: byte {error.offset}: {error.message}",
                           EXIT_ERRORS) from None
@@ -72,7 +77,7 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
         if not isinstance(source, Source):
             return emit([source], "human", "auto", "sim", err=True)
         outcome = run_source(source.text, os.path.basename(source.name), device,
-                             "ast" if engine == "ast" else "vm")
+                             "ast" if engine == "ast" else "vm", budget)
         if not isinstance(outcome, RunResult):
             return emit([FileDiagnostics(source.name, source.text, outcome)], "human",
                         "auto", "sim", err=True)

@@ -29,7 +29,7 @@ def render_text(result: RunResult, device: SimDevice) -> str:
         lines.append(f"  {entry.time:9.2f}  {call:<28} ({pose.x:7.1f}, {pose.y:7.1f}) "
                      f"{math.degrees(pose.heading):6.1f}")
     for event in device.sim.events:
-        if event.kind in ("lost", "found"):
+        if event.kind in ("lost", "handler", "found"):
             lines.append(f"  {event.time:9.2f}  [{event.text}]")
     lines.append(_ending(result, device))
     named = [f"{name}={value}" for name, value in result.named().items() if value]

@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from support.cli import rl1c
 
 EXAMPLES = Path(__file__).parents[2] / "examples"
@@ -82,3 +84,20 @@ def test_the_readme_picture_is_the_one_the_command_draws(tmp_path: Path) -> None
     assert svg.read_text() == (EXAMPLES / "sample.svg").read_text(), (
         "regenerate it: rl1c sim examples/sample.rob --world examples/sample.world.toml "
         "--svg examples/sample.svg")
+
+
+@settings(max_examples=25, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.lists(st.sampled_from([
+    "(MOV 3,3)", "(MVI 2,2,30)", "(ROT 90)", "(STX 450)", "(STL 75)", "(TRC 3)", "(TRC 2)",
+    "(CAM D)", "(CAM U)", "(CAM P 500)", "(SCN 0)", "(SCN 2)", "A=(IMG)", "B=(ULT A)",
+    "C=(KYO)", "(KYC)", "(TIM 5)", "(MOV 0,0)", "(FRE)", "(INP 3)", "(FZI)", ":10", "#10",
+    "?A>#10", ":96", ":98",
+]), max_size=12))
+def test_any_program_ends_with_a_known_status_and_no_traceback(tmp_path: Path,
+                                                                statements: list[str]) -> None:
+    program = tmp_path / "any.rob"
+    program.write_text("\n".join(statements) + "\n(END)\n")
+    result = rl1c("sim", program, "--world", WORLD, "--budget", "20000", "--format", "json")
+    assert result.exit_code in (0, 1, 10, 11, 12, 13), result.output
+    assert "Traceback" not in result.output

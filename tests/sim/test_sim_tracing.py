@@ -74,3 +74,20 @@ def test_a_lost_line_during_mvi_interrupts_it_in_mode_2() -> None:
     assert device.poll_event() == LineLost("MVI", 2)
     assert device.sim.motion is None
     assert device.sim.pose.x < 500
+
+
+def test_a_program_hears_of_a_lost_line_at_its_handler() -> None:
+    from rl1.compiler.cli.run import run_source
+    from rl1.vm.faults import RunResult
+
+    world = line_world()
+    world = replace(world, lines=(replace(world.lines[0], points=((0.0, 500.0),
+                                                                   (400.0, 500.0))),))
+    device = SimDevice(world)
+    text = "(CAM D); (TRC 3); (MOV 6,6)\n:10 (TIM 1); #10\n:96 (MOV 0,0); H=1; (END)\n"
+    result = run_source(text, "t.rob", device)
+    assert isinstance(result, RunResult) and result.fault is None
+    assert result.named()["H"] == 1
+    kinds = [event.kind for event in device.sim.events]
+    assert kinds == ["lost", "handler"]
+    assert "jump to :96" in device.sim.events[1].text

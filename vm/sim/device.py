@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from rl1.vm.device import DeviceError, FuzzyReading, ImageReading, LineLost, Odometry
+from rl1.vm.language import LOST_LINE_RULES
 
 from .camera import PULSES
 from .motion import Pose
@@ -217,4 +218,8 @@ class SimDevice:
 
     def poll_event(self) -> LineLost | None:
         event, self.pending = self.pending, None
+        if event is not None:
+            label = next((rule.label for rule in LOST_LINE_RULES
+                          if (rule.mode, rule.command) == (event.mode, event.command)), None)
+            self.sim.note("handler", f"the program takes the lost line: jump to :{label}")
         return event

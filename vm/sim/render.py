@@ -15,7 +15,8 @@ from .simulator import Event
 from .world import World
 
 OUTLINE_EVERY = 40.0  # cm of travel (or, turning, its equivalent) between two outlines
-_COLOURS = {"lost": "#e67e00", "found": "#2a9d2a", "fault": "#d11", "end": "#1565c0"}
+_COLOURS = {"lost": "#e67e00", "handler": "#8e24aa", "found": "#2a9d2a", "fault": "#d11",
+            "end": "#1565c0"}
 
 
 def _points(points: Sequence[Point]) -> str:
