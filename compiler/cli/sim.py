@@ -91,8 +91,10 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
         write_file(svg_file, svg(the_world, device.sim.track, device.sim.events,
                                  title).encode())
     if html_file is not None:
-        calls = [(entry.time, entry.call + (" " + ",".join(map(str, entry.args))
-                                            if entry.args else "")) for entry in device.trace]
+        calls = [(entry.time, entry.call
+                  + (" " + ",".join(map(str, entry.args)) if entry.args else "")
+                  + (" -> " + " ".join(map(str, entry.result)) if entry.result else ""))
+                 for entry in device.trace]
         write_file(html_file, html(the_world, device.sim.track, device.sim.events, calls,
                                    title).encode())
     render = render_json if sim_format == "json" else render_text

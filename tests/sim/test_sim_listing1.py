@@ -112,3 +112,15 @@ def test_both_engines_drive_the_simulator_to_the_same_trace(name: str) -> None:
     ast_result, ast_device = _run(world, "ast")
     assert vm_device.trace == ast_device.trace
     assert vm_result == ast_result
+
+
+def test_halving_the_step_leaves_listing_1_where_it_was() -> None:
+    world = _world("sample.world.toml")
+    ends = []
+    for step in (0.05, 0.025):
+        device = SimDevice(world, step=step)
+        result = run_source(SAMPLE, "sample.rob", device)
+        assert isinstance(result, RunResult) and result.fault is None
+        ends.append(device.sim.pose)
+    assert math.hypot(ends[0].x - ends[1].x, ends[0].y - ends[1].y) < 1.0
+    assert ends[0].heading == pytest.approx(ends[1].heading, abs=1e-6)

@@ -148,6 +148,9 @@ function frame(now) {{
 play.onclick = () => {{ playing = !playing; play.textContent = playing ? "Pause" : "Play";
   if (playing) {{ if (time >= end) time = 0; last = null; requestAnimationFrame(frame); }} }};
 scrub.oninput = () => {{ time = end * scrub.value / 1000; draw(); }};
+// A link can open the page at a moment: page.html#t=30 shows the run at 30 s.
+const at = /t=([0-9.]+)/.exec(location.hash);
+if (at) time = Math.min(end, parseFloat(at[1]));
 draw();
 </script></body></html>
 """
