@@ -106,3 +106,21 @@ def test_ultrasonic_reads_the_nearest_wall_in_its_cone(sensor: str, dx: int, dy:
     device = SimDevice(replace(world, blocks=(Block("wall", wall),)))
     assert device.ultrasonic(sensor) == pytest.approx(gap, abs=1)
     assert SimDevice(world).ultrasonic(sensor) == 100  # nothing within its reach
+
+
+def test_a_sensor_delay_reports_where_the_vehicle_was() -> None:
+    world = stand_world(150)
+    delayed = replace(world, noise=replace(world.noise, delay=2.0))
+    readings = []
+    for each in (world, delayed):
+        device = SimDevice(each)
+        device.camera_up()
+        device.select_scene(2)
+        device.move(2, 2)  # 10 cm/s towards the marker
+        device.wait(40)
+        readings.append(device.measure_image().y)
+    f = focal(Vehicle())
+    # Driving from 0.2 s (after the tilt) to the image at 4.24 s: 40.4 cm nearer; the
+    # delayed sensor sees the vehicle of 2.24 s, 20.4 cm nearer.
+    assert readings[0] == pytest.approx(120 + 3 * f / (150 - 40.4), abs=0.5)
+    assert readings[1] == pytest.approx(120 + 3 * f / (150 - 20.4), abs=0.5)

@@ -7,6 +7,7 @@ This module knows nothing of the Device protocol: device.py adapts it.
 
 from __future__ import annotations
 
+import bisect
 import math
 from dataclasses import dataclass, field
 from typing import Literal
@@ -76,6 +77,7 @@ class Simulator:
     _rng: np.random.Generator = field(init=False)
     _obstacles: list[tuple[str, list[Point], Point, float]] = field(init=False)
     _lines: tracing.Segments = field(init=False)
+    _times: list[float] = field(default_factory=lambda: [0.0])  # the track's times
 
     def __post_init__(self) -> None:
         x, y, heading = self.world.start
@@ -128,10 +130,19 @@ class Simulator:
 
     # Sensing -------------------------------------------------------------------------------
 
+    def sensed_pose(self) -> Pose:
+        """The pose the sensors report on: the present one, or the one `noise.delay`
+        seconds ago (the last recorded at or before then)."""
+        delay = self.world.noise.delay
+        if not delay:
+            return self.pose
+        index = bisect.bisect_right(self._times, self.time - delay) - 1
+        return self.track[max(index, 0)][1]
+
     def view(self) -> camera.View:
         tilt = math.radians(self.world.vehicle.tilt_down) if self.tilted_down else 0.0
-        return camera.view_of(self.pose.x, self.pose.y, self.pose.heading, self.pan, tilt,
-                              self.world.vehicle)
+        pose = self.sensed_pose()
+        return camera.view_of(pose.x, pose.y, pose.heading, self.pan, tilt, self.world.vehicle)
 
     def image(self) -> camera.Moments:
         """What the image processor measures now, in the selected scene."""
@@ -154,7 +165,7 @@ class Simulator:
 
     def range_to(self, sensor: str) -> float:
         vehicle = self.world.vehicle
-        distance = ultrasonic.sense(sensor, self.pose, vehicle.length, vehicle.width,
+        distance = ultrasonic.sense(sensor, self.sensed_pose(), vehicle.length, vehicle.width,
                                     vehicle.ultrasonic_cone, vehicle.ultrasonic_range,
                                     [points for _, points, _, _ in self._obstacles])
         noise = self.world.noise.ultrasonic_cm
@@ -215,6 +226,7 @@ class Simulator:
         if self.motion is not None and self.motion.command == "MVI":
             self.motion.remaining -= abs(left + right) / 2 * seconds
         self.track.append((self.time + seconds, self.pose))
+        self._times.append(self.time + seconds)
 
     def _trace(self) -> Command | None:
         """One tick of the tracing timer; the command the line was lost during, when the

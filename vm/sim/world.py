@@ -114,6 +114,7 @@ class Noise:
     image_px: float = 0.0  # on the centroid
     odometry: float = 0.0  # relative, on each wheel's count
     ultrasonic_cm: float = 0.0
+    delay: float = 0.0  # s: the camera, image processor and ultrasonic report this late
 
 
 @dataclass(frozen=True, slots=True)
@@ -397,5 +398,5 @@ def _fuzzy(r: _Reader, value: object) -> tuple[int, int]:
 
 
 def _noise(r: _Reader, value: object) -> Noise:
-    table = r.table(value, ("noise",), ("image_px", "odometry", "ultrasonic_cm"))
+    table = r.table(value, ("noise",), ("image_px", "odometry", "ultrasonic_cm", "delay"))
     return Noise(**{key: r.number(item, ("noise", key), 0, 1000) for key, item in table.items()})
