@@ -208,7 +208,13 @@ class Moments:
 def moments(image: Mask, window: tuple[int, int, int, int]) -> Moments:
     """The zeroth, first and second moments of a binary image whose top left pixel is
     (window[0], window[1])."""
-    # Sums over rows and columns by matrix products: cheaper than listing the pixels.
+    # Only the box around what is set is summed; the sums over rows and columns are
+    # matrix products, cheaper than listing the pixels.
+    rows, columns = np.flatnonzero(image.any(axis=1)), np.flatnonzero(image.any(axis=0))
+    if rows.size == 0:
+        return Moments(0, 0.0, 0.0, 0.0)
+    image = image[rows[0]:rows[-1] + 1, columns[0]:columns[-1] + 1]
+    window = (window[0] + int(columns[0]), window[1] + int(rows[0]), window[2], window[3])
     pixels = image.astype(np.float64)
     column_counts, row_counts = pixels.sum(axis=0), pixels.sum(axis=1)
     area = int(column_counts.sum())

@@ -76,7 +76,7 @@ class Simulator:
     _tick: int = 1  # the tracing timer's next tick
     _rng: np.random.Generator = field(init=False)
     _obstacles: list[tuple[str, list[Point], Point, float]] = field(init=False)
-    _lines: tracing.Segments = field(init=False)
+    _lines: tracing.LineIndex = field(init=False)
     _times: list[float] = field(default_factory=lambda: [0.0])  # the track's times
 
     def __post_init__(self) -> None:
@@ -84,7 +84,7 @@ class Simulator:
         self.pose = Pose(x, y, math.radians(heading))
         self.track.append((0.0, self.pose))
         self._rng = np.random.default_rng(self.seed)
-        self._lines = tracing.segments(self.world.lines)
+        self._lines = tracing.LineIndex(self.world.lines)
         self._obstacles = []
         for name, points in [(f"stand {s.name}", s.corners()) for s in self.world.stands] + [
                 (f"obstacle {b.name}", list(b.points)) for b in self.world.blocks]:

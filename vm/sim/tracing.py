@@ -12,12 +12,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from itertools import pairwise
 
-import numpy as np
-import numpy.typing as npt
-
+from .geometry import Point, segment_nearest
 from .world import Line
-
-Floats = npt.NDArray[np.float64]
 
 MAX_SPEED = 12  # wheel speed units: the range of MOV and MVI
 
@@ -31,51 +27,64 @@ class LineView:
     angle: float
 
 
+CELL = 25.0  # cm: the side of a cell of the lines' index
+
+
 @dataclass(frozen=True, slots=True)
-class Segments:
-    """Every straight piece of the guidance lines, as arrays: start points, direction
-    vectors, squared lengths, half widths, angles. Built once per world, so that a
-    measurement at each timer tick is a few array operations."""
+class Piece:
+    """One straight piece of a guidance line."""
 
-    ax: Floats
-    ay: Floats
-    dx: Floats
-    dy: Floats
-    length2: Floats
-    half_width: Floats
-    angle: Floats
+    a: Point
+    b: Point
+    half_width: float
+    angle: float  # radians, from a to b
 
 
-def segments(lines: Sequence[Line]) -> Segments:
-    pieces = [(a, b, line.width / 2) for line in lines for a, b in pairwise(line.points)]
-    ax = np.array([a[0] for a, _, _ in pieces], dtype=float)
-    ay = np.array([a[1] for a, _, _ in pieces], dtype=float)
-    dx = np.array([b[0] - a[0] for a, b, _ in pieces], dtype=float)
-    dy = np.array([b[1] - a[1] for a, b, _ in pieces], dtype=float)
-    length2 = dx * dx + dy * dy
-    return Segments(ax, ay, dx, dy, np.where(length2 == 0, 1.0, length2),
-                    np.array([w for _, _, w in pieces], dtype=float), np.arctan2(dy, dx))
+class LineIndex:
+    """The guidance lines' pieces, filed by the square cells of the floor that each
+    piece's box covers, so that a measurement at each timer tick looks at a few pieces
+    near the view rather than at all of them."""
+
+    def __init__(self, lines: Sequence[Line]) -> None:
+        self.pieces = [Piece(a, b, line.width / 2, math.atan2(b[1] - a[1], b[0] - a[0]))
+                       for line in lines for a, b in pairwise(line.points)]
+        self.widest = max((piece.half_width for piece in self.pieces), default=0.0)
+        self.cells: dict[tuple[int, int], list[int]] = {}
+        for index, piece in enumerate(self.pieces):
+            (x0, x1), (y0, y1) = sorted((piece.a[0], piece.b[0])), sorted((piece.a[1], piece.b[1]))
+            for i in range(math.floor(x0 / CELL), math.floor(x1 / CELL) + 1):
+                for j in range(math.floor(y0 / CELL), math.floor(y1 / CELL) + 1):
+                    self.cells.setdefault((i, j), []).append(index)
+
+    def near(self, x: float, y: float, reach: float) -> set[int]:
+        """The pieces whose cells lie within `reach` of (x, y): every piece that comes
+        that near is among them."""
+        found: set[int] = set()
+        for i in range(math.floor((x - reach) / CELL), math.floor((x + reach) / CELL) + 1):
+            for j in range(math.floor((y - reach) / CELL), math.floor((y + reach) / CELL) + 1):
+                found.update(self.cells.get((i, j), ()))
+        return found
 
 
-def measure(pieces: Segments, cx: float, cy: float, direction: float,
+def measure(index: LineIndex, cx: float, cy: float, direction: float,
             half_width: float) -> LineView | None:
     """The guidance line nearest to the view centre (cx, cy) of a view looking along
     `direction` (radians) and `half_width` cm wide either side; None when no line's
     edge is within the view."""
-    if pieces.ax.size == 0:
+    best: tuple[float, float, float, float] | None = None  # gap, nx, ny, piece angle
+    for number in sorted(index.near(cx, cy, half_width + index.widest)):  # a fixed order
+        piece = index.pieces[number]
+        nx, ny, distance = segment_nearest(cx, cy, piece.a, piece.b)
+        gap = max(0.0, distance - piece.half_width)
+        if best is None or gap < best[0]:
+            best = (gap, nx, ny, piece.angle)
+    if best is None or best[0] > half_width:
         return None
-    t = np.clip(((cx - pieces.ax) * pieces.dx + (cy - pieces.ay) * pieces.dy) / pieces.length2,
-                0.0, 1.0)
-    nx, ny = pieces.ax + t * pieces.dx, pieces.ay + t * pieces.dy
-    gaps = np.maximum(np.hypot(cx - nx, cy - ny) - pieces.half_width, 0.0)
-    nearest = int(np.argmin(gaps))
-    if gaps[nearest] > half_width:
-        return None
+    _, nx, ny, angle = best
     # Offset to the right of the view direction; the line's direction is taken modulo
     # 180 degrees, the way that is nearer the view's.
-    offset = ((float(nx[nearest]) - cx) * math.sin(direction)
-              - (float(ny[nearest]) - cy) * math.cos(direction))
-    relative = (float(pieces.angle[nearest]) - direction + math.pi / 2) % math.pi - math.pi / 2
+    offset = (nx - cx) * math.sin(direction) - (ny - cy) * math.cos(direction)
+    relative = (angle - direction + math.pi / 2) % math.pi - math.pi / 2
     return LineView(offset, -relative)
 
 
