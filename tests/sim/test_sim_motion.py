@@ -139,6 +139,8 @@ def test_halving_the_step_moves_the_final_pose_by_less_than_a_centimetre(
 @given(program)
 def test_odometry_agrees_with_the_wheels(commands: list[tuple[object, ...]]) -> None:
     device = _drive(0.05, commands)
+    times = [time for time, _ in device.sim.track]
+    assert times == sorted(times)  # the clock never runs back
     centre, right, left = device.sim.distance()
     assert centre == pytest.approx((right + left) / 2, abs=1e-6)
     # The heading changes by the wheels' difference over the tread, whatever the path.

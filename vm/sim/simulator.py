@@ -200,7 +200,10 @@ class Simulator:
                 self.time = end
                 self._check_time()
                 return None
-            tick_time = self._tick * self.world.vehicle.trace_interval
+            interval = self.world.vehicle.trace_interval
+            if self._tick * interval < self.time:  # the timer ticked on while standing
+                self._tick = math.floor(self.time / interval) + 1
+            tick_time = self._tick * interval
             until = min(end, self.time + self.step, tick_time)
             left, right = self._speeds[0] * unit, self._speeds[1] * unit
             if self.motion is not None and self.motion.command == "MVI":
@@ -209,7 +212,7 @@ class Simulator:
             self.time = until
             self._check_safety()
             if (self.motion is not None and self.motion.command == "MVI"
-                    and self.motion.remaining <= 1e-9):
+                    and self.motion.remaining <= 1e-6):  # 10 nm: well above rounding
                 self.halt()
                 continue
             if self.time >= tick_time:
