@@ -57,22 +57,3 @@ def rectangle(cx: float, cy: float, length: float, width: float,
     corners = ((length / 2, width / 2), (-length / 2, width / 2),
                (-length / 2, -width / 2), (length / 2, -width / 2))
     return [(cx + x * c - y * s, cy + x * s + y * c) for x, y in corners]
-
-
-def ray_polygon(ox: float, oy: float, dx: float, dy: float,
-                polygon: Sequence[Point]) -> float | None:
-    """The distance along the unit ray from (ox, oy) in direction (dx, dy) to the first
-    edge of `polygon` it meets, None if it meets none."""
-    best: float | None = None
-    for i in range(len(polygon)):
-        ax, ay = polygon[i]
-        bx, by = polygon[(i + 1) % len(polygon)]
-        ex, ey = bx - ax, by - ay
-        denominator = dx * ey - dy * ex
-        if denominator == 0:
-            continue
-        t = ((ax - ox) * ey - (ay - oy) * ex) / denominator
-        u = ((ax - ox) * dy - (ay - oy) * dx) / denominator
-        if t >= 0 and 0 <= u <= 1 and (best is None or t < best):
-            best = t
-    return best

@@ -77,6 +77,7 @@ class Simulator:
     _rng: np.random.Generator = field(init=False)
     _obstacles: list[tuple[str, list[Point], Point, float]] = field(init=False)
     _lines: tracing.LineIndex = field(init=False)
+    _echoes: ultrasonic.Echoes = field(init=False)
     _times: list[float] = field(default_factory=lambda: [0.0])  # the track's times
 
     def __post_init__(self) -> None:
@@ -92,6 +93,7 @@ class Simulator:
             cy = sum(p[1] for p in points) / len(points)
             radius = max(math.hypot(p[0] - cx, p[1] - cy) for p in points)
             self._obstacles.append((name, points, (cx, cy), radius))
+        self._echoes = ultrasonic.Echoes([points for _, points, _, _ in self._obstacles])
 
     # Commands, in physical terms ---------------------------------------------------------
 
@@ -167,7 +169,7 @@ class Simulator:
         vehicle = self.world.vehicle
         distance = ultrasonic.sense(sensor, self.sensed_pose(), vehicle.length, vehicle.width,
                                     vehicle.ultrasonic_cone, vehicle.ultrasonic_range,
-                                    [points for _, points, _, _ in self._obstacles])
+                                    self._echoes)
         noise = self.world.noise.ultrasonic_cm
         return distance + float(self._rng.normal(0.0, noise)) if noise else distance
 
@@ -275,15 +277,20 @@ class Simulator:
 
     def _check_safety(self) -> None:
         self._check_time()
-        corners = self.outline()
         width, depth = self.world.floor
-        for x, y in corners:
-            if not (0 <= x <= width and 0 <= y <= depth):
-                self._stop("off-floor", f"the vehicle left the floor at corner ({x:.1f}, {y:.1f})")
         reach = math.hypot(self.world.vehicle.length, self.world.vehicle.width) / 2
-        for name, points, (cx, cy), radius in self._obstacles:
-            if (math.hypot(cx - self.pose.x, cy - self.pose.y) <= radius + reach
-                    and overlap(corners, points)):
+        x, y = self.pose.x, self.pose.y
+        near = [(name, points) for name, points, (cx, cy), radius in self._obstacles
+                if math.hypot(cx - x, cy - y) <= radius + reach]
+        if min(x, width - x, y, depth - y) > reach and not near:
+            return  # the outline cannot reach an edge or an obstacle: no need to draw it
+        corners = self.outline()
+        for cx, cy in corners:
+            if not (0 <= cx <= width and 0 <= cy <= depth):
+                self._stop("off-floor", f"the vehicle left the floor at corner "
+                                        f"({cx:.1f}, {cy:.1f})")
+        for name, points in near:
+            if overlap(corners, points):
                 self._stop("collision", f"the vehicle hit {name}")
 
     def _stop(self, kind: str, message: str) -> None:
