@@ -30,6 +30,12 @@ demo: $(STAMP)
 	@echo '$$ rl1c run build/sample.ilc --sensors examples/sample.sensors.json'
 	@$(BIN)/rl1c run build/sample.ilc --sensors examples/sample.sensors.json
 	@echo
+	@echo '$$ rl1c sim build/sample.ilc --world examples/sample.world.toml --svg build/sample.svg --html build/sample.html > build/sample.sim.txt'
+	@$(BIN)/rl1c sim build/sample.ilc --world examples/sample.world.toml --svg build/sample.svg --html build/sample.html > build/sample.sim.txt
+	@tail -n 2 build/sample.sim.txt
+	@echo "Listing 1 simulated on the scene of Fig. 4: the trace is build/sample.sim.txt,"
+	@echo "the picture build/sample.svg, the replay build/sample.html (open it in a browser)."
+	@echo
 	@echo 'Next: `. .venv/bin/activate`, then the first session in README.md.'
 
 test: lint typecheck vscode-test c-test pytest

@@ -23,7 +23,7 @@ import click
 
 from rl1.compiler.reporting.render import EXIT_USAGE
 
-from . import build, source
+from . import build, sim, source
 from .command import (
     CONTEXT_SETTINGS,
     Context,
@@ -37,6 +37,7 @@ from .command import (
 SECTIONS: tuple[tuple[str, Sequence[click.Command]], ...] = (
     (source.SECTION, source.COMMANDS),
     (build.SECTION, build.COMMANDS),
+    (sim.SECTION, sim.COMMANDS),
 )
 
 class Toolchain(click.Group):

@@ -17,6 +17,7 @@ from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.frontend.diagnostics import Diagnostic
 from rl1.compiler.interpreter import interpret
+from rl1.vm.device import Device
 from rl1.vm.drive import drive
 from rl1.vm.faults import DEFAULT_BUDGET, RunResult
 from rl1.vm.hardware import Blocking
@@ -30,13 +31,13 @@ Engine = Literal["vm", "ast"]
 ENGINES: tuple[Engine, ...] = ("vm", "ast")
 
 
-def run_source(text: str, source_name: str, device: ScriptedDevice, engine: Engine = "vm",
+def run_source(text: str, source_name: str, device: Device, engine: Engine = "vm",
                budget: int = DEFAULT_BUDGET) -> RunResult | list[Diagnostic]:
     """Run RL/I source by `engine`; the diagnostics instead when it has errors. For the
     VM the compiled bytes go through the verifier, as a file read from disk would.
     ScriptError when the interpreter is given losses after instruction counts."""
     if engine == "ast":
-        if device.script.instruction_losses:
+        if isinstance(device, ScriptedDevice) and device.script.instruction_losses:
             raise ScriptError("the sensor script loses the line after instruction counts, "
                               "which only the VM counts: run it with --engine vm")
         analysis = analyze(text)
@@ -49,16 +50,18 @@ def run_source(text: str, source_name: str, device: ScriptedDevice, engine: Engi
     return run_program(verify(compilation.output), device, budget)
 
 
-def run_ilc(data: bytes, device: ScriptedDevice, budget: int = DEFAULT_BUDGET) -> RunResult:
+def run_ilc(data: bytes, device: Device, budget: int = DEFAULT_BUDGET) -> RunResult:
     """Run the bytes of an .ilc file on the VM; verifier.VerifyError if they are not
     valid intermediate code."""
     return run_program(verify(data), device, budget)
 
 
-def run_program(program: VerifiedProgram, device: ScriptedDevice,
+def run_program(program: VerifiedProgram, device: Device,
                 budget: int = DEFAULT_BUDGET) -> RunResult:
-    """Step a verified program on the VM to its end."""
-    return drive(Machine(program, Blocking(device), budget), device)
+    """Step a verified program on the VM to its end (on the scripted device, losing the
+    line after the instruction counts its script names)."""
+    machine = Machine(program, Blocking(device), budget)
+    return drive(machine, device) if isinstance(device, ScriptedDevice) else machine.run()
 
 
 def load_script(path: str | Path) -> Script:

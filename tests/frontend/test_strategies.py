@@ -142,7 +142,9 @@ def test_lines_and_programs_cover_the_whole_syntax() -> None:
         "variable argument", "hex", "negative", "decimal", "non-ASCII comment", "tab",
         "empty statement", "CR LF", "shift by < 0", "shift by >= 16",
     }
-    assert expected - coverage(programs(max_lines=8), 300) == set()
+    # Hypothesis mixes the literals of the modules loaded so far into what it draws, so
+    # which ones a run covers shifts as the project grows: 600 examples leave a margin.
+    assert expected - coverage(programs(max_lines=8), 600) == set()
 
 
 def test_checked_programs_cover_every_form_operator_edge_and_handler() -> None:

@@ -38,8 +38,11 @@ def test_the_demo_shows_each_command_and_each_warning_once(tmp_path: Path) -> No
     assert re.findall(r"^\$ (.*)$", shown, re.MULTILINE) == [
         "rl1c examples/sample.rob -o build/sample.ilc",
         "rl1c run build/sample.ilc --sensors examples/sample.sensors.json",
+        "rl1c sim build/sample.ilc --world examples/sample.world.toml --svg build/sample.svg "
+        "--html build/sample.html > build/sample.sim.txt",
     ]
     codes = re.findall(r"^warning\[(\w+)\]", shown, re.MULTILINE)
     assert codes and len(codes) == len(set(codes)), codes
     assert "the program ended normally" in demo.stdout
     assert (tmp_path / "build" / "sample.ilc").is_file()
+    assert (tmp_path / "build" / "sample.svg").is_file()

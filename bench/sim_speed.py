@@ -1,0 +1,79 @@
+"""The simulator's speed: simulated seconds per wall-clock second on Listing 1 (the
+scene of Fig. 4) and on a ten-minute patrol (tracing a round track, reading the
+ultrasonic sensor, the odometer and a small image window once a second), against the
+goal of 1000x real time; and the cost of one (IMG) on a full 256 x 240 image and on
+Listing 1's 60 x 6 window.
+
+    .venv/bin/python bench/sim_speed.py
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+from timing import best_time
+
+from rl1.compiler.cli.run import run_source
+from rl1.vm.faults import RunResult
+from rl1.vm.sim.device import SimDevice
+from rl1.vm.sim.world import Line, Scene, Stand, World, decode_world
+
+ROOT = Path(__file__).parents[1]
+SAMPLE = (ROOT / "examples" / "sample.rob").read_text()
+WORLD = decode_world((ROOT / "examples" / "sample.world.toml").read_bytes(), "sample.world.toml")
+
+PATROL = """'PATROL: trace the round track for ten minutes, looking ahead once a second
+(CAM A 90); (CAM D); (SCN 0); (TRC 1); (KYC)
+N=600
+:10 (MOV 4,4); (TIM 10); A=(ULT A); B=(KYO); C=(IMG); N--
+?N>#10
+(MOV 0,0); (FRE); (END)
+"""
+
+
+def patrol_world() -> World:
+    """A round guidance track of radius 200 cm (72 straight pieces) on a 6 m floor, the
+    vehicle on it facing along it."""
+    points = tuple((300 + 200 * math.cos(math.radians(a)), 300 + 200 * math.sin(math.radians(a)))
+                   for a in range(0, 361, 5))
+    return World(floor=(600.0, 600.0), start=(500.0, 300.0, 90.0),
+                 lines=(Line("track", points, 2.0),),
+                 stands=(Stand("stand", 300.0, 300.0, 40.0, 40.0, 0.0),),
+                 scenes={0: Scene(("lines",), (98, 117, 158, 123))}, time_limit=900.0)
+
+
+def simulate(text: str, world: World) -> tuple[float, float]:
+    """Simulated and wall-clock seconds of one run."""
+    device = SimDevice(world)
+    started = time.perf_counter()
+    result = run_source(text, "bench.rob", device)
+    wall = time.perf_counter() - started
+    assert isinstance(result, RunResult) and result.fault is None, result
+    return device.sim.time, wall
+
+
+def image_cost(window: tuple[int, int, int, int]) -> float:
+    world = World(floor=WORLD.floor, start=WORLD.start, lines=WORLD.lines, marks=WORLD.marks,
+                  stands=WORLD.stands, scenes={0: Scene(("lines", "marks", "markers"), window)})
+    device = SimDevice(world)
+    device.camera_down()
+    return best_time(device.sim.image, 20)
+
+
+def main() -> None:
+    for name, text, world in (("Listing 1, Fig. 4", SAMPLE, WORLD),
+                              ("ten-minute patrol", PATROL, patrol_world())):
+        runs = [simulate(text, world) for _ in range(3)]
+        simulated, wall = min(runs, key=lambda run: run[1])
+        print(f"{name}: {simulated:7.1f} s simulated in {wall:6.3f} s: "
+              f"{simulated / wall:7.0f}x real time")
+    full = image_cost((0, 0, 256, 240))
+    small = image_cost((98, 117, 158, 123))
+    print(f"one IMG: {full * 1000:.2f} ms on the full 256 x 240 image, "
+          f"{small * 1000:.3f} ms on a 60 x 6 window")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,93 @@
+"""Line tracing: the paper's law brings the vehicle onto the line, and Table 4 decides
+what a lost line does."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import pytest
+from support.worlds import line_world
+
+from rl1.vm.device import LineLost
+from rl1.vm.sim.device import SimDevice
+from rl1.vm.sim.tracing import LineView, correct
+
+
+def _tracing(offset: float, angle: float, mode: int = 3, end: float = 1000.0) -> SimDevice:
+    world = line_world(offset, angle)
+    device = SimDevice(replace(world, lines=(replace(world.lines[0], points=(
+        (0.0, 500.0), (end, 500.0))),)))
+    device.camera_pan_angle(90)
+    device.camera_down()
+    device.set_tracing(mode)
+    device.move(3, 3)
+    return device
+
+
+@pytest.mark.parametrize(("offset", "angle"), [(8, 0), (-8, 0), (0, 5), (0, -5), (4, -6)])
+def test_tracing_converges_onto_the_line(offset: float, angle: float) -> None:
+    device = _tracing(offset, angle)
+    device.wait(100)
+    device.wait(100)  # 20 s at 15 cm/s: 3 m
+    pose = device.sim.pose
+    assert abs(pose.y - 500) < 0.5
+    assert abs(math.degrees(pose.heading)) < 0.5
+    assert device.pending is None
+    assert pose.x > 100 + 280  # it kept going along the line
+
+
+def test_without_tracing_the_offset_stays() -> None:
+    device = _tracing(8, 0, mode=0)
+    device.wait(100)
+    assert device.sim.pose.y == pytest.approx(508)
+
+
+def test_the_law_turns_towards_the_line() -> None:
+    # A line to the right and turning right: the left wheel speeds up, the right slows.
+    left, right = correct(3, 3, LineView(offset=5.0, angle=0.1), k1=0.02, k2=0.3)
+    v_d = 3 * (0.02 * 5.0 + 0.3 * math.tan(0.1))
+    assert (left, right) == pytest.approx((3 + v_d, 3 - v_d))
+
+
+@pytest.mark.parametrize(("mode", "handler_hears", "keeps_moving"),
+                         [(1, False, True), (2, True, False), (3, True, True)])
+def test_a_lost_line_follows_table_4(mode: int, handler_hears: bool, keeps_moving: bool) -> None:
+    device = _tracing(0, 0, mode, end=500.0)  # drive off the line's end
+    device.move(12, 12)
+    device.wait(100)
+    lost = [e for e in device.sim.events if e.kind == "lost"]
+    assert len(lost) == 1
+    # Lost when the line's end (and its half width) leaves the view's half width:
+    # the view centre is 30 + 40/tan(50 deg) cm ahead of the vehicle's centre.
+    view_ahead = 30 + 40 / math.tan(math.radians(50))
+    half_width = 40 / math.sin(math.radians(50)) * math.tan(math.radians(11))
+    assert lost[0].pose.x == pytest.approx(500 + 1 + half_width - view_ahead, abs=3.1)
+    assert (device.poll_event() is not None) == handler_hears
+    assert (device.sim.motion is not None) == keeps_moving
+
+
+def test_a_lost_line_during_mvi_interrupts_it_in_mode_2() -> None:
+    device = _tracing(0, 0, mode=2, end=500.0)
+    device.move(0, 0)
+    device.move_distance(12, 12, 600)  # would go past the line's end
+    assert device.poll_event() == LineLost("MVI", 2)
+    assert device.sim.motion is None
+    assert device.sim.pose.x < 500
+
+
+def test_a_program_hears_of_a_lost_line_at_its_handler() -> None:
+    from rl1.compiler.cli.run import run_source
+    from rl1.vm.faults import RunResult
+
+    world = line_world()
+    world = replace(world, lines=(replace(world.lines[0], points=((0.0, 500.0),
+                                                                   (400.0, 500.0))),))
+    device = SimDevice(world)
+    text = "(CAM D); (TRC 3); (MOV 6,6)\n:10 (TIM 1); #10\n:96 (MOV 0,0); H=1; (END)\n"
+    result = run_source(text, "t.rob", device)
+    assert isinstance(result, RunResult) and result.fault is None
+    assert result.named()["H"] == 1
+    kinds = [event.kind for event in device.sim.events]
+    assert kinds == ["lost", "handler"]
+    assert "jump to :96" in device.sim.events[1].text

@@ -1,0 +1,299 @@
+"""The physics of a simulated run (spec/simulator.md): the vehicle's state, the clock
+that advances it in fixed steps, the tracing timer, the safety checks, and the record
+of the run (pose track and events) that the pictures draw.
+
+This module knows nothing of the Device protocol: device.py adapts it.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from . import camera, tracing, ultrasonic
+from .geometry import Point, overlap, rectangle
+from .motion import Odometer, Pose, advance, count, time_to_cover
+from .world import Scene, World
+
+Command = Literal["MOV", "MVI"]
+DEFAULT_STEP = 0.05  # s between two safety checks; the tracing timer has its own interval
+_EMPTY_SCENE = Scene((), (0, 0, 1, 1))
+
+
+class SafetyFault(Exception):
+    """The run was stopped: the vehicle left the floor, hit something, or ran out of
+    time. `kind`, `time` and `pose` say which, when and where."""
+
+    def __init__(self, kind: str, message: str, time: float, pose: Pose) -> None:
+        super().__init__(f"{message} at {time:.2f} s, the vehicle at "
+                         f"({pose.x:.1f}, {pose.y:.1f}) cm heading "
+                         f"{math.degrees(pose.heading):.1f} degrees")
+        self.kind = kind
+        self.time = time
+        self.pose = pose
+
+
+@dataclass(frozen=True, slots=True)
+class Event:
+    """Something the picture marks: a lost or found line, a fault, the end."""
+
+    time: float
+    kind: str
+    text: str
+    pose: Pose
+
+
+@dataclass(slots=True)
+class _Motion:
+    command: Command
+    left: int  # the commanded wheel speeds, units
+    right: int
+    remaining: float = math.inf  # cm the centre still has to cover (MVI)
+
+
+@dataclass(slots=True)
+class Simulator:
+    world: World
+    step: float = DEFAULT_STEP
+    seed: int = 0
+    time: float = 0.0
+    pose: Pose = field(init=False)
+    steering: float = 0.0  # radians, + left
+    motion: _Motion | None = None
+    mode: int = 0
+    lost: bool = False  # the line is out of view while tracing
+    pan: int = camera.PULSES // 2
+    tilted_down: bool = False
+    scene: int = 0
+    odometer: Odometer = field(default_factory=Odometer)
+    track: list[tuple[float, Pose]] = field(default_factory=list)
+    events: list[Event] = field(default_factory=list)
+    _speeds: tuple[float, float] = (0.0, 0.0)  # the wheels' speeds now, units
+    _tick: int = 1  # the tracing timer's next tick
+    _rng: np.random.Generator = field(init=False)
+    _obstacles: list[tuple[str, list[Point], Point, float]] = field(init=False)
+    _lines: tracing.LineIndex = field(init=False)
+    _echoes: ultrasonic.Echoes = field(init=False)
+    _times: list[float] = field(default_factory=lambda: [0.0])  # the track's times
+
+    def __post_init__(self) -> None:
+        x, y, heading = self.world.start
+        self.pose = Pose(x, y, math.radians(heading))
+        self.track.append((0.0, self.pose))
+        self._rng = np.random.default_rng(self.seed)
+        self._lines = tracing.LineIndex(self.world.lines)
+        self._obstacles = []
+        for name, points in [(f"stand {s.name}", s.corners()) for s in self.world.stands] + [
+                (f"obstacle {b.name}", list(b.points)) for b in self.world.blocks]:
+            cx = sum(p[0] for p in points) / len(points)
+            cy = sum(p[1] for p in points) / len(points)
+            radius = max(math.hypot(p[0] - cx, p[1] - cy) for p in points)
+            self._obstacles.append((name, points, (cx, cy), radius))
+        self._echoes = ultrasonic.Echoes([points for _, points, _, _ in self._obstacles])
+
+    # Commands, in physical terms ---------------------------------------------------------
+
+    def drive(self, command: Command, left: int, right: int, cm: float = math.inf) -> None:
+        """Set the wheel speeds (units); an MVI also the distance its centre covers."""
+        self.motion = _Motion(command, left, right, abs(cm)) if (left or right) else None
+        self._speeds = (float(left), float(right)) if self.motion else (0.0, 0.0)
+        self.lost = False
+
+    def halt(self) -> None:
+        self.motion = None
+        self._speeds = (0.0, 0.0)
+
+    def turn_steering(self, radians: float) -> float:
+        """Set the steering; the seconds the steering motor takes."""
+        delta = abs(radians - self.steering)
+        self.steering = radians
+        return math.degrees(delta) / self.world.vehicle.steer_rate
+
+    def rotate(self, degrees: int) -> None:
+        """Turn on the spot (PWS) by `degrees`, + left, stopping any motion first."""
+        self.halt()
+        vehicle = self.world.vehicle
+        speed = vehicle.rotate_speed * (1 if degrees > 0 else -1)
+        self._speeds = (-float(speed), float(speed))
+        seconds = math.radians(abs(degrees)) * vehicle.tread / 2 / (
+            vehicle.rotate_speed * vehicle.wheel_unit)
+        self.run_for(seconds, interruptible=False)
+        self._speeds = (0.0, 0.0)
+
+    def pan_to(self, pulse: int) -> float:
+        """Pan the camera; the seconds the pan motor takes."""
+        delta = abs(pulse - self.pan) * 180 / camera.PULSES
+        self.pan = pulse
+        return delta / self.world.vehicle.pan_rate
+
+    # Sensing -------------------------------------------------------------------------------
+
+    def sensed_pose(self) -> Pose:
+        """The pose the sensors report on: the present one, or the one `noise.delay`
+        seconds ago (the last recorded at or before then)."""
+        delay = self.world.noise.delay
+        if not delay:
+            return self.pose
+        index = bisect.bisect_right(self._times, self.time - delay) - 1
+        return self.track[max(index, 0)][1]
+
+    def view(self) -> camera.View:
+        tilt = math.radians(self.world.vehicle.tilt_down) if self.tilted_down else 0.0
+        pose = self.sensed_pose()
+        return camera.view_of(pose.x, pose.y, pose.heading, self.pan, tilt, self.world.vehicle)
+
+    def image(self) -> camera.Moments:
+        """What the image processor measures now, in the selected scene."""
+        scene = self.world.scenes.get(self.scene, _EMPTY_SCENE)
+        found = camera.moments(camera.render(self.world, scene, self.view()), scene.window)
+        noise = self.world.noise.image_px
+        if noise and found.area:
+            dx, dy = self._rng.normal(0.0, noise, 2)
+            return camera.Moments(found.area, found.x + dx, found.y + dy, found.angle)
+        return found
+
+    def line_view(self) -> tracing.LineView | None:
+        view = self.view()
+        centre = camera.view_centre(view)
+        if centre is None:
+            return None
+        cx, cy, slant = centre
+        half = slant * math.tan(math.radians(self.world.vehicle.camera_fov) / 2)
+        return tracing.measure(self._lines, cx, cy, view.yaw, half)
+
+    def range_to(self, sensor: str) -> float:
+        vehicle = self.world.vehicle
+        distance = ultrasonic.sense(sensor, self.sensed_pose(), vehicle.length, vehicle.width,
+                                    vehicle.ultrasonic_cone, vehicle.ultrasonic_range,
+                                    self._echoes)
+        noise = self.world.noise.ultrasonic_cm
+        return distance + float(self._rng.normal(0.0, noise)) if noise else distance
+
+    def distance(self) -> tuple[float, float, float]:
+        """The counters: centre, right wheel, left wheel, in cm."""
+        noise = self.world.noise.odometry
+        odometer = self.odometer
+        if not noise:
+            return odometer.centre, odometer.right, odometer.left
+        right, left = (value * (1 + float(self._rng.normal(0.0, noise)))
+                       for value in (odometer.right, odometer.left))
+        return (right + left) / 2, right, left
+
+    # The clock ----------------------------------------------------------------------------
+
+    def run_for(self, seconds: float, interruptible: bool) -> Command | None:
+        """Let `seconds` pass (math.inf: until a foreground MVI ends). Returns the command
+        during which the line was lost, when the program must hear of it and the wait is
+        `interruptible`; the wait then ends at once. Raises SafetyFault."""
+        end = self.time + seconds
+        foreground = self.motion is not None and self.motion.command == "MVI"
+        unit = self.world.vehicle.wheel_unit
+        while self.time < end:
+            if foreground and self.motion is None:
+                return None
+            moving = self._speeds != (0.0, 0.0)
+            if not moving:
+                if math.isinf(end):
+                    return None
+                self.time = end
+                self._check_time()
+                return None
+            interval = self.world.vehicle.trace_interval
+            if self._tick * interval < self.time:  # the timer ticked on while standing
+                self._tick = math.floor(self.time / interval) + 1
+            tick_time = self._tick * interval
+            until = min(end, self.time + self.step, tick_time)
+            left, right = self._speeds[0] * unit, self._speeds[1] * unit
+            if self.motion is not None and self.motion.command == "MVI":
+                until = min(until, self.time + time_to_cover(self.motion.remaining, left, right))
+            self._move(until - self.time, left, right)
+            self.time = until
+            self._check_safety()
+            if (self.motion is not None and self.motion.command == "MVI"
+                    and self.motion.remaining <= 1e-6):  # 10 nm: well above rounding
+                self.halt()
+                continue
+            if self.time >= tick_time:
+                self._tick += 1
+                lost = self._trace()
+                if lost is not None and interruptible:
+                    return lost
+        return None
+
+    def _move(self, seconds: float, left: float, right: float) -> None:
+        vehicle = self.world.vehicle
+        self.pose = advance(self.pose, self.steering, left, right, vehicle.tread, seconds)
+        count(self.odometer, left, right, seconds)
+        if self.motion is not None and self.motion.command == "MVI":
+            self.motion.remaining -= abs(left + right) / 2 * seconds
+        self.track.append((self.time + seconds, self.pose))
+        self._times.append(self.time + seconds)
+
+    def _trace(self) -> Command | None:
+        """One tick of the tracing timer; the command the line was lost during, when the
+        program is to hear of it (modes 2 and 3)."""
+        motion = self.motion
+        if motion is None or self.mode == 0:
+            return None
+        seen = self.line_view()
+        if seen is not None:
+            if self.lost:
+                self.lost = False
+                self.note("found", "line found")
+            vehicle = self.world.vehicle
+            self._speeds = tracing.correct(motion.left, motion.right, seen, vehicle.k1,
+                                           vehicle.k2)
+            return None
+        self._speeds = (float(motion.left), float(motion.right))  # straight on, uncorrected
+        if self.lost:
+            return None
+        self.lost = True
+        self.note("lost", f"line lost during {motion.command} in mode {self.mode}")
+        if self.mode == 1:
+            return None
+        if self.mode == 2:
+            self.halt()
+        return motion.command
+
+    def note(self, kind: str, text: str) -> None:
+        """Record an event at the present time and pose, for the pictures."""
+        self.events.append(Event(self.time, kind, text, self.pose))
+
+    # Safety -------------------------------------------------------------------------------
+
+    def outline(self) -> list[Point]:
+        vehicle = self.world.vehicle
+        return rectangle(self.pose.x, self.pose.y, vehicle.length, vehicle.width,
+                         self.pose.heading)
+
+    def _check_time(self) -> None:
+        if self.time > self.world.time_limit:
+            self._stop("time-limit", f"the run passed its time limit of "
+                                     f"{self.world.time_limit:g} s")
+
+    def _check_safety(self) -> None:
+        self._check_time()
+        width, depth = self.world.floor
+        reach = math.hypot(self.world.vehicle.length, self.world.vehicle.width) / 2
+        x, y = self.pose.x, self.pose.y
+        near = [(name, points) for name, points, (cx, cy), radius in self._obstacles
+                if math.hypot(cx - x, cy - y) <= radius + reach]
+        if min(x, width - x, y, depth - y) > reach and not near:
+            return  # the outline cannot reach an edge or an obstacle: no need to draw it
+        corners = self.outline()
+        for cx, cy in corners:
+            if not (0 <= cx <= width and 0 <= cy <= depth):
+                self._stop("off-floor", f"the vehicle left the floor at corner "
+                                        f"({cx:.1f}, {cy:.1f})")
+        for name, points in near:
+            if overlap(corners, points):
+                self._stop("collision", f"the vehicle hit {name}")
+
+    def _stop(self, kind: str, message: str) -> None:
+        self.halt()
+        self.note("fault", message)
+        raise SafetyFault(kind, message, self.time, self.pose)
