@@ -19,7 +19,6 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import click
 
 from rl1.compiler.reporting.render import COLOR_CHOICES, EXIT_ERRORS, EXIT_USAGE, FORMATS
-from rl1.vm.faults import MAX_BUDGET
 
 if TYPE_CHECKING:  # click's completion module loads only when a shell asks
     from click.shell_completion import CompletionItem
@@ -156,6 +155,8 @@ def choice_option(*names: str, choices: Sequence[str], help: str,
 
 def a_budget(ctx: click.Context, param: click.Parameter, value: str) -> int:
     """An option's callback: a watchdog budget, a whole number in 1..MAX_BUDGET."""
+    from rl1.vm.faults import MAX_BUDGET  # the VM's modules load only for commands that run
+
     try:
         number = int(value)
     except ValueError:

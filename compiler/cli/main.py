@@ -1,29 +1,34 @@
 """`rl1c`: compile RL/I (`rl1c FILE.rob -o FILE.ilc`) and the commands beside it.
 
-The commands live by what they work on: source.py (check, fmt, explain) and build.py
-(compile, run, dis, asm); command.py has what they share. This module makes them one
-click group with what the toolchain adds to click: a first word that names a file means
-`compile`, a mistyped command gets a suggestion, and usage errors read
+The commands live by what they work on: source.py (check, fmt, explain), build.py
+(compile, run, dis, asm) and sim.py (sim); command.py has what they share. A command's
+module is imported only when the command runs (or help lists them all), as click's
+documentation shows for lazy groups: `rl1c check` pays for no other command.
+
+This module makes them one click group with what the toolchain adds to click: a first
+word that names a file means `compile`, a mistyped command gets a suggestion, and usage
+errors read
 `usage: ...` then `rl1c check: error: what is wrong`. Exit statuses: 0 success, 1 the
 input has errors, 2 a usage problem or an unreadable file, 3 an internal error (a bug in
 rl1c), 10-13 faults of `rl1c run`, 130 interrupted.
 
 To add a command: write it in the module of its group (or a new one listed in
-`SECTIONS`), as command.py says.
+`MODULES`), add its name there, as command.py says.
 """
 
 from __future__ import annotations
 
+import importlib
 import os
 import sys
 from collections.abc import Sequence
+from types import ModuleType
 from typing import Any
 
 import click
 
 from rl1.compiler.reporting.render import EXIT_USAGE
 
-from . import build, sim, source
 from .command import (
     CONTEXT_SETTINGS,
     Context,
@@ -33,12 +38,19 @@ from .command import (
     write_usage,
 )
 
-# The commands, by the section of `rl1c --help` that lists them.
-SECTIONS: tuple[tuple[str, Sequence[click.Command]], ...] = (
-    (source.SECTION, source.COMMANDS),
-    (build.SECTION, build.COMMANDS),
-    (sim.SECTION, sim.COMMANDS),
+# The modules of the commands, in the order of `rl1c --help`'s sections, with the names
+# of their commands (each module's SECTION and COMMANDS; a test holds the names equal).
+MODULES: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("source", ("check", "fmt", "explain")),
+    ("build", ("compile", "run", "dis", "asm")),
+    ("sim", ("sim",)),
 )
+COMMAND_NAMES = tuple(name for _, names in MODULES for name in names)
+
+
+def command_module(name: str) -> ModuleType:
+    return importlib.import_module(f"{__package__}.{name}")
+
 
 class Toolchain(click.Group):
     """The `rl1c` group: click's, with the toolchain's default command, suggestions,
@@ -49,30 +61,41 @@ class Toolchain(click.Group):
     def format_usage(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         write_usage(self, ctx, formatter)
 
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted(COMMAND_NAMES)  # as click's own groups list them
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        for module, names in MODULES:
+            if cmd_name in names:
+                commands: Sequence[click.Command] = command_module(module).COMMANDS
+                return next(command for command in commands if command.name == cmd_name)
+        return None
+
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         with formatter.section("Commands"):
-            for index, (title, commands) in enumerate(SECTIONS):
+            for index, (name, _) in enumerate(MODULES):
+                module = command_module(name)
                 if index:
                     formatter.write_paragraph()
-                formatter.write_heading(title)
+                formatter.write_heading(module.SECTION)
                 with formatter.indentation():
                     # The whole first sentence: write_dl wraps it to the terminal's width.
                     formatter.write_dl([(command.name or "", command.get_short_help_str(1000))
-                                        for command in commands])
+                                        for command in module.COMMANDS])
 
     def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
         if not args and not ctx.resilient_parsing:
             # Nothing to do is a usage problem: the help goes to standard error.
             click.echo(ctx.get_help(), err=True)
             ctx.exit(EXIT_USAGE)
-        if args and args[0] not in self.commands and names_a_file(args[0]):
+        if args and args[0] not in COMMAND_NAMES and names_a_file(args[0]):
             args = ["compile", *args]  # compiling needs no command
         return super().parse_args(ctx, args)
 
     def resolve_command(self, ctx: click.Context, args: list[str]
                         ) -> tuple[str | None, click.Command | None, list[str]]:
         name = args[0]
-        if name not in self.commands and not name.startswith("-") \
+        if name not in COMMAND_NAMES and not name.startswith("-") \
                 and not ctx.resilient_parsing:
             raise click.UsageError(self._no_such_command(name), ctx)
         return super().resolve_command(ctx, args)
@@ -80,10 +103,10 @@ class Toolchain(click.Group):
     def _no_such_command(self, name: str) -> str:
         import difflib  # for this message only
 
-        close = difflib.get_close_matches(name, self.commands, n=1)
+        close = difflib.get_close_matches(name, COMMAND_NAMES, n=1)
         if close:
             return f"No such command {name!r}. Did you mean {close[0]!r}?"
-        return (f"No such command {name!r}. The commands are {', '.join(self.commands)}; "
+        return (f"No such command {name!r}. The commands are {', '.join(COMMAND_NAMES)}; "
                 "to compile a file, give its path (such as `rl1c prog.rob`)")
 
     def shell_complete(self, ctx: click.Context, incomplete: str) -> list[Any]:
@@ -166,8 +189,3 @@ def rl1c() -> None:
     """The RL/I toolchain. `rl1c FILE.rob -o FILE.ilc` compiles (the same as
     `rl1c compile FILE.rob -o FILE.ilc`); the commands below check, format, explain,
     disassemble, assemble and run programs. `rl1c COMMAND --help` tells more."""
-
-
-for _, commands in SECTIONS:
-    for command in commands:
-        rl1c.add_command(command)

@@ -10,6 +10,7 @@ from support import SAMPLE
 
 from rl1.compiler.backend import driver, firmware
 from rl1.compiler.cli import build as cli
+from rl1.compiler.cli import main
 from rl1.compiler.cli import run as runner
 from rl1.vm import faults
 
@@ -59,6 +60,18 @@ def test_check_loads_neither_the_back_end_nor_the_vm_nor_lark(loaded_by_check: s
     assert loaded_by_check & back_end == set()
     # The parser runs the tables make_tables.py wrote; lark itself costs 40 ms to import.
     assert "rl1.compiler.frontend.lalr_tables" in loaded_by_check
+
+
+def test_check_loads_only_its_own_commands(loaded_by_check: set[str]) -> None:
+    assert "rl1.compiler.cli.source" in loaded_by_check
+    assert loaded_by_check & {"rl1.compiler.cli.build", "rl1.compiler.cli.sim",
+                              "rl1.vm.faults"} == set()
+
+
+def test_the_lazy_table_names_each_modules_commands() -> None:
+    for module, names in main.MODULES:
+        commands = main.command_module(module).COMMANDS
+        assert tuple(command.name for command in commands) == names
 
 
 def test_check_loads_nothing_costly(loaded_by_check: set[str]) -> None:
