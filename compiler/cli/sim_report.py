@@ -6,20 +6,29 @@ from __future__ import annotations
 import json
 import math
 
+from rl1.compiler.frontend.source import Source
 from rl1.vm.faults import RunResult
 from rl1.vm.sim.device import SimDevice
 
+from .run_report import fault_text, status_json
 
-def _ending(result: RunResult, device: SimDevice) -> str:
+
+def _ending(result: RunResult, device: SimDevice, name: str, source: Source | None,
+            color: bool) -> str:
+    """How the run ended, as `rl1c run` says it."""
     fault = result.fault
     if fault is None:
-        moving = device.sim.motion is not None
-        return ("the program ended normally" + (", the vehicle still moving" if moving else ""))
-    where = f" at line {fault.line}" if fault.line is not None else ""
-    return f"fault[{fault.kind.code}]{where}: {fault.message}"
+        if device.sim.motion is None:
+            return "the program ended normally"
+        return ("the program ended normally\nnote: the program ended with the vehicle still "
+                "moving")
+    return fault_text(fault, name, source.name if source else name,
+                      source.text if source else None, color=color).rstrip("\n")
 
 
-def render_text(result: RunResult, device: SimDevice) -> str:
+def render_text(result: RunResult, device: SimDevice, name: str, source: Source | None,
+                *, color: bool = False) -> str:
+    """The report for people of a run of the program `name` (`source`, when known)."""
     lines = ["trace (simulated time in s; pose x, y in cm, heading in degrees):"]
     for entry in device.trace:
         call = entry.call + (" " + ",".join(map(str, entry.args)) if entry.args else "")
@@ -31,20 +40,19 @@ def render_text(result: RunResult, device: SimDevice) -> str:
     for event in device.sim.events:
         if event.kind in ("lost", "handler", "found"):
             lines.append(f"  {event.time:9.2f}  [{event.text}]")
-    lines.append(_ending(result, device))
+    lines.append(_ending(result, device, name, source, color))
     named = [f"{name}={value}" for name, value in result.named().items() if value]
     lines.append("variables: " + (" ".join(named) + " (all others 0)" if named else "all 0"))
     return "\n".join(lines) + "\n"
 
 
 def render_json(result: RunResult, device: SimDevice) -> str:
-    status = "ok" if result.fault is None else result.fault.to_json()
+    status = status_json(result)  # the shape of `rl1c run`'s, and a safety stop's facts
     if device.fault is not None:
         pose = device.fault.pose
-        status = {**(status if isinstance(status, dict) else {}),
-                  "safety": device.fault.kind, "time": round(device.fault.time, 4),
-                  "pose": [round(pose.x, 2), round(pose.y, 2),
-                           round(math.degrees(pose.heading), 2)]}
+        status |= {"safety": device.fault.kind, "time": round(device.fault.time, 4),
+                   "pose": [round(pose.x, 2), round(pose.y, 2),
+                            round(math.degrees(pose.heading), 2)]}
     document = {
         "status": status,
         "variables": result.named(),

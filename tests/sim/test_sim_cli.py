@@ -31,7 +31,7 @@ def test_json_report_has_the_track_and_is_deterministic(tmp_path: Path) -> None:
                             "--seed", seed).stdout)
             for world, seed in ((WORLD, "1"), (WORLD, "2"), (noisy, "7"), (noisy, "7"),
                                 (noisy, "8"))]
-    assert runs[0]["status"] == "ok"
+    assert runs[0]["status"]["code"] == "ok"
     assert runs[0]["track"][0] == [0.0, 60.0, 150.0, 0.0]
     assert {"time", "call", "args", "pose"} <= set(runs[0]["trace"][0])
     assert runs[0] == runs[1]  # noise is off by default: the seed changes nothing
@@ -57,6 +57,10 @@ def test_a_safety_stop_is_a_device_fault_with_its_line(tmp_path: Path) -> None:
     assert result.exit_code == 13
     status = json.loads(result.stdout)["status"]
     assert status["safety"] == "off-floor" and status["line"] == 2
+    assert (status["code"], status["exit_status"]) == ("device-error", 13)  # run's shape
+    text = rl1c("sim", program, "--world", WORLD).stdout
+    assert "error[device-error]: " in text  # shown as `rl1c run` shows a fault
+    assert f"\n --> {program}:2:5\n" in text and "\n2 | :10 (IMG)\n" in text
 
 
 def test_a_bad_world_file_is_a_message_and_status_2(tmp_path: Path) -> None:
