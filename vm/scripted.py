@@ -107,6 +107,10 @@ class LossAt:
 
     time: int
 
+    def to_json(self) -> dict[str, Any]:
+        """The loss as the script writes it."""
+        return {"time": self.time}
+
 
 @dataclass(frozen=True, slots=True)
 class LossDuring:
@@ -116,12 +120,18 @@ class LossDuring:
     nth: int
     after: int
 
+    def to_json(self) -> dict[str, Any]:
+        return {"during": self.command, "nth": self.nth, "after": self.after}
+
 
 @dataclass(frozen=True, slots=True)
 class LossAfter:
     """The line is lost right after the VM's `instruction`-th instruction."""
 
     instruction: int
+
+    def to_json(self) -> dict[str, Any]:
+        return {"instruction": self.instruction}
 
 
 @dataclass(frozen=True, slots=True)
@@ -301,8 +311,8 @@ def _list(value: object, where: str) -> list[object]:
     if not isinstance(value, list):
         raise ScriptError(f"{where}: expected a list of readings, found {_kind(value)}")
     if not value:
-        raise ScriptError(f"{where}: the list is empty; give at least one reading "
-                          "or leave the key out (readings are then 0)")
+        raise ScriptError(f"{where}: the list is empty; give at least one reading, "
+                          "or leave the key out")
     return value
 
 
@@ -422,6 +432,7 @@ class ScriptedDevice:
         self._read_counts: dict[str, int] = {}
         self._arrivals: dict[str, int] = {}  # calls of each form so far, for "fail"
         self._failing: str | None = None  # why the waiting built-in under way fails
+        self._met: set[LossAt | LossDuring | LossAfter] = set()  # the losses that happened
 
     # Bookkeeping
 
@@ -511,8 +522,34 @@ class ScriptedDevice:
                 self.time = until
                 return
             self.time = loss
+            self._met.add(LossAt(loss))
+            if motion is not None:
+                self._met.add(LossDuring(motion.command, motion.nth, loss - motion.start))
             if self.lose_line() and interruptible:
                 return
+
+    def lose_line_after(self, instruction: int) -> bool:
+        """The line is lost after the VM's `instruction`-th instruction (LossAfter)."""
+        self._met.add(LossAfter(instruction))
+        return self.lose_line()
+
+    def losses_not_met(self) -> list[tuple[int, LossAt | LossDuring | LossAfter, str]]:
+        """The script's losses that have not happened (yet): each with its index in
+        `line_lost` and why, so that a report drops none silently."""
+        missed = []
+        for index, loss in enumerate(self.script.losses):
+            if loss in self._met:
+                continue
+            if isinstance(loss, LossDuring) and self._calls[loss.command] >= loss.nth:
+                why = (f"that {loss.command} was not in effect {loss.after} ms after "
+                       "it started")
+            elif isinstance(loss, LossDuring):
+                calls = self._calls[loss.command]
+                why = f"the run made {calls} {loss.command} call{'s' if calls != 1 else ''}"
+            else:
+                why = "the run ended before it"
+            missed.append((index, loss, why))
+        return missed
 
     def lose_line(self) -> bool:
         """The line is lost now; True if the program is to hear of it."""

@@ -306,7 +306,8 @@ def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoi
                        select_trace(device.log, trace_choice or
                                     ("short" if run_format == "text" else "all")),
                        finished.instructions, device.time,
-                       device.motion if finished.result.fault is None else None)
+                       device.motion if finished.result.fault is None else None,
+                       device.losses_not_met())
     if run_format == "json":
         sys.stdout.write(render_json(report))
     else:

@@ -17,7 +17,7 @@ from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.compiler.frontend.parser import parse_program
 from rl1.compiler.reporting.render import FileDiagnostics, diagnostic_blocks
 from rl1.vm.faults import Fault, FaultKind, RunResult
-from rl1.vm.scripted import LOST, TraceEntry
+from rl1.vm.scripted import LOST, LossAfter, LossAt, LossDuring, TraceEntry
 
 TraceChoice = Literal["short", "all", "calls", "none"]
 TRACE_CHOICES: tuple[TraceChoice, ...] = ("short", "all", "calls", "none")
@@ -62,6 +62,8 @@ class RunReport:
     instructions: int | None  # None when the interpreter ran it
     device_time: int  # ms
     moving: str | None  # the motion in effect when the program ended: "(MOV 3,3)"
+    missed: Sequence[tuple[int, LossAt | LossDuring | LossAfter, str]] = ()
+    """The script's losses that never happened: index in line_lost, loss, why."""
 
 
 # Text ---------------------------------------------------------------------------------
@@ -79,7 +81,7 @@ def render_text(report: RunReport, *, color: bool = False) -> str:
             lines += [_entry_line(entry) for entry in trace.tail]
     fault = report.result.fault
     if fault is None:
-        lines.append(f"the program ended at {report.device_time} ms of device time"
+        lines.append(f"the program ended normally at {report.device_time} ms of device time"
                      + _executed(report))
         if report.moving is not None:
             lines.append(f"note: the program ended with {report.moving} in effect: the "
@@ -89,6 +91,8 @@ def render_text(report: RunReport, *, color: bool = False) -> str:
                                 color=color).rstrip("\n"))
         lines.append(f"the run stopped at {report.device_time} ms of device time"
                      + _executed(report))
+    lines += [f"note: the sensor script's line_lost[{index}], {json.dumps(loss.to_json())}, "
+              f"never happened: {why}" for index, loss, why in report.missed]
     named = [f"{name}={value}" for name, value in report.result.named().items() if value]
     lines.append("variables: " + (" ".join(named) + " (all others 0)" if named else "all 0"))
     return "\n".join(lines) + "\n"
@@ -218,6 +222,8 @@ def render_json(report: RunReport) -> str:
         "trace": [entry_json(entry) for entry in (*trace.head, *trace.tail)],
         "trace_left_out": ({"after": len(trace.head), "count": trace.left_out}
                            if trace.left_out else None),
+        "losses_not_met": [{"index": index, "loss": loss.to_json(), "why": why}
+                           for index, loss, why in report.missed],
     }
     return json.dumps(document, indent=2) + "\n"
 

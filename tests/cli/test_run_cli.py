@@ -47,7 +47,8 @@ def test_the_sample_runs_its_main_path_and_prints_trace_lines_and_variables() ->
     assert [line.split() for line in lines[-6:-2]] == [
         ["3200", "40", "MVI", "1,1,50"], ["13200", "40", "MOV", "3,3"],
         ["13200", "41", "MOV", "0,0"], ["13200", "43", "FRE"]]  # the MVI takes 10 s
-    assert lines[-2] == "the program ended at 13200 ms of device time, after 286 instructions"
+    assert lines[-2] == ("the program ended normally at 13200 ms of device time, after 286 "
+                         "instructions")
     assert lines[-1].startswith("variables: A=5 C=589 D=450 L=100 U=160 ")
 
 
@@ -292,3 +293,22 @@ def test_the_help_links_the_sensor_script_page() -> None:
     assert "spec/sensors.md" in help_text
     assert re.search(r"--time-limit SECONDS\s", help_text)
     assert (EXAMPLES.parent / "spec" / "sensors.md").is_file()
+
+
+def test_a_scripted_loss_that_never_happens_is_said(tmp_path: Path) -> None:
+    args = program(tmp_path, "(TRC 3); (MOV 3,3); (MOV 0,0)\n(TIM 5)\n(END)\n", {"line_lost": [
+        {"time": 200}, {"time": 50000}, {"during": "MOV", "nth": 1, "after": 100},
+        {"during": "MVI", "nth": 1}]})
+    lines = rl1c("run", *args).stdout.splitlines()
+    assert lines[-4:-1] == [
+        'note: the sensor script\'s line_lost[1], {"time": 50000}, never happened: the run '
+        'ended before it',
+        'note: the sensor script\'s line_lost[2], {"during": "MOV", "nth": 1, "after": 100}, '
+        'never happened: that MOV was not in effect 100 ms after it started',
+        'note: the sensor script\'s line_lost[3], {"during": "MVI", "nth": 1, "after": 1}, '
+        'never happened: the run made 0 MVI calls']
+    assert report(*args)[1]["losses_not_met"][0] == {
+        "index": 1, "loss": {"time": 50000}, "why": "the run ended before it"}
+    instruction = program(tmp_path, "A=1\nB=2\n", {"line_lost": [{"instruction": 1},
+                                                                 {"instruction": 9}]})
+    assert [item["index"] for item in report(*instruction)[1]["losses_not_met"]] == [1]

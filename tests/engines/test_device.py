@@ -436,3 +436,21 @@ def test_entries_carry_the_line_the_locate_callback_gives() -> None:
     device.wait(1)
     assert [(entry.call, entry.line) for entry in device.trace] == [("MOV", 7), ("TIM", 9)]
     assert device.trace[0] == TraceEntry(0, "MOV", (1, 1))  # the line is no part of equality
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.integers(1, 3000), min_size=1, max_size=8),
+       st.lists(st.integers(0, 10), max_size=8),
+       st.integers(0, 3))
+def test_every_scripted_loss_is_logged_or_said_not_to_have_happened(
+        times: list[int], waits: list[int], mode: int) -> None:
+    device = ScriptedDevice(parse_script({"line_lost": [{"time": t} for t in times]}))
+    device.set_tracing(mode)
+    device.move(2, 2)
+    for tenths in waits:
+        device.wait(tenths)
+        device.poll_event()
+    logged = {entry.time for entry in device.log if entry.call == "LINE LOST"}
+    missed = {loss.time for _, loss, _ in device.losses_not_met() if isinstance(loss, LossAt)}
+    assert logged | missed == set(times) and not logged & missed
+    assert all(time > device.time for time in missed)
