@@ -109,6 +109,17 @@ def _shift_right(value: int, count: int) -> int:
     return value >> count
 
 
+def evaluate(operator: str, left: int, right: int) -> int:
+    """`left operator right` as the VM computes it (operator one of isa.ALU_OPERATORS):
+    what the optimizer folds a constant expression to."""
+    if operator == "<":
+        return _shift_left(left, right)
+    if operator == ">":
+        return _shift_right(left, right)
+    return _wrap({"+": left + right, "-": left - right, "&": left & right,
+                  "|": left | right, "^": left ^ right}[operator])
+
+
 class Machine:
     def __init__(self, program: VerifiedProgram, device: Device,
                  budget: int = DEFAULT_BUDGET) -> None:
@@ -125,6 +136,9 @@ class Machine:
         self.handlers = {label: program.index_of[offset]
                          for label, offset in program.image.handlers.items()}
         self.executed = 0  # instructions the last run executed
+        # For each call of the last run, the instructions executed up to it, itself
+        # included: what the optimizer's budget invariant bounds (spec/optimization.md).
+        self.call_counts: list[int] = []
 
     # Decoding
 
@@ -190,6 +204,7 @@ class Machine:
         cells = self.cells[:]
         device = self.device
         poll, divert = device.poll_event, self._divert
+        call_counts = self.call_counts = []
         acc = 0  # modulo 2**16: see the module's docstring
         pc = 0
         start = 0  # where the current straight run of instructions began
@@ -253,6 +268,7 @@ class Machine:
                     if executed + pc - start > budget:
                         executed += pc - start
                         break
+                    call_counts.append(executed + pc - start)
                     self._call(self.sites[a], cells)
                     event = poll()
                     if event is not None:

@@ -6,10 +6,12 @@ blocks, not addresses; every instruction carries the source line it came from. C
 leaves a block only through its terminator: a jump, a two-way branch or the end. Nothing
 falls through implicitly; the code generator drops a jump to the block laid out next.
 
-Passes rewrite the IR in place: `Program.blocks` maps each block's id to the block, in
-layout order, and a block's instructions are a list of small frozen dataclasses, so a
-pass replaces instructions and terminators rather than mutating them. `validate` states
-the invariants every pass must keep.
+The accumulator is dead where a block starts: a block reads it only after loading it
+(each statement's load-operate-store lies within one block), so passes reason about it
+block by block. Passes rewrite the IR in place: `Program.blocks` maps each block's id to
+the block, in layout order, and a block's instructions are a list of small frozen
+dataclasses, so a pass replaces instructions and terminators rather than mutating them.
+`validate` states the invariants every pass must keep.
 """
 
 from __future__ import annotations
@@ -260,6 +262,7 @@ def _block_problems(block: Block) -> Iterator[str]:
     if not isinstance(block.terminator, Jump | Branch | End):
         yield f"ends with {block.terminator!r}, which is not a terminator"
     result_set = False  # whether R holds a value here (only a call within the block sets it)
+    loaded = False  # whether acc holds a value here: it is dead where a block starts
     for instruction in block.instructions:
         if not isinstance(instruction, Load | Operate | Store | StepVar | Call):
             yield f"holds {instruction!r}, which is not an instruction"
@@ -271,6 +274,9 @@ def _block_problems(block: Block) -> Iterator[str]:
                 yield f"line {instruction.line}: {operand.value} does not fit 16 bits"
             elif isinstance(operand, Result) and not result_set:
                 yield f"line {instruction.line}: `{instruction}` reads R before a call sets it"
+        if isinstance(instruction, Operate | Store) and not loaded:
+            yield f"line {instruction.line}: `{instruction}` reads acc before a load sets it"
+        loaded = loaded or isinstance(instruction, Load)
         if isinstance(instruction, Call):
             yield from _call_problems(instruction)
             result_set = instruction.mnemonic in BUILTINS and instruction.returns_value

@@ -49,6 +49,7 @@ SECTION = "Intermediate code"
 EMIT_CHOICES = ("ilc", "ir")
 ENGINE_CHOICES = ("vm", "ast")
 DEFAULT_BUDGET = 10_000_000
+DEFAULT_LEVEL = 1
 
 
 @click.command("compile", cls=Command)
@@ -60,8 +61,10 @@ DEFAULT_BUDGET = 10_000_000
               help="leave out the debug section (the map from code to source lines)")
 @choice_option("--emit", "emit_kind", choices=EMIT_CHOICES, default="ilc",
                help="ilc: the .ilc file; ir: the IR as text")
-@click.option("-O", "optimize", default="0", metavar="LEVEL",
-              help="optimization level; only -O0 (none) exists so far")
+@click.option("-O", "optimize", default=str(DEFAULT_LEVEL), metavar="LEVEL",
+              show_default=True,
+              help="optimization level: 0 none; 1 the passes whose code every format 1.0 "
+                   "reader runs; 2 all of them (spec/optimization.md)")
 @force_option
 @format_option
 @color_option
@@ -77,8 +80,8 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: Emit,
     from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
 
     if optimize not in {str(level) for level in OPTIMIZATION_LEVELS}:
-        raise click.UsageError(f"argument -O: `-O{optimize}`: only -O0 (no optimization) "
-                               "exists so far")
+        raise click.UsageError(f"argument -O: `-O{optimize}`: the levels are "
+                               + ", ".join(f"-O{level}" for level in OPTIMIZATION_LEVELS))
     if strip and emit_kind == "ir":
         raise click.UsageError("--strip drops the debug section of an .ilc file; "
                                "it has no meaning with --emit ir")
@@ -90,7 +93,7 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: Emit,
         raise click.UsageError(f"the output `{target}` is the source file itself: "
                                "give another path with -o")
     compilation = compile_text(source.text, os.path.basename(source.name), emit=emit_kind,
-                               strip_debug=strip)
+                               strip_debug=strip, level=int(optimize))
     status = emit([FileDiagnostics(source.name, source.text, compilation.diagnostics)],
                   output_format, color, "compile", err=True)
     if compilation.output is None:

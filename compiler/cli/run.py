@@ -12,6 +12,7 @@ from typing import Literal
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.backend.optimize import DEFAULT_LEVEL
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.frontend.diagnostics import Diagnostic
 from rl1.compiler.interpreter import interpret
@@ -30,13 +31,14 @@ ENGINES: tuple[Engine, ...] = ("vm", "ast")
 def run_source(text: str, source_name: str, device: Device, engine: Engine = "vm",
                budget: int = DEFAULT_BUDGET) -> RunResult | list[Diagnostic]:
     """Run RL/I source by `engine`; the diagnostics instead when it has errors. For the
-    VM the compiled bytes go through the verifier, as a file read from disk would."""
+    VM it is compiled as `rl1c FILE.rob` compiles it (at the default level), and the
+    bytes go through the verifier, as a file read from disk would."""
     if engine == "ast":
         analysis = analyze(text)
         if analysis.has_errors:
             return analysis.diagnostics
         return interpret(analysis.program, device, budget)
-    compilation = compile_text(text, source_name)
+    compilation = compile_text(text, source_name, level=DEFAULT_LEVEL)
     if compilation.output is None:
         return compilation.diagnostics
     return Machine(verify(compilation.output), device, budget).run()
