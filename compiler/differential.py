@@ -22,10 +22,10 @@ from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
 from rl1.compiler.interpreter import interpret
 from rl1.compiler.strategies import Run
-from rl1.vm.faults import FaultKind, RunResult
+from rl1.vm.faults import FaultKind
 from rl1.vm.language import VARIABLES
 from rl1.vm.machine import Machine
-from rl1.vm.scripted import ScriptedDevice, TraceEntry, parse_script
+from rl1.vm.scripted import ScriptedDevice, parse_script, run_document
 from rl1.vm.verifier import verify
 
 SOURCE_NAME = "fuzz.rob"
@@ -33,19 +33,12 @@ EXEC_TIMEOUT = 10.0  # seconds an exec: engine may take for one run
 BUDGET_CODE = FaultKind.BUDGET.code
 
 
-def run_document(result: RunResult, trace: Sequence[TraceEntry]) -> dict[str, Any]:
-    """A run as `rl1c run --format json` prints it: status ("ok" or the fault), all 53
-    variables, the trace."""
-    return {"status": "ok" if result.fault is None else result.fault.to_json(),
-            "variables": result.named(), "trace": [entry.to_json() for entry in trace]}
-
-
 @dataclass(frozen=True)
 class Observation:
     """What section 2 of spec/optimization.md says a run shows, and, from the reference
     VM, the instructions executed (in all, and up to each call)."""
 
-    document: dict[str, Any]  # as run_document gives it
+    document: dict[str, Any]  # as scripted.run_document gives it
     executed: int | None = None
     call_counts: tuple[int, ...] | None = None
 

@@ -1,10 +1,10 @@
 """`rl1c`: compile RL/I (`rl1c FILE.rob -o FILE.ilc`) and the commands beside it.
 
-The commands live by what they work on: source.py (check, fmt, explain) and build.py
-(compile, run, dis, asm); command.py has what they share. This module makes them one
-click group with what the toolchain adds to click: a first word that names a file means
-`compile`, a mistyped command gets a suggestion, and usage errors read
-`usage: ...` then `rl1c check: error: what is wrong`. Exit statuses: 0 success, 1 the
+The commands live by what they work on: source.py (check, fmt, explain), build.py
+(compile, run, dis, asm) and fuzz.py (fuzz); command.py has what they share. This module
+makes them one click group with what the toolchain adds to click: a first word that
+names a file means `compile`, a mistyped command gets a suggestion, and usage errors
+read `usage: ...` then `rl1c check: error: what is wrong`. Exit statuses: 0 success, 1 the
 input has errors, 2 a usage problem or an unreadable file, 3 an internal error (a bug in
 rl1c), 10-13 faults of `rl1c run`, 130 interrupted.
 
@@ -23,7 +23,7 @@ import click
 
 from rl1.compiler.reporting.render import EXIT_USAGE
 
-from . import build, source
+from . import build, fuzz, source
 from .command import (
     CONTEXT_SETTINGS,
     Context,
@@ -37,6 +37,7 @@ from .command import (
 SECTIONS: tuple[tuple[str, Sequence[click.Command]], ...] = (
     (source.SECTION, source.COMMANDS),
     (build.SECTION, build.COMMANDS),
+    (fuzz.SECTION, fuzz.COMMANDS),
 )
 
 class Toolchain(click.Group):

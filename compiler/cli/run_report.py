@@ -5,9 +5,8 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 
-from rl1.compiler.differential import run_document
 from rl1.vm.faults import RunResult
-from rl1.vm.scripted import TraceEntry
+from rl1.vm.scripted import TraceEntry, run_document
 
 
 def render_json(result: RunResult, trace: Sequence[TraceEntry]) -> str:
