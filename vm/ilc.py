@@ -19,7 +19,9 @@ from dataclasses import dataclass
 from .language import HANDLER_LABELS, Feature
 
 MAGIC = b"RLIC"
-VERSION_MAJOR, VERSION_MINOR = 1, 0
+# The newest version this module reads. A writer writes the oldest minor version whose
+# instructions the code uses (Image.minor; vm/isa.py says which instruction came when).
+VERSION_MAJOR, VERSION_MINOR = 1, 1
 
 # magic, major, minor, flags, crc, header size, then the size of each section in order.
 # The debug section's size is a u32: one entry per instruction can pass 64 KiB.
@@ -72,6 +74,7 @@ class Image:
     features: frozenset[Feature]
     debug: DebugInfo | None = None
     flags: int = 0  # the header's flag bits, kept so that a file reads back as it was
+    minor: int = 0  # the format minor version the file says
 
 
 @dataclass(frozen=True)
@@ -133,9 +136,11 @@ def encode(image: Image) -> bytes:
     handlers = _encode_handlers(image.handlers, len(image.code))
     features = struct.pack("<H", sum(1 << feature.value for feature in image.features))
     debug = b"" if image.debug is None else _encode_debug(image.debug)
+    if not 0 <= image.minor <= 0xFF:
+        raise ValueError(f"minor version {image.minor} does not fit its byte")
     if not 0 <= image.flags <= 0xFFFF:
         raise ValueError(f"flags 0x{image.flags:X} do not fit the 16-bit field")
-    header = HEADER.pack(MAGIC, VERSION_MAJOR, VERSION_MINOR, image.flags, 0, HEADER.size,
+    header = HEADER.pack(MAGIC, VERSION_MAJOR, image.minor, image.flags, 0, HEADER.size,
                          len(image.code), len(handlers), len(features), len(debug))
     data = bytearray(header + image.code + handlers + features + debug)
     struct.pack_into("<I", data, CRC_OFFSET, crc_of(bytes(data)))
@@ -209,8 +214,8 @@ def read(data: bytes) -> Container:
     handlers = _decode_handlers(data, header)
     features = _decode_features(data, header.feature_start)
     debug, entry_offsets = (None, ()) if header.debug_size == 0 else _decode_debug(data, header)
-    return Container(header, Image(code, handlers, features, debug, header.flags),
-                     entry_offsets)
+    return Container(header, Image(code, handlers, features, debug, header.flags,
+                                   header.minor), entry_offsets)
 
 
 def read_header(data: bytes) -> Header:

@@ -17,6 +17,7 @@ lists for that opcode, so an instruction's length is known from its first byte.
 from __future__ import annotations
 
 import struct
+from collections.abc import Iterable
 from dataclasses import dataclass
 from enum import Enum
 
@@ -38,6 +39,7 @@ class OpInfo:
     meaning: str
     builtin: tuple[str, str | None] | None = None  # (mnemonic, selector) for calls
     arity: int = 0  # number of call arguments
+    minor: int = 0  # the format minor version that added it (a file using it says so)
 
     @property
     def length(self) -> int:
@@ -69,6 +71,11 @@ ALU_VAR, ALU_IMM, ALU_RESULT = 0x10, 0x18, 0x20
 
 JUMP_IF = {"=": 0x31, ">": 0x32, "<": 0x33}  # conditional jump opcode by relation
 
+# The superinstructions of -O2 (spec/ilc.md, section 7) came with this minor version of
+# the format; it is written here once, so that a merge with another 1.x can renumber it.
+FUSED_MINOR = 1
+STORE_JUMP_IF = {"=": 0x35, ">": 0x36, "<": 0x37}  # store acc, then jump on it
+
 # The built-in forms, in opcode order from CALL_BASE; END is opcode 0.
 CALL_BASE = 0x40
 CALL_FORMS: tuple[tuple[str, str | None], ...] = (
@@ -94,6 +101,17 @@ def _table() -> dict[int, OpInfo]:
         OpInfo(0x31, "JZ", (Operand.VAR, Operand.ADDR), "jump to a if V[v] = 0"),
         OpInfo(0x32, "JGT", (Operand.VAR, Operand.ADDR), "jump to a if V[v] > 0"),
         OpInfo(0x33, "JLT", (Operand.VAR, Operand.ADDR), "jump to a if V[v] < 0"),
+        OpInfo(0x07, "MOVV", (Operand.VAR, Operand.VAR), "V[v] = V[w] (the second v)",
+               minor=FUSED_MINOR),
+        OpInfo(0x08, "MOVI", (Operand.VAR, Operand.IMM), "V[v] = i", minor=FUSED_MINOR),
+        OpInfo(0x34, "DJGT", (Operand.VAR, Operand.ADDR),
+               "V[v] = V[v] - 1, then jump to a if V[v] > 0", minor=FUSED_MINOR),
+        OpInfo(0x35, "SJZ", (Operand.VAR, Operand.ADDR),
+               "V[v] = acc, then jump to a if V[v] = 0", minor=FUSED_MINOR),
+        OpInfo(0x36, "SJGT", (Operand.VAR, Operand.ADDR),
+               "V[v] = acc, then jump to a if V[v] > 0", minor=FUSED_MINOR),
+        OpInfo(0x37, "SJLT", (Operand.VAR, Operand.ADDR),
+               "V[v] = acc, then jump to a if V[v] < 0", minor=FUSED_MINOR),
     ]
     for index, (name, meaning) in enumerate(zip(_ALU_NAMES, _ALU_MEANINGS, strict=True)):
         rows.append(OpInfo(ALU_VAR + index, name + "V", (Operand.VAR,),
@@ -118,6 +136,12 @@ BY_NAME: dict[str, OpInfo] = {info.name: info for info in OPCODES.values()}
 BY_FORM: dict[tuple[str, str | None], OpInfo] = {
     info.builtin: info for info in OPCODES.values() if info.builtin is not None
 }
+
+
+def minor_needed(infos: Iterable[OpInfo]) -> int:
+    """The format minor version a file holding these instructions must say: the newest
+    that added one of them."""
+    return max((info.minor for info in infos), default=0)
 
 
 @dataclass(frozen=True, slots=True)

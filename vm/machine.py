@@ -50,12 +50,16 @@ R_CELL = len(VARIABLES)
 
 # The operations of the dispatch loop (not opcodes: decoding folds operand kinds).
 (LOAD, STORE, ADD, SUB, AND, OR, XOR, SHL, SHR, INC, DEC,
- JUMP, JUMP_ZERO, JUMP_POSITIVE, JUMP_NEGATIVE, CALL, END, EXPRESSION) = range(18)
+ JUMP, JUMP_ZERO, JUMP_POSITIVE, JUMP_NEGATIVE, CALL, END, EXPRESSION,
+ MOVE, DEC_JUMP_POSITIVE, STORE_JUMP_ZERO, STORE_JUMP_POSITIVE, STORE_JUMP_NEGATIVE,
+ ) = range(23)
 
 _ALU = (ADD, SUB, AND, OR, XOR, SHL, SHR)  # in isa.ALU_OPERATORS order
 _ALU_BASES = (isa.ALU_RESULT, isa.ALU_IMM, isa.ALU_VAR)  # highest first
 _SIMPLE = {"STV": STORE, "INC": INC, "DEC": DEC}
-_JUMPS = {"JMP": JUMP, "JZ": JUMP_ZERO, "JGT": JUMP_POSITIVE, "JLT": JUMP_NEGATIVE}
+_JUMPS = {"JMP": JUMP, "JZ": JUMP_ZERO, "JGT": JUMP_POSITIVE, "JLT": JUMP_NEGATIVE,
+          "DJGT": DEC_JUMP_POSITIVE, "SJZ": STORE_JUMP_ZERO, "SJGT": STORE_JUMP_POSITIVE,
+          "SJLT": STORE_JUMP_NEGATIVE}
 
 
 @dataclass(frozen=True, slots=True)
@@ -162,6 +166,10 @@ class Machine:
             return (LOAD, R_CELL, 0)
         if name in _SIMPLE:
             return (_SIMPLE[name], operands[0], 0)
+        if name == "MOVV":
+            return (MOVE, operands[0], operands[1])
+        if name == "MOVI":
+            return (MOVE, operands[0], self._immediate(operands[1]))
         if name in _JUMPS:
             *condition, target = operands
             return (_JUMPS[name], condition[0] if condition else 0,
@@ -294,6 +302,23 @@ class Machine:
                     count = cells[a]
                     acc = _wrap(acc)
                     acc = acc >> count if 0 <= count < 16 else _shift_right(acc, count)
+                elif op == MOVE:
+                    cells[a] = cells[b]
+                elif op == DEC_JUMP_POSITIVE:
+                    cells[a] = ((cells[a] - 1 + 0x8000) & 0xFFFF) - 0x8000
+                    if cells[a] > 0:
+                        executed += pc - start
+                        if executed > budget:
+                            break
+                        pc = start = b if device.pending is None else divert(poll(), b)
+                elif STORE_JUMP_ZERO <= op <= STORE_JUMP_NEGATIVE:
+                    value = cells[a] = ((acc + 0x8000) & 0xFFFF) - 0x8000
+                    if (value == 0 if op == STORE_JUMP_ZERO
+                            else value > 0 if op == STORE_JUMP_POSITIVE else value < 0):
+                        executed += pc - start
+                        if executed > budget:
+                            break
+                        pc = start = b if device.pending is None else divert(poll(), b)
                 else:  # END
                     self.executed = executed + pc - start
                     return RunResult(tuple(cells[:R_CELL]))

@@ -73,6 +73,11 @@ class _CodeVerifier:
         info = isa.OPCODES.get(self.code[offset])
         if info is None:
             raise self.fail(offset, f"unknown opcode 0x{self.code[offset]:02X}")
+        header = self.container.header
+        if info.minor > header.minor:
+            raise self.fail(offset, f"{info.name} is an instruction of format "
+                                    f"{header.major}.{info.minor}, but the file says "
+                                    f"{header.major}.{header.minor}")
         if offset + info.length > len(self.code):
             raise self.fail(offset, f"{info.name} needs {info.length} bytes, only "
                                     f"{len(self.code) - offset} remain in the code")

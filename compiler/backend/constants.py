@@ -154,6 +154,9 @@ def _fold(block: ir.Block, known: Known) -> _Folded:
             value = known.get(name)
             _set(known, name, None if value is None
                  else evaluate("+" if instruction.step == "++" else "-", value, 1))
+        elif isinstance(instruction, ir.Move):
+            out.append(instruction)
+            _set(known, instruction.target.name, _value(instruction.source, known))
         else:
             out.append(_call(instruction, known))
             form = BUILTINS[instruction.mnemonic].form(instruction.selector)

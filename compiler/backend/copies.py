@@ -38,7 +38,7 @@ def _without_copies(instructions: list[ir.Instruction]) -> list[ir.Instruction]:
             holds.add(instruction.target.name)
         elif isinstance(instruction, ir.Operate):
             holds = set()
-        elif isinstance(instruction, ir.StepVar):
+        elif isinstance(instruction, ir.StepVar | ir.Move):
             holds.discard(instruction.target.name)
         else:
             form = BUILTINS[instruction.mnemonic].form(instruction.selector)

@@ -59,11 +59,23 @@ def _sweep(block: ir.Block, live_out: frozenset[str]
     """The block's instructions without its dead ones, and what is live where it
     starts."""
     live = set(live_out)
-    acc_used = False  # whether an instruction after this point reads the accumulator
+    terminator = block.terminator
+    if isinstance(terminator, ir.StoreBranch):
+        live.discard(terminator.var.name)  # stored here, from the accumulator
+    elif isinstance(terminator, ir.DecrementBranch):
+        live.add(terminator.var.name)
+    # Whether an instruction after this point reads the accumulator.
+    acc_used = isinstance(terminator, ir.StoreBranch)
     kept: list[ir.Instruction] = []
     for instruction in reversed(block.instructions):
         if isinstance(instruction, ir.Call):
             live = set(ALL)  # a fault here shows every variable
+        elif isinstance(instruction, ir.Move):
+            if instruction.target.name not in live:
+                continue
+            live.discard(instruction.target.name)
+            if isinstance(instruction.source, ir.Var):
+                live.add(instruction.source.name)
         elif isinstance(instruction, ir.Store):
             name = instruction.target.name
             if name not in live:

@@ -40,3 +40,15 @@ def reachable(program: ir.Program) -> set[ir.BlockId]:
         seen.add(block_id)
         work.extend(program.successors(block_id))
     return seen
+
+
+def acc_dead_after(instructions: list[ir.Instruction], index: int,
+                   terminator: ir.Terminator) -> bool:
+    """Whether nothing from `instructions[index]` on (the terminator included) reads
+    the accumulator before loading it again."""
+    for instruction in instructions[index:]:
+        if isinstance(instruction, ir.Load):
+            return True
+        if isinstance(instruction, ir.Operate | ir.Store):
+            return False
+    return not isinstance(terminator, ir.StoreBranch)

@@ -141,7 +141,19 @@ class Call:
         return text + (" " + ", ".join(map(str, self.args)) if self.args else "")
 
 
-Instruction = Load | Operate | Store | StepVar | Call
+@dataclass(frozen=True, slots=True)
+class Move:
+    """target = source, without touching acc (a superinstruction of -O2)."""
+
+    target: Var
+    source: Var | Imm
+    line: int
+
+    def __str__(self) -> str:
+        return f"move {self.target}, {self.source}"
+
+
+Instruction = Load | Operate | Store | StepVar | Call | Move
 
 
 # Terminators ------------------------------------------------------------------------
@@ -179,6 +191,44 @@ class Branch:
 
 
 @dataclass(frozen=True, slots=True)
+class StoreBranch:
+    """var = acc, then go to `if_true` when var compares with zero as `relation` says,
+    else `if_false` (a superinstruction of -O2)."""
+
+    var: Var
+    relation: Relation
+    if_true: BlockId
+    if_false: BlockId
+    line: int
+
+    @property
+    def targets(self) -> tuple[BlockId, ...]:
+        return (self.if_true, self.if_false)
+
+    def __str__(self) -> str:
+        return (f"store {self.var}; if {self.var}{self.relation}0 then {self.if_true} "
+                f"else {self.if_false}")
+
+
+@dataclass(frozen=True, slots=True)
+class DecrementBranch:
+    """var--, then go to `if_true` when var > 0, else `if_false` (a superinstruction of
+    -O2, for counted loops)."""
+
+    var: Var
+    if_true: BlockId
+    if_false: BlockId
+    line: int
+
+    @property
+    def targets(self) -> tuple[BlockId, ...]:
+        return (self.if_true, self.if_false)
+
+    def __str__(self) -> str:
+        return f"dec {self.var}; if {self.var}>0 then {self.if_true} else {self.if_false}"
+
+
+@dataclass(frozen=True, slots=True)
 class End:
     line: int
 
@@ -190,7 +240,7 @@ class End:
         return "end"
 
 
-Terminator = Jump | Branch | End
+Terminator = Jump | Branch | StoreBranch | DecrementBranch | End
 
 
 # Blocks and programs ----------------------------------------------------------------
@@ -259,12 +309,12 @@ def validate(program: Program) -> list[str]:
 
 
 def _block_problems(block: Block) -> Iterator[str]:
-    if not isinstance(block.terminator, Jump | Branch | End):
+    if not isinstance(block.terminator, Jump | Branch | StoreBranch | DecrementBranch | End):
         yield f"ends with {block.terminator!r}, which is not a terminator"
     result_set = False  # whether R holds a value here (only a call within the block sets it)
     loaded = False  # whether acc holds a value here: it is dead where a block starts
     for instruction in block.instructions:
-        if not isinstance(instruction, Load | Operate | Store | StepVar | Call):
+        if not isinstance(instruction, Load | Operate | Store | StepVar | Call | Move):
             yield f"holds {instruction!r}, which is not an instruction"
             continue
         for operand in _operands(instruction):
@@ -280,8 +330,12 @@ def _block_problems(block: Block) -> Iterator[str]:
         if isinstance(instruction, Call):
             yield from _call_problems(instruction)
             result_set = instruction.mnemonic in BUILTINS and instruction.returns_value
-    if isinstance(block.terminator, Branch) and block.terminator.var.name not in VARIABLES:
-        yield f"branches on `{block.terminator.var.name}`, which is not a variable"
+    terminator = block.terminator
+    if isinstance(terminator, StoreBranch) and not loaded:
+        yield f"line {terminator.line}: `{terminator}` reads acc before a load sets it"
+    if isinstance(terminator, Branch | StoreBranch | DecrementBranch) \
+            and terminator.var.name not in VARIABLES:
+        yield f"branches on `{terminator.var.name}`, which is not a variable"
 
 
 def _operands(instruction: Instruction) -> tuple[Operand, ...]:
@@ -289,6 +343,8 @@ def _operands(instruction: Instruction) -> tuple[Operand, ...]:
         return (instruction.source,)
     if isinstance(instruction, Store | StepVar):
         return (instruction.target,)
+    if isinstance(instruction, Move):
+        return (instruction.target, instruction.source)
     return instruction.args
 
 

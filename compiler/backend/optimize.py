@@ -16,6 +16,7 @@ from .control import simplify_control
 from .copies import propagate_copies
 from .dead_stores import remove_dead_stores
 from .peephole import rewrite_steps
+from .superinstructions import fuse
 
 Pass = Callable[[ir.Program], ir.Program]
 
@@ -25,6 +26,9 @@ Pass = Callable[[ir.Program], ir.Program]
 O1_PASSES: tuple[Pass, ...] = (simplify_control, fold_constants, propagate_copies,
                                rewrite_steps, remove_dead_stores, simplify_control)
 LEVELS: dict[int, tuple[Pass, ...]] = {0: (), 1: O1_PASSES, 2: O1_PASSES}
+# What runs once after a level's passes stop changing the program: -O2's fusion, which
+# the other passes need not know.
+FINAL_PASSES: dict[int, tuple[Pass, ...]] = {0: (), 1: (), 2: (fuse,)}
 DEFAULT_LEVEL = 1
 MAX_ROUNDS = 8  # a round seldom finds anything after the third
 
@@ -49,6 +53,10 @@ def optimize(program: ir.Program, level: int, *, check: bool = False) -> ir.Prog
         before, shape = shape, _shape(program)
         if shape == before:
             break
+    for run in FINAL_PASSES[level]:
+        program = run(program)
+        if check:
+            _validate(program, run.__name__)
     _validate(program, "the optimizer")
     return program
 

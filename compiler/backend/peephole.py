@@ -13,22 +13,23 @@ from __future__ import annotations
 
 from rl1.compiler.frontend.ast import Step
 
-from . import ir
+from . import flow, ir
 
 MAX_STEPS = 2  # +-3 would take as many instructions as the load-add-store
 
 
 def rewrite_steps(program: ir.Program) -> ir.Program:
     for block in program:
-        block.instructions = _with_steps(block.instructions)
+        block.instructions = _with_steps(block.instructions, block.terminator)
     return program
 
 
-def _with_steps(instructions: list[ir.Instruction]) -> list[ir.Instruction]:
+def _with_steps(instructions: list[ir.Instruction], terminator: ir.Terminator
+                ) -> list[ir.Instruction]:
     out: list[ir.Instruction] = []
     index = 0
     while index < len(instructions):
-        steps = _steps_at(instructions, index)
+        steps = _steps_at(instructions, index, terminator)
         if steps is None:
             out.append(instructions[index])
             index += 1
@@ -38,7 +39,8 @@ def _with_steps(instructions: list[ir.Instruction]) -> list[ir.Instruction]:
     return out
 
 
-def _steps_at(instructions: list[ir.Instruction], index: int) -> list[ir.StepVar] | None:
+def _steps_at(instructions: list[ir.Instruction], index: int, terminator: ir.Terminator
+              ) -> list[ir.StepVar] | None:
     window = instructions[index:index + 3]
     if len(window) < 3:
         return None
@@ -46,19 +48,10 @@ def _steps_at(instructions: list[ir.Instruction], index: int) -> list[ir.StepVar
     if not (isinstance(load, ir.Load) and isinstance(operate, ir.Operate)
             and isinstance(store, ir.Store) and isinstance(load.source, ir.Var)
             and load.source == store.target and isinstance(operate.source, ir.Imm)
-            and operate.op in "+-" and _acc_dead_after(instructions, index + 3)):
+            and operate.op in "+-" and flow.acc_dead_after(instructions, index + 3, terminator)):
         return None
     delta = operate.source.value if operate.op == "+" else -operate.source.value
     if delta == 0 or abs(delta) > MAX_STEPS:
         return None
     step: Step = "++" if delta > 0 else "--"
     return [ir.StepVar(store.target, step, store.line)] * abs(delta)
-
-
-def _acc_dead_after(instructions: list[ir.Instruction], index: int) -> bool:
-    for instruction in instructions[index:]:
-        if isinstance(instruction, ir.Load):
-            return True
-        if isinstance(instruction, ir.Operate | ir.Store):
-            return False
-    return True  # dead where the block ends

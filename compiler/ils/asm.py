@@ -354,7 +354,9 @@ class _Assembler:
         debug = None if self.source_name is None else ilc.DebugInfo(self.source_name,
                                                                      tuple(self.entries))
         features = self.features if self.features is not None else self.needed_features()
-        return ilc.Image(bytes(self.code), handlers, features, debug, self.flags or 0)
+        minor = isa.minor_needed(isa.OPCODES[self.code[start]]
+                                 for start in self.instruction_starts)
+        return ilc.Image(bytes(self.code), handlers, features, debug, self.flags or 0, minor)
 
     def needed_features(self) -> frozenset[Feature]:
         needed = set()

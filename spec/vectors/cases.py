@@ -50,10 +50,12 @@ class Case:
     status: str = "ok"  # "ok" or a fault code (vm/faults.py)
     fault_line: int = 0
     trace: tuple[TraceItem, ...] | None = None  # the expected trace, when the case fixes it
+    level: int = 0  # the optimization level it is compiled at (2: format 1.1's fused code)
 
 
 def all_cases() -> list[Case]:
-    return [*arithmetic(), *shifts(), *control(), *calls(), *tracing(), *faults(), *sample()]
+    return [*arithmetic(), *shifts(), *control(), *calls(), *tracing(), *faults(), *sample(),
+            *fused()]
 
 
 def _straight(group: str, name: str, covers: str, program: Straight) -> Case:
@@ -585,3 +587,22 @@ def _sample_variables(ending: dict[str, int]) -> dict[str, int]:
         "w": 105, "x": 128, "y": 100,
         **ending,
     }
+
+
+# --- fused: the superinstructions of format 1.1, as -O2 compiles them ----------------------
+
+
+def fused() -> Iterator[Case]:
+    yield Case("fused", "fused-moves", "MOVV and MOVI: a variable copied, a constant "
+               "stored (-O2)", "A=(KYO); D=A+1; B=A; C=5; (FZO B,C)\n",
+               {"A": 42, "u": 40, "v": 44, "B": 42, "C": 5, "D": 43},
+               {"KYO": [{"centre": 42, "right": 40, "left": 44}]}, level=2)
+    yield Case("fused", "fused-counted-loop", "DJGT: a counted loop's decrement and jump "
+               "(-O2)", "@=3\n:10 A=A+7; (TIM 1); @--; ?@>#10\n(END)\n", {"A": 21},
+               level=2)
+    yield Case("fused", "fused-store-and-jump", "SJLT, SJZ, SJGT: an expression stored and "
+               "tested in one instruction, each jump taken (-O2)",
+               "A=(ULT A)-100; ?A<#10\nB=1\n:10 C=(ULT B); ?C=#20\nD=1\n"
+               ":20 E=(ULT C)-5; ?E>#30\nF=1\n:30 (END)\n",
+               {"A": -50, "B": 0, "C": 0, "D": 0, "E": 5, "F": 0},
+               {"ULT A": [50], "ULT B": [0], "ULT C": [10]}, level=2)

@@ -80,7 +80,8 @@ def compile_both(case: Case) -> tuple[bytes, bytes]:
     """The case's .ilc file with its debug section, and without."""
     files = []
     for strip in (False, True):
-        compilation = compile_text(case.source, source_name(case), strip_debug=strip)
+        compilation = compile_text(case.source, source_name(case), strip_debug=strip,
+                                   level=case.level)
         if compilation.output is None:
             errors = "; ".join(f"line {d.span.line}: {d.code} {d.message}"
                                for d in compilation.diagnostics if d.is_error)

@@ -28,6 +28,7 @@ from rl1.compiler.backend.ir import (
 )
 from rl1.compiler.backend.lower import lower
 from rl1.compiler.backend.peephole import rewrite_steps
+from rl1.compiler.backend.superinstructions import fuse
 from rl1.compiler.frontend.parser import parse_program
 
 A, B, C, X = Var("A"), Var("B"), Var("C"), Var("x")
@@ -215,6 +216,32 @@ def test_a_branch_to_one_block_either_way_is_a_jump() -> None:
     ))
     assert list(program.blocks) == ["B0"]
     assert code(program) == ["inc A", "inc B", "end"]
+
+
+# Superinstructions (-O2) ---------------------------------------------------------------------
+
+
+def test_a_store_and_the_branch_on_it_fuse() -> None:
+    program = after(fuse, "A=(KYO)-5; ?A<#10\n:10 (END)")
+    assert code(program) == ["call KYO", "load R", "sub 5",
+                             "store A; if A<0 then L10 else B1"]
+
+
+def test_a_counted_loop_decrements_and_branches_at_once() -> None:
+    program = after(fuse, "@=3\n:10 (TIM 1); @--; ?@>#10\nA=B; B++; ?B>#10")
+    assert code(program, "L10")[-1] == "dec @; if @>0 then L10 else B1"
+    assert code(program, "B1")[-2:] == ["inc B", "if B>0 then L10 else B2"]  # not --
+
+
+def test_a_load_and_its_stores_become_moves_when_the_accumulator_is_dead() -> None:
+    assert code(after(fuse, "A=B; C=5; D=C; E=A+1")) == [
+        "move A, B", "move C, 5", "move D, C", "load A", "add 1", "store E", "end"]
+    stores_then_branch = jumps(("B0", [], End(1)))
+    stores_then_branch.blocks["B0"].instructions = [Load(Imm(5), 1), Store(A, 1)]
+    stores_then_branch.blocks["B0"].terminator = ir.StoreBranch(B, "=", "B0", "B0", 1)
+    fused = fuse(stores_then_branch)
+    assert ir.validate(fused) == []
+    assert fused.blocks["B0"].instructions == [Load(Imm(5), 1), Store(A, 1)]
 
 
 # The pipeline ---------------------------------------------------------------------------------

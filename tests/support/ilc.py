@@ -79,4 +79,5 @@ def images(draw: st.DrawFn, max_instructions: int = 25) -> ilc.Image:
     features = frozenset(needed_features(infos)) | extra
     debug = draw(st.none() | debug_infos(offsets))
     optional_flags = draw(st.integers(0, 0xFF)) << 8  # a reader must accept unknown ones
-    return ilc.Image(code, handlers, features, debug, optional_flags)
+    return ilc.Image(code, handlers, features, debug, optional_flags,
+                     isa.minor_needed(infos))

@@ -76,7 +76,9 @@ def test_container_refusals_come_as_verify_errors() -> None:
 
 
 @pytest.mark.parametrize(("code", "offset", "message"), [
-    (op("LDI", 0) + bytes([0x07]), CODE + 3, "code offset 3: unknown opcode 0x07"),
+    (op("LDI", 0) + bytes([0x09]), CODE + 3, "code offset 3: unknown opcode 0x09"),
+    (op("LDI", 0) + op("MOVV", 0, 1), CODE + 3,
+     "code offset 3: MOVV is an instruction of format 1.1, but the file says 1.0"),
     (op("LDI", 0)[:2], CODE, "LDI needs 3 bytes, only 2 remain"),
     (op("LDI", 0) + op("MVI", args=(const(1), const(1), const(1)))[:5], CODE + 3,
      "MVI needs 8 bytes, only 5 remain"),
