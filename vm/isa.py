@@ -104,6 +104,8 @@ def _table() -> dict[int, OpInfo]:
         OpInfo(0x07, "MOVV", (Operand.VAR, Operand.VAR), "V[v] = V[w] (the second v)",
                minor=FUSED_MINOR),
         OpInfo(0x08, "MOVI", (Operand.VAR, Operand.IMM), "V[v] = i", minor=FUSED_MINOR),
+        OpInfo(0x09, "MOVR", (Operand.VAR,), "V[v] = R (the last call's result)",
+               minor=FUSED_MINOR),
         OpInfo(0x34, "DJGT", (Operand.VAR, Operand.ADDR),
                "V[v] = V[v] - 1, then jump to a if V[v] > 0", minor=FUSED_MINOR),
         OpInfo(0x35, "SJZ", (Operand.VAR, Operand.ADDR),

@@ -23,7 +23,7 @@ _SERVES = {
 }
 _FUSED = f"(-O2; format 1.{isa.FUSED_MINOR})"
 _SERVES |= {
-    "MOVV": f"`V=W` {_FUSED}", "MOVI": f"`V=i` {_FUSED}",
+    "MOVV": f"`V=W` {_FUSED}", "MOVI": f"`V=i` {_FUSED}", "MOVR": f"`V=(call)` {_FUSED}",
     "DJGT": f"`V--; ?V>#NN` {_FUSED}", "SJZ": f"`V=...; ?V=#NN` {_FUSED}",
     "SJGT": f"`V=...; ?V>#NN` {_FUSED}", "SJLT": f"`V=...; ?V<#NN` {_FUSED}",
 }

@@ -170,6 +170,8 @@ class Machine:
             return (MOVE, operands[0], operands[1])
         if name == "MOVI":
             return (MOVE, operands[0], self._immediate(operands[1]))
+        if name == "MOVR":
+            return (MOVE, operands[0], R_CELL)
         if name in _JUMPS:
             *condition, target = operands
             return (_JUMPS[name], condition[0] if condition else 0,

@@ -142,7 +142,7 @@ def _instruction(instruction: ir.Instruction) -> _MachineOp:
                           (), line)
     if isinstance(instruction, ir.Move):
         kind, operands = _source(instruction.source)
-        return _MachineOp(isa.BY_NAME[("MOVV", "MOVI")[kind]],
+        return _MachineOp(isa.BY_NAME[("MOVV", "MOVI", "MOVR")[kind]],
                           (VARIABLE_INDEX[instruction.target.name], *operands), (), line)
     args = tuple(isa.Arg(True, VARIABLE_INDEX[arg.name]) if isinstance(arg, ir.Var)
                  else isa.Arg(False, arg.value) for arg in instruction.args)

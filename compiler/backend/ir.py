@@ -146,7 +146,7 @@ class Move:
     """target = source, without touching acc (a superinstruction of -O2)."""
 
     target: Var
-    source: Var | Imm
+    source: Operand
     line: int
 
     def __str__(self) -> str:

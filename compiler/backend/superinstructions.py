@@ -10,7 +10,7 @@ fused jump is a jump, where the budget is checked and an event taken); no path l
 - `dec V` then a branch on V > 0 (`@--; ?@>#14`, a counted loop) becomes one
   decrement-and-branch.
 - `load x` then stores of it, when nothing reads the accumulator after them, become
-  moves (`A=B`, `A=5`): one instruction per store instead of one more.
+  moves (`A=B`, `A=5`, `A=(IMG)`): one instruction per store instead of one more.
 """
 
 from __future__ import annotations
@@ -51,7 +51,7 @@ def _moves(instructions: list[ir.Instruction], terminator: ir.Terminator
         while end < len(instructions) and isinstance(instructions[end], ir.Store):
             end += 1
         stores = instructions[index + 1:end]
-        if (isinstance(load, ir.Load) and not isinstance(load.source, ir.Result) and stores
+        if (isinstance(load, ir.Load) and stores
                 and flow.acc_dead_after(instructions, end, terminator)):
             out += [ir.Move(store.target, load.source, store.line)
                     for store in stores if isinstance(store, ir.Store)]

@@ -76,7 +76,7 @@ def test_container_refusals_come_as_verify_errors() -> None:
 
 
 @pytest.mark.parametrize(("code", "offset", "message"), [
-    (op("LDI", 0) + bytes([0x09]), CODE + 3, "code offset 3: unknown opcode 0x09"),
+    (op("LDI", 0) + bytes([0x0A]), CODE + 3, "code offset 3: unknown opcode 0x0A"),
     (op("LDI", 0) + op("MOVV", 0, 1), CODE + 3,
      "code offset 3: MOVV is an instruction of format 1.1, but the file says 1.0"),
     (op("LDI", 0)[:2], CODE, "LDI needs 3 bytes, only 2 remain"),
