@@ -256,23 +256,27 @@ class Machine:
                         executed += pc - start
                         if executed > budget:
                             break
+                        start = pc  # counted: a fault in divert must not count it again
                         pc = start = b if device.pending is None else divert(poll(), b)
                 elif op == JUMP_ZERO:
                     if cells[a] == 0:
                         executed += pc - start
                         if executed > budget:
                             break
+                        start = pc
                         pc = start = b if device.pending is None else divert(poll(), b)
                 elif op == JUMP_NEGATIVE:
                     if cells[a] < 0:
                         executed += pc - start
                         if executed > budget:
                             break
+                        start = pc
                         pc = start = b if device.pending is None else divert(poll(), b)
                 elif op == JUMP:
                     executed += pc - start
                     if executed > budget:
                         break
+                    start = pc
                     pc = start = b if device.pending is None else divert(poll(), b)
                 elif op == CALL:
                     if executed + pc - start > budget:
@@ -283,6 +287,7 @@ class Machine:
                     event = poll()
                     if event is not None:
                         executed += pc - start
+                        start = pc
                         pc = start = divert(event, pc)
                 elif op == LOAD:
                     acc = cells[a]
@@ -312,6 +317,7 @@ class Machine:
                         executed += pc - start
                         if executed > budget:
                             break
+                        start = pc
                         pc = start = b if device.pending is None else divert(poll(), b)
                 elif STORE_JUMP_ZERO <= op <= STORE_JUMP_NEGATIVE:
                     value = cells[a] = ((acc + 0x8000) & 0xFFFF) - 0x8000
@@ -320,6 +326,7 @@ class Machine:
                         executed += pc - start
                         if executed > budget:
                             break
+                        start = pc
                         pc = start = b if device.pending is None else divert(poll(), b)
                 else:  # END
                     self.executed = executed + pc - start
