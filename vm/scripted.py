@@ -66,7 +66,7 @@ import bisect
 import json
 import math
 import tomllib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, TypeVar
@@ -80,6 +80,7 @@ from .device import (
     Odometry,
     form_name,
 )
+from .faults import RunResult
 from .language import BUILTINS, TOO_LONG, decimal_value, lost_line_handler
 
 T = TypeVar("T")
@@ -212,6 +213,13 @@ _EFFECT_TEXT: dict[str, Callable[[TraceEntry], str]] = {
     "no-motion": lambda entry: ": ignored, no motion in effect",
     "tracing-off": lambda entry: ": ignored, tracing is off",
 }
+
+
+def run_document(result: RunResult, trace: Sequence[TraceEntry]) -> dict[str, Any]:
+    """A run on this device as JSON data: what `rl1c run --format json` prints, and what
+    an `exec:` engine of `rl1c fuzz` prints (spec/optimization.md, section 5)."""
+    return {"status": result.status(), "variables": result.named(),
+            "trace": [entry.to_json() for entry in trace]}
 
 
 # Loading and validating scripts --------------------------------------------------------

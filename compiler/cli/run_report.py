@@ -189,16 +189,6 @@ def fault_span(line: str, fault: Fault) -> Span:
 # JSON ---------------------------------------------------------------------------------
 
 
-def status_json(result: RunResult) -> dict[str, Any]:
-    """How a run ended, in one shape whether it ended or faulted: `code` is "ok" or the
-    fault's kind, with its exit status, message and source line (null when none)."""
-    fault = result.fault
-    if fault is None:
-        return {"code": "ok", "exit_status": 0, "message": "the program ended", "line": None}
-    return {"code": fault.kind.code, "exit_status": fault.kind.exit_status,
-            "message": fault.message, "line": fault.line}
-
-
 def entry_json(entry: TraceEntry) -> dict[str, Any]:
     """A trace entry as the report writes it: as the vectors do, with its source line,
     and for a lost line what it did (`effect`) and the handler it jumped to."""
@@ -214,7 +204,7 @@ def entry_json(entry: TraceEntry) -> dict[str, Any]:
 def render_json(report: RunReport) -> str:
     trace = report.trace
     document = {
-        "status": status_json(report.result),
+        "status": report.result.status(),
         "instructions": report.instructions,
         "device_time": report.device_time,
         "moving": report.moving,

@@ -10,7 +10,7 @@ from rl1.compiler.frontend.source import Source
 from rl1.vm.faults import RunResult
 from rl1.vm.sim.device import SimDevice
 
-from .run_report import fault_text, status_json
+from .run_report import fault_text
 
 
 def _ending(result: RunResult, device: SimDevice, name: str, source: Source | None,
@@ -47,7 +47,7 @@ def render_text(result: RunResult, device: SimDevice, name: str, source: Source 
 
 
 def render_json(result: RunResult, device: SimDevice) -> str:
-    status = status_json(result)  # the shape of `rl1c run`'s, and a safety stop's facts
+    status = result.status()  # the shape of `rl1c run`'s, and a safety stop's facts
     if device.fault is not None:
         pose = device.fault.pose
         status |= {"safety": device.fault.kind, "time": round(device.fault.time, 4),
