@@ -52,6 +52,8 @@ from .streams import (
 )
 
 if TYPE_CHECKING:  # the back end and the engines load only for the command that runs them
+    from rl1.vm.verifier import VerifiedProgram
+
     from .run import Engine
     from .run_report import TraceChoice
 
@@ -254,7 +256,6 @@ def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoi
     budget exhausted, 13 device error (a sensing call past the script's readings, the
     time limit)."""
     from rl1.compiler.files import SourceError
-    from rl1.compiler.ils.sources import find_source
     from rl1.vm.scripted import Script, ScriptedDevice, ScriptError
     from rl1.vm.verifier import VerifyError, verify
 
@@ -282,12 +283,7 @@ def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoi
             raise invalid_file(ILC_ROLE, STDIN_NAME if file == "-" else file,
                                f"byte {error.offset}: {error.message}",
                                "compile the program again", EXIT_ERRORS) from None
-        found = find_source(program.image.debug, file, None) if file != "-" else None
-        source_lines = found.lines if found is not None else None
-        source_text = "\n".join(source_lines) if source_lines is not None else None
-        debug = program.image.debug
-        source_name = (os.path.join(os.path.dirname(file), debug.source_name)
-                       if debug is not None and source_text is not None else file)
+        source_name, source_text = _recorded_source(program, file)
         finished = execute_program(program, device, budget)
     else:
         source = read_input(file)
@@ -317,6 +313,20 @@ def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoi
         sys.stdout.write(render_text(report, color=use_color("auto", sys.stdout)))
     fault = finished.result.fault
     return fault.kind.exit_status if fault is not None else 0
+
+
+def _recorded_source(program: VerifiedProgram, file: str) -> tuple[str, str | None]:
+    """The name and text of the source the .ilc file `file` records, when it is found
+    beside it and is still the one compiled (as `dis` finds it); else `file` and None."""
+    from rl1.compiler.ils.sources import find_source
+
+    debug = program.image.debug
+    if file == "-" or debug is None:
+        return file, None
+    lines = find_source(debug, file, None).lines
+    if lines is None:
+        return file, None
+    return os.path.join(os.path.dirname(file), debug.source_name), "\n".join(lines)
 
 
 @click.command(cls=Command)
