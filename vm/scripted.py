@@ -199,25 +199,26 @@ class TraceEntry:
         `LINE LOST (mode 3, MOV) -> :96`."""
         if self.call == LOST:
             mode = f"mode {self.args[0]}" + (f", {self.during}" if self.during else "")
-            return f"{LOST} ({mode}){_EFFECT_TEXT[self.effect or 'jump'](self)}"
+            if self.effect in (None, "jump"):
+                return f"{LOST} ({mode}) -> :{self.handler}"
+            return f"{LOST} ({mode}): {_EFFECT_TEXT[self.effect]}"
         text = self.call + (" " + ",".join(map(str, self.args)) if self.args else "")
         if self.result is not None:
             text += " -> " + " ".join(map(str, self.result))
         return text
 
 
-_EFFECT_TEXT: dict[str, Callable[[TraceEntry], str]] = {
-    "jump": lambda entry: f" -> :{entry.handler}",
-    "drive-on": lambda entry: ": mode 1 drives straight on, no jump",
-    "already-waiting": lambda entry: ": a loss already waits for the program",
-    "no-motion": lambda entry: ": ignored, no motion in effect",
-    "tracing-off": lambda entry: ": ignored, tracing is off",
+_EFFECT_TEXT: dict[str | None, str] = {
+    "drive-on": "mode 1 drives straight on, no jump",
+    "already-waiting": "a loss already waits for the program",
+    "no-motion": "ignored, no motion in effect",
+    "tracing-off": "ignored, tracing is off",
 }
 
 
 def run_document(result: RunResult, trace: Sequence[TraceEntry]) -> dict[str, Any]:
-    """A run on this device as JSON data: what `rl1c run --format json` prints, and what
-    an `exec:` engine of `rl1c fuzz` prints (spec/optimization.md, section 5)."""
+    """A run on this device as JSON data: the fields of `rl1c run --format json` that an
+    `exec:` engine of `rl1c fuzz` prints too (spec/optimization.md, section 5)."""
     return {"status": result.status(), "variables": result.named(),
             "trace": [entry.to_json() for entry in trace]}
 
