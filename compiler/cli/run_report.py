@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import json
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any, Generic, Literal, Protocol, TypeVar
 
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.ast import Span
@@ -28,16 +28,36 @@ TAIL = 20
 between them; a trace that would leave out only one entry is shown whole."""
 
 
+class Traced(Protocol):
+    """A trace entry of either device: the scripted one's, or the simulator's."""
+
+    @property
+    def call(self) -> str: ...
+
+
+Entry = TypeVar("Entry", bound=Traced)
+
+
 @dataclass(frozen=True, slots=True)
-class ShownTrace:
+class ShownTrace(Generic[Entry]):
     """The entries a report shows: `head`, then `left_out` entries not shown, then `tail`."""
 
-    head: Sequence[TraceEntry]
+    head: Sequence[Entry]
     left_out: int = 0
-    tail: Sequence[TraceEntry] = ()
+    tail: Sequence[Entry] = ()
+
+    def lines(self, line_of: Callable[[Entry], str]) -> list[str]:
+        """The entries as text, a line each (`line_of`), with a line saying how many were
+        left out where they were."""
+        lines = [line_of(entry) for entry in self.head]
+        if self.left_out:
+            lines.append(f"{'...':>9}  ({self.left_out:,} entries left out: --trace all "
+                         "shows every one)")
+            lines += [line_of(entry) for entry in self.tail]
+        return lines
 
 
-def select_trace(log: Sequence[TraceEntry], choice: TraceChoice) -> ShownTrace:
+def select_trace(log: Sequence[Entry], choice: TraceChoice) -> ShownTrace[Entry]:
     """What `--trace` shows of a run's log: all of it, its calls alone (no lost lines, no
     stop after a fault), nothing, or (short) its head and tail."""
     if choice == "none":
@@ -58,7 +78,7 @@ class RunReport:
     source_name: str  # the file whose lines `source` holds
     source: str | None
     result: RunResult
-    trace: ShownTrace
+    trace: ShownTrace[TraceEntry]
     instructions: int | None  # None when the interpreter ran it
     device_time: int  # ms
     moving: str | None  # the motion in effect when the program ended: "(MOV 3,3)"
@@ -72,13 +92,9 @@ class RunReport:
 def render_text(report: RunReport, *, color: bool = False) -> str:
     lines = []
     trace = report.trace
-    if trace.head or trace.left_out:
+    if trace.head:
         lines.append(f"{'time ms':>9}  {'line':>4}  call")
-        lines += [_entry_line(entry) for entry in trace.head]
-        if trace.left_out:
-            lines.append(f"{'...':>9}  {'':>4}  ({trace.left_out:,} entries left out: "
-                         "--trace all shows every one)")
-            lines += [_entry_line(entry) for entry in trace.tail]
+        lines += trace.lines(_entry_line)
     fault = report.result.fault
     if fault is None:
         lines.append(f"the program ended normally at {report.device_time} ms of device time"

@@ -14,6 +14,7 @@ from rl1.compiler.reporting.render import EXIT_ERRORS, FileDiagnostics, use_colo
 from rl1.vm.faults import DEFAULT_BUDGET
 
 from .command import PATH, Command, a_budget, choice_option
+from .run_report import TRACE_CHOICES, TraceChoice
 from .streams import ILC_ROLE, emit, invalid_file, read_failure, read_ilc, read_input, write_file
 
 SECTION = "Simulation"
@@ -40,8 +41,12 @@ WORLD_ROLE = "world file"
               metavar="N", show_default=True,
               help="instructions (statements with --engine ast) before the watchdog stops "
                    "a runaway program")
+@choice_option("--trace", "trace_choice", choices=TRACE_CHOICES, default=None,
+               help="which calls to show, as `rl1c run --trace`: short: the first 40 and "
+                    "the last 20 of a longer trace, with how many were left out; all; calls; "
+                    "none. Default: short with --format text, all with json")
 def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_format: str,
-        seed: int, engine: str, budget: int) -> int:
+        seed: int, engine: str, budget: int, trace_choice: TraceChoice | None) -> int:
     """Run a program (.rob source, or an .ilc file) on the simulated vehicle and world.
 
     Prints each call with the time and the vehicle's pose, how the run ended and the
@@ -104,9 +109,9 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
         write_file(html_file, html(the_world, device.sim.track, device.sim.events, calls,
                                    title).encode(), role="HTML file")
     if sim_format == "json":
-        sys.stdout.write(render_json(result, device))
+        sys.stdout.write(render_json(result, device, trace_choice or "all"))
     else:
-        sys.stdout.write(render_text(result, device, file, source,
+        sys.stdout.write(render_text(result, device, file, source, trace_choice or "short",
                                      color=use_color("auto", sys.stdout)))
     return result.fault.kind.exit_status if result.fault is not None else 0
 

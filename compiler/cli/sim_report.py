@@ -8,12 +8,12 @@ import math
 
 from rl1.compiler.frontend.source import Source
 from rl1.vm.faults import RunResult
-from rl1.vm.sim.device import SimDevice
+from rl1.vm.sim.device import SimDevice, SimEntry
 
-from .run_report import fault_text
+from .run_report import TraceChoice, fault_text, select_trace
 
 
-def _ending(result: RunResult, device: SimDevice, name: str, source: Source | None,
+def _ending(result: RunResult, device: SimDevice, program: str, source: Source | None,
             color: bool) -> str:
     """How the run ended, as `rl1c run` says it."""
     fault = result.fault
@@ -22,41 +22,51 @@ def _ending(result: RunResult, device: SimDevice, name: str, source: Source | No
             return "the program ended normally"
         return ("the program ended normally\nnote: the program ended with the vehicle still "
                 "moving")
-    return fault_text(fault, name, source.name if source else name,
+    return fault_text(fault, program, source.name if source else program,
                       source.text if source else None, color=color).rstrip("\n")
 
 
-def render_text(result: RunResult, device: SimDevice, name: str, source: Source | None,
-                *, color: bool = False) -> str:
-    """The report for people of a run of the program `name` (`source`, when known)."""
-    lines = ["trace (simulated time in s; pose x, y in cm, heading in degrees):"]
-    for entry in device.trace:
-        call = entry.call + (" " + ",".join(map(str, entry.args)) if entry.args else "")
-        if entry.result is not None:
-            call += " -> " + " ".join(map(str, entry.result))
-        pose = entry.pose
-        lines.append(f"  {entry.time:9.2f}  {call:<28} ({pose.x:7.1f}, {pose.y:7.1f}) "
-                     f"{math.degrees(pose.heading):6.1f}")
+def _entry_line(entry: SimEntry) -> str:
+    call = entry.call + (" " + ",".join(map(str, entry.args)) if entry.args else "")
+    if entry.result is not None:
+        call += " -> " + " ".join(map(str, entry.result))
+    pose = entry.pose
+    return (f"  {entry.time:9.2f}  {call:<28} ({pose.x:7.1f}, {pose.y:7.1f}) "
+            f"{math.degrees(pose.heading):6.1f}")
+
+
+def render_text(result: RunResult, device: SimDevice, program: str, source: Source | None,
+                trace: TraceChoice = "short", *, color: bool = False) -> str:
+    """The report for people of a run of `program` (`source`, when known), with the
+    calls `trace` chooses (as `rl1c run --trace`)."""
+    lines = []
+    shown = select_trace(device.trace, trace)
+    if shown.head:
+        lines.append("trace (simulated time in s; pose x, y in cm, heading in degrees):")
+        lines += shown.lines(_entry_line)
     for event in device.sim.events:
         if event.kind in ("lost", "handler", "found"):
             lines.append(f"  {event.time:9.2f}  [{event.text}]")
-    lines.append(_ending(result, device, name, source, color))
+    lines.append(_ending(result, device, program, source, color))
     named = [f"{name}={value}" for name, value in result.named().items() if value]
     lines.append("variables: " + (" ".join(named) + " (all others 0)" if named else "all 0"))
     return "\n".join(lines) + "\n"
 
 
-def render_json(result: RunResult, device: SimDevice) -> str:
+def render_json(result: RunResult, device: SimDevice, trace: TraceChoice = "all") -> str:
     status = result.status()  # the shape of `rl1c run`'s, and a safety stop's facts
     if device.fault is not None:
         pose = device.fault.pose
         status |= {"safety": device.fault.kind, "time": round(device.fault.time, 4),
                    "pose": [round(pose.x, 2), round(pose.y, 2),
                             round(math.degrees(pose.heading), 2)]}
+    shown = select_trace(device.trace, trace)
     document = {
         "status": status,
         "variables": result.named(),
-        "trace": [entry.to_json() for entry in device.trace],
+        "trace": [entry.to_json() for entry in (*shown.head, *shown.tail)],
+        "trace_left_out": ({"after": len(shown.head), "count": shown.left_out}
+                           if shown.left_out else None),
         "events": [{"time": round(e.time, 4), "kind": e.kind, "text": e.text,
                     "pose": [round(e.pose.x, 2), round(e.pose.y, 2)]}
                    for e in device.sim.events],

@@ -16,7 +16,7 @@ WORLD = EXAMPLES / "sample.world.toml"
 
 
 def test_text_report_has_calls_poses_ending_and_variables() -> None:
-    result = rl1c("sim", SAMPLE, "--world", WORLD)
+    result = rl1c("sim", SAMPLE, "--world", WORLD, "--trace", "all")
     assert result.exit_code == 0, result.output
     assert "CAM P 579" in result.stdout
     assert "(  236.4,   150.0)" in result.stdout  # the pose at the branch mark
@@ -105,3 +105,19 @@ def test_any_program_ends_with_a_known_status_and_no_traceback(tmp_path: Path,
     result = rl1c("sim", program, "--world", WORLD, "--budget", "20000", "--format", "json")
     assert result.exit_code in (0, 1, 10, 11, 12, 13), result.output
     assert "Traceback" not in result.output
+
+
+def test_the_trace_is_bounded_as_rl1c_run_bounds_it() -> None:
+    every = rl1c("sim", SAMPLE, "--world", WORLD, "--trace", "all").stdout.splitlines()
+    short = rl1c("sim", SAMPLE, "--world", WORLD).stdout.splitlines()
+    calls = [line for line in every if line.startswith("  ") and "[" not in line]
+    assert short[1:41] == calls[:40]
+    assert short[41].split()[:2] == ["...", f"({len(calls) - 60:,}"]
+    assert short[42:62] == calls[-20:]
+    assert short[62:] == every[len(calls) + 1:]  # the events, the ending, the variables
+    document = json.loads(rl1c("sim", SAMPLE, "--world", WORLD, "--format", "json",
+                               "--trace", "short").stdout)
+    assert len(document["trace"]) == 60
+    assert document["trace_left_out"] == {"after": 40, "count": len(calls) - 60}
+    none = rl1c("sim", SAMPLE, "--world", WORLD, "--trace", "none").stdout
+    assert not none.startswith("trace") and "the program ended normally" in none
