@@ -54,13 +54,14 @@ typedef struct rl1_program {
     const uint8_t *code;        /* the code section */
     const uint8_t *lines;       /* the first line entry; NULL without a debug section */
     const uint8_t *source_name; /* UTF-8, not NUL-terminated; NULL without debug */
-    const uint8_t *digest;      /* the 16-byte source digest (1.1); NULL when absent */
+    const uint8_t *digest;      /* the 16-byte source digest (1.1+); NULL when absent */
     uint16_t code_size;
     uint16_t handlers[4];       /* code offsets of :96..:99; RL1_ABSENT when undefined */
     uint16_t features;          /* bit n: the program needs device feature n */
     uint16_t flags;
     uint16_t line_count;
     uint8_t source_name_size;
+    uint8_t minor;              /* the format's minor version the file says */
 } rl1_program;
 
 #define RL1_ABSENT 0xFFFFu     /* a handler table entry for a label not defined */

@@ -26,7 +26,8 @@
 #define FEATURE_SIZE 2u
 #define DIGEST_SIZE 16u
 #define DIGEST_MINOR 1u      /* the first minor version with a source digest */
-#define KNOWN_MINOR 1u       /* the newest minor version this reader knows */
+#define FUSED_MINOR 2u       /* the superinstructions, MOVV ... SJLT, came in 1.2 */
+#define KNOWN_MINOR 2u       /* the newest minor version this reader knows */
 #define REQUIRED_FLAGS 0x00FFu
 #define KNOWN_FEATURES 0x007Fu
 #define VARIABLES 53u
@@ -100,12 +101,31 @@ static uint32_t file_crc(const loader *ld)
 
 /* --- the instruction set (spec/ilc.md 8.3) ----------------------------------------- */
 
-enum shape { NONE, VAR, IMM, ADDR, VAR_ADDR, ARGS };
+enum shape { NONE, VAR, IMM, ADDR, VAR_ADDR, VAR_VAR, VAR_IMM, ARGS };
 
-/* The operands of `op`, and 0 bytes for an opcode this version does not define. */
-static uint8_t op_length(uint8_t op, enum shape *shape)
+/* The operands of `op`, and 0 bytes for an opcode the file's minor version does not
+ * define (a superinstruction in a 1.0 or 1.1 file is unknown there). */
+static uint8_t op_length(uint8_t op, uint8_t minor, enum shape *shape)
 {
     *shape = NONE;
+    if (minor >= FUSED_MINOR) {
+        if (op == 0x07u) {
+            *shape = VAR_VAR; /* MOVV */
+            return 3;
+        }
+        if (op == 0x08u) {
+            *shape = VAR_IMM; /* MOVI */
+            return 4;
+        }
+        if (op == 0x09u) {
+            *shape = VAR; /* MOVR */
+            return 2;
+        }
+        if (op >= 0x34u && op <= 0x37u) {
+            *shape = VAR_ADDR; /* DJGT, SJZ, SJGT, SJLT */
+            return 4;
+        }
+    }
     if (op == 0x00u || op == 0x03u || (op >= 0x20u && op <= 0x26u)) {
         return 1; /* END, LDR, the ...R arithmetic */
     }
@@ -360,6 +380,7 @@ static rl1_status check_container(loader *ld, rl1_program *program, uint32_t *co
         return fail(ld, RL1_BAD_CRC, 8);
     }
     program->flags = u16_at(file + 6);
+    program->minor = minor;
     if (program->flags & REQUIRED_FLAGS) { /* versions 1.0 and 1.1 define no flag */
         return fail(ld, RL1_REQUIRED_FLAG, 6);
     }
@@ -407,7 +428,7 @@ static bool starts_instruction(const starts *s, uint16_t target)
         return ((unsigned)s->bitmap[target >> 3] >> (target & 7u)) & 1u;
     }
     while (pos < target) {
-        pos += op_length(BYTE(s->program->code + pos), &shape);
+        pos += op_length(BYTE(s->program->code + pos), s->program->minor, &shape);
     }
     return pos == target;
 }
@@ -447,15 +468,18 @@ static rl1_status check_instructions(loader *ld, const rl1_program *program, uin
         uint32_t at = base + pos;
         enum shape shape;
         rl1_status status = RL1_OK;
-        length = op_length(op, &shape);
+        length = op_length(op, program->minor, &shape);
         if (length == 0u) {
             return fail(ld, RL1_UNKNOWN_OPCODE, at);
         }
         if (length > program->code_size - pos) {
             return fail(ld, RL1_CUT_OFF, at);
         }
-        if (shape == VAR || shape == VAR_ADDR) {
+        if (shape == VAR || shape == VAR_ADDR || shape == VAR_VAR || shape == VAR_IMM) {
             status = check_variable(ld, BYTE(ld->file + at + 1u), at + 1u);
+        }
+        if (status == RL1_OK && shape == VAR_VAR) {
+            status = check_variable(ld, BYTE(ld->file + at + 2u), at + 2u);
         } else if (shape == ARGS) {
             status = check_call(ld, op, length, at + 1u);
         }
@@ -483,7 +507,7 @@ static rl1_status check_targets(loader *ld, const rl1_program *program, uint32_t
     uint8_t i;
     while (pos < program->code_size) {
         enum shape shape;
-        uint8_t length = op_length(BYTE(program->code + pos), &shape);
+        uint8_t length = op_length(BYTE(program->code + pos), program->minor, &shape);
         at = base + pos + (shape == VAR_ADDR ? 2u : 1u); /* the target operand */
         if ((shape == ADDR || shape == VAR_ADDR)
             && !starts_instruction(s, u16_at(ld->file + at))) {
