@@ -377,7 +377,8 @@ def _scenes(r: _Reader, value: object, document: dict[str, Any]) -> dict[int, Sc
         table = r.table(item, path, ("number", "sees", "window"), ("number", "sees"))
         number = r.integer(table["number"], (*path, "number"), 0, 7)
         if number in scenes:
-            raise r.fail((*path, "number"), f"scene {number} is defined twice")
+            raise r.fail((*path, "number"), f"scene {number} is defined twice; give each "
+                                            "[[scenes]] its own number")
         sees = tuple(r.text(s, (*path, "sees", j))
                      for j, s in enumerate(r.array(table["sees"], (*path, "sees"), "names")))
         window = r.array(table.get("window", [0, 0, 1024, 1024]), (*path, "window"),
