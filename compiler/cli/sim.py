@@ -93,8 +93,12 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
             return emit([FileDiagnostics(source.name, source.text, outcome)], "human",
                         "auto", "sim", err=True)
         result = outcome
+    run_on = None
     if result.fault is None:
-        device.sim.note("end", "the program ended")
+        moving = device.sim.motion is not None
+        device.sim.note("end", "the program ended" + (
+            " with the vehicle moving: it runs on" if moving else ""))
+        run_on = device.run_on()  # (END) leaves motion in effect: where does it go?
     elif device.fault is None:  # a safety stop has noted itself
         device.sim.note("fault", result.fault.message)
     title = f"{os.path.basename(file)} on {os.path.basename(world)}"
@@ -109,9 +113,10 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
         write_file(html_file, html(the_world, device.sim.track, device.sim.events, calls,
                                    title).encode(), role="HTML file")
     if sim_format == "json":
-        sys.stdout.write(render_json(result, device, trace_choice or "all"))
+        sys.stdout.write(render_json(result, device, run_on, trace_choice or "all"))
     else:
-        sys.stdout.write(render_text(result, device, file, source, trace_choice or "short",
+        sys.stdout.write(render_text(result, device, file, source, run_on,
+                                     trace_choice or "short",
                                      color=use_color("auto", sys.stdout)))
     return result.fault.kind.exit_status if result.fault is not None else 0
 

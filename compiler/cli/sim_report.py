@@ -8,20 +8,30 @@ import math
 
 from rl1.compiler.frontend.source import Source
 from rl1.vm.faults import RunResult
-from rl1.vm.sim.device import SimDevice, SimEntry
+from rl1.vm.sim.device import RunOn, SimDevice, SimEntry
+from rl1.vm.sim.motion import Pose
 
 from .run_report import TraceChoice, fault_text, select_trace
 
 
-def _ending(result: RunResult, device: SimDevice, program: str, source: Source | None,
-            color: bool) -> str:
-    """How the run ended, as `rl1c run` says it."""
+def _pose(pose: Pose) -> list[float]:
+    return [round(pose.x, 2), round(pose.y, 2), round(math.degrees(pose.heading), 2)]
+
+
+def _ending(result: RunResult, device: SimDevice, run_on: RunOn | None, program: str,
+            source: Source | None, color: bool) -> str:
+    """How the run ended: where the vehicle ran on to after an (END) that left it moving,
+    or the fault as `rl1c run` shows it."""
     fault = result.fault
     if fault is None:
-        if device.sim.motion is None:
+        if run_on is None:
             return "the program ended normally"
-        return ("the program ended normally\nnote: the program ended with the vehicle still "
-                "moving")
+        pose = device.sim.pose
+        stop = (f"until a safety stop [{run_on.stop.kind}]: {run_on.stop}"
+                if run_on.stop is not None else
+                f"until it stopped at ({pose.x:.1f}, {pose.y:.1f})")
+        return (f"the program ended normally with the vehicle moving: it ran on for "
+                f"{run_on.seconds:.2f} s, {stop}")
     return fault_text(fault, program, source.name if source else program,
                       source.text if source else None, color=color).rstrip("\n")
 
@@ -36,7 +46,8 @@ def _entry_line(entry: SimEntry) -> str:
 
 
 def render_text(result: RunResult, device: SimDevice, program: str, source: Source | None,
-                trace: TraceChoice = "short", *, color: bool = False) -> str:
+                run_on: RunOn | None = None, trace: TraceChoice = "short", *,
+                color: bool = False) -> str:
     """The report for people of a run of `program` (`source`, when known), with the
     calls `trace` chooses (as `rl1c run --trace`)."""
     lines = []
@@ -47,23 +58,26 @@ def render_text(result: RunResult, device: SimDevice, program: str, source: Sour
     for event in device.sim.events:
         if event.kind in ("lost", "handler", "found"):
             lines.append(f"  {event.time:9.2f}  [{event.text}]")
-    lines.append(_ending(result, device, program, source, color))
+    lines.append(_ending(result, device, run_on, program, source, color))
     named = [f"{name}={value}" for name, value in result.named().items() if value]
     lines.append("variables: " + (" ".join(named) + " (all others 0)" if named else "all 0"))
     return "\n".join(lines) + "\n"
 
 
-def render_json(result: RunResult, device: SimDevice, trace: TraceChoice = "all") -> str:
+def render_json(result: RunResult, device: SimDevice, run_on: RunOn | None = None,
+                trace: TraceChoice = "all") -> str:
     status = result.status()  # the shape of `rl1c run`'s, and a safety stop's facts
     if device.fault is not None:
-        pose = device.fault.pose
         status |= {"safety": device.fault.kind, "time": round(device.fault.time, 4),
-                   "pose": [round(pose.x, 2), round(pose.y, 2),
-                            round(math.degrees(pose.heading), 2)]}
+                   "pose": _pose(device.fault.pose)}
     shown = select_trace(device.trace, trace)
     document = {
         "status": status,
         "variables": result.named(),
+        # After an (END) with the vehicle moving: how long it ran on, and what stopped it.
+        "run_on": None if run_on is None else {
+            "seconds": round(run_on.seconds, 4), "pose": _pose(device.sim.pose),
+            "stop": None if run_on.stop is None else run_on.stop.kind},
         "trace": [entry.to_json() for entry in (*shown.head, *shown.tail)],
         "trace_left_out": ({"after": len(shown.head), "count": shown.left_out}
                            if shown.left_out else None),
