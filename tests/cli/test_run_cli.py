@@ -17,7 +17,7 @@ from support.cli import rl1c
 from rl1.compiler.cli.run import load_script
 from rl1.compiler.cli.run_report import HEAD, TAIL, select_trace
 from rl1.vm.language import VARIABLES
-from rl1.vm.scripted import TraceEntry
+from rl1.vm.scripted import TraceEntry, decode_script
 
 SENSORS = SAMPLE_SENSORS
 SAMPLE_TOML = EXAMPLES / "sample.sensors.toml"
@@ -325,3 +325,12 @@ def test_a_scripted_loss_that_never_happens_is_said(tmp_path: Path) -> None:
     instruction = program(tmp_path, "A=1\nB=2\n", {"line_lost": [{"instruction": 1},
                                                                  {"instruction": 9}]})
     assert [item["index"] for item in report(*instruction)[1]["losses_not_met"]] == [1]
+
+
+def test_the_spec_s_json_and_toml_examples_are_the_same_valid_script() -> None:
+    page = (EXAMPLES.parent / "spec" / "sensors.md").read_text(encoding="utf-8")
+    json_example = re.findall(r"```json\n(.*?)```", page, re.DOTALL)[0]
+    toml_example = re.findall(r"```toml\n(.*?)```", page, re.DOTALL)[0]
+    from_json = decode_script(json_example.encode(), "example.json")
+    assert from_json == decode_script(toml_example.encode(), "example.toml")
+    assert from_json.losses and from_json.images and from_json.ports
