@@ -27,7 +27,7 @@ PROGRAM = """(TRC 1); N=50
 def script_of(losses: int) -> bytes:
     entries = [{"during": "MOV", "nth": 1 + i % 50, "after": 1 + i % 499} for i in range(losses)]
     entries += [{"time": 3 * i + 1} for i in range(losses)]
-    return json.dumps({"line_lost": entries}).encode()
+    return json.dumps({"line_lost": entries, "after_last": "repeat"}).encode()  # KYO reads 0
 
 
 def run(data: bytes) -> None:

@@ -26,10 +26,11 @@ from rl1.vm.faults import FaultKind
 from rl1.vm.hardware import Blocking
 from rl1.vm.language import VARIABLES
 from rl1.vm.machine import Machine
-from rl1.vm.scripted import ScriptedDevice, parse_script, run_document
+from rl1.vm.scripted import IGNORED, ScriptedDevice, parse_script, run_document
 from rl1.vm.verifier import verify
 
 SOURCE_NAME = "fuzz.rob"
+_ENTRY_KEYS = ("time", "call", "args", "result")
 EXEC_TIMEOUT = 10.0  # seconds an exec: engine may take for one run
 BUDGET_CODE = FaultKind.BUDGET.code
 
@@ -52,11 +53,18 @@ class Observation:
         status = self.document.get("status")
         if isinstance(status, dict):
             return {"code": status.get("code"), "line": status.get("line")}
+        if status == "ok":  # the status of format 1 of the protocol
+            return {"code": "ok", "line": None}
         return status
 
     def commands(self) -> list[Any]:
-        """The trace, without the stop that ends a run the watchdog stopped."""
-        trace = list(self.document.get("trace", []))
+        """The trace as the vectors write it (time, call, args, result: the source line
+        and what a loss did are `rl1c run`'s additions), without the losses that did
+        nothing, nor the stop that ends a run the watchdog stopped."""
+        trace = [{key: entry[key] for key in _ENTRY_KEYS if key in entry}
+                 if isinstance(entry, dict) else entry
+                 for entry in self.document.get("trace", [])
+                 if not (isinstance(entry, dict) and entry.get("effect") in IGNORED)]
         if self.ran_away and trace and trace[-1].get("call") == "STOP":
             trace.pop()
         return trace

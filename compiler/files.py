@@ -15,8 +15,18 @@ from pathlib import Path
 
 
 class SourceError(Exception):
-    """An input file that cannot be read, or not as RL/I text; the message says why and
-    what to do."""
+    """An input file that cannot be read, or not as RL/I text: `path`, why (`reason`,
+    such as "no such file") and what to do (`help`). str() is "PATH: REASON"."""
+
+    def __init__(self, path: str | os.PathLike[str], reason: str, help: str = "") -> None:
+        super().__init__(f"{path}: {reason}")
+        self.path = str(path)
+        self.reason = reason
+        self.help = help
+
+
+class TooLargeError(SourceError):
+    """An input file larger than its kind of file can be."""
 
 
 def read_bounded(path: str | os.PathLike[str], limit: int, what: str) -> bytes:
@@ -26,15 +36,19 @@ def read_bounded(path: str | os.PathLike[str], limit: int, what: str) -> bytes:
         with open(path, "rb") as stream:
             data = stream.read(limit + 1)
     except FileNotFoundError:
-        raise SourceError(f"{path}: no such file") from None
+        raise SourceError(path, "no such file", "check the name, and the folder rl1c runs "
+                          "in") from None
     except IsADirectoryError:
-        raise SourceError(f"{path} is a directory, not {what}") from None
+        raise SourceError(path, f"it is a directory, not {what}",
+                          "name a file inside it") from None
     except PermissionError:
-        raise SourceError(f"{path}: permission denied") from None
+        raise SourceError(path, "permission denied",
+                          "make the file readable (chmod +r), or name another") from None
     except OSError as error:
-        raise SourceError(f"{path}: cannot read ({error.strerror or error})") from None
+        raise SourceError(path, f"cannot read it ({error.strerror or error})") from None
     if len(data) > limit:
-        raise SourceError(f"{path} is larger than {limit // 2**20} MiB, the limit for {what}")
+        raise TooLargeError(path, f"it is larger than {limit // 2**20} MiB, the limit for "
+                          f"{what}", f"check that this is {what}")
     return data
 
 

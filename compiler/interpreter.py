@@ -113,6 +113,7 @@ class Interpreter:
         self.device = device
         self.budget = budget
         self.steps = 0  # statements run so far
+        self.line: int | None = None  # the source line of the statement running
         self.variables = [0] * len(VARIABLES)
         self.statements: list[ast.Statement] = []
         self.labels: dict[int, int] = {}
@@ -175,6 +176,7 @@ class Interpreter:
         try:
             while pc < len(self.statements):
                 statement = self.statements[pc]
+                self.line = statement.span.line
                 self.steps += 1
                 try:
                     pc = self._execute(statement, pc + 1)

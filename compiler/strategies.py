@@ -521,6 +521,7 @@ def sensor_scripts(draw: st.DrawFn) -> JsonScript:
     ), max_size=4))
     if losses:
         script["line_lost"] = losses
+    script["after_last"] = "repeat"  # the last readings end the loops: they must repeat
     return script
 
 

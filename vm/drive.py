@@ -23,5 +23,5 @@ def drive(machine: Machine, device: ScriptedDevice) -> RunResult:
             pass
         if machine.state not in _GOING:
             break
-        device.lose_line()
+        device.lose_line_after(count)
     return machine.run()

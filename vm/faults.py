@@ -42,9 +42,6 @@ class Fault:
     message: str
     line: int | None  # the source line, when known
 
-    def to_json(self) -> dict[str, Any]:
-        return {"code": self.kind.code, "message": self.message, "line": self.line}
-
 
 @dataclass(frozen=True, slots=True)
 class RunResult:
@@ -56,6 +53,17 @@ class RunResult:
 
     def named(self) -> dict[str, int]:
         return dict(zip(VARIABLES, self.variables, strict=True))
+
+    def status(self) -> dict[str, Any]:
+        """How the run ended, as JSON data in one shape whether it ended or faulted:
+        `code` ("ok" or the fault's kind), the exit status of `rl1c run`, a message, and
+        the fault's source line (None when it ended, or when unknown)."""
+        fault = self.fault
+        if fault is None:
+            return {"code": "ok", "exit_status": 0, "message": "the program ended",
+                    "line": None}
+        return {"code": fault.kind.code, "exit_status": fault.kind.exit_status,
+                "message": fault.message, "line": fault.line}
 
 
 def missing_handler_message(mode: int, command: str, label: int) -> str:

@@ -376,6 +376,7 @@ class Machine:
                         executed += pc - start
                         break
                     call_counts.append(executed + pc - start)
+                    self.pc = pc  # for current_line, while the device works
                     args = self._arguments(site, cells)
                     if site.waits:
                         started = hardware.start(site.form, args)
@@ -548,6 +549,11 @@ class Machine:
         line = None if index is None else self._line_of(index)
         self.result = RunResult(tuple(self.cells[:R_CELL]), Fault(fault.kind, message, line))
         return State.FAULTED
+
+    def current_line(self) -> int | None:
+        """The source line of the call under way, or of the instruction run last between
+        steps; None before the first instruction, or without a line map."""
+        return self._line_of(self.pc - 1) if self.pc > 0 else None
 
     def _line_of(self, index: int) -> int | None:
         debug = self.program.image.debug

@@ -14,12 +14,17 @@ returns, in order, and when the guidance line is lost:
                     {"instruction": 40}],
       "fail": {"ULT A": 2, ...},     (the 2nd ULT A call of the run fails)
       "stop_fails": true,
+      "after_last": "stop",          (or "repeat")
       "comment": "free text, ignored"
     }
 
-Each call takes the next reading of its list; when a list runs out its last reading
-repeats; a call with no list reads zeros. Values are 16-bit signed integers (INP data
-0..255, CAM R 0..784).
+Each call takes the next reading of its list. A call whose reading the script does not
+give (its list is used up, or there is none) ends the run at once with a device error
+that names the reading and the device time: a script stands for a test of limited
+length, and zeros or a repeated reading would let a loop run on for ever on readings
+nobody wrote. `"after_last": "repeat"` asks for the other rule instead: a list's last
+reading repeats, and a call with no list reads zeros. Values are 16-bit signed
+integers (INP data 0..255, CAM R 0..784). spec/sensors.md is the user's page.
 
 Line losses: `{"time": T}` at device time T ms; `{"during": "MOV"|"MVI", "nth": N,
 "after": A}` A ms (default 1) after the N-th MOV or MVI call of the run (counting every
@@ -30,8 +35,10 @@ after the VM has run N instructions, between two instructions, as a vehicle's de
 posts a loss from an interrupt; the device cannot see instructions, so whoever steps the
 VM calls `lose_line` then (vm/drive.py), and an engine that counts no instructions (the
 AST interpreter) cannot run such a script. A loss matters only while
-motion is in effect (a non-zero MOV, or an MVI in progress); see device.py for what each
-tracing mode does with it.
+motion is in effect (a non-zero MOV, or an MVI in progress) and tracing is on (mode 1-3);
+see device.py for what each tracing mode does with it. Every loss is in the log
+(`ScriptedDevice.log`), those that did nothing too, with why; `trace` holds only those
+that mattered (the test vectors' contract).
 
 Failures: a call named in "fail" (a form as the trace writes it: "TIM", "CAM R") fails
 the N-th time it arrives: the device records it, then raises DeviceError, at once for a
@@ -45,6 +52,12 @@ The motion model (device time in integer milliseconds, starting at 0):
   every other built-in that waits (language.Builtin.waits) takes 100 ms; the rest 0 ms.
 - A loss interrupts only TIM and MVI (they return at the loss's time); any other call
   completes first, and the loss reaches the program after it.
+- A device-time limit (`time_limit`, ms) ends a run whose clock would pass it with a
+  device error, at the limit: a program waiting in a loop for a reading that never
+  comes.
+
+Each entry also carries the source line of the call the engine was running when it was
+recorded, as the `locate` callback (set by whoever runs the engine) tells.
 """
 
 from __future__ import annotations
@@ -53,10 +66,10 @@ import bisect
 import json
 import math
 import tomllib
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, Literal, TypeVar
 
 from .device import (
     DeviceError,
@@ -68,13 +81,21 @@ from .device import (
     form_name,
 )
 from .faults import RunResult
-from .language import BUILTINS, TOO_LONG, decimal_value
+from .language import BUILTINS, TOO_LONG, decimal_value, lost_line_handler
 
 T = TypeVar("T")
 
 WHEEL_UNIT_CM_PER_S = 5
 STEP_MS = 100  # a waiting built-in with no duration of its own
 ROT_MS_PER_DEGREE = 10
+
+
+AfterLast = Literal["stop", "repeat"]
+AFTER_LAST: tuple[AfterLast, ...] = ("stop", "repeat")
+
+DEFAULT_TIME_LIMIT_MS = 3_600_000
+"""The device-time limit of `rl1c run`: an hour, far beyond any test a script writes
+(Listing 1 takes 13 s), and reached in a second or two by a runaway loop of (TIM 1)."""
 
 
 class ScriptError(Exception):
@@ -87,6 +108,10 @@ class LossAt:
 
     time: int
 
+    def to_json(self) -> dict[str, Any]:
+        """The loss as the script writes it."""
+        return {"time": self.time}
+
 
 @dataclass(frozen=True, slots=True)
 class LossDuring:
@@ -96,12 +121,18 @@ class LossDuring:
     nth: int
     after: int
 
+    def to_json(self) -> dict[str, Any]:
+        return {"during": self.command, "nth": self.nth, "after": self.after}
+
 
 @dataclass(frozen=True, slots=True)
 class LossAfter:
     """The line is lost right after the VM's `instruction`-th instruction."""
 
     instruction: int
+
+    def to_json(self) -> dict[str, Any]:
+        return {"instruction": self.instruction}
 
 
 @dataclass(frozen=True, slots=True)
@@ -115,6 +146,8 @@ class Script:
     losses: tuple[LossAt | LossDuring | LossAfter, ...] = ()
     failures: dict[str, int] = field(default_factory=dict)  # a form -> the call that fails
     stop_fails: bool = False
+    after_last: AfterLast = "stop"
+    name: str = field(default="", compare=False)  # its file; "" when no script was given
 
     @property
     def instruction_losses(self) -> tuple[int, ...]:
@@ -123,34 +156,78 @@ class Script:
                             if isinstance(loss, LossAfter)))
 
 
+LOST = "LINE LOST"
+
+# What a lost line did (TraceEntry.effect): the program jumps to its handler; tracing
+# mode 1 drives on; a loss already waits for the program; nothing, as no motion is in
+# effect or tracing is off (mode 0).
+Effect = Literal["jump", "drive-on", "already-waiting", "no-motion", "tracing-off"]
+IGNORED: frozenset[Effect] = frozenset({"no-motion", "tracing-off"})
+
+
 @dataclass(frozen=True, slots=True)
 class TraceEntry:
-    """One command the device received (or a line it lost), at device time `time` ms."""
+    """One command the device received (or a line it lost), at device time `time` ms.
+    A LINE LOST entry's args are (mode,); `during` is the motion command in effect and
+    `effect` what the loss did. `line` is the source line the engine was running."""
 
     time: int
     call: str
     args: tuple[int, ...] = ()
     result: tuple[int, ...] | None = None  # what a sensing call read
+    line: int | None = field(default=None, compare=False)
+    during: str | None = None
+    effect: Effect | None = None
 
     def to_json(self) -> dict[str, Any]:
+        """The entry as the test vectors write it (no source line: a stripped file has
+        none)."""
         entry: dict[str, Any] = {"time": self.time, "call": self.call, "args": list(self.args)}
         if self.result is not None:
             entry["result"] = list(self.result)
         return entry
 
+    @property
+    def handler(self) -> int | None:
+        """The label a lost line sent the program to (Table 4), if it did."""
+        if self.effect != "jump" or self.during is None:
+            return None
+        return lost_line_handler(self.args[0], self.during)
+
+    def describe(self) -> str:
+        """The entry for people: `MOV 3,3`, `IMG -> 120 128 90 0`,
+        `LINE LOST (mode 3, MOV) -> :96`."""
+        if self.call == LOST:
+            mode = f"mode {self.args[0]}" + (f", {self.during}" if self.during else "")
+            if self.effect in (None, "jump"):
+                return f"{LOST} ({mode}) -> :{self.handler}"
+            return f"{LOST} ({mode}): {_EFFECT_TEXT[self.effect]}"
+        text = self.call + (" " + ",".join(map(str, self.args)) if self.args else "")
+        if self.result is not None:
+            text += " -> " + " ".join(map(str, self.result))
+        return text
+
+
+_EFFECT_TEXT: dict[str | None, str] = {
+    "drive-on": "mode 1 drives straight on, no jump",
+    "already-waiting": "a loss already waits for the program",
+    "no-motion": "ignored, no motion in effect",
+    "tracing-off": "ignored, tracing is off",
+}
+
 
 def run_document(result: RunResult, trace: Sequence[TraceEntry]) -> dict[str, Any]:
-    """A run on this device as JSON data: what `rl1c run --format json` prints, and what
-    an `exec:` engine of `rl1c fuzz` prints (spec/optimization.md, section 5)."""
-    return {"status": "ok" if result.fault is None else result.fault.to_json(),
-            "variables": result.named(), "trace": [entry.to_json() for entry in trace]}
+    """A run on this device as JSON data: the fields of `rl1c run --format json` that an
+    `exec:` engine of `rl1c fuzz` prints too (spec/optimization.md, section 5)."""
+    return {"status": result.status(), "variables": result.named(),
+            "trace": [entry.to_json() for entry in trace]}
 
 
 # Loading and validating scripts --------------------------------------------------------
 
 _INT16 = (-32768, 32767)
 _LIST_KEYS = ("IMG", "KYO", "CAM R", "ULT A", "ULT B", "ULT C", "ULT D", "FZI")
-_KEYS = (*_LIST_KEYS, "INP", "line_lost", "fail", "stop_fails", "comment")
+_KEYS = (*_LIST_KEYS, "INP", "line_lost", "fail", "stop_fails", "after_last", "comment")
 
 
 def decode_script(data: bytes, name: str) -> Script:
@@ -195,6 +272,10 @@ def parse_script(document: object, name: str = "<script>") -> Script:
         raise ScriptError(f"{name}:comment: expected a string")
     if not isinstance(document.get("stop_fails", False), bool):
         raise ScriptError(f"{name}:stop_fails: expected true or false")
+    after_last = document.get("after_last", "stop")
+    if after_last not in AFTER_LAST:
+        raise ScriptError(f'{name}:after_last: expected "stop" or "repeat", '
+                          f"found {_kind(after_last)}")
 
     def readings(key: str) -> list[object]:
         return _list(document[key], f"{name}:{key}") if key in document else []
@@ -218,6 +299,8 @@ def parse_script(document: object, name: str = "<script>") -> Script:
                      for i, item in enumerate(readings("line_lost"))),
         failures=_failures(document.get("fail", {}), f"{name}:fail"),
         stop_fails=document.get("stop_fails", False),
+        after_last=after_last,
+        name=name,
     )
 
 
@@ -237,8 +320,8 @@ def _list(value: object, where: str) -> list[object]:
     if not isinstance(value, list):
         raise ScriptError(f"{where}: expected a list of readings, found {_kind(value)}")
     if not value:
-        raise ScriptError(f"{where}: the list is empty; give at least one reading "
-                          "or leave the key out (readings are then 0)")
+        raise ScriptError(f"{where}: the list is empty; give at least one reading, "
+                          "or leave the key out")
     return value
 
 
@@ -324,15 +407,22 @@ class _Motion:
     nth: int
     start: int
     end: int | None = None
+    args: tuple[int, ...] = ()
+
+    def describe(self) -> str:
+        return f"({self.command} {','.join(map(str, self.args))})"
 
 
 class ScriptedDevice:
     """A Device whose sensors replay a Script and whose clock follows the motion model
     above. `trace` lists every command received, in order."""
 
-    def __init__(self, script: Script | None = None) -> None:
+    def __init__(self, script: Script | None = None, time_limit: int | None = None) -> None:
         self.script = script or Script()
+        self.time_limit = time_limit  # ms of device time; None: no limit
         self.trace: list[TraceEntry] = []
+        self.log: list[TraceEntry] = []  # the trace, and the losses that did nothing
+        self.locate: Callable[[], int | None] = lambda: None  # the engine's source line
         self.time = 0
         self.mode = 0
         self._motion: _Motion | None = None
@@ -351,11 +441,19 @@ class ScriptedDevice:
         self._read_counts: dict[str, int] = {}
         self._arrivals: dict[str, int] = {}  # calls of each form so far, for "fail"
         self._failing: str | None = None  # why the waiting built-in under way fails
+        self._met: set[LossAt | LossDuring | LossAfter] = set()  # the losses that happened
 
     # Bookkeeping
 
+    @property
+    def motion(self) -> str | None:
+        """The motion command in effect, as `(MOV 3,3)`; None when the vehicle stands."""
+        return self._motion.describe() if self._motion is not None else None
+
     def _record(self, call: str, *args: int, result: tuple[int, ...] | None = None) -> None:
-        self.trace.append(TraceEntry(self.time, call, args, result))
+        entry = TraceEntry(self.time, call, args, result, self.locate())
+        self.trace.append(entry)
+        self.log.append(entry)
         arrived = self._arrivals.get(call, 0) + 1
         self._arrivals[call] = arrived
         if self.script.failures.get(call) == arrived:
@@ -364,12 +462,27 @@ class ScriptedDevice:
                 raise DeviceError(failure)
             self._failing = failure  # at the end of its device time
 
-    def _next(self, key: str, readings: tuple[T, ...], nothing: T) -> T:
+    def _next(self, key: str, readings: tuple[T, ...], nothing: T, call: str,
+              *args: int) -> T:
+        """The next reading of `key` for a `call` with `args`; when the script has none
+        left, the other rule it chose, or the call recorded and a DeviceError."""
         count = self._read_counts.get(key, 0)
         self._read_counts[key] = count + 1
+        if count < len(readings):
+            return readings[count]
+        if self.script.after_last == "repeat":
+            return readings[-1] if readings else nothing
+        self._record(call, *args)
+        form = f"({key})"
+        if not self.script.name:
+            raise DeviceError(f"{form} at {self.time} ms has no reading: no sensor script "
+                              "was given")
         if not readings:
-            return nothing
-        return readings[min(count, len(readings) - 1)]
+            raise DeviceError(f"{form} at {self.time} ms has no reading: the sensor script "
+                              f"{self.script.name} gives no {key} readings")
+        raise DeviceError(f"{form} at {self.time} ms has no reading: it is call "
+                          f"{count + 1}, and the sensor script {self.script.name} gives "
+                          f"{len(readings)} {key} reading{'s' if len(readings) > 1 else ''}")
 
     def _next_loss(self, until: int) -> int | None:
         """The time of the next loss that could matter in (time, until]."""
@@ -387,8 +500,16 @@ class ScriptedDevice:
 
     def _advance(self, duration: int, interruptible: bool) -> None:
         """Let the device time of a waiting built-in pass; then it fails, if the script
-        says so (a failing poll)."""
-        self._pass_time(duration, interruptible)
+        says so (a failing poll). Passing the time limit ends the run at the limit."""
+        limit = self.time_limit
+        if limit is not None and self.time + duration > limit:
+            self._pass_time(limit - self.time, interruptible)
+            if self.time >= limit:
+                self._failing = None
+                raise DeviceError(f"the run reached its device-time limit of "
+                                  f"{limit / 1000:g} s, during ({self.trace[-1].describe()})")
+        else:
+            self._pass_time(duration, interruptible)
         failing, self._failing = self._failing, None
         if failing is not None:
             raise DeviceError(failing)
@@ -410,16 +531,50 @@ class ScriptedDevice:
                 self.time = until
                 return
             self.time = loss
+            self._met.add(LossAt(loss))
+            if motion is not None:
+                self._met.add(LossDuring(motion.command, motion.nth, loss - motion.start))
             if self.lose_line() and interruptible:
                 return
+
+    def lose_line_after(self, instruction: int) -> bool:
+        """The line is lost after the VM's `instruction`-th instruction (LossAfter)."""
+        self._met.add(LossAfter(instruction))
+        return self.lose_line()
+
+    def losses_not_met(self) -> list[tuple[int, LossAt | LossDuring | LossAfter, str]]:
+        """The script's losses that have not happened (yet): each with its index in
+        `line_lost` and why, so that a report drops none silently."""
+        missed = []
+        for index, loss in enumerate(self.script.losses):
+            if loss in self._met:
+                continue
+            if isinstance(loss, LossDuring) and self._calls[loss.command] >= loss.nth:
+                why = (f"that {loss.command} was not in effect {loss.after} ms after "
+                       "it started")
+            elif isinstance(loss, LossDuring):
+                calls = self._calls[loss.command]
+                why = f"the run made {calls} {loss.command} call{'s' if calls != 1 else ''}"
+            else:
+                why = "the run ended before it"
+            missed.append((index, loss, why))
+        return missed
 
     def lose_line(self) -> bool:
         """The line is lost now; True if the program is to hear of it."""
         motion = self._motion
         if motion is None or self.mode == 0:
+            self.log.append(TraceEntry(self.time, LOST, (self.mode,), None, self.locate(),
+                                       motion.command if motion is not None else None,
+                                       "no-motion" if motion is None else "tracing-off"))
             return False
-        self._record("LINE LOST", self.mode)
-        if self.mode == 1 or self.pending is not None:
+        effect: Effect = ("drive-on" if self.mode == 1 else
+                          "already-waiting" if self.pending is not None else "jump")
+        entry = TraceEntry(self.time, LOST, (self.mode,), None, self.locate(),
+                           motion.command, effect)
+        self.trace.append(entry)
+        self.log.append(entry)
+        if effect != "jump":
             return False
         self.pending = LineLost(motion.command, self.mode)
         if self.mode == 2:
@@ -458,14 +613,16 @@ class ScriptedDevice:
             raise DeviceError(f"(MVI {left},{right},{cm}) would never end: with wheel speeds "
                               f"{left} and {right} the vehicle's centre does not move")
         duration = math.ceil(abs(cm) * 1000 * 2 / (abs(left + right) * WHEEL_UNIT_CM_PER_S))
-        self._motion = _Motion("MVI", self._calls["MVI"], self.time, self.time + duration)
+        self._motion = _Motion("MVI", self._calls["MVI"], self.time, self.time + duration,
+                               (left, right, cm))
         self._advance(duration, interruptible=True)
 
     def move(self, left: int, right: int) -> None:
         self._calls["MOV"] += 1
         self._record("MOV", left, right)
         moving = left != 0 or right != 0
-        self._motion = _Motion("MOV", self._calls["MOV"], self.time) if moving else None
+        self._motion = (_Motion("MOV", self._calls["MOV"], self.time, None, (left, right))
+                        if moving else None)
 
     def steer_right(self, degrees: int) -> None:
         self._takes("STR", degrees)
@@ -494,7 +651,7 @@ class ScriptedDevice:
         self._takes("KYC")
 
     def read_distance(self) -> Odometry:
-        reading = self._next("KYO", self.script.odometry, Odometry(0, 0, 0))
+        reading = self._next("KYO", self.script.odometry, Odometry(0, 0, 0), "KYO")
         self._takes("KYO", result=(reading.centre, reading.right, reading.left))
         return reading
 
@@ -502,7 +659,7 @@ class ScriptedDevice:
         self._takes("SCN", scene)
 
     def measure_image(self) -> ImageReading:
-        reading = self._next("IMG", self.script.images, ImageReading(0, 0, 0, 0))
+        reading = self._next("IMG", self.script.images, ImageReading(0, 0, 0, 0), "IMG")
         self._takes("IMG", result=(reading.area, reading.x, reading.y, reading.z))
         return reading
 
@@ -522,12 +679,13 @@ class ScriptedDevice:
         self._takes("CAM P", pulse)
 
     def camera_position(self) -> int:
-        position = self._next("CAM R", self.script.camera, 0)
+        position = self._next("CAM R", self.script.camera, 0, "CAM R")
         self._takes("CAM R", result=(position,))
         return position
 
     def ultrasonic(self, sensor: str) -> int:
-        distance = self._next(f"ULT {sensor}", self.script.ultrasonic.get(sensor, ()), 0)
+        distance = self._next(f"ULT {sensor}", self.script.ultrasonic.get(sensor, ()), 0,
+                              f"ULT {sensor}")
         self._takes(f"ULT {sensor}", result=(distance,))
         return distance
 
@@ -535,7 +693,7 @@ class ScriptedDevice:
         self._takes("LMP", on)
 
     def read_port(self, port: int) -> int:
-        data = self._next(f"INP {port}", self.script.ports.get(port, ()), 0)
+        data = self._next(f"INP {port}", self.script.ports.get(port, ()), 0, "INP", port)
         self._takes("INP", port, result=(data,))
         return data
 
@@ -546,7 +704,7 @@ class ScriptedDevice:
         self._takes("FZO", a, b)
 
     def fuzzy_read(self) -> FuzzyReading:
-        reading = self._next("FZI", self.script.fuzzy, FuzzyReading(0, 0))
+        reading = self._next("FZI", self.script.fuzzy, FuzzyReading(0, 0), "FZI")
         self._takes("FZI", result=(reading.s, reading.t))
         return reading
 

@@ -4,7 +4,8 @@
 Each command imports the stages it runs when it runs, so that `rl1c check` starts
 without loading the back end, the VM or the assembler (bench/cold_start.py). For the
 same reason these option values are spelled here; tests/cli/test_cli_imports.py holds
-them equal to driver.EMITS, runner.ENGINES and faults.DEFAULT_BUDGET.
+them equal to driver.EMITS, runner.ENGINES, faults.DEFAULT_BUDGET,
+run_report.TRACE_CHOICES and scripted.DEFAULT_TIME_LIMIT_MS.
 """
 
 from __future__ import annotations
@@ -17,7 +18,13 @@ import click
 
 from rl1.compiler.files import SourceError
 from rl1.compiler.frontend.source import Source
-from rl1.compiler.reporting.render import EXIT_ERRORS, ColorChoice, FileDiagnostics, Format
+from rl1.compiler.reporting.render import (
+    EXIT_ERRORS,
+    ColorChoice,
+    FileDiagnostics,
+    Format,
+    use_color,
+)
 
 from .command import (
     PATH,
@@ -30,7 +37,12 @@ from .command import (
     format_option,
 )
 from .streams import (
+    ILC_ROLE,
+    STDIN_NAME,
     emit,
+    file_failure,
+    invalid_file,
+    read_failure,
     read_ilc,
     read_input,
     same_file,
@@ -40,7 +52,10 @@ from .streams import (
 )
 
 if TYPE_CHECKING:  # the back end and the engines load only for the command that runs them
+    from rl1.vm.verifier import VerifiedProgram
+
     from .run import Engine
+    from .run_report import TraceChoice
 
 SECTION = "Intermediate code"
 
@@ -52,6 +67,9 @@ EMIT_SUFFIXES = {"ilc": ".ilc", "ir": None, "c": ".c", "ihex": ".hex", "ils": ".
 ENGINE_CHOICES = ("vm", "ast")
 DEFAULT_BUDGET = 10_000_000
 DEFAULT_LEVEL = 1
+TRACE_CHOICES = ("short", "all", "calls", "none")  # run_report.TRACE_CHOICES
+DEFAULT_TIME_LIMIT = "3600"  # seconds: scripted.DEFAULT_TIME_LIMIT_MS
+SCRIPT_ROLE = "sensor script"
 
 
 def _address(ctx: click.Context, param: click.Parameter, value: str | None) -> int | None:
@@ -188,63 +206,127 @@ def _default_output(source: str, emit_kind: str) -> str:
     return with_suffix(source, suffix)
 
 
+def _time_limit(ctx: click.Context, param: click.Parameter, value: str) -> int:
+    """An option's callback: a device-time limit in seconds (a decimal number, down to
+    the millisecond) as milliseconds, from 1 ms to MAX_BUDGET ms (24.8 days)."""
+    from rl1.vm.faults import MAX_BUDGET
+
+    try:
+        milliseconds = round(float(value) * 1000)
+    except (ValueError, OverflowError):
+        milliseconds = 0
+    if not 1 <= milliseconds <= MAX_BUDGET:
+        raise click.BadParameter(f"expected seconds from 0.001 to {MAX_BUDGET // 1000}, "
+                                 f"got {value!r}", ctx, param)
+    return milliseconds
+
+
 @click.command(cls=Command)
 @click.argument("file", metavar="FILE", type=PATH)
 @click.option("--sensors", metavar="FILE", type=PATH,
-              help="sensor script for the scripted device (JSON, or TOML if FILE ends in "
-                   ".toml). Without one every sensor reads 0 and the line is never lost")
+              help="the sensor script: what each sensing call reads and when the line is "
+                   "lost (JSON, or TOML if FILE ends in .toml; spec/sensors.md). Without one "
+                   "the first sensing call stops the run")
 @choice_option("--format", "run_format", choices=("text", "json"), default="text",
-               help="text: for people; json: one object for tools")
+               help="text: for people; json: one object for tools (spec/sensors.md)")
+@choice_option("--trace", "trace_choice", choices=TRACE_CHOICES, default=None,
+               help="which entries of the device's trace to show: short: the first 40 and "
+                    "the last 20 of a longer trace, with how many were left out; all: every "
+                    "one; calls: the program's calls only (no lost line, no stop); none. "
+                    "Default: short with --format text, all with json")
 @click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget,
               metavar="N", show_default=True,
               help="instructions (statements with --engine ast) before the watchdog stops "
                    "a runaway program")
+@click.option("--time-limit", type=str, default=DEFAULT_TIME_LIMIT, callback=_time_limit,
+              metavar="SECONDS", show_default=True,
+              help="device time before the run is stopped (a device error): a program "
+                   "waiting in a loop for a reading that never comes")
 @choice_option("--engine", choices=ENGINE_CHOICES, default="vm",
                help="vm: compile, then run on the reference VM; ast: interpret the source")
-def run(file: str, sensors: str | None, run_format: str, budget: int, engine: Engine) -> int:
+def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoice | None,
+        budget: int, time_limit: int, engine: Engine) -> int:
     """Run a program (.rob source, or a compiled .ilc file) on the scripted device.
 
-    Prints the device's trace and the final variables. Exit status: 0 the program ended;
-    1 it has errors (or the .ilc file is not valid); 2 a usage problem or an unreadable
-    file (sensor scripts included); faults: 10 argument out of range, 11 missing handler,
-    12 budget exhausted, 13 device error."""
-    from rl1.vm.faults import RunResult
+    Prints the device's trace with the source line of each entry, how the run ended and
+    the final variables; a .rob file's warnings come first, on standard error. The
+    sensor script's format: spec/sensors.md. Exit status: 0 the program ended; 1 it has
+    errors (or the .ilc file is not valid); 2 a usage problem or an unreadable file
+    (sensor scripts included); faults: 10 argument out of range, 11 missing handler, 12
+    budget exhausted, 13 device error (a sensing call past the script's readings, the
+    time limit)."""
+    from rl1.compiler.files import SourceError
     from rl1.vm.scripted import Script, ScriptedDevice, ScriptError
-    from rl1.vm.verifier import VerifyError
+    from rl1.vm.verifier import VerifyError, verify
 
-    from .run import load_script, run_ilc, run_source
-    from .run_report import render_json, render_text
+    from .run import Finished, execute_program, execute_source, load_script
+    from .run_report import RunReport, render_json, render_text, select_trace
 
-    try:
-        device = ScriptedDevice(load_script(sensors) if sensors is not None else Script())
-    except ScriptError as error:
-        raise Failure(f"error: {error}") from None
+    script = Script()
+    if sensors is not None:
+        try:
+            script = load_script(sensors)
+        except SourceError as error:
+            raise read_failure(error, SCRIPT_ROLE) from None
+        except ScriptError as error:
+            raise invalid_file(SCRIPT_ROLE, sensors, str(error),
+                               "correct it as spec/sensors.md describes") from None
+    device = ScriptedDevice(script, time_limit)
     if file.lower().endswith(".ilc"):
         if engine == "ast":
             raise click.UsageError("--engine ast interprets RL/I source; an .ilc file runs "
                                    "on the VM: leave out --engine, or run the .rob file")
         data = read_ilc(file)
         try:
-            result = run_ilc(data, device, budget)
+            program = verify(data)
         except VerifyError as error:
-            raise Failure(f"error: {file}: byte {error.offset}: {error.message}",
-                          EXIT_ERRORS) from None
+            raise invalid_file(ILC_ROLE, STDIN_NAME if file == "-" else file,
+                               f"byte {error.offset}: {error.message}",
+                               "compile the program again", EXIT_ERRORS) from None
+        source_name, source_text = _recorded_source(program, file)
+        finished = execute_program(program, device, budget)
     else:
         source = read_input(file)
         if not isinstance(source, Source):
             return emit([source], "human", "auto", "run", err=True)
         try:
-            outcome = run_source(source.text, os.path.basename(source.name), device, engine,
-                                 budget)
+            outcome = execute_source(source.text, os.path.basename(source.name), device,
+                                     engine, budget)
         except ScriptError as error:
-            raise Failure(f"error: {error}") from None
-        if not isinstance(outcome, RunResult):
+            raise click.UsageError(str(error)) from None
+        if not isinstance(outcome, Finished):
             return emit([FileDiagnostics(source.name, source.text, outcome)], "human",
                         "auto", "run", err=True)
-        result = outcome
-    render = render_json if run_format == "json" else render_text
-    sys.stdout.write(render(result, device.trace))
-    return result.fault.kind.exit_status if result.fault is not None else 0
+        if outcome.warnings:
+            emit([FileDiagnostics(source.name, source.text, outcome.warnings)], "human",
+                 "auto", "run", err=True)
+        finished, source_text, source_name = outcome, source.text, source.name
+    report = RunReport(file, source_name, source_text, finished.result,
+                       select_trace(device.log, trace_choice or
+                                    ("short" if run_format == "text" else "all")),
+                       finished.instructions, device.time,
+                       device.motion if finished.result.fault is None else None,
+                       device.losses_not_met())
+    if run_format == "json":
+        sys.stdout.write(render_json(report))
+    else:
+        sys.stdout.write(render_text(report, color=use_color("auto", sys.stdout)))
+    fault = finished.result.fault
+    return fault.kind.exit_status if fault is not None else 0
+
+
+def _recorded_source(program: VerifiedProgram, file: str) -> tuple[str, str | None]:
+    """The name and text of the source the .ilc file `file` records, when it is found
+    beside it and is still the one compiled (as `dis` finds it); else `file` and None."""
+    from rl1.compiler.ils.sources import find_source
+
+    debug = program.image.debug
+    if file == "-" or debug is None:
+        return file, None
+    lines = find_source(debug, file, None).lines
+    if lines is None:
+        return file, None
+    return os.path.join(os.path.dirname(file), debug.source_name), "\n".join(lines)
 
 
 @click.command(cls=Command)
@@ -269,12 +351,14 @@ def dis(file: str, source_file: str | None) -> int:
     try:
         debug = verify(data).image.debug  # an invalid file is refused before any source is read
     except VerifyError as error:
-        raise Failure(f"error: {file}: byte {error.offset}: {error.message}",
-                      EXIT_ERRORS) from None
+        raise invalid_file(ILC_ROLE, STDIN_NAME if file == "-" else file,
+                           f"byte {error.offset}: {error.message}",
+                           "compile the program again, or assemble it with `rl1c asm`",
+                           EXIT_ERRORS) from None
     try:
         found = find_source(debug, file, source_file)
     except SourceError as error:
-        raise Failure(f"error: cannot read the source given with --source: {error}") from None
+        raise read_failure(error, "--source file") from None
     if found.note is not None:
         click.echo(found.note, err=True)
     sys.stdout.write(disassemble(data, file, found.lines))
@@ -294,9 +378,9 @@ def assemble_file(file: str, output: str | None, force: bool) -> int:
     (nothing is written), 2 an unreadable input or an output that cannot be written."""
     from rl1.compiler.ils.asm import AsmError, assemble
 
-    source = read_input(file)
+    source = read_input(file, ".ils file")
     if not isinstance(source, Source):
-        raise Failure(f"error: {source.diagnostics[0].message}")
+        raise file_failure(source)
     target = output or _default_output(file, "ilc")
     if same_file(file, target):
         raise click.UsageError(f"the output `{target}` is the input file itself: "

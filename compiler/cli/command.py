@@ -136,7 +136,9 @@ def choice_option(*names: str, choices: Sequence[str], help: str,
     """An option taking one of `choices`, shown as `--format {human,json,sarif}`, with
     the message `invalid choice: 'xml' (choose from human, json, sarif)`; the choices
     complete in the shell."""
-    def one_of(ctx: click.Context, param: click.Parameter, value: str) -> str:
+    def one_of(ctx: click.Context, param: click.Parameter, value: str | None) -> str | None:
+        if value is None:  # not given, and the default is to decide later
+            return None
         if value not in choices:
             raise click.BadParameter(
                 f"invalid choice: {value!r} (choose from {', '.join(choices)})", ctx, param)

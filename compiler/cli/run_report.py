@@ -1,35 +1,235 @@
-"""What `rl1c run` prints: the device's trace, how the run ended, the final variables."""
+"""What `rl1c run` prints: the device's trace (bounded, or chosen by --trace), how the
+run ended (a fault shown as the checker shows a diagnostic, with its source line and the
+call underlined), whether the vehicle still moves, and the final variables; or all of it
+as one JSON object (spec/sensors.md, "The report in JSON")."""
 
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any, Generic, Literal, Protocol, TypeVar
 
-from rl1.vm.faults import RunResult
-from rl1.vm.scripted import TraceEntry, run_document
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.ast import Span
+from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
+from rl1.compiler.frontend.parser import parse_program
+from rl1.compiler.reporting.render import FileDiagnostics, diagnostic_blocks
+from rl1.vm.faults import Fault, FaultKind, RunResult
+from rl1.vm.scripted import LOST, LossAfter, LossAt, LossDuring, TraceEntry
+
+TraceChoice = Literal["short", "all", "calls", "none"]
+TRACE_CHOICES: tuple[TraceChoice, ...] = ("short", "all", "calls", "none")
+
+HEAD = 40
+TAIL = 20
+"""A short trace shows its first HEAD and last TAIL entries, and how many it left out
+between them; a trace that would leave out only one entry is shown whole."""
 
 
-def render_json(result: RunResult, trace: Sequence[TraceEntry]) -> str:
-    """One JSON object: status ("ok" or the fault), all 53 variables, the trace."""
-    return json.dumps(run_document(result, trace), indent=2) + "\n"
+class Traced(Protocol):
+    """A trace entry of either device: the scripted one's, or the simulator's."""
+
+    @property
+    def call(self) -> str: ...
 
 
-def render_text(result: RunResult, trace: Sequence[TraceEntry]) -> str:
-    lines = ["trace (device time in ms):"]
-    for entry in trace:
-        call = entry.call + (" " + ",".join(map(str, entry.args)) if entry.args else "")
-        if entry.result is not None:
-            call += " -> " + " ".join(map(str, entry.result))
-        lines.append(f"  {entry.time:>8}  {call}")
-    if not trace:
-        lines.append("  (no device command)")
-    fault = result.fault
+Entry = TypeVar("Entry", bound=Traced)
+
+
+@dataclass(frozen=True, slots=True)
+class ShownTrace(Generic[Entry]):
+    """The entries a report shows: `head`, then `left_out` entries not shown, then `tail`."""
+
+    head: Sequence[Entry]
+    left_out: int = 0
+    tail: Sequence[Entry] = ()
+
+    def lines(self, line_of: Callable[[Entry], str]) -> list[str]:
+        """The entries as text, a line each (`line_of`), with a line saying how many were
+        left out where they were."""
+        lines = [line_of(entry) for entry in self.head]
+        if self.left_out:
+            lines.append(f"{'...':>9}  ({self.left_out:,} entries left out: --trace all "
+                         "shows every one)")
+            lines += [line_of(entry) for entry in self.tail]
+        return lines
+
+
+def select_trace(log: Sequence[Entry], choice: TraceChoice) -> ShownTrace[Entry]:
+    """What `--trace` shows of a run's log: all of it, its calls alone (no lost lines, no
+    stop after a fault), nothing, or (short) its head and tail."""
+    if choice == "none":
+        return ShownTrace(())
+    if choice == "calls":
+        return ShownTrace([entry for entry in log if entry.call not in (LOST, "STOP")])
+    if choice == "all" or len(log) <= HEAD + TAIL + 1:
+        return ShownTrace(log)
+    return ShownTrace(log[:HEAD], len(log) - HEAD - TAIL, log[len(log) - TAIL:])
+
+
+@dataclass(frozen=True, slots=True)
+class RunReport:
+    """Everything a report of a run says. `source` is the program's text, when known (a
+    .rob file, or the source an .ilc file records and that is still the one compiled)."""
+
+    name: str  # the program's file, as given
+    source_name: str  # the file whose lines `source` holds
+    source: str | None
+    result: RunResult
+    trace: ShownTrace[TraceEntry]
+    instructions: int | None  # None when the interpreter ran it
+    device_time: int  # ms
+    moving: str | None  # the motion in effect when the program ended: "(MOV 3,3)"
+    missed: Sequence[tuple[int, LossAt | LossDuring | LossAfter, str]] = ()
+    """The script's losses that never happened: index in line_lost, loss, why."""
+
+
+# Text ---------------------------------------------------------------------------------
+
+
+def render_text(report: RunReport, *, color: bool = False) -> str:
+    lines = []
+    trace = report.trace
+    if trace.head:
+        lines.append(f"{'time ms':>9}  {'line':>4}  call")
+        lines += trace.lines(_entry_line)
+    fault = report.result.fault
     if fault is None:
-        lines.append("the program ended normally")
+        lines.append(f"the program ended normally at {report.device_time} ms of device time"
+                     + _executed(report))
+        if report.moving is not None:
+            lines.append(f"note: the program ended with {report.moving} in effect: the "
+                         "vehicle is still moving")
     else:
-        where = f" at line {fault.line}" if fault.line is not None else ""
-        lines.append(f"fault[{fault.kind.code}]{where}: {fault.message}")
-    set_variables = [f"{name}={value}" for name, value in result.named().items() if value]
-    lines.append("variables: " + (" ".join(set_variables) + " (all others 0)"
-                                  if set_variables else "all 0"))
+        lines.append(fault_text(fault, report.name, report.source_name, report.source,
+                                color=color).rstrip("\n"))
+        lines.append(f"the run stopped at {report.device_time} ms of device time"
+                     + _executed(report))
+    lines += [f"note: the sensor script's line_lost[{index}], {json.dumps(loss.to_json())}, "
+              f"never happened: {why}" for index, loss, why in report.missed]
+    named = [f"{name}={value}" for name, value in report.result.named().items() if value]
+    lines.append("variables: " + (" ".join(named) + " (all others 0)" if named else "all 0"))
     return "\n".join(lines) + "\n"
+
+
+def _entry_line(entry: TraceEntry) -> str:
+    line = str(entry.line) if entry.line is not None else "-"
+    return f"{entry.time:>9}  {line:>4}  {entry.describe()}"
+
+
+def _executed(report: RunReport) -> str:
+    if report.instructions is None:
+        return ""
+    return f", after {report.instructions:,} instructions"
+
+
+# A fault as a diagnostic ---------------------------------------------------------------
+
+_HELP = {
+    FaultKind.ARGUMENT_RANGE: "test the variable before the call (`?V<#NN`, `?V>#NN`), or "
+                              "compute it so that it stays in the range",
+    FaultKind.MISSING_HANDLER: "add the handler label the message names, to say what the "
+                               "vehicle does when it loses the line (`rl1c explain W0301`)",
+    FaultKind.BUDGET: "if the program should run longer, raise --budget; if not, this jump "
+                      "closes a loop that nothing ends",
+    FaultKind.DEVICE: "the vehicle refused or failed the call; on the scripted device, the "
+                      "sensor script decides readings and failures (spec/sensors.md)",
+}
+_TIME_LIMIT_HELP = ("if the program should run longer, raise --time-limit; if not, it waits "
+                    "in a loop for something that does not come")
+_NO_READING_HELP = ("add readings to the sensor script (spec/sensors.md), or give "
+                    "\"after_last\": \"repeat\" to repeat the last one")
+_NO_SCRIPT_HELP = ("give the readings the program needs in a sensor script: "
+                   "--sensors FILE (spec/sensors.md)")
+_FORM = re.compile(r"\(([A-Z]{3})\b")
+
+
+def fault_help(fault: Fault) -> str:
+    """What to do about `fault`."""
+    if fault.kind is FaultKind.DEVICE:
+        if "device-time limit" in fault.message:
+            return _TIME_LIMIT_HELP
+        if "no sensor script was given" in fault.message:
+            return _NO_SCRIPT_HELP
+        if "has no reading" in fault.message:
+            return _NO_READING_HELP
+    return _HELP[fault.kind]
+
+
+def fault_text(fault: Fault, name: str, source_name: str, text: str | None, *,
+               color: bool = False) -> str:
+    """The fault of a run of the program `name` as the checker shows a diagnostic:
+    `error[argument-range]: message`, `--> file:line:col`, the source line (of `text`, the
+    file `source_name`, when known) with the call underlined, and what to do."""
+    lines = text.splitlines() if text is not None else []
+    message = fault.message
+    if fault.line is not None and 1 <= fault.line <= len(lines):
+        found = fault_span(lines[fault.line - 1], fault)
+        span = Span(fault.line, found.column, fault.line, found.end_column)
+        shown = FileDiagnostics(source_name, text, [])
+    else:  # no source to show: the line, if known, goes into the message
+        span = Span(1, 1, 1, 1)
+        if fault.line is not None:
+            message += f" (at line {fault.line})"
+        shown = FileDiagnostics(name, None, [])
+    diagnostic = Diagnostic(fault.kind.code, Severity.ERROR, message, span,
+                            help=fault_help(fault))
+    return diagnostic_blocks(FileDiagnostics(shown.name, shown.text, [diagnostic]),
+                             color=color)
+
+
+def fault_span(line: str, fault: Fault) -> Span:
+    """Where on its source line (numbered 1 here) `fault` happened: the call it names
+    (`(MOV)` in its message), else the jump for a fault taken at a jump, else the line's
+    first call, else the whole line."""
+    program, _ = parse_program(line)
+    nodes = list(ast.walk(program))
+    calls = [node for node in nodes if isinstance(node, ast.Call)]
+    jumps = [node for node in nodes if isinstance(node, ast.Goto | ast.CondJump)]
+    named = _FORM.search(fault.message)
+    if named is not None:
+        for call in calls:
+            if call.mnemonic.upper() == named.group(1):
+                return call.span
+    if jumps and (fault.kind in (FaultKind.BUDGET, FaultKind.MISSING_HANDLER) or not calls):
+        return jumps[-1].span
+    if calls:
+        return calls[0].span
+    code = line.split("'")[0].rstrip()
+    start = len(code) - len(code.lstrip())
+    return Span(1, start + 1, 1, max(len(code), start + 1) + 1)
+
+
+# JSON ---------------------------------------------------------------------------------
+
+
+def entry_json(entry: TraceEntry) -> dict[str, Any]:
+    """A trace entry as the report writes it: as the vectors do, with its source line,
+    and for a lost line what it did (`effect`) and the handler it jumped to."""
+    document = entry.to_json()
+    document["line"] = entry.line
+    if entry.call == LOST:
+        document["during"] = entry.during
+        document["effect"] = entry.effect
+        document["handler"] = entry.handler
+    return document
+
+
+def render_json(report: RunReport) -> str:
+    trace = report.trace
+    document = {
+        "status": report.result.status(),
+        "instructions": report.instructions,
+        "device_time": report.device_time,
+        "moving": report.moving,
+        "variables": report.result.named(),
+        "trace": [entry_json(entry) for entry in (*trace.head, *trace.tail)],
+        "trace_left_out": ({"after": len(trace.head), "count": trace.left_out}
+                           if trace.left_out else None),
+        "losses_not_met": [{"index": index, "loss": loss.to_json(), "why": why}
+                           for index, loss, why in report.missed],
+    }
+    return json.dumps(document, indent=2) + "\n"
+

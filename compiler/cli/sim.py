@@ -10,14 +10,16 @@ import click
 
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.frontend.source import Source
-from rl1.compiler.reporting.render import EXIT_ERRORS, FileDiagnostics
+from rl1.compiler.reporting.render import EXIT_ERRORS, FileDiagnostics, use_color
 from rl1.vm.faults import DEFAULT_BUDGET
 
-from .command import PATH, Command, Failure, a_budget, choice_option
-from .streams import emit, read_ilc, read_input, write_file
+from .command import PATH, Command, a_budget, choice_option
+from .run_report import TRACE_CHOICES, TraceChoice
+from .streams import ILC_ROLE, emit, invalid_file, read_failure, read_ilc, read_input, write_file
 
 SECTION = "Simulation"
 MAX_WORLD_BYTES = 4 * 2**20
+WORLD_ROLE = "world file"
 
 
 @click.command(cls=Command)
@@ -39,8 +41,12 @@ MAX_WORLD_BYTES = 4 * 2**20
               metavar="N", show_default=True,
               help="instructions (statements with --engine ast) before the watchdog stops "
                    "a runaway program")
+@choice_option("--trace", "trace_choice", choices=TRACE_CHOICES, default=None,
+               help="which calls to show, as `rl1c run --trace`: short: the first 40 and "
+                    "the last 20 of a longer trace, with how many were left out; all; calls; "
+                    "none. Default: short with --format text, all with json")
 def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_format: str,
-        seed: int, engine: str, budget: int) -> int:
+        seed: int, engine: str, budget: int, trace_choice: TraceChoice | None) -> int:
     """Run a program (.rob source, or an .ilc file) on the simulated vehicle and world.
 
     Prints each call with the time and the vehicle's pose, how the run ended and the
@@ -60,9 +66,13 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
 
     try:
         the_world = decode_world(read_bounded(world, MAX_WORLD_BYTES, "a world file"), world)
-    except (SourceError, WorldError) as error:
-        raise Failure(f"error: {error}") from None
+    except SourceError as error:
+        raise read_failure(error, WORLD_ROLE) from None
+    except WorldError as error:
+        raise invalid_file(WORLD_ROLE, world, str(error),
+                           "correct it as spec/simulator.md describes") from None
     device = SimDevice(the_world, seed=seed)
+    source: Source | None = None
     if file.lower().endswith(".ilc"):
         if engine == "ast":
             raise click.UsageError("--engine ast interprets RL/I source; an .ilc file runs "
@@ -70,12 +80,13 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
         try:
             result = run_ilc(read_ilc(file), device, budget)
         except VerifyError as error:
-            raise Failure(f"error: {file}: byte {error.offset}: {error.message}",
-                          EXIT_ERRORS) from None
+            raise invalid_file(ILC_ROLE, file, f"byte {error.offset}: {error.message}",
+                               "compile the program again", EXIT_ERRORS) from None
     else:
-        source = read_input(file)
-        if not isinstance(source, Source):
-            return emit([source], "human", "auto", "sim", err=True)
+        read = read_input(file)
+        if not isinstance(read, Source):
+            return emit([read], "human", "auto", "sim", err=True)
+        source = read
         outcome = run_source(source.text, os.path.basename(source.name), device,
                              "ast" if engine == "ast" else "vm", budget)
         if not isinstance(outcome, RunResult):
@@ -93,16 +104,20 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
     title = f"{os.path.basename(file)} on {os.path.basename(world)}"
     if svg_file is not None:
         write_file(svg_file, svg(the_world, device.sim.track, device.sim.events,
-                                 title).encode())
+                                 title).encode(), role="SVG file")
     if html_file is not None:
         calls = [(entry.time, entry.call
                   + (" " + ",".join(map(str, entry.args)) if entry.args else "")
                   + (" -> " + " ".join(map(str, entry.result)) if entry.result else ""))
                  for entry in device.trace]
         write_file(html_file, html(the_world, device.sim.track, device.sim.events, calls,
-                                   title).encode())
-    render = render_json if sim_format == "json" else render_text
-    sys.stdout.write(render(result, device, run_on))
+                                   title).encode(), role="HTML file")
+    if sim_format == "json":
+        sys.stdout.write(render_json(result, device, run_on, trace_choice or "all"))
+    else:
+        sys.stdout.write(render_text(result, device, file, source, run_on,
+                                     trace_choice or "short",
+                                     color=use_color("auto", sys.stdout)))
     return result.fault.kind.exit_status if result.fault is not None else 0
 
 

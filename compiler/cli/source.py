@@ -25,8 +25,14 @@ from rl1.compiler.reporting.render import (
 
 from .command import PATH, Command, Failure, color_option, force_option, format_option
 from .streams import (
+    cannot,
+    cannot_write,
     emit,
     encode_like,
+    file_failure,
+    file_problem,
+    invalid_file,
+    problem_text,
     read_input,
     source_files,
     unified_diff,
@@ -91,8 +97,14 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
                 selection = given.over(project(item))
             inputs.append((item, selection))
     except ProjectFileError as error:
-        raise Failure(f"error: {error}\n  = help: correct the file (README.md, \"Controlling "
-                      "`rl1c check`\", shows its form), or move it aside") from None
+        role = "project file"
+        if error.unreadable:
+            raise file_failure(file_problem(error.path, cannot("read", role, error.path,
+                                                               error.detail),
+                                            error.help)) from None
+        raise invalid_file(role, error.path, error.detail,
+                           "correct the file (README.md, \"Controlling `rl1c check`\", shows "
+                           "its form), or move it aside") from None
     if diff:
         return _fix_diff(inputs)
     checked: list[FileDiagnostics] = []
@@ -112,8 +124,8 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
                     write_back(source, fixing.text, force=force)
                     fixed += fixing.fixes
             except OSError as error:
-                print(f"error: cannot write the fixes to `{source.name}`: "
-                      f"{error.strerror or error}", file=sys.stderr)
+                print(problem_text(cannot_write(source.name, "source file", error,
+                                                "to make its fixes")), file=sys.stderr)
                 status = EXIT_USAGE
                 text, diagnostics = source.text, None  # the file is as it was
         if diagnostics is None:
@@ -202,7 +214,8 @@ def fmt(files: tuple[str, ...], check: bool, diff: bool, force: bool) -> int:
             try:
                 write_back(source, formatted, force=force)
             except OSError as error:
-                print(f"error: cannot write `{source.name}`: {error.strerror or error}",
+                print(problem_text(cannot_write(source.name, "source file", error,
+                                                "in the canonical layout")),
                       file=sys.stderr)
                 changed -= 1
                 failed += 1

@@ -8,7 +8,7 @@ import os
 import sys
 from collections.abc import Sequence
 
-from rl1.compiler.files import SourceError, write_atomically
+from rl1.compiler.files import SourceError, TooLargeError, read_bounded, write_atomically
 from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.compiler.frontend.source import (
@@ -21,9 +21,11 @@ from rl1.compiler.frontend.source import (
 )
 from rl1.compiler.reporting.render import (
     EXIT_ERRORS,
+    EXIT_USAGE,
     ColorChoice,
     FileDiagnostics,
     Format,
+    diagnostic_blocks,
     exit_status,
     report,
     use_color,
@@ -36,19 +38,19 @@ SOURCE_SUFFIX = ".rob"  # in any case: DOS wrote SAMPLE.ROB
 MAX_ILC_BYTES = 16 * 1024 * 1024  # far more than any .ilc file holds
 
 
-def read_input(name: str) -> Source | FileDiagnostics:
+def read_input(name: str, role: str = "source file") -> Source | FileDiagnostics:
     """The source file `name` (`-` is standard input), or the E0100 report of why it
-    cannot be read."""
+    cannot be read; `role` names it there."""
     try:
         if name != "-":
             return read_source(name)
         data = sys.stdin.buffer.read(MAX_SOURCE_BYTES + 1)
         if len(data) > MAX_SOURCE_BYTES:
-            raise SourceError(f"{STDIN_NAME} holds more than {MAX_SOURCE_BYTES} bytes; "
+            raise SourceError(STDIN_NAME, f"it holds more than {MAX_SOURCE_BYTES} bytes",
                               "RL/I sources are limited to that size")
         return decode(data, STDIN_NAME)
     except SourceError as error:
-        return unreadable(STDIN_NAME if name == "-" else name, str(error))
+        return unreadable(STDIN_NAME if name == "-" else name, error, role)
 
 
 def source_files(names: Sequence[str], command: str) -> list[str | FileDiagnostics]:
@@ -72,18 +74,63 @@ def source_files(names: Sequence[str], command: str) -> list[str | FileDiagnosti
                       if os.path.isfile(path)]
         for error in unlisted:
             folder = str(error.filename or name)
-            found.append(unreadable(folder, f"{folder}: cannot list this folder "
-                                    f"({error.strerror or error}); check its permissions"))
+            found.append(file_problem(folder, cannot("list", "folder", folder,
+                                                     os_reason(error)),
+                                      "check its permissions"))
         if len(found) == before:
             print(f"rl1c {command}: warning: no {SOURCE_SUFFIX} file under `{name}`",
                   file=sys.stderr)
     return found
 
 
-def unreadable(name: str, message: str) -> FileDiagnostics:
-    """The E0100 report of a file or folder that cannot be read."""
-    problem = Diagnostic("E0100", Severity.ERROR, message, Span(1, 1, 1, 1))
+# Every problem with a file, whatever the command and whatever the file's role, is an
+# E0100 diagnostic that names the role: "cannot read the sensor script `s.json`: ...".
+
+
+def cannot(verb: str, role: str, name: str, reason: str, purpose: str = "") -> str:
+    """`cannot read the sensor script `s.json`: permission denied`; `purpose` says what
+    for, after the name ("to make its fixes")."""
+    return f"cannot {verb} the {role} `{name}`{' ' + purpose if purpose else ''}: {reason}"
+
+
+def os_reason(error: OSError) -> str:
+    """Why an OS call failed, as a clause: "permission denied"."""
+    reason = str(error.strerror or error)
+    return reason[:1].lower() + reason[1:]
+
+
+def file_problem(name: str, message: str, help: str = "") -> FileDiagnostics:
+    """The E0100 report of a file or folder that cannot be read, written or used."""
+    problem = Diagnostic("E0100", Severity.ERROR, message, Span(1, 1, 1, 1), help=help or None)
     return FileDiagnostics(name, None, [problem])
+
+
+def unreadable(name: str, error: SourceError, role: str) -> FileDiagnostics:
+    """The E0100 report of the `role` file `name` that `error` could not read."""
+    return file_problem(name, cannot("read", role, name, error.reason), error.help)
+
+
+def problem_text(problem: FileDiagnostics) -> str:
+    """`problem` as the checker prints a diagnostic on standard error, without a final
+    newline."""
+    return diagnostic_blocks(problem, color=use_color("auto", sys.stderr)).rstrip("\n")
+
+
+def file_failure(problem: FileDiagnostics, status: int = EXIT_USAGE) -> Failure:
+    """A Failure that prints `problem` as the checker prints a diagnostic."""
+    return Failure(problem_text(problem), status)
+
+
+def read_failure(error: SourceError, role: str) -> Failure:
+    """The Failure of the `role` file that `error` could not read (exit status 2)."""
+    return file_failure(unreadable(error.path, error, role))
+
+
+def invalid_file(role: str, name: str, detail: str, help: str = "",
+                 status: int = EXIT_USAGE) -> Failure:
+    """The Failure of the `role` file `name` that was read but is not what it must be."""
+    return file_failure(file_problem(name, f"the {role} `{name}` is not valid: {detail}",
+                                     help), status)
 
 
 def emit(files: list[FileDiagnostics], output_format: Format, color: ColorChoice,
@@ -102,13 +149,26 @@ def write_stdout_bytes(data: bytes) -> None:
     sys.stdout.buffer.flush()
 
 
-def write_file(target: str, data: bytes, *, force: bool = False) -> None:
+def write_file(target: str, data: bytes, *, force: bool = False,
+               role: str = "output file") -> None:
     """Writes `target` as files.write_atomically does (a read-only file only with
     `force`); a Failure (exit status 2) saying why it cannot be."""
     try:
         write_atomically(target, data, force=force)
     except OSError as error:
-        raise Failure(f"error: cannot write `{target}`: {error.strerror or error}") from None
+        raise file_failure(cannot_write(target, role, error)) from None
+
+
+def cannot_write(target: str, role: str, error: OSError, purpose: str = "") -> FileDiagnostics:
+    """The E0100 report of the `role` file `target` that `error` kept from being written
+    (`purpose`: what for, as "to make its fixes")."""
+    reason = os_reason(error)
+    help = ("" if "--force" in reason else
+            "check that its folder exists and is writable, or write elsewhere")
+    return file_problem(target, cannot("write", role, target, reason, purpose), help)
+
+
+ILC_ROLE = "intermediate code file"
 
 
 def read_ilc(file: str) -> bytes:
@@ -116,17 +176,19 @@ def read_ilc(file: str) -> bytes:
     when it cannot be read, 1 when it is too large to be one (without reading a huge
     file whole)."""
     name = STDIN_NAME if file == "-" else file
+    data: bytes | None
     try:
         if file == "-":
             data = sys.stdin.buffer.read(MAX_ILC_BYTES + 1)
         else:
-            with open(file, "rb") as stream:
-                data = stream.read(MAX_ILC_BYTES + 1)
-    except OSError as error:
-        raise Failure(f"error: cannot read `{name}`: {error.strerror or error}") from None
-    if len(data) > MAX_ILC_BYTES:
-        raise Failure(f"error: `{name}` is larger than {MAX_ILC_BYTES} bytes: not an .ilc "
-                      "file", EXIT_ERRORS)
+            data = read_bounded(file, MAX_ILC_BYTES, "an .ilc file")
+    except TooLargeError:
+        data = None
+    except SourceError as error:
+        raise read_failure(error, ILC_ROLE) from None
+    if data is None or len(data) > MAX_ILC_BYTES:
+        raise invalid_file(ILC_ROLE, name, f"it is larger than {MAX_ILC_BYTES} bytes",
+                           "check that this is the .ilc file you meant", EXIT_ERRORS)
     return data
 
 

@@ -42,7 +42,7 @@ def decode(data: bytes, name: str = "<input>") -> Source:
     if b"\x00" in data:
         offset = data.index(b"\x00")
         raise SourceError(
-            f"{name} looks like a binary file (a NUL byte at offset {offset}); "
+            name, f"it looks like a binary file (a NUL byte at offset {offset})",
             "RL/I source is text: check that this is the .rob file you meant"
         )
     bom = data.startswith(UTF8_BOM)
@@ -55,8 +55,8 @@ def decode(data: bytes, name: str = "<input>") -> Source:
             return Source(name, data.decode("cp932"), "cp932")
         except UnicodeDecodeError:
             raise SourceError(
-                f"{name} is neither UTF-8 nor Shift-JIS text (invalid byte "
-                f"0x{data[utf8_error.start]:02X} at offset {utf8_error.start}); "
+                name, f"it is neither UTF-8 nor Shift-JIS text (invalid byte "
+                f"0x{data[utf8_error.start]:02X} at offset {utf8_error.start})",
                 "save it as UTF-8"
             ) from None
 

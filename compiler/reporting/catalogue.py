@@ -34,7 +34,7 @@ def _entries(*rows: tuple[str, Severity, str]) -> dict[str, CodeInfo]:
 E, W = Severity.ERROR, Severity.WARNING
 
 CODES: dict[str, CodeInfo] = _entries(
-    ("E0100", E, "source file cannot be read"),
+    ("E0100", E, "a file cannot be read, written or used"),
     ("E0101", E, "syntax error"),
     ("E0102", E, "unexpected character"),
     ("E0103", E, "a word that is not a variable"),

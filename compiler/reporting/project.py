@@ -26,7 +26,16 @@ TABLE = "check"
 
 
 class ProjectFileError(Exception):
-    """An rl1.toml that cannot be read or used; the message says where and why."""
+    """An rl1.toml that cannot be read (`unreadable`) or used: its `path`, and where in
+    it and why (`detail`); str() is "PATH: DETAIL"."""
+
+    def __init__(self, path: str, detail: str, *, unreadable: bool = False,
+                 help: str = "") -> None:
+        super().__init__(f"{path}: {detail}")
+        self.path = path
+        self.detail = detail
+        self.unreadable = unreadable
+        self.help = help
 
 
 def find_project_file(folder: str) -> str | None:
@@ -50,21 +59,22 @@ def load_project_file(path: str) -> Selection:
         data = read_bounded(path, MAX_PROJECT_FILE_BYTES, "a project file")
         document = tomllib.loads(data.decode("utf-8"))
     except SourceError as error:
-        raise ProjectFileError(f"{error}") from None
+        raise ProjectFileError(error.path, error.reason, unreadable=True,
+                               help=error.help) from None
     except UnicodeDecodeError as error:
-        raise ProjectFileError(f"{path}: not UTF-8 text (byte {error.start}); TOML files are "
+        raise ProjectFileError(path, f"not UTF-8 text (byte {error.start}); TOML files are "
                                "UTF-8") from None
     except tomllib.TOMLDecodeError as error:
-        raise ProjectFileError(f"{path}: not valid TOML: {error}") from None
+        raise ProjectFileError(path, f"not valid TOML: {error}") from None
     except RecursionError:  # tomllib reads nested arrays recursively
-        raise ProjectFileError(f"{path}: arrays or tables nested too deeply to read") from None
+        raise ProjectFileError(path, "arrays or tables nested too deeply to read") from None
     unknown = sorted(set(document) - {TABLE})
     if unknown:
-        raise ProjectFileError(f"{path}: unknown table or key `{unknown[0]}`: rl1.toml has "
+        raise ProjectFileError(path, f"unknown table or key `{unknown[0]}`: rl1.toml has "
                                f"a `[{TABLE}]` table only")
     table = document.get(TABLE, {})
     if not isinstance(table, dict):
-        raise ProjectFileError(f"{path}: `{TABLE}` must be a table, `[{TABLE}]`")
+        raise ProjectFileError(path, f"`{TABLE}` must be a table, `[{TABLE}]`")
     return _selection(path, table)
 
 
@@ -74,7 +84,7 @@ _KEYS = ("select", "ignore", "warnings-as-errors")
 def _selection(path: str, table: dict[str, Any]) -> Selection:
     for key in table:
         if key not in _KEYS:
-            raise ProjectFileError(f"{path}: unknown key `{key}` in `[{TABLE}]`; the keys are "
+            raise ProjectFileError(path, f"unknown key `{key}` in `[{TABLE}]`; the keys are "
                                    + ", ".join(f"`{known}`" for known in _KEYS))
 
     def codes(key: str) -> tuple[str, ...] | None:
@@ -82,16 +92,16 @@ def _selection(path: str, table: dict[str, Any]) -> Selection:
         if value is None:
             return None
         if not isinstance(value, list) or not all(isinstance(item, str) for item in value):
-            raise ProjectFileError(f"{path}: `{key}` in `[{TABLE}]` must be a list of codes, "
+            raise ProjectFileError(path, f"`{key}` in `[{TABLE}]` must be a list of codes, "
                                    f'such as {key} = ["W0601", "W06"]')
         try:
             return parse_codes(value)
         except SelectionError as error:
-            raise ProjectFileError(f"{path}: `{key}` in `[{TABLE}]`: {error}") from None
+            raise ProjectFileError(path, f"`{key}` in `[{TABLE}]`: {error}") from None
 
     strict = table.get("warnings-as-errors")
     if strict is not None and not isinstance(strict, bool):
-        raise ProjectFileError(f"{path}: `warnings-as-errors` in `[{TABLE}]` must be true or "
+        raise ProjectFileError(path, f"`warnings-as-errors` in `[{TABLE}]` must be true or "
                                "false")
     return Selection(codes("select"), codes("ignore"), strict)
 

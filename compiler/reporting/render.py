@@ -76,6 +76,14 @@ def report(
     return "\n".join(text for text in rendered if text)
 
 
+def diagnostic_blocks(file: FileDiagnostics, *, color: bool = False) -> str:
+    """The human text of `file`'s diagnostics with no closing summary, ending in one
+    newline: what a command prints about a file other than the one it acts on (a sensor
+    script that cannot be read), or of a fault at run time."""
+    renderer = _HumanRenderer(file, color)
+    return "".join(renderer.diagnostic(d) for d in _ordered(file.diagnostics)).rstrip("\n") + "\n"
+
+
 def summary(files: Sequence[FileDiagnostics], fixed: int = 0) -> str:
     """One line that counts the files and what was found in them: "3 files checked:
     0 errors, 1 warning" (a file that could not be read counts its E0100 error), and

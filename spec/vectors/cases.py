@@ -34,6 +34,7 @@ from rl1.vm.language import BUILTINS, Param
 
 EXAMPLES = Path(__file__).resolve().parent.parent.parent / "examples"
 DEFAULT_BUDGET = 100_000
+REPEAT = {"after_last": "repeat"}  # a used-up list repeats its last reading, none reads 0
 
 TraceItem = tuple[int | None, str, tuple[int, ...]]  # (time, or None: not checked; call; args)
 
@@ -308,7 +309,8 @@ def _form_with_arguments(form: tuple[str, str | None]) -> Case:
     return Case("calls", f"call-{label}", f"{_call(form, list(names))} with both ends of each "
                 "range, as constants, as variables and mixed",
                 "".join(line + "\n" for line in lines),
-                {name: value for name, value in variables.items() if value}, trace=tuple(calls))
+                {name: value for name, value in variables.items() if value}, trace=tuple(calls),
+                sensors=REPEAT if form == ("INP", None) else {})
 
 
 def calls() -> Iterator[Case]:
@@ -337,33 +339,34 @@ def calls() -> Iterator[Case]:
                {"A": 50, "B": 91, "C": 201, "u": 101, "v": 99},
                sensors={"KYO": [{"centre": 50, "right": 52, "left": 48},
                                 {"centre": -7, "right": -9, "left": -5},
-                                {"centre": 100, "right": 101, "left": 99}]})
+                                {"centre": 100, "right": 101, "left": 99}], **REPEAT})
     yield Case(group, "img-results", "(IMG) writes w, x, y, z and returns the area; x read before "
                "an (IMG) in the same expression is the old x; the target is written last",
                "(SCN 5)\n(IMG)\nA=(IMG)\nB=x+(IMG)\nx=(IMG)+1\n",
                {"A": 120, "B": 129, "w": -1, "x": 0, "y": 32767, "z": 359},
                sensors={"IMG": [{"area": 7, "x": 8, "y": 9, "z": 10},
                                 {"area": 120, "x": 130, "y": 100, "z": -5},
-                                {"area": -1, "x": -32768, "y": 32767, "z": 359}]},
+                                {"area": -1, "x": -32768, "y": 32767, "z": 359}],
+                        **REPEAT},
                trace=((0, "SCN", (5,)), (0, "IMG", ()), (100, "IMG", ()), (200, "IMG", ()),
                       (300, "IMG", ())))
     yield Case(group, "cam-r-results", "(CAM R) returns the pan position and writes no variable",
                "(CAM P 100)\nA=(CAM R)\nB=(CAM R)+1\n(CAM R)\nC=0-(CAM R)\n",
-               {"A": 392, "B": 785, "C": -784}, sensors={"CAM R": [392, 784]})
+               {"A": 392, "B": 785, "C": -784}, sensors={"CAM R": [392, 784], **REPEAT})
     yield Case(group, "ult-results", "(ULT A) .. (ULT D): each sensor its own readings; a list "
                "that runs out repeats its last reading; a sensor with none reads 0",
                "A=(ULT A)\nB=(ULT B)\nC=(ULT B)\nD=(ULT C)\nE=(ULT D)\n(ULT A)\nF=(ULT B)\n",
                {"A": 150, "B": 1, "C": 2, "D": -5, "F": 2},
-               sensors={"ULT A": [150], "ULT B": [1, 2], "ULT C": [-5]})
+               sensors={"ULT A": [150], "ULT B": [1, 2], "ULT C": [-5], **REPEAT})
     yield Case(group, "inp-results", "(INP p) with a constant and a variable port, both "
                "ends of the port range; each port its own readings",
                "A=(INP 0)\np=0; B=(INP p)\np=125; C=(INP p)\nD=(INP 125)\nE=(INP 3)\n",
                {"A": 9, "B": 255, "p": 125, "C": 7, "D": 7},
-               sensors={"INP": {"0": [9, 255], "125": [7]}})
+               sensors={"INP": {"0": [9, 255], "125": [7]}, **REPEAT})
     yield Case(group, "fzi-results", "(FZI) writes s and t and returns nothing",
                "(FZI)\nA=s; B=t\n(FZI)\n(FZI)\n",
                {"A": 1, "B": -2, "s": 32767, "t": -32768},
-               sensors={"FZI": [{"s": 1, "t": -2}, {"s": 32767, "t": -32768}]})
+               sensors={"FZI": [{"s": 1, "t": -2}, {"s": 32767, "t": -32768}], **REPEAT})
 
 
 # --- tracing -----------------------------------------------------------------------------
@@ -648,10 +651,19 @@ def faults() -> Iterator[Case]:
                "device error at that call, after the vehicle is stopped; the first reading "
                "was written",
                "(MOV 1,1)\nA=(ULT A)\nB=(ULT A)\n", {"A": 7}, status="device-error",
-               fault_line=3, sensors={"ULT A": [7], "fail": {"ULT A": 2}},
+               fault_line=3, sensors={"ULT A": [7], "fail": {"ULT A": 2}, **REPEAT},
                trace=((0, "MOV", (1, 1)), (0, "ULT A", ()), (100, "ULT A", ()),
                       (200, "STOP", ())),
                executed=5)
+    yield Case(group, "readings-run-out", "a sensing call past the last reading of its list "
+               "ends the run: the device records the call, then a device error",
+               "A=(ULT A)\nB=(ULT A)\nC=1\n", {"A": 150}, status="device-error",
+               fault_line=2, sensors={"ULT A": [150]},
+               trace=((0, "ULT A", ()), (100, "ULT A", ()), (100, "STOP", ())))
+    yield Case(group, "no-readings", "a sensing call that the script gives no list ends the "
+               "run likewise, at its first call",
+               "(SCN 1)\n(IMG)\n", {}, status="device-error", fault_line=2,
+               trace=((0, "SCN", (1,)), (0, "IMG", ()), (0, "STOP", ())))
     yield Case(group, "failing-stop", "the stop after a fault fails: the fault reported is "
                "still the one that caused the stop (argument-range), not a device error",
                "a=13\n(MOV a,0)\n", {"a": 13}, status="argument-range", fault_line=2,

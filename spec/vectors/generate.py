@@ -41,7 +41,7 @@ from rl1.vm.scripted import ScriptedDevice, parse_script
 from rl1.vm.verifier import VerifyError, verify
 
 HERE = Path(__file__).resolve().parent
-FORMAT = 2  # the version of the vector format (README.md); a change of layout bumps it
+FORMAT = 3  # the version of the vector format (README.md); a change of layout bumps it
 EXIT_STATUS = {kind.code: kind.exit_status for kind in FaultKind} | {"ok": 0}
 
 Record = tuple[int, str, tuple[int, ...], tuple[int, ...]]  # time, call, args, result
@@ -279,6 +279,8 @@ def _sensor_lines(sensors: Mapping[str, Any]) -> list[str]:
             lines += [f"fail {_word(call)} {nth}" for call, nth in readings.items()]
         elif key == "stop_fails" and readings:
             lines.append("stop_fails")
+        elif key == "after_last":
+            lines.append(f"after_last {readings}")
     return lines
 
 

@@ -139,7 +139,9 @@ class Straight:
     def sensors(self) -> dict[str, object]:
         if not self.ports:
             return {}
-        return {"INP": {str(port): readings for port, readings in self.ports.items()}}
+        # The oracle reads a used-up list's last reading again (sensors.md, "after_last").
+        return {"INP": {str(port): readings for port, readings in self.ports.items()},
+                "after_last": "repeat"}
 
     def evaluate(self) -> dict[str, int]:
         """The final value of every variable, by spec 7.2 and 7.3."""

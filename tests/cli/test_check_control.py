@@ -62,7 +62,8 @@ def test_concise_places_an_unreadable_file_at_its_start(tmp_path: Path) -> None:
     result = check("--format", "concise", tmp_path / "gone.rob")
     assert result.exit_code == 2
     assert result.stdout == (f"{tmp_path / 'gone.rob'}:1:1: error[E0100]: "
-                             f"{tmp_path / 'gone.rob'}: no such file\n"
+                             f"cannot read the source file `{tmp_path / 'gone.rob'}`: "
+                             "no such file\n"
                              "1 file checked: 1 error, 0 warnings\n")
 
 
@@ -125,7 +126,7 @@ def test_a_folder_that_cannot_be_listed_is_e0100(tmp_path: Path,
     assert result.exit_code == 2
     items = json.loads(result.stdout)
     assert [(Path(i["file"]).name, i["code"]) for i in items] == [("locked", "E0100")]
-    assert "cannot list this folder (Permission denied)" in items[0]["message"]
+    assert items[0]["message"] == f"cannot list the folder `{items[0]['file']}`: permission denied"
 
 
 # --select, --ignore, --warnings-as-errors -----------------------------------------------
@@ -231,7 +232,8 @@ def test_fix_refuses_a_read_only_file_unless_forced(tmp_path: Path) -> None:
     program.chmod(stat.S_IRUSR | stat.S_IRGRP)
     result = check("--fix", program)
     assert result.exit_code == 2
-    assert f"cannot write the fixes to `{program}`: it is read-only" in result.stderr
+    assert result.stderr.startswith(f"error[E0100]: cannot write the source file `{program}` to "
+                                    "make its fixes: it is read-only; give --force")
     assert program.read_text(encoding="utf-8") == MOVING
     assert "warning[W0603]" in result.stdout  # what the file still has is reported
     assert check("--fix", "--force", program).exit_code == 0
@@ -319,7 +321,7 @@ def test_a_bad_project_file_stops_the_check_with_where_and_why(
     project = write(tmp_path, "rl1.toml", content)
     result = check(write(tmp_path, "a.rob", MOVING))
     assert (result.exit_code, result.stdout) == (2, "")
-    assert result.stderr.startswith(f"error: {project}: ")
+    assert result.stderr.startswith(f"error[E0100]: the project file `{project}` is not valid: ")
     assert says in result.stderr
     assert "= help: correct the file" in result.stderr
     assert "Traceback" not in result.stderr
@@ -333,4 +335,6 @@ def test_an_unreadable_project_file_is_said(tmp_path: Path) -> None:
     if os.access(project, os.R_OK):
         pytest.skip("this user reads any file (root)")
     result = check(write(tmp_path, "sub/a.rob", CLEAN))
-    assert result.exit_code == 2 and "permission denied" in result.stderr
+    assert result.exit_code == 2
+    assert result.stderr.startswith(f"error[E0100]: cannot read the project file `{project}`: "
+                                    "permission denied\n")

@@ -169,7 +169,9 @@ def test_a_missing_file_is_reported_after_the_others(tmp_path: Path) -> None:
     assert [(i["file"], i["code"]) for i in items] == [("missing.rob", "E0100"), (good, "E0101")]
     assert "no such file" in items[0]["message"]
     human = run("check", "missing.rob").stdout
-    assert human.startswith("error[E0100]: missing.rob: no such file\n --> missing.rob\n")
+    assert human.startswith("error[E0100]: cannot read the source file `missing.rob`: no such "
+                            "file\n --> missing.rob\n  |\n  = help: check the name, and the "
+                            "folder rl1c runs in\n")
 
 
 @pytest.mark.parametrize("data, says", [

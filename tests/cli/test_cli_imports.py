@@ -10,9 +10,9 @@ from support import SAMPLE
 
 from rl1.compiler.backend import driver, firmware, optimize
 from rl1.compiler.cli import build as cli
-from rl1.compiler.cli import main
+from rl1.compiler.cli import main, run_report
 from rl1.compiler.cli import run as runner
-from rl1.vm import faults
+from rl1.vm import faults, scripted
 
 # What `rl1c check` must not load: heavy packages that only other commands need (lark
 # builds the parser's tables offline, numpy is for the simulator, hypothesis for the
@@ -26,6 +26,8 @@ def test_option_values_are_the_stages_own() -> None:
     assert cli.ENGINE_CHOICES == runner.ENGINES
     assert cli.DEFAULT_BUDGET == faults.DEFAULT_BUDGET
     assert cli.DEFAULT_LEVEL == optimize.DEFAULT_LEVEL
+    assert cli.TRACE_CHOICES == run_report.TRACE_CHOICES
+    assert int(cli.DEFAULT_TIME_LIMIT) * 1000 == scripted.DEFAULT_TIME_LIMIT_MS
 
 
 def modules_loaded_by(argv: list[str]) -> tuple[int, set[str]]:

@@ -230,7 +230,9 @@ def test_unreadable_source_is_exit_2(tmp_path: Path) -> None:
 def test_unwritable_output_is_exit_2_with_the_reason(sample: Path, tmp_path: Path) -> None:
     result = rl1c(str(sample), "-o", str(tmp_path / "no" / "such" / "dir.ilc"))
     assert result.exit_code == 2
-    assert "cannot write" in result.stderr and "No such file or directory" in result.stderr
+    assert (f"error[E0100]: cannot write the output file `{tmp_path / 'no' / 'such' / 'dir.ilc'}`"
+            ": no such file or directory\n") in result.stderr
+    assert "= help: check that its folder exists and is writable" in result.stderr
 
 
 def test_the_source_is_never_the_output(sample: Path) -> None:
@@ -286,5 +288,6 @@ def test_failed_write_through_the_cli_reports_and_leaves_nothing(
     monkeypatch.setattr(os, "replace", failing_replace)
     result = rl1c(str(sample))
     assert result.exit_code == 2
-    assert "cannot write" in result.stderr and "No space left on device" in result.stderr
+    assert "cannot write the output file" in result.stderr
+    assert "no space left on device" in result.stderr
     assert sorted(os.listdir(sample.parent)) == ["sample.rob"]

@@ -13,6 +13,7 @@ from support import ROOT
 from support.cli import rl1c
 
 from rl1.compiler import fuzz
+from rl1.compiler.differential import Observation, differences
 from rl1.compiler.frontend.source import split_lines
 
 PYTHON = shlex.quote(sys.executable)
@@ -76,3 +77,19 @@ def test_bad_options_are_usage_errors(args: list[str], message: str) -> None:
     result = rl1c("fuzz", *args)
     assert result.exit_code == 2
     assert message in result.stderr
+
+
+def test_runs_are_compared_on_what_the_protocol_names_only() -> None:
+    plain = Observation({"status": "ok", "variables": {}, "trace": [
+        {"time": 0, "call": "MOV", "args": [3, 3]}]})  # the first form of the protocol
+    annotated = Observation({
+        "status": {"code": "ok", "exit_status": 0, "message": "the program ended",
+                   "line": None},
+        "variables": {}, "trace": [
+            {"time": 0, "call": "LINE LOST", "args": [0], "line": 1, "during": None,
+             "effect": "no-motion", "handler": None},
+            {"time": 0, "call": "MOV", "args": [3, 3], "line": 2}]})
+    assert differences(plain, annotated) == []
+    moved = Observation({**annotated.document, "trace": [
+        {"time": 0, "call": "MOV", "args": [3, 2], "line": 2}]})
+    assert differences(annotated, moved) != []

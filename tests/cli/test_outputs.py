@@ -51,7 +51,8 @@ def test_a_read_only_output_is_refused_unless_forced(source: Path, tmp_path: Pat
     target.chmod(0o444)
     refused = rl1c(source, "-o", target)
     assert refused.exit_code == 2
-    assert f"cannot write `{target}`: it is read-only; give --force" in refused.stderr
+    assert (f"error[E0100]: cannot write the output file `{target}`: it is read-only; give "
+            "--force") in refused.stderr
     assert target.read_bytes() == b"old"
     forced = rl1c(source, "-o", target, "--force")
     assert forced.exit_code == 0, forced.output
@@ -86,7 +87,8 @@ def test_a_directory_is_refused(source: Path, tmp_path: Path) -> None:
     folder.mkdir()
     result = rl1c(source, "-o", folder)
     assert result.exit_code == 2
-    assert f"cannot write `{folder}`: it is a directory" in result.stderr
+    assert f"error[E0100]: cannot write the output file `{folder}`: it is a directory" \
+        in result.stderr
     assert folder.is_dir()
 
 

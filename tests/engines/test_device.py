@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from support import SAMPLE_SENSORS
 
 from rl1.compiler.cli.run import load_script
+from rl1.compiler.files import SourceError
 from rl1.vm.device import (
     BINDINGS,
     DeviceError,
@@ -104,20 +105,24 @@ def test_bad_scripts_are_refused_with_file_key_and_reason(
     assert str(refused.value).startswith(str(tmp_path) + "/" + message)
 
 
-def test_unreadable_and_malformed_files_are_script_errors(tmp_path: Path) -> None:
+def test_malformed_files_are_script_errors_and_unreadable_ones_source_errors(
+        tmp_path: Path) -> None:
     (tmp_path / "bad.json").write_text('{"IMG": [\n')
     (tmp_path / "bad.toml").write_text("IMG = [\n")
     (tmp_path / "bin.json").write_bytes(b"\xff\xfe")
     (tmp_path / "deep.json").write_text("[" * 100_000)
-    expected = {
+    malformed = {
         "bad.json": "bad.json:2:1: invalid JSON", "bad.toml": "bad.toml: invalid TOML",
-        "bin.json": "bin.json: not UTF-8 text", "none.json": "none.json: no such file",
+        "bin.json": "bin.json: not UTF-8 text",
         "deep.json": "deep.json(:1:100001)?: invalid JSON",
-        ".": "is a directory",
     }
-    for name, message in expected.items():
+    for name, message in malformed.items():
         with pytest.raises(ScriptError, match=message):
             load_script(tmp_path / name)
+    for name, reason in {"none.json": "no such file", ".": "it is a directory"}.items():
+        with pytest.raises(SourceError) as raised:
+            load_script(tmp_path / name)
+        assert raised.value.reason.startswith(reason)
 
 
 json_values = st.recursive(
@@ -143,9 +148,10 @@ def test_any_document_is_a_script_or_a_script_error(document: object) -> None:
 # Readings -----------------------------------------------------------------------------
 
 
-def test_readings_come_in_order_then_the_last_repeats_and_absent_ones_read_zero() -> None:
+def test_with_after_last_repeat_the_last_reading_repeats_and_absent_ones_read_zero() -> None:
     device = ScriptedDevice(Script(images=(ImageReading(1, 2, 3, 4), ImageReading(5, 6, 7, 8)),
-                                   ultrasonic={"A": (100,)}, ports={3: (9, 8)}))
+                                   ultrasonic={"A": (100,)}, ports={3: (9, 8)},
+                                   after_last="repeat"))
     assert [device.measure_image().area for _ in range(4)] == [1, 5, 5, 5]
     ranges = [device.ultrasonic("A"), device.ultrasonic("A"), device.ultrasonic("B")]
     assert ranges == [100, 100, 0]
@@ -157,6 +163,44 @@ def test_readings_come_in_order_then_the_last_repeats_and_absent_ones_read_zero(
     # 4 IMG and 3 ULT of 100 ms each; INP, KYO and FZI take no time.
     assert device.trace[-1].to_json() == {"time": 700, "call": "CAM R", "args": [],
                                           "result": [0]}
+
+
+def test_a_reading_past_the_end_of_its_list_stops_at_once_naming_the_call_and_time() -> None:
+    script = parse_script({"IMG": [{"area": 1, "x": 2, "y": 3, "z": 4}], "INP": {"3": [9]}},
+                          "s.json")
+    device = ScriptedDevice(script)
+    assert device.measure_image().area == 1
+    with pytest.raises(DeviceError, match=r"^\(IMG\) at 100 ms has no reading: it is call 2, "
+                       r"and the sensor script s.json gives 1 IMG reading$"):
+        device.measure_image()
+    assert device.trace[-1] == TraceEntry(100, "IMG")  # recorded, no time taken, nothing read
+    assert device.time == 100
+    with pytest.raises(DeviceError, match=r"^\(ULT B\) at 100 ms has no reading: the sensor "
+                       "script s.json gives no ULT B readings$"):
+        device.ultrasonic("B")
+    assert device.read_port(3) == 9
+    with pytest.raises(DeviceError, match=r"^\(INP 3\) at 100 ms .* gives 1 INP 3 reading$"):
+        device.read_port(3)
+    assert device.trace[-1] == TraceEntry(100, "INP", (3,))
+
+
+def test_without_a_script_a_sensing_call_says_that_none_was_given() -> None:
+    with pytest.raises(DeviceError, match=r"^\(KYO\) at 0 ms has no reading: no sensor script "
+                       "was given$"):
+        ScriptedDevice().read_distance()
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.integers(-32768, 32767), min_size=1, max_size=20), st.integers(1, 40))
+def test_any_list_gives_exactly_its_readings_then_stops(readings: list[int], calls: int) -> None:
+    device = ScriptedDevice(parse_script({"ULT A": readings}, "s.json"))
+    got = []
+    try:
+        for _ in range(calls):
+            got.append(device.ultrasonic("A"))
+    except DeviceError:
+        assert calls > len(readings)
+    assert got == readings[:calls]
 
 
 # The clock ----------------------------------------------------------------------------
@@ -343,7 +387,8 @@ def test_in_mode_1_every_scheduled_loss_under_motion_is_traced_once_in_time_orde
 
 
 def test_a_scripted_failure_refuses_the_nth_call_and_a_failing_stop_records_first() -> None:
-    device = ScriptedDevice(parse_script({"fail": {"ULT A": 2}, "stop_fails": True}))
+    device = ScriptedDevice(parse_script({"fail": {"ULT A": 2}, "stop_fails": True,
+                                          "after_last": "repeat"}))
     device.ultrasonic("A")
     with pytest.raises(DeviceError, match=r"\(ULT A\) failed: the sensor script says its "
                        "call 2 fails"):
@@ -353,3 +398,59 @@ def test_a_scripted_failure_refuses_the_nth_call_and_a_failing_stop_records_firs
         device.stop()
     assert [entry.call for entry in device.trace] == ["ULT A"] * 3 + ["STOP"]
     assert device.time == 300  # the failing call took its time, then failed
+
+
+# The log: every loss with what it did ---------------------------------------------------
+
+
+def test_the_log_holds_every_loss_with_its_effect_and_the_trace_only_those_that_mattered(
+        ) -> None:
+    device = ScriptedDevice(parse_script({"line_lost": [
+        {"time": 100}, {"time": 300}, {"time": 500}, {"time": 700}, {"time": 710}]}))
+    device.wait(2)  # 100: no motion in effect
+    device.move(3, 3)
+    device.wait(2)  # 300: tracing off (mode 0)
+    device.set_tracing(1)
+    device.wait(2)  # 500: mode 1 drives on
+    device.set_tracing(3)
+    device.rotate(20)  # 700 and 710 during a ROT, which no loss interrupts: the second waits
+    losses = [(entry.time, entry.during, entry.effect, entry.describe())
+              for entry in device.log if entry.call == "LINE LOST"]
+    assert losses == [
+        (100, None, "no-motion", "LINE LOST (mode 0): ignored, no motion in effect"),
+        (300, "MOV", "tracing-off", "LINE LOST (mode 0, MOV): ignored, tracing is off"),
+        (500, "MOV", "drive-on", "LINE LOST (mode 1, MOV): mode 1 drives straight on, no jump"),
+        (700, "MOV", "jump", "LINE LOST (mode 3, MOV) -> :96"),
+        (710, "MOV", "already-waiting",
+         "LINE LOST (mode 3, MOV): a loss already waits for the program"),
+    ]
+    assert [entry.time for entry in device.trace if entry.call == "LINE LOST"] == [500, 700, 710]
+    assert device.log[-1].handler is None and device.log[-2].handler == 96
+
+
+def test_entries_carry_the_line_the_locate_callback_gives() -> None:
+    device = ScriptedDevice()
+    lines = iter([7, 9])
+    device.locate = lambda: next(lines)
+    device.move(1, 1)
+    device.wait(1)
+    assert [(entry.call, entry.line) for entry in device.trace] == [("MOV", 7), ("TIM", 9)]
+    assert device.trace[0] == TraceEntry(0, "MOV", (1, 1))  # the line is no part of equality
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.integers(1, 3000), min_size=1, max_size=8),
+       st.lists(st.integers(0, 10), max_size=8),
+       st.integers(0, 3))
+def test_every_scripted_loss_is_logged_or_said_not_to_have_happened(
+        times: list[int], waits: list[int], mode: int) -> None:
+    device = ScriptedDevice(parse_script({"line_lost": [{"time": t} for t in times]}))
+    device.set_tracing(mode)
+    device.move(2, 2)
+    for tenths in waits:
+        device.wait(tenths)
+        device.poll_event()
+    logged = {entry.time for entry in device.log if entry.call == "LINE LOST"}
+    missed = {loss.time for _, loss, _ in device.losses_not_met() if isinstance(loss, LossAt)}
+    assert logged | missed == set(times) and not logged & missed
+    assert all(time > device.time for time in missed)

@@ -91,7 +91,8 @@ def test_running_off_the_end_ends_the_program() -> None:
 
 def test_sensing_calls_write_their_reserved_variables_and_return_results() -> None:
     script = Script(images=(ImageReading(180, 130, 90, -4),), odometry=(Odometry(50, 52, 48),),
-                    camera=(392,), ultrasonic={"B": (77,)}, ports={5: (200,)})
+                    camera=(392,), ultrasonic={"B": (77,)}, ports={5: (200,)},
+                    after_last="repeat")  # FZI reads zeros
     assert variables("A=(IMG)-180; B=(KYO); (FZI); C=(CAM R)+(ULT B); D=(INP 5)",
                      script) == {"w": 180, "x": 130, "y": 90, "z": -4, "B": 50, "u": 52,
                                  "v": 48, "C": 469, "D": 200}
@@ -140,7 +141,7 @@ def test_a_loss_without_motion_does_not_jump() -> None:
 
 def test_a_loss_during_an_operand_call_abandons_its_statement() -> None:
     result, device = run("(TRC 3); (MOV 3,3)\n:10 A=(IMG)-180; B++; ?A<#10\n(END)\n"
-                         ":96 (MOV 0,0)\n", Script(losses=(LossAt(350),)))
+                         ":96 (MOV 0,0)\n", Script(losses=(LossAt(350),), after_last="repeat"))
     assert result.fault is None
     # IMG at 0, 100, 200, 300 ms; the line is lost during the fourth, before A is written.
     assert result.named()["B"] == 3

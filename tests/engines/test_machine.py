@@ -16,7 +16,7 @@ from support.semantics import int16, operate
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.cli.run import load_script
-from rl1.compiler.interpreter import interpret
+from rl1.compiler.interpreter import Interpreter
 from rl1.compiler.strategies import checked_programs
 from rl1.vm import ilc, isa
 from rl1.vm.device import DeviceError, FuzzyReading, ImageReading, LineLost, Odometry
@@ -24,7 +24,7 @@ from rl1.vm.faults import FaultKind, RunResult
 from rl1.vm.hardware import Blocking
 from rl1.vm.language import BUILTINS, VARIABLES
 from rl1.vm.machine import Machine
-from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
+from rl1.vm.scripted import AFTER_LAST, LossAt, LossDuring, Script, ScriptedDevice, TraceEntry
 from rl1.vm.verifier import VerifiedProgram, verify
 
 
@@ -329,6 +329,7 @@ def scripts(draw: st.DrawFn) -> Script:
         ports={port: (draw(st.integers(0, 255)),) for port in range(0, 0x7E, 7)},
         fuzzy=tuple(draw(st.lists(st.builds(FuzzyReading, INT16, INT16), max_size=2))),
         losses=tuple(losses),
+        after_last=draw(st.sampled_from(AFTER_LAST)),  # a run past them ends, or runs on
     )
 
 
@@ -339,9 +340,18 @@ def both(text: str, script: Script) -> tuple[tuple[RunResult, ScriptedDevice],
     compiled = compile_text(text, "generated.rob")
     assert compiled.output is not None
     interpreted_device, vm_device = ScriptedDevice(script), ScriptedDevice(script)
-    interpreted = interpret(analysis.program, interpreted_device)
-    ran = Machine(verify(compiled.output), Blocking(vm_device)).run()
+    interpreter = Interpreter(analysis.program, interpreted_device)
+    interpreted_device.locate = lambda: interpreter.line
+    interpreted = interpreter.run()
+    machine = Machine(verify(compiled.output), Blocking(vm_device))
+    vm_device.locate = machine.current_line
+    ran = machine.run()
     return (interpreted, interpreted_device), (ran, vm_device)
+
+
+def logged(device: ScriptedDevice) -> list[tuple[TraceEntry, int | None]]:
+    """Every entry of the device's log with its source line."""
+    return [(entry, entry.line) for entry in device.log]
 
 
 # Starts that put the vehicle in motion with a tracing mode that jumps, so that more runs
@@ -357,6 +367,7 @@ def test_vm_and_interpreter_give_the_same_trace_variables_and_fault(
 ) -> None:
     (interpreted, interpreted_device), (ran, vm_device) = both(start + text, script)
     assert vm_device.trace == interpreted_device.trace
+    assert logged(vm_device) == logged(interpreted_device)  # each entry's line included
     assert ran.variables == interpreted.variables
     assert ran.fault == interpreted.fault
 

@@ -33,7 +33,8 @@ def read_text(text: str) -> tuple[str, list[dict[str, Any]]]:
         if word == "vector":
             vector, script = {"name": rest[0], "trace": []}, {
                 "images": [], "odometry": [], "camera": [], "ultrasonic": {}, "ports": {},
-                "fuzzy": [], "losses": [], "failures": {}, "stop_fails": False}
+                "fuzzy": [], "losses": [], "failures": {}, "stop_fails": False,
+                "after_last": "stop"}
         elif word in ("budget", "executed"):
             vector[word] = numbers[0]
         elif word in ("ilc", "ilc_stripped"):
@@ -61,6 +62,8 @@ def read_text(text: str) -> tuple[str, list[dict[str, Any]]]:
             script["failures"][_call(rest[0])] = numbers[0]
         elif word == "stop_fails":
             script["stop_fails"] = True
+        elif word == "after_last":
+            script["after_last"] = rest[0]
         elif word == "status":
             vector["status"], vector["exit_status"], vector["fault_line"] = (
                 rest[0], numbers[0], numbers[1])
@@ -80,7 +83,8 @@ def read_text(text: str) -> tuple[str, list[dict[str, Any]]]:
                 ultrasonic={k: tuple(v) for k, v in script["ultrasonic"].items()},
                 ports={k: tuple(v) for k, v in script["ports"].items()},
                 fuzzy=tuple(script["fuzzy"]), losses=tuple(script["losses"]),
-                failures=script["failures"], stop_fails=script["stop_fails"])
+                failures=script["failures"], stop_fails=script["stop_fails"],
+                after_last=script["after_last"])
             vectors.append(vector)
     return group, vectors
 

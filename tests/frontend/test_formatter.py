@@ -262,7 +262,8 @@ def test_fmt_reports_an_unreadable_file_and_goes_on(tmp_path: Path) -> None:
     binary = write(tmp_path, b"A=1\x00", "binary.rob")
     result = run(str(tmp_path / "missing.rob"), str(binary), str(messy))
     assert result.exit_code == 2
-    assert "missing.rob: no such file" in result.stderr
+    assert (f"error[E0100]: cannot read the source file `{tmp_path / 'missing.rob'}`: no such "
+            "file\n") in result.stderr
     assert "binary file" in result.stderr
     assert "Traceback" not in result.output
     assert messy.read_bytes() == b"A=1\n"
@@ -296,7 +297,8 @@ def test_fmt_reports_a_file_it_cannot_write(tmp_path: Path,
     messy = write(tmp_path, b"A = 1\n")
     result = run(str(messy))
     assert result.exit_code == 2
-    assert f"cannot write `{messy}`: No space left on device" in result.stderr
+    assert (f"error[E0100]: cannot write the source file `{messy}` in the canonical layout: "
+            "no space left on device\n") in result.stderr
     assert messy.read_bytes() == b"A = 1\n"
 
 

@@ -121,6 +121,7 @@ def scripts(draw: st.DrawFn) -> Script:
             st.builds(LossDuring, st.sampled_from(("MOV", "MVI")), st.integers(1, 3),
                       st.integers(0, 2_000)),
         ), max_size=3))),
+        after_last="repeat",  # a run that outlasts its readings would end with a fault
     )
 
 

@@ -17,7 +17,7 @@ WORLD = EXAMPLES / "sample.world.toml"
 
 
 def test_text_report_has_calls_poses_ending_and_variables() -> None:
-    result = rl1c("sim", SAMPLE, "--world", WORLD)
+    result = rl1c("sim", SAMPLE, "--world", WORLD, "--trace", "all")
     assert result.exit_code == 0, result.output
     assert "CAM P 579" in result.stdout
     assert "(  236.4,   150.0)" in result.stdout  # the pose at the branch mark
@@ -55,7 +55,7 @@ def test_json_report_has_the_track_and_is_deterministic(tmp_path: Path) -> None:
                             "--seed", seed).stdout)
             for world, seed in ((WORLD, "1"), (WORLD, "2"), (noisy, "7"), (noisy, "7"),
                                 (noisy, "8"))]
-    assert runs[0]["status"] == "ok"
+    assert runs[0]["status"]["code"] == "ok"
     assert runs[0]["track"][0] == [0.0, 60.0, 150.0, 0.0]
     assert {"time", "call", "args", "pose"} <= set(runs[0]["trace"][0])
     assert runs[0] == runs[1]  # noise is off by default: the seed changes nothing
@@ -81,6 +81,10 @@ def test_a_safety_stop_is_a_device_fault_with_its_line(tmp_path: Path) -> None:
     assert result.exit_code == 13
     status = json.loads(result.stdout)["status"]
     assert status["safety"] == "off-floor" and status["line"] == 2
+    assert (status["code"], status["exit_status"]) == ("device-error", 13)  # run's shape
+    text = rl1c("sim", program, "--world", WORLD).stdout
+    assert "error[device-error]: " in text  # shown as `rl1c run` shows a fault
+    assert f"\n --> {program}:2:5\n" in text and "\n2 | :10 (IMG)\n" in text
 
 
 def test_a_bad_world_file_is_a_message_and_status_2(tmp_path: Path) -> None:
@@ -125,3 +129,19 @@ def test_any_program_ends_with_a_known_status_and_no_traceback(tmp_path: Path,
     result = rl1c("sim", program, "--world", WORLD, "--budget", "20000", "--format", "json")
     assert result.exit_code in (0, 1, 10, 11, 12, 13), result.output
     assert "Traceback" not in result.output
+
+
+def test_the_trace_is_bounded_as_rl1c_run_bounds_it() -> None:
+    every = rl1c("sim", SAMPLE, "--world", WORLD, "--trace", "all").stdout.splitlines()
+    short = rl1c("sim", SAMPLE, "--world", WORLD).stdout.splitlines()
+    calls = [line for line in every if line.startswith("  ") and "[" not in line]
+    assert short[1:41] == calls[:40]
+    assert short[41].split()[:2] == ["...", f"({len(calls) - 60:,}"]
+    assert short[42:62] == calls[-20:]
+    assert short[62:] == every[len(calls) + 1:]  # the events, the ending, the variables
+    document = json.loads(rl1c("sim", SAMPLE, "--world", WORLD, "--format", "json",
+                               "--trace", "short").stdout)
+    assert len(document["trace"]) == 60
+    assert document["trace_left_out"] == {"after": 40, "count": len(calls) - 60}
+    none = rl1c("sim", SAMPLE, "--world", WORLD, "--trace", "none").stdout
+    assert not none.startswith("trace") and "the program ended normally" in none
