@@ -49,7 +49,7 @@ SECTION = "Intermediate code"
 EMIT_CHOICES = ("ilc", "ir", "c", "ihex", "ils")
 # The file each --emit kind is written to beside the source (None: standard output).
 EMIT_SUFFIXES = {"ilc": ".ilc", "ir": None, "c": ".c", "ihex": ".hex", "ils": ".ils"}
-ENGINE_CHOICES = ("vm", "ast")
+ENGINE_CHOICES = ("vm", "ast", "c")
 DEFAULT_BUDGET = 10_000_000
 
 
@@ -197,7 +197,8 @@ def _default_output(source: str, emit_kind: str) -> str:
               help="instructions (statements with --engine ast) before the watchdog stops "
                    "a runaway program")
 @choice_option("--engine", choices=ENGINE_CHOICES, default="vm",
-               help="vm: compile, then run on the reference VM; ast: interpret the source")
+               help="vm: compile, then run on the reference VM; ast: interpret the source; "
+                    "c: run on the C VM of the firmware (vm/c, built on first use)")
 def run(file: str, sensors: str | None, run_format: str, budget: int, engine: Engine) -> int:
     """Run a program (.rob source, or a compiled .ilc file) on the scripted device.
 
@@ -206,6 +207,7 @@ def run(file: str, sensors: str | None, run_format: str, budget: int, engine: En
     file (sensor scripts included); faults: 10 argument out of range, 11 missing handler,
     12 budget exhausted, 13 device error."""
     from rl1.vm.faults import RunResult
+    from rl1.vm.native import BuildError
     from rl1.vm.scripted import Script, ScriptedDevice, ScriptError
     from rl1.vm.verifier import VerifyError
 
@@ -222,10 +224,12 @@ def run(file: str, sensors: str | None, run_format: str, budget: int, engine: En
                                    "on the VM: leave out --engine, or run the .rob file")
         data = read_ilc(file)
         try:
-            result = run_ilc(data, device, budget)
+            result = run_ilc(data, device, budget, "c" if engine == "c" else "vm")
         except VerifyError as error:
             raise Failure(f"error: {file}: byte {error.offset}: {error.message}",
                           EXIT_ERRORS) from None
+        except BuildError as error:
+            raise Failure(f"error: {error}") from None
     else:
         source = read_input(file)
         if not isinstance(source, Source):
@@ -233,7 +237,7 @@ def run(file: str, sensors: str | None, run_format: str, budget: int, engine: En
         try:
             outcome = run_source(source.text, os.path.basename(source.name), device, engine,
                                  budget)
-        except ScriptError as error:
+        except (ScriptError, BuildError) as error:
             raise Failure(f"error: {error}") from None
         if not isinstance(outcome, RunResult):
             return emit([FileDiagnostics(source.name, source.text, outcome)], "human",

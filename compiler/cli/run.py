@@ -1,10 +1,12 @@
-"""Running a program by either engine: the stage behind `rl1c run`.
+"""Running a program by any engine: the stage behind `rl1c run`.
 
-A .rob program is interpreted (engine "ast") or compiled in memory and run on the VM
-(engine "vm"); an .ilc file runs on the VM only. Both engines drive the same scripted
-device, so their traces and final variables can be compared. The VM runs in steps
-(vm/drive.py), which is also how a script's losses after instruction N are made; the
-interpreter counts no instructions, so it refuses such a script.
+A .rob program is interpreted (engine "ast") or compiled in memory and run on the
+reference VM (engine "vm") or on the C VM of the firmware through ctypes (engine "c",
+vm/native.py, which builds it on first use); an .ilc file runs on either VM. Every
+engine drives the same scripted device, so their traces and final variables can be
+compared. The VMs run in steps (vm/drive.py), which is also how a script's losses after
+instruction N are made; the interpreter counts no instructions, so it refuses such a
+script.
 """
 
 from __future__ import annotations
@@ -22,13 +24,15 @@ from rl1.vm.drive import drive
 from rl1.vm.faults import DEFAULT_BUDGET, RunResult
 from rl1.vm.hardware import Blocking
 from rl1.vm.machine import Machine
+from rl1.vm.native import NativeMachine, library, load
 from rl1.vm.scripted import Script, ScriptedDevice, ScriptError, decode_script
 from rl1.vm.verifier import VerifiedProgram, verify
 
 MAX_SCRIPT_BYTES = 16 * 2**20
 
-Engine = Literal["vm", "ast"]
-ENGINES: tuple[Engine, ...] = ("vm", "ast")
+Engine = Literal["vm", "ast", "c"]
+ENGINES: tuple[Engine, ...] = ("vm", "ast", "c")
+VmEngine = Literal["vm", "c"]
 
 
 def run_source(text: str, source_name: str, device: Device, engine: Engine = "vm",
@@ -47,13 +51,24 @@ def run_source(text: str, source_name: str, device: Device, engine: Engine = "vm
     compilation = compile_text(text, source_name)
     if compilation.output is None:
         return compilation.diagnostics
-    return run_program(verify(compilation.output), device, budget)
+    return run_ilc(compilation.output, device, budget, engine)
 
 
-def run_ilc(data: bytes, device: Device, budget: int = DEFAULT_BUDGET) -> RunResult:
-    """Run the bytes of an .ilc file on the VM; verifier.VerifyError if they are not
-    valid intermediate code."""
-    return run_program(verify(data), device, budget)
+def run_ilc(data: bytes, device: Device, budget: int = DEFAULT_BUDGET,
+            engine: VmEngine = "vm") -> RunResult:
+    """Run the bytes of an .ilc file on a VM; verifier.VerifyError if they are not
+    valid intermediate code (the Python verifier says why in words, for both VMs);
+    native.BuildError if the C VM cannot be built here."""
+    program = verify(data)
+    if engine == "c":
+        return run_native(data, device, budget)
+    return run_program(program, device, budget)
+
+
+def run_native(data: bytes, device: Device, budget: int = DEFAULT_BUDGET) -> RunResult:
+    """Step verified .ilc bytes on the C VM to their end, as `run_program` does."""
+    machine = NativeMachine(data, Blocking(device), budget, load(library()))
+    return drive(machine, device) if isinstance(device, ScriptedDevice) else machine.run()
 
 
 def run_program(program: VerifiedProgram, device: Device,

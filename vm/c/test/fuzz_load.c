@@ -30,12 +30,12 @@ static void check(const uint8_t *data, uint32_t size)
     rl1_program program, rescanned;
     uint32_t offset, rescanned_offset, code_offset;
     int i;
-    rl1_status status = rl1_load(&program, data, size, bitmap, sizeof bitmap, &offset);
-    rl1_status again = rl1_load(&rescanned, data, size, NULL, 0, &rescanned_offset);
+    rl1_refusal status = rl1_load(&program, data, size, bitmap, sizeof bitmap, &offset);
+    rl1_refusal again = rl1_load(&rescanned, data, size, NULL, 0, &rescanned_offset);
     if (status != again || offset != rescanned_offset || offset > size) {
         __builtin_trap();
     }
-    if (status != RL1_OK) {
+    if (status != RL1_ACCEPTED) {
         return;
     }
     /* What the VM will rely on without checking: the sections inside the file, every
