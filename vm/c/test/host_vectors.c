@@ -30,6 +30,15 @@ void harness_print(const char *text)
     fputs(text, stdout);
 }
 
+void harness_stack_paint(void)
+{
+}
+
+uint32_t harness_stack_depth(void)
+{
+    return 0; /* measured on the emulated targets */
+}
+
 static void fail_input(const char *path, unsigned line, const char *why)
 {
     fprintf(stderr, "%s:%u: %s\n", path, line, why);
@@ -87,12 +96,13 @@ static void run_vector(reading *r)
         v.ilc_size = form ? r->stripped_size : r->ilc_size;
         v.line = form ? 0u : r->v.line; /* a stripped file has no line map */
         for (w = 0; w < sizeof WAYS / sizeof *WAYS; w++) {
+            uint32_t stack;
             snprintf(label, sizeof label, "%s%s (steps of %lu, %u busy polls)", r->name,
                      form ? ".stripped" : ".ilc", (unsigned long)WAYS[w].slice,
                      WAYS[w].busy_polls);
             runs++;
             if (!vector_run(&v, label, WAYS[w].slice, WAYS[w].busy_polls, bitmap,
-                            sizeof bitmap)) {
+                            sizeof bitmap, &stack)) {
                 failed++;
             }
         }

@@ -139,7 +139,7 @@ static rl1_state drive(rl1_vm *vm, scripted *device, uint32_t slice)
 }
 
 bool vector_run(const vector *v, const char *name, uint32_t slice, uint8_t busy_polls,
-                uint8_t *bitmap, size_t bitmap_size)
+                uint8_t *bitmap, size_t bitmap_size, uint32_t *stack)
 {
     rl1_program program;
     rl1_vm vm;
@@ -169,7 +169,9 @@ bool vector_run(const vector *v, const char *name, uint32_t slice, uint8_t busy_
     device.sink = &c;
     device.busy_polls = busy_polls;
     scripted_hardware(&hw, &device);
+    harness_stack_paint();
     (void)drive(&vm, &device, slice);
+    *stack = harness_stack_depth();
     if (vm.fault != (rl1_fault)v->fault) {
         say(name, "fault", (uint32_t)vm.fault, v->fault);
         ok = false;
