@@ -23,6 +23,15 @@ simulator, an editor plug-in):
       @given(checked_programs())
       def test_engines_agree(source: str) -> None:
           assert interpreter_run(source) == vm_run(source)
+
+- `runs()`: a `Run`, a program the checker accepts and the sensor script to run it on
+  (a dict as a JSON script file holds it). Beyond counted loops, its programs wait in
+  loops that a sensor reading ends (the script's last readings end every such loop),
+  lose the guidance line in tracing modes 2 and 3 (the script's `line_lost` entries) and
+  enter handlers that end, or jump back into the program and so are entered again, or
+  are missing; and some pass a variable argument out of its range or ask the device for
+  a move it refuses, so that runs fault. Most runs end within a small budget; a few
+  meet the watchdog.
 """
 
 from __future__ import annotations
@@ -220,6 +229,14 @@ class _Line:
 
 
 @dataclass
+class _Wild:
+    """What `runs()` adds to the always-ending programs: sensor loops, faults, and the
+    labels at the program's top level (safe places for a handler to jump back to)."""
+
+    top_labels: list[int] = field(default_factory=list)
+
+
+@dataclass
 class _Builder:
     """Builds a program that passes the checker and ends: counted loops, forward jumps,
     arguments in range. Variables that count a loop in progress are never written by the
@@ -230,6 +247,7 @@ class _Builder:
     lines: list[_Line] = field(default_factory=lambda: [_Line()])
     counters: set[str] = field(default_factory=set)
     traces: bool = False  # some (TRC 2) or (TRC 3) may run
+    wild: _Wild | None = None  # runs(): sensor loops, re-entered handlers, faults
 
     # Layout
 
@@ -270,10 +288,14 @@ class _Builder:
         args: list[str] = []
         values = self.arguments(mnemonic, form)
         spare = [v for v in _ORDINARY_VARIABLES if v not in self.counters]
-        for value in values:
+        for value, param in zip(values, form.params, strict=True):
             if self.draw(st.integers(0, 2)) == 0:
                 variable = self.draw(st.sampled_from(spare))
                 spare.remove(variable)
+                if self.wild and self.draw(st.integers(0, 11)) == 0:
+                    value = self.draw(st.sampled_from(  # out of range: a fault at run time
+                        [v for v in (param.low - 1, param.high + 1) if -32768 <= v <= 32767]
+                        or [value]))
                 self.emit((variable, "=", str(value)))
                 args.append(variable)
             else:
@@ -294,7 +316,9 @@ class _Builder:
         """One statement; with `tracing` False, no (TRC ...) (handlers must not set a
         mode whose handlers might not exist)."""
         kind = self.draw(st.sampled_from(("assign", "assign", "step", "call", "call")))
-        if kind == "assign":
+        if self.wild and self.draw(st.integers(0, 199)) == 100:  # not 0: Hypothesis favours 0
+            self.emit(("(", "MVI", "3", ",", "-3", ",", "10", ")"))  # a device error
+        elif kind == "assign":
             target = self.writable()
             tokens = [target, "=", *self.operand()]
             for _ in range(self.draw(st.integers(0, 5))):
@@ -308,8 +332,14 @@ class _Builder:
                 self.emit(self.call(mnemonic, form))
 
     def block(self, depth: int) -> None:
-        kind = self.draw(st.sampled_from(("straight", "straight", "loop", "skip")))
-        if kind == "loop" and depth < 2 and len(self.free_labels) >= 2:
+        kinds = ("straight", "straight", "loop", "skip") + (("sensed",) if self.wild else ())
+        kind = self.draw(st.sampled_from(kinds))
+        if self.wild and depth == 0 and self.free_labels and self.draw(st.booleans()):
+            self.wild.top_labels.append(number := self.free_labels.pop())
+            self.label(number)
+        if kind == "sensed" and self.free_labels:
+            self.sensed_loop()
+        elif kind == "loop" and depth < 2 and len(self.free_labels) >= 2:
             self.loop(depth)
         elif kind == "skip" and depth < 3 and self.free_labels:
             self.skip(depth)
@@ -356,6 +386,20 @@ class _Builder:
             self.free_labels.append(exit_label)
         self.counters.discard(counter)
 
+    def sensed_loop(self) -> None:
+        """A loop that waits for a sensor, as Listing 1's `:10 A=(IMG)-180; ?A<#10`: the
+        script's last readings (`_ENDING_READINGS`) end it."""
+        top = self.new_label()
+        assert top is not None
+        self.label(top)
+        if self.draw(st.booleans()):
+            self.statement()
+        variable = self.writable()
+        sensor, relation = self.draw(st.sampled_from(_SENSED))
+        threshold = self.draw(st.integers(0, 1000))
+        self.emit((variable, "=", *sensor, "-", str(threshold)))
+        self.emit(("?", variable, relation, f"#{top:02d}"))
+
     def skip(self, depth: int) -> None:
         """A forward jump over a block: conditional, or rarely an early `(END)`."""
         target = self.new_label()
@@ -375,13 +419,19 @@ class _Builder:
         self.emit(("(", "END", ")"))
 
     def handlers(self) -> None:
-        """:96-:99, each ending the program; all four when a mode 2 or 3 may be set."""
+        """:96-:99, each ending the program; all four when a mode 2 or 3 may be set. In
+        runs(), a handler may be missing (a fault when it is needed) or jump back to a
+        label of the top level (the script's losses are finite, so it ends)."""
         for number in HANDLER_LABELS:
-            if self.traces or self.draw(st.booleans()):
+            if (self.traces and not self.wild) or self.draw(st.booleans()):
                 self.label(number)
                 for _ in range(self.draw(st.integers(0, 2))):
                     self.statement(tracing=False)
-                self.end()
+                if self.wild and self.wild.top_labels and self.draw(st.booleans()):
+                    back = self.draw(st.sampled_from(self.wild.top_labels))
+                    self.emit((f"#{back:02d}",))
+                else:
+                    self.end()
 
     def text(self) -> str:
         draw = self.draw
@@ -394,17 +444,87 @@ class _Builder:
         return _joined(draw, rendered)
 
 
-@st.composite
-def checked_programs(draw: st.DrawFn, max_blocks: int = 6) -> str:
-    """A program with no checker errors that always ends (see the module's notes)."""
+def _build(draw: st.DrawFn, max_blocks: int, wild: _Wild | None) -> str:
     labels = list(draw(st.permutations(range(96))))
-    builder = _Builder(draw, labels)
-    if draw(st.booleans()):
-        mode = draw(st.integers(0, 3))
+    builder = _Builder(draw, labels, wild=wild)
+    if wild or draw(st.booleans()):
+        # runs() mostly trace in modes 2 and 3, so that its scripts' losses matter.
+        mode = draw(st.sampled_from((0, 1, 2, 3, 2, 3) if wild else (0, 1, 2, 3)))
         builder.emit(("(", "TRC", str(mode), ")"))
         builder.traces = mode >= 2
+        if wild and draw(st.booleans()):
+            # Under a label a handler may jump back to: driving again, it may lose the
+            # line again, and enter its handler again.
+            wild.top_labels.append(number := labels.pop())
+            builder.label(number)
+            builder.emit(("(", "MOV", "3", ",", "3", ")"))
     for _ in range(draw(st.integers(1, max_blocks))):
         builder.block(0)
     builder.end()
     builder.handlers()
     return builder.text()
+
+
+@st.composite
+def checked_programs(draw: st.DrawFn, max_blocks: int = 6) -> str:
+    """A program with no checker errors that always ends (see the module's notes)."""
+    return _build(draw, max_blocks, None)
+
+
+# runs() ---------------------------------------------------------------------------------
+
+# What a sensor loop reads and how it tests it; the script's last readings (large areas,
+# ultrasonic distances and odometry of 0) end every such loop.
+_SENSED: tuple[tuple[Tokens, str], ...] = (
+    (("(", "IMG", ")"), "<"), (("(", "ULT", "A", ")"), ">"), (("(", "ULT", "C", ")"), ">"),
+    (("(", "KYO", ")"), ">"),
+)
+_ENDING_AREA = 1000  # at least every threshold: `A=(IMG)-K; ?A<#NN` goes on
+
+JsonScript = dict[str, object]
+
+
+@dataclass(frozen=True)
+class Run:
+    """A program and the sensor script (as JSON data) to run it on."""
+
+    source: str
+    script: JsonScript
+
+
+def _readings(draw: st.DrawFn, make: st.SearchStrategy[object], ending: object) -> list[object]:
+    return [*draw(st.lists(make, max_size=4)), ending]
+
+
+@st.composite
+def sensor_scripts(draw: st.DrawFn) -> JsonScript:
+    """A sensor script (JSON data, spec of vm/scripted.py) whose last readings end the
+    sensor loops of `runs()`, with up to four losses of the guidance line."""
+    small = st.integers(-300, 1200)
+    image = st.builds(lambda area, x, y, z: {"area": area, "x": x, "y": y, "z": z},
+                      small, small, small, st.integers(-180, 180))
+    odometry = st.builds(lambda c, r, left: {"centre": c, "right": r, "left": left},
+                         small, small, small)
+    script: JsonScript = {
+        "IMG": _readings(draw, image, {"area": _ENDING_AREA, "x": 128, "y": 100, "z": 0}),
+        "KYO": _readings(draw, odometry, {"centre": 0, "right": 0, "left": 0}),
+        "ULT A": _readings(draw, small, 0),
+        "ULT C": _readings(draw, small, 0),
+        "CAM R": draw(st.lists(st.integers(0, 784), min_size=1, max_size=3)),
+        "FZI": draw(st.lists(st.builds(lambda a, b: {"s": a, "t": b}, small, small),
+                             min_size=1, max_size=2)),
+    }
+    losses = draw(st.lists(st.one_of(
+        st.builds(lambda time: {"time": time}, st.integers(1, 2000)),
+        st.builds(lambda command, nth, after: {"during": command, "nth": nth, "after": after},
+                  st.sampled_from(("MOV", "MVI")), st.integers(1, 2), st.integers(1, 300)),
+    ), max_size=4))
+    if losses:
+        script["line_lost"] = losses
+    return script
+
+
+@st.composite
+def runs(draw: st.DrawFn, max_blocks: int = 6) -> Run:
+    """A program the checker accepts, with a sensor script (see the module's notes)."""
+    return Run(_build(draw, max_blocks, _Wild()), draw(sensor_scripts()))

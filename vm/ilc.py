@@ -19,10 +19,14 @@ import zlib
 from dataclasses import dataclass
 from enum import IntEnum
 
+from . import isa
 from .language import HANDLER_LABELS, Feature
 
 MAGIC = b"RLIC"
-VERSION_MAJOR, VERSION_MINOR = 1, 1
+# The newest version this module reads. A writer writes the oldest minor version that
+# holds what the file carries: the source digest came in 1.1, and each instruction's
+# version is in vm/isa.py.
+VERSION_MAJOR, VERSION_MINOR = 1, 2
 DIGEST_MINOR = 1  # the first minor version with the source digest section
 DIGEST_SIZE = 16  # the first 16 bytes of SHA-256
 
@@ -196,8 +200,12 @@ def encode(image: Image) -> bytes:
         raise ValueError(f"a source digest is {DIGEST_SIZE} bytes, not {len(digest)}")
     if not 0 <= image.flags <= 0xFFFF:
         raise ValueError(f"flags 0x{image.flags:X} do not fit the 16-bit field")
-    # A file without a digest is written as 1.0, so that every 1.0 reader reads it.
-    minor = DIGEST_MINOR if digest else 0
+    # A file without a digest whose code needs nothing newer is written as 1.0, so that
+    # every 1.0 reader reads it.
+    minor = max(isa.code_minor(image.code), DIGEST_MINOR if digest else 0)
+    if minor >= DIGEST_MINOR and image.debug is not None and not digest:
+        raise ValueError(f"a version 1.{minor} file's debug section is followed by the "
+                         "source digest, and this image has none")
     header = HEADER.pack(MAGIC, VERSION_MAJOR, minor, image.flags, 0, HEADER.size,
                          len(image.code), len(handlers), len(features), len(debug))
     data = bytearray(header + image.code + handlers + features + debug + digest)

@@ -38,6 +38,7 @@ class OpInfo:
     meaning: str
     builtin: tuple[str, str | None] | None = None  # (mnemonic, selector) for calls
     arity: int = 0  # number of call arguments
+    minor: int = 0  # the format minor version that added it (a file using it says so)
 
     @property
     def length(self) -> int:
@@ -69,6 +70,11 @@ ALU_VAR, ALU_IMM, ALU_RESULT = 0x10, 0x18, 0x20
 
 JUMP_IF = {"=": 0x31, ">": 0x32, "<": 0x33}  # conditional jump opcode by relation
 
+# The superinstructions of -O2 (spec/ilc.md, section 7) came with this minor version of
+# the format; it is written here once, so that a merge with another 1.x can renumber it.
+FUSED_MINOR = 2
+STORE_JUMP_IF = {"=": 0x35, ">": 0x36, "<": 0x37}  # store acc, then jump on it
+
 # The built-in forms, in opcode order from CALL_BASE; END is opcode 0.
 CALL_BASE = 0x40
 CALL_FORMS: tuple[tuple[str, str | None], ...] = (
@@ -94,6 +100,19 @@ def _table() -> dict[int, OpInfo]:
         OpInfo(0x31, "JZ", (Operand.VAR, Operand.ADDR), "jump to a if V[v] = 0"),
         OpInfo(0x32, "JGT", (Operand.VAR, Operand.ADDR), "jump to a if V[v] > 0"),
         OpInfo(0x33, "JLT", (Operand.VAR, Operand.ADDR), "jump to a if V[v] < 0"),
+        OpInfo(0x07, "MOVV", (Operand.VAR, Operand.VAR), "V[v] = V[w] (the second v)",
+               minor=FUSED_MINOR),
+        OpInfo(0x08, "MOVI", (Operand.VAR, Operand.IMM), "V[v] = i", minor=FUSED_MINOR),
+        OpInfo(0x09, "MOVR", (Operand.VAR,), "V[v] = R (the last call's result)",
+               minor=FUSED_MINOR),
+        OpInfo(0x34, "DJGT", (Operand.VAR, Operand.ADDR),
+               "V[v] = V[v] - 1, then jump to a if V[v] > 0", minor=FUSED_MINOR),
+        OpInfo(0x35, "SJZ", (Operand.VAR, Operand.ADDR),
+               "V[v] = acc, then jump to a if V[v] = 0", minor=FUSED_MINOR),
+        OpInfo(0x36, "SJGT", (Operand.VAR, Operand.ADDR),
+               "V[v] = acc, then jump to a if V[v] > 0", minor=FUSED_MINOR),
+        OpInfo(0x37, "SJLT", (Operand.VAR, Operand.ADDR),
+               "V[v] = acc, then jump to a if V[v] < 0", minor=FUSED_MINOR),
     ]
     for index, (name, meaning) in enumerate(zip(_ALU_NAMES, _ALU_MEANINGS, strict=True)):
         rows.append(OpInfo(ALU_VAR + index, name + "V", (Operand.VAR,),
@@ -118,6 +137,17 @@ BY_NAME: dict[str, OpInfo] = {info.name: info for info in OPCODES.values()}
 BY_FORM: dict[tuple[str, str | None], OpInfo] = {
     info.builtin: info for info in OPCODES.values() if info.builtin is not None
 }
+
+
+def code_minor(code: bytes) -> int:
+    """The format minor version that code needs: the newest that added one of its
+    instructions. It reads up to the first opcode it does not know, so that any bytes
+    can be written (the verifier is what refuses them)."""
+    minor = offset = 0
+    while offset < len(code) and (info := OPCODES.get(code[offset])) is not None:
+        minor = max(minor, info.minor)
+        offset += info.length
+    return minor
 
 
 @dataclass(frozen=True, slots=True)

@@ -21,6 +21,12 @@ _SERVES = {
     "INC": "`V++`", "DEC": "`V--`",
     "JMP": "`#NN`", "JZ": "`?V=#NN`", "JGT": "`?V>#NN`", "JLT": "`?V<#NN`",
 }
+_FUSED = f"(-O2; format 1.{isa.FUSED_MINOR})"
+_SERVES |= {
+    "MOVV": f"`V=W` {_FUSED}", "MOVI": f"`V=i` {_FUSED}", "MOVR": f"`V=(call)` {_FUSED}",
+    "DJGT": f"`V--; ?V>#NN` {_FUSED}", "SJZ": f"`V=...; ?V=#NN` {_FUSED}",
+    "SJGT": f"`V=...; ?V>#NN` {_FUSED}", "SJLT": f"`V=...; ?V<#NN` {_FUSED}",
+}
 _ALU_SERVES = {isa.ALU_VAR: "a variable", isa.ALU_IMM: "a constant", isa.ALU_RESULT: "a call"}
 
 

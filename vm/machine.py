@@ -72,7 +72,9 @@ SLICE = 1 << 20
 
 # The operations of the dispatch loop (not opcodes: decoding folds operand kinds).
 (LOAD, STORE, ADD, SUB, AND, OR, XOR, SHL, SHR, INC, DEC,
- JUMP, JUMP_ZERO, JUMP_POSITIVE, JUMP_NEGATIVE, CALL, END, EXPRESSION, HALT) = range(19)
+ JUMP, JUMP_ZERO, JUMP_POSITIVE, JUMP_NEGATIVE, CALL, END, EXPRESSION, HALT,
+ MOVE, DEC_JUMP_POSITIVE, STORE_JUMP_ZERO, STORE_JUMP_POSITIVE, STORE_JUMP_NEGATIVE,
+ ) = range(24)
 _BOUNDARIES = (JUMP, END)  # where a straight run of instructions surely stops
 
 
@@ -87,7 +89,9 @@ class State(Enum):
 _ALU = (ADD, SUB, AND, OR, XOR, SHL, SHR)  # in isa.ALU_OPERATORS order
 _ALU_BASES = (isa.ALU_RESULT, isa.ALU_IMM, isa.ALU_VAR)  # highest first
 _SIMPLE = {"STV": STORE, "INC": INC, "DEC": DEC}
-_JUMPS = {"JMP": JUMP, "JZ": JUMP_ZERO, "JGT": JUMP_POSITIVE, "JLT": JUMP_NEGATIVE}
+_JUMPS = {"JMP": JUMP, "JZ": JUMP_ZERO, "JGT": JUMP_POSITIVE, "JLT": JUMP_NEGATIVE,
+          "DJGT": DEC_JUMP_POSITIVE, "SJZ": STORE_JUMP_ZERO, "SJGT": STORE_JUMP_POSITIVE,
+          "SJLT": STORE_JUMP_NEGATIVE}
 
 
 @dataclass(frozen=True, slots=True)
@@ -142,6 +146,17 @@ def _shift_right(value: int, count: int) -> int:
     return value >> count
 
 
+def evaluate(operator: str, left: int, right: int) -> int:
+    """`left operator right` as the VM computes it (operator one of isa.ALU_OPERATORS):
+    what the optimizer folds a constant expression to."""
+    if operator == "<":
+        return _shift_left(left, right)
+    if operator == ">":
+        return _shift_right(left, right)
+    return _wrap({"+": left + right, "-": left - right, "&": left & right,
+                  "|": left | right, "^": left ^ right}[operator])
+
+
 class Machine:
     """One run of a verified program on `hardware`, stepped (`step`) or to its end
     (`run`). Its resumable state: the cells (the variables, R), acc, pc (an instruction
@@ -172,6 +187,9 @@ class Machine:
         self.state = State.RUNNING
         self.result: RunResult | None = None  # once ENDED or FAULTED
         self._begun = False
+        # For each call, the instructions executed up to it, itself included: what the
+        # optimizer's budget invariant bounds (spec/optimization.md).
+        self.call_counts: list[int] = []
 
     # Decoding
 
@@ -195,6 +213,12 @@ class Machine:
             return (LOAD, R_CELL, 0)
         if name in _SIMPLE:
             return (_SIMPLE[name], operands[0], 0)
+        if name == "MOVV":
+            return (MOVE, operands[0], operands[1])
+        if name == "MOVI":
+            return (MOVE, operands[0], self._immediate(operands[1]))
+        if name == "MOVR":
+            return (MOVE, operands[0], R_CELL)
         if name in _JUMPS:
             *condition, target = operands
             return (_JUMPS[name], condition[0] if condition else 0,
@@ -275,6 +299,7 @@ class Machine:
         last = len(self.program.instructions)  # the END that running off the end runs
         hardware = self.hardware
         take, divert = hardware.take_event, self._divert
+        call_counts = self.call_counts
         acc, pc = self.acc, self.pc  # acc modulo 2**16: see the module's docstring
         start = pc  # where the current straight run of instructions began
         executed = self.executed  # instructions run before `start`
@@ -359,6 +384,7 @@ class Machine:
                     if executed + pc - start > budget:
                         executed += pc - start
                         break
+                    call_counts.append(executed + pc - start)
                     args = self._arguments(site, cells)
                     if site.waits:
                         started = hardware.start(site.form, args)
@@ -400,6 +426,29 @@ class Machine:
                     pc -= 1
                     self.acc, self.pc, self.executed = acc, pc, executed + pc - start
                     return State.RUNNING
+                elif op == MOVE:
+                    cells[a] = cells[b]
+                elif op == DEC_JUMP_POSITIVE:
+                    cells[a] = ((cells[a] - 1 + 0x8000) & 0xFFFF) - 0x8000
+                    if cells[a] > 0:
+                        executed += pc - start
+                        start = pc
+                        if executed > budget:
+                            break
+                        pc = start = b if hardware.pending is None else divert(take(), b)
+                        if executed + reach[pc] > check:
+                            check = self._bound(pc, executed, stop_at)
+                elif STORE_JUMP_ZERO <= op <= STORE_JUMP_NEGATIVE:
+                    value = cells[a] = ((acc + 0x8000) & 0xFFFF) - 0x8000
+                    if (value == 0 if op == STORE_JUMP_ZERO
+                            else value > 0 if op == STORE_JUMP_POSITIVE else value < 0):
+                        executed += pc - start
+                        start = pc
+                        if executed > budget:
+                            break
+                        pc = start = b if hardware.pending is None else divert(take(), b)
+                        if executed + reach[pc] > check:
+                            check = self._bound(pc, executed, stop_at)
                 else:  # END
                     pc = min(pc, last)  # running off the end is no instruction
                     self.acc, self.pc, self.executed = acc, pc, executed + pc - start

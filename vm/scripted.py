@@ -53,6 +53,7 @@ import bisect
 import json
 import math
 import tomllib
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
@@ -66,6 +67,7 @@ from .device import (
     Odometry,
     form_name,
 )
+from .faults import RunResult
 from .language import BUILTINS, TOO_LONG, decimal_value
 
 T = TypeVar("T")
@@ -135,6 +137,13 @@ class TraceEntry:
         if self.result is not None:
             entry["result"] = list(self.result)
         return entry
+
+
+def run_document(result: RunResult, trace: Sequence[TraceEntry]) -> dict[str, Any]:
+    """A run on this device as JSON data: what `rl1c run --format json` prints, and what
+    an `exec:` engine of `rl1c fuzz` prints (spec/optimization.md, section 5)."""
+    return {"status": "ok" if result.fault is None else result.fault.to_json(),
+            "variables": result.named(), "trace": [entry.to_json() for entry in trace]}
 
 
 # Loading and validating scripts --------------------------------------------------------

@@ -76,6 +76,12 @@ class _CodeVerifier:
         if info is None:
             raise self.fail(offset, f"unknown opcode 0x{self.code[offset]:02X}",
                             Refusal.UNKNOWN_OPCODE)
+        header = self.container.header
+        if info.minor > header.minor:  # to a reader of the file's version, it is unknown
+            raise self.fail(offset, f"{info.name} is an instruction of format "
+                                    f"{header.major}.{info.minor}, but the file says "
+                                    f"{header.major}.{header.minor}",
+                            Refusal.UNKNOWN_OPCODE)
         if offset + info.length > len(self.code):
             raise self.fail(offset, f"{info.name} needs {info.length} bytes, only "
                                     f"{len(self.code) - offset} remain in the code",

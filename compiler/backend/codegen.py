@@ -101,13 +101,19 @@ def _select(block: ir.Block, following: ir.BlockId | None) -> list[_MachineOp]:
     if isinstance(terminator, ir.End):
         ops.append(_MachineOp(isa.BY_NAME["END"], (), (), terminator.line))
         return ops
-    if isinstance(terminator, ir.Branch):
-        ops.append(_MachineOp(isa.OPCODES[isa.JUMP_IF[terminator.relation]],
+    if isinstance(terminator, ir.Jump):
+        otherwise = terminator.target
+    else:
+        if isinstance(terminator, ir.Branch):
+            opcode = isa.JUMP_IF[terminator.relation]
+        elif isinstance(terminator, ir.StoreBranch):
+            opcode = isa.STORE_JUMP_IF[terminator.relation]
+        else:
+            opcode = isa.BY_NAME["DJGT"].opcode
+        ops.append(_MachineOp(isa.OPCODES[opcode],
                               (VARIABLE_INDEX[terminator.var.name], terminator.if_true),
                               (), terminator.line))
         otherwise = terminator.if_false
-    else:
-        otherwise = terminator.target
     if otherwise != following:
         ops.append(_MachineOp(isa.BY_NAME["JMP"], (otherwise,), (), terminator.line))
     return ops
@@ -133,6 +139,10 @@ def _instruction(instruction: ir.Instruction) -> _MachineOp:
         name = "INC" if instruction.step == "++" else "DEC"
         return _MachineOp(isa.BY_NAME[name], (VARIABLE_INDEX[instruction.target.name],),
                           (), line)
+    if isinstance(instruction, ir.Move):
+        kind, operands = _source(instruction.source)
+        return _MachineOp(isa.BY_NAME[("MOVV", "MOVI", "MOVR")[kind]],
+                          (VARIABLE_INDEX[instruction.target.name], *operands), (), line)
     args = tuple(isa.Arg(True, VARIABLE_INDEX[arg.name]) if isinstance(arg, ir.Var)
                  else isa.Arg(False, arg.value) for arg in instruction.args)
     return _MachineOp(isa.BY_FORM[instruction.mnemonic, instruction.selector], (), args, line)

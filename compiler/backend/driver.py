@@ -1,6 +1,7 @@
 """Compiling one program: source text to the bytes of an .ilc file, or to its IR as text.
 
-The stages run in order (front end, lowering, code generation) and the first that
+The stages run in order (front end, lowering, the optimizer at the level asked for, code
+generation) and the first that
 refuses the program stops the compilation; its diagnostics say why. Reading the input
 and writing the output are the CLI's job.
 """
@@ -17,10 +18,11 @@ from rl1.vm import ilc
 from .codegen import CodegenError, generate
 from .ir import format_program
 from .lower import lower
+from .optimize import LEVELS, optimize
 
 Emit = Literal["ilc", "ir"]
 EMITS: tuple[Emit, ...] = ("ilc", "ir")
-OPTIMIZATION_LEVELS = (0,)  # -O0 only, until the optimizer exists
+OPTIMIZATION_LEVELS = tuple(LEVELS)
 
 
 @dataclass(frozen=True, slots=True)
@@ -32,12 +34,15 @@ class Compilation:
 
 
 def compile_text(text: str, source_name: str, *, emit: Emit = "ilc",
-                 strip_debug: bool = False) -> Compilation:
-    """Compile a program; `source_name` is recorded in the debug section."""
+                 strip_debug: bool = False, level: int = 0,
+                 check: bool = False) -> Compilation:
+    """Compile a program at optimization `level` (-O0 by default here: the command line
+    chooses optimize.DEFAULT_LEVEL); `source_name` is recorded in the debug section.
+    `check` validates the IR after every pass (optimize.optimize)."""
     analysis = analyze(text)
     if analysis.has_errors:
         return Compilation(analysis.diagnostics, None)
-    program = lower(analysis.program)
+    program = optimize(lower(analysis.program), level, check=check)
     if emit == "ir":
         return Compilation(analysis.diagnostics, format_program(program).encode("utf-8"))
     try:

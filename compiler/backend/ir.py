@@ -6,10 +6,12 @@ blocks, not addresses; every instruction carries the source line it came from. C
 leaves a block only through its terminator: a jump, a two-way branch or the end. Nothing
 falls through implicitly; the code generator drops a jump to the block laid out next.
 
-Passes rewrite the IR in place: `Program.blocks` maps each block's id to the block, in
-layout order, and a block's instructions are a list of small frozen dataclasses, so a
-pass replaces instructions and terminators rather than mutating them. `validate` states
-the invariants every pass must keep.
+The accumulator is dead where a block starts: a block reads it only after loading it
+(each statement's load-operate-store lies within one block), so passes reason about it
+block by block. Passes rewrite the IR in place: `Program.blocks` maps each block's id to
+the block, in layout order, and a block's instructions are a list of small frozen
+dataclasses, so a pass replaces instructions and terminators rather than mutating them.
+`validate` states the invariants every pass must keep.
 """
 
 from __future__ import annotations
@@ -139,7 +141,19 @@ class Call:
         return text + (" " + ", ".join(map(str, self.args)) if self.args else "")
 
 
-Instruction = Load | Operate | Store | StepVar | Call
+@dataclass(frozen=True, slots=True)
+class Move:
+    """target = source, without touching acc (a superinstruction of -O2)."""
+
+    target: Var
+    source: Operand
+    line: int
+
+    def __str__(self) -> str:
+        return f"move {self.target}, {self.source}"
+
+
+Instruction = Load | Operate | Store | StepVar | Call | Move
 
 
 # Terminators ------------------------------------------------------------------------
@@ -177,6 +191,44 @@ class Branch:
 
 
 @dataclass(frozen=True, slots=True)
+class StoreBranch:
+    """var = acc, then go to `if_true` when var compares with zero as `relation` says,
+    else `if_false` (a superinstruction of -O2)."""
+
+    var: Var
+    relation: Relation
+    if_true: BlockId
+    if_false: BlockId
+    line: int
+
+    @property
+    def targets(self) -> tuple[BlockId, ...]:
+        return (self.if_true, self.if_false)
+
+    def __str__(self) -> str:
+        return (f"store {self.var}; if {self.var}{self.relation}0 then {self.if_true} "
+                f"else {self.if_false}")
+
+
+@dataclass(frozen=True, slots=True)
+class DecrementBranch:
+    """var--, then go to `if_true` when var > 0, else `if_false` (a superinstruction of
+    -O2, for counted loops)."""
+
+    var: Var
+    if_true: BlockId
+    if_false: BlockId
+    line: int
+
+    @property
+    def targets(self) -> tuple[BlockId, ...]:
+        return (self.if_true, self.if_false)
+
+    def __str__(self) -> str:
+        return f"dec {self.var}; if {self.var}>0 then {self.if_true} else {self.if_false}"
+
+
+@dataclass(frozen=True, slots=True)
 class End:
     line: int
 
@@ -188,7 +240,7 @@ class End:
         return "end"
 
 
-Terminator = Jump | Branch | End
+Terminator = Jump | Branch | StoreBranch | DecrementBranch | End
 
 
 # Blocks and programs ----------------------------------------------------------------
@@ -257,11 +309,12 @@ def validate(program: Program) -> list[str]:
 
 
 def _block_problems(block: Block) -> Iterator[str]:
-    if not isinstance(block.terminator, Jump | Branch | End):
+    if not isinstance(block.terminator, Jump | Branch | StoreBranch | DecrementBranch | End):
         yield f"ends with {block.terminator!r}, which is not a terminator"
     result_set = False  # whether R holds a value here (only a call within the block sets it)
+    loaded = False  # whether acc holds a value here: it is dead where a block starts
     for instruction in block.instructions:
-        if not isinstance(instruction, Load | Operate | Store | StepVar | Call):
+        if not isinstance(instruction, Load | Operate | Store | StepVar | Call | Move):
             yield f"holds {instruction!r}, which is not an instruction"
             continue
         for operand in _operands(instruction):
@@ -271,11 +324,18 @@ def _block_problems(block: Block) -> Iterator[str]:
                 yield f"line {instruction.line}: {operand.value} does not fit 16 bits"
             elif isinstance(operand, Result) and not result_set:
                 yield f"line {instruction.line}: `{instruction}` reads R before a call sets it"
+        if isinstance(instruction, Operate | Store) and not loaded:
+            yield f"line {instruction.line}: `{instruction}` reads acc before a load sets it"
+        loaded = loaded or isinstance(instruction, Load)
         if isinstance(instruction, Call):
             yield from _call_problems(instruction)
             result_set = instruction.mnemonic in BUILTINS and instruction.returns_value
-    if isinstance(block.terminator, Branch) and block.terminator.var.name not in VARIABLES:
-        yield f"branches on `{block.terminator.var.name}`, which is not a variable"
+    terminator = block.terminator
+    if isinstance(terminator, StoreBranch) and not loaded:
+        yield f"line {terminator.line}: `{terminator}` reads acc before a load sets it"
+    if isinstance(terminator, Branch | StoreBranch | DecrementBranch) \
+            and terminator.var.name not in VARIABLES:
+        yield f"branches on `{terminator.var.name}`, which is not a variable"
 
 
 def _operands(instruction: Instruction) -> tuple[Operand, ...]:
@@ -283,6 +343,8 @@ def _operands(instruction: Instruction) -> tuple[Operand, ...]:
         return (instruction.source,)
     if isinstance(instruction, Store | StepVar):
         return (instruction.target,)
+    if isinstance(instruction, Move):
+        return (instruction.target, instruction.source)
     return instruction.args
 
 

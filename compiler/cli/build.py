@@ -51,6 +51,7 @@ EMIT_CHOICES = ("ilc", "ir", "c", "ihex", "ils")
 EMIT_SUFFIXES = {"ilc": ".ilc", "ir": None, "c": ".c", "ihex": ".hex", "ils": ".ils"}
 ENGINE_CHOICES = ("vm", "ast", "c")
 DEFAULT_BUDGET = 10_000_000
+DEFAULT_LEVEL = 1
 
 
 def _address(ctx: click.Context, param: click.Parameter, value: str | None) -> int | None:
@@ -85,8 +86,10 @@ def _address(ctx: click.Context, param: click.Parameter, value: str | None) -> i
 @click.option("--base-address", metavar="ADDRESS", callback=_address,
               help="with --emit ihex: the address of the first byte, decimal or 0x hex "
                    "(default 0)")
-@click.option("-O", "optimize", default="0", metavar="LEVEL",
-              help="optimization level; only -O0 (none) exists so far")
+@click.option("-O", "optimize", default=str(DEFAULT_LEVEL), metavar="LEVEL",
+              show_default=True,
+              help="optimization level: 0 none; 1 the passes whose code every format 1.0 "
+                   "reader runs; 2 all of them (spec/optimization.md)")
 @force_option
 @format_option
 @color_option
@@ -104,8 +107,8 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: str,
     from rl1.compiler.ils.sources import recorded_name
 
     if optimize not in {str(level) for level in OPTIMIZATION_LEVELS}:
-        raise click.UsageError(f"argument -O: `-O{optimize}`: only -O0 (no optimization) "
-                               "exists so far")
+        raise click.UsageError(f"argument -O: `-O{optimize}`: the levels are "
+                               + ", ".join(f"-O{level}" for level in OPTIMIZATION_LEVELS))
     if strip and emit_kind == "ir":
         raise click.UsageError("--strip drops the debug section of an .ilc file; "
                                "it has no meaning with --emit ir")
@@ -119,7 +122,7 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: str,
                                "give another path with -o")
     compilation = compile_text(source.text, recorded_name(source.name, target),
                                emit="ir" if emit_kind == "ir" else "ilc",
-                               strip_debug=strip)
+                               strip_debug=strip, level=int(optimize))
     status = emit([FileDiagnostics(source.name, source.text, compilation.diagnostics)],
                   output_format, color, "compile", err=True)
     if compilation.output is None:

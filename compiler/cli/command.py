@@ -153,6 +153,18 @@ def choice_option(*names: str, choices: Sequence[str], help: str,
                         **settings)
 
 
+def at_least_one(ctx: click.Context, param: click.Parameter, value: str) -> int:
+    """An option's callback: a whole number, at least 1."""
+    try:
+        number = int(value)
+    except ValueError:
+        number = 0
+    if number < 1:
+        raise click.BadParameter(f"expected a whole number of at least 1, got {value!r}",
+                                 ctx, param)
+    return number
+
+
 def a_budget(ctx: click.Context, param: click.Parameter, value: str) -> int:
     """An option's callback: a watchdog budget, a whole number in 1..MAX_BUDGET."""
     from rl1.vm.faults import MAX_BUDGET  # the VM's modules load only for commands that run

@@ -1,16 +1,16 @@
 """`rl1c`: compile RL/I (`rl1c FILE.rob -o FILE.ilc`) and the commands beside it.
 
 The commands live by what they work on: source.py (check, fmt, explain), build.py
-(compile, run, dis, asm) and sim.py (sim); command.py has what they share. A command's
-module is imported only when the command runs (or help lists them all), as click's
-documentation shows for lazy groups: `rl1c check` pays for no other command.
+(compile, run, dis, asm), sim.py (sim) and fuzz.py (fuzz); command.py has what they
+share. A command's module is imported only when the command runs (or help lists them
+all), as click's documentation shows for lazy groups: `rl1c check` pays for no other
+command.
 
 This module makes them one click group with what the toolchain adds to click: a first
 word that names a file means `compile`, a mistyped command gets a suggestion, and usage
-errors read
-`usage: ...` then `rl1c check: error: what is wrong`. Exit statuses: 0 success, 1 the
-input has errors, 2 a usage problem or an unreadable file, 3 an internal error (a bug in
-rl1c), 10-13 faults of `rl1c run`, 130 interrupted.
+errors read `usage: ...` then `rl1c check: error: what is wrong`. Exit statuses: 0
+success, 1 the input has errors, 2 a usage problem or an unreadable file, 3 an internal
+error (a bug in rl1c), 10-13 faults of `rl1c run`, 130 interrupted.
 
 To add a command: write it in the module of its group (or a new one listed in
 `MODULES`), add its name there, as command.py says.
@@ -44,6 +44,7 @@ MODULES: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("source", ("check", "fmt", "explain")),
     ("build", ("compile", "run", "dis", "asm")),
     ("sim", ("sim",)),
+    ("fuzz", ("fuzz",)),
 )
 COMMAND_NAMES = tuple(name for _, names in MODULES for name in names)
 

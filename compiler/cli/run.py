@@ -16,6 +16,7 @@ from typing import Literal
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.backend.optimize import DEFAULT_LEVEL
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.frontend.diagnostics import Diagnostic
 from rl1.compiler.interpreter import interpret
@@ -38,8 +39,9 @@ VmEngine = Literal["vm", "c"]
 def run_source(text: str, source_name: str, device: Device, engine: Engine = "vm",
                budget: int = DEFAULT_BUDGET) -> RunResult | list[Diagnostic]:
     """Run RL/I source by `engine`; the diagnostics instead when it has errors. For the
-    VM the compiled bytes go through the verifier, as a file read from disk would.
-    ScriptError when the interpreter is given losses after instruction counts."""
+    VM it is compiled as `rl1c FILE.rob` compiles it (at the default level), and the
+    bytes go through the verifier, as a file read from disk would. ScriptError when the
+    interpreter is given losses after instruction counts."""
     if engine == "ast":
         if isinstance(device, ScriptedDevice) and device.script.instruction_losses:
             raise ScriptError("the sensor script loses the line after instruction counts, "
@@ -48,7 +50,7 @@ def run_source(text: str, source_name: str, device: Device, engine: Engine = "vm
         if analysis.has_errors:
             return analysis.diagnostics
         return interpret(analysis.program, device, budget)
-    compilation = compile_text(text, source_name)
+    compilation = compile_text(text, source_name, level=DEFAULT_LEVEL)
     if compilation.output is None:
         return compilation.diagnostics
     return run_ilc(compilation.output, device, budget, engine)

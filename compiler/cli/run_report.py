@@ -6,15 +6,12 @@ import json
 from collections.abc import Sequence
 
 from rl1.vm.faults import RunResult
-from rl1.vm.scripted import TraceEntry
+from rl1.vm.scripted import TraceEntry, run_document
 
 
 def render_json(result: RunResult, trace: Sequence[TraceEntry]) -> str:
     """One JSON object: status ("ok" or the fault), all 53 variables, the trace."""
-    status = "ok" if result.fault is None else result.fault.to_json()
-    document = {"status": status, "variables": result.named(),
-                "trace": [entry.to_json() for entry in trace]}
-    return json.dumps(document, indent=2) + "\n"
+    return json.dumps(run_document(result, trace), indent=2) + "\n"
 
 
 def render_text(result: RunResult, trace: Sequence[TraceEntry]) -> str:

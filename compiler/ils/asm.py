@@ -151,6 +151,7 @@ class _Assembler:
     flags: int | None = None
     source_name: str | None = None
     source_digest: bytes | None = None
+    source_origin: tuple[int, int] = (0, 0)  # (line, column) of .source
     current_line: int | None = None
     entries: list[tuple[int, int]] = field(default_factory=list)
     problems: list[Problem] = field(default_factory=list)
@@ -224,6 +225,7 @@ class _Assembler:
         elif token.text == ".source":
             if self.source_name is not None:
                 raise _LineError(token.column, ".source is given twice")
+            self.source_origin = position
             name = cursor.expect("string", "a quoted file name")
             try:
                 self.source_name = json.loads(name.text)
@@ -369,6 +371,15 @@ class _Assembler:
                 self.problems.append(Problem(number, token.column, f"handler :{label} at "
                                              f"{handlers[label]} is outside the "
                                              f"{len(self.code)}-byte code"))
+        minor = isa.code_minor(bytes(self.code))
+        if minor >= ilc.DIGEST_MINOR and self.source_name is not None \
+                and self.source_digest is None:
+            line, column = self.source_origin
+            self.problems.append(Problem(line, column, f"the code uses instructions of format "
+                                         f"1.{minor}, whose debug section carries the "
+                                         "source's digest: add `.digest \"HEX\"` after "
+                                         "`.source` (`rl1c dis` prints it) or leave out "
+                                         "`.source`"))
         if self.problems:
             raise AsmError(self.problems)
         debug = None if self.source_name is None else ilc.DebugInfo(

@@ -52,11 +52,13 @@ class Case:
     trace: tuple[TraceItem, ...] | None = None  # the expected trace, when the case fixes it
     executed: int | None = None  # the VM's instruction count, when the case fixes it
     language: str = "rl1"  # "ils": `source` is intermediate code written by hand (.ils)
+    level: int = 0  # the optimization level it is compiled at (2: format 1.2's fused code)
 
 
 def all_cases() -> list[Case]:
     return [*arithmetic(), *shifts(), *control(), *calls(), *tracing(), *events(), *faults(),
-            *sample(), *intermediate()]
+            *sample(), *intermediate(),
+            *fused()]
 
 
 def _straight(group: str, name: str, covers: str, program: Straight) -> Case:
@@ -744,3 +746,23 @@ def _sample_variables(ending: dict[str, int]) -> dict[str, int]:
         "w": 105, "x": 128, "y": 100,
         **ending,
     }
+
+
+# --- fused: the superinstructions of format 1.2, as -O2 compiles them ----------------------
+
+
+def fused() -> Iterator[Case]:
+    yield Case("fused", "fused-moves", "MOVV, MOVI and MOVR: a variable copied, a "
+               "constant stored, a call's result stored (-O2)",
+               "A=(KYO); D=A+1; B=A; C=5; (FZO B,C); G=(ULT A)\n",
+               {"A": 42, "u": 40, "v": 44, "B": 42, "C": 5, "D": 43, "G": 7},
+               {"KYO": [{"centre": 42, "right": 40, "left": 44}], "ULT A": [7]}, level=2)
+    yield Case("fused", "fused-counted-loop", "DJGT: a counted loop's decrement and jump "
+               "(-O2)", "@=3\n:10 A=A+7; (TIM 1); @--; ?@>#10\n(END)\n", {"A": 21},
+               level=2)
+    yield Case("fused", "fused-store-and-jump", "SJLT, SJZ, SJGT: an expression stored and "
+               "tested in one instruction, each jump taken (-O2)",
+               "A=(ULT A)-100; ?A<#10\nB=1\n:10 C=(ULT B); ?C=#20\nD=1\n"
+               ":20 E=(ULT C)-5; ?E>#30\nF=1\n:30 (END)\n",
+               {"A": -50, "B": 0, "C": 0, "D": 0, "E": 5, "F": 0},
+               {"ULT A": [50], "ULT B": [0], "ULT C": [10]}, level=2)

@@ -53,6 +53,9 @@ def with_crc(data: bytes) -> bytes:
 
 
 BASE = ilc_file()
+# MOVV 0 1; MOVI 2 5; MOVR 3; DJGT 0 0; SJZ 1 0; SJGT 1 0; SJLT 1 0; END (version 1.2)
+FUSED = bytes.fromhex("070001" "08020500" "0903" "34000000" "35010000" "36010000"
+                      "37010000" "00")
 DIGEST = bytes(range(0xA0, 0xB0))  # a version 1.1 source digest (section 4.5)
 DEBUG = 46  # the debug section's file offset in BASE
 ENTRY = DEBUG + 1 + len(NAME) + 2  # the first line entry's file offset
@@ -98,7 +101,7 @@ def refused() -> list[FileCase]:
         FileCase("size-overflow", "debug_size so large that header_size + code_size + 10 + "
                  "debug_size wraps a u32 to 30, inside a newer minor version's file: "
                  "truncated, not accepted",
-                 ilc_file(minor=2, sizes={"debug": 2**32 - 46 + 30}), 6, len(BASE)),
+                 ilc_file(minor=3, sizes={"debug": 2**32 - 46 + 30}), 6, len(BASE)),
         FileCase("digest-truncated", "a version 1.1 file whose source digest is cut short",
                  ilc_file(minor=1, trailing=DIGEST[:10]), 6, len(BASE) + 10),
         FileCase("extra-byte", "a byte after the last section of a 1.0 file",
@@ -133,7 +136,11 @@ def refused() -> list[FileCase]:
                  ilc_file(debug=debug_section(count=1, entries=b"\x00\x00")), 12, ENTRY),
         FileCase("left-over", "a byte left over after the last line entry",
                  ilc_file(debug=debug_section(entries=ENTRIES + b"\x00")), 12, ENTRY + 8),
-        FileCase("unknown-opcode", "opcode 0x07 is unused", _code(b"\x07"), 13, 24),
+        FileCase("unknown-opcode", "opcode 0x0A is unused", _code(b"\x0a"), 13, 24),
+        FileCase("newer-opcode", "MOVV, an instruction of version 1.2, in a 1.1 file",
+                 ilc_file(bytes.fromhex("07000100"), debug=b"", minor=1), 13, 24),
+        FileCase("fused-variable", "MOVV whose second variable is 53, in a 1.2 file",
+                 ilc_file(bytes.fromhex("07003500"), debug=b"", minor=2), 15, 26),
         FileCase("cut-instruction", "LDI cut off by the end of the code", _code(b"\x02\x05"),
                  14, 24),
         FileCase("variable-operand", "STV with variable index 53", _code(b"\x04\x35"), 15, 25),
@@ -171,10 +178,16 @@ def accepted() -> list[FileCase]:
                  ilc_file(minor=1, trailing=DIGEST)),
         FileCase("version-1.1-stripped", "minor version 1 without a debug section, so "
                  "without a digest", ilc_file(minor=1, debug=b"")),
-        FileCase("newer-minor-header", "minor version 2 with 4 header bytes 1.1 does not "
-                 "know", ilc_file(minor=2, header_extra=b"\1\2\3\4", trailing=DIGEST)),
-        FileCase("newer-minor-trailing", "minor version 2 with a section after the source "
-                 "digest", ilc_file(minor=2, trailing=DIGEST + b"\xaa\xbb\xcc")),
+        FileCase("version-1.2", "minor version 2: every superinstruction, a debug section "
+                 "and its digest", ilc_file(FUSED, features=0, minor=2,
+                                            debug=debug_section(count=1, entries=b"\x00\x01"),
+                                            trailing=DIGEST)),
+        FileCase("version-1.2-stripped", "minor version 2 without a debug section",
+                 ilc_file(FUSED, features=0, minor=2, debug=b"")),
+        FileCase("newer-minor-header", "minor version 3 with 4 header bytes 1.2 does not "
+                 "know", ilc_file(minor=3, header_extra=b"\1\2\3\4", trailing=DIGEST)),
+        FileCase("newer-minor-trailing", "minor version 3 with a section after the source "
+                 "digest", ilc_file(minor=3, trailing=DIGEST + b"\xaa\xbb\xcc")),
         FileCase("optional-flag", "optional flag bits 8 and 15", ilc_file(flags=0x8100)),
         FileCase("sparse-line-map", "one line entry for four instructions",
                  ilc_file(debug=debug_section(count=1, entries=b"\x00\x01"))),

@@ -104,7 +104,8 @@ def compile_both(case: Case) -> tuple[bytes, bytes]:
         return full, ilc.encode(ilc.strip_debug(ilc.decode(full)))
     files = []
     for strip in (False, True):
-        compilation = compile_text(case.source, source_name(case), strip_debug=strip)
+        compilation = compile_text(case.source, source_name(case), strip_debug=strip,
+                                   level=case.level)
         if compilation.output is None:
             errors = "; ".join(f"line {d.span.line}: {d.code} {d.message}"
                                for d in compilation.diagnostics if d.is_error)
@@ -224,7 +225,8 @@ RULE_MESSAGES = {
     5: "section must be", 6: "truncated: the header's section sizes", 7: "unexpected bytes",
     8: "CRC-32 mismatch", 9: "required flag", 10: "points at code offset",
     11: "unknown feature bits", 12: "debug|line entry (repeats|\\(offset)|UTF-8|left over",
-    13: "unknown opcode", 14: "needs \\d+ bytes", 15: "variable index|argument mask|out of range",
+    13: "unknown opcode|an instruction of format", 14: "needs \\d+ bytes",
+    15: "variable index|argument mask|out of range",
     16: "needs the device feature", 17: "jump target", 18: "handler :\\d+ at code offset",
     19: "line entry for code offset",
 }

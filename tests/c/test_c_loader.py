@@ -31,7 +31,7 @@ sys.path.insert(0, str(ROOT / "spec" / "vectors"))
 from ilc_files import run_files, verifier_files
 
 C_DIR = ROOT / "vm" / "c"
-CODE = 24  # file offset of the code section in a 1.0 or 1.1 file
+CODE = 24  # file offset of the code section in a file of version 1.0 to 1.2
 MAX_BITMAP = 8192  # RL1_BITMAP_SIZE(65535)
 
 
@@ -161,7 +161,7 @@ def test_section_sizes_whose_sum_passes_32_bits_are_truncated(c_loader: Loader) 
     struct.pack_into("<I", data, 20, 0xFFFFFFFF - 24 - 3 - 10 + 20)
     assert assert_agree(c_loader, with_crc(data)) == (ilc.Refusal.TRUNCATED, len(data))
     struct.pack_into("<HH", data, 12, 0xFFFF, 0xFFFF)  # and a newer minor's header size
-    data[5] = 2
+    data[5] = ilc.VERSION_MINOR + 1
     assert assert_agree(c_loader, with_crc(data)) == (ilc.Refusal.TRUNCATED, len(data))
 
 

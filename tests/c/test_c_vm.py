@@ -1,9 +1,10 @@
 """The C VM (vm/c/rl1vm.c) against the reference VM (vm/machine.py), driven from Python
 through ctypes (vm/native.py): on every run vector, both its files, and on generated
-programs with generated sensor scripts and hardware that fails, answers busy or reads
-values out of range, the two give the same variables, fault (kind, message, source
-line), device trace and number of instructions executed. The library is built with
-UBSan, which aborts the run on undefined behaviour."""
+programs compiled at every optimization level, with generated sensor scripts and with
+hardware that fails, answers busy or reads values out of range, the two give the same
+variables, fault (kind, message, source line), device trace and number of instructions
+executed. The library is built with UBSan, which aborts the run on undefined
+behaviour."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ from hypothesis import strategies as st
 from support import ROOT
 from support.scripts import MOVING_STARTS, scripts
 
-from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
 from rl1.compiler.strategies import checked_programs
 from rl1.vm import native
 from rl1.vm.device import FormKey, LineLost, Outcome
@@ -78,13 +79,13 @@ def test_every_run_vector_runs_alike(c_vm: ctypes.CDLL, vector: dict[str, object
         assert got.executed == vector["executed"]
 
 
-def _compiled(text: str) -> bytes:
-    compiled = compile_text(text, "generated.rob")
+def _compiled(text: str, level: int = 0) -> bytes:
+    compiled = compile_text(text, "generated.rob", level=level)
     assert compiled.output is not None, compiled.diagnostics
     return compiled.output
 
 
-@settings(max_examples=120, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(st.sampled_from(MOVING_STARTS), checked_programs(), scripts(),
        st.lists(st.integers(0, 300), max_size=3), st.integers(1, 3000))
 def test_generated_programs_run_alike(c_vm: ctypes.CDLL, start: str, text: str,
@@ -93,7 +94,8 @@ def test_generated_programs_run_alike(c_vm: ctypes.CDLL, start: str, text: str,
     losses = script.losses + tuple(LossAfter(count) for count in instructions)
     script = Script(**{**{name: getattr(script, name) for name in Script.__slots__},
                        "losses": losses})
-    assert_same_runs(c_vm, _compiled(start + text), script, budget)
+    for level in OPTIMIZATION_LEVELS:
+        assert_same_runs(c_vm, _compiled(start + text, level), script, budget)
 
 
 # Hardware that misbehaves: the same plan for both VMs, one action per callback.
@@ -166,13 +168,14 @@ def _flaky_run(machine: Stepper, device: ScriptedDevice) -> Run:
     return Run(machine.run(), list(device.trace), machine.executed)
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=100, deadline=None)
 @given(st.sampled_from(MOVING_STARTS), checked_programs(max_blocks=3), scripts(),
        st.lists(st.sampled_from((PASS, PASS, PASS, ERROR, BUSY_TWICE, OUT_OF_RANGE)),
-                max_size=12))
+                max_size=12), st.sampled_from(OPTIMIZATION_LEVELS))
 def test_misbehaving_hardware_gives_the_same_faults(c_vm: ctypes.CDLL, start: str, text: str,
-                                                    script: Script, plan: list[int]) -> None:
-    data = _compiled(start + text)
+                                                    script: Script, plan: list[int],
+                                                    level: int) -> None:
+    data = _compiled(start + text, level)
     reference_device, c_device = ScriptedDevice(script), ScriptedDevice(script)
     reference: Hardware = Flaky(Blocking(reference_device), plan)
     expected = _flaky_run(Machine(verify(data), reference, 5000), reference_device)

@@ -8,7 +8,7 @@ from importlib.metadata import version
 import pytest
 from support import SAMPLE
 
-from rl1.compiler.backend import driver, firmware
+from rl1.compiler.backend import driver, firmware, optimize
 from rl1.compiler.cli import build as cli
 from rl1.compiler.cli import main
 from rl1.compiler.cli import run as runner
@@ -25,6 +25,7 @@ def test_option_values_are_the_stages_own() -> None:
     assert set(cli.EMIT_SUFFIXES) == set(cli.EMIT_CHOICES)
     assert cli.ENGINE_CHOICES == runner.ENGINES
     assert cli.DEFAULT_BUDGET == faults.DEFAULT_BUDGET
+    assert cli.DEFAULT_LEVEL == optimize.DEFAULT_LEVEL
 
 
 def modules_loaded_by(argv: list[str]) -> tuple[int, set[str]]:

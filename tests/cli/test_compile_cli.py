@@ -15,6 +15,7 @@ from rl1.compiler.backend import driver
 from rl1.compiler.backend.firmware import c_source
 from rl1.compiler.backend.ir import format_program
 from rl1.compiler.backend.lower import lower
+from rl1.compiler.backend.optimize import DEFAULT_LEVEL, optimize
 from rl1.compiler.files import write_atomically
 from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
@@ -67,12 +68,16 @@ def test_strip_drops_only_the_debug_section(sample: Path, tmp_path: Path) -> Non
 
 
 def test_emit_ir_prints_the_ir_or_writes_it_with_o(sample: Path, tmp_path: Path) -> None:
-    expected = format_program(lower(parse_program(SAMPLE.read_text(encoding="utf-8"))[0]))
-    printed = rl1c(str(sample), "--emit", "ir")
+    lowered = lower(parse_program(SAMPLE.read_text(encoding="utf-8"))[0])
+    expected = format_program(lowered)
+    printed = rl1c(str(sample), "--emit", "ir", "-O0")
     assert printed.exit_code == 0 and printed.stdout == expected
-    assert rl1c(str(sample), "--emit", "ir", "-o", str(tmp_path / "s.ir")).exit_code == 0
+    assert rl1c(str(sample), "--emit", "ir", "-O0", "-o", str(tmp_path / "s.ir")).exit_code == 0
     assert (tmp_path / "s.ir").read_text(encoding="utf-8") == expected
     assert not (tmp_path / "sample.ilc").exists()
+    # Without -O, the IR after the default level's passes.
+    optimized = rl1c(str(sample), "--emit", "ir")
+    assert optimized.stdout == format_program(optimize(lowered, DEFAULT_LEVEL)) != expected
 
 
 def test_emit_c_writes_the_ilc_bytes_as_a_c_array_beside_the_source(sample: Path) -> None:
@@ -135,8 +140,8 @@ def test_standard_input_and_output(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("args, message", [
-    (["-O1"], "only -O0"),
-    (["-O", "s"], "only -O0"),
+    (["-O3"], "`-O3`: the levels are -O0, -O1, -O2"),
+    (["-O", "s"], "the levels are -O0, -O1, -O2"),
     (["--emit", "ir", "-s"], "no meaning with --emit ir"),
     (["--emit", "asm"], "argument --emit: invalid choice: 'asm'"),
     (["--c-name", "x"], "--c-name names the array of --emit c"),
@@ -190,10 +195,13 @@ def test_warnings_are_printed_and_do_not_block(
 
 
 def test_code_too_large_is_refused_with_e0190(tmp_path: Path) -> None:
-    # A=B+1 is 7 bytes (LDV, ADDI, STV): 9363 of them pass 65535 bytes at line 9363.
+    # A=B+1 is 7 bytes (LDV, ADDI, STV): 9363 of them pass 65535 bytes at line 9363
+    # (unoptimized: -O1 keeps only the last, the others being dead stores).
     source = tmp_path / "huge.rob"
     source.write_text("A=B+1\n" * 9363, encoding="utf-8")
-    result = rl1c(str(source), "--color", "never")
+    assert rl1c(str(source), "-o", str(tmp_path / "small.ilc")).exit_code == 0
+    (tmp_path / "small.ilc").unlink()
+    result = rl1c(str(source), "-O0", "--color", "never")
     assert result.exit_code == 1
     assert "error[E0190]" in result.stderr and "huge.rob:9363:1" in result.stderr
     assert sorted(os.listdir(tmp_path)) == ["huge.rob"]

@@ -361,3 +361,20 @@ def test_the_sample_faults_without_a_97_handler_when_the_line_is_lost_in_its_mvi
     assert ran.fault is not None
     assert (ran.fault.kind, ran.fault.line) == (FaultKind.MISSING_HANDLER, 40)
     assert commands(vm_device)[-2:] == ["LINE LOST 3", "STOP"]
+
+
+def test_a_fault_where_an_event_is_taken_counts_each_instruction_once() -> None:
+    # Mode 2 loses the line during the wait and there is no :98: a fault right after TIM,
+    # the third instruction (the fourth with a jump taken before it).
+    loss = Script(losses=(LossAt(50),))
+    after_call = assemble(call("TRC", 2), call("MOV", 3, 3), call("TIM", 1), op("END"))
+    result, _ = execute(after_call, loss)
+    assert result.fault is not None and result.fault.kind is FaultKind.MISSING_HANDLER
+    machine = Machine(after_call, Blocking(ScriptedDevice(loss)), 100)
+    machine.run()
+    assert machine.executed == 3
+    after_jump = assemble(call("TRC", 2), call("MOV", 3, 3), op("JMP", To(3)),
+                          call("TIM", 1), op("END"))
+    machine = Machine(after_jump, Blocking(ScriptedDevice(loss)), 100)
+    assert machine.run().fault is not None
+    assert machine.executed == 4

@@ -21,18 +21,19 @@ import generate  # spec/vectors is not a package: it needs the path
 
 SOURCE = (ROOT / "vm" / "machine.py").read_text(encoding="utf-8")
 IN_JUMP, IN_CONDITION = " " * 20, " " * 24  # the indentation of a jump's body, and a condition's
+# (the conditional jumps: JZ, JGT, JLT and the superinstructions DJGT and SJZ/SJGT/SJLT)
 
 Replacement = tuple[str, str, int]  # old text, new text, how often the old text occurs
 
 MUTANTS: dict[str, list[Replacement]] = {
     "no event check at taken jumps": [
-        ("b if hardware.pending is None else divert(take(), b)", "b", 4)],
+        ("b if hardware.pending is None else divert(take(), b)", "b", 6)],
     "no budget check at conditional jumps": [
-        (f"{IN_CONDITION}if executed > budget:\n{IN_CONDITION}    break\n", "", 3)],
+        (f"{IN_CONDITION}if executed > budget:\n{IN_CONDITION}    break\n", "", 5)],
     "a handler jump counted as an instruction": [
         ("pc = start = divert(event, pc)", "pc = start = divert(event, pc); executed += 1", 1),
         (f"else divert(take(), b)\n{IN_CONDITION}if", f"else divert(take(), b)\n"
-         f"{IN_CONDITION}executed += pc != b\n{IN_CONDITION}if", 3),
+         f"{IN_CONDITION}executed += pc != b\n{IN_CONDITION}if", 5),
         (f"else divert(take(), b)\n{IN_JUMP}if", f"else divert(take(), b)\n"
          f"{IN_JUMP}executed += pc != b\n{IN_JUMP}if", 1)],
     "a negative or large shift count from R taken as 0": [

@@ -5,17 +5,18 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from hypothesis import given, settings
+import pytest
+from hypothesis import HealthCheck, Phase, find, given, settings
 from hypothesis import strategies as st
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.parser import parse_line, parse_program
 from rl1.compiler.interpreter import interpret
-from rl1.compiler.strategies import OPERATORS, checked_programs, lines, programs
+from rl1.compiler.strategies import OPERATORS, Run, checked_programs, lines, programs, runs
 from rl1.vm.device import FuzzyReading, ImageReading, Odometry
 from rl1.vm.language import BUILTINS
-from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice
+from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice, parse_script
 
 ALL_FORMS = {f"call {b.mnemonic} {form.selector}" for b in BUILTINS.values()
              for form in b.forms}
@@ -155,3 +156,24 @@ def test_checked_programs_cover_every_form_operator_edge_and_handler() -> None:
         "handler :99",
     }
     assert expected - coverage(checked_programs(), 200) == set()
+
+
+def what_a_run_does(case: Run) -> set[str]:
+    """What a run of `runs()` shows when interpreted: how it ends, and whether a handler
+    was entered, and entered again."""
+    analysis = analyze(case.source)
+    assert not analysis.has_errors, describe(case.source)()
+    device = ScriptedDevice(parse_script(case.script))
+    result = interpret(analysis.program, device, budget=20_000)
+    losses = sum(entry.call == "LINE LOST" for entry in device.trace)
+    return {result.fault.kind.code if result.fault else "ok",
+            *(["handler entered"] if losses else []), *(["entered again"] * (losses > 1))}
+
+
+@pytest.mark.parametrize("outcome", ["ok", "argument-range", "missing-handler",
+                                     "device-error", "handler entered", "entered again"])
+def test_runs_wait_on_sensors_enter_handlers_and_fault(outcome: str) -> None:
+    # Each is common enough that a few hundred runs show it (not shrunk: any will do).
+    search = settings(max_examples=500, phases=[Phase.generate], database=None,
+                      deadline=None, suppress_health_check=list(HealthCheck))
+    find(runs(), lambda case: outcome in what_a_run_does(case), settings=search)

@@ -52,7 +52,9 @@ def instruction_bytes(draw: st.DrawFn, info: isa.OpInfo, offsets: list[int]) -> 
 
 
 @st.composite
-def debug_infos(draw: st.DrawFn, offsets: list[int]) -> ilc.DebugInfo:
+def debug_infos(draw: st.DrawFn, offsets: list[int], digested: bool) -> ilc.DebugInfo:
+    """A debug section; `digested`: with a source digest (a file of version 1.2 has
+    one), else perhaps."""
     name = draw(st.text(max_size=20))
     covered = [offset for offset in offsets if draw(st.integers(0, 4))]  # most, not all
     line = draw(st.integers(1, 100))
@@ -61,7 +63,8 @@ def debug_infos(draw: st.DrawFn, offsets: list[int]) -> ilc.DebugInfo:
         lines.append((offset, line))
         # Mostly small steps; sometimes large ones, for the multi-byte numbers.
         line = min(ilc.MAX_LINE, line + draw(st.integers(0, 3) | st.integers(0, 40000)))
-    digest = draw(st.none() | st.binary(min_size=ilc.DIGEST_SIZE, max_size=ilc.DIGEST_SIZE))
+    some_digest = st.binary(min_size=ilc.DIGEST_SIZE, max_size=ilc.DIGEST_SIZE)
+    digest = draw(some_digest if digested else st.none() | some_digest)
     return ilc.DebugInfo(name, tuple(lines), digest)
 
 
@@ -78,7 +81,7 @@ def images(draw: st.DrawFn, max_instructions: int = 25) -> ilc.Image:
                                     st.sampled_from(offsets))) if offsets else {}
     extra = draw(st.frozensets(st.sampled_from(list(Feature))))
     features = frozenset(needed_features(infos)) | extra
-    debug = draw(st.none() | debug_infos(offsets))
+    debug = draw(st.none() | debug_infos(offsets, isa.code_minor(code) >= ilc.DIGEST_MINOR))
     optional_flags = draw(st.integers(0, 0xFF)) << 8  # a reader must accept unknown ones
     return ilc.Image(code, handlers, features, debug, optional_flags)
 

@@ -17,8 +17,8 @@ LDI_5_END = bytes([0x02, 0x05, 0x00, 0x00])  # LDI 5; END
 SAMPLE_DEBUG = ilc.DebugInfo("a.rob", ((0, 2), (3, 130)))
 SAMPLE = ilc.Image(LDI_5_END, {97: 3}, frozenset({Feature.MOTION, Feature.IO}), SAMPLE_DEBUG)
 DIGEST = ilc.source_digest("A=5\n")
-DIGESTED = dataclasses.replace(SAMPLE, debug=dataclasses.replace(SAMPLE_DEBUG,
-                                                                 source_digest=DIGEST))
+DIGESTED = dataclasses.replace(
+    SAMPLE, debug=dataclasses.replace(SAMPLE_DEBUG, source_digest=DIGEST))
 
 
 def patched(data: bytes, offset: int, fmt: str, value: int) -> bytes:

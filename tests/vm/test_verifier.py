@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 from hypothesis import given, settings
-from support.ilc import damaged, images
+from support.ilc import damaged, images, with_crc
 
 from rl1.vm import ilc, isa, machine
 from rl1.vm.ilc import Refusal
@@ -74,7 +74,7 @@ def test_container_refusals_come_as_verify_errors() -> None:
 
 
 @pytest.mark.parametrize(("code", "offset", "message", "kind"), [
-    (op("LDI", 0) + bytes([0x07]), CODE + 3, "code offset 3: unknown opcode 0x07",
+    (op("LDI", 0) + bytes([0x0A]), CODE + 3, "code offset 3: unknown opcode 0x0A",
      Refusal.UNKNOWN_OPCODE),
     (op("LDI", 0)[:2], CODE, "LDI needs 3 bytes, only 2 remain", Refusal.CUT_OFF),
     (op("LDI", 0) + op("MVI", args=(const(1), const(1), const(1)))[:5], CODE + 3,
@@ -98,6 +98,17 @@ def test_bad_code_is_refused_at_the_offending_byte(code: bytes, offset: int, mes
     error = refusal(file_of(code))
     assert (error.offset, error.refusal) == (offset, kind)
     assert message in error.message
+
+
+@pytest.mark.parametrize("minor", [0, ilc.DIGEST_MINOR])
+def test_an_instruction_newer_than_the_files_version_is_unknown(minor: int) -> None:
+    data = bytearray(file_of(op("LDI", 0) + op("MOVV", 0, 1)))
+    assert data[5] == isa.FUSED_MINOR  # the writer says what the code needs
+    data[5] = minor
+    error = refusal(with_crc(data))
+    assert (error.offset, error.refusal) == (CODE + 3, Refusal.UNKNOWN_OPCODE)
+    assert (f"code offset 3: MOVV is an instruction of format 1.{isa.FUSED_MINOR}, but the "
+            f"file says 1.{minor}") in error.message
 
 
 PARAMETERS = [(info, index, param) for info in isa.OPCODES.values()
@@ -180,7 +191,8 @@ def test_damage_is_refused_or_verifies_never_anything_else(data: bytes) -> None:
         return
     header = ilc.read_header(data)
     debug = program.image.debug
-    written_minor = ilc.DIGEST_MINOR if debug and debug.source_digest else 0
+    written_minor = max(isa.code_minor(program.image.code),
+                        ilc.DIGEST_MINOR if debug and debug.source_digest else 0)
     if (header.minor, header.flags) == (written_minor, 0):
         # One image, one encoding: what verifies is exactly what the writer writes.
         assert ilc.encode(program.image) == data

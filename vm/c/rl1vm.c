@@ -115,7 +115,7 @@ static rl1_fault call(rl1_vm *vm, uint8_t op, const uint8_t *operands)
     int16_t args[3];
     rl1_reading out = {0, {0, 0, 0, 0}};
     rl1_status status;
-    uint8_t shape, length = rl1_op_length(op, &shape), mask, k;
+    uint8_t shape, length = rl1_op_length(op, 0, &shape), mask, k;
     uint8_t arity = shape == RL1_SHAPE_ARGS ? (uint8_t)((length - 2u) / 2u) : 0u;
     if (arity) {
         mask = RL1_BYTE(operands);
@@ -199,7 +199,7 @@ static rl1_state ended(rl1_vm *vm, uint16_t at)
 static uint16_t call_length(uint8_t op)
 {
     uint8_t shape;
-    return rl1_op_length(op, &shape);
+    return rl1_op_length(op, 0, &shape);
 }
 
 /* Resumes a call in progress (12.2): polls it once. */
@@ -290,8 +290,29 @@ static rl1_state run(rl1_vm *vm, uint32_t n)
         case 0x30: /* JMP a */
             target = RL1_U16(code + pc + 1u);
             goto jump;
+        case 0x07: /* MOVV v, w (format 1.2, as the others below) */
+            V[RL1_BYTE(code + pc + 1u)] = V[RL1_BYTE(code + pc + 2u)];
+            pc = (uint16_t)(pc + 3u);
+            continue;
+        case 0x08: /* MOVI v, i */
+            V[RL1_BYTE(code + pc + 1u)] = (int16_t)RL1_U16(code + pc + 2u);
+            pc = (uint16_t)(pc + 4u);
+            continue;
+        case 0x09: /* MOVR v */
+            V[RL1_BYTE(code + pc + 1u)] = vm->R;
+            pc = (uint16_t)(pc + 2u);
+            continue;
         case 0x31: case 0x32: case 0x33: /* JZ, JGT, JLT v, a */
-            x = (uint16_t)V[RL1_BYTE(code + pc + 1u)];
+        case 0x34: /* DJGT v, a: V[v]--, then JGT */
+        case 0x35: case 0x36: case 0x37: /* SJZ, SJGT, SJLT v, a: V[v] = acc, then JZ ... */
+            x = RL1_BYTE(code + pc + 1u);
+            if (op == 0x34u) {
+                V[x] = (int16_t)(uint16_t)((uint16_t)V[x] - 1u);
+            } else if (op >= 0x35u) {
+                V[x] = (int16_t)acc;
+            }
+            x = (uint16_t)V[x];
+            op = (uint8_t)(op == 0x34u ? 0x32u : op >= 0x35u ? op - 4u : op); /* JZ JGT JLT */
             if (op == 0x31u ? x == 0u : op == 0x32u ? (x != 0u && x < 0x8000u) : x >= 0x8000u) {
                 target = RL1_U16(code + pc + 2u);
                 goto jump;

@@ -58,13 +58,14 @@ typedef struct rl1_program {
     const uint8_t *code;        /* the code section */
     const uint8_t *lines;       /* the first line entry; NULL without a debug section */
     const uint8_t *source_name; /* UTF-8, not NUL-terminated; NULL without debug */
-    const uint8_t *digest;      /* the 16-byte source digest (1.1); NULL when absent */
+    const uint8_t *digest;      /* the 16-byte source digest (1.1+); NULL when absent */
     uint16_t code_size;
     uint16_t handlers[4];       /* code offsets of :96..:99; RL1_ABSENT when undefined */
     uint16_t features;          /* bit n: the program needs device feature n */
     uint16_t flags;
     uint16_t line_count;
     uint8_t source_name_size;
+    uint8_t minor;              /* the format's minor version the file says */
 } rl1_program;
 
 #define RL1_ABSENT 0xFFFFu     /* a handler table entry for a label not defined */
@@ -116,10 +117,13 @@ void rl1_vm_init(rl1_vm *vm, const rl1_program *program, const rl1_hardware *har
 #define RL1_SHAPE_IMM 2u      /* i */
 #define RL1_SHAPE_ADDR 3u     /* a */
 #define RL1_SHAPE_VAR_ADDR 4u /* v, a */
-#define RL1_SHAPE_ARGS 5u     /* mask, then 2 bytes an argument */
+#define RL1_SHAPE_VAR_VAR 5u  /* v, v */
+#define RL1_SHAPE_VAR_IMM 6u  /* v, i */
+#define RL1_SHAPE_ARGS 7u     /* mask, then 2 bytes an argument */
 
-/* The length of instruction `op` and its operands' shape; 0 for an unknown opcode. */
-uint8_t rl1_op_length(uint8_t op, uint8_t *shape);
+/* The length of instruction `op` in a file of format minor version `minor`, and its
+ * operands' shape; 0 for an opcode unknown in that version. */
+uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape);
 
 /* Whether `value` lies in the range of parameter `index` of call `op`. */
 bool rl1_arg_in_range(uint8_t op, uint8_t index, int32_t value);

@@ -20,7 +20,8 @@
 #define FEATURE_SIZE 2u
 #define DIGEST_SIZE 16u
 #define DIGEST_MINOR 1u      /* the first minor version with a source digest */
-#define KNOWN_MINOR 1u       /* the newest minor version this reader knows */
+#define FUSED_MINOR 2u       /* the superinstructions, MOVV ... SJLT, came in 1.2 */
+#define KNOWN_MINOR 2u       /* the newest minor version this reader knows */
 #define REQUIRED_FLAGS 0x00FFu
 #define KNOWN_FEATURES 0x007Fu
 #define VARIABLES 53u
@@ -99,12 +100,33 @@ static uint32_t file_crc(const loader *ld)
 #define IMM RL1_SHAPE_IMM
 #define ADDR RL1_SHAPE_ADDR
 #define VAR_ADDR RL1_SHAPE_VAR_ADDR
+#define VAR_VAR RL1_SHAPE_VAR_VAR
+#define VAR_IMM RL1_SHAPE_VAR_IMM
 #define ARGS RL1_SHAPE_ARGS
 
-/* The operands of `op`, and 0 bytes for an opcode this version does not define. */
-uint8_t rl1_op_length(uint8_t op, uint8_t *shape)
+/* The operands of `op`, and 0 bytes for an opcode the file's minor version does not
+ * define (a superinstruction in a 1.0 or 1.1 file is unknown there). */
+uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape)
 {
     *shape = NONE;
+    if (minor >= FUSED_MINOR) {
+        if (op == 0x07u) {
+            *shape = VAR_VAR; /* MOVV */
+            return 3;
+        }
+        if (op == 0x08u) {
+            *shape = VAR_IMM; /* MOVI */
+            return 4;
+        }
+        if (op == 0x09u) {
+            *shape = VAR; /* MOVR */
+            return 2;
+        }
+        if (op >= 0x34u && op <= 0x37u) {
+            *shape = VAR_ADDR; /* DJGT, SJZ, SJGT, SJLT */
+            return 4;
+        }
+    }
     if (op == 0x00u || op == 0x03u || (op >= 0x20u && op <= 0x26u)) {
         return 1; /* END, LDR, the ...R arithmetic */
     }
@@ -359,6 +381,7 @@ static rl1_refusal check_container(loader *ld, rl1_program *program, uint32_t *c
         return fail(ld, RL1_BAD_CRC, 8);
     }
     program->flags = u16_at(file + 6);
+    program->minor = minor;
     if (program->flags & REQUIRED_FLAGS) { /* versions 1.0 and 1.1 define no flag */
         return fail(ld, RL1_REQUIRED_FLAG, 6);
     }
@@ -406,7 +429,7 @@ static bool starts_instruction(const starts *s, uint16_t target)
         return ((unsigned)s->bitmap[target >> 3] >> (target & 7u)) & 1u;
     }
     while (pos < target) {
-        pos += rl1_op_length(BYTE(s->program->code + pos), &shape);
+        pos += rl1_op_length(BYTE(s->program->code + pos), s->program->minor, &shape);
     }
     return pos == target;
 }
@@ -446,15 +469,18 @@ static rl1_refusal check_instructions(loader *ld, const rl1_program *program, ui
         uint32_t at = base + pos;
         uint8_t shape;
         rl1_refusal status = RL1_ACCEPTED;
-        length = rl1_op_length(op, &shape);
+        length = rl1_op_length(op, program->minor, &shape);
         if (length == 0u) {
             return fail(ld, RL1_UNKNOWN_OPCODE, at);
         }
         if (length > program->code_size - pos) {
             return fail(ld, RL1_CUT_OFF, at);
         }
-        if (shape == VAR || shape == VAR_ADDR) {
+        if (shape == VAR || shape == VAR_ADDR || shape == VAR_VAR || shape == VAR_IMM) {
             status = check_variable(ld, BYTE(ld->file + at + 1u), at + 1u);
+        }
+        if (status == RL1_ACCEPTED && shape == VAR_VAR) {
+            status = check_variable(ld, BYTE(ld->file + at + 2u), at + 2u);
         } else if (shape == ARGS) {
             status = check_call(ld, op, length, at + 1u);
         }
@@ -482,7 +508,7 @@ static rl1_refusal check_targets(loader *ld, const rl1_program *program, uint32_
     uint8_t i;
     while (pos < program->code_size) {
         uint8_t shape;
-        uint8_t length = rl1_op_length(BYTE(program->code + pos), &shape);
+        uint8_t length = rl1_op_length(BYTE(program->code + pos), program->minor, &shape);
         at = base + pos + (shape == VAR_ADDR ? 2u : 1u); /* the target operand */
         if ((shape == ADDR || shape == VAR_ADDR)
             && !starts_instruction(s, u16_at(ld->file + at))) {

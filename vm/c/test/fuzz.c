@@ -86,7 +86,7 @@ static rl1_status begin(void *ctx)
 static rl1_status call(void *ctx, uint8_t opcode, const int16_t *args, rl1_reading *out)
 {
     uint8_t shape;
-    if (opcode < 0x40u || opcode > 0x5Du || (rl1_op_length(opcode, &shape) > 1u) != (args != NULL)) {
+    if (opcode < 0x40u || opcode > 0x5Du || (rl1_op_length(opcode, 0, &shape) > 1u) != (args != NULL)) {
         __builtin_trap(); /* only calls, with arguments when they have any */
     }
     read_values(ctx, out);

@@ -1,0 +1,196 @@
+"""Constant folding and propagation, across blocks.
+
+Assumes: the IR is valid (`ir.validate`), so the accumulator is dead where a block starts.
+Keeps: every call, in order, with its arguments' values; the value of every variable
+after every instruction that remains; the line of every instruction that remains.
+
+A forward data flow finds the variables whose value is known where each block starts:
+all 53 are 0 where the program starts; nothing is known where a handler starts (an
+event can arrive from anywhere); a call forgets the reserved variables it writes. A
+branch on a known variable becomes a jump, and the path it no longer takes is not
+followed, so that code behind a branch that never goes that way learns nothing from it.
+
+Within a block, an expression whose operands are known is folded left to right with the
+VM's own arithmetic (16-bit wrap, the shift rules of spec/language.md 7.2). A known
+value is kept out of the accumulator until something needs it there (a store, an
+operation on an unknown operand), so a folded expression costs one load at most; an
+operation with a known operand that changes nothing (`+0`, `|0`, `&-1`, `<0`) goes; a
+store of the value the variable already holds goes; a variable argument with a known
+value in its parameter's range becomes a constant (out of range, it must stay a
+variable: that is a fault at run time). No path gets an instruction more, which keeps
+the budget invariant (spec/optimization.md, section 3).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+from rl1.vm.language import BUILTINS, VARIABLES
+from rl1.vm.machine import evaluate
+
+from . import flow, ir
+
+# The operand that leaves the accumulator as it is, for each operator; 0 unless listed.
+_IDENTITY = {"&": -1}
+# A known accumulator that no operand changes: (value, operator).
+_ABSORBING = {(0, "&"), (-1, "|"), (0, "<"), (0, ">")}
+
+Known = dict[str, int]
+"""The variables whose value is known at a point; a variable not in it is unknown."""
+
+
+def fold_constants(program: ir.Program) -> ir.Program:
+    for block_id, folded in _solve(program).items():
+        block = program.blocks[block_id]  # a block no path reaches is control.py's to remove
+        block.instructions, block.terminator = folded.instructions, folded.terminator
+    return program
+
+
+@dataclass(slots=True)
+class _Folded:
+    instructions: list[ir.Instruction]
+    terminator: ir.Terminator
+    known: Known  # where the block ends
+
+
+def _solve(program: ir.Program) -> dict[ir.BlockId, _Folded]:
+    """Each reachable block folded from what is known where it starts: the meet (the
+    values all agree on) of what its predecessors know at their ends, and of the start
+    of the program or a handler's entry. A worklist in layout order, each block queued
+    once at a time."""
+    starts: dict[ir.BlockId, list[Known]] = {block_id: [] for block_id in program.blocks}
+    starts[program.entry].append(dict.fromkeys(VARIABLES, 0))
+    for block_id in program.handlers.values():
+        starts[block_id].append({})
+    # For each block, what each predecessor visited so far knows where it leads there.
+    incoming: dict[ir.BlockId, dict[ir.BlockId, Known]] = {
+        block_id: {} for block_id in program.blocks}
+    entries: dict[ir.BlockId, Known] = {}
+    folded: dict[ir.BlockId, _Folded] = {}
+    work = deque(flow.roots(program))
+    queued = set(work)
+    while work:
+        block_id = work.popleft()
+        queued.discard(block_id)
+        known = _meet([*starts[block_id], *incoming[block_id].values()])
+        if entries.get(block_id) == known:
+            continue
+        entries[block_id] = known
+        before = folded.get(block_id)
+        after = folded[block_id] = _fold(program.blocks[block_id], dict(known))
+        for target in before.terminator.targets if before else ():
+            incoming[target].pop(block_id, None)
+        for target in after.terminator.targets:
+            incoming[target][block_id] = after.known
+            if target not in queued:
+                queued.add(target)
+                work.append(target)
+    return folded
+
+
+def _meet(states: list[Known]) -> Known:
+    if len(states) < 2:
+        return dict(states[0]) if states else {}
+    first, *rest = states
+    common = first.items() & rest[0].items()
+    for state in rest[1:]:
+        common &= state.items()
+    return dict(common)
+
+
+def _value(operand: ir.Operand, known: Known) -> int | None:
+    if isinstance(operand, ir.Imm):
+        return operand.value
+    if isinstance(operand, ir.Var):
+        return known.get(operand.name)
+    return None  # R: the device's answer
+
+
+def _fold(block: ir.Block, known: Known) -> _Folded:
+    out: list[ir.Instruction] = []
+    acc: int | None = None  # the accumulator's value, when known
+    pending = False  # whether that known value has yet to be loaded into the accumulator
+
+    def materialize(line: int) -> None:
+        nonlocal pending
+        if pending:
+            assert acc is not None
+            out.append(ir.Load(ir.Imm(acc), line))
+            pending = False
+
+    for instruction in block.instructions:
+        if isinstance(instruction, ir.Load):
+            acc = _value(instruction.source, known)
+            pending = acc is not None
+            if not pending:
+                out.append(instruction)
+        elif isinstance(instruction, ir.Operate):
+            operand = _value(instruction.source, known)
+            if acc is not None and operand is not None:
+                acc, pending = evaluate(instruction.op, acc, operand), True
+            elif operand is not None and operand == _IDENTITY.get(instruction.op, 0):
+                continue  # `+0`, `|0`, `&-1`, a shift by 0: the accumulator stays
+            elif pending and acc == _IDENTITY.get(instruction.op, 0) \
+                    and instruction.op in "+|^&":
+                out.append(ir.Load(instruction.source, instruction.line))  # `0+B` is `B`
+                acc, pending = None, False
+            elif pending and (acc, instruction.op) in _ABSORBING:
+                continue  # `0&B`, `-1|B`, 0 shifted: the accumulator is known still
+            else:
+                materialize(instruction.line)
+                out.append(instruction)
+                acc = None
+        elif isinstance(instruction, ir.Store):
+            name = instruction.target.name
+            if acc is not None and known.get(name) == acc:
+                continue  # the variable holds this value already
+            materialize(instruction.line)
+            out.append(instruction)
+            _set(known, name, acc)
+        elif isinstance(instruction, ir.StepVar):
+            out.append(instruction)
+            name = instruction.target.name
+            value = known.get(name)
+            _set(known, name, None if value is None
+                 else evaluate("+" if instruction.step == "++" else "-", value, 1))
+        elif isinstance(instruction, ir.Move):
+            out.append(instruction)
+            _set(known, instruction.target.name, _value(instruction.source, known))
+        else:
+            out.append(_call(instruction, known))
+            form = BUILTINS[instruction.mnemonic].form(instruction.selector)
+            assert form is not None
+            for name in form.writes:
+                known.pop(name, None)
+    return _Folded(out, _terminator(block.terminator, known), known)
+
+
+def _set(known: Known, name: str, value: int | None) -> None:
+    if value is None:
+        known.pop(name, None)
+    else:
+        known[name] = value
+
+
+def _call(call: ir.Call, known: Known) -> ir.Call:
+    """The call with each variable argument whose known value its parameter accepts
+    replaced by that value."""
+    form = BUILTINS[call.mnemonic].form(call.selector)
+    assert form is not None
+    args: list[ir.Argument] = []
+    for arg, param in zip(call.args, form.params, strict=True):
+        value = _value(arg, known)
+        in_range = value is not None and param.low <= value <= param.high
+        args.append(ir.Imm(value) if in_range and value is not None else arg)
+    return ir.Call(call.mnemonic, call.selector, tuple(args), call.line)
+
+
+def _terminator(terminator: ir.Terminator, known: Known) -> ir.Terminator:
+    if not isinstance(terminator, ir.Branch):
+        return terminator
+    value = known.get(terminator.var.name)
+    if value is None:
+        return terminator
+    holds = {"=": value == 0, ">": value > 0, "<": value < 0}[terminator.relation]
+    return ir.Jump(terminator.if_true if holds else terminator.if_false, terminator.line)

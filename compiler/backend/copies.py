@@ -1,0 +1,48 @@
+"""Copy propagation within a block: the loads and stores that move a value where it is.
+
+Assumes: the IR is valid (the accumulator is dead where a block starts).
+Keeps: every instruction but the loads and stores it drops; what every variable holds
+after every instruction that remains.
+
+Walking a block, it remembers the variables whose value the accumulator holds (after
+`load A` or `store A`, until A or the accumulator changes). A load of one of them
+(`STV A; LDV A`, as `A=B+1; C=A` compiles) and a store into one of them (`A=A`, or
+`B=A` after `A=B`) do nothing, and go.
+"""
+
+from __future__ import annotations
+
+from rl1.vm.language import BUILTINS
+
+from . import ir
+
+
+def propagate_copies(program: ir.Program) -> ir.Program:
+    for block in program:
+        block.instructions = _without_copies(block.instructions)
+    return program
+
+
+def _without_copies(instructions: list[ir.Instruction]) -> list[ir.Instruction]:
+    out: list[ir.Instruction] = []
+    holds: set[str] = set()  # the variables equal to the accumulator
+    for instruction in instructions:
+        if isinstance(instruction, ir.Load):
+            source = instruction.source
+            if isinstance(source, ir.Var) and source.name in holds:
+                continue
+            holds = {source.name} if isinstance(source, ir.Var) else set()
+        elif isinstance(instruction, ir.Store):
+            if instruction.target.name in holds:
+                continue
+            holds.add(instruction.target.name)
+        elif isinstance(instruction, ir.Operate):
+            holds = set()
+        elif isinstance(instruction, ir.StepVar | ir.Move):
+            holds.discard(instruction.target.name)
+        else:
+            form = BUILTINS[instruction.mnemonic].form(instruction.selector)
+            assert form is not None
+            holds.difference_update(form.writes)
+        out.append(instruction)
+    return out

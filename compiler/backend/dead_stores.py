@@ -1,0 +1,96 @@
+"""Dead store removal: a store (or a step) whose value no one can see.
+
+Assumes: the IR is valid (the accumulator is dead where a block starts).
+Keeps: every call and terminator; the value of every variable wherever it can be seen
+(spec/optimization.md, section 2): at the end, at every call (which can fault, and
+after which an event can be taken) and, in a program that can take lost-line events,
+at every jump (where an event can be taken).
+
+A backward data flow over the variables: a variable is live where some path reads it
+before writing it, or reaches one of those points first. A store or a step of a
+variable that is not live goes, and with a store the load and operations that computed
+its value, when nothing else uses the accumulator (they have no other effect; a call
+among them stays).
+"""
+
+from __future__ import annotations
+
+from rl1.vm.language import VARIABLES
+
+from . import flow, ir
+
+ALL = frozenset(VARIABLES)
+
+
+def remove_dead_stores(program: ir.Program) -> ir.Program:
+    events = flow.takes_events(program)
+    live_in = _live_in(program, events)
+    for block in program:
+        block.instructions, _ = _sweep(block, _live_out(block, live_in, events))
+    return program
+
+
+def _live_out(block: ir.Block, live_in: dict[ir.BlockId, frozenset[str]],
+              events: bool) -> frozenset[str]:
+    terminator = block.terminator
+    if isinstance(terminator, ir.End) or events:
+        return ALL  # the final variables; or a handler (or a fault) after a jump
+    live = frozenset().union(*(live_in.get(target, frozenset())
+                               for target in terminator.targets))
+    return live | {terminator.var.name} if isinstance(terminator, ir.Branch) else live
+
+
+def _live_in(program: ir.Program, events: bool) -> dict[ir.BlockId, frozenset[str]]:
+    preds = program.predecessors()
+    live_in: dict[ir.BlockId, frozenset[str]] = {}
+    work = list(program.blocks)
+    while work:
+        block_id = work.pop()
+        block = program.blocks[block_id]
+        _, live = _sweep(block, _live_out(block, live_in, events))
+        if live_in.get(block_id) != live:
+            live_in[block_id] = live
+            work.extend(preds[block_id])
+    return live_in
+
+
+def _sweep(block: ir.Block, live_out: frozenset[str]
+           ) -> tuple[list[ir.Instruction], frozenset[str]]:
+    """The block's instructions without its dead ones, and what is live where it
+    starts."""
+    live = set(live_out)
+    terminator = block.terminator
+    if isinstance(terminator, ir.StoreBranch):
+        live.discard(terminator.var.name)  # stored here, from the accumulator
+    elif isinstance(terminator, ir.DecrementBranch):
+        live.add(terminator.var.name)
+    # Whether an instruction after this point reads the accumulator.
+    acc_used = isinstance(terminator, ir.StoreBranch)
+    kept: list[ir.Instruction] = []
+    for instruction in reversed(block.instructions):
+        if isinstance(instruction, ir.Call):
+            live = set(ALL)  # a fault here shows every variable
+        elif isinstance(instruction, ir.Move):
+            if instruction.target.name not in live:
+                continue
+            live.discard(instruction.target.name)
+            if isinstance(instruction.source, ir.Var):
+                live.add(instruction.source.name)
+        elif isinstance(instruction, ir.Store):
+            name = instruction.target.name
+            if name not in live:
+                continue
+            live.discard(name)
+            acc_used = True
+        elif isinstance(instruction, ir.StepVar):
+            if instruction.target.name not in live:
+                continue
+        elif not acc_used:
+            continue  # a load or operation whose result no one reads
+        else:
+            if isinstance(instruction.source, ir.Var):
+                live.add(instruction.source.name)
+            acc_used = isinstance(instruction, ir.Operate)
+        kept.append(instruction)
+    kept.reverse()
+    return kept, frozenset(live)

@@ -1,0 +1,127 @@
+"""`rl1c fuzz`: differential fuzzing of RL/I engines, ours and anyone's.
+
+The campaign and the comparison are compiler/fuzz.py's and compiler/differential.py's;
+this module reads the options, draws the progress bar and reports. It imports them
+when it runs: they load Hypothesis.
+"""
+
+from __future__ import annotations
+
+import random
+import sys
+
+import click
+
+from rl1.compiler.reporting.render import EXIT_ERRORS
+
+from .command import PATH, Command, Failure, a_budget, at_least_one
+
+SECTION = "Testing"
+
+DEFAULT_COUNT = 1000
+DEFAULT_BUDGET = 20_000  # generated programs are short; a runaway is found quickly
+BAR_WIDTH = 30
+
+
+@click.command(cls=Command)
+@click.option("--engine", "engine_names", multiple=True, metavar="NAME",
+              help="an engine to compare, repeatable: ast, vm-O0, vm-O1, vm-O2, the C VM "
+                   "of the firmware c-O0, c-O1, c-O2 (built on first use), or "
+                   "exec:COMMAND ({ilc}, {sensors} and {budget} replaced; it prints the run "
+                   "as `rl1c run --format json` does). Default: ast, vm-O0, vm-O1, vm-O2; "
+                   "the first is the reference")
+@click.option("--count", type=str, default=None, callback=lambda c, p, v: None if v is None
+              else at_least_one(c, p, v), metavar="N",
+              help=f"programs to run (default {DEFAULT_COUNT})")
+@click.option("--time", "seconds", type=str, default=None, metavar="SECONDS",
+              callback=lambda c, p, v: None if v is None else at_least_one(c, p, v),
+              help="run for this long instead of a count")
+@click.option("--seed", type=str, default=None, metavar="N",
+              help="the seed of the generator, to repeat a campaign (default: random)")
+@click.option("--out", "out_dir", default="fuzz-out", show_default=True, metavar="DIR",
+              type=PATH, help="where to write the reproducer of a disagreement")
+@click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget,
+              metavar="N", show_default=True, help="the budget of every run")
+def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
+         seed: str | None, out_dir: str, budget: int) -> int:
+    """Run generated programs on several engines and compare what they do.
+
+    Every program (with a sensor script to match) runs on each engine; the runs must
+    agree on the device trace, how they end and the final variables, and optimized code
+    must keep the budget invariant (spec/optimization.md). On the first disagreement the
+    program is shrunk to a small one, written with each engine's run and a replay
+    script to --out, and the difference printed. Exit status: 0 all agreed, 1 a
+    disagreement, 2 a usage problem."""
+    from rl1.compiler.differential import DEFAULT_ENGINES, ENGINE_NAMES, Engine, engine_named
+    from rl1.compiler.frontend.source import split_lines
+    from rl1.compiler.fuzz import campaign, write_reproducer
+    from rl1.vm.native import BuildError
+
+    if count is not None and seconds is not None:
+        raise click.UsageError("give --count or --time, not both")
+    engines: list[Engine] = []
+    for name in engine_names or DEFAULT_ENGINES:
+        engine = engine_named(name)
+        if engine is None:
+            raise click.UsageError(f"argument --engine: unknown engine {name!r} (choose from "
+                                   f"{', '.join(ENGINE_NAMES)}, or exec:COMMAND)")
+        engines.append(engine)
+    if len({engine.name for engine in engines}) < 2 or len(set(engine_names)) < len(
+            engine_names):
+        raise click.UsageError("argument --engine: give at least two different engines")
+    try:
+        seed_value = random.SystemRandom().randrange(2**32) if seed is None else int(seed)
+    except ValueError:
+        raise click.UsageError(f"argument --seed: expected a whole number, got {seed!r}"
+                               ) from None
+    limit = None if seconds is not None else count or DEFAULT_COUNT
+    bar = _Bar(limit, seconds)
+    try:
+        outcome = campaign(engines, budget, count=limit, seconds=seconds, seed=seed_value,
+                           progress=bar.update)
+    except BuildError as error:  # a c-ON engine on a machine without a C compiler
+        raise Failure(f"error: {error}") from None
+    finally:
+        bar.close()
+    names = ", ".join(engine.name for engine in engines)
+    rate = outcome.programs / outcome.seconds if outcome.seconds else 0.0
+    summary = (f"fuzz: {outcome.programs} programs in {outcome.seconds:.1f} s "
+               f"({rate:.1f} per second); engines {names}; seed {seed_value}")
+    if outcome.finding is None:
+        click.echo(f"{summary}: all agreed")
+        return 0
+    finding = outcome.finding
+    replay = write_reproducer(out_dir, finding, engines, budget)
+    numbered = "\n".join(f"{number:4} | {line}" for number, line
+                         in enumerate(split_lines(finding.case.source), 1))
+    click.echo(f"{summary}: the engines disagree (reference: {engines[0].name})\n\n"
+               f"the smallest program found:\n{numbered}\n\n"
+               + "\n".join(finding.verdict.problems)
+               + f"\n\nreproducer: {out_dir} (program, sensor script, each engine's run); "
+                 f"replay: {replay}")
+    return EXIT_ERRORS
+
+
+class _Bar:
+    """A progress bar on standard error, when it is a terminal."""
+
+    def __init__(self, count: int | None, seconds: int | None) -> None:
+        self.count, self.seconds = count, seconds
+        self.shown = sys.stderr.isatty()
+
+    def update(self, programs: int, elapsed: float) -> None:
+        if not self.shown or programs % 10:
+            return
+        done = programs / self.count if self.count else elapsed / (self.seconds or 1)
+        filled = int(BAR_WIDTH * min(done, 1.0))
+        rate = programs / elapsed if elapsed else 0.0
+        sys.stderr.write(f"\r[{'#' * filled}{'.' * (BAR_WIDTH - filled)}] {programs} programs, "
+                         f"{rate:.0f}/s, {elapsed:.0f} s")
+        sys.stderr.flush()
+
+    def close(self) -> None:
+        if self.shown:
+            sys.stderr.write("\n")
+
+
+COMMANDS = (fuzz,)

@@ -1,0 +1,289 @@
+"""Differential runs: one program and sensor script on several engines, and what differs.
+
+spec/optimization.md is the contract: section 2 says what is observable (the device
+trace, how the run ends, the 53 variables), section 3 the budget invariant between
+optimization levels, section 5 the engines (`ast`, `vm-O0`..`vm-O2`, `c-O0`..`c-O2`,
+`exec:COMMAND`). `rl1c fuzz` and the property tests both compare runs through this
+module. The C VM of the firmware (vm/c/, through vm/native.py) is one more `Engine`: a
+name and a `run`.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shlex
+import subprocess
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+from rl1.compiler.analysis import analyze
+from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
+from rl1.compiler.interpreter import interpret
+from rl1.compiler.strategies import Run
+from rl1.vm.faults import FaultKind
+from rl1.vm.hardware import Blocking
+from rl1.vm.language import VARIABLES
+from rl1.vm.machine import Machine
+from rl1.vm.native import NativeMachine, library, load
+from rl1.vm.scripted import ScriptedDevice, parse_script, run_document
+from rl1.vm.verifier import verify
+
+SOURCE_NAME = "fuzz.rob"
+EXEC_TIMEOUT = 10.0  # seconds an exec: engine may take for one run
+BUDGET_CODE = FaultKind.BUDGET.code
+
+
+@dataclass(frozen=True)
+class Observation:
+    """What section 2 of spec/optimization.md says a run shows, and, from the reference
+    VM, the instructions executed (in all, and up to each call)."""
+
+    document: dict[str, Any]  # as scripted.run_document gives it
+    executed: int | None = None
+    call_counts: tuple[int, ...] | None = None
+
+    @property
+    def ran_away(self) -> bool:
+        status = self.document.get("status")
+        return isinstance(status, dict) and status.get("code") == BUDGET_CODE
+
+    def ending(self) -> object:
+        status = self.document.get("status")
+        if isinstance(status, dict):
+            return {"code": status.get("code"), "line": status.get("line")}
+        return status
+
+    def commands(self) -> list[Any]:
+        """The trace, without the stop that ends a run the watchdog stopped."""
+        trace = list(self.document.get("trace", []))
+        if self.ran_away and trace and trace[-1].get("call") == "STOP":
+            trace.pop()
+        return trace
+
+
+class Engine(Protocol):
+    @property
+    def name(self) -> str: ...
+
+    def run(self, case: Run, budget: int) -> Observation: ...
+
+
+@dataclass(frozen=True)
+class AstEngine:
+    """The AST interpreter: the reference for what a program means."""
+
+    name: str = "ast"
+
+    def run(self, case: Run, budget: int) -> Observation:
+        device = ScriptedDevice(parse_script(case.script))
+        result = interpret(analyze(case.source).program, device, budget)
+        return Observation(run_document(result, device.trace))
+
+
+@dataclass(frozen=True)
+class VmEngine:
+    """The compiler at one level, then the reference VM."""
+
+    level: int
+    name: str = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "name", f"vm-O{self.level}")
+
+    def run(self, case: Run, budget: int) -> Observation:
+        device = ScriptedDevice(parse_script(case.script))
+        machine = Machine(verify(compiled(case.source, self.level)), Blocking(device), budget)
+        result = machine.run()
+        return Observation(run_document(result, device.trace), machine.executed,
+                           tuple(machine.call_counts))
+
+
+@dataclass(frozen=True)
+class CEngine:
+    """The compiler at one level, then the C VM of the firmware (built on first use:
+    native.BuildError when this machine has no C compiler)."""
+
+    level: int
+    name: str = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "name", f"c-O{self.level}")
+
+    def run(self, case: Run, budget: int) -> Observation:
+        device = ScriptedDevice(parse_script(case.script))
+        machine = NativeMachine(compiled(case.source, self.level), Blocking(device), budget,
+                                load(library()))
+        result = machine.run()
+        return Observation(run_document(result, device.trace), machine.executed)
+
+
+@dataclass(frozen=True)
+class ExecEngine:
+    """A command run once per program (spec/optimization.md, section 5)."""
+
+    command: str
+    name: str = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "name", f"exec:{self.command}")
+
+    def command_line(self, ilc_path: str, sensors_path: str, budget: int) -> str:
+        return (self.command.replace("{ilc}", shlex.quote(ilc_path))
+                .replace("{sensors}", shlex.quote(sensors_path))
+                .replace("{budget}", str(budget)))
+
+    def run(self, case: Run, budget: int) -> Observation:
+        with tempfile.TemporaryDirectory(prefix="rl1-fuzz-") as folder:
+            ilc_path = os.path.join(folder, "fuzz.ilc")
+            sensors_path = os.path.join(folder, "fuzz.sensors.json")
+            with open(ilc_path, "wb") as stream:
+                stream.write(compiled(case.source, 0))
+            with open(sensors_path, "w", encoding="utf-8") as stream:
+                json.dump(case.script, stream)
+            try:
+                done = subprocess.run(self.command_line(ilc_path, sensors_path, budget),
+                                      shell=True, capture_output=True, timeout=EXEC_TIMEOUT,
+                                      check=False)
+            except subprocess.TimeoutExpired:
+                return Observation({"status": {"code": "timeout", "line": None},
+                                    "variables": {}, "trace": []})
+        return Observation(_document(done.stdout, done.stderr))
+
+
+def _document(stdout: bytes, stderr: bytes) -> dict[str, Any]:
+    """The run an exec: engine printed, or a status saying it printed none."""
+    try:
+        document = json.loads(stdout)
+    except (UnicodeDecodeError, json.JSONDecodeError):
+        document = None
+    if isinstance(document, dict) and {"status", "variables", "trace"} <= set(document):
+        return document
+    said = stderr.decode("utf-8", "replace").strip().splitlines()
+    return {"status": {"code": "no-run", "line": None,
+                       "message": said[-1] if said else "no output"},
+            "variables": {}, "trace": []}
+
+
+def compiled(source: str, level: int) -> bytes:
+    """The .ilc bytes of a generated program (which the checker accepts), the IR
+    validated after every pass."""
+    output = compile_text(source, SOURCE_NAME, level=level, check=True).output
+    assert output is not None, "a generated program has errors"
+    return output
+
+
+DEFAULT_ENGINES = ("ast", *(f"vm-O{level}" for level in OPTIMIZATION_LEVELS))
+ENGINE_NAMES = (*DEFAULT_ENGINES, *(f"c-O{level}" for level in OPTIMIZATION_LEVELS))
+
+
+def engine_named(name: str) -> Engine | None:
+    """The engine a name on the command line means; None when it means none."""
+    if name == "ast":
+        return AstEngine()
+    if name.startswith("vm-O") and name[4:] in {str(level) for level in OPTIMIZATION_LEVELS}:
+        return VmEngine(int(name[4:]))
+    if name.startswith("c-O") and name[3:] in {str(level) for level in OPTIMIZATION_LEVELS}:
+        return CEngine(int(name[3:]))
+    if name.startswith("exec:") and name[5:].strip():
+        return ExecEngine(name[5:])
+    return None
+
+
+# Comparing runs --------------------------------------------------------------------------
+
+
+def differences(reference: Observation, other: Observation) -> list[str]:
+    """How `other` differs from `reference`, one line each; empty when they agree. When
+    either met the watchdog, only the traces up to it are compared (engines count steps
+    differently, and optimized code runs fewer)."""
+    found: list[str] = []
+    ours, theirs = reference.commands(), other.commands()
+    if reference.ran_away or other.ran_away:
+        shorter = min(len(ours), len(theirs))
+        ours, theirs = ours[:shorter], theirs[:shorter]
+    for index, (mine, yours) in enumerate(zip(ours, theirs, strict=False)):
+        if mine != yours:
+            found.append(f"trace entry {index + 1}: {_entry(mine)} / {_entry(yours)}")
+            break
+    else:
+        if len(ours) != len(theirs):
+            longer = ours if len(ours) > len(theirs) else theirs
+            found.append(f"trace: {len(ours)} / {len(theirs)} entries, the first extra "
+                         f"one {_entry(longer[min(len(ours), len(theirs))])}")
+    if reference.ran_away or other.ran_away:
+        return found
+    if reference.ending() != other.ending():
+        found.append(f"ending: {_ending(reference)} / {_ending(other)}")
+    mine_vars = reference.document.get("variables", {})
+    your_vars = other.document.get("variables", {})
+    changed = [name for name in VARIABLES if mine_vars.get(name) != your_vars.get(name)]
+    if changed:
+        found.append("variables: " + ", ".join(
+            f"{name} {mine_vars.get(name)} / {your_vars.get(name)}" for name in changed[:8])
+            + (f" and {len(changed) - 8} more" if len(changed) > 8 else ""))
+    return found
+
+
+def budget_violations(unoptimized: Observation, optimized: Observation,
+                      budget: int) -> list[str]:
+    """Where an optimized VM run breaks the budget invariant (spec/optimization.md,
+    section 3) against the -O0 run of the same program."""
+    found: list[str] = []
+    before, after = unoptimized.call_counts or (), optimized.call_counts or ()
+    for index, (then, now) in enumerate(zip(before, after, strict=False)):
+        if now > then:
+            found.append(f"call {index + 1} comes after {now} instructions, "
+                         f"-O0 reached it after {then}")
+            break
+    ended = not unoptimized.ran_away and (unoptimized.executed or 0) <= budget
+    if ended and optimized.ran_away:
+        found.append("met the watchdog where -O0 ended within the budget")
+    if ended and not optimized.ran_away and (optimized.executed or 0) > (
+            unoptimized.executed or 0):
+        found.append(f"ran {optimized.executed} instructions, -O0 {unoptimized.executed}")
+    return found
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """Every engine's run of one case, and what disagrees (empty when all agree)."""
+
+    observations: dict[str, Observation]
+    problems: list[str]
+
+
+def judge(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
+    """Run `case` on every engine; compare each with the first, and the optimized VM
+    runs with the -O0 one."""
+    observations = {engine.name: engine.run(case, budget) for engine in engines}
+    names = list(observations)
+    reference = observations[names[0]]
+    problems = [f"{name}: {line}" for name in names[1:]
+                for line in differences(reference, observations[name])]
+    unoptimized = observations.get("vm-O0")
+    if unoptimized is not None:
+        problems += [f"{name}: {line}" for name in names
+                     if name.startswith("vm-O") and name != "vm-O0"
+                     for line in budget_violations(unoptimized, observations[name], budget)]
+    return Verdict(observations, problems)
+
+
+def _entry(entry: Any) -> str:
+    if not isinstance(entry, dict):
+        return repr(entry)
+    args = ",".join(map(str, entry.get("args", [])))
+    result = entry.get("result")
+    read = " -> " + " ".join(map(str, result)) if result is not None else ""
+    return f"{entry.get('call')} {args}{read} at {entry.get('time')} ms".replace("  ", " ")
+
+
+def _ending(observation: Observation) -> str:
+    ending = observation.ending()
+    if isinstance(ending, dict):
+        line = ending.get("line")
+        return f"fault {ending.get('code')}" + (f" at line {line}" if line else "")
+    return "ended normally" if ending == "ok" else repr(ending)
+

@@ -1,0 +1,197 @@
+"""A differential fuzzing campaign: generated runs on several engines until one
+disagrees, then that run shrunk to a small one and written down as a reproducer.
+
+Runs come from `strategies.runs()`; Hypothesis' `find` generates them and, on the first
+disagreement, shrinks the run to the smallest it can find that still disagrees (the
+disagreement may change on the way: it is the smallest run that shows one), for at most
+SHRINK_SECONDS: a slow `exec:` engine can make shrinking take long. `judge` in
+differential.py decides what disagrees (spec/optimization.md).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import re
+import shlex
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from random import Random
+from typing import TypeVar
+
+from hypothesis import HealthCheck, Phase, find, settings
+from hypothesis.errors import NoSuchExample
+
+from rl1.compiler.analysis import analyze
+from rl1.compiler.differential import (
+    AstEngine,
+    CEngine,
+    Engine,
+    ExecEngine,
+    Verdict,
+    VmEngine,
+    compiled,
+    judge,
+)
+from rl1.compiler.frontend.source import split_lines
+from rl1.compiler.strategies import Run, runs
+
+SHRINK_SECONDS = 20.0  # Hypothesis' shrinking stops here, with the smallest run so far
+LABEL = re.compile(r"[ \t\f\v]*:[0-9]*")  # a label where a line starts (language 3.1)
+SOURCE = "program.rob"
+SCRIPT = "program.sensors.json"
+
+
+@dataclass(frozen=True)
+class Finding:
+    """The smallest run found that disagrees, and every engine's run of it."""
+
+    case: Run
+    verdict: Verdict
+
+
+@dataclass(frozen=True)
+class Outcome:
+    programs: int  # programs run up to the first disagreement (or in all)
+    seconds: float  # the time they took (shrinking not counted)
+    finding: Finding | None
+
+
+class _TimeUp(Exception):
+    pass
+
+
+def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
+             seconds: float | None, seed: int,
+             progress: Callable[[int, float], None]) -> Outcome:
+    """Run generated programs on `engines` until `count` programs or `seconds` have
+    passed, or until they disagree; `progress(programs, elapsed)` after each program."""
+    start = time.monotonic()
+    programs = 0
+    found_after: float | None = None  # seconds until the first disagreement
+    smallest: Run | None = None  # the last run that disagreed: the smallest so far
+
+    def disagrees(case: Run) -> bool:
+        nonlocal programs, found_after, smallest
+        elapsed = time.monotonic() - start
+        if found_after is None:
+            if seconds is not None and elapsed >= seconds:
+                raise _TimeUp
+            programs += 1
+            progress(programs, elapsed)
+        elif elapsed - found_after > SHRINK_SECONDS:
+            raise _TimeUp  # small enough: keep the smallest so far
+        if not judge(case, engines, budget).problems:
+            return False
+        if found_after is None:
+            found_after = elapsed
+        smallest = case
+        return True
+
+    limits = settings(max_examples=count or 10**9, database=None, deadline=None,
+                      suppress_health_check=list(HealthCheck),
+                      phases=(Phase.generate, Phase.shrink))
+    with contextlib.suppress(NoSuchExample, _TimeUp):
+        smallest = find(runs(), disagrees, settings=limits, random=Random(seed))
+    elapsed = time.monotonic() - start if found_after is None else found_after
+    if smallest is None:
+        return Outcome(programs, elapsed, None)
+    smallest = _deleted(smallest, lambda case: bool(judge(case, engines, budget).problems))
+    return Outcome(programs, elapsed, Finding(smallest, judge(smallest, engines, budget)))
+
+
+def _deleted(case: Run, disagrees: Callable[[Run], bool]) -> Run:
+    """The run with its comments gone and each label on a line of its own, then the
+    lines, and the statements of each line, that the disagreement does not need (and
+    the checker does not miss) deleted, in halves, quarters... down to one, until
+    nothing more goes: the last step of shrinking, cheap where Hypothesis' is slow (a
+    slow `exec:` engine)."""
+    def source(lines: list[list[str]]) -> str:
+        return "".join(";".join(statements) + "\n" for statements in lines)
+
+    def keeps(lines: list[list[str]]) -> bool:
+        text = source(lines)
+        return not analyze(text).has_errors and disagrees(Run(text, case.script))
+
+    lines: list[list[str]] = []
+    for line in split_lines(case.source):
+        label = LABEL.match(line)
+        code = line.split("'", 1)[0][label.end() if label else 0:]
+        lines += [[label.group().strip()]] if label else []
+        lines += [code.split(";")] if code.strip(" \t\f\v;") else []
+    if not keeps(lines):
+        return case  # the checker objects to the program laid out so
+    while True:
+        before = len(source(lines))
+        lines = _reduce(lines, keeps)
+        for row in range(len(lines)):
+            lines[row] = _reduce(lines[row], _in_row(lines, row, keeps))
+        if len(source(lines)) == before:
+            return Run(source(lines), case.script)
+
+
+def _in_row(lines: list[list[str]], row: int, keeps: Callable[[list[list[str]]], bool]
+            ) -> Callable[[list[str]], bool]:
+    """`keeps` for the statements of one line, the others as they are."""
+    return lambda statements: keeps([*lines[:row], statements, *lines[row + 1:]])
+
+
+T = TypeVar("T")
+
+
+def _reduce(items: list[T], keeps: Callable[[list[T]], bool]) -> list[T]:
+    """`items` without the runs of them that `keeps` does not need, trying runs of half
+    their number first, then of a quarter, down to single items; never empty."""
+    size = len(items) // 2
+    while size >= 1:
+        start = 0
+        while start < len(items):
+            shorter = items[:start] + items[start + size:]
+            if shorter and keeps(shorter):
+                items = shorter
+            else:
+                start += size
+        size //= 2
+    return items
+
+
+def write_reproducer(folder: str, finding: Finding, engines: Sequence[Engine],
+                     budget: int) -> str:
+    """Write the run, its compiled files, each engine's run and `replay.sh` (every
+    engine's run again, one command each) into `folder`; the command that replays it."""
+    os.makedirs(folder, exist_ok=True)
+    case = finding.case
+
+    def write(name: str, data: bytes | str) -> str:
+        path = os.path.join(folder, name)
+        with open(path, "wb") as stream:
+            stream.write(data.encode("utf-8") if isinstance(data, str) else data)
+        return name
+
+    write(SOURCE, case.source)
+    write(SCRIPT, json.dumps(case.script, indent=2) + "\n")
+    commands = ["#!/bin/sh", "# Each engine's run of the program, as `rl1c fuzz` compared "
+                "them.", 'cd "$(dirname "$0")"']
+    for index, engine in enumerate(engines, 1):
+        slug = re.sub(r"[^A-Za-z0-9]+", "-", engine.name).strip("-")[:40]
+        write(f"run-{index}-{slug}.json",
+              json.dumps(finding.verdict.observations[engine.name].document, indent=2) + "\n")
+        commands.append(_replay(engine, case, budget, write))
+    write("replay.sh", "\n".join(commands) + "\n")
+    return f"sh {shlex.quote(os.path.join(folder, 'replay.sh'))}"
+
+
+def _replay(engine: Engine, case: Run, budget: int,
+            write: Callable[[str, bytes | str], str]) -> str:
+    run = f"--sensors {SCRIPT} --budget {budget} --format json"
+    if isinstance(engine, AstEngine):
+        return f"rl1c run {SOURCE} --engine ast {run}"
+    if isinstance(engine, VmEngine | CEngine):
+        ilc = write(f"program-O{engine.level}.ilc", compiled(case.source, engine.level))
+        return f"rl1c run {ilc} {run}" + (" --engine c" if isinstance(engine, CEngine) else "")
+    if isinstance(engine, ExecEngine):
+        ilc = write("program-O0.ilc", compiled(case.source, 0))
+        return engine.command_line(ilc, SCRIPT, budget)
+    return f"# {engine.name}: no command replays it"

@@ -1,0 +1,269 @@
+"""Each optimizer pass alone, on small IR: what it rewrites, and what it must leave."""
+
+from __future__ import annotations
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from support.semantics import operate
+
+from rl1.compiler.backend import ir, optimize
+from rl1.compiler.backend.constants import fold_constants
+from rl1.compiler.backend.control import simplify_control
+from rl1.compiler.backend.copies import propagate_copies
+from rl1.compiler.backend.dead_stores import remove_dead_stores
+from rl1.compiler.backend.ir import (
+    Block,
+    Branch,
+    Call,
+    End,
+    Imm,
+    Jump,
+    Load,
+    Operate,
+    Program,
+    StepVar,
+    Store,
+    Var,
+)
+from rl1.compiler.backend.lower import lower
+from rl1.compiler.backend.peephole import rewrite_steps
+from rl1.compiler.backend.superinstructions import fuse
+from rl1.compiler.frontend.parser import parse_program
+
+A, B, C, X = Var("A"), Var("B"), Var("C"), Var("x")
+
+
+def lowered(text: str) -> Program:
+    program, diagnostics = parse_program(text)
+    assert diagnostics == []
+    return lower(program)
+
+
+def after(run: optimize.Pass, text: str) -> Program:
+    program = run(lowered(text))
+    assert ir.validate(program) == []
+    return program
+
+
+def code(program: Program, block_id: str | None = None) -> list[str]:
+    """A block's instructions and terminator as IR text, without their lines."""
+    block = program.blocks[block_id or program.entry]
+    return [str(item) for item in [*block.instructions, block.terminator]]
+
+
+# Constant folding and propagation ------------------------------------------------------
+
+
+def test_expressions_of_known_values_fold_to_one_load() -> None:
+    program = after(fold_constants, "A=5; B=A+3<2; C=B-A")
+    assert code(program) == ["load 5", "store A", "load 32", "store B", "load 27",
+                             "store C", "end"]
+
+
+def test_every_variable_starts_at_zero_so_storing_zero_first_does_nothing() -> None:
+    assert code(after(fold_constants, "A=0; B=A+C; (MOV B,B)")) == ["call MOV 0, 0", "end"]
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.sampled_from("+-&|^<>"), st.integers(-32768, 32767), st.integers(-32768, 32767))
+def test_folding_follows_the_16_bit_wrap_and_shift_rules(op: str, left: int, right: int
+                                                         ) -> None:
+    program = after(fold_constants, f"A={left}\nB={right}\nC=A{op}B; (FZO C,C)")
+    result = Imm(operate(op, left, right))
+    assert program.blocks[program.entry].instructions[-1] == Call("FZO", None,
+                                                                  (result, result), 3)
+
+
+def test_an_unknown_operand_gets_the_known_value_so_far_loaded_before_it() -> None:
+    assert code(after(fold_constants, "A=2+3+(KYO)-1")) == [
+        "call KYO", "load 5", "add R", "sub 1", "store A", "end"]
+    # 0+B is B, 0&B is 0, and operations that change nothing go.
+    assert code(after(fold_constants, "B=(KYO); A=0+B+0|0; C=0&B<3")) == [
+        "call KYO", "load R", "store B", "load B", "store A", "end"]
+
+
+def test_knowledge_crosses_blocks_and_a_known_branch_becomes_a_jump() -> None:
+    program = after(fold_constants, "A=3\n:10 B=A+1\n?A=#20\nC=B\n:20 (END)")
+    # A is 3 wherever :10 runs, so `?A=#20` never jumps: B1 (line 4) follows.
+    assert code(program, "L10") == ["load 4", "store B", "jump B1"]
+    assert code(program, "B1") == ["load 4", "store C", "jump L20"]
+
+
+def test_a_loop_forgets_what_its_body_changes() -> None:
+    program = after(fold_constants, "A=3; B=7\n:10 A--; C=B+1; ?A>#10")
+    assert code(program, "L10") == ["dec A", "load 8", "store C",
+                                    "if A>0 then L10 else B1"]
+
+
+def test_handlers_and_reserved_variables_start_unknown() -> None:
+    program = after(fold_constants, "A=5; x=1; (TRC 3); (MOV 1,1); (IMG); B=x\n:96 C=A")
+    assert code(program)[-3:] == ["load x", "store B", "jump L96"]
+    assert code(program, "L96") == ["load A", "store C", "end"]
+
+
+def test_a_known_argument_becomes_a_constant_only_within_its_range() -> None:
+    assert code(after(fold_constants, "A=12; B=13; (MOV A,B)"))[-2] == "call MOV 12, B"
+
+
+# Copy propagation -------------------------------------------------------------------------
+
+
+def test_a_load_of_what_the_accumulator_holds_goes() -> None:
+    assert code(after(propagate_copies, "A=B+1; C=A; D=C")) == [
+        "load B", "add 1", "store A", "store C", "store D", "end"]
+    assert code(after(propagate_copies, "A=B; B=A; A=A")) == ["load B", "store A", "end"]
+
+
+def test_a_step_or_a_call_that_changes_the_variable_keeps_the_load() -> None:
+    assert code(after(propagate_copies, "A=x; (IMG); B=x; B++; C=B")) == [
+        "load x", "store A", "call IMG", "load x", "store B", "inc B", "load B",
+        "store C", "end"]
+
+
+# Dead stores --------------------------------------------------------------------------------
+
+
+def test_a_store_overwritten_before_any_use_goes_with_its_expression() -> None:
+    assert code(after(remove_dead_stores, "A=B+(KYO); A=1; A++; A=2")) == [
+        "call KYO", "load 2", "store A", "end"]
+    assert code(after(remove_dead_stores, "A=1; A++; A=2")) == ["load 2", "store A", "end"]
+
+
+def test_stores_seen_by_a_call_or_the_end_stay() -> None:
+    assert code(after(remove_dead_stores, "A=1; (TIM 1); A=2")) == [
+        "load 1", "store A", "call TIM 1", "load 2", "store A", "end"]
+
+
+def test_across_a_jump_a_store_is_dead_only_without_lost_line_events() -> None:
+    quiet = after(remove_dead_stores, "(TRC 1); A=1\n#10\n:10 A=2")
+    assert code(quiet) == ["call TRC 1", "jump L10"]
+    traced = after(remove_dead_stores, "(TRC 3); A=1\n#10\n:10 A=2")
+    assert code(traced) == ["call TRC 3", "load 1", "store A", "jump L10"]
+
+
+# Peephole -----------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("text", "expected"), [
+    ("A=A+1", ["inc A"]),
+    ("A=A-1", ["dec A"]),
+    ("A=A+-2", ["dec A", "dec A"]),
+    ("A=A--1", ["inc A"]),
+    ("A=A+3", ["load A", "add 3", "store A"]),
+    ("A=B+1", ["load B", "add 1", "store A"]),
+])
+def test_adding_a_small_constant_to_a_variable_becomes_steps(text: str,
+                                                             expected: list[str]) -> None:
+    assert code(after(rewrite_steps, text)) == [*expected, "end"]
+
+
+def test_no_step_where_the_accumulator_is_read_after_the_store() -> None:
+    block = Block("B0", [Load(A, 1), Operate("+", Imm(1), 1), Store(A, 1), Store(B, 1)],
+                  End(1))
+    program = rewrite_steps(Program({"B0": block}, "B0"))
+    assert program.blocks["B0"].instructions[:3] == [Load(A, 1), Operate("+", Imm(1), 1),
+                                                     Store(A, 1)]
+
+
+# Control flow -------------------------------------------------------------------------------
+
+
+def test_unreachable_blocks_go_and_a_jump_to_an_end_ends() -> None:
+    program = after(simplify_control, "#10\nA=1\n:10 #20\n:20 (END)")
+    assert list(program.blocks) == ["B0"]
+    assert code(program) == ["end"]
+
+
+def test_a_block_entered_only_from_the_one_before_joins_it() -> None:
+    program = after(simplify_control, "A=1\n:10 B=2\n(MOV 1,1)\n:20 C=3; ?C>#20")
+    assert list(program.blocks) == ["B0", "L20", "B1"]
+    assert code(program) == ["load 1", "store A", "load 2", "store B", "call MOV 1, 1",
+                             "jump L20"]
+
+
+def jumps(*blocks: tuple[str, list[StepVar], ir.Terminator]) -> Program:
+    return Program({block_id: Block(block_id, list[ir.Instruction](instructions), terminator)
+                    for block_id, instructions, terminator in blocks}, blocks[0][0])
+
+
+def test_jumps_to_jumps_are_threaded_only_past_real_jumps() -> None:
+    step = [StepVar(A, "++", 1)]
+    program = simplify_control(jumps(
+        ("B0", step, Branch(A, ">", "B1", "B2", 1)),
+        ("B1", [], Jump("B3", 2)),  # a real jump: B2 lies between
+        ("B2", step, Jump("B1", 3)),
+        ("B3", step, Branch(A, "<", "B1", "B4", 4)),
+        ("B4", step, Jump("B0", 5)),
+    ))
+    assert ir.validate(program) == []
+    assert program.blocks["B0"].terminator == Branch(A, ">", "B3", "B2", 1)
+    assert program.blocks["B2"].terminator == Jump("B3", 3)
+    assert "B1" not in program.blocks
+    fall_through = simplify_control(jumps(
+        ("B0", step, Branch(A, ">", "B1", "B9", 1)),
+        ("B1", [], Jump("B2", 2)),  # falls through to B2: threading would add a jump
+        ("B2", step, Jump("B0", 3)),
+        ("B9", step, End(4)),
+    ))
+    assert fall_through.blocks["B0"].terminator == Branch(A, ">", "B1", "B9", 1)
+
+
+def test_a_branch_to_one_block_either_way_is_a_jump() -> None:
+    program = simplify_control(jumps(
+        ("B0", [StepVar(A, "++", 1)], Branch(A, "=", "B1", "B1", 1)),
+        ("B1", [StepVar(B, "++", 2)], End(2)),
+    ))
+    assert list(program.blocks) == ["B0"]
+    assert code(program) == ["inc A", "inc B", "end"]
+
+
+# Superinstructions (-O2) ---------------------------------------------------------------------
+
+
+def test_a_store_and_the_branch_on_it_fuse() -> None:
+    program = after(fuse, "A=(KYO)-5; ?A<#10\n:10 (END)")
+    assert code(program) == ["call KYO", "load R", "sub 5",
+                             "store A; if A<0 then L10 else B1"]
+
+
+def test_a_counted_loop_decrements_and_branches_at_once() -> None:
+    program = after(fuse, "@=3\n:10 (TIM 1); @--; ?@>#10\nA=B; B++; ?B>#10")
+    assert code(program, "L10")[-1] == "dec @; if @>0 then L10 else B1"
+    assert code(program, "B1")[-2:] == ["inc B", "if B>0 then L10 else B2"]  # not --
+
+
+def test_a_load_and_its_stores_become_moves_when_the_accumulator_is_dead() -> None:
+    assert code(after(fuse, "A=B; C=5; D=C; E=A+1")) == [
+        "move A, B", "move C, 5", "move D, C", "load A", "add 1", "store E", "end"]
+    stores_then_branch = jumps(("B0", [], End(1)))
+    stores_then_branch.blocks["B0"].instructions = [Load(Imm(5), 1), Store(A, 1)]
+    stores_then_branch.blocks["B0"].terminator = ir.StoreBranch(B, "=", "B0", "B0", 1)
+    fused = fuse(stores_then_branch)
+    assert ir.validate(fused) == []
+    assert fused.blocks["B0"].instructions == [Load(Imm(5), 1), Store(A, 1)]
+
+
+# The pipeline ---------------------------------------------------------------------------------
+
+
+def test_a_pass_that_breaks_the_ir_is_caught_where_it_runs(monkeypatch: pytest.MonkeyPatch
+                                                           ) -> None:
+    def breaks(program: Program) -> Program:
+        program.blocks[program.entry].instructions.insert(0, Store(X, 1))
+        return program
+
+    monkeypatch.setitem(optimize.LEVELS, 1, (breaks, simplify_control))
+    with pytest.raises(optimize.OptimizerError, match=r"breaks broke the IR: .*reads acc"):
+        optimize.optimize(lowered("A=1"), 1, check=True)
+    with pytest.raises(optimize.OptimizerError, match=r"the optimizer broke the IR"):
+        optimize.optimize(lowered("A=1"), 1)
+
+
+def test_level_0_changes_nothing_and_level_1_runs_until_nothing_changes() -> None:
+    text = "A=1\n#10\n:10 B=A+1; A=B-2; (MOV A,B)"
+    assert ir.format_program(optimize.optimize(lowered(text), 0)) == \
+        ir.format_program(lowered(text))
+    # A=1 is dead (A=B-2 follows before any call); then A=B-2 stores 0, which A holds.
+    assert code(optimize.optimize(lowered(text), 1)) == [
+        "load 2", "store B", "call MOV 0, 2", "end"]

@@ -1,0 +1,78 @@
+"""`rl1c fuzz`: the built-in engines agree, an `exec:` engine speaks the protocol of
+spec/optimization.md section 5, and a planted bug is found, shrunk and written down."""
+
+from __future__ import annotations
+
+import json
+import shlex
+import sys
+from pathlib import Path
+
+import pytest
+from support import ROOT
+from support.cli import rl1c
+
+from rl1.compiler import fuzz
+from rl1.compiler.frontend.source import split_lines
+
+PYTHON = shlex.quote(sys.executable)
+RL1C = shlex.quote(str(Path(sys.executable).with_name("rl1c")))
+BROKEN_VM = f"exec:{PYTHON} {shlex.quote(str(ROOT / 'tests/support/broken_vm.py'))} " \
+            "{ilc} {sensors} {budget}"
+
+
+def test_the_built_in_engines_agree_and_the_summary_says_so() -> None:
+    result = rl1c("fuzz", "--count", "25", "--seed", "5")
+    assert result.exit_code == 0, result.output
+    assert result.stdout.startswith("fuzz: 25 programs in ")
+    assert "engines ast, vm-O0, vm-O1, vm-O2; seed 5: all agreed" in result.stdout
+
+
+def test_rl1c_run_itself_is_an_exec_engine_as_the_spec_shows(tmp_path: Path) -> None:
+    command = f"exec:{RL1C} run {{ilc}} --sensors {{sensors}} --budget {{budget}} --format json"
+    result = rl1c("fuzz", "--engine", "vm-O0", "--engine", command, "--count", "4",
+                  "--seed", "2", "--out", str(tmp_path))
+    assert result.exit_code == 0, result.output
+    assert "all agreed" in result.stdout
+
+
+def test_a_planted_shift_bug_is_found_and_shrunk_to_a_few_lines(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fuzz, "SHRINK_SECONDS", 3.0)  # then deleting lines does the rest
+    out = tmp_path / "found"
+    result = rl1c("fuzz", "--engine", "vm-O0", "--engine", BROKEN_VM, "--count", "300",
+                  "--seed", "1", "--out", str(out))
+    assert result.exit_code == 1, result.output
+    assert "the engines disagree (reference: vm-O0)" in result.stdout
+    program = (out / "program.rob").read_text(encoding="utf-8")
+    assert 1 <= len(split_lines(program)) <= 3, program
+    assert "<" in program  # a left shift, by a negative count
+    runs = [json.loads(path.read_text(encoding="utf-8")) for path in sorted(out.glob("run-*"))]
+    assert len(runs) == 2 and runs[0]["variables"] != runs[1]["variables"]
+    assert "variables: " in result.stdout and f"sh {out}/replay.sh" in result.stdout
+    replay = (out / "replay.sh").read_text(encoding="utf-8")
+    assert "rl1c run program-O0.ilc --sensors program.sensors.json" in replay
+    assert {"program.sensors.json", "program-O0.ilc", "replay.sh"} <= {
+        path.name for path in out.iterdir()}
+
+
+def test_an_engine_that_prints_no_run_disagrees(tmp_path: Path) -> None:
+    result = rl1c("fuzz", "--engine", "ast", "--engine", "exec:echo not json", "--count", "3",
+                  "--seed", "4", "--out", str(tmp_path))
+    assert result.exit_code == 1
+    assert "ending: ended normally / fault no-run" in result.stdout \
+        or "fault no-run" in result.stdout
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--engine", "vm-O7", "--engine", "ast"], "unknown engine 'vm-O7'"),
+    (["--engine", "ast"], "give at least two different engines"),
+    (["--engine", "ast", "--engine", "ast"], "give at least two different engines"),
+    (["--count", "5", "--time", "5"], "give --count or --time, not both"),
+    (["--count", "0"], "argument --count: expected a whole number of at least 1"),
+    (["--seed", "x"], "argument --seed: expected a whole number"),
+])
+def test_bad_options_are_usage_errors(args: list[str], message: str) -> None:
+    result = rl1c("fuzz", *args)
+    assert result.exit_code == 2
+    assert message in result.stderr
