@@ -107,16 +107,17 @@ static bool finish(rl1_vm *vm, uint8_t op, rl1_status status, const rl1_reading 
     return true;
 }
 
-/* The call `op` whose operands start at `operands` (section 9, steps 2-6): a fault, or
- * RL1_FAULT_NONE with vm->waiting set when its first poll answered busy. */
-static rl1_fault call(rl1_vm *vm, uint8_t op, const uint8_t *operands)
+/* The call `op`, `length` bytes long, whose operands start at `operands` (section 9,
+ * steps 2-6): a fault, or RL1_FAULT_NONE with vm->waiting set when its first poll
+ * answered busy. */
+static rl1_fault call(rl1_vm *vm, uint8_t op, uint8_t length, const uint8_t *operands)
 {
     const rl1_hardware *hw = vm->hw;
     int16_t args[3];
     rl1_reading out = {0, {0, 0, 0, 0}};
     rl1_status status;
-    uint8_t shape, length = rl1_op_length(op, 0, &shape), mask, k;
-    uint8_t arity = shape == RL1_SHAPE_ARGS ? (uint8_t)((length - 2u) / 2u) : 0u;
+    uint8_t mask, k;
+    uint8_t arity = length > 1u ? (uint8_t)((length - 2u) / 2u) : 0u; /* mask, 2 bytes each */
     if (arity) {
         mask = RL1_BYTE(operands);
         for (k = 0; k < arity; k++) { /* left to right; the first out of range faults */
@@ -195,8 +196,8 @@ static rl1_state ended(rl1_vm *vm, uint16_t at)
     return RL1_ENDED;
 }
 
-/* The length of the call instruction `op`: a call in progress is at pc minus it. */
-static uint16_t call_length(uint8_t op)
+/* The length of the call instruction `op` (a call in progress is at pc minus it). */
+static uint8_t call_length(uint8_t op)
 {
     uint8_t shape;
     return rl1_op_length(op, 0, &shape);
@@ -224,110 +225,122 @@ static rl1_state resume(rl1_vm *vm)
     return RL1_RUNNING;
 }
 
+/* Where no case applies, so that the compiler's jump table needs no range check. */
+#if defined(__GNUC__)
+#define UNREACHABLE() __builtin_unreachable()
+#else
+#define UNREACHABLE() ((void)0)
+#endif
+
+/* The operand bytes of the instruction at ip. */
+#define U8_AT(k) RL1_BYTE(ip + (k))
+#define U16_AT(k) RL1_U16(ip + (k))
+#define VAR_AT(k) V[U8_AT(k)]
+
+/* The seven operators of one operand kind (spec/ilc.md 8.2: base + the operator's
+ * index), each its own case: a second dispatch on the operator would cost as much. */
+#define ALU_CASES(base, operand, size)                                                   \
+    case (base) + 0: acc = (uint16_t)(acc + (operand)); ip += (size); continue;          \
+    case (base) + 1: acc = (uint16_t)(acc - (operand)); ip += (size); continue;          \
+    case (base) + 2: acc = (uint16_t)(acc & (operand)); ip += (size); continue;          \
+    case (base) + 3: acc = (uint16_t)(acc | (operand)); ip += (size); continue;          \
+    case (base) + 4: acc = (uint16_t)(acc ^ (operand)); ip += (size); continue;          \
+    case (base) + 5: acc = shifted(acc, (int16_t)(operand), true); ip += (size); continue; \
+    case (base) + 6: acc = shifted(acc, (int16_t)(operand), false); ip += (size); continue
+
+/* A conditional jump on V[v] (at ip + 1) to the target at ip + 2. */
+#define JUMP_IF(condition)                                                                \
+    if (condition) {                                                                     \
+        target = U16_AT(2);                                                              \
+        goto jump;                                                                       \
+    }                                                                                    \
+    ip += 4;                                                                             \
+    continue
+
+/* Where the dispatch loop must look at the step's limit and the code's end: at the end
+ * when the limit cannot come first (each instruction takes at least a byte, so a
+ * straight run from ip meets the end within end - ip instructions); else at every
+ * instruction (`code`, which every ip passes). Set again wherever a jump lands. */
+#define STOP (left >= (uint32_t)(end - ip) ? end : code)
+
 /* Runs at most n instructions from vm->pc. The hot state lives in locals and goes back
- * into *vm at every exit: pc, acc, and the instructions run (n - left). */
+ * into *vm at every exit: pc, acc, and the instructions run (n - left). `ip` stays on an
+ * instruction's first byte until it is done, so that a fault or an end points at it. */
 static rl1_state run(rl1_vm *vm, uint32_t n)
 {
-    const uint8_t *code = vm->code;
-    int16_t *V = vm->V;
-    uint16_t pc = vm->pc, at = 0, acc = (uint16_t)vm->acc, x = 0, target;
-    uint16_t code_size = vm->code_size;
-    uint32_t left = n, before = vm->executed, budget = vm->budget;
+    const uint8_t *const code = vm->code, *const end = code + vm->code_size;
+    const uint8_t *ip = code + vm->pc;
+    int16_t *const V = vm->V;
+    uint16_t acc = (uint16_t)vm->acc, target = 0;
+    uint32_t left = n, before = vm->executed;
+    /* The watchdog (section 9): more than `budget` run in all once left < over_below. */
+    uint32_t room = before > vm->budget ? 0u : vm->budget - before;
+    uint32_t over_below = n > room ? n - room : 0u;
+    const uint8_t *stop = STOP;
     rl1_fault kind = RL1_FAULT_NONE;
-    uint8_t op;
     rl1_state state = RL1_RUNNING;
+    uint8_t op, length;
     for (;;) {
-        if (left == 0u) {
-            state = RL1_RUNNING;
-            break;
+        if (ip >= stop) { /* one comparison an instruction while the limit is far */
+            if (left == 0u) { /* the step's limit */
+                break;
+            }
+            if (ip >= end) { /* past the last instruction: (END), not counted */
+                state = RL1_ENDED;
+                break;
+            }
         }
-        if (pc >= code_size) { /* past the last instruction: (END), not counted */
-            at = pc;
-            state = RL1_ENDED;
-            break;
-        }
-        at = pc;
-        op = RL1_BYTE(code + pc);
         left--;
-        switch (op) {
+        switch (RL1_BYTE(ip)) {
         case 0x00: /* END */
             state = RL1_ENDED;
             break;
-        case 0x01: /* LDV v */
-            acc = (uint16_t)V[RL1_BYTE(code + pc + 1u)];
-            pc = (uint16_t)(pc + 2u);
+        case 0x01: acc = (uint16_t)VAR_AT(1); ip += 2; continue;           /* LDV v */
+        case 0x02: acc = U16_AT(1); ip += 3; continue;                     /* LDI i */
+        case 0x03: acc = (uint16_t)vm->R; ip += 1; continue;               /* LDR */
+        case 0x04: VAR_AT(1) = (int16_t)acc; ip += 2; continue;            /* STV v */
+        case 0x05:                                                           /* INC v */
+            VAR_AT(1) = (int16_t)(uint16_t)((uint16_t)VAR_AT(1) + 1u);
+            ip += 2;
             continue;
-        case 0x02: /* LDI i */
-            acc = RL1_U16(code + pc + 1u);
-            pc = (uint16_t)(pc + 3u);
+        case 0x06:                                                           /* DEC v */
+            VAR_AT(1) = (int16_t)(uint16_t)((uint16_t)VAR_AT(1) - 1u);
+            ip += 2;
             continue;
-        case 0x03: /* LDR */
-            acc = (uint16_t)vm->R;
-            pc = (uint16_t)(pc + 1u);
-            continue;
-        case 0x04: /* STV v */
-            V[RL1_BYTE(code + pc + 1u)] = (int16_t)acc;
-            pc = (uint16_t)(pc + 2u);
-            continue;
-        case 0x05: /* INC v */
-        case 0x06: /* DEC v */
-            x = RL1_BYTE(code + pc + 1u);
-            V[x] = (int16_t)(uint16_t)((uint16_t)V[x] + (op == 0x05u ? 1u : 0xFFFFu));
-            pc = (uint16_t)(pc + 2u);
-            continue;
-        case 0x10: case 0x11: case 0x12: case 0x13: case 0x14: case 0x15: case 0x16:
-            x = (uint16_t)V[RL1_BYTE(code + pc + 1u)]; /* the ...V arithmetic */
-            pc = (uint16_t)(pc + 2u);
-            goto arithmetic;
-        case 0x18: case 0x19: case 0x1A: case 0x1B: case 0x1C: case 0x1D: case 0x1E:
-            x = RL1_U16(code + pc + 1u); /* the ...I arithmetic */
-            pc = (uint16_t)(pc + 3u);
-            goto arithmetic;
-        case 0x20: case 0x21: case 0x22: case 0x23: case 0x24: case 0x25: case 0x26:
-            x = (uint16_t)vm->R; /* the ...R arithmetic */
-            pc = (uint16_t)(pc + 1u);
-            goto arithmetic;
-        case 0x30: /* JMP a */
-            target = RL1_U16(code + pc + 1u);
-            goto jump;
-        case 0x07: /* MOVV v, w (format 1.2, as the others below) */
-            V[RL1_BYTE(code + pc + 1u)] = V[RL1_BYTE(code + pc + 2u)];
-            pc = (uint16_t)(pc + 3u);
-            continue;
-        case 0x08: /* MOVI v, i */
-            V[RL1_BYTE(code + pc + 1u)] = (int16_t)RL1_U16(code + pc + 2u);
-            pc = (uint16_t)(pc + 4u);
-            continue;
-        case 0x09: /* MOVR v */
-            V[RL1_BYTE(code + pc + 1u)] = vm->R;
-            pc = (uint16_t)(pc + 2u);
-            continue;
-        case 0x31: case 0x32: case 0x33: /* JZ, JGT, JLT v, a */
-        case 0x34: /* DJGT v, a: V[v]--, then JGT */
-        case 0x35: case 0x36: case 0x37: /* SJZ, SJGT, SJLT v, a: V[v] = acc, then JZ ... */
-            x = RL1_BYTE(code + pc + 1u);
-            if (op == 0x34u) {
-                V[x] = (int16_t)(uint16_t)((uint16_t)V[x] - 1u);
-            } else if (op >= 0x35u) {
-                V[x] = (int16_t)acc;
-            }
-            x = (uint16_t)V[x];
-            op = (uint8_t)(op == 0x34u ? 0x32u : op >= 0x35u ? op - 4u : op); /* JZ JGT JLT */
-            if (op == 0x31u ? x == 0u : op == 0x32u ? (x != 0u && x < 0x8000u) : x >= 0x8000u) {
-                target = RL1_U16(code + pc + 2u);
-                goto jump;
-            }
-            pc = (uint16_t)(pc + 4u);
-            continue;
-        default: /* a call: the verifier let no other opcode through */
-            if (before + (n - left) > budget) {
+        /* The superinstructions of format 1.2 (the verifier refuses them in older files). */
+        case 0x07: VAR_AT(1) = VAR_AT(2); ip += 3; continue;               /* MOVV v, w */
+        case 0x08: VAR_AT(1) = (int16_t)U16_AT(2); ip += 4; continue;      /* MOVI v, i */
+        case 0x09: VAR_AT(1) = vm->R; ip += 2; continue;                   /* MOVR v */
+        ALU_CASES(0x10, (uint16_t)VAR_AT(1), 2);                             /* ...V */
+        ALU_CASES(0x18, U16_AT(1), 3);                                       /* ...I */
+        ALU_CASES(0x20, (uint16_t)vm->R, 1);                                 /* ...R */
+        case 0x30: target = U16_AT(1); goto jump;                          /* JMP a */
+        case 0x31: JUMP_IF(VAR_AT(1) == 0);                                  /* JZ v, a */
+        case 0x32: JUMP_IF(VAR_AT(1) > 0);                                   /* JGT v, a */
+        case 0x33: JUMP_IF(VAR_AT(1) < 0);                                   /* JLT v, a */
+        case 0x34:                                                           /* DJGT v, a */
+            VAR_AT(1) = (int16_t)(uint16_t)((uint16_t)VAR_AT(1) - 1u);
+            JUMP_IF(VAR_AT(1) > 0);
+        case 0x35: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) == 0);       /* SJZ v, a */
+        case 0x36: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) > 0);        /* SJGT v, a */
+        case 0x37: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) < 0);        /* SJLT v, a */
+        default:
+            UNREACHABLE(); /* the verifier refuses every other opcode */
+            break;
+        case 0x40: case 0x41: case 0x42: case 0x43: case 0x44: case 0x45: case 0x46:
+        case 0x47: case 0x48: case 0x49: case 0x4A: case 0x4B: case 0x4C: case 0x4D:
+        case 0x4E: case 0x4F: case 0x50: case 0x51: case 0x52: case 0x53: case 0x54:
+        case 0x55: case 0x56: case 0x57: case 0x58: case 0x59: case 0x5A: case 0x5B:
+        case 0x5C: case 0x5D: /* the calls */
+            if (left < over_below) {
                 kind = RL1_FAULT_BUDGET;
                 break;
             }
+            op = RL1_BYTE(ip);
+            length = call_length(op);
             vm->executed = before + (n - left);
-            pc = (uint16_t)(pc + call_length(op));
-            vm->pc = pc;
-            kind = call(vm, op, code + at + 1u);
+            vm->pc = (uint16_t)(ip - code + length);
+            kind = call(vm, op, length, ip + 1);
             if (kind != RL1_FAULT_NONE) {
                 break;
             }
@@ -336,44 +349,36 @@ static rl1_state run(rl1_vm *vm, uint32_t n)
                 vm->state = RL1_WAITING;
                 return RL1_WAITING;
             }
-            if (!take_event(vm, &pc)) {
+            target = vm->pc;
+            if (!take_event(vm, &target)) {
                 kind = RL1_FAULT_MISSING_HANDLER;
                 break;
             }
+            ip = code + target;
+            stop = STOP;
             continue;
         }
         break;
 
-    arithmetic: /* acc op x, with the operator in the opcode's low 3 bits */
-        switch (op & 7u) {
-        case 0: acc = (uint16_t)(acc + x); break;
-        case 1: acc = (uint16_t)(acc - x); break;
-        case 2: acc &= x; break;
-        case 3: acc |= x; break;
-        case 4: acc ^= x; break;
-        case 5: acc = shifted(acc, (int16_t)x, true); break;
-        default: acc = shifted(acc, (int16_t)x, false); break;
-        }
-        continue;
-
     jump: /* a jump taken: the watchdog, then the event point (section 9) */
-        if (before + (n - left) > budget) {
+        if (left < over_below) {
             kind = RL1_FAULT_BUDGET;
             break;
         }
-        pc = target;
-        if (vm->mailbox.posted != vm->mailbox.taken && !take_event(vm, &pc)) {
+        if (vm->mailbox.posted != vm->mailbox.taken && !take_event(vm, &target)) {
             kind = RL1_FAULT_MISSING_HANDLER;
             break;
         }
+        ip = code + target;
+        stop = STOP;
     }
-    vm->pc = pc;
+    vm->pc = (uint16_t)(ip - code);
     vm->acc = (int16_t)acc;
     vm->executed = before + (n - left);
     if (kind != RL1_FAULT_NONE) {
-        return fault(vm, kind, at, false);
+        return fault(vm, kind, vm->pc, false);
     }
-    return state == RL1_ENDED ? ended(vm, at) : state;
+    return state == RL1_ENDED ? ended(vm, vm->pc) : state;
 }
 
 rl1_state rl1_step(rl1_vm *vm, uint32_t n)

@@ -2,8 +2,9 @@
  * spec/vectors (*.txt; spec/vectors/README.md), runs every run vector, both its files,
  * in four ways (one step or steps of 1, 3 and 7 instructions, waiting built-ins
  * answering busy 0 to 2 times first) and checks the verifier's files with and without a
- * bitmap. Prints what differs; exits 1 if anything does.
- *     host-vectors spec/vectors/GROUP.txt ... */
+ * bitmap. Prints what differs; exits 1 if anything does. With --once, each vector's
+ * `ilc` file runs once, in one step (bench/c_speed.py measures that).
+ *     host-vectors [--once] spec/vectors/GROUP.txt ... */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -84,18 +85,19 @@ typedef struct reading {
 } reading;
 
 static unsigned runs, failed, files, files_failed;
+static bool once; /* each vector's ilc file, in one step, and nothing else */
 
 static void run_vector(reading *r)
 {
     char label[200];
     size_t w;
     int form;
-    for (form = 0; form < 2; form++) {
+    for (form = 0; form < (once ? 1 : 2); form++) {
         vector v = r->v;
         v.ilc = form ? r->stripped : r->ilc;
         v.ilc_size = form ? r->stripped_size : r->ilc_size;
         v.line = form ? 0u : r->v.line; /* a stripped file has no line map */
-        for (w = 0; w < sizeof WAYS / sizeof *WAYS; w++) {
+        for (w = 0; w < (once ? 1u : sizeof WAYS / sizeof *WAYS); w++) {
             uint32_t stack;
             snprintf(label, sizeof label, "%s%s (steps of %lu, %u busy polls)", r->name,
                      form ? ".stripped" : ".ilc", (unsigned long)WAYS[w].slice,
@@ -275,8 +277,12 @@ static void read_file(const char *path, reading *r)
 int main(int argc, char **argv)
 {
     static reading r;
-    int i;
-    for (i = 1; i < argc; i++) {
+    int i = 1;
+    if (argc > 1 && strcmp(argv[1], "--once") == 0) {
+        once = true;
+        i = 2;
+    }
+    for (; i < argc; i++) {
         read_file(argv[i], &r);
     }
     printf("conformance: %u runs of the run vectors, %u failed; %u loads of the "
