@@ -18,6 +18,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from support import ROOT
+from support.cli import rl1c
 from support.scripts import MOVING_STARTS, scripts
 
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
@@ -191,3 +192,35 @@ def test_a_machine_without_a_compiler_is_told_what_to_do(
     monkeypatch.setenv("PATH", str(tmp_path))
     with pytest.raises(native.BuildError, match=r"needs a C compiler.*--engine vm"):
         native.library(tmp_path / "cache")
+
+
+def test_rl1c_run_engine_c_prints_what_the_reference_prints(
+    c_vm: ctypes.CDLL, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The sample with its script, from source and from the compiled file: the same trace,
+    # variables and exit status as the reference VM (the CLI builds its own library, here
+    # into a cache of the test's own).
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    sample, sensors = ROOT / "examples" / "sample.rob", ROOT / "examples" / "sample.sensors.json"
+    compiled = tmp_path / "sample.ilc"
+    assert rl1c(sample, "-o", compiled).exit_code == 0
+    for program in (sample, compiled):
+        reference = rl1c("run", program, "--sensors", sensors, "--format", "json")
+        native_run = rl1c("run", program, "--sensors", sensors, "--format", "json",
+                          "--engine", "c")
+        assert (native_run.exit_code, native_run.stdout) == (reference.exit_code,
+                                                             reference.stdout)
+        assert json.loads(native_run.stdout)["trace"]
+
+
+def test_rl1c_run_engine_c_without_a_compiler_says_what_to_do(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
+) -> None:
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))  # nothing built there
+    monkeypatch.setenv("CC", "")
+    monkeypatch.setenv("PATH", str(tmp_path))
+    program = tmp_path / "p.rob"
+    program.write_text("A=1\n", encoding="utf-8")
+    result = rl1c("run", program, "--engine", "c")
+    assert result.exit_code == 2
+    assert "needs a C compiler" in result.stderr and "Traceback" not in result.output
