@@ -4,7 +4,7 @@ program's comments allow left out); `fix` makes the checker's fixes."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from typing import NamedTuple
 
 from .checker import apply_suppressions, check
 from .frontend.ast import Program
@@ -13,8 +13,7 @@ from .frontend.edits import apply_edits, compatible
 from .frontend.parser import parse_program
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class Analysis:
+class Analysis(NamedTuple):
     program: Program
     diagnostics: list[Diagnostic]
 
@@ -36,8 +35,7 @@ MAX_FIX_ROUNDS = 10
 `(END)` that the vehicle reaches still moving), and fixes at one place wait a round."""
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class Fixed:
+class Fixed(NamedTuple):
     """The text with the fixes made, how many were made, and its analysis."""
 
     text: str

@@ -13,8 +13,8 @@ people; keep the two in step.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from enum import Enum
+from typing import NamedTuple
 
 
 class Feature(Enum):
@@ -29,8 +29,7 @@ class Feature(Enum):
     FUZZY = 6
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class Param:
+class Param(NamedTuple):
     """One parameter of a built-in: its name, range and meaning."""
 
     name: str
@@ -42,8 +41,7 @@ class Param:
         return f"{self.name}: {self.meaning}, {self.low}..{self.high}"
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class Form:
+class Form(NamedTuple):
     """One way to call a built-in. Most have a single form with `selector` None;
     `(CAM ...)` and `(ULT ...)` have one form per selector letter."""
 
@@ -59,8 +57,7 @@ class Form:
         return self.result is not None
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class Builtin:
+class Builtin(NamedTuple):
     """A built-in function (a row of Table 2 or 3) and the forms it is called in."""
 
     mnemonic: str
@@ -174,8 +171,7 @@ VARIABLES = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz@"
 VARIABLE_INDEX: dict[str, int] = {name: index for index, name in enumerate(VARIABLES)}
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class LostLineRule:
+class LostLineRule(NamedTuple):
     """One row of Table 4: a line lost in tracing `mode` while `command` (MOV or MVI)
     is in effect jumps to `label`; `stops` tells whether the command stops first (mode 2)
     or goes on (mode 3, an MVI then running on in the background)."""

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from rl1.compiler.frontend import ast
 from rl1.vm.language import BUILTINS, RESERVED_VARIABLES
@@ -49,8 +50,7 @@ class BlockEffects:
 Segment = tuple[tuple[ast.Statement, ...], BlockEffects | None, bool]
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class _CallFacts:
+class _CallFacts(NamedTuple):
     writes: int
     observes: bool
     device: bool  # whether device.operation may find something in it

@@ -6,8 +6,8 @@ The catalogue of codes (titles and the long explanations of `rl1c explain`) live
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from enum import Enum
+from typing import NamedTuple
 
 from .ast import Span
 
@@ -18,16 +18,14 @@ class Severity(Enum):
     INFO = "info"
 
 
-@dataclass(frozen=True, slots=True)
-class Edit:
+class Edit(NamedTuple):
     """Replace the text of `span` with `text` (an empty span inserts)."""
 
     span: Span
     text: str
 
 
-@dataclass(frozen=True, slots=True)
-class Fix:
+class Fix(NamedTuple):
     """A machine-applicable fix: the editor's quick fix, the help line's suggestion.
     `automatic` is False for a guess (a misspelt name's closest match), which
     `rl1c check --fix` leaves for a person to confirm."""
@@ -37,16 +35,14 @@ class Fix:
     automatic: bool = True
 
 
-@dataclass(frozen=True, slots=True)
-class Related:
+class Related(NamedTuple):
     """Another place that explains a diagnostic (the first definition of a label...)."""
 
     span: Span
     message: str
 
 
-@dataclass(frozen=True, slots=True)
-class Diagnostic:
+class Diagnostic(NamedTuple):
     code: str
     severity: Severity
     message: str

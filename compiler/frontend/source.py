@@ -7,7 +7,7 @@ with LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+from typing import NamedTuple
 
 from rl1.compiler.files import SourceError, read_bounded
 
@@ -17,8 +17,7 @@ LINE_BREAK = re.compile(r"\r\n|\r|\n")
 """A line end: LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them."""
 
 
-@dataclass(frozen=True, slots=True)
-class Source:
+class Source(NamedTuple):
     name: str
     text: str
     encoding: str  # "utf-8" or "cp932"

@@ -10,15 +10,14 @@ W07xx safety. The long explanation of CODE is explanations/CODE.md, printed by
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from typing import NamedTuple
 
 from rl1.compiler.frontend.diagnostics import Severity
 
 _EXPLANATIONS = os.path.join(os.path.dirname(__file__), "explanations")
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class CodeInfo:
+class CodeInfo(NamedTuple):
     code: str
     severity: Severity
     title: str

@@ -5,9 +5,8 @@ project's rl1.toml (project.py) set the same `Selection`; the command line wins.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from typing import NamedTuple
 
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 
@@ -20,8 +19,7 @@ class SelectionError(ValueError):
     """A code list that selects nothing a user can select; the message says why."""
 
 
-@dataclass(frozen=True, slots=True)
-class Selection:
+class Selection(NamedTuple):
     """None: not set here (so another source, or the default, decides). `select` and
     `ignore` hold code prefixes: `W06` is every W06xx code, `W` every warning."""
 
@@ -31,8 +29,11 @@ class Selection:
 
     def over(self, base: Selection) -> Selection:
         """This selection, with what it leaves unset taken from `base`."""
-        return Selection(*(mine if mine is not None else theirs for mine, theirs in zip(
-            dataclasses.astuple(self), dataclasses.astuple(base), strict=True)))
+        return Selection(
+            self.select if self.select is not None else base.select,
+            self.ignore if self.ignore is not None else base.ignore,
+            self.warnings_as_errors if self.warnings_as_errors is not None
+            else base.warnings_as_errors)
 
     def reports(self, diagnostic: Diagnostic) -> bool:
         """Errors always; a warning when it is selected (every one by default) and not
@@ -48,7 +49,7 @@ class Selection:
         kept = [d for d in diagnostics if self.reports(d)]
         if not self.warnings_as_errors:
             return kept
-        return [dataclasses.replace(d, severity=Severity.ERROR)
+        return [d._replace(severity=Severity.ERROR)
                 if d.severity is Severity.WARNING else d for d in kept]
 
 
