@@ -100,13 +100,15 @@ def compiled(source: str, name: str, level: int = 0) -> bytes:
     return output
 
 
-def whole_process(command: Sequence[str], repeat: int) -> float:
-    """The best wall time of `repeat` runs of a command, which must succeed."""
-    best = float("inf")
+def whole_processes(commands: Sequence[Sequence[str]], repeat: int) -> list[float]:
+    """The best wall time of each command (which must succeed) over `repeat` rounds; a
+    round runs every command once, so that a load on the machine weighs on all alike."""
+    best = [float("inf")] * len(commands)
     for _ in range(repeat):
-        start = time.perf_counter()
-        subprocess.run(command, check=True, capture_output=True)
-        best = min(best, time.perf_counter() - start)
+        for index, command in enumerate(commands):
+            start = time.perf_counter()
+            subprocess.run(command, check=True, capture_output=True)
+            best[index] = min(best[index], time.perf_counter() - start)
     return best
 
 
@@ -139,26 +141,29 @@ def speed(runner: Path, folder: Path, repeat: int) -> None:
     lua_empty.write_text("", encoding="ascii")
     lua_said = subprocess.run(["lua5.4", str(lua_work)], check=True, capture_output=True,
                               text=True).stdout.strip()
-    lua_time = whole_process(["lua5.4", str(lua_work)], repeat)
-    lua_start = whole_process(["lua5.4", str(lua_empty)], repeat)
-    lua_net = lua_time - lua_start
     empty = folder / "empty.txt"
     write_vectors(empty, [vector("empty", compiled("(END)\n", "e.rob"), {})])
-    c_start = whole_process([str(runner), "--once", str(empty)], repeat)
-    print(f"1. the computation ({OUTER} x 200 iterations; best of {repeat}, start-up "
-          "subtracted)")
-    print(f"   Lua 5.4       {lua_net * 1000:8.1f} ms  ({lua_time * 1000:.1f} - "
-          f"{lua_start * 1000:.1f})")
+    commands = [["lua5.4", str(lua_work)], ["lua5.4", str(lua_empty)],
+                [str(runner), "--once", str(empty)]]
+    executed = []
     for level in (0, 2):
         data = compiled(COMPUTATION, "c.rob", level)
-        work = folder / f"computation-O{level}.txt"
-        executed = write_vectors(work, [vector("computation", data, {})])
         answer = Machine(verify(data), Blocking(ScriptedDevice()), BUDGET).run().variables[0]
         assert lua_said == str(answer), f"Lua computes {lua_said}, the VM {answer}"
-        c_net = whole_process([str(runner), "--once", str(work)], repeat) - c_start
-        print(f"   C VM, -O{level}    {c_net * 1000:8.1f} ms  ({executed:,} instructions, "
-              f"{executed / c_net / 1e6:.0f} M/s): {lua_net / c_net:.2f}x Lua's speed   "
-              "(goal: at least 2x)")
+        work = folder / f"computation-O{level}.txt"
+        executed.append(write_vectors(work, [vector("computation", data, {})]))
+        commands.append([str(runner), "--once", str(work)])
+    lua_time, lua_start, c_start, *c_times = whole_processes(commands, repeat)
+    lua_net = lua_time - lua_start
+    print(f"1. the computation ({OUTER} x 200 iterations; the best of {repeat} rounds, "
+          "start-up subtracted)")
+    print(f"   Lua 5.4       {lua_net * 1000:8.1f} ms  ({lua_time * 1000:.1f} - "
+          f"{lua_start * 1000:.1f})")
+    for level, c_time, count in zip((0, 2), c_times, executed, strict=True):
+        c_net = c_time - c_start
+        print(f"   C VM, -O{level}    {c_net * 1000:8.1f} ms  ({c_time * 1000:.1f} - "
+              f"{c_start * 1000:.1f}; {count:,} instructions, {count / c_net / 1e6:.0f} M/s): "
+              f"{lua_net / c_net:.2f}x Lua's speed   (goal: at least 2x)")
 
 
 def instructions(runner: Path, folder: Path) -> None:
