@@ -14,16 +14,21 @@ an editable install leaves that to the first run, which cannot do it where
 PYTHONDONTWRITEBYTECODE is set (as on our development machine), so every start would
 compile all of rl1 again.
 
-    .venv/bin/python bench/cold_start.py [--runs 15]
+With `--instructions` it also counts the instructions each command executes under
+`valgrind --tool=callgrind`: a figure that does not depend on the machine's load.
+
+    .venv/bin/python bench/cold_start.py [--runs 15] [--instructions]
 """
 
 from __future__ import annotations
 
 import argparse
 import compileall
+import re
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -36,9 +41,23 @@ def run_seconds(command: list[str]) -> float:
     return time.perf_counter() - start
 
 
+def instructions(command: list[str]) -> int:
+    """The instructions `command` executes, counted by callgrind."""
+    with tempfile.TemporaryDirectory() as folder:
+        result = subprocess.run(["valgrind", "--tool=callgrind",
+                                 f"--callgrind-out-file={folder}/out", *command],
+                                capture_output=True, text=True, check=False)
+    found = re.search(r"Collected : (\d+)", result.stderr)
+    if found is None:
+        raise SystemExit(f"callgrind gave no count:\n{result.stderr}")
+    return int(found.group(1))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=15)
+    parser.add_argument("--instructions", action="store_true",
+                        help="also count instructions with valgrind's callgrind")
     options = parser.parse_args()
     for package in ("compiler", "vm", "lsp"):
         compileall.compile_dir(ROOT / package, quiet=1)
@@ -60,6 +79,12 @@ def main() -> None:
         print(f"{name:<{width}}: {median:.1f} ms (median of {options.runs})")
     check, click = medians["rl1c check sample.rob"], medians['python3 -c "import click"']
     print(f"ratio rl1c check / import click: {check / click:.2f}x (goal <= 1.5x)")
+    if options.instructions:
+        counts = {name: instructions(command) for name, command in commands.items()}
+        for name, count in counts.items():
+            print(f"{name:<{width}}: {count / 1e6:.1f} M instructions")
+        ratio = counts["rl1c check sample.rob"] / counts['python3 -c "import click"']
+        print(f"ratio in instructions: {ratio:.2f}x (goal <= 1.5x)")
 
 
 if __name__ == "__main__":

@@ -23,8 +23,10 @@ sys.path.insert(0, str(ROOT / "tests"))
 from support.hostile import (  # noqa: E402  (tests/ is put on the path just above)
     hostile_ilc_files,
     hostile_sources,
+    hostile_worlds,
     ilc_attack,
     source_attack,
+    world_attack,
 )
 
 Attack = Callable[[bytes, Path], list[str]]
@@ -62,9 +64,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=1.0)
     options = parser.parse_args()
-    half = options.minutes * 30
-    campaign("sources (check, fmt, compile, run)", hostile_sources(), source_attack, half)
-    campaign(".ilc files (run, dis, asm)", hostile_ilc_files(), ilc_attack, half)
+    third = options.minutes * 20
+    campaign("sources (check, fmt, compile, run)", hostile_sources(), source_attack, third)
+    campaign(".ilc files (run, dis, asm)", hostile_ilc_files(), ilc_attack, third)
+    campaign("world files (sim)", hostile_worlds(), world_attack, third)
 
 
 if __name__ == "__main__":

@@ -9,7 +9,7 @@ Listing 1's 60 x 6 window.
 
 from __future__ import annotations
 
-import math
+import sys
 import time
 from pathlib import Path
 
@@ -18,9 +18,13 @@ from timing import best_time
 from rl1.compiler.cli.run import run_source
 from rl1.vm.faults import RunResult
 from rl1.vm.sim.device import SimDevice
-from rl1.vm.sim.world import Line, Scene, Stand, World, decode_world
+from rl1.vm.sim.world import Scene, World, decode_world
 
 ROOT = Path(__file__).parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+from support.worlds import round_track  # noqa: E402  (tests/ is put on the path just above)
+
 SAMPLE = (ROOT / "examples" / "sample.rob").read_text()
 WORLD = decode_world((ROOT / "examples" / "sample.world.toml").read_bytes(), "sample.world.toml")
 
@@ -31,17 +35,6 @@ N=600
 ?N>#10
 (MOV 0,0); (FRE); (END)
 """
-
-
-def patrol_world() -> World:
-    """A round guidance track of radius 200 cm (72 straight pieces) on a 6 m floor, the
-    vehicle on it facing along it."""
-    points = tuple((300 + 200 * math.cos(math.radians(a)), 300 + 200 * math.sin(math.radians(a)))
-                   for a in range(0, 361, 5))
-    return World(floor=(600.0, 600.0), start=(500.0, 300.0, 90.0),
-                 lines=(Line("track", points, 2.0),),
-                 stands=(Stand("stand", 300.0, 300.0, 40.0, 40.0, 0.0),),
-                 scenes={0: Scene(("lines",), (98, 117, 158, 123))}, time_limit=900.0)
 
 
 def simulate(text: str, world: World) -> tuple[float, float]:
@@ -64,7 +57,7 @@ def image_cost(window: tuple[int, int, int, int]) -> float:
 
 def main() -> None:
     for name, text, world in (("Listing 1, Fig. 4", SAMPLE, WORLD),
-                              ("ten-minute patrol", PATROL, patrol_world())):
+                              ("ten-minute patrol", PATROL, round_track())):
         runs = [simulate(text, world) for _ in range(3)]
         simulated, wall = min(runs, key=lambda run: run[1])
         print(f"{name}: {simulated:7.1f} s simulated in {wall:6.3f} s: "

@@ -23,6 +23,7 @@ which says which blocks some path reaches.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 from rl1.compiler.frontend import ast
 
@@ -36,14 +37,13 @@ def closes_block(statement: ast.Statement) -> bool:
     return isinstance(statement, JUMPS) or ast.is_end(statement)
 
 
-@dataclass(frozen=True, slots=True)
-class HandlerEdge:
-    """A lost guidance line may jump to `:label` from the event point of statement
-    `index` of the block (the first such in the block): right after its calls, before an
-    assignment stores its value, or right after its jump."""
+class HandlerEdge(NamedTuple):
+    """A lost guidance line may jump to `:label` from the event point of the block's
+    statement number `statement` (the first such in the block): right after its calls,
+    before an assignment stores its value, or right after its jump."""
 
     label: int
-    index: int
+    statement: int
     target: int | None  # the handler's block; None when the program does not define it
 
 

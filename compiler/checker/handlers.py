@@ -38,7 +38,7 @@ def check_handlers(program: ast.Program, graph: ControlFlowGraph) -> list[Diagno
     for block in graph.blocks:
         for edge in block.handlers:
             if edge.target is None and edge.label not in first:
-                first[edge.label] = block.statements[edge.index]
+                first[edge.label] = block.statements[edge.statement]
     return [_missing(program, label, statement) for label, statement in sorted(first.items())]
 
 

@@ -35,7 +35,7 @@ def check_reserved(graph: ControlFlowGraph) -> list[Diagnostic]:
             return 0, []
         writes = block.effects.writes
         return state & _kept(writes, len(block.statements)), [
-            (edge.target, state & _kept(writes, edge.index))
+            (edge.target, state & _kept(writes, edge.statement))
             for edge in block.handlers if edge.target is not None]
 
     states = dataflow.solve(graph, ALL_RESERVED, transfer)

@@ -82,8 +82,12 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
             return emit([FileDiagnostics(source.name, source.text, outcome)], "human",
                         "auto", "sim", err=True)
         result = outcome
+    run_on = None
     if result.fault is None:
-        device.sim.note("end", "the program ended")
+        moving = device.sim.motion is not None
+        device.sim.note("end", "the program ended" + (
+            " with the vehicle moving: it runs on" if moving else ""))
+        run_on = device.run_on()  # (END) leaves motion in effect: where does it go?
     elif device.fault is None:  # a safety stop has noted itself
         device.sim.note("fault", result.fault.message)
     title = f"{os.path.basename(file)} on {os.path.basename(world)}"
@@ -98,7 +102,7 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
         write_file(html_file, html(the_world, device.sim.track, device.sim.events, calls,
                                    title).encode())
     render = render_json if sim_format == "json" else render_text
-    sys.stdout.write(render(result, device))
+    sys.stdout.write(render(result, device, run_on))
     return result.fault.kind.exit_status if result.fault is not None else 0
 
 

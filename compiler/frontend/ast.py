@@ -1,16 +1,15 @@
 """The RL/I abstract syntax tree: small value classes, separate from parsing.
 
-Every node carries a `Span`. Nodes are dataclasses, values never changed after they are
-built. Lines are the unit of parsing (RL/I is line-oriented), so a `Line` can be parsed
-alone; its spans share one `Row`, the line's number, so that the language server moves
-a line (and every node and per-line diagnostic on it) by renumbering its row, without
-rebuilding anything. `walk` visits a tree in source order.
+Every node carries a `Span`. Nodes are plain classes with slots, values never changed
+after they are built. Lines are the unit of parsing (RL/I is line-oriented), so a
+`Line` can be parsed alone; its spans share one `Row`, the line's number, so that the
+language server moves a line (and every node and per-line diagnostic on it) by
+renumbering its row, without rebuilding anything. `walk` visits a tree in source order.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, fields
 from operator import attrgetter
 from typing import Literal
 
@@ -102,18 +101,20 @@ class Span:
         return (self.line, self.column) <= (line, column) < (self.end_line, self.end_column)
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class Node:
     """The base of every node. Nodes are never changed once built, but not frozen
-    dataclasses: a frozen dataclass's `__init__` takes more than twice as long, and the
+    classes: a frozen class's `__init__` takes more than twice as long, and the
     parser builds about ten nodes per line (bench/parse_check.py).
 
-    Each node class is a dataclass for its fields and `__init__` alone; equality,
-    hashing and `repr` by the fields' values are written once, here. Generating them for
-    each of the 16 classes, as `@dataclass` does by default, costs 0.15 ms a class at
-    every start of `rl1c check` (bench/cold_start.py)."""
+    Node classes are plain classes, as pycparser's are: `__slots__` holds the fields and
+    `__init__` takes them, in their order, `span` first; equality, hashing and
+    `repr` by the fields' values are written once, here. As dataclasses they cost 0.4 ms
+    a class to define, 6 ms of every start of `rl1c check` (bench/cold_start.py)."""
 
-    span: Span
+    __slots__ = ("span",)
+
+    def __init__(self, span: Span) -> None:
+        self.span = span
 
     def _values(self) -> tuple[object, ...]:
         return _layout(type(self)).values(self)
@@ -125,10 +126,12 @@ class Node:
     def __hash__(self) -> int:
         return hash((type(self), self._values()))
 
+    def fields(self) -> Iterator[tuple[str, object]]:
+        """The fields' names and values, in order."""
+        return zip(_layout(type(self)).names, self._values(), strict=True)
+
     def __repr__(self) -> str:
-        shown = ", ".join(f"{name}={value!r}"
-                          for name, value in zip(_layout(type(self)).names, self._values(),
-                                                 strict=True))
+        shown = ", ".join(f"{name}={value!r}" for name, value in self.fields())
         return f"{type(self).__name__}({shown})"
 
     def children(self) -> Iterator[Node]:
@@ -147,7 +150,8 @@ class _Layout:
     __slots__ = ("child_names", "names", "values")
 
     def __init__(self, node_class: type[Node]) -> None:
-        self.names = tuple(field.name for field in fields(node_class))
+        code = node_class.__init__.__code__  # the fields in order: its parameters
+        self.names = code.co_varnames[1:code.co_argcount]
         self.child_names = tuple(name for name in self.names if name != "span")
         get = attrgetter(*self.names)
         # attrgetter of one name gives the value alone, not a tuple.
@@ -168,40 +172,53 @@ def _layout(node_class: type[Node]) -> _Layout:
 # Operands and arguments -------------------------------------------------------------
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class Var(Node):
     """A one-letter variable: `A`-`Z`, `a`-`z` or `@`."""
 
-    name: str
+    __slots__ = ("name",)
+
+    def __init__(self, span: Span, name: str) -> None:
+        self.span = span
+        self.name = name
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class Const(Node):
     """A constant as written. `value` is the number written (a decimal may lie outside
     16 bits; the checker reports it); `hex` constants are 16-bit bit patterns."""
 
-    value: int
-    text: str
-    hex: bool
+    __slots__ = ("hex", "text", "value")
+
+    def __init__(self, span: Span, value: int, text: str, hex: bool) -> None:
+        self.span = span
+        self.value = value
+        self.text = text
+        self.hex = hex
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class Selector(Node):
     """The letter that selects a form of `(CAM ...)` or a sensor of `(ULT ...)`."""
 
-    letter: str
+    __slots__ = ("letter",)
+
+    def __init__(self, span: Span, letter: str) -> None:
+        self.span = span
+        self.letter = letter
 
 
 Arg = Var | Const | Selector
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class Call(Node):
     """A built-in function call `(MNEMONIC args)`; `mnemonic` is as written."""
 
-    mnemonic: str
-    mnemonic_span: Span
-    args: tuple[Arg, ...]
+    __slots__ = ("args", "mnemonic", "mnemonic_span")
+
+    def __init__(self, span: Span, mnemonic: str, mnemonic_span: Span, args: tuple[Arg,
+                 ...]) -> None:
+        self.span = span
+        self.mnemonic = mnemonic
+        self.mnemonic_span = mnemonic_span
+        self.args = args
 
     @property
     def is_end(self) -> bool:
@@ -215,57 +232,79 @@ Operand = Var | Const | Call
 # Statements -------------------------------------------------------------------------
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class BinaryStep(Node):
     """One `op operand` of a left-to-right expression."""
 
-    op: BinaryOperator
-    op_span: Span
-    operand: Operand
+    __slots__ = ("op", "op_span", "operand")
+
+    def __init__(self, span: Span, op: BinaryOperator, op_span: Span, operand: Operand) -> None:
+        self.span = span
+        self.op = op
+        self.op_span = op_span
+        self.operand = operand
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class Assign(Node):
     """`V=operand {op operand}`, evaluated strictly left to right."""
 
-    target: Var
-    first: Operand
-    rest: tuple[BinaryStep, ...]
+    __slots__ = ("first", "rest", "target")
+
+    def __init__(self, span: Span, target: Var, first: Operand, rest: tuple[BinaryStep,
+                 ...]) -> None:
+        self.span = span
+        self.target = target
+        self.first = first
+        self.rest = rest
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class IncDec(Node):
     """`V++` or `V--`."""
 
-    target: Var
-    step: Step
+    __slots__ = ("step", "target")
+
+    def __init__(self, span: Span, target: Var, step: Step) -> None:
+        self.span = span
+        self.target = target
+        self.step = step
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class LabelRef(Node):
     """`#NN` as written; `number` is None when the digits are not a valid label."""
 
-    text: str
-    number: int | None
+    __slots__ = ("number", "text")
+
+    def __init__(self, span: Span, text: str, number: int | None) -> None:
+        self.span = span
+        self.text = text
+        self.number = number
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class Goto(Node):
-    target: LabelRef
+    __slots__ = ("target",)
+
+    def __init__(self, span: Span, target: LabelRef) -> None:
+        self.span = span
+        self.target = target
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class CondJump(Node):
     """`?V=#NN`, `?V>#NN`, `?V<#NN`: jump when V compares so with zero."""
 
-    var: Var
-    relation: Relation
-    target: LabelRef
+    __slots__ = ("relation", "target", "var")
+
+    def __init__(self, span: Span, var: Var, relation: Relation, target: LabelRef) -> None:
+        self.span = span
+        self.var = var
+        self.relation = relation
+        self.target = target
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class CallStmt(Node):
-    call: Call
+    __slots__ = ("call",)
+
+    def __init__(self, span: Span, call: Call) -> None:
+        self.span = span
+        self.call = call
 
 
 Statement = Assign | IncDec | Goto | CondJump | CallStmt
@@ -279,30 +318,40 @@ def is_end(statement: Statement) -> bool:
 # Lines and programs -----------------------------------------------------------------
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class LabelDef(Node):
     """`:NN` at the start of a line; `number` is None when not exactly two digits."""
 
-    text: str
-    number: int | None
+    __slots__ = ("number", "text")
+
+    def __init__(self, span: Span, text: str, number: int | None) -> None:
+        self.span = span
+        self.text = text
+        self.number = number
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class Comment(Node):
     """`' text` to the end of the line; `text` excludes the quote."""
 
-    text: str
+    __slots__ = ("text",)
+
+    def __init__(self, span: Span, text: str) -> None:
+        self.span = span
+        self.text = text
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class Line(Node):
     """One source line. `ok` is False when the line has a syntax error; its
     statements are then empty and the parser's diagnostic says why."""
 
-    label: LabelDef | None
-    statements: tuple[Statement, ...]
-    comment: Comment | None
-    ok: bool = True
+    __slots__ = ("comment", "label", "ok", "statements")
+
+    def __init__(self, span: Span, label: LabelDef | None, statements: tuple[Statement, ...],
+                 comment: Comment | None, ok: bool = True) -> None:
+        self.span = span
+        self.label = label
+        self.statements = statements
+        self.comment = comment
+        self.ok = ok
 
     @property
     def number(self) -> int:
@@ -310,9 +359,12 @@ class Line(Node):
         return self.span.row.number
 
 
-@dataclass(slots=True, eq=False, repr=False)
 class Program(Node):
-    lines: tuple[Line, ...]
+    __slots__ = ("lines",)
+
+    def __init__(self, span: Span, lines: tuple[Line, ...]) -> None:
+        self.span = span
+        self.lines = lines
 
     def statements(self) -> Iterator[Statement]:
         for line in self.lines:

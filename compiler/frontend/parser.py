@@ -17,8 +17,7 @@ from __future__ import annotations
 
 import functools
 import unicodedata
-from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 from rl1.vm.language import BUILTINS
 
@@ -49,12 +48,11 @@ _LONGEST_CACHED_PLAN = 64
 huge line's plan could fill the cache."""
 
 
-@dataclass(frozen=True, slots=True, eq=False)
-class Rejection:
+class Rejection(NamedTuple):
     """The outcome of a line the grammar rejects: the index of the token the automaton
     could not take (None: the end of the line) and the terminals it expected there."""
 
-    index: int | None
+    token: int | None
     expected: frozenset[str]
 
 
@@ -123,18 +121,18 @@ def _plan(kinds: Kinds) -> Plan:
 
 def _syntax_error(row: ast.Row, code: str, kinds: Kinds, lexemes: list[Lexeme],
                   rejection: Rejection) -> Diagnostic:
-    if rejection.index is None:
+    if rejection.token is None:
         column = len(code.rstrip()) + 1
         span = ast.Span(row, column, row, column + 1)
         kind, text = "$END", ""
     else:
-        kind = kinds[rejection.index]
-        text, start = lexemes[rejection.index]
+        kind = kinds[rejection.token]
+        text, start = lexemes[rejection.token]
         span = ast.Span(row, start + 1, row, start + 1 + max(len(text), 1))
     if kind == "BAD":
         return _bad_character(span, text)
     if kind == "WORD":
-        return _misused_word(row, span, kinds, lexemes, rejection.index)
+        return _misused_word(row, span, kinds, lexemes, rejection.token)
     if kind == "BADHEX":
         return Diagnostic(
             "E0105", Severity.ERROR, f"`{_excerpt(text)}` is not a 16-bit hex constant", span,
@@ -166,7 +164,7 @@ _STARTS_STATEMENT = frozenset({"VAR", "LPAR", "LABELREF", "QMARK"})
 def _syntax_help(row: ast.Row, kinds: Kinds, lexemes: list[Lexeme],
                  rejection: Rejection) -> tuple[str | None, tuple[Fix, ...]]:
     """The help of an E0101, and its fix when the intent is plain."""
-    index, expected = rejection.index, rejection.expected
+    index, expected = rejection.token, rejection.expected
     found = lexemes[index][0] if index is not None else ""
     if found == "-" and "_COMMA" in expected and index is not None:
         # `(MOV 3 -3)`: after an argument, ` -3` scans as a subtraction (3.2).

@@ -283,5 +283,5 @@ def test_handler_edges_follow_the_tracing_mode_and_the_motion() -> None:
     )
     graph = build_cfg(program)
     first, loop = graph.blocks[0], graph.blocks[1]
-    assert [(e.label, e.index, e.target) for e in first.handlers] == [(96, 2, 2)]
-    assert [(e.label, e.index, e.target) for e in loop.handlers] == [(96, 0, 2), (97, 0, None)]
+    assert [(e.label, e.statement, e.target) for e in first.handlers] == [(96, 2, 2)]
+    assert [(e.label, e.statement, e.target) for e in loop.handlers] == [(96, 0, 2), (97, 0, None)]

@@ -7,7 +7,6 @@ idempotent.
 
 from __future__ import annotations
 
-import dataclasses
 import errno
 import os
 import re
@@ -81,9 +80,7 @@ def shape(node: object) -> object:
     """A node as nested tuples without its spans: equal shapes mean the same program."""
     if isinstance(node, ast.Node):
         return (type(node).__name__, *(
-            shape(getattr(node, field.name)) for field in dataclasses.fields(node)
-            if not isinstance(getattr(node, field.name), ast.Span)
-        ))
+            shape(value) for _, value in node.fields() if not isinstance(value, ast.Span)))
     if isinstance(node, tuple):
         return tuple(shape(item) for item in node)
     return node

@@ -142,7 +142,7 @@ def _our_outcome(code: str) -> object:
     plan = make_plan(kinds)
     if callable(plan):
         return plan(lexemes, ast.Row(1))
-    at = None if plan.index is None else lexemes[plan.index][1]
+    at = None if plan.token is None else lexemes[plan.token][1]
     return ("rejected", at, plan.expected)
 
 

@@ -18,7 +18,7 @@ from rl1.vm.sim.world import Block, Vehicle
 def test_moments_of_a_rectangle() -> None:
     image = np.zeros((40, 60), dtype=bool)
     image[10:20, 5:45] = True  # 40 wide, 10 high
-    found = moments(image, (100, 50, 160, 90))
+    found = moments(image, (100, 50))
     assert found.area == 400
     assert (found.x, found.y) == pytest.approx((100 + 25, 50 + 15))
     assert found.angle == pytest.approx(0)
@@ -28,7 +28,7 @@ def test_moments_of_a_diagonal_bar_give_its_angle() -> None:
     image = np.zeros((100, 100), dtype=bool)
     for i in range(80):
         image[10 + i, 10 + i] = True
-    found = moments(image, (0, 0, 100, 100))
+    found = moments(image, (0, 0))
     assert found.area == 80
     assert found.angle == pytest.approx(45)  # y grows downward
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from support.cli import rl1c
@@ -22,6 +23,29 @@ def test_text_report_has_calls_poses_ending_and_variables() -> None:
     assert "(  236.4,   150.0)" in result.stdout  # the pose at the branch mark
     assert "the program ended normally" in result.stdout
     assert "C=579 D=450" in result.stdout
+
+
+def test_a_vehicle_moving_at_the_end_runs_on_until_it_stops(tmp_path: Path) -> None:
+    program, picture = tmp_path / "away.rob", tmp_path / "away.svg"
+    program.write_text("(MOV 6,6)\n(END)\n")
+    result = rl1c("sim", program, "--world", WORLD, "--format", "json", "--svg", picture)
+    assert result.exit_code == 0, result.output  # the program itself ended normally
+    report = json.loads(result.stdout)
+    # 30 cm/s from x = 60 until the front corners (40 cm ahead) pass x = 800: found at
+    # most one step (0.05 s) late.
+    assert report["run_on"]["stop"] == "off-floor"
+    assert 700 / 30 <= report["run_on"]["seconds"] <= 700 / 30 + 0.05
+    assert report["track"][-1][1] == pytest.approx(760, abs=1.5)
+    assert [event["kind"] for event in report["events"]] == ["end", "fault"]
+    assert "it runs on" in picture.read_text() and "left the floor" in picture.read_text()
+    text = rl1c("sim", program, "--world", WORLD).stdout
+    assert "with the vehicle moving: it ran on for 23.3" in text
+
+
+def test_a_vehicle_standing_at_the_end_does_not_run_on() -> None:
+    report = json.loads(rl1c("sim", SAMPLE, "--world", WORLD, "--format", "json").stdout)
+    assert report["run_on"] is None
+    assert report["events"][-1]["kind"] == "end"
 
 
 def test_json_report_has_the_track_and_is_deterministic(tmp_path: Path) -> None:

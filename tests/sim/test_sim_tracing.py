@@ -7,7 +7,7 @@ import math
 from dataclasses import replace
 
 import pytest
-from support.worlds import line_world
+from support.worlds import line_world, round_track
 
 from rl1.vm.device import LineLost
 from rl1.vm.sim.device import SimDevice
@@ -67,6 +67,17 @@ def test_a_lost_line_follows_table_4(mode: int, handler_hears: bool, keeps_movin
     assert (device.sim.motion is not None) == keeps_moving
 
 
+def test_after_the_end_a_tracing_vehicle_runs_on_until_mode_2_stops_it() -> None:
+    device = _tracing(0, 0, mode=2, end=500.0)
+    run_on = device.run_on()  # as after (END) with (MOV 3,3) in effect
+    assert run_on is not None and run_on.stop is None
+    view_ahead = 30 + 40 / math.tan(math.radians(50))
+    half_width = 40 / math.sin(math.radians(50)) * math.tan(math.radians(11))
+    assert device.sim.pose.x == pytest.approx(500 + 1 + half_width - view_ahead, abs=1)
+    assert run_on.seconds == pytest.approx((device.sim.pose.x - 100) / 15)
+    assert device.run_on() is None  # standing now
+
+
 def test_a_lost_line_during_mvi_interrupts_it_in_mode_2() -> None:
     device = _tracing(0, 0, mode=2, end=500.0)
     device.move(0, 0)
@@ -91,3 +102,22 @@ def test_a_program_hears_of_a_lost_line_at_its_handler() -> None:
     kinds = [event.kind for event in device.sim.events]
     assert kinds == ["lost", "handler"]
     assert "jump to :96" in device.sim.events[1].text
+
+
+def test_halving_the_step_leaves_a_patrol_where_it_was() -> None:
+    from rl1.compiler.cli.run import run_source
+    from rl1.vm.faults import RunResult
+
+    patrol = ("(CAM A 90); (CAM D); (SCN 0); (TRC 1); (KYC)\nN=60\n"
+              ":10 (MOV 4,4); (TIM 10); A=(ULT A); B=(KYO); C=(IMG); N--\n?N>#10\n"
+              "(MOV 0,0); (FRE); (END)\n")
+    ends = []
+    for step in (0.05, 0.025):
+        device = SimDevice(round_track(), step=step)
+        result = run_source(patrol, "patrol.rob", device)
+        assert isinstance(result, RunResult) and result.fault is None
+        ends.append(device.sim.pose)
+    # A minute at 20 cm/s, tracing all the way: nearly a lap of the 12.6 m track.
+    assert device.sim.time > 60
+    assert math.hypot(ends[0].x - ends[1].x, ends[0].y - ends[1].y) < 1.0
+    assert abs(ends[0].heading - ends[1].heading) < math.radians(0.5)

@@ -60,6 +60,12 @@ def test_a_good_world_loads_with_defaults_filled_in() -> None:
      "w.toml:11: lines[0].points: expected at least 2 points"),
     (GOOD.replace(b'"3" = 7', b'"3" = 700'), "w.toml:24: ports.3: 700 is outside 0..255"),
     (GOOD + b"\n[vehicle]\ntread = -5\n", "w.toml:27: vehicle.tread: -5 must be greater than 0"),
+    (GOOD.replace(b"x = 400", b"x = nan"),
+     "w.toml:14: stands[0].x: nan is not a finite number; write one in -1e+06..1e+06"),
+    (GOOD.replace(b"x = 400", b"x = " + b"9" * 400),
+     "w.toml:14: stands[0].x: a number that long is outside -1e+06..1e+06"),
+    (GOOD + b"\n[[walls]]\npoints = [" + b", ".join(b"[%d, 1]" % i for i in range(10_001)) + b"]\n",
+     "w.toml:27: walls[0].points: the world's lines and polygons have more than 10000 points"),
     (b"[floor\n", "w.toml: invalid TOML"),
     (b"\xff\xfe", "w.toml: not UTF-8 text"),
 ])

@@ -1,21 +1,24 @@
 """Hostile inputs for every `rl1c` command, and what each must still do.
 
 Shared by tests/cli/test_hostile_inputs.py (a bounded run in the test command) and
-bench/hostile_fuzz.py (a campaign as long as asked). `source_attack` and `ilc_attack`
-run the commands in-process on one input and return the problems found: an internal
-error, an exit status the command does not document, output written by a command that
-failed, a traceback on any stream.
+bench/hostile_fuzz.py (a campaign as long as asked). `source_attack`, `ilc_attack` and
+`world_attack` run the commands in-process on one input and return the problems found:
+an internal error, an exit status the command does not document, output written by a
+command that failed, a traceback on any stream; and for world files, a bad world not
+refused with status 2 and a message naming the file.
 """
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 from hypothesis import strategies as st
 
 from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.strategies import programs
+from rl1.vm.sim.world import WorldError, decode_world
 
 from . import EXAMPLES, ROOT
 from .cli import Result, rl1c
@@ -29,6 +32,7 @@ STATUSES = {
     "run": {0, 1, 2, 10, 11, 12, 13},
     "dis": {0, 1, 2},
     "asm": {0, 1, 2},
+    "sim": {0, 1, 2, 10, 11, 12, 13},
 }
 BUDGET = "20000"  # instructions: a runaway input ends quickly
 
@@ -137,4 +141,60 @@ def ilc_attack(data: bytes, folder: Path) -> list[str]:
         found += _problems("asm", built, again)
         if built.exit_code != 0 or again.read_bytes() != data:
             found.append(f"asm(dis(x)) != x: {built.output_bytes[-300:]!r}")
+    return found
+
+
+# A short program that uses every part of the world: the floor and its lines (tracing,
+# the camera looking down), the markers (looking level), the ultrasonic sensors, the
+# motion and the odometry.
+SIM_PROGRAM = b"""(CAM D); (SCN 0); (TRC 1); (MOV 12,12); (TIM 10); A=(IMG)
+(CAM U); (SCN 2); B=(IMG); C=(ULT A); D=(ULT B); (INP 3); (FZI)
+(TRC 0); (ROT 90); (STX 450); (MVI 3,3,40); E=(KYO); (MOV 2,2)
+(END)
+"""
+SEED_WORLDS = [path.read_bytes() for path in sorted(EXAMPLES.glob("*.world.toml"))]
+# Values that break naive code: not finite, huge, tiny, of the wrong type, degenerate
+# polygons, deep nesting.
+HOSTILE_VALUES = [
+    "nan", "inf", "-inf", "1e308", "-1e308", "1e6", "-1e6", "0", "-0.0", "5e-324",
+    "9" * 400, '"x"', "true", "[]", "{}", "[[0, 0], [0, 0], [0, 0]]",
+    "[[0, 0], [1e6, 1e6]]", "[[0, 0], [1e6, 0], [1e6, 1e6], [0, 1e6]]", "[1e6, 1e6]",
+    "[0, 0, 0, 0]", "[0, 0, 1024, 1024]", "[" * 600 + "]" * 600,
+]
+
+
+@st.composite
+def hostile_worlds(draw: st.DrawFn) -> bytes:
+    """Arbitrary bytes, the example worlds mutated byte by byte, and the example worlds
+    with one value replaced by a hostile one."""
+    kind = draw(st.sampled_from(["bytes", "mutated", "value"]))
+    if kind == "bytes":
+        return draw(st.binary(max_size=400))
+    world = draw(st.sampled_from(SEED_WORLDS))
+    if kind == "mutated":
+        return _mutated(world, draw)
+    assignments = list(re.finditer(rb"(?m)^(\s*[\w\"]+\s*=\s*)(.*?)(\s*(#.*)?)$", world))
+    chosen = draw(st.sampled_from(assignments))
+    value = draw(st.sampled_from(HOSTILE_VALUES)).encode()
+    return world[:chosen.start(2)] + value + world[chosen.end(2):]
+
+
+def world_attack(data: bytes, folder: Path) -> list[str]:
+    """`rl1c sim` on the world file `data`, with pictures and JSON: a world the loader
+    refuses must end with status 2 and a message naming the file, and write nothing."""
+    world, program, picture = folder / "hostile.world.toml", folder / "run.rob", folder / "run.svg"
+    world.write_bytes(data)
+    program.write_bytes(SIM_PROGRAM)
+    picture.unlink(missing_ok=True)
+    result = rl1c("sim", program, "--world", world, "--svg", picture, "--format", "json",
+                  "--budget", BUDGET)
+    # A run that faulted still draws its picture (the fault is in it); a refused input
+    # draws none.
+    found = _problems("sim", result, picture if result.exit_code in (1, 2) else None)
+    try:
+        decode_world(data, str(world))
+    except WorldError:
+        if result.exit_code != 2 or f"error: {world}" not in result.stderr:
+            found.append(f"sim: a bad world gave status {result.exit_code}: "
+                         f"{result.output_bytes[-300:]!r}")
     return found

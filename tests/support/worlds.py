@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Any
 
@@ -29,3 +30,15 @@ def stand_world(distance: float) -> World:
     marker_x = 200.0 + world.vehicle.camera_ahead + distance
     return replace(world, stands=(Stand("stand", marker_x + 20.0, 500.0, 40.0, 40.0, 180.0),),
                    scenes={2: Scene(("markers",), (0, 0, 256, 240))})
+
+
+def round_track() -> World:
+    """A round guidance track of radius 200 cm (72 straight pieces) centred on a 6 m
+    floor, a stand in its middle, the vehicle on it facing along it (bench/sim_speed.py's
+    patrol)."""
+    points = tuple((300 + 200 * math.cos(math.radians(a)), 300 + 200 * math.sin(math.radians(a)))
+                   for a in range(0, 361, 5))
+    return World(floor=(600.0, 600.0), start=(500.0, 300.0, 90.0),
+                 lines=(Line("track", points, 2.0),),
+                 stands=(Stand("stand", 300.0, 300.0, 40.0, 40.0, 0.0),),
+                 scenes={0: Scene(("lines",), (98, 117, 158, 123))}, time_limit=900.0)

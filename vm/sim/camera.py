@@ -11,12 +11,14 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from itertools import pairwise
 
 import numpy as np
 import numpy.typing as npt
 
+from .geometry import Point
 from .world import Scene, Vehicle, World
 
 Floats = npt.NDArray[np.float64]
@@ -58,63 +60,82 @@ def focal(vehicle: Vehicle) -> float:
 
 
 @functools.lru_cache(maxsize=8)
-def _camera_rays(width: int, height: int, fov: float,
-                 window: tuple[int, int, int, int]) -> Floats:
-    """Unit ray directions for each pixel of `window` in the camera's frame (forward,
-    left, down), shape (rows, columns, 3): the same for every image of a camera."""
+def _ray_lengths(width: int, height: int, f: float) -> Floats:
+    """The length of each pixel's ray f forward + column left + row down (unnormalised),
+    shape (rows, columns): the same for every image of a camera."""
+    columns, rows = _offsets(width, height, (0, 0, width, height))
+    lengths: Floats = np.sqrt(f * f + columns[None, :] ** 2 + rows[:, None] ** 2)
+    lengths.setflags(write=False)
+    return lengths
+
+
+@functools.lru_cache(maxsize=16)
+def _offsets(width: int, height: int, window: tuple[int, int, int, int]) -> tuple[Floats, Floats]:
+    """Each column's and each row's pixel centre in `window`, from the optical axis."""
     x0, y0, x1, y1 = window
-    xs = np.arange(x0, min(x1, width)) + 0.5 - width / 2
-    ys = np.arange(y0, min(y1, height)) + 0.5 - height / 2
-    f = width / 2 / math.tan(math.radians(fov) / 2)
-    directions = np.empty((ys.size, xs.size, 3))
-    directions[..., 0] = f
-    directions[..., 1] = xs[None, :]  # x grows to the left
-    directions[..., 2] = ys[:, None]
-    result: Floats = directions / np.linalg.norm(directions, axis=2, keepdims=True)
-    result.setflags(write=False)
-    return result
+    columns = np.arange(x0, x1, dtype=np.float64) + (0.5 - width / 2)
+    rows = np.arange(y0, y1, dtype=np.float64) + (0.5 - height / 2)
+    columns.setflags(write=False)
+    rows.setflags(write=False)
+    return columns, rows
 
 
-def _axes(view: View) -> Floats:
-    """The camera's forward, left and down unit vectors in the world, as rows."""
+Axes = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
+
+
+def _axes(view: View) -> Axes:
+    """The camera's forward, left and down unit vectors in the world."""
     cp, sp = math.cos(view.pitch), math.sin(view.pitch)
     cy, sy = math.cos(view.yaw), math.sin(view.yaw)
-    return np.array([[cp * cy, cp * sy, sp], [-sy, cy, 0.0], [sp * cy, sp * sy, -cp]])
+    return (cp * cy, cp * sy, sp), (-sy, cy, 0.0), (sp * cy, sp * sy, -cp)
 
 
-def rays(view: View, vehicle: Vehicle, window: tuple[int, int, int, int]) -> Floats:
-    """Unit ray directions in the world for each pixel of `window`, shape
-    (rows, columns, 3)."""
-    x0, y0, x1, y1 = window
-    local = _camera_rays(vehicle.image_width, vehicle.image_height, vehicle.camera_fov,
-                         (0, 0, vehicle.image_width, vehicle.image_height))[y0:y1, x0:x1]
-    result: Floats = local @ _axes(view)
-    return result
+Box = tuple[float, float, float, float]  # x0, y0, x1, y1 on the floor, cm
 
 
-def _floor_points(view: View, directions: Floats) -> tuple[Floats, Floats, Mask]:
-    dz = directions[..., 2]
-    down = dz < -1e-9
-    t = np.where(down, -view.z / np.where(down, dz, -1.0), 0.0)
-    return view.x + t * directions[..., 0], view.y + t * directions[..., 1], down
+def _overlaps(first: Box, second: Box) -> bool:
+    return (first[2] >= second[0] and first[0] <= second[2]
+            and first[3] >= second[1] and first[1] <= second[3])
 
 
-def _near_polyline(px: Floats, py: Floats, points: tuple[tuple[float, float], ...],
-                   half_width: float, box: tuple[float, float, float, float]) -> Mask:
-    hit = np.zeros(px.shape, dtype=bool)
-    for (ax, ay), (bx, by) in pairwise(points):
-        if (max(ax, bx) + half_width < box[0] or min(ax, bx) - half_width > box[2]
-                or max(ay, by) + half_width < box[1] or min(ay, by) - half_width > box[3]):
-            continue  # the piece is nowhere near what the camera sees
-        dx, dy = bx - ax, by - ay
-        length2 = dx * dx + dy * dy or 1.0
-        t = np.clip(((px - ax) * dx + (py - ay) * dy) / length2, 0.0, 1.0)
-        hit |= np.hypot(px - (ax + t * dx), py - (ay + t * dy)) <= half_width
-    return hit
+def _box(points: Sequence[Point], reach: float = 0.0) -> Box:
+    xs, ys = [p[0] for p in points], [p[1] for p in points]
+    return min(xs) - reach, min(ys) - reach, max(xs) + reach, max(ys) + reach
 
 
-def _in_polygon(px: Floats, py: Floats, polygon: tuple[tuple[float, float], ...]) -> Mask:
-    inside = np.zeros(px.shape, dtype=bool)
+@dataclass(frozen=True, slots=True)
+class _Piece:
+    """A straight piece of a guidance line, `half_width` either side of ab."""
+
+    a: Point
+    b: Point
+    half_width: float
+    box: Box  # what it covers on the floor
+
+
+def _near_piece(ahead: Floats, left: Floats, a: Point, b: Point, half_width: float,
+                corners: Sequence[Point]) -> Mask:
+    """The floor points (ahead, left) within `half_width` of the segment ab, all in the
+    camera's frame, the points all inside the quadrilateral `corners`."""
+    (ax, ay), (bx, by) = a, b
+    dx, dy = bx - ax, by - ay
+    length2 = dx * dx + dy * dy
+    if length2 and all(0 <= (x - ax) * dx + (y - ay) * dy <= length2 for x, y in corners):
+        # Every point seen lies beside the segment, not beyond an end: its distance is
+        # the distance to the segment's line.
+        length = math.sqrt(length2)
+        nx, ny = -dy / length, dx / length
+        distance = left * ny
+        distance += ahead * nx - (ax * nx + ay * ny)
+        return np.abs(distance) <= half_width
+    t = np.clip(((ahead - ax) * dx + (left - ay) * dy) / (length2 or 1.0), 0.0, 1.0)
+    return np.hypot(ahead - (ax + t * dx), left - (ay + t * dy)) <= half_width
+
+
+def _in_polygon(px: Floats, py: Floats, polygon: Sequence[Point]) -> Mask:
+    """Whether each point (px, py), broadcast together, lies inside `polygon` (the
+    even-odd rule)."""
+    inside = np.zeros(np.broadcast_shapes(px.shape, py.shape), dtype=bool)
     for i in range(len(polygon)):
         x1, y1 = polygon[i]
         x2, y2 = polygon[(i + 1) % len(polygon)]
@@ -125,73 +146,200 @@ def _in_polygon(px: Floats, py: Floats, polygon: tuple[tuple[float, float], ...]
     return inside
 
 
-def _seen(scene: Scene, kind: str, name: str) -> bool:
-    return kind in scene.sees or name in scene.sees
+@dataclass(frozen=True, slots=True)
+class _Ground:
+    """Where the window's rows that look down (from `first` on) meet the floor, for one
+    pitch of the camera, in its frame turned to the world: cm ahead along its yaw (per
+    row) and to the left (per pixel); `corners` those of the window's four corner pixels.
+    The yaw only turns this, so it is computed once per pitch."""
+
+    first: int
+    ahead: Floats  # shape (rows, 1)
+    left: Floats  # shape (rows, columns)
+    corners: tuple[Point, Point, Point, Point]
 
 
-def _floor(world: World, scene: Scene, view: View, image: Mask) -> None:
-    """Set the pixels of `image` that see a line or mark of `scene` on the floor."""
-    lines = [line for line in world.lines if _seen(scene, "lines", line.name)]
-    marks = [mark for mark in world.marks if _seen(scene, "marks", mark.name)]
-    if not (lines or marks):
-        return
-    px, py, down = _floor_points(view, rays(view, world.vehicle, scene.window))
-    if not down.any():
-        return
-    box = (float(px[down].min()), float(py[down].min()),
-           float(px[down].max()), float(py[down].max()))
-    for line in lines:
-        image |= down & _near_polyline(px, py, line.points, line.width / 2, box)
-    for mark in marks:
-        xs, ys = [p[0] for p in mark.points], [p[1] for p in mark.points]
-        if max(xs) >= box[0] and min(xs) <= box[2] and max(ys) >= box[1] and min(ys) <= box[3]:
-            image |= down & _in_polygon(px, py, mark.points)
+def _led_extent(ahead: float, left: float, down: float,
+                f: float) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The columns and rows (from the optical axis) that an LED at (ahead, left, down)
+    from the camera covers in the image: the box of the ellipse where the cone of rays
+    that pass within LED_RADIUS of its centre meets the image plane. The ray through
+    (u, v) is p = (f, u, v); it is in the cone when (p.c)^2 >= (|c|^2 - r^2) |p|^2, a
+    conic A u^2 + B uv + C v^2 + D u + E v + F >= 0; it is an ellipse while the LED is
+    wholly in front (ahead > r). Its extent in u is where, in v, it has one root."""
+    r2 = LED_RADIUS * LED_RADIUS
+    a = r2 - ahead * ahead - down * down
+    b = 2 * left * down
+    c = r2 - ahead * ahead - left * left
+    d = 2 * f * ahead * left
+    e = 2 * f * ahead * down
+    g = f * f * (r2 - left * left - down * down)
+
+    def interval(p: float, q: float, r: float) -> tuple[float, float]:
+        # Where p x^2 + q x + r >= 0, p < 0: between the roots.
+        root = math.sqrt(max(0.0, q * q - 4 * p * r))
+        low, high = (-q + root) / (2 * p), (-q - root) / (2 * p)
+        return min(low, high), max(low, high)
+
+    shape = b * b - 4 * a * c  # negative for an ellipse
+    return (interval(shape, 2 * b * e - 4 * c * d, e * e - 4 * c * g),
+            interval(shape, 2 * b * d - 4 * a * e, d * d - 4 * a * g))
 
 
-def _leds(world: World, scene: Scene, view: View, image: Mask) -> None:
-    """Set the pixels of `image` whose rays pass within an LED's radius of its centre;
-    only a box around each LED's projection is tested."""
-    vehicle = world.vehicle
-    axes = _axes(view)
-    f = focal(vehicle)
-    x0, y0 = scene.window[0], scene.window[1]
-    rows, columns = image.shape
-    for stand in world.stands:
-        if not _seen(scene, "markers", stand.name):
-            continue
-        mx, my = stand.marker()
-        facing = math.radians(stand.facing)
-        if (view.x - mx) * math.cos(facing) + (view.y - my) * math.sin(facing) <= 0:
-            continue  # the camera is behind the marker's face
-        for height in (vehicle.camera_height, vehicle.camera_height - LED_SPACING):
-            centre = np.array([mx - view.x, my - view.y, height - view.z])
-            ahead, left, down = (float(v) for v in axes @ centre)
-            if ahead <= LED_RADIUS:
-                continue
-            u = vehicle.image_width / 2 + f * left / ahead - x0
-            v = vehicle.image_height / 2 + f * down / ahead - y0
-            reach = 2 * f * LED_RADIUS / ahead + 2  # generous: the box only saves work
-            c0, c1 = max(0, int(u - reach)), min(columns, int(u + reach) + 1)
-            r0, r1 = max(0, int(v - reach)), min(rows, int(v + reach) + 1)
-            if c0 >= c1 or r0 >= r1:
-                continue
-            window = (x0 + c0, y0 + r0, x0 + c1, y0 + r1)
-            directions = rays(view, vehicle, window)
-            along = directions @ centre
-            miss2 = float(centre @ centre) - along * along
-            image[r0:r1, c0:c1] |= (along > 0) & (miss2 <= LED_RADIUS * LED_RADIUS)
+_Patch = tuple[int, int, Mask]  # top row and left column in the image, and the pixels
 
 
-def render(world: World, scene: Scene, view: View) -> Mask:
-    """The binary image of `scene`'s window as the camera at `view` sees it: True where
-    a feature the scene sees is."""
-    x0, y0, x1, y1 = scene.window
-    shape = (min(y1, world.vehicle.image_height) - y0, min(x1, world.vehicle.image_width) - x0)
-    image = np.zeros((max(shape[0], 0), max(shape[1], 0)), dtype=bool)
-    if image.size:
-        _floor(world, scene, view, image)
-        _leds(world, scene, view, image)
-    return image
+class Scenery:
+    """What one scene of a world sees (its lines' pieces, marks and markers) and the
+    camera's constants, prepared once, so that each (IMG) only renders."""
+
+    def __init__(self, world: World, scene: Scene) -> None:
+        def seen(kind: str, name: str) -> bool:
+            return kind in scene.sees or name in scene.sees
+
+        vehicle = world.vehicle
+        self.vehicle = vehicle
+        self.focal = focal(vehicle)
+        x0, y0, x1, y1 = scene.window
+        self.window = (x0, y0, min(x1, vehicle.image_width), min(y1, vehicle.image_height))
+        self.columns, self.rows = _offsets(vehicle.image_width, vehicle.image_height,
+                                           self.window)
+        self.pieces = [_Piece(a, b, line.width / 2, _box((a, b), line.width / 2))
+                       for line in world.lines if seen("lines", line.name)
+                       for a, b in pairwise(line.points)]
+        self.marks = [(mark.points, _box(mark.points)) for mark in world.marks
+                      if seen("marks", mark.name)]
+        self.markers = [(*stand.marker(), math.cos(math.radians(stand.facing)),
+                         math.sin(math.radians(stand.facing)))
+                        for stand in world.stands if seen("markers", stand.name)]
+        self.all_columns, self.all_rows = _offsets(vehicle.image_width, vehicle.image_height,
+                                                   (0, 0, vehicle.image_width,
+                                                    vehicle.image_height))
+        self.ray_lengths = _ray_lengths(vehicle.image_width, vehicle.image_height, self.focal)
+        self._grounds: dict[float, _Ground | None] = {}  # by pitch
+
+    def render(self, view: View) -> tuple[Mask, tuple[int, int]]:
+        """The binary image of what the camera at `view` sees, True where a feature is,
+        cut to a part of the window that holds every set pixel: the image and its top
+        left pixel (column, row)."""
+        x0, y0, x1, y1 = self.window
+        if x0 >= x1 or y0 >= y1:
+            return np.zeros((0, 0), dtype=bool), (x0, y0)
+        floor = self._floor(view) if self.pieces or self.marks else None
+        patches = self._leds(view, _axes(view)) if self.markers else []
+        if floor is None:
+            if not patches:
+                return np.zeros((0, 0), dtype=bool), (x0, y0)
+            # Only the LEDs: the image is the box around their patches.
+            top = min(r0 for r0, _, _ in patches)
+            left = min(c0 for _, c0, _ in patches)
+            bottom = max(r0 + mask.shape[0] for r0, _, mask in patches)
+            right = max(c0 + mask.shape[1] for _, c0, mask in patches)
+            image = np.zeros((bottom - top, right - left), dtype=bool)
+        else:
+            first, image = floor
+            top, left = y0 + first, x0
+        for r0, c0, mask in patches:
+            r, c = r0 - top, c0 - left
+            if r < 0:  # an LED above the rows that look down
+                image = np.vstack((np.zeros((-r, image.shape[1]), dtype=bool), image))
+                top, r = r0, 0
+            image[r:r + mask.shape[0], c:c + mask.shape[1]] |= mask
+        return image, (left, top)
+
+    def _ground(self, pitch: float) -> _Ground | None:
+        """A pixel's ray is f forward + column left + row down (unnormalised), so its
+        drop depends on its row alone: the rows that look down are the last ones, and
+        where they meet the floor is, in each row, an affine function of the column."""
+        if pitch in self._grounds:
+            return self._grounds[pitch]
+        cp, sp = math.cos(pitch), math.sin(pitch)
+        f = self.focal
+        drops = f * sp - self.rows * cp
+        down = drops < -1e-9 * f
+        ground = None
+        if down[-1]:  # rows drop more the lower they are: some look down
+            first = int(np.argmax(down))
+            scale = self.vehicle.camera_height / -drops[first:]
+            ahead = (scale * (f * cp + self.rows[first:] * sp))[:, None]
+            left = np.multiply.outer(scale, self.columns)
+            ahead.setflags(write=False)
+            left.setflags(write=False)
+            corners = ((float(ahead[0, 0]), float(left[0, 0])),
+                       (float(ahead[0, 0]), float(left[0, -1])),
+                       (float(ahead[-1, 0]), float(left[-1, -1])),
+                       (float(ahead[-1, 0]), float(left[-1, 0])))
+            ground = _Ground(first, ahead, left, corners)
+        self._grounds[pitch] = ground
+        return ground
+
+    def _floor(self, view: View) -> tuple[int, Mask] | None:
+        """The rows of the window from the first that looks down, set where they see a
+        line or mark on the floor; None when they see none. The features are brought
+        into the camera's frame, rather than every pixel into the world's."""
+        ground = self._ground(view.pitch)
+        if ground is None:
+            return None
+        cy, sy = math.cos(view.yaw), math.sin(view.yaw)
+
+        def local(point: Point) -> Point:
+            x, y = point[0] - view.x, point[1] - view.y
+            return x * cy + y * sy, y * cy - x * sy
+
+        # The window's floor is the projective image of a rectangle: a convex
+        # quadrilateral, so its corners bound it.
+        world_x = [view.x + a * cy - b * sy for a, b in ground.corners]
+        world_y = [view.y + a * sy + b * cy for a, b in ground.corners]
+        margin = 1e-6 * (1 + max(map(abs, world_x + world_y)))
+        seen = (min(world_x) - margin, min(world_y) - margin,
+                max(world_x) + margin, max(world_y) + margin)
+        pieces = [piece for piece in self.pieces if _overlaps(piece.box, seen)]
+        marks = [points for points, box in self.marks if _overlaps(box, seen)]
+        if not (pieces or marks):
+            return None
+        image: Mask | None = None
+        for piece in pieces:
+            near = _near_piece(ground.ahead, ground.left, local(piece.a), local(piece.b),
+                               piece.half_width, ground.corners)
+            image = near if image is None else image | near
+        for points in marks:
+            inside = _in_polygon(ground.ahead, ground.left, [local(p) for p in points])
+            image = inside if image is None else image | inside
+        assert image is not None
+        return ground.first, image
+
+    def _leds(self, view: View, axes: Axes) -> list[_Patch]:
+        """The pixels whose rays pass within an LED's radius of its centre, as patches
+        of the window: only a box around each LED's projection is tested. A ray at
+        angle a to the LED's direction misses its centre by |c| sin a, so it hits when
+        its component along c is at least sqrt(|c|^2 - r^2)."""
+        vehicle, f = self.vehicle, self.focal
+        x0, y0, x1, y1 = self.window
+        patches = []
+        for mx, my, cos_facing, sin_facing in self.markers:
+            if (view.x - mx) * cos_facing + (view.y - my) * sin_facing <= 0:
+                continue  # the camera is behind the marker's face
+            for height in (vehicle.camera_height, vehicle.camera_height - LED_SPACING):
+                cx, cy, cz = mx - view.x, my - view.y, height - view.z
+                ahead, left, down = (ax * cx + ay * cy + az * cz for ax, ay, az in axes)
+                if ahead <= LED_RADIUS:
+                    continue
+                (u0, u1), (v0, v1) = _led_extent(ahead, left, down, f)
+                # Pixel i's centre is i + 0.5 - width / 2 from the axis; a pixel more
+                # each side absorbs the rounding of the extent.
+                half_width, half_height = vehicle.image_width / 2, vehicle.image_height / 2
+                c0 = max(x0, math.floor(u0 + half_width - 0.5) - 1)
+                c1 = min(x1, math.ceil(u1 + half_width - 0.5) + 2)
+                r0 = max(y0, math.floor(v0 + half_height - 0.5) - 1)
+                r1 = min(y1, math.ceil(v1 + half_height - 0.5) + 2)
+                if c0 >= c1 or r0 >= r1:
+                    continue
+                # The ray's component along c, times its length, against the least.
+                along = (self.all_rows[r0:r1, None] * down + f * ahead) + (
+                    self.all_columns[c0:c1] * left)
+                least = math.sqrt(cx * cx + cy * cy + cz * cz - LED_RADIUS * LED_RADIUS)
+                patches.append((r0, c0, along >= least * self.ray_lengths[r0:r1, c0:c1]))
+        return patches
 
 
 @dataclass(frozen=True, slots=True)
@@ -205,30 +353,35 @@ class Moments:
     angle: float
 
 
-def moments(image: Mask, window: tuple[int, int, int, int]) -> Moments:
+@functools.lru_cache(maxsize=4)
+def _powers(count: int) -> Floats:
+    """For pixels 0..count-1, their centre's coordinate to the powers 0, 1 and 2."""
+    centres = np.arange(count) + 0.5
+    powers = np.stack((np.ones(count), centres, centres * centres), axis=1)
+    powers.setflags(write=False)
+    return powers
+
+
+def moments(image: Mask, origin: tuple[int, int]) -> Moments:
     """The zeroth, first and second moments of a binary image whose top left pixel is
-    (window[0], window[1])."""
-    # Only the box around what is set is summed; the sums over rows and columns are
-    # matrix products, cheaper than listing the pixels.
-    rows, columns = np.flatnonzero(image.any(axis=1)), np.flatnonzero(image.any(axis=0))
-    if rows.size == 0:
-        return Moments(0, 0.0, 0.0, 0.0)
-    image = image[rows[0]:rows[-1] + 1, columns[0]:columns[-1] + 1]
-    window = (window[0] + int(columns[0]), window[1] + int(rows[0]), window[2], window[3])
-    pixels = image.astype(np.float64)
-    column_counts, row_counts = pixels.sum(axis=0), pixels.sum(axis=1)
-    area = int(column_counts.sum())
+    `origin` (column, row)."""
+    # Two matrix products give every raw moment: image @ [1 x x^2] sums each row's,
+    # [1 y y^2]^T @ that sums them over the rows. Pixel centres are halves, so the sums
+    # are exact (far below 2^53) whatever the order of summation.
+    rows, columns = image.shape
+    powers = _powers(max(1024, origin[0] + columns, origin[1] + rows))
+    sums = (powers[origin[1]:origin[1] + rows].T
+            @ (image @ powers[origin[0]:origin[0] + columns])).tolist()
+    area = sums[0][0]
     if area == 0:
         return Moments(0, 0.0, 0.0, 0.0)
-    xs = np.arange(image.shape[1]) + window[0] + 0.5
-    ys = np.arange(image.shape[0]) + window[1] + 0.5
-    cx, cy = float(column_counts @ xs) / area, float(row_counts @ ys) / area
-    mu20 = float(column_counts @ (xs - cx) ** 2) / area
-    mu02 = float(row_counts @ (ys - cy) ** 2) / area
-    mu11 = float((ys - cy) @ (pixels @ (xs - cx))) / area
+    cx, cy = sums[0][1] / area, sums[1][0] / area
+    mu20 = sums[0][2] / area - cx * cx
+    mu02 = sums[2][0] / area - cy * cy
+    mu11 = sums[1][1] / area - cx * cy
     if abs(mu11) < 1e-9 * (mu20 + mu02):
         mu11 = 0.0  # rounding noise would flip a vertical axis between -90 and 90
-    return Moments(area, cx, cy, math.degrees(0.5 * math.atan2(2 * mu11, mu20 - mu02)))
+    return Moments(int(area), cx, cy, math.degrees(0.5 * math.atan2(2 * mu11, mu20 - mu02)))
 
 
 def view_centre(view: View) -> tuple[float, float, float] | None:

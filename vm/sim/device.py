@@ -49,6 +49,16 @@ class SimEntry:
         return entry
 
 
+@dataclass(frozen=True, slots=True)
+class RunOn:
+    """What the vehicle did after the program ended with it moving ((END) leaves motion
+    in effect): it ran on for `seconds` until `stop` stopped it (a safety stop, the time
+    limit included), or until it stopped by itself (`stop` None: a lost line in mode 2)."""
+
+    seconds: float
+    stop: SafetyFault | None
+
+
 class SimDevice:
     """A Device that drives the simulated vehicle in `world`."""
 
@@ -209,6 +219,21 @@ class SimDevice:
         s, t = self.sim.world.fuzzy
         self._record("FZI", result=(s, t))
         return FuzzyReading(s, t)
+
+    # After the program
+
+    def run_on(self) -> RunOn | None:
+        """Let the world run on after the program ended with the vehicle moving, until
+        it stops: what it did, or None when it was standing (or had faulted)."""
+        if self.sim.motion is None or self.fault is not None:
+            return None
+        started = self.sim.time
+        try:
+            self.sim.run_for(math.inf, interruptible=False)
+        except SafetyFault as fault:
+            return RunOn(self.sim.time - started, fault)
+        self.sim.note("end", "the vehicle stopped")
+        return RunOn(self.sim.time - started, None)
 
     # Engine services
 

@@ -78,6 +78,8 @@ class Simulator:
     _obstacles: list[tuple[str, list[Point], Point, float]] = field(init=False)
     _lines: tracing.LineIndex = field(init=False)
     _echoes: ultrasonic.Echoes = field(init=False)
+    _sceneries: dict[int, camera.Scenery] = field(default_factory=dict)  # built when used
+    _reach: float = field(init=False)  # from the centre to the outline's corners
     _times: list[float] = field(default_factory=lambda: [0.0])  # the track's times
 
     def __post_init__(self) -> None:
@@ -94,6 +96,7 @@ class Simulator:
             radius = max(math.hypot(p[0] - cx, p[1] - cy) for p in points)
             self._obstacles.append((name, points, (cx, cy), radius))
         self._echoes = ultrasonic.Echoes([points for _, points, _, _ in self._obstacles])
+        self._reach = math.hypot(self.world.vehicle.length, self.world.vehicle.width) / 2
 
     # Commands, in physical terms ---------------------------------------------------------
 
@@ -148,8 +151,11 @@ class Simulator:
 
     def image(self) -> camera.Moments:
         """What the image processor measures now, in the selected scene."""
-        scene = self.world.scenes.get(self.scene, _EMPTY_SCENE)
-        found = camera.moments(camera.render(self.world, scene, self.view()), scene.window)
+        scenery = self._sceneries.get(self.scene)
+        if scenery is None:
+            scene = self.world.scenes.get(self.scene, _EMPTY_SCENE)
+            scenery = self._sceneries[self.scene] = camera.Scenery(self.world, scene)
+        found = camera.moments(*scenery.render(self.view()))
         noise = self.world.noise.image_px
         if noise and found.area:
             dx, dy = self._rng.normal(0.0, noise, 2)
@@ -276,13 +282,14 @@ class Simulator:
                                      f"{self.world.time_limit:g} s")
 
     def _check_safety(self) -> None:
-        self._check_time()
-        width, depth = self.world.floor
-        reach = math.hypot(self.world.vehicle.length, self.world.vehicle.width) / 2
+        if self.time > self.world.time_limit:
+            self._check_time()
         x, y = self.pose.x, self.pose.y
+        reach = self._reach
         near = [(name, points) for name, points, (cx, cy), radius in self._obstacles
                 if math.hypot(cx - x, cy - y) <= radius + reach]
-        if min(x, width - x, y, depth - y) > reach and not near:
+        width, depth = self.world.floor
+        if not near and reach < x < width - reach and reach < y < depth - reach:
             return  # the outline cannot reach an edge or an obstacle: no need to draw it
         corners = self.outline()
         for cx, cy in corners:

@@ -27,7 +27,8 @@ class LineView:
     angle: float
 
 
-CELL = 25.0  # cm: the side of a cell of the lines' index
+CELL = 25.0  # cm: the side of a cell of the lines' index, on a floor of a few metres
+MOST_SAMPLES = 100_000  # the index's size, whatever the lines' length
 
 
 @dataclass(frozen=True, slots=True)
@@ -41,27 +42,37 @@ class Piece:
 
 
 class LineIndex:
-    """The guidance lines' pieces, filed by the square cells of the floor that each
-    piece's box covers, so that a measurement at each timer tick looks at a few pieces
-    near the view rather than at all of them."""
+    """The guidance lines' pieces, filed by the square cells of the floor that points
+    sampled along each piece fall in, so that a measurement at each timer tick looks at
+    a few pieces near the view rather than at all of them. The cells grow with the
+    lines' total length, so that the index stays small on any floor."""
 
     def __init__(self, lines: Sequence[Line]) -> None:
         self.pieces = [Piece(a, b, line.width / 2, math.atan2(b[1] - a[1], b[0] - a[0]))
                        for line in lines for a, b in pairwise(line.points)]
         self.widest = max((piece.half_width for piece in self.pieces), default=0.0)
+        total = sum(math.dist(piece.a, piece.b) for piece in self.pieces)
+        self.cell = max(CELL, 2 * total / MOST_SAMPLES)
+        self.spacing = self.cell / 2  # between two samples along a piece
         self.cells: dict[tuple[int, int], list[int]] = {}
         for index, piece in enumerate(self.pieces):
-            (x0, x1), (y0, y1) = sorted((piece.a[0], piece.b[0])), sorted((piece.a[1], piece.b[1]))
-            for i in range(math.floor(x0 / CELL), math.floor(x1 / CELL) + 1):
-                for j in range(math.floor(y0 / CELL), math.floor(y1 / CELL) + 1):
-                    self.cells.setdefault((i, j), []).append(index)
+            (ax, ay), (bx, by) = piece.a, piece.b
+            samples = math.ceil(math.dist(piece.a, piece.b) / self.spacing) + 1
+            filed = {(math.floor((ax + (bx - ax) * k / (samples - 1 or 1)) / self.cell),
+                      math.floor((ay + (by - ay) * k / (samples - 1 or 1)) / self.cell))
+                     for k in range(samples)}
+            for cell in filed:
+                self.cells.setdefault(cell, []).append(index)
 
     def near(self, x: float, y: float, reach: float) -> set[int]:
-        """The pieces whose cells lie within `reach` of (x, y): every piece that comes
-        that near is among them."""
+        """The pieces filed within `reach` of (x, y), widened by the samples' spacing:
+        every piece that comes that near is among them, since each of its points is
+        within the spacing of a sample."""
+        reach += self.spacing
+        cell = self.cell
         found: set[int] = set()
-        for i in range(math.floor((x - reach) / CELL), math.floor((x + reach) / CELL) + 1):
-            for j in range(math.floor((y - reach) / CELL), math.floor((y + reach) / CELL) + 1):
+        for i in range(math.floor((x - reach) / cell), math.floor((x + reach) / cell) + 1):
+            for j in range(math.floor((y - reach) / cell), math.floor((y + reach) / cell) + 1):
                 found.update(self.cells.get((i, j), ()))
         return found
 

@@ -138,6 +138,7 @@ class World:
 _TOP = ("floor", "start", "vehicle", "lines", "marks", "stands", "walls", "obstacles",
         "scenes", "ports", "fuzzy", "noise", "limits")
 _LIMIT = 1e6  # no length, angle or time in a world is near this; larger is a typo
+MAX_POINTS = 10_000  # in all lines and polygons: a floor of a few metres needs far fewer
 
 
 class _Reader:
@@ -146,6 +147,7 @@ class _Reader:
     def __init__(self, text: str, name: str) -> None:
         self.lines = text.splitlines()
         self.name = name
+        self.points_seen = 0
 
     def line_of(self, path: tuple[str | int, ...]) -> int | None:
         """The line where `path` is written, found from the table headers: a best
@@ -199,11 +201,19 @@ class _Reader:
                high: float = _LIMIT, positive: bool = False) -> float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise self.fail(path, f"expected a number, found {_kind(value)}")
+        if positive:
+            low = max(low, 0.0)
+        if isinstance(value, int) and value.bit_length() > 64:  # too long for a float
+            raise self.fail(path, f"a number that long is outside {low:g}..{high:g}; "
+                                  "write one within it")
         number = float(value)
-        if not math.isfinite(number) or not low <= number <= high:
-            raise self.fail(path, f"{value} is outside {low:g}..{high:g}")
+        if not math.isfinite(number):
+            raise self.fail(path, f"{value} is not a finite number; write one in "
+                                  f"{low:g}..{high:g}")
         if positive and number <= 0:
             raise self.fail(path, f"{value} must be greater than 0")
+        if not low <= number <= high:
+            raise self.fail(path, f"{value} is outside {low:g}..{high:g}; write one within it")
         return number
 
     def integer(self, value: object, path: tuple[str | int, ...], low: int,
@@ -239,6 +249,15 @@ class _Reader:
     def tables(self, document: dict[str, Any], key: str) -> list[Any]:
         items = self.array(document.get(key, []), (key,), f"tables ([[{key}]])")
         return items
+
+    def count(self, points: tuple[Point, ...], path: tuple[str | int, ...]) -> tuple[Point, ...]:
+        """`points`, counted against MAX_POINTS for the whole world."""
+        self.points_seen += len(points)
+        if self.points_seen > MAX_POINTS:
+            raise self.fail(path, f"the world's lines and polygons have more than "
+                                  f"{MAX_POINTS} points; simplify them (a straight run "
+                                  "needs only its two ends)")
+        return points
 
 
 def _kind(value: object) -> str:
@@ -288,11 +307,13 @@ def parse_world(document: dict[str, Any], text: str = "", name: str = "<world>")
         floor=floor, start=start, vehicle=_vehicle(r, document.get("vehicle", {})),
         lines=tuple(_line(r, item, i) for i, item in enumerate(r.tables(document, "lines"))),
         marks=tuple(Mark(_name(r, item, ("marks", i), ("name", "points"), f"mark{i}"),
-                         r.points(item["points"], ("marks", i, "points"), 3))
+                         r.count(r.points(item["points"], ("marks", i, "points"), 3),
+                                 ("marks", i, "points")))
                     for i, item in enumerate(r.tables(document, "marks"))),
         stands=tuple(_stand(r, item, i) for i, item in enumerate(r.tables(document, "stands"))),
         blocks=tuple(Block(_name(r, item, (kind, i), ("name", "points"), f"{kind}{i}"),
-                           r.points(item["points"], (kind, i, "points"), 3))
+                           r.count(r.points(item["points"], (kind, i, "points"), 3),
+                                   (kind, i, "points")))
                      for kind in ("walls", "obstacles")
                      for i, item in enumerate(r.tables(document, kind))),
         scenes=_scenes(r, document.get("scenes", []), document),
@@ -334,7 +355,7 @@ def _line(r: _Reader, item: object, i: int) -> Line:
     path: tuple[str | int, ...] = ("lines", i)
     table = r.table(item, path, ("name", "points", "width"), ("points",))
     return Line(r.text(table.get("name", f"line{i}"), (*path, "name")),
-                r.points(table["points"], (*path, "points"), 2),
+                r.count(r.points(table["points"], (*path, "points"), 2), (*path, "points")),
                 r.number(table.get("width", 2.0), (*path, "width"), positive=True))
 
 
@@ -356,7 +377,8 @@ def _scenes(r: _Reader, value: object, document: dict[str, Any]) -> dict[int, Sc
         table = r.table(item, path, ("number", "sees", "window"), ("number", "sees"))
         number = r.integer(table["number"], (*path, "number"), 0, 7)
         if number in scenes:
-            raise r.fail((*path, "number"), f"scene {number} is defined twice")
+            raise r.fail((*path, "number"), f"scene {number} is defined twice; give each "
+                                            "[[scenes]] its own number")
         sees = tuple(r.text(s, (*path, "sees", j))
                      for j, s in enumerate(r.array(table["sees"], (*path, "sees"), "names")))
         window = r.array(table.get("window", [0, 0, 1024, 1024]), (*path, "window"),
