@@ -40,8 +40,9 @@ demo: $(STAMP)
 
 test: lint typecheck vscode-test c-test pytest
 
-# The C loader (vm/c/): the Debian packages it needs when missing (CI runs as root),
-# then its builds, sanitizers, cross builds and a bounded fuzzing run.
+# The C VM (vm/c/): the Debian packages it needs when missing (CI runs as root),
+# then its builds, the conformance vectors under sanitizers and on emulated targets,
+# cross builds and a bounded fuzzing run.
 c-test: $(STAMP)
 	vm/c/install-tools
 	$(MAKE) -C vm/c test RL1_PYTHON=$(CURDIR)/$(BIN)/python

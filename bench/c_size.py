@@ -1,14 +1,17 @@
-"""Flash and RAM of the C loader and verifier (vm/c/rl1vm_load.c) on the firmware
-targets, from the objects `make -C vm/c cross` builds at -Os, against the anchors of
-issue 13 (EmbedVM ~3 KB with no verifier, Microvium 7.3 KB on Cortex-M0).
+"""Flash, RAM and stack of the C VM and its loader and verifier (vm/c/) on the firmware
+targets, from the objects `make -C vm/c cross` builds at -Os, against the goals of issue
+13 (VM and verifier at most 4 KB of flash on Cortex-M3, no static RAM, a state struct of
+at most 128 bytes, a stack of at most 256 bytes) and its anchors (EmbedVM ~3 KB with no
+verifier, Microvium 7.3 KB on Cortex-M0).
 
 Flash is text, rodata and initialized data; static RAM is data and bss, and rodata on
-AVR, whose start-up copies it to RAM: the loader must have none (on AVR it is built with
--fno-tree-switch-conversion, which would make lookup tables of its switches). Stack:
-each function's frame from gcc's -fstack-usage; as nothing recurses and each helper
-appears at most once on a chain of calls, a call to `rl1_load` needs at most its frame
-plus every helper's (return addresses aside), a bound rather than a measured high-water
-mark.
+AVR, whose start-up copies it to RAM: the VM must have none (on AVR it is built with
+-fno-tree-switch-conversion, which would make lookup tables of its switches). The state
+struct (rl1_vm) is read from the size of test/probe.c's symbol. Stack: from gcc's
+-fstack-usage, for each public entry the sum of its frame and every helper's it may call
+(nothing recurses, and each helper appears at most once on a chain), a bound that leaves
+out return addresses and the hardware callbacks, which are the firmware's; the emulated
+targets (make -C vm/c targets) measure the high-water mark of a real run.
 
     python3 bench/c_size.py [BUILD-FOLDER]      (default vm/c/build)
 """
@@ -20,10 +23,19 @@ import subprocess
 import sys
 from pathlib import Path
 
-# name, size tool, object, whether .rodata costs RAM (avr-gcc's start-up copies it there)
-TARGETS = (("Cortex-M0", "arm-none-eabi-size", "rl1vm_load-cortex-m0.o", False),
-           ("Cortex-M3", "arm-none-eabi-size", "rl1vm_load-cortex-m3.o", False),
-           ("ATmega328P", "avr-size", "rl1vm_load-atmega328p.o", True))
+# name, binutils prefix, object suffix, whether .rodata costs RAM (avr-gcc copies it there)
+TARGETS = (("Cortex-M0", "arm-none-eabi-", "cortex-m0", False),
+           ("Cortex-M3", "arm-none-eabi-", "cortex-m3", False),
+           ("ATmega328P", "avr-", "atmega328p", True))
+OBJECTS = ("rl1vm", "rl1vm_load")  # the VM, the loader and verifier
+# Each public entry and the helpers it may call, by object.
+Chain = dict[str, tuple[str, ...]]
+LOAD_CHAIN: Chain = {"rl1vm_load": ("rl1_load", "leb128", "starts_instruction",
+                                    "rl1_op_length", "rl1_arg_in_range", "check_")}
+STEP_CHAIN: Chain = {"rl1vm": ("rl1_step", "take_event", "fault", "finish", "shifted",
+                               "call", "resume", "run", "ended"),
+                     "rl1vm_load": ("rl1_op_length", "rl1_arg_in_range")}
+GOALS = {"flash": 4096, "struct": 128, "stack": 256}
 
 
 def sizes(tool: str, path: Path, rodata_in_ram: bool) -> tuple[int, int]:
@@ -43,34 +55,61 @@ def sizes(tool: str, path: Path, rodata_in_ram: bool) -> tuple[int, int]:
     return flash, ram
 
 
-PUBLIC = ("rl1_load", "rl1_line_at")
-
-
-def stack_bound(path: Path) -> int:
-    """rl1_load's frame plus every helper's (not the other public function's)."""
-    frames = {}
+def frames(path: Path) -> dict[str, int]:
+    """Each function's frame from a -fstack-usage file (gcc may add .part.0 suffixes)."""
+    found = {}
     for line in path.read_text(encoding="utf-8").splitlines():
         where, size, _kind = line.split("\t")
-        frames[where.rsplit(":", 1)[1]] = int(size)
-    return sum(size for name, size in frames.items() if name not in PUBLIC[1:])
+        found[where.rsplit(":", 1)[1].split(".")[0]] = int(size)
+    return found
+
+
+def stack_bound(build: Path, suffix: str, chain: Chain) -> int:
+    total = 0
+    for object_name, names in chain.items():
+        for function, size in frames(build / f"{object_name}-{suffix}.su").items():
+            if function.startswith(names):
+                total += size
+    return total
+
+
+def struct_size(tool: str, path: Path) -> int:
+    output = subprocess.run([tool, "-S", str(path)], check=True, capture_output=True,
+                            text=True).stdout
+    for line in output.splitlines():
+        fields = line.split()
+        if fields[-1] == "rl1_vm_size_probe":
+            return int(fields[1], 16)
+    raise ValueError(f"no rl1_vm_size_probe in {path}")
 
 
 def main() -> int:
     build = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).parent.parent / \
         "vm" / "c" / "build"
-    print("loader + verifier, -Os   flash                static RAM             stack bound")
+    print("-Os          flash: VM + verifier = total   static RAM   rl1_vm   "
+          "stack bound: rl1_load, rl1_step")
     status = 0
-    for name, tool, object_name, rodata_in_ram in TARGETS:
-        path = build / object_name
-        if shutil.which(tool) is None or not path.exists():
-            print(f"{name:<26} skipped: no {tool} or no {path}")
+    for name, prefix, suffix, rodata_in_ram in TARGETS:
+        tool = prefix + "size"
+        paths = [build / f"{object_name}-{suffix}.o" for object_name in OBJECTS]
+        if shutil.which(tool) is None or not all(path.exists() for path in paths):
+            print(f"{name:<12} skipped: no {tool} or no objects in {build} (make cross)")
             continue
-        flash, ram = sizes(tool, path, rodata_in_ram)
-        stack = stack_bound(path.with_suffix(".su"))
-        print(f"{name:<24} {flash:>8} bytes {ram:>18} bytes {stack:>8} bytes")
-        if ram:
-            print(f"  {name}: the loader must have no static data")
+        (vm_flash, vm_ram), (load_flash, load_ram) = (sizes(tool, path, rodata_in_ram)
+                                                     for path in paths)
+        struct = struct_size(prefix + "nm", build / f"probe-{suffix}.o")
+        load_stack = stack_bound(build, suffix, LOAD_CHAIN)
+        step_stack = stack_bound(build, suffix, STEP_CHAIN)
+        total = vm_flash + load_flash
+        print(f"{name:<12} {vm_flash:>6} + {load_flash:>6} = {total:>5} bytes"
+              f"   {vm_ram + load_ram:>6} bytes   {struct:>3} bytes   "
+              f"{load_stack:>4}, {step_stack:>4} bytes")
+        if vm_ram + load_ram:
+            print(f"  {name}: the VM must have no static data")
             status = 1
+    print(f"goals (Cortex-M3): flash <= {GOALS['flash']}, no static RAM, rl1_vm <= "
+          f"{GOALS['struct']} bytes (its 53 variables alone take 106), stack <= "
+          f"{GOALS['stack']}")
     return status
 
 

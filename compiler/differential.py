@@ -2,9 +2,10 @@
 
 spec/optimization.md is the contract: section 2 says what is observable (the device
 trace, how the run ends, the 53 variables), section 3 the budget invariant between
-optimization levels, section 5 the engines (`ast`, `vm-O0`..`vm-O2`, `exec:COMMAND`).
-`rl1c fuzz` and the property tests both compare runs through this module. A C VM will be
-one more `Engine`: a name and a `run`.
+optimization levels, section 5 the engines (`ast`, `vm-O0`..`vm-O2`, `c-O0`..`c-O2`,
+`exec:COMMAND`). `rl1c fuzz` and the property tests both compare runs through this
+module. The C VM of the firmware (vm/c/, through vm/native.py) is one more `Engine`: a
+name and a `run`.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from rl1.vm.faults import FaultKind
 from rl1.vm.hardware import Blocking
 from rl1.vm.language import VARIABLES
 from rl1.vm.machine import Machine
+from rl1.vm.native import NativeMachine, library, load
 from rl1.vm.scripted import IGNORED, ScriptedDevice, parse_script, run_document
 from rl1.vm.verifier import verify
 
@@ -108,6 +110,25 @@ class VmEngine:
 
 
 @dataclass(frozen=True)
+class CEngine:
+    """The compiler at one level, then the C VM of the firmware (built on first use:
+    native.BuildError when this machine has no C compiler)."""
+
+    level: int
+    name: str = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "name", f"c-O{self.level}")
+
+    def run(self, case: Run, budget: int) -> Observation:
+        device = ScriptedDevice(parse_script(case.script))
+        machine = NativeMachine(compiled(case.source, self.level), Blocking(device), budget,
+                                load(library()))
+        result = machine.run()
+        return Observation(run_document(result, device.trace), machine.executed)
+
+
+@dataclass(frozen=True)
 class ExecEngine:
     """A command run once per program (spec/optimization.md, section 5)."""
 
@@ -162,8 +183,8 @@ def compiled(source: str, level: int) -> bytes:
     return output
 
 
-ENGINE_NAMES = ("ast", *(f"vm-O{level}" for level in OPTIMIZATION_LEVELS))
-DEFAULT_ENGINES = ENGINE_NAMES
+DEFAULT_ENGINES = ("ast", *(f"vm-O{level}" for level in OPTIMIZATION_LEVELS))
+ENGINE_NAMES = (*DEFAULT_ENGINES, *(f"c-O{level}" for level in OPTIMIZATION_LEVELS))
 
 
 def engine_named(name: str) -> Engine | None:
@@ -172,6 +193,8 @@ def engine_named(name: str) -> Engine | None:
         return AstEngine()
     if name.startswith("vm-O") and name[4:] in {str(level) for level in OPTIMIZATION_LEVELS}:
         return VmEngine(int(name[4:]))
+    if name.startswith("c-O") and name[3:] in {str(level) for level in OPTIMIZATION_LEVELS}:
+        return CEngine(int(name[3:]))
     if name.startswith("exec:") and name[5:].strip():
         return ExecEngine(name[5:])
     return None

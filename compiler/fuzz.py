@@ -4,8 +4,8 @@ disagrees, then that run shrunk to a small one and written down as a reproducer.
 Runs come from `strategies.runs()`; Hypothesis' `find` generates them and, on the first
 disagreement, shrinks the run to the smallest it can find that still disagrees (the
 disagreement may change on the way: it is the smallest run that shows one), for at most
-SHRINK_SECONDS: a slow `exec:` engine can make shrinking take long. `judge` in
-differential.py decides what disagrees (spec/optimization.md).
+SHRINK_SECONDS or SHRINK_ATTEMPTS runs: a slow `exec:` engine can make shrinking take
+long. `judge` in differential.py decides what disagrees (spec/optimization.md).
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ from hypothesis.errors import NoSuchExample
 from rl1.compiler.analysis import analyze
 from rl1.compiler.differential import (
     AstEngine,
+    CEngine,
     Engine,
     ExecEngine,
     Verdict,
@@ -38,6 +39,7 @@ from rl1.compiler.frontend.source import split_lines
 from rl1.compiler.strategies import Run, runs
 
 SHRINK_SECONDS = 20.0  # Hypothesis' shrinking stops here, with the smallest run so far
+SHRINK_ATTEMPTS = 10_000  # or after trying so many runs, whichever comes first
 LABEL = re.compile(r"[ \t\f\v]*:[0-9]*")  # a label where a line starts (language 3.1)
 SOURCE = "program.rob"
 SCRIPT = "program.sensors.json"
@@ -71,17 +73,20 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
     programs = 0
     found_after: float | None = None  # seconds until the first disagreement
     smallest: Run | None = None  # the last run that disagreed: the smallest so far
+    attempts = 0  # runs tried since the first disagreement
 
     def disagrees(case: Run) -> bool:
-        nonlocal programs, found_after, smallest
+        nonlocal programs, found_after, smallest, attempts
         elapsed = time.monotonic() - start
         if found_after is None:
             if seconds is not None and elapsed >= seconds:
                 raise _TimeUp
             programs += 1
             progress(programs, elapsed)
-        elif elapsed - found_after > SHRINK_SECONDS:
+        elif elapsed - found_after > SHRINK_SECONDS or attempts >= SHRINK_ATTEMPTS:
             raise _TimeUp  # small enough: keep the smallest so far
+        else:
+            attempts += 1
         if not judge(case, engines, budget).problems:
             return False
         if found_after is None:
@@ -187,9 +192,9 @@ def _replay(engine: Engine, case: Run, budget: int,
     run = f"--sensors {SCRIPT} --budget {budget} --format json"
     if isinstance(engine, AstEngine):
         return f"rl1c run {SOURCE} --engine ast {run}"
-    if isinstance(engine, VmEngine):
+    if isinstance(engine, VmEngine | CEngine):
         ilc = write(f"program-O{engine.level}.ilc", compiled(case.source, engine.level))
-        return f"rl1c run {ilc} {run}"
+        return f"rl1c run {ilc} {run}" + (" --engine c" if isinstance(engine, CEngine) else "")
     if isinstance(engine, ExecEngine):
         ilc = write("program-O0.ilc", compiled(case.source, 0))
         return engine.command_line(ilc, SCRIPT, budget)

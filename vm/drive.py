@@ -9,14 +9,31 @@ from an interrupt (spec/ilc.md, section 12.4).
 
 from __future__ import annotations
 
+from typing import Protocol
+
 from .faults import RunResult
-from .machine import Machine, State
+from .machine import State
 from .scripted import ScriptedDevice
 
 _GOING = (State.RUNNING, State.WAITING)
 
 
-def drive(machine: Machine, device: ScriptedDevice) -> RunResult:
+class Stepper(Protocol):
+    """A VM run stepped as spec/ilc.md section 12 says: machine.Machine, or the C VM's
+    native.NativeMachine."""
+
+    @property
+    def executed(self) -> int: ...
+
+    @property
+    def state(self) -> State: ...
+
+    def step(self, limit: int) -> State: ...
+
+    def run(self) -> RunResult: ...
+
+
+def drive(machine: Stepper, device: ScriptedDevice) -> RunResult:
     """Run `machine`, whose hardware is `device`, to its end."""
     for count in device.script.instruction_losses:
         while machine.executed < count and machine.step(count - machine.executed) in _GOING:

@@ -70,3 +70,21 @@ def missing_handler_message(mode: int, command: str, label: int) -> str:
     """What a MISSING_HANDLER fault says, whichever engine meets it."""
     return (f"the line was lost during {command} in tracing mode {mode}, which jumps to "
             f":{label}, but the program has no label :{label}")
+
+
+def budget_message(budget: int) -> str:
+    """What a BUDGET fault of the VM says."""
+    return (f"the program ran more than {budget} instructions without ending (raise the "
+            "budget if it should run longer)")
+
+
+def argument_range_message(param: str, form: str, value: int, variable: int, low: int,
+                           high: int) -> str:
+    """What an ARGUMENT_RANGE fault of the VM says: parameter `param` of built-in `form`
+    got `value` from the variable of index `variable`."""
+    return (f"argument {param} of ({form}) is {value} (the value of {VARIABLES[variable]}), "
+            f"outside {low}..{high}")
+
+
+STOP_FAILED = "; stopping the vehicle failed too: "
+"""What a fault's message gains when stopping the vehicle failed, before the reason."""

@@ -52,7 +52,7 @@ KNOWN_FLAGS = 0x0000
 
 class Refusal(IntEnum):
     """Why a file is refused: one kind per rule of spec/ilc.md section 10, in the order
-    the rules are checked. The C loader's `rl1_status` (vm/c/rl1vm.h) has the same names
+    the rules are checked. The C loader's `rl1_refusal` (vm/c/rl1vm.h) has the same names
     (prefixed RL1_) and numbers, so that the two can be compared refusal for refusal."""
 
     TRUNCATED = 1  # the header or a section passes the file's end

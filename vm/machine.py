@@ -51,7 +51,16 @@ from enum import Enum
 
 from . import isa
 from .device import Device, DeviceError, FormKey, LineLost, checked, form_name
-from .faults import DEFAULT_BUDGET, Fault, FaultKind, RunResult, missing_handler_message
+from .faults import (
+    DEFAULT_BUDGET,
+    STOP_FAILED,
+    Fault,
+    FaultKind,
+    RunResult,
+    argument_range_message,
+    budget_message,
+    missing_handler_message,
+)
 from .hardware import Answer, Blocking, Hardware, Status
 from .language import BUILTINS, VARIABLE_INDEX, VARIABLES, Param, lost_line_handler
 from .verifier import VerifiedProgram
@@ -460,9 +469,7 @@ class Machine:
         finally:
             self._unbound()
         self.acc, self.pc, self.executed = acc, pc, executed
-        watchdog = _Faulted(FaultKind.BUDGET, f"the program ran more than {budget} "
-                            "instructions without ending (raise the budget if it should "
-                            "run longer)")
+        watchdog = _Faulted(FaultKind.BUDGET, budget_message(budget))
         return self._faulted(watchdog, pc - 1)
 
     # The step's limit: a HALT put in the code where the step must stop
@@ -499,10 +506,9 @@ class Machine:
         for param, arg in zip(site.params, site.args, strict=True):
             value = cells[arg.value] if arg.is_var else arg.value
             if arg.is_var and not param.low <= value <= param.high:
-                raise _Faulted(FaultKind.ARGUMENT_RANGE,
-                               f"argument {param.name} of ({form_name(site.form)}) is "
-                               f"{value} (the value of {VARIABLES[arg.value]}), outside "
-                               f"{param.low}..{param.high}")
+                raise _Faulted(FaultKind.ARGUMENT_RANGE, argument_range_message(
+                    param.name, form_name(site.form), value, arg.value, param.low,
+                    param.high))
             values.append(value)
         return tuple(values)
 
@@ -542,7 +548,7 @@ class Machine:
         message = fault.message
         stopped = self.hardware.stop()
         if stopped.status is not Status.OK:
-            message += f"; stopping the vehicle failed too: {stopped.message}"
+            message += STOP_FAILED + stopped.message
         if not ended:
             self.hardware.end()  # the fault is reported whatever the end answers
         self.state = State.FAULTED

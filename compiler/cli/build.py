@@ -64,7 +64,7 @@ SECTION = "Intermediate code"
 EMIT_CHOICES = ("ilc", "ir", "c", "ihex", "ils")
 # The file each --emit kind is written to beside the source (None: standard output).
 EMIT_SUFFIXES = {"ilc": ".ilc", "ir": None, "c": ".c", "ihex": ".hex", "ils": ".ils"}
-ENGINE_CHOICES = ("vm", "ast")
+ENGINE_CHOICES = ("vm", "ast", "c")
 DEFAULT_BUDGET = 10_000_000
 DEFAULT_LEVEL = 1
 TRACE_CHOICES = ("short", "all", "calls", "none")  # run_report.TRACE_CHOICES
@@ -243,7 +243,8 @@ def _time_limit(ctx: click.Context, param: click.Parameter, value: str) -> int:
               help="device time before the run is stopped (a device error): a program "
                    "waiting in a loop for a reading that never comes")
 @choice_option("--engine", choices=ENGINE_CHOICES, default="vm",
-               help="vm: compile, then run on the reference VM; ast: interpret the source")
+               help="vm: compile, then run on the reference VM; ast: interpret the source; "
+                    "c: run on the C VM of the firmware (vm/c, built on first use)")
 def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoice | None,
         budget: int, time_limit: int, engine: Engine) -> int:
     """Run a program (.rob source, or a compiled .ilc file) on the scripted device.
@@ -256,6 +257,7 @@ def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoi
     budget exhausted, 13 device error (a sensing call past the script's readings, the
     time limit)."""
     from rl1.compiler.files import SourceError
+    from rl1.vm.native import BuildError
     from rl1.vm.scripted import Script, ScriptedDevice, ScriptError
     from rl1.vm.verifier import VerifyError, verify
 
@@ -284,7 +286,11 @@ def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoi
                                f"byte {error.offset}: {error.message}",
                                "compile the program again", EXIT_ERRORS) from None
         source_name, source_text = _recorded_source(program, file)
-        finished = execute_program(program, device, budget)
+        try:
+            finished = execute_program(program, device, budget,
+                                       "c" if engine == "c" else "vm", data)
+        except BuildError as error:
+            raise Failure(f"error: {error}") from None
     else:
         source = read_input(file)
         if not isinstance(source, Source):
@@ -294,6 +300,8 @@ def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoi
                                      engine, budget)
         except ScriptError as error:
             raise click.UsageError(str(error)) from None
+        except BuildError as error:
+            raise Failure(f"error: {error}") from None
         if not isinstance(outcome, Finished):
             return emit([FileDiagnostics(source.name, source.text, outcome)], "human",
                         "auto", "run", err=True)

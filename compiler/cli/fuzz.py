@@ -14,7 +14,7 @@ import click
 
 from rl1.compiler.reporting.render import EXIT_ERRORS
 
-from .command import PATH, Command, a_budget, at_least_one
+from .command import PATH, Command, Failure, a_budget, at_least_one
 
 SECTION = "Testing"
 
@@ -25,7 +25,8 @@ BAR_WIDTH = 30
 
 @click.command(cls=Command)
 @click.option("--engine", "engine_names", multiple=True, metavar="NAME",
-              help="an engine to compare, repeatable: ast, vm-O0, vm-O1, vm-O2, or "
+              help="an engine to compare, repeatable: ast, vm-O0, vm-O1, vm-O2, the C VM "
+                   "of the firmware c-O0, c-O1, c-O2 (built on first use), or "
                    "exec:COMMAND ({ilc}, {sensors} and {budget} replaced; it prints the run "
                    "as `rl1c run --format json` does). Default: ast, vm-O0, vm-O1, vm-O2; "
                    "the first is the reference")
@@ -51,9 +52,10 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     program is shrunk to a small one, written with each engine's run and a replay
     script to --out, and the difference printed. Exit status: 0 all agreed, 1 a
     disagreement, 2 a usage problem."""
-    from rl1.compiler.differential import DEFAULT_ENGINES, Engine, engine_named
+    from rl1.compiler.differential import DEFAULT_ENGINES, ENGINE_NAMES, Engine, engine_named
     from rl1.compiler.frontend.source import split_lines
     from rl1.compiler.fuzz import campaign, write_reproducer
+    from rl1.vm.native import BuildError
 
     if count is not None and seconds is not None:
         raise click.UsageError("give --count or --time, not both")
@@ -62,7 +64,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         engine = engine_named(name)
         if engine is None:
             raise click.UsageError(f"argument --engine: unknown engine {name!r} (choose from "
-                                   f"{', '.join(DEFAULT_ENGINES)}, or exec:COMMAND)")
+                                   f"{', '.join(ENGINE_NAMES)}, or exec:COMMAND)")
         engines.append(engine)
     if len({engine.name for engine in engines}) < 2 or len(set(engine_names)) < len(
             engine_names):
@@ -74,9 +76,13 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
                                ) from None
     limit = None if seconds is not None else count or DEFAULT_COUNT
     bar = _Bar(limit, seconds)
-    outcome = campaign(engines, budget, count=limit, seconds=seconds, seed=seed_value,
-                       progress=bar.update)
-    bar.close()
+    try:
+        outcome = campaign(engines, budget, count=limit, seconds=seconds, seed=seed_value,
+                           progress=bar.update)
+    except BuildError as error:  # a c-ON engine on a machine without a C compiler
+        raise Failure(f"error: {error}") from None
+    finally:
+        bar.close()
     names = ", ".join(engine.name for engine in engines)
     rate = outcome.programs / outcome.seconds if outcome.seconds else 0.0
     summary = (f"fuzz: {outcome.programs} programs in {outcome.seconds:.1f} s "

@@ -39,14 +39,20 @@ def test_rl1c_run_itself_is_an_exec_engine_as_the_spec_shows(tmp_path: Path) -> 
 
 def test_a_planted_shift_bug_is_found_and_shrunk_to_a_few_lines(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(fuzz, "SHRINK_SECONDS", 3.0)  # then deleting lines does the rest
+    # A bound in runs, not seconds, so that a loaded machine shrinks as far as an idle
+    # one; then deleting lines does the rest.
+    monkeypatch.setattr(fuzz, "SHRINK_SECONDS", 600.0)
+    monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 40)
     out = tmp_path / "found"
     result = rl1c("fuzz", "--engine", "vm-O0", "--engine", BROKEN_VM, "--count", "300",
                   "--seed", "1", "--out", str(out))
     assert result.exit_code == 1, result.output
     assert "the engines disagree (reference: vm-O0)" in result.stdout
     program = (out / "program.rob").read_text(encoding="utf-8")
-    assert 1 <= len(split_lines(program)) <= 3, program
+    # Which run disagrees first depends on Hypothesis' draws, which mix in the literals
+    # of the modules the suite has loaded: a loop around the shift (5 lines) is as small
+    # as some of those runs go.
+    assert 1 <= len(split_lines(program)) <= 5, program
     assert "<" in program  # a left shift, by a negative count
     runs = [json.loads(path.read_text(encoding="utf-8")) for path in sorted(out.glob("run-*"))]
     assert len(runs) == 2 and runs[0]["variables"] != runs[1]["variables"]

@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from support import EXAMPLES
 from support.ilc import images
+from support.scripts import MOVING_STARTS, scripts
 from support.semantics import int16, operate
 
 from rl1.compiler.analysis import analyze
@@ -24,7 +25,7 @@ from rl1.vm.faults import FaultKind, RunResult
 from rl1.vm.hardware import Blocking
 from rl1.vm.language import BUILTINS, VARIABLES
 from rl1.vm.machine import Machine
-from rl1.vm.scripted import AFTER_LAST, LossAt, LossDuring, Script, ScriptedDevice, TraceEntry
+from rl1.vm.scripted import LossAt, LossDuring, Script, ScriptedDevice, TraceEntry
 from rl1.vm.verifier import VerifiedProgram, verify
 
 
@@ -310,29 +311,6 @@ def test_any_verified_image_runs_to_an_end_or_a_fault(
 
 # The VM and the interpreter agree ------------------------------------------------------------
 
-INT16 = st.integers(-32768, 32767)
-
-
-@st.composite
-def scripts(draw: st.DrawFn) -> Script:
-    """Readings, and line losses at times or during commands."""
-    losses = draw(st.lists(st.builds(LossAt, st.integers(1, 5000))
-                           | st.builds(LossDuring, st.sampled_from(("MOV", "MVI")),
-                                       st.integers(1, 3), st.integers(1, 2000)), max_size=6))
-    return Script(
-        images=tuple(draw(st.lists(st.builds(ImageReading, INT16, INT16, INT16, INT16),
-                                   max_size=3))),
-        odometry=tuple(draw(st.lists(st.builds(Odometry, INT16, INT16, INT16), max_size=2))),
-        camera=tuple(draw(st.lists(st.integers(0, 784), max_size=2))),
-        ultrasonic={letter: tuple(draw(st.lists(INT16, min_size=1, max_size=2)))
-                    for letter in "ABCD"},
-        ports={port: (draw(st.integers(0, 255)),) for port in range(0, 0x7E, 7)},
-        fuzzy=tuple(draw(st.lists(st.builds(FuzzyReading, INT16, INT16), max_size=2))),
-        losses=tuple(losses),
-        after_last=draw(st.sampled_from(AFTER_LAST)),  # a run past them ends, or runs on
-    )
-
-
 def both(text: str, script: Script) -> tuple[tuple[RunResult, ScriptedDevice],
                                              tuple[RunResult, ScriptedDevice]]:
     analysis = analyze(text)
@@ -352,12 +330,6 @@ def both(text: str, script: Script) -> tuple[tuple[RunResult, ScriptedDevice],
 def logged(device: ScriptedDevice) -> list[tuple[TraceEntry, int | None]]:
     """Every entry of the device's log with its source line."""
     return [(entry, entry.line) for entry in device.log]
-
-
-# Starts that put the vehicle in motion with a tracing mode that jumps, so that more runs
-# lose the line (a generated program may lack the handler: a fault both must report).
-MOVING_STARTS = ("", "", "(TRC 2); (MOV 1,1)\n", "(TRC 3); (MOV 2,2)\n",
-                 "(TRC 2); (MVI 1,1,10)\n", "(TRC 3); (MVI 1,2,30)\n")
 
 
 @settings(max_examples=150, deadline=None)

@@ -9,7 +9,8 @@ from dataclasses import dataclass, field
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_machine import MOVING_STARTS, To, assemble, call, commands, op, scripts, v
+from support.scripts import MOVING_STARTS, scripts
+from test_machine import To, assemble, call, commands, op, v
 
 from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.strategies import checked_programs

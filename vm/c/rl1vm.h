@@ -1,13 +1,15 @@
 /* rl1vm: the RL/I virtual machine for firmware, in C99 (freestanding).
  *
- * This header is the whole public interface. Today it holds the loader and verifier
- * (rl1vm_load.c): every check of spec/ilc.md section 10, made on the file in place
- * (in flash, say) before any of it runs, and the debug line lookup for fault reports.
- * The VM itself (rl1vm.c) will follow the firmware contract of spec/ilc.md.
+ * This header and spec/rl1_hardware.h (which it includes: put both folders on the
+ * include path) are the whole public interface: the loader and verifier
+ * (rl1vm_load.c), every check of spec/ilc.md section 10 made on the file in place (in
+ * flash, say) before any of it runs, with the debug line lookup for fault reports; and
+ * the VM (rl1vm.c), which steps a verified program (spec/ilc.md section 12) and drives
+ * the vehicle through the callbacks of rl1_hardware.h.
  *
  * No allocation, no recursion, no floating point, no static data: all state is in
- * the caller's rl1_program. Sizes are u32 and every sum of them is checked before it
- * is made, so no file, however damaged, makes the loader read outside it.
+ * the caller's rl1_program and rl1_vm. Sizes are u32 and every sum of them is checked
+ * before it is made, so no file, however damaged, makes the loader read outside it.
  */
 #ifndef RL1VM_H
 #define RL1VM_H
@@ -16,11 +18,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "rl1_hardware.h"
+
 /* Why a file is refused: one code per rule of spec/ilc.md section 10, in the order the
  * rules are checked. vm/ilc.py's Refusal has the same names and numbers (a test holds
  * them equal). The comment says where the error offset points. */
-typedef enum rl1_status {
-    RL1_OK = 0,
+typedef enum rl1_refusal {
+    RL1_ACCEPTED = 0,
     RL1_TRUNCATED = 1,          /* the header or a section passes the file's end: the end */
     RL1_BAD_MAGIC = 2,          /* 0 */
     RL1_BAD_MAJOR = 3,          /* 4: a major version other than 1 */
@@ -46,7 +50,7 @@ typedef enum rl1_status {
     RL1_BAD_JUMP = 23,          /* the target operand: not the start of an instruction */
     RL1_BAD_HANDLER = 24,       /* the handler entry: not the start of an instruction */
     RL1_BAD_LINE_ENTRY = 25     /* the line entry: not the start of an instruction */
-} rl1_status;
+} rl1_refusal;
 
 /* A verified file, its sections found: everything the VM needs, pointing into the
  * caller's file (which must stay in place while the program is used). */
@@ -81,12 +85,47 @@ typedef struct rl1_program {
  * rescans the code from its start for each target instead: at most code_size bytes of
  * decoding per jump, handler and line entry (quadratic in the worst case: keep it for
  * small programs or for targets with no RAM to spare). Both give the same answer. */
-rl1_status rl1_load(rl1_program *program, const uint8_t *file, uint32_t size,
+rl1_refusal rl1_load(rl1_program *program, const uint8_t *file, uint32_t size,
                     uint8_t *bitmap, size_t bitmap_size, uint32_t *error_offset);
 
 /* The source line of the instruction at `code_offset`: the line of the last line entry
  * at or before it (spec/ilc.md 4.4); 0 when unknown (no debug section, or no entry at or
  * before it). It walks the line map, so it costs one pass over it: for fault reports. */
 uint16_t rl1_line_at(const rl1_program *program, uint16_t code_offset);
+
+/* Makes `vm` ready to run `program` (loaded by rl1_load) on `hardware` with the
+ * watchdog `budget` (1 .. 2^31 - 1, spec/ilc.md 12.6): every other field zero. Then call
+ * rl1_step until it answers RL1_ENDED or RL1_FAULTED; the device posts lost lines into
+ * vm->mailbox with rl1_post_line_lost. */
+void rl1_vm_init(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hardware,
+                 uint32_t budget);
+
+/* --- Internal: the instruction set, shared by the loader and the VM ----------------- */
+
+/* How a byte of the file is read: a plain load, unless the build says otherwise. AVR's
+ * flash is not in its data address space, so a file kept there is read with
+ * -DRL1_READ_BYTE(p)=pgm_read_byte(p) -include avr/pgmspace.h (vm/c/README.md). */
+#ifndef RL1_READ_BYTE
+#define RL1_READ_BYTE(p) (*(p))
+#endif
+#define RL1_BYTE(p) ((uint8_t)RL1_READ_BYTE(p))
+#define RL1_U16(p) ((uint16_t)(RL1_BYTE(p) | ((unsigned)RL1_BYTE((p) + 1) << 8)))
+
+/* The operand shapes of rl1_op_length. */
+#define RL1_SHAPE_NONE 0u
+#define RL1_SHAPE_VAR 1u      /* v */
+#define RL1_SHAPE_IMM 2u      /* i */
+#define RL1_SHAPE_ADDR 3u     /* a */
+#define RL1_SHAPE_VAR_ADDR 4u /* v, a */
+#define RL1_SHAPE_VAR_VAR 5u  /* v, v */
+#define RL1_SHAPE_VAR_IMM 6u  /* v, i */
+#define RL1_SHAPE_ARGS 7u     /* mask, then 2 bytes an argument */
+
+/* The length of instruction `op` in a file of format minor version `minor`, and its
+ * operands' shape; 0 for an opcode unknown in that version. */
+uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape);
+
+/* Whether `value` lies in the range of parameter `index` of call `op`. */
+bool rl1_arg_in_range(uint8_t op, uint8_t index, int32_t value);
 
 #endif

@@ -13,13 +13,7 @@
  */
 #include "rl1vm.h"
 
-/* How a byte of the file is read: a plain load, unless the build says otherwise. AVR's
- * flash is not in its data address space, so a file kept there is read with
- * -DRL1_READ_BYTE(p)=pgm_read_byte(p) -include avr/pgmspace.h (vm/c/README.md). */
-#ifndef RL1_READ_BYTE
-#define RL1_READ_BYTE(p) (*(p))
-#endif
-#define BYTE(p) ((uint8_t)RL1_READ_BYTE(p))
+#define BYTE(p) RL1_BYTE(p)
 
 #define HEADER_SIZE 24u
 #define HANDLER_SIZE 8u
@@ -41,7 +35,7 @@ typedef struct loader {
     uint32_t error_offset;
 } loader;
 
-static rl1_status fail(loader *ld, rl1_status status, uint32_t offset)
+static rl1_refusal fail(loader *ld, rl1_refusal status, uint32_t offset)
 {
     ld->error_offset = offset;
     return status;
@@ -49,7 +43,7 @@ static rl1_status fail(loader *ld, rl1_status status, uint32_t offset)
 
 static uint16_t u16_at(const uint8_t *p)
 {
-    return (uint16_t)(BYTE(p) | ((unsigned)BYTE(p + 1) << 8));
+    return RL1_U16(p);
 }
 
 static uint32_t u32_at(const uint8_t *p)
@@ -101,11 +95,18 @@ static uint32_t file_crc(const loader *ld)
 
 /* --- the instruction set (spec/ilc.md 8.3) ----------------------------------------- */
 
-enum shape { NONE, VAR, IMM, ADDR, VAR_ADDR, VAR_VAR, VAR_IMM, ARGS };
+#define NONE RL1_SHAPE_NONE
+#define VAR RL1_SHAPE_VAR
+#define IMM RL1_SHAPE_IMM
+#define ADDR RL1_SHAPE_ADDR
+#define VAR_ADDR RL1_SHAPE_VAR_ADDR
+#define VAR_VAR RL1_SHAPE_VAR_VAR
+#define VAR_IMM RL1_SHAPE_VAR_IMM
+#define ARGS RL1_SHAPE_ARGS
 
 /* The operands of `op`, and 0 bytes for an opcode the file's minor version does not
  * define (a superinstruction in a 1.0 or 1.1 file is unknown there). */
-static uint8_t op_length(uint8_t op, uint8_t minor, enum shape *shape)
+uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape)
 {
     *shape = NONE;
     if (minor >= FUSED_MINOR) {
@@ -190,7 +191,7 @@ static uint8_t op_feature(uint8_t op)
 
 /* Whether `value` lies in the range of parameter `index` of call `op`
  * (spec/language.md section 8). */
-static bool in_range(uint8_t op, uint8_t index, int32_t value)
+bool rl1_arg_in_range(uint8_t op, uint8_t index, int32_t value)
 {
     int32_t low = -32768, high = 32767; /* FZO a, b */
     switch (op) {
@@ -222,7 +223,7 @@ static bool in_range(uint8_t op, uint8_t index, int32_t value)
 /* --- the container (spec/ilc.md sections 2-7) -------------------------------------- */
 
 /* One number of the debug section (4.4): LEB128, at most 3 bytes, shortest form. */
-static rl1_status leb128(loader *ld, uint32_t *pos, uint32_t end, uint32_t *value)
+static rl1_refusal leb128(loader *ld, uint32_t *pos, uint32_t end, uint32_t *value)
 {
     uint32_t start = *pos;
     uint8_t n, byte;
@@ -235,7 +236,7 @@ static rl1_status leb128(loader *ld, uint32_t *pos, uint32_t end, uint32_t *valu
         *value |= (uint32_t)(byte & 0x7Fu) << (7u * n);
         if (!(byte & 0x80u)) {
             /* A last byte of 0 after another byte: not the shortest form. */
-            return (n > 0u && byte == 0u) ? fail(ld, RL1_DEBUG_NUMBER, start) : RL1_OK;
+            return (n > 0u && byte == 0u) ? fail(ld, RL1_DEBUG_NUMBER, start) : RL1_ACCEPTED;
         }
     }
     return fail(ld, RL1_DEBUG_NUMBER, start);
@@ -243,7 +244,7 @@ static rl1_status leb128(loader *ld, uint32_t *pos, uint32_t end, uint32_t *valu
 
 /* Strict UTF-8 (RFC 3629: no overlong form, no surrogate, nothing past U+10FFFF); the
  * offset of the first bad sequence's lead byte, as Python's decoder reports it. */
-static rl1_status check_utf8(loader *ld, uint32_t pos, uint32_t end)
+static rl1_refusal check_utf8(loader *ld, uint32_t pos, uint32_t end)
 {
     while (pos < end) {
         uint8_t lead = BYTE(ld->file + pos);
@@ -277,22 +278,22 @@ static rl1_status check_utf8(loader *ld, uint32_t pos, uint32_t end)
         }
         pos += length;
     }
-    return RL1_OK;
+    return RL1_ACCEPTED;
 }
 
 /* The debug section from `pos` to `end` (4.4). */
-static rl1_status check_debug(loader *ld, rl1_program *program, uint32_t pos, uint32_t end)
+static rl1_refusal check_debug(loader *ld, rl1_program *program, uint32_t pos, uint32_t end)
 {
     uint32_t offset = 0, line = 0, offset_delta, line_delta;
     uint16_t index, count;
-    rl1_status status;
+    rl1_refusal status;
     /* The name's size byte is there: a debug section of size 0 is no debug section. */
     program->source_name_size = BYTE(ld->file + pos++);
     if (end - pos < program->source_name_size) {
         return fail(ld, RL1_DEBUG_CUT_OFF, pos);
     }
     status = check_utf8(ld, pos, pos + program->source_name_size);
-    if (status != RL1_OK) {
+    if (status != RL1_ACCEPTED) {
         return status;
     }
     program->source_name = ld->file + pos;
@@ -307,10 +308,10 @@ static rl1_status check_debug(loader *ld, rl1_program *program, uint32_t pos, ui
     for (index = 0; index < count; index++) {
         uint32_t start = pos;
         status = leb128(ld, &pos, end, &offset_delta);
-        if (status == RL1_OK) {
+        if (status == RL1_ACCEPTED) {
             status = leb128(ld, &pos, end, &line_delta);
         }
-        if (status != RL1_OK) {
+        if (status != RL1_ACCEPTED) {
             return status;
         }
         if (index > 0u && offset_delta == 0u) {
@@ -326,12 +327,12 @@ static rl1_status check_debug(loader *ld, rl1_program *program, uint32_t pos, ui
     if (pos != end) {
         return fail(ld, RL1_DEBUG_LEFTOVER, pos);
     }
-    return RL1_OK;
+    return RL1_ACCEPTED;
 }
 
 /* The header and every section but the code's contents (sections 2-7, and the first
  * rows of section 10). Leaves in *code_start the code's file offset. */
-static rl1_status check_container(loader *ld, rl1_program *program, uint32_t *code_start)
+static rl1_refusal check_container(loader *ld, rl1_program *program, uint32_t *code_start)
 {
     const uint8_t *file = ld->file;
     uint32_t header_size, debug_size, pos, handler_start, debug_start, digest_size;
@@ -405,7 +406,7 @@ static rl1_status check_container(loader *ld, rl1_program *program, uint32_t *co
     program->line_count = 0;
     program->digest = digest_size ? file + debug_start + debug_size : NULL;
     return debug_size ? check_debug(ld, program, debug_start, debug_start + debug_size)
-                      : RL1_OK;
+                      : RL1_ACCEPTED;
 }
 
 /* --- the code (section 8 and the rest of section 10) -------------------------------- */
@@ -420,7 +421,7 @@ typedef struct starts {
 static bool starts_instruction(const starts *s, uint16_t target)
 {
     uint32_t pos = 0;
-    enum shape shape;
+    uint8_t shape;
     if (target >= s->program->code_size) {
         return false;
     }
@@ -428,29 +429,29 @@ static bool starts_instruction(const starts *s, uint16_t target)
         return ((unsigned)s->bitmap[target >> 3] >> (target & 7u)) & 1u;
     }
     while (pos < target) {
-        pos += op_length(BYTE(s->program->code + pos), s->program->minor, &shape);
+        pos += rl1_op_length(BYTE(s->program->code + pos), s->program->minor, &shape);
     }
     return pos == target;
 }
 
-static rl1_status check_variable(loader *ld, uint32_t index, uint32_t offset)
+static rl1_refusal check_variable(loader *ld, uint32_t index, uint32_t offset)
 {
-    return index < VARIABLES ? RL1_OK : fail(ld, RL1_BAD_VARIABLE, offset);
+    return index < VARIABLES ? RL1_ACCEPTED : fail(ld, RL1_BAD_VARIABLE, offset);
 }
 
 /* A call's mask and arguments; `at` is the mask's file offset. */
-static rl1_status check_call(loader *ld, uint8_t op, uint8_t length, uint32_t at)
+static rl1_refusal check_call(loader *ld, uint8_t op, uint8_t length, uint32_t at)
 {
     uint8_t mask = BYTE(ld->file + at), arity = (uint8_t)((length - 2u) / 2u), k;
-    rl1_status status = RL1_OK;
+    rl1_refusal status = RL1_ACCEPTED;
     if (mask >> arity) {
         return fail(ld, RL1_BAD_MASK, at);
     }
-    for (k = 0; k < arity && status == RL1_OK; k++) {
+    for (k = 0; k < arity && status == RL1_ACCEPTED; k++) {
         uint32_t field = at + 1u + 2u * k;
         if (((unsigned)mask >> k) & 1u) {
             status = check_variable(ld, u16_at(ld->file + field), field);
-        } else if (!in_range(op, k, i16_at(ld->file + field))) {
+        } else if (!rl1_arg_in_range(op, k, i16_at(ld->file + field))) {
             status = fail(ld, RL1_ARGUMENT_RANGE, field);
         }
     }
@@ -459,16 +460,16 @@ static rl1_status check_call(loader *ld, uint8_t op, uint8_t length, uint32_t at
 
 /* Pass 1: every instruction whole, known, with valid operands and its feature listed;
  * marks the instruction starts in the bitmap. */
-static rl1_status check_instructions(loader *ld, const rl1_program *program, uint32_t base,
+static rl1_refusal check_instructions(loader *ld, const rl1_program *program, uint32_t base,
                                      uint8_t *bitmap)
 {
     uint32_t pos = 0;
     while (pos < program->code_size) {
         uint8_t op = BYTE(program->code + pos), length, feature;
         uint32_t at = base + pos;
-        enum shape shape;
-        rl1_status status = RL1_OK;
-        length = op_length(op, program->minor, &shape);
+        uint8_t shape;
+        rl1_refusal status = RL1_ACCEPTED;
+        length = rl1_op_length(op, program->minor, &shape);
         if (length == 0u) {
             return fail(ld, RL1_UNKNOWN_OPCODE, at);
         }
@@ -478,12 +479,12 @@ static rl1_status check_instructions(loader *ld, const rl1_program *program, uin
         if (shape == VAR || shape == VAR_ADDR || shape == VAR_VAR || shape == VAR_IMM) {
             status = check_variable(ld, BYTE(ld->file + at + 1u), at + 1u);
         }
-        if (status == RL1_OK && shape == VAR_VAR) {
+        if (status == RL1_ACCEPTED && shape == VAR_VAR) {
             status = check_variable(ld, BYTE(ld->file + at + 2u), at + 2u);
         } else if (shape == ARGS) {
             status = check_call(ld, op, length, at + 1u);
         }
-        if (status != RL1_OK) {
+        if (status != RL1_ACCEPTED) {
             return status;
         }
         feature = op_feature(op);
@@ -495,19 +496,19 @@ static rl1_status check_instructions(loader *ld, const rl1_program *program, uin
         }
         pos += length;
     }
-    return RL1_OK;
+    return RL1_ACCEPTED;
 }
 
 /* Pass 2: jump targets, in code order, then handler entries, then line entries. */
-static rl1_status check_targets(loader *ld, const rl1_program *program, uint32_t base,
+static rl1_refusal check_targets(loader *ld, const rl1_program *program, uint32_t base,
                                 const starts *s)
 {
     uint32_t pos = 0, at, entry, offset = 0, delta;
     uint16_t index;
     uint8_t i;
     while (pos < program->code_size) {
-        enum shape shape;
-        uint8_t length = op_length(BYTE(program->code + pos), program->minor, &shape);
+        uint8_t shape;
+        uint8_t length = rl1_op_length(BYTE(program->code + pos), program->minor, &shape);
         at = base + pos + (shape == VAR_ADDR ? 2u : 1u); /* the target operand */
         if ((shape == ADDR || shape == VAR_ADDR)
             && !starts_instruction(s, u16_at(ld->file + at))) {
@@ -522,7 +523,7 @@ static rl1_status check_targets(loader *ld, const rl1_program *program, uint32_t
         }
     }
     if (!program->lines) {
-        return RL1_OK;
+        return RL1_ACCEPTED;
     }
     entry = (uint32_t)(program->lines - ld->file);
     for (index = 0; index < program->line_count; index++) {
@@ -535,21 +536,21 @@ static rl1_status check_targets(loader *ld, const rl1_program *program, uint32_t
             return fail(ld, RL1_BAD_LINE_ENTRY, at);
         }
     }
-    return RL1_OK;
+    return RL1_ACCEPTED;
 }
 
-rl1_status rl1_load(rl1_program *program, const uint8_t *file, uint32_t size,
+rl1_refusal rl1_load(rl1_program *program, const uint8_t *file, uint32_t size,
                     uint8_t *bitmap, size_t bitmap_size, uint32_t *error_offset)
 {
     loader ld;
     starts s;
     uint32_t base = 0, i;
-    rl1_status status;
+    rl1_refusal status;
     ld.file = file;
     ld.size = size;
     ld.error_offset = 0;
     status = check_container(&ld, program, &base);
-    if (status == RL1_OK) {
+    if (status == RL1_ACCEPTED) {
         s.program = program;
         s.bitmap = (bitmap && bitmap_size >= RL1_BITMAP_SIZE(program->code_size)) ? bitmap
                                                                                   : NULL;
@@ -558,7 +559,7 @@ rl1_status rl1_load(rl1_program *program, const uint8_t *file, uint32_t size,
         }
         status = check_instructions(&ld, program, base, s.bitmap);
     }
-    if (status == RL1_OK) {
+    if (status == RL1_ACCEPTED) {
         status = check_targets(&ld, program, base, &s);
     }
     *error_offset = ld.error_offset;

@@ -5,6 +5,11 @@
 
 extern uint32_t __bss_start__, __bss_end__, __stack_top__;
 void reset(void);
+void harness_read(void *to, const void *from, size_t size);
+
+#define PAINT 0xA5u
+static uint8_t *painted_top; /* the highest painted byte */
+static uint8_t *stack_mark;  /* about the caller's stack pointer: depths count from it */
 
 /* Semihosting call `op` with argument `arg` (the ARM semihosting specification). */
 static void semihost(uint32_t op, const void *arg)
@@ -22,6 +27,56 @@ void target_print(const char *text)
 uint32_t target_case_field(const uint32_t *field)
 {
     return *field;
+}
+
+/* gcc may call these for a structure's copy or initialization; there is no C library. */
+void *memset(void *to, int value, size_t size);
+void *memcpy(void *to, const void *from, size_t size);
+
+void *memset(void *to, int value, size_t size)
+{
+    uint8_t *out = to;
+    while (size--) {
+        *out++ = (uint8_t)value;
+    }
+    return to;
+}
+
+void *memcpy(void *to, const void *from, size_t size)
+{
+    harness_read(to, from, size);
+    return to;
+}
+
+void harness_read(void *to, const void *from, size_t size)
+{
+    uint8_t *out = to;
+    const uint8_t *in = from;
+    while (size--) {
+        *out++ = *in++;
+    }
+}
+
+/* Paints the stack from 64 bytes below this frame down to the end of .bss; nothing
+ * else runs meanwhile (no interrupts). */
+void target_stack_paint(void)
+{
+    uint8_t here = 0;
+    uint8_t *p;
+    stack_mark = &here;
+    painted_top = (uint8_t *)((uintptr_t)&here - 64u);
+    for (p = painted_top; p >= (uint8_t *)&__bss_end__; p--) {
+        *p = PAINT;
+    }
+}
+
+uint32_t target_stack_depth(void)
+{
+    const uint8_t *p = (const uint8_t *)&__bss_end__;
+    while (p <= painted_top && *p == PAINT) {
+        p++;
+    }
+    return (uint32_t)(stack_mark - p); /* the unpainted gap counts as used */
 }
 
 void reset(void)

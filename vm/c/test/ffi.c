@@ -1,10 +1,17 @@
-/* Host-only entry points for the differential tests (tests/c/), which call them through
- * ctypes: the loader's own interface needs a struct that Python need not mirror. */
+/* Host-only entry points for Python (rl1.vm.native, and the tests of tests/c/), which
+ * calls them through ctypes: the loader's checks on a file alone, and the VM's start and
+ * its mailbox, whose inline functions ctypes cannot call. */
+#include <stddef.h>
+
 #include "../rl1vm.h"
 
 int rl1_test_load(const uint8_t *file, uint32_t size, size_t bitmap_size,
                   uint32_t *error_offset);
 uint16_t rl1_test_line_at(const uint8_t *file, uint32_t size, uint16_t code_offset);
+void rl1_ffi_layout(uint32_t *out);
+int rl1_ffi_start(rl1_vm *vm, const uint8_t *file, uint32_t size,
+                  const rl1_hardware *hardware, uint32_t budget, uint32_t *error_offset);
+int rl1_ffi_post(rl1_vm *vm, uint8_t mode, uint8_t command);
 
 static uint8_t bitmap[RL1_BITMAP_SIZE(0xFFFFu)];
 
@@ -22,8 +29,43 @@ uint16_t rl1_test_line_at(const uint8_t *file, uint32_t size, uint16_t code_offs
 {
     rl1_program program;
     uint32_t error_offset;
-    if (rl1_load(&program, file, size, bitmap, sizeof bitmap, &error_offset) != RL1_OK) {
+    if (rl1_load(&program, file, size, bitmap, sizeof bitmap, &error_offset)
+        != RL1_ACCEPTED) {
         return 0;
     }
     return rl1_line_at(&program, code_offset);
+}
+
+/* The sizes and offsets Python's mirror of the structures must have. */
+void rl1_ffi_layout(uint32_t *out)
+{
+    out[0] = sizeof(rl1_vm);
+    out[1] = offsetof(rl1_vm, mailbox);
+    out[2] = offsetof(rl1_vm, V);
+    out[3] = offsetof(rl1_vm, executed);
+    out[4] = offsetof(rl1_vm, state);
+    out[5] = offsetof(rl1_vm, fault_pc);
+    out[6] = offsetof(rl1_vm, stop_failed);
+    out[7] = sizeof(rl1_hardware);
+    out[8] = sizeof(rl1_reading);
+}
+
+/* Loads `file` (which must stay in place) and makes `vm` ready to run it; the loader's
+ * refusal otherwise. */
+int rl1_ffi_start(rl1_vm *vm, const uint8_t *file, uint32_t size,
+                  const rl1_hardware *hardware, uint32_t budget, uint32_t *error_offset)
+{
+    rl1_program program;
+    rl1_refusal refusal = rl1_load(&program, file, size, bitmap, sizeof bitmap,
+                                   error_offset);
+    if (refusal == RL1_ACCEPTED) {
+        rl1_vm_init(vm, &program, hardware, budget);
+    }
+    return (int)refusal;
+}
+
+/* rl1_post_line_lost, for a device written in Python. */
+int rl1_ffi_post(rl1_vm *vm, uint8_t mode, uint8_t command)
+{
+    return rl1_post_line_lost(&vm->mailbox, mode, command);
 }

@@ -23,8 +23,11 @@ extern const uint16_t target_case_count;
 /* From the target's start-up file. */
 void target_print(const char *text);
 uint32_t target_case_field(const uint32_t *field); /* reads a case's field from flash */
+void target_stack_paint(void);      /* marks the free stack below the caller's frame */
+uint32_t target_stack_depth(void);  /* how much of it has been written since */
 
-/* Runs every case; returns the number that differ from the host. */
+/* Runs every case of the image (target_run.c: the loader's; target_vectors.c: the run
+ * vectors'); returns the number that differ from the host. */
 uint16_t target_run(void);
 
 #endif

@@ -1,13 +1,15 @@
-"""Writes the conformance cases the emulated targets run (make -C vm/c targets) as C:
-every vector file, which must load, and damaged copies of the stripped ones (one byte
-changed at each of a few places, the CRC made right) with the Python verifier's
-refusal and offset, so that the loader on a 16-bit or 32-bit `int` target gives exactly
-the host's answers.
+"""Writes the conformance cases the emulated targets run (make -C vm/c targets) as C.
+For the loader: every vector file, which must load, and damaged copies of the stripped
+ones (one byte changed at each of a few places, the CRC made right) with the Python
+verifier's refusal and offset, so that the loader on a 16-bit or 32-bit `int` target
+gives exactly the host's answers. For the VM: every run vector, both its files, from
+the vectors' text form (spec/vectors/*.txt), as the structures of test/vector.h.
 
     .venv/bin/python vm/c/test/target_cases.py FOLDER LIMIT-BYTES
 
-It writes FOLDER/cases-0.c, cases-1.c, ...: each holds at most LIMIT-BYTES of files,
-so that each fits the target's flash; each is linked into an image of its own.
+It writes FOLDER/cases-0.c, cases-1.c, ... and FOLDER/vectors-0.c, vectors-1.c, ...:
+each holds at most about LIMIT-BYTES of data, so that each fits the target's flash; each
+is linked into an image of its own (with target_run.c, or with target_vectors.c).
 """
 
 from __future__ import annotations
@@ -16,7 +18,8 @@ import struct
 import sys
 from pathlib import Path
 
-from rl1.vm import ilc
+from rl1.vm import ilc, isa
+from rl1.vm.device import form_name
 from rl1.vm.verifier import VerifyError, verify
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "spec" / "vectors"))
@@ -75,13 +78,125 @@ def source(batch: list[bytes]) -> str:
     return "\n".join(lines)
 
 
+# The run vectors ------------------------------------------------------------------------
+
+VECTORS = Path(__file__).resolve().parents[3] / "spec" / "vectors"
+CALLS = {form_name(info.builtin).replace(" ", "_"): opcode
+         for opcode, info in isa.OPCODES.items() if info.builtin and info.form is not None
+         and opcode >= isa.CALL_BASE} | {"LINE_LOST": 0x100, "STOP": 0x101}
+SCRIPT_KINDS = {"sensor": 0, "loss time": 1, "loss during": 2, "loss instruction": 3,
+                "fail": 4, "stop_fails": 5}  # scripted.h's enum script_kind
+
+
+def _words(line: str) -> list[str]:
+    return line.split(" ")
+
+
+def _item(words: list[str]) -> str:
+    """A script line of the text form as a script_item initializer."""
+    if words[0] == "loss":
+        kind, rest = SCRIPT_KINDS[f"loss {words[1]}"], words[2:]
+        key = 0
+        if words[1] == "during":
+            key, rest = (0 if rest[0] == "MOV" else 1), rest[1:]
+    elif words[0] == "stop_fails":
+        kind, key, rest = SCRIPT_KINDS["stop_fails"], 0, []
+    else:
+        kind, key, rest = SCRIPT_KINDS[words[0]], CALLS[words[1]], words[2:]
+    values = [*rest, "0", "0", "0", "0"][:4]
+    return f"{{{kind}, {key}, {{{', '.join(values)}}}}}"
+
+
+def _entry(words: list[str]) -> str:
+    """A trace line of the text form as a trace_entry initializer."""
+    time, call, nargs = words[1], CALLS[words[2]], int(words[3])
+    args = words[4:4 + nargs]
+    nresult = int(words[4 + nargs])
+    result = words[5 + nargs:5 + nargs + nresult]
+    return (f"{{{time}u, {call}u, {nargs}, {nresult}, {{{', '.join([*args, '0', '0', '0'][:3])}}}, "
+            f"{{{', '.join([*result, '0', '0', '0', '0'][:4])}}}}}")
+
+
+def run_vectors() -> list[dict[str, list[str]]]:
+    """Each run vector of the text form: its lines by first word."""
+    found: list[dict[str, list[str]]] = []
+    for path in sorted(VECTORS.glob("*.txt")):
+        for line in path.read_text(encoding="ascii").splitlines():
+            word = line.split(" ", 1)[0]
+            if word == "vector":
+                found.append({})
+            elif found and word != "end":
+                found[-1].setdefault(word, []).append(line)
+    return [vector for vector in found if "ilc" in vector]
+
+
+def vector_source(vectors: list[dict[str, list[str]]]) -> str:
+    """The C of a batch: for each vector, both its files as two `vector`s."""
+    blob = bytearray()
+    items: list[str] = []
+    entries: list[str] = []
+    variables: list[str] = []
+    rows: list[str] = []
+    for vector in vectors:
+        script = [_item(_words(line)) for key in ("sensor", "loss", "fail", "stop_fails")
+                  for line in vector.get(key, [])]
+        trace = [_entry(_words(line)) for line in vector.get("trace", [])]
+        status = _words(vector["status"][0])
+        values = _words(vector["variables"][0])[1:]
+        budget, executed = _words(vector["budget"][0])[1], _words(vector["executed"][0])[1]
+        for key, line in (("ilc", status[3]), ("ilc_stripped", "0")):
+            data = bytes.fromhex(_words(vector[key][0])[1])
+            rows.append(f"    {{vector_blob + {len(blob)}, {len(data)}u, "
+                        f"target_script + {len(items)}, target_trace + {len(entries)}, "
+                        f"target_variables + {len(variables)}, {budget}u, {executed}u, "
+                        f"{len(script)}, {len(trace)}, {line}, {status[2]}}},")
+            blob += data
+        items += script
+        entries += trace
+        variables += values
+    lines = [f"/* Generated by vm/c/test/target_cases.py: {len(rows)} runs. */",
+             '#include "target.h"', '#include "vector.h"', "",
+             f"static const uint8_t vector_blob[{len(blob)}] TARGET_FLASH = {{"]
+    lines += ["    " + ", ".join(f"0x{byte:02x}" for byte in blob[i:i + 16]) + ","
+              for i in range(0, len(blob), 16)]
+    lines += ["};", f"static const script_item target_script[{max(len(items), 1)}] "
+              "TARGET_FLASH = {", *(f"    {item}," for item in items or ["{0, 0, {0}}"]),
+              "};", f"static const trace_entry target_trace[{max(len(entries), 1)}] "
+              "TARGET_FLASH = {", *(f"    {entry}," for entry in entries or ["{0}"]), "};",
+              f"static const int16_t target_variables[{len(variables)}] TARGET_FLASH = {{"]
+    lines += ["    " + ", ".join(variables[i:i + 16]) + ","
+              for i in range(0, len(variables), 16)]
+    lines += ["};", "", f"const vector target_vectors[{len(rows)}] TARGET_FLASH = {{", *rows,
+              "};", f"const uint16_t target_vector_count = {len(rows)}u;", ""]
+    return "\n".join(lines)
+
+
+def vector_batches(limit: int) -> list[list[dict[str, list[str]]]]:
+    """The run vectors in batches of about `limit` bytes of flash (files, scripts,
+    traces and variables, at their sizes on an 8-bit target)."""
+    out: list[list[dict[str, list[str]]]] = [[]]
+    size = 0
+    for vector in run_vectors():
+        cost = (sum(len(vector[key][0]) // 2 for key in ("ilc", "ilc_stripped"))
+                + 18 * sum(len(vector.get(key, [])) for key in ("sensor", "loss", "fail"))
+                + 2 * (22 * len(vector.get("trace", [])) + 106 + 30))
+        if out[-1] and size + cost > limit:
+            out.append([])
+            size = 0
+        out[-1].append(vector)
+        size += cost
+    return out
+
+
 def main(folder: str, limit: int) -> None:
     out = Path(folder)
     out.mkdir(parents=True, exist_ok=True)
-    for stale in out.glob("cases-*.c"):
+    for stale in [*out.glob("cases-*.c"), *out.glob("vectors-*.c")]:
         stale.unlink()
     for index, batch in enumerate(batches(limit)):
         (out / f"cases-{index}.c").write_text(source(batch), encoding="ascii")
+    for index, vectors in enumerate(vector_batches(limit)):
+        (out / f"vectors-{index}.c").write_text(vector_source(vectors), encoding="ascii")
 
 
 if __name__ == "__main__":

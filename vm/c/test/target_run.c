@@ -28,10 +28,10 @@ uint16_t target_run(void)
         for (mode = 0; mode < 2u; mode++) {
             rl1_program program;
             uint32_t where = 0;
-            rl1_status got = rl1_load(&program, target_blob + start, size,
+            rl1_refusal got = rl1_load(&program, target_blob + start, size,
                                       mode ? NULL : bitmap, mode ? 0u : sizeof bitmap,
                                       &where);
-            if ((uint32_t)got != status || (got != RL1_OK && where != offset)) {
+            if ((uint32_t)got != status || (got != RL1_ACCEPTED && where != offset)) {
                 target_print("case ");
                 print_number(n);
                 target_print(mode ? " (rescan): status " : " (bitmap): status ");

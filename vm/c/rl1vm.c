@@ -1,0 +1,404 @@
+/* The RL/I VM: runs a program rl1_load verified, in steps (spec/ilc.md sections 8, 9
+ * and 12; vm/machine.py is the reference, and every vector pins the two together).
+ *
+ * The code is read in place (from flash) with RL1_READ_BYTE; the verifier has checked
+ * every opcode, operand, jump target and handler entry, so the VM checks nothing about
+ * the code, only what exists at run time: a variable argument's range, what the device
+ * answers, the watchdog budget and lost-line events.
+ *
+ * Portability: `int` may be 16 bits (AVR). `acc` is kept as a uint16_t bit pattern, so
+ * that +, - and the shifts wrap without signed overflow; a value becomes an int16_t
+ * only when stored (two's complement, spec/ilc.md section 13). No table in static data.
+ */
+#include "rl1vm.h"
+
+#define NO_PC 0xFFFFu  /* fault_pc of a fault before the first instruction */
+
+/* The reserved variables the sensing calls write (spec/ilc.md 8.3), by index. */
+#define VAR_S 44u
+#define VAR_U 46u
+#define VAR_W 48u
+
+/* The opcodes the VM treats apart from the generic call. */
+#define OP_KYO 0x4Cu
+#define OP_IMG 0x4Eu
+#define OP_CAMR 0x54u
+#define OP_ULTA 0x55u
+#define OP_ULTD 0x58u
+#define OP_INP 0x5Au
+#define OP_FZI 0x5Du
+
+void rl1_vm_init(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hardware,
+                 uint32_t budget)
+{
+    unsigned char *byte = (unsigned char *)vm;
+    size_t i;
+    uint8_t k;
+    for (i = 0; i < sizeof *vm; i++) { /* no memset: freestanding */
+        byte[i] = 0;
+    }
+    vm->code = program->code;
+    vm->code_size = program->code_size;
+    for (k = 0; k < 4u; k++) {
+        vm->handlers[k] = program->handlers[k];
+    }
+    vm->budget = budget;
+    vm->hw = hardware;
+}
+
+/* x shifted by `count` places, left or right (spec/language.md 7.2): a count of 16 or
+ * more gives 0, or the sign for a right shift; a negative count shifts the other way
+ * (-32768 by 32768 places). Never a shift by the raw count, which could be undefined. */
+static uint16_t shifted(uint16_t x, int16_t count, bool left)
+{
+    uint16_t places = (uint16_t)count;
+    if (count < 0) {
+        left = !left;
+        places = (uint16_t)(0u - places);
+    }
+    if (places >= 16u) {
+        return (!left && (x & 0x8000u)) ? (uint16_t)0xFFFFu : (uint16_t)0u;
+    }
+    if (left) {
+        return (uint16_t)((uint32_t)x << places);
+    }
+    if (x & 0x8000u) { /* arithmetic: shift the complement, a non-negative value */
+        return (uint16_t)~((uint16_t)~x >> places);
+    }
+    return (uint16_t)(x >> places);
+}
+
+/* Whether built-in `op` takes device time, so is started and polled (12.2): ORG MVI
+ * STR STL STX ROT TIM IMG, every CAM and ULT form. */
+static bool takes_time(uint8_t op)
+{
+    return op == 0x42u || op == 0x43u || (op >= 0x45u && op <= 0x48u) || op == 0x4Au
+           || (op >= OP_IMG && op <= OP_ULTD);
+}
+
+/* Takes a finished call's answer: false for a device error (an ERROR, or a value out of
+ * its documented range, 12.5: then nothing is written); else writes the reserved
+ * variables, then R (spec/ilc.md section 9, steps 4-6). */
+static bool finish(rl1_vm *vm, uint8_t op, rl1_status status, const rl1_reading *out)
+{
+    uint8_t first = 0, count = 0, k;
+    if (status != RL1_OK) {
+        return false;
+    }
+    if (op == OP_KYO) {
+        first = VAR_U; /* u, v */
+        count = 2;
+    } else if (op == OP_IMG) {
+        first = VAR_W; /* w, x, y, z */
+        count = 4;
+    } else if (op == OP_FZI) {
+        first = VAR_S; /* s, t */
+        count = 2;
+    } else if ((op == OP_CAMR && (out->result < 0 || out->result > 784))
+               || (op == OP_INP && (out->result < 0 || out->result > 255))) {
+        return false;
+    }
+    for (k = 0; k < count; k++) {
+        vm->V[first + k] = out->writes[k];
+    }
+    if (op == OP_KYO || op == OP_IMG || (op >= OP_CAMR && op <= OP_ULTD) || op == OP_INP) {
+        vm->R = out->result;
+    }
+    return true;
+}
+
+/* The call `op`, `length` bytes long, whose operands start at `operands` (section 9,
+ * steps 2-6): a fault, or RL1_FAULT_NONE with vm->waiting set when its first poll
+ * answered busy. */
+static rl1_fault call(rl1_vm *vm, uint8_t op, uint8_t length, const uint8_t *operands)
+{
+    const rl1_hardware *hw = vm->hw;
+    int16_t args[3];
+    rl1_reading out = {0, {0, 0, 0, 0}};
+    rl1_status status;
+    uint8_t mask, k;
+    uint8_t arity = length > 1u ? (uint8_t)((length - 2u) / 2u) : 0u; /* mask, 2 bytes each */
+    if (arity) {
+        mask = RL1_BYTE(operands);
+        for (k = 0; k < arity; k++) { /* left to right; the first out of range faults */
+            uint16_t field = RL1_U16(operands + 1u + 2u * k);
+            if (((unsigned)mask >> k) & 1u) {
+                args[k] = vm->V[field];
+                if (!rl1_arg_in_range(op, k, args[k])) {
+                    return RL1_FAULT_ARGUMENT_RANGE;
+                }
+            } else {
+                args[k] = (int16_t)field;
+            }
+        }
+    }
+    if (takes_time(op)) {
+        if (hw->start(hw->ctx, op, arity ? args : NULL) != RL1_OK) {
+            return RL1_FAULT_DEVICE;
+        }
+        status = hw->poll(hw->ctx, &out);
+        if (status == RL1_BUSY) {
+            vm->waiting = op;
+            return RL1_FAULT_NONE;
+        }
+    } else {
+        status = hw->call(hw->ctx, op, arity ? args : NULL, &out);
+    }
+    return finish(vm, op, status, &out) ? RL1_FAULT_NONE : RL1_FAULT_DEVICE;
+}
+
+/* The event point (section 9): takes a pending lost line and moves *pc to the handler
+ * Table 4 names for it (mode 2: MOV :98, MVI :99; mode 3: MOV :96, MVI :97; no other
+ * mode jumps). False when that handler is absent: the fault missing-handler. */
+static bool take_event(rl1_vm *vm, uint16_t *pc)
+{
+    uint8_t event, mode, entry;
+    if (!rl1_take_line_lost(&vm->mailbox, &event)) {
+        return true;
+    }
+    mode = RL1_EVENT_MODE(event);
+    if (mode != 2u && mode != 3u) {
+        return true;
+    }
+    entry = (uint8_t)((mode == 2u ? 2u : 0u) + RL1_EVENT_COMMAND(event));
+    if (vm->handlers[entry] == RL1_ABSENT) {
+        return false;
+    }
+    *pc = vm->handlers[entry];
+    return true;
+}
+
+/* Stops the vehicle and ends the run with fault `kind` at code offset `at` (12.3); `end`
+ * is not called again when it is its answer that faulted. */
+static rl1_state fault(rl1_vm *vm, rl1_fault kind, uint16_t at, bool ended)
+{
+    const rl1_hardware *hw = vm->hw;
+    if (hw->stop(hw->ctx) != RL1_OK) {
+        vm->stop_failed = 1;
+    }
+    if (!ended) {
+        (void)hw->end(hw->ctx); /* the fault is reported whatever it answers */
+    }
+    vm->fault = kind;
+    vm->fault_pc = at;
+    vm->state = RL1_FAULTED;
+    return RL1_FAULTED;
+}
+
+/* The run has reached END at `at` (or the code's end: `at` is then code_size). */
+static rl1_state ended(rl1_vm *vm, uint16_t at)
+{
+    const rl1_hardware *hw = vm->hw;
+    vm->state = RL1_ENDED;
+    if (hw->end(hw->ctx) != RL1_OK) {
+        return fault(vm, RL1_FAULT_DEVICE, at, true);
+    }
+    return RL1_ENDED;
+}
+
+/* The length of the call instruction `op` (a call in progress is at pc minus it). */
+static uint8_t call_length(uint8_t op)
+{
+    uint8_t shape;
+    return rl1_op_length(op, 0, &shape);
+}
+
+/* Resumes a call in progress (12.2): polls it once. */
+static rl1_state resume(rl1_vm *vm)
+{
+    const rl1_hardware *hw = vm->hw;
+    rl1_reading out = {0, {0, 0, 0, 0}};
+    uint8_t op = vm->waiting;
+    uint16_t at = (uint16_t)(vm->pc - call_length(op));
+    rl1_status status = hw->poll(hw->ctx, &out);
+    if (status == RL1_BUSY) {
+        return RL1_WAITING;
+    }
+    vm->waiting = 0;
+    vm->state = RL1_RUNNING;
+    if (!finish(vm, op, status, &out)) {
+        return fault(vm, RL1_FAULT_DEVICE, at, false);
+    }
+    if (!take_event(vm, &vm->pc)) {
+        return fault(vm, RL1_FAULT_MISSING_HANDLER, at, false);
+    }
+    return RL1_RUNNING;
+}
+
+/* Where no case applies, so that the compiler's jump table needs no range check. */
+#if defined(__GNUC__)
+#define UNREACHABLE() __builtin_unreachable()
+#else
+#define UNREACHABLE() ((void)0)
+#endif
+
+/* The operand bytes of the instruction at ip. */
+#define U8_AT(k) RL1_BYTE(ip + (k))
+#define U16_AT(k) RL1_U16(ip + (k))
+#define VAR_AT(k) V[U8_AT(k)]
+
+/* The seven operators of one operand kind (spec/ilc.md 8.2: base + the operator's
+ * index), each its own case: a second dispatch on the operator would cost as much. */
+#define ALU_CASES(base, operand, size)                                                   \
+    case (base) + 0: acc = (uint16_t)(acc + (operand)); ip += (size); continue;          \
+    case (base) + 1: acc = (uint16_t)(acc - (operand)); ip += (size); continue;          \
+    case (base) + 2: acc = (uint16_t)(acc & (operand)); ip += (size); continue;          \
+    case (base) + 3: acc = (uint16_t)(acc | (operand)); ip += (size); continue;          \
+    case (base) + 4: acc = (uint16_t)(acc ^ (operand)); ip += (size); continue;          \
+    case (base) + 5: acc = shifted(acc, (int16_t)(operand), true); ip += (size); continue; \
+    case (base) + 6: acc = shifted(acc, (int16_t)(operand), false); ip += (size); continue
+
+/* A conditional jump on V[v] (at ip + 1) to the target at ip + 2. */
+#define JUMP_IF(condition)                                                                \
+    if (condition) {                                                                     \
+        target = U16_AT(2);                                                              \
+        goto jump;                                                                       \
+    }                                                                                    \
+    ip += 4;                                                                             \
+    continue
+
+/* Where the dispatch loop must look at the step's limit and the code's end: at the end
+ * when the limit cannot come first (each instruction takes at least a byte, so a
+ * straight run from ip meets the end within end - ip instructions); else at every
+ * instruction (`code`, which every ip passes). Set again wherever a jump lands. */
+#define STOP (left >= (uint32_t)(end - ip) ? end : code)
+
+/* Runs at most n instructions from vm->pc. The hot state lives in locals and goes back
+ * into *vm at every exit: pc, acc, and the instructions run (n - left). `ip` stays on an
+ * instruction's first byte until it is done, so that a fault or an end points at it. */
+static rl1_state run(rl1_vm *vm, uint32_t n)
+{
+    const uint8_t *const code = vm->code, *const end = code + vm->code_size;
+    const uint8_t *ip = code + vm->pc;
+    int16_t *const V = vm->V;
+    uint16_t acc = (uint16_t)vm->acc, target = 0;
+    uint32_t left = n, before = vm->executed;
+    /* The watchdog (section 9): more than `budget` run in all once left < over_below. */
+    uint32_t room = before > vm->budget ? 0u : vm->budget - before;
+    uint32_t over_below = n > room ? n - room : 0u;
+    const uint8_t *stop = STOP;
+    rl1_fault kind = RL1_FAULT_NONE;
+    rl1_state state = RL1_RUNNING;
+    uint8_t op, length;
+    for (;;) {
+        if (ip >= stop) { /* one comparison an instruction while the limit is far */
+            if (left == 0u) { /* the step's limit */
+                break;
+            }
+            if (ip >= end) { /* past the last instruction: (END), not counted */
+                state = RL1_ENDED;
+                break;
+            }
+        }
+        left--;
+        switch (RL1_BYTE(ip)) {
+        case 0x00: /* END */
+            state = RL1_ENDED;
+            break;
+        case 0x01: acc = (uint16_t)VAR_AT(1); ip += 2; continue;           /* LDV v */
+        case 0x02: acc = U16_AT(1); ip += 3; continue;                     /* LDI i */
+        case 0x03: acc = (uint16_t)vm->R; ip += 1; continue;               /* LDR */
+        case 0x04: VAR_AT(1) = (int16_t)acc; ip += 2; continue;            /* STV v */
+        case 0x05:                                                           /* INC v */
+            VAR_AT(1) = (int16_t)(uint16_t)((uint16_t)VAR_AT(1) + 1u);
+            ip += 2;
+            continue;
+        case 0x06:                                                           /* DEC v */
+            VAR_AT(1) = (int16_t)(uint16_t)((uint16_t)VAR_AT(1) - 1u);
+            ip += 2;
+            continue;
+        /* The superinstructions of format 1.2 (the verifier refuses them in older files). */
+        case 0x07: VAR_AT(1) = VAR_AT(2); ip += 3; continue;               /* MOVV v, w */
+        case 0x08: VAR_AT(1) = (int16_t)U16_AT(2); ip += 4; continue;      /* MOVI v, i */
+        case 0x09: VAR_AT(1) = vm->R; ip += 2; continue;                   /* MOVR v */
+        ALU_CASES(0x10, (uint16_t)VAR_AT(1), 2);                             /* ...V */
+        ALU_CASES(0x18, U16_AT(1), 3);                                       /* ...I */
+        ALU_CASES(0x20, (uint16_t)vm->R, 1);                                 /* ...R */
+        case 0x30: target = U16_AT(1); goto jump;                          /* JMP a */
+        case 0x31: JUMP_IF(VAR_AT(1) == 0);                                  /* JZ v, a */
+        case 0x32: JUMP_IF(VAR_AT(1) > 0);                                   /* JGT v, a */
+        case 0x33: JUMP_IF(VAR_AT(1) < 0);                                   /* JLT v, a */
+        case 0x34:                                                           /* DJGT v, a */
+            VAR_AT(1) = (int16_t)(uint16_t)((uint16_t)VAR_AT(1) - 1u);
+            JUMP_IF(VAR_AT(1) > 0);
+        case 0x35: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) == 0);       /* SJZ v, a */
+        case 0x36: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) > 0);        /* SJGT v, a */
+        case 0x37: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) < 0);        /* SJLT v, a */
+        default:
+            UNREACHABLE(); /* the verifier refuses every other opcode */
+            break;
+        case 0x40: case 0x41: case 0x42: case 0x43: case 0x44: case 0x45: case 0x46:
+        case 0x47: case 0x48: case 0x49: case 0x4A: case 0x4B: case 0x4C: case 0x4D:
+        case 0x4E: case 0x4F: case 0x50: case 0x51: case 0x52: case 0x53: case 0x54:
+        case 0x55: case 0x56: case 0x57: case 0x58: case 0x59: case 0x5A: case 0x5B:
+        case 0x5C: case 0x5D: /* the calls */
+            if (left < over_below) {
+                kind = RL1_FAULT_BUDGET;
+                break;
+            }
+            op = RL1_BYTE(ip);
+            length = call_length(op);
+            vm->executed = before + (n - left);
+            vm->pc = (uint16_t)(ip - code + length);
+            kind = call(vm, op, length, ip + 1);
+            if (kind != RL1_FAULT_NONE) {
+                break;
+            }
+            if (vm->waiting) {
+                vm->acc = (int16_t)acc;
+                vm->state = RL1_WAITING;
+                return RL1_WAITING;
+            }
+            target = vm->pc;
+            if (!take_event(vm, &target)) {
+                kind = RL1_FAULT_MISSING_HANDLER;
+                break;
+            }
+            ip = code + target;
+            stop = STOP;
+            continue;
+        }
+        break;
+
+    jump: /* a jump taken: the watchdog, then the event point (section 9) */
+        if (left < over_below) {
+            kind = RL1_FAULT_BUDGET;
+            break;
+        }
+        if (vm->mailbox.posted != vm->mailbox.taken && !take_event(vm, &target)) {
+            kind = RL1_FAULT_MISSING_HANDLER;
+            break;
+        }
+        ip = code + target;
+        stop = STOP;
+    }
+    vm->pc = (uint16_t)(ip - code);
+    vm->acc = (int16_t)acc;
+    vm->executed = before + (n - left);
+    if (kind != RL1_FAULT_NONE) {
+        return fault(vm, kind, vm->pc, false);
+    }
+    return state == RL1_ENDED ? ended(vm, vm->pc) : state;
+}
+
+rl1_state rl1_step(rl1_vm *vm, uint32_t n)
+{
+    const rl1_hardware *hw = vm->hw;
+    if (vm->state == RL1_ENDED || vm->state == RL1_FAULTED) {
+        return vm->state;
+    }
+    if (!vm->begun) {
+        vm->begun = 1;
+        if (hw->begin(hw->ctx) != RL1_OK) {
+            return fault(vm, RL1_FAULT_DEVICE, NO_PC, false);
+        }
+        vm->mailbox.taken = vm->mailbox.posted; /* a loss before the program is not its own */
+    }
+    if (vm->waiting) {
+        rl1_state state = resume(vm);
+        if (state != RL1_RUNNING) {
+            return state;
+        }
+    }
+    return run(vm, n);
+}

@@ -1,0 +1,370 @@
+"""The C VM of the firmware (vm/c/) driven from Python, through ctypes: `rl1c run --engine
+c`, and the differential tests that hold it to the reference VM (machine.py).
+
+ctypes rather than cffi: it is in the standard library, so the only build step is the
+shared library, which `library()` compiles on first use with the machine's C compiler
+(cc, gcc or clang, or $CC) from the checkout's vm/c and spec/rl1_hardware.h, into a cache
+folder keyed by the sources' digest; no make, no Python headers, nothing installed.
+
+`NativeMachine` has Machine's stepping interface (`step`, `run`, `executed`, `state`,
+`result`) over a `hardware.Hardware`, so that drive.py steps either. The C VM calls the
+hardware's callbacks through function pointers; lost lines go through the C VM's own
+mailbox, kept equal to the hardware's `pending` event at every crossing (a step's start
+and each callback): an event the device holds is posted, an event the VM took is taken
+from the device. Faults get the reference VM's messages, from the fault's kind, the
+instruction at `fault_pc` and what the callbacks answered.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, TypeVar
+
+from . import isa
+from .device import DeviceError, FormKey, Outcome, checked, form_name
+from .faults import (
+    STOP_FAILED,
+    Fault,
+    FaultKind,
+    RunResult,
+    argument_range_message,
+    budget_message,
+    missing_handler_message,
+)
+from .hardware import Answer, Hardware, Status
+from .language import VARIABLES, lost_line_handler
+from .machine import SLICE, State
+
+C_FOLDER = Path(__file__).resolve().parent / "c"
+HEADER_FOLDER = Path(__file__).resolve().parent.parent / "spec"
+SOURCES = (C_FOLDER / "rl1vm.c", C_FOLDER / "rl1vm_load.c", C_FOLDER / "test" / "ffi.c")
+HEADERS = (C_FOLDER / "rl1vm.h", HEADER_FOLDER / "rl1_hardware.h")
+FLAGS = ("-std=c99", "-O2", "-shared", "-fPIC")
+SANITIZE = ("-fsanitize=undefined", "-fno-sanitize-recover=all")
+NO_PC = 0xFFFF
+MOV, MVI = 0, 1  # RL1_MOV, RL1_MVI
+
+
+class BuildError(Exception):
+    """The C VM's shared library cannot be built here; the message says why and what
+    to do."""
+
+
+def _compiler() -> str:
+    for name in (os.environ.get("CC", ""), "cc", "gcc", "clang"):
+        if name and shutil.which(name):
+            return name
+    raise BuildError("the C engine needs a C compiler to build vm/c, and this machine has "
+                     "none (cc, gcc or clang, or $CC); install one (Debian: apt-get install "
+                     "gcc), or run with --engine vm")
+
+
+def _cache() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "rl1"
+
+
+def library(folder: Path | None = None, sanitize: bool = False) -> Path:
+    """The shared library of the C VM, built into `folder` (default: the user's cache,
+    ~/.cache/rl1) unless a build of the same sources is there. With `sanitize`,
+    undefined behaviour aborts the process (for the tests)."""
+    missing = [str(path) for path in (*SOURCES, *HEADERS) if not path.is_file()]
+    if missing:
+        raise BuildError("the C engine builds vm/c from a checkout of rl1, and these files "
+                         f"are missing: {', '.join(missing)}")
+    flags = (*FLAGS, *(SANITIZE if sanitize else ()))
+    digest = hashlib.sha256(" ".join(flags).encode())
+    for path in (*SOURCES, *HEADERS):
+        digest.update(path.read_bytes())
+    folder = folder or _cache()
+    target = folder / f"librl1vm-{digest.hexdigest()[:16]}.so"
+    if target.is_file():
+        return target
+    compiler = _compiler()
+    folder.mkdir(parents=True, exist_ok=True)
+    # Built under another name, then renamed: a concurrent build never sees half a file.
+    with tempfile.TemporaryDirectory(dir=folder) as scratch:
+        built = Path(scratch) / target.name
+        command = [compiler, *flags, f"-I{HEADER_FOLDER}", "-o", str(built),
+                   *map(str, SOURCES)]
+        process = subprocess.run(command, capture_output=True, text=True, check=False)
+        if process.returncode != 0:
+            raise BuildError(f"{compiler} could not build the C VM ({' '.join(command)}):\n"
+                             f"{process.stderr.strip()}")
+        built.replace(target)
+    return target
+
+
+# The C structures of spec/rl1_hardware.h, mirrored (checked against rl1_ffi_layout).
+
+class _Reading(ctypes.Structure):
+    _fields_ = [("result", ctypes.c_int16), ("writes", ctypes.c_int16 * 4)]
+
+
+if TYPE_CHECKING:  # what the callbacks get, as typeshed spells it
+    _Args = ctypes._Pointer[ctypes.c_int16]
+    _Out = ctypes._Pointer[_Reading]
+_ARGS = ctypes.POINTER(ctypes.c_int16)
+_OUT = ctypes.POINTER(_Reading)
+_BEGIN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p)
+_CALL = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_uint8, _ARGS, _OUT)
+_START = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_uint8, _ARGS)
+_POLL = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, _OUT)
+
+
+class _Hardware(ctypes.Structure):
+    _fields_ = [("ctx", ctypes.c_void_p), ("begin", _BEGIN), ("call", _CALL),
+                ("start", _START), ("poll", _POLL), ("stop", _BEGIN), ("end", _BEGIN)]
+
+
+class _Mailbox(ctypes.Structure):
+    _fields_ = [("event", ctypes.c_uint8), ("posted", ctypes.c_uint8),
+                ("taken", ctypes.c_uint8)]
+
+
+class _Vm(ctypes.Structure):
+    _fields_ = [("code", ctypes.c_void_p), ("code_size", ctypes.c_uint16),
+                ("handlers", ctypes.c_uint16 * 4), ("budget", ctypes.c_uint32),
+                ("hw", ctypes.c_void_p), ("mailbox", _Mailbox),
+                ("V", ctypes.c_int16 * len(VARIABLES)), ("acc", ctypes.c_int16),
+                ("R", ctypes.c_int16), ("pc", ctypes.c_uint16),
+                ("executed", ctypes.c_uint32), ("begun", ctypes.c_uint8),
+                ("waiting", ctypes.c_uint8), ("state", ctypes.c_int),
+                ("fault", ctypes.c_int), ("fault_pc", ctypes.c_uint16),
+                ("stop_failed", ctypes.c_uint8)]
+
+
+_LAYOUT = (ctypes.sizeof(_Vm), _Vm.mailbox.offset, _Vm.V.offset, _Vm.executed.offset,
+           _Vm.state.offset, _Vm.fault_pc.offset, _Vm.stop_failed.offset,
+           ctypes.sizeof(_Hardware), ctypes.sizeof(_Reading))
+
+_FAULTS = {kind.exit_status: kind for kind in FaultKind}
+_STATUS = {Status.OK: 0, Status.BUSY: 1, Status.ERROR: 2}
+_libraries: dict[Path, ctypes.CDLL] = {}
+
+F = TypeVar("F", bound=Callable[..., int])
+
+
+def load(path: Path) -> ctypes.CDLL:
+    """The library at `path` (library()), its functions typed, its layout checked."""
+    if path in _libraries:
+        return _libraries[path]
+    lib = ctypes.CDLL(str(path))
+    lib.rl1_ffi_layout.argtypes = [ctypes.POINTER(ctypes.c_uint32)]
+    lib.rl1_ffi_start.argtypes = [ctypes.POINTER(_Vm), ctypes.c_char_p, ctypes.c_uint32,
+                                  ctypes.POINTER(_Hardware), ctypes.c_uint32,
+                                  ctypes.POINTER(ctypes.c_uint32)]
+    lib.rl1_ffi_post.argtypes = [ctypes.POINTER(_Vm), ctypes.c_uint8, ctypes.c_uint8]
+    lib.rl1_step.argtypes = [ctypes.POINTER(_Vm), ctypes.c_uint32]
+    lib.rl1_test_line_at.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_uint16]
+    lib.rl1_test_line_at.restype = ctypes.c_uint16
+    lib.rl1_test_load.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_size_t,
+                                  ctypes.POINTER(ctypes.c_uint32)]
+    layout = (ctypes.c_uint32 * len(_LAYOUT))()
+    lib.rl1_ffi_layout(layout)
+    if tuple(layout) != _LAYOUT:
+        raise BuildError(f"the C VM's structures are not laid out as rl1.vm.native mirrors "
+                         f"them: {tuple(layout)} != {_LAYOUT}")
+    _libraries[path] = lib
+    return lib
+
+
+class NativeMachine:
+    """One run of the .ilc file `data` on the C VM, driving `hardware`; the C loader
+    must accept the file (verify it in Python first for a readable refusal)."""
+
+    def __init__(self, data: bytes, hardware: Hardware, budget: int, lib: ctypes.CDLL) -> None:
+        self.hardware = hardware
+        self.lib = lib
+        self._file = ctypes.create_string_buffer(data, len(data))  # the VM reads it in place
+        self._size = len(data)
+        self._vm = _Vm()
+        self._error: BaseException | None = None  # raised in a callback, raised again
+        self._posted = False  # the hardware's pending event is in the mailbox
+        self._message = ""  # why the device failed, for the fault's message
+        self._stop_message: str | None = None
+        self._form: FormKey | None = None  # the started built-in
+        self._callbacks = _Hardware(None, _BEGIN(self._guard(self._begin)),
+                                    _CALL(self._guard(self._call)),
+                                    _START(self._guard(self._start)),
+                                    _POLL(self._guard(self._poll)),
+                                    _BEGIN(self._guard(self._stop)),
+                                    _BEGIN(self._guard(self._end)))
+        where = ctypes.c_uint32(0)
+        refusal = lib.rl1_ffi_start(ctypes.byref(self._vm), self._file, self._size,
+                                    ctypes.byref(self._callbacks), budget, ctypes.byref(where))
+        if refusal:
+            raise ValueError(f"the C loader refuses the file (refusal {refusal} at file "
+                             f"offset {where.value}), which the caller was to verify")
+        self.budget = budget
+        self.result: RunResult | None = None
+
+    # The stepping interface of machine.Machine
+
+    @property
+    def executed(self) -> int:
+        return int(self._vm.executed)
+
+    @property
+    def state(self) -> State:
+        return State(self._vm.state)
+
+    def current_line(self) -> int | None:
+        """The source line of the call under way, or of the instruction run last between
+        steps (as Machine.current_line): the line entry at or before the byte before pc;
+        None before the first instruction, or without a line map."""
+        pc = int(self._vm.pc)
+        if pc == 0:
+            return None
+        line = int(self.lib.rl1_test_line_at(self._file, self._size, pc - 1))
+        return line or None
+
+    def step(self, limit: int) -> State:
+        """Run at most `limit` instructions and say where the run stands."""
+        self._sync()
+        state = State(self.lib.rl1_step(ctypes.byref(self._vm), limit))
+        if self._error is not None:
+            error, self._error = self._error, None
+            raise error
+        self._sync()
+        if state in (State.ENDED, State.FAULTED) and self.result is None:
+            self.result = RunResult(tuple(self._vm.V), self._fault())
+        return state
+
+    def run(self) -> RunResult:
+        while self.step(SLICE) in (State.RUNNING, State.WAITING):
+            pass
+        assert self.result is not None
+        return self.result
+
+    # Lost lines: the mailbox and the hardware's pending event kept equal
+
+    def _sync(self) -> None:
+        box = self._vm.mailbox
+        if self._posted and box.posted == box.taken:  # the VM took it
+            self._posted = False
+            self.hardware.take_event()
+        event = self.hardware.pending
+        if event is not None and not self._posted:
+            self.lib.rl1_ffi_post(ctypes.byref(self._vm), event.mode,
+                                  MOV if event.command == "MOV" else MVI)
+            self._posted = True
+
+    # The callbacks
+
+    def _guard(self, callback: F) -> F:
+        """`callback` synchronizing the mailbox around it, and keeping an exception to
+        raise after the step (ctypes would print it and answer 0)."""
+        def guarded(*args: object) -> int:
+            try:
+                self._sync()
+                status = callback(*args)
+                self._sync()
+                return status
+            except BaseException as error:  # raised again by step()
+                self._error = self._error or error
+                return _STATUS[Status.ERROR]
+        return guarded  # type: ignore[return-value]
+
+    def _answer(self, answer: Answer, form: FormKey | None, out: _Out | None) -> int:
+        """A callback's status; an ERROR's message kept; what a finished call read put in
+        `out` (a value that is no 16-bit integer is the device's error, as machine.py's
+        device.checked says, and so is one outside its range, which the C VM finds)."""
+        if answer.status is Status.OK and form is not None and out is not None:
+            try:
+                checked(form, answer.outcome)
+            except DeviceError as error:
+                self._message = str(error)
+                if not all(-0x8000 <= value <= 0x7FFF for value in _values(answer.outcome)):
+                    return _STATUS[Status.ERROR]
+            _fill(out.contents, answer.outcome)
+        if answer.status is Status.ERROR:
+            self._message = answer.message
+        return _STATUS[answer.status]
+
+    def _begin(self, _ctx: object) -> int:
+        return self._answer(self.hardware.begin(), None, None)
+
+    def _call(self, _ctx: object, opcode: int, args: _Args, out: _Out) -> int:
+        form, values = _decode_call(opcode, args)
+        return self._answer(self.hardware.call(form, values), form, out)
+
+    def _start(self, _ctx: object, opcode: int, args: _Args) -> int:
+        form, values = _decode_call(opcode, args)
+        self._form = form
+        return self._answer(self.hardware.start(form, values), None, None)
+
+    def _poll(self, _ctx: object, out: _Out) -> int:
+        return self._answer(self.hardware.poll(), self._form, out)
+
+    def _stop(self, _ctx: object) -> int:
+        answer = self.hardware.stop()
+        self._stop_message = answer.message if answer.status is not Status.OK else None
+        return _STATUS[answer.status]
+
+    def _end(self, _ctx: object) -> int:
+        answer = self.hardware.end()
+        if self._vm.state != State.ENDED.value:  # after a fault: its message stays
+            return _STATUS[answer.status]
+        return self._answer(answer, None, None)
+
+    # The fault, told as the reference VM tells it
+
+    def _fault(self) -> Fault | None:
+        vm = self._vm
+        kind = _FAULTS.get(vm.fault)
+        if kind is None:
+            return None
+        at = int(vm.fault_pc)
+        line = None if at == NO_PC else (
+            self.lib.rl1_test_line_at(self._file, self._size, at) or None)
+        message = self._message
+        if kind is FaultKind.BUDGET:
+            message = budget_message(self.budget)
+        elif kind is FaultKind.ARGUMENT_RANGE:
+            message = self._range_message(at)
+        elif kind is FaultKind.MISSING_HANDLER:
+            event = int(vm.mailbox.event)
+            mode, command = event >> 1, "MVI" if event & 1 else "MOV"
+            label = lost_line_handler(mode, command)
+            assert label is not None
+            message = missing_handler_message(mode, command, label)
+        if self._stop_message is not None:
+            message += STOP_FAILED + self._stop_message
+        return Fault(kind, message, line)
+
+    def _range_message(self, at: int) -> str:
+        start = int.from_bytes(self._file.raw[12:14], "little")  # header_size
+        size = int.from_bytes(self._file.raw[14:16], "little")  # code_size
+        instruction = isa.decode_at(self._file.raw[start:start + size], at)
+        form = instruction.info.form
+        assert form is not None and instruction.info.builtin is not None
+        for param, arg in zip(form.params, instruction.args, strict=True):
+            value = int(self._vm.V[arg.value]) if arg.is_var else arg.value
+            if arg.is_var and not param.low <= value <= param.high:
+                return argument_range_message(param.name, form_name(instruction.info.builtin),
+                                              value, arg.value, param.low, param.high)
+        raise AssertionError("an argument-range fault with every argument in range")
+
+
+def _decode_call(opcode: int, args: _Args) -> tuple[FormKey, tuple[int, ...]]:
+    info = isa.OPCODES[opcode]
+    assert info.builtin is not None and info.form is not None
+    return info.builtin, tuple(args[k] for k in range(len(info.form.params)))
+
+
+def _values(outcome: Outcome) -> tuple[int, ...]:
+    return (*outcome.writes, *(() if outcome.result is None else (outcome.result,)))
+
+
+def _fill(out: _Reading, outcome: Outcome) -> None:
+    out.result = outcome.result or 0
+    for index, value in enumerate(outcome.writes):
+        out.writes[index] = value
