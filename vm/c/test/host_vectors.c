@@ -207,7 +207,8 @@ static void read_file(const char *path, reading *r)
         } else if (strcmp(word, "ilc_stripped") == 0) {
             r->stripped = hex_bytes(strtok(NULL, " "), &r->stripped_size);
         } else if (strcmp(word, "sensor") == 0 || strcmp(word, "loss") == 0
-                   || strcmp(word, "fail") == 0 || strcmp(word, "stop_fails") == 0) {
+                   || strcmp(word, "fail") == 0 || strcmp(word, "stop_fails") == 0
+                   || strcmp(word, "after_last") == 0) {
             script_item *item = &r->items[r->v.script_count];
             int k;
             if (r->v.script_count == sizeof r->items / sizeof *r->items) {
@@ -228,6 +229,11 @@ static void read_file(const char *path, reading *r)
             } else if (word[0] == 'f') {
                 item->kind = FAIL;
                 item->key = (uint8_t)call_of(strtok(NULL, " "));
+            } else if (word[0] == 'a') {
+                if (strcmp(strtok(NULL, " "), "repeat") != 0) {
+                    fail_input(path, number_of_line, "after_last is repeat or absent");
+                }
+                item->kind = REPEAT_AFTER_LAST;
             } else {
                 item->kind = STOP_FAILS;
             }

@@ -61,9 +61,10 @@ static rl1_status record(scripted *d, uint16_t call, const int16_t *args, uint8_
     return RL1_OK;
 }
 
-/* The reading of a sensing call: the next one of its list (INP: of its port), the last
- * one again when the list is used up, zeros when there is none. */
-static void next_reading(scripted *d, uint8_t op, int16_t port, int16_t *values)
+/* The reading of a sensing call: the next one of its list (INP: of its port). Past
+ * the list, false; or with "after_last": "repeat", the last one again (zeros when there
+ * is none). */
+static bool next_reading(scripted *d, uint8_t op, int16_t port, int16_t *values)
 {
     script_item item, found = {0, 0, {0, 0, 0, 0}};
     uint16_t index, seen = 0, i;
@@ -90,6 +91,15 @@ static void next_reading(scripted *d, uint8_t op, int16_t port, int16_t *values)
     for (k = 0; seen && k + first < 4u; k++) {
         values[k] = (int16_t)found.value[k + first];
     }
+    if (seen > index) {
+        return true;
+    }
+    for (i = 0; item_at(d, i, &item); i++) {
+        if (item.kind == REPEAT_AFTER_LAST) {
+            return true;
+        }
+    }
+    return false;
 }
 
 /* The time of the next loss that could matter in (time, until]. */
@@ -188,6 +198,7 @@ static rl1_status perform(scripted *d, uint8_t op, const int16_t *args, rl1_read
     bool waits = op == 0x42u || op == 0x43u || (op >= 0x45u && op <= 0x48u) || op == 0x4Au
                  || (op >= 0x4Eu && op <= 0x58u);
     rl1_status status;
+    bool have_reading = true; /* false: a sensing call past its readings */
     uint32_t cm, speed;
     out->result = 0;
     switch (op) {
@@ -236,14 +247,14 @@ static rl1_status perform(scripted *d, uint8_t op, const int16_t *args, rl1_read
         return advance(d, magnitude(args[0]) * 100u, true);
     case 0x4C: /* KYO: centre, right (u), left (v) */
         nresult = 3;
-        next_reading(d, op, 0, values);
+        have_reading = next_reading(d, op, 0, values);
         out->result = values[0];
         out->writes[0] = values[1];
         out->writes[1] = values[2];
         break;
     case 0x4E: /* IMG: area (R and w), x, y, z */
         nresult = 4;
-        next_reading(d, op, 0, values);
+        have_reading = next_reading(d, op, 0, values);
         out->result = values[0];
         out->writes[0] = values[0];
         out->writes[1] = values[1];
@@ -252,22 +263,26 @@ static rl1_status perform(scripted *d, uint8_t op, const int16_t *args, rl1_read
         break;
     case 0x54: case 0x55: case 0x56: case 0x57: case 0x58: /* CAM R, ULT A-D */
         nresult = 1;
-        next_reading(d, op, 0, values);
+        have_reading = next_reading(d, op, 0, values);
         out->result = values[0];
         break;
     case 0x5A: /* INP port */
         nresult = 1;
-        next_reading(d, op, args[0], values);
+        have_reading = next_reading(d, op, args[0], values);
         out->result = values[0];
         break;
     case 0x5D: /* FZI: s, t */
         nresult = 2;
-        next_reading(d, op, 0, values);
+        have_reading = next_reading(d, op, 0, values);
         out->writes[0] = values[0];
         out->writes[1] = values[1];
         break;
     default:
         break;
+    }
+    if (!have_reading) { /* recorded without a result, then the device fails */
+        (void)record(d, op, args, n, NULL, 0, waits);
+        return RL1_ERROR;
     }
     status = record(d, op, args, n, values, nresult, waits);
     if (status != RL1_OK || !waits) {

@@ -11,7 +11,11 @@
 #include "../rl1vm.h"
 
 /* One line of a sensor script, as the vectors' text form writes it. */
-enum script_kind { SENSOR, LOSS_TIME, LOSS_DURING, LOSS_INSTRUCTION, FAIL, STOP_FAILS };
+/* REPEAT_AFTER_LAST: the script's "after_last": "repeat" (a call past the readings
+ * gets the last one again, or zeros); without it such a call fails (a device error). */
+enum script_kind {
+    SENSOR, LOSS_TIME, LOSS_DURING, LOSS_INSTRUCTION, FAIL, STOP_FAILS, REPEAT_AFTER_LAST
+};
 
 typedef struct script_item {
     uint8_t kind;     /* enum script_kind */

@@ -85,7 +85,7 @@ CALLS = {form_name(info.builtin).replace(" ", "_"): opcode
          for opcode, info in isa.OPCODES.items() if info.builtin and info.form is not None
          and opcode >= isa.CALL_BASE} | {"LINE_LOST": 0x100, "STOP": 0x101}
 SCRIPT_KINDS = {"sensor": 0, "loss time": 1, "loss during": 2, "loss instruction": 3,
-                "fail": 4, "stop_fails": 5}  # scripted.h's enum script_kind
+                "fail": 4, "stop_fails": 5, "after_last": 6}  # scripted.h's enum script_kind
 
 
 def _words(line: str) -> list[str]:
@@ -101,6 +101,8 @@ def _item(words: list[str]) -> str:
             key, rest = (0 if rest[0] == "MOV" else 1), rest[1:]
     elif words[0] == "stop_fails":
         kind, key, rest = SCRIPT_KINDS["stop_fails"], 0, []
+    elif words[0] == "after_last":  # only "repeat" is written: "stop" is the default
+        kind, key, rest = SCRIPT_KINDS["after_last"], 0, []
     else:
         kind, key, rest = SCRIPT_KINDS[words[0]], CALLS[words[1]], words[2:]
     values = [*rest, "0", "0", "0", "0"][:4]
@@ -138,7 +140,8 @@ def vector_source(vectors: list[dict[str, list[str]]]) -> str:
     variables: list[str] = []
     rows: list[str] = []
     for vector in vectors:
-        script = [_item(_words(line)) for key in ("sensor", "loss", "fail", "stop_fails")
+        script = [_item(_words(line))
+                  for key in ("sensor", "loss", "fail", "stop_fails", "after_last")
                   for line in vector.get(key, [])]
         trace = [_entry(_words(line)) for line in vector.get("trace", [])]
         status = _words(vector["status"][0])
