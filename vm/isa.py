@@ -74,6 +74,10 @@ JUMP_IF = {"=": 0x31, ">": 0x32, "<": 0x33}  # conditional jump opcode by relati
 # the format; it is written here once, so that a merge with another 1.x can renumber it.
 FUSED_MINOR = 2
 STORE_JUMP_IF = {"=": 0x35, ">": 0x36, "<": 0x37}  # store acc, then jump on it
+# The load-and-operate superinstructions (format 1.2): acc = first op second, in blocks of
+# 8 by the kinds of the two operands, the operator in the low 3 bits as in the ALU block.
+# An expression's load and first operation in one: `V=a-b` is COMPUTE then STV.
+COMPUTE_VAR_VAR, COMPUTE_VAR_IMM, COMPUTE_RESULT_VAR, COMPUTE_RESULT_IMM = 0x60, 0x68, 0x70, 0x78
 
 # The built-in forms, in opcode order from CALL_BASE; END is opcode 0.
 CALL_BASE = 0x40
@@ -84,6 +88,16 @@ CALL_FORMS: tuple[tuple[str, str | None], ...] = (
     ("CAM", "Z"), ("CAM", "U"), ("CAM", "D"), ("CAM", "A"), ("CAM", "P"), ("CAM", "R"),
     ("ULT", "A"), ("ULT", "B"), ("ULT", "C"), ("ULT", "D"),
     ("LMP", None), ("INP", None), ("OUT", None), ("FZO", None), ("FZI", None),
+)
+
+
+# Each load-and-operate block: base, mnemonic suffix, operands, and the two operands as
+# the meaning names them.
+_COMPUTE_KINDS = (
+    (COMPUTE_VAR_VAR, "VV", (Operand.VAR, Operand.VAR), "V[v]", "V[w]"),
+    (COMPUTE_VAR_IMM, "VI", (Operand.VAR, Operand.IMM), "V[v]", "i"),
+    (COMPUTE_RESULT_VAR, "RV", (Operand.VAR,), "R", "V[v]"),
+    (COMPUTE_RESULT_IMM, "RI", (Operand.IMM,), "R", "i"),
 )
 
 
@@ -121,6 +135,10 @@ def _table() -> dict[int, OpInfo]:
                            meaning.replace("x", "i") + ", into acc"))
         rows.append(OpInfo(ALU_RESULT + index, name + "R", (),
                            meaning.replace("x", "R") + ", into acc"))
+        for base, suffix, kinds, first, second in _COMPUTE_KINDS:
+            rows.append(OpInfo(base + index, name + suffix, kinds,
+                               "acc = " + meaning.replace("acc", first).replace("x", second),
+                               minor=FUSED_MINOR))
     for index, (mnemonic, selector) in enumerate(CALL_FORMS):
         form = BUILTINS[mnemonic].form(selector)
         assert form is not None

@@ -28,6 +28,13 @@ _SERVES |= {
     "SJGT": f"`V=...; ?V>#NN` {_FUSED}", "SJLT": f"`V=...; ?V<#NN` {_FUSED}",
 }
 _ALU_SERVES = {isa.ALU_VAR: "a variable", isa.ALU_IMM: "a constant", isa.ALU_RESULT: "a call"}
+# The load-and-operate blocks: the first two operands of an expression.
+_COMPUTE_SERVES = {
+    isa.COMPUTE_VAR_VAR: "a variable and a variable",
+    isa.COMPUTE_VAR_IMM: "a variable and a constant",
+    isa.COMPUTE_RESULT_VAR: "a call and a variable",
+    isa.COMPUTE_RESULT_IMM: "a call and a constant",
+}
 
 
 def operands(info: isa.OpInfo) -> str:
@@ -49,7 +56,10 @@ def serves(info: isa.OpInfo) -> str:
     if info.name in _SERVES:
         return _SERVES[info.name]
     base = info.opcode & ~7
-    return f"`{isa.ALU_OPERATORS[info.opcode - base]}` then {_ALU_SERVES[base]}"
+    operator = isa.ALU_OPERATORS[info.opcode - base]
+    if base in _COMPUTE_SERVES:
+        return f"`{operator}` between {_COMPUTE_SERVES[base]}, first in `V=` {_FUSED}"
+    return f"`{operator}` then {_ALU_SERVES[base]}"
 
 
 def writes(info: isa.OpInfo) -> str:

@@ -87,6 +87,10 @@ def _sweep(block: ir.Block, live_out: frozenset[str]
                 continue
         elif not acc_used:
             continue  # a load or operation whose result no one reads
+        elif isinstance(instruction, ir.Compute):
+            live.update(operand.name for operand in (instruction.first, instruction.second)
+                        if isinstance(operand, ir.Var))
+            acc_used = False
         else:
             if isinstance(instruction.source, ir.Var):
                 live.add(instruction.source.name)

@@ -153,7 +153,21 @@ class Move:
         return f"move {self.target}, {self.source}"
 
 
-Instruction = Load | Operate | Store | StepVar | Call | Move
+@dataclass(frozen=True, slots=True)
+class Compute:
+    """acc = first op second: an expression's load and first operation in one (a
+    superinstruction of -O2)."""
+
+    first: Var | Result
+    op: BinaryOperator
+    second: Var | Imm
+    line: int
+
+    def __str__(self) -> str:
+        return f"load {self.first} {OPERATOR_NAMES[self.op]} {self.second}"
+
+
+Instruction = Load | Operate | Store | StepVar | Call | Move | Compute
 
 
 # Terminators ------------------------------------------------------------------------
@@ -314,7 +328,7 @@ def _block_problems(block: Block) -> Iterator[str]:
     result_set = False  # whether R holds a value here (only a call within the block sets it)
     loaded = False  # whether acc holds a value here: it is dead where a block starts
     for instruction in block.instructions:
-        if not isinstance(instruction, Load | Operate | Store | StepVar | Call | Move):
+        if not isinstance(instruction, Load | Operate | Store | StepVar | Call | Move | Compute):
             yield f"holds {instruction!r}, which is not an instruction"
             continue
         for operand in _operands(instruction):
@@ -326,7 +340,7 @@ def _block_problems(block: Block) -> Iterator[str]:
                 yield f"line {instruction.line}: `{instruction}` reads R before a call sets it"
         if isinstance(instruction, Operate | Store) and not loaded:
             yield f"line {instruction.line}: `{instruction}` reads acc before a load sets it"
-        loaded = loaded or isinstance(instruction, Load)
+        loaded = loaded or isinstance(instruction, Load | Compute)
         if isinstance(instruction, Call):
             yield from _call_problems(instruction)
             result_set = instruction.mnemonic in BUILTINS and instruction.returns_value
@@ -345,6 +359,8 @@ def _operands(instruction: Instruction) -> tuple[Operand, ...]:
         return (instruction.target,)
     if isinstance(instruction, Move):
         return (instruction.target, instruction.source)
+    if isinstance(instruction, Compute):
+        return (instruction.first, instruction.second)
     return instruction.args
 
 
