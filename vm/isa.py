@@ -9,6 +9,7 @@ Encoding (little-endian, no alignment): one opcode byte, then the operands the t
 lists for that opcode, so an instruction's length is known from its first byte.
 - VAR: 1 byte, a variable index 0..52 (builtins.VARIABLES order).
 - IMM: 2 bytes, a signed 16-bit immediate.
+- BYTE: 1 byte, a signed 8-bit immediate (format 1.2's MOVB).
 - ADDR: 2 bytes, an unsigned offset into the code section (an instruction boundary).
 - ARGS: a call's arguments: 1 mask byte (bit i set: argument i is a variable), then
   2 bytes per argument, an IMM or a variable index. Calls with no argument have none.
@@ -26,6 +27,7 @@ from .language import BUILTINS, Form
 class Operand(Enum):
     VAR = "var"  # 1 byte
     IMM = "imm"  # 2 bytes, signed
+    BYTE = "byte"  # 1 byte, signed
     ADDR = "addr"  # 2 bytes, unsigned
     ARGS = "args"  # mask byte + 2 bytes per argument; the arity comes from the opcode
 
@@ -44,7 +46,7 @@ class OpInfo:
     def length(self) -> int:
         size = 1
         for operand in self.operands:
-            if operand is Operand.VAR:
+            if operand in (Operand.VAR, Operand.BYTE):
                 size += 1
             elif operand is Operand.ARGS:
                 size += 1 + 2 * self.arity
@@ -119,6 +121,7 @@ def _table() -> dict[int, OpInfo]:
         OpInfo(0x08, "MOVI", (Operand.VAR, Operand.IMM), "V[v] = i", minor=FUSED_MINOR),
         OpInfo(0x09, "MOVR", (Operand.VAR,), "V[v] = R (the last call's result)",
                minor=FUSED_MINOR),
+        OpInfo(0x0A, "MOVB", (Operand.VAR, Operand.BYTE), "V[v] = b", minor=FUSED_MINOR),
         OpInfo(0x34, "DJGT", (Operand.VAR, Operand.ADDR),
                "V[v] = V[v] - 1, then jump to a if V[v] > 0", minor=FUSED_MINOR),
         OpInfo(0x35, "SJZ", (Operand.VAR, Operand.ADDR),
@@ -216,6 +219,9 @@ def decode_at(code: bytes, offset: int) -> Instruction:
         elif operand is Operand.IMM:
             operands.append(struct.unpack_from("<h", code, position)[0])
             position += 2
+        elif operand is Operand.BYTE:
+            operands.append(struct.unpack_from("<b", code, position)[0])
+            position += 1
         elif operand is Operand.ADDR:
             operands.append(struct.unpack_from("<H", code, position)[0])
             position += 2
@@ -239,6 +245,8 @@ def encode(info: OpInfo, operands: tuple[int, ...] = (), args: tuple[Arg, ...] =
             out.append(next(values))
         elif operand is Operand.IMM:
             out += struct.pack("<h", next(values))
+        elif operand is Operand.BYTE:
+            out += struct.pack("<b", next(values))
         elif operand is Operand.ADDR:
             out += struct.pack("<H", next(values))
         else:

@@ -11,7 +11,8 @@ from . import isa
 HEADER = ("| opcode | mnemonic | operands | bytes | meaning | writes | serves |\n"
           "|---|---|---|---|---|---|---|")
 
-_OPERAND_TEXT = {isa.Operand.VAR: "v", isa.Operand.IMM: "i", isa.Operand.ADDR: "a"}
+_OPERAND_TEXT = {isa.Operand.VAR: "v", isa.Operand.IMM: "i", isa.Operand.ADDR: "a",
+                 isa.Operand.BYTE: "b"}
 
 # What source construct each non-call instruction compiles from (spec/language.md).
 _SERVES = {
@@ -24,6 +25,7 @@ _SERVES = {
 _FUSED = f"(-O2; format 1.{isa.FUSED_MINOR})"
 _SERVES |= {
     "MOVV": f"`V=W` {_FUSED}", "MOVI": f"`V=i` {_FUSED}", "MOVR": f"`V=(call)` {_FUSED}",
+    "MOVB": f"`V=i`, i in -128..127 {_FUSED}",
     "DJGT": f"`V--; ?V>#NN` {_FUSED}", "SJZ": f"`V=...; ?V=#NN` {_FUSED}",
     "SJGT": f"`V=...; ?V>#NN` {_FUSED}", "SJLT": f"`V=...; ?V<#NN` {_FUSED}",
 }

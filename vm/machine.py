@@ -217,7 +217,7 @@ class Machine:
             return (_SIMPLE[name], operands[0], 0)
         if name == "MOVV":
             return (MOVE, operands[0], operands[1])
-        if name == "MOVI":
+        if name in ("MOVI", "MOVB"):
             return (MOVE, operands[0], self._immediate(operands[1]))
         if name == "MOVR":
             return (MOVE, operands[0], R_CELL)

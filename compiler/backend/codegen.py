@@ -141,6 +141,9 @@ def _instruction(instruction: ir.Instruction) -> _MachineOp:
                           (), line)
     if isinstance(instruction, ir.Move):
         kind, operands = _source(instruction.source)
+        if isinstance(instruction.source, ir.Imm) and -0x80 <= instruction.source.value <= 0x7F:
+            return _MachineOp(isa.BY_NAME["MOVB"], (VARIABLE_INDEX[instruction.target.name],
+                                                     instruction.source.value), (), line)
         return _MachineOp(isa.BY_NAME[("MOVV", "MOVI", "MOVR")[kind]],
                           (VARIABLE_INDEX[instruction.target.name], *operands), (), line)
     if isinstance(instruction, ir.Compute):

@@ -20,15 +20,12 @@ from .superinstructions import fuse
 
 Pass = Callable[[ir.Program], ir.Program]
 
-# -O1: the passes whose output every format 1.0 reader runs, a round of them until the
-# program stops changing. The control pass runs once before the first round, so that
-# the others see merged blocks, and last in each round, to remove what they made
-# unreachable (it is idempotent, so a round need not begin with it again).
-O1_PASSES: tuple[Pass, ...] = (fold_constants, propagate_copies, rewrite_steps,
-                               remove_dead_stores, simplify_control)
+# -O1: the passes whose output every format 1.0 reader runs. The control pass comes
+# first so that the others see merged blocks, and last so that it removes what they
+# made unreachable.
+O1_PASSES: tuple[Pass, ...] = (simplify_control, fold_constants, propagate_copies,
+                               rewrite_steps, remove_dead_stores, simplify_control)
 LEVELS: dict[int, tuple[Pass, ...]] = {0: (), 1: O1_PASSES, 2: O1_PASSES}
-FIRST_PASSES: dict[int, tuple[Pass, ...]] = {0: (), 1: (simplify_control,),
-                                             2: (simplify_control,)}
 # What runs once after a level's passes stop changing the program: -O2's fusion, which
 # the other passes need not know.
 FINAL_PASSES: dict[int, tuple[Pass, ...]] = {0: (), 1: (), 2: (fuse,)}
@@ -47,7 +44,6 @@ def optimize(program: ir.Program, level: int, *, check: bool = False) -> ir.Prog
     passes = LEVELS[level]
     if not passes:
         return program
-    program = _run(FIRST_PASSES[level], program, check)
     shape = _shape(program)
     for _ in range(MAX_ROUNDS):
         program = _run(passes, program, check)

@@ -10,7 +10,8 @@ fused jump is a jump, where the budget is checked and an event taken); no path l
 - `dec V` then a branch on V > 0 (`@--; ?@>#14`, a counted loop) becomes one
   decrement-and-branch.
 - `load x` then stores of it, when nothing reads the accumulator after them, become
-  moves (`A=B`, `A=5`, `A=(IMG)`): one instruction per store instead of one more.
+  moves (`A=B`, `A=5`, `A=(IMG)`): one instruction per store instead of one more (the
+  code generator writes a constant move as MOVB, a byte shorter, when it fits a byte).
 - `load x` then an operation on y, x a variable or R and y a variable or a constant,
   become one load-and-operate (`E=L-M`, `A=(IMG)-180`): an expression's first two
   operands in one instruction. (A constant first is folded by -O1 or stays: `0-M`.)

@@ -752,10 +752,10 @@ def _sample_variables(ending: dict[str, int]) -> dict[str, int]:
 
 
 def fused() -> Iterator[Case]:
-    yield Case("fused", "fused-moves", "MOVV, MOVI and MOVR: a variable copied, a "
-               "constant stored, a call's result stored (-O2)",
-               "A=(KYO); D=A+1; B=A; C=5; (FZO B,C); G=(ULT A)\n",
-               {"A": 42, "u": 40, "v": 44, "B": 42, "C": 5, "D": 43, "G": 7},
+    yield Case("fused", "fused-moves", "MOVV, MOVB, MOVI and MOVR: a variable copied, a "
+               "small and a large constant stored, a call's result stored (-O2)",
+               "A=(KYO); D=A+1; B=A; C=5; E=-1000; (FZO B,C); G=(ULT A)\n",
+               {"A": 42, "u": 40, "v": 44, "B": 42, "C": 5, "D": 43, "E": -1000, "G": 7},
                {"KYO": [{"centre": 42, "right": 40, "left": 44}], "ULT A": [7]}, level=2)
     yield Case("fused", "fused-counted-loop", "DJGT: a counted loop's decrement and jump "
                "(-O2)", "@=3\n:10 A=A+7; (TIM 1); @--; ?@>#10\n(END)\n", {"A": 21},

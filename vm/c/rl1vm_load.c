@@ -121,6 +121,10 @@ static uint8_t op_length(uint8_t op, uint8_t minor, enum shape *shape)
             *shape = VAR; /* MOVR */
             return 2;
         }
+        if (op == 0x0Au) {
+            *shape = VAR; /* MOVB: a variable, then a signed byte, which needs no check */
+            return 3;
+        }
         if (op >= 0x34u && op <= 0x37u) {
             *shape = VAR_ADDR; /* DJGT, SJZ, SJGT, SJLT */
             return 4;
