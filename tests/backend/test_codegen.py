@@ -303,5 +303,5 @@ def test_a_move_of_a_constant_that_fits_a_byte_is_movb() -> None:
     assert names(image) == ["MOVB", "MOVI", "MOVB", "MOVI", "END"]
     assert image.code[:3] == bytes([0x0A, var("A"), 127])
     assert image.code[7:10] == bytes([0x0A, var("A"), 0x80])  # -128, signed
-    cells = machine.run(verify(ilc.encode(image)), ScriptedDevice(Script({}))).variables
+    cells = machine.run(verify(ilc.encode(image)), ScriptedDevice(Script())).variables
     assert cells[var("A")] == -129
