@@ -28,7 +28,7 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 
-from rl1.vm.language import BUILTINS, VARIABLES
+from rl1.vm.language import VARIABLES
 from rl1.vm.machine import evaluate
 
 from . import flow, ir
@@ -171,9 +171,7 @@ def _fold(block: ir.Block, known: Known) -> _Folded:
             acc, pending = None, False
         else:
             out.append(_call(instruction, known))
-            form = BUILTINS[instruction.mnemonic].form(instruction.selector)
-            assert form is not None
-            for name in form.writes:
+            for name in instruction.form.writes:
                 known.pop(name, None)
     return _Folded(out, _terminator(block.terminator, known), known)
 
@@ -192,10 +190,10 @@ def _set(known: Known, name: str, value: int | None) -> None:
 def _call(call: ir.Call, known: Known) -> ir.Call:
     """The call with each variable argument whose known value its parameter accepts
     replaced by that value."""
-    form = BUILTINS[call.mnemonic].form(call.selector)
-    assert form is not None
+    if all(isinstance(arg, ir.Imm) for arg in call.args):
+        return call
     args: list[ir.Argument] = []
-    for arg, param in zip(call.args, form.params, strict=True):
+    for arg, param in zip(call.args, call.form.params, strict=True):
         value = _value(arg, known)
         in_range = value is not None and param.low <= value <= param.high
         args.append(ir.Imm(value) if in_range and value is not None else arg)

@@ -14,8 +14,6 @@ operation on what the load named (`add D`): one instruction instead of two.
 
 from __future__ import annotations
 
-from rl1.vm.language import BUILTINS
-
 from . import ir
 
 COMMUTATIVE = "+&|^"
@@ -56,8 +54,6 @@ def _without_copies(instructions: list[ir.Instruction]) -> list[ir.Instruction]:
         elif isinstance(instruction, ir.StepVar | ir.Move):
             holds.discard(instruction.target.name)
         else:
-            form = BUILTINS[instruction.mnemonic].form(instruction.selector)
-            assert form is not None
-            holds.difference_update(form.writes)
+            holds.difference_update(instruction.form.writes)
         out.append(instruction)
     return out

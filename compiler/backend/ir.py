@@ -18,9 +18,10 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from functools import cache
 
 from rl1.compiler.frontend.ast import BinaryOperator, Relation, Step
-from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES
+from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES, Form
 
 BlockId = str
 """`Lnn` for the block a source label `:nn` starts, `Bn` for the others."""
@@ -131,14 +132,27 @@ class Call:
     line: int
 
     @property
+    def form(self) -> Form:
+        """The built-in form called (valid IR calls only forms that exist)."""
+        form = _call_form(self.mnemonic, self.selector)
+        assert form is not None
+        return form
+
+    @property
     def returns_value(self) -> bool:
-        form = BUILTINS[self.mnemonic].form(self.selector)
+        form = _call_form(self.mnemonic, self.selector)
         return form is not None and form.returns_value
 
     def __str__(self) -> str:
         words = [self.mnemonic, *([self.selector] if self.selector else [])]
         text = "call " + " ".join(words)
         return text + (" " + ", ".join(map(str, self.args)) if self.args else "")
+
+
+@cache
+def _call_form(mnemonic: str, selector: str | None) -> Form | None:
+    """BUILTINS' form lookup, which the passes make for every call they pass."""
+    return BUILTINS[mnemonic].form(selector)
 
 
 @dataclass(frozen=True, slots=True)
