@@ -9,6 +9,7 @@ Encoding (little-endian, no alignment): one opcode byte, then the operands the t
 lists for that opcode, so an instruction's length is known from its first byte.
 - VAR: 1 byte, a variable index 0..52 (builtins.VARIABLES order).
 - IMM: 2 bytes, a signed 16-bit immediate.
+- BYTE: 1 byte, a signed 8-bit immediate (format 1.2's MOVB).
 - ADDR: 2 bytes, an unsigned offset into the code section (an instruction boundary).
 - ARGS: a call's arguments: 1 mask byte (bit i set: argument i is a variable), then
   2 bytes per argument, an IMM or a variable index. Calls with no argument have none.
@@ -26,6 +27,7 @@ from .language import BUILTINS, Form
 class Operand(Enum):
     VAR = "var"  # 1 byte
     IMM = "imm"  # 2 bytes, signed
+    BYTE = "byte"  # 1 byte, signed
     ADDR = "addr"  # 2 bytes, unsigned
     ARGS = "args"  # mask byte + 2 bytes per argument; the arity comes from the opcode
 
@@ -44,7 +46,7 @@ class OpInfo:
     def length(self) -> int:
         size = 1
         for operand in self.operands:
-            if operand is Operand.VAR:
+            if operand in (Operand.VAR, Operand.BYTE):
                 size += 1
             elif operand is Operand.ARGS:
                 size += 1 + 2 * self.arity
@@ -74,6 +76,10 @@ JUMP_IF = {"=": 0x31, ">": 0x32, "<": 0x33}  # conditional jump opcode by relati
 # the format; it is written here once, so that a merge with another 1.x can renumber it.
 FUSED_MINOR = 2
 STORE_JUMP_IF = {"=": 0x35, ">": 0x36, "<": 0x37}  # store acc, then jump on it
+# The load-and-operate superinstructions (format 1.2): acc = first op second, in blocks of
+# 8 by the kinds of the two operands, the operator in the low 3 bits as in the ALU block.
+# An expression's load and first operation in one: `V=a-b` is COMPUTE then STV.
+COMPUTE_VAR_VAR, COMPUTE_VAR_IMM, COMPUTE_RESULT_VAR, COMPUTE_RESULT_IMM = 0x60, 0x68, 0x70, 0x78
 
 # The built-in forms, in opcode order from CALL_BASE; END is opcode 0.
 CALL_BASE = 0x40
@@ -84,6 +90,16 @@ CALL_FORMS: tuple[tuple[str, str | None], ...] = (
     ("CAM", "Z"), ("CAM", "U"), ("CAM", "D"), ("CAM", "A"), ("CAM", "P"), ("CAM", "R"),
     ("ULT", "A"), ("ULT", "B"), ("ULT", "C"), ("ULT", "D"),
     ("LMP", None), ("INP", None), ("OUT", None), ("FZO", None), ("FZI", None),
+)
+
+
+# Each load-and-operate block: base, mnemonic suffix, operands, and the two operands as
+# the meaning names them.
+_COMPUTE_KINDS = (
+    (COMPUTE_VAR_VAR, "VV", (Operand.VAR, Operand.VAR), "V[v]", "V[w]"),
+    (COMPUTE_VAR_IMM, "VI", (Operand.VAR, Operand.IMM), "V[v]", "i"),
+    (COMPUTE_RESULT_VAR, "RV", (Operand.VAR,), "R", "V[v]"),
+    (COMPUTE_RESULT_IMM, "RI", (Operand.IMM,), "R", "i"),
 )
 
 
@@ -105,6 +121,7 @@ def _table() -> dict[int, OpInfo]:
         OpInfo(0x08, "MOVI", (Operand.VAR, Operand.IMM), "V[v] = i", minor=FUSED_MINOR),
         OpInfo(0x09, "MOVR", (Operand.VAR,), "V[v] = R (the last call's result)",
                minor=FUSED_MINOR),
+        OpInfo(0x0A, "MOVB", (Operand.VAR, Operand.BYTE), "V[v] = b", minor=FUSED_MINOR),
         OpInfo(0x34, "DJGT", (Operand.VAR, Operand.ADDR),
                "V[v] = V[v] - 1, then jump to a if V[v] > 0", minor=FUSED_MINOR),
         OpInfo(0x35, "SJZ", (Operand.VAR, Operand.ADDR),
@@ -121,6 +138,10 @@ def _table() -> dict[int, OpInfo]:
                            meaning.replace("x", "i") + ", into acc"))
         rows.append(OpInfo(ALU_RESULT + index, name + "R", (),
                            meaning.replace("x", "R") + ", into acc"))
+        for base, suffix, kinds, first, second in _COMPUTE_KINDS:
+            rows.append(OpInfo(base + index, name + suffix, kinds,
+                               "acc = " + meaning.replace("acc", first).replace("x", second),
+                               minor=FUSED_MINOR))
     for index, (mnemonic, selector) in enumerate(CALL_FORMS):
         form = BUILTINS[mnemonic].form(selector)
         assert form is not None
@@ -198,6 +219,9 @@ def decode_at(code: bytes, offset: int) -> Instruction:
         elif operand is Operand.IMM:
             operands.append(struct.unpack_from("<h", code, position)[0])
             position += 2
+        elif operand is Operand.BYTE:
+            operands.append(struct.unpack_from("<b", code, position)[0])
+            position += 1
         elif operand is Operand.ADDR:
             operands.append(struct.unpack_from("<H", code, position)[0])
             position += 2
@@ -221,6 +245,8 @@ def encode(info: OpInfo, operands: tuple[int, ...] = (), args: tuple[Arg, ...] =
             out.append(next(values))
         elif operand is Operand.IMM:
             out += struct.pack("<h", next(values))
+        elif operand is Operand.BYTE:
+            out += struct.pack("<b", next(values))
         elif operand is Operand.ADDR:
             out += struct.pack("<H", next(values))
         else:

@@ -11,7 +11,8 @@ from . import isa
 HEADER = ("| opcode | mnemonic | operands | bytes | meaning | writes | serves |\n"
           "|---|---|---|---|---|---|---|")
 
-_OPERAND_TEXT = {isa.Operand.VAR: "v", isa.Operand.IMM: "i", isa.Operand.ADDR: "a"}
+_OPERAND_TEXT = {isa.Operand.VAR: "v", isa.Operand.IMM: "i", isa.Operand.ADDR: "a",
+                 isa.Operand.BYTE: "b"}
 
 # What source construct each non-call instruction compiles from (spec/language.md).
 _SERVES = {
@@ -24,10 +25,18 @@ _SERVES = {
 _FUSED = f"(-O2; format 1.{isa.FUSED_MINOR})"
 _SERVES |= {
     "MOVV": f"`V=W` {_FUSED}", "MOVI": f"`V=i` {_FUSED}", "MOVR": f"`V=(call)` {_FUSED}",
+    "MOVB": f"`V=i`, i in -128..127 {_FUSED}",
     "DJGT": f"`V--; ?V>#NN` {_FUSED}", "SJZ": f"`V=...; ?V=#NN` {_FUSED}",
     "SJGT": f"`V=...; ?V>#NN` {_FUSED}", "SJLT": f"`V=...; ?V<#NN` {_FUSED}",
 }
 _ALU_SERVES = {isa.ALU_VAR: "a variable", isa.ALU_IMM: "a constant", isa.ALU_RESULT: "a call"}
+# The load-and-operate blocks: the first two operands of an expression.
+_COMPUTE_SERVES = {
+    isa.COMPUTE_VAR_VAR: "a variable and a variable",
+    isa.COMPUTE_VAR_IMM: "a variable and a constant",
+    isa.COMPUTE_RESULT_VAR: "a call and a variable",
+    isa.COMPUTE_RESULT_IMM: "a call and a constant",
+}
 
 
 def operands(info: isa.OpInfo) -> str:
@@ -49,7 +58,10 @@ def serves(info: isa.OpInfo) -> str:
     if info.name in _SERVES:
         return _SERVES[info.name]
     base = info.opcode & ~7
-    return f"`{isa.ALU_OPERATORS[info.opcode - base]}` then {_ALU_SERVES[base]}"
+    operator = isa.ALU_OPERATORS[info.opcode - base]
+    if base in _COMPUTE_SERVES:
+        return f"`{operator}` between {_COMPUTE_SERVES[base]}, first in `V=` {_FUSED}"
+    return f"`{operator}` then {_ALU_SERVES[base]}"
 
 
 def writes(info: isa.OpInfo) -> str:

@@ -31,10 +31,11 @@ How this implementation is fast enough (bench/vm_speed.py) without hiding the me
 - The accumulator is kept modulo 2**16 rather than wrapped after every operation: + - &
   | and ^ give the same low 16 bits either way, so it is wrapped only where its value is
   read as a number (a store, a shift) and where it could grow fast (a left shift).
-- A statement's run "load; operators; store" is also decoded as one EXPRESSION step at
-  the index of its load. Nothing in such a run can fault, call the device or be seen
-  before the store, so running it at once means the same; a jump into the middle of it
-  (none comes from the compiler) runs the single instructions, which stay in place.
+- A statement's run "load; operators; store" (the load may be a load-and-operate of
+  format 1.2) is also decoded as one EXPRESSION step at the index of its load. Nothing
+  in such a run can fault, call the device or be seen before the store, so running it
+  at once means the same; a jump into the middle of it (none comes from the compiler)
+  runs the single instructions, which stay in place.
 - Instructions are counted by index arithmetic when control leaves a straight run (a
   jump taken, a handler entered, the end), not one by one.
 - So a step's limit is not counted down either: where a straight run could pass it, a
@@ -74,7 +75,7 @@ SLICE = 1 << 20
 (LOAD, STORE, ADD, SUB, AND, OR, XOR, SHL, SHR, INC, DEC,
  JUMP, JUMP_ZERO, JUMP_POSITIVE, JUMP_NEGATIVE, CALL, END, EXPRESSION, HALT,
  MOVE, DEC_JUMP_POSITIVE, STORE_JUMP_ZERO, STORE_JUMP_POSITIVE, STORE_JUMP_NEGATIVE,
- ) = range(24)
+ COMPUTE) = range(25)
 _BOUNDARIES = (JUMP, END)  # where a straight run of instructions surely stops
 
 
@@ -88,6 +89,8 @@ class State(Enum):
 
 _ALU = (ADD, SUB, AND, OR, XOR, SHL, SHR)  # in isa.ALU_OPERATORS order
 _ALU_BASES = (isa.ALU_RESULT, isa.ALU_IMM, isa.ALU_VAR)  # highest first
+_COMPUTE_BASES = (isa.COMPUTE_VAR_VAR, isa.COMPUTE_VAR_IMM, isa.COMPUTE_RESULT_VAR,
+                  isa.COMPUTE_RESULT_IMM)
 _SIMPLE = {"STV": STORE, "INC": INC, "DEC": DEC}
 _JUMPS = {"JMP": JUMP, "JZ": JUMP_ZERO, "JGT": JUMP_POSITIVE, "JLT": JUMP_NEGATIVE,
           "DJGT": DEC_JUMP_POSITIVE, "SJZ": STORE_JUMP_ZERO, "SJGT": STORE_JUMP_POSITIVE,
@@ -146,6 +149,12 @@ def _shift_right(value: int, count: int) -> int:
     return value >> count
 
 
+def _operate(operator: int, left: int, right: int) -> int:
+    """`left operator right` for an operation of the dispatch loop (ADD ... SHR), modulo
+    2**16 as the accumulator is kept."""
+    return evaluate(isa.ALU_OPERATORS[_ALU.index(operator)], left, right)
+
+
 def evaluate(operator: str, left: int, right: int) -> int:
     """`left operator right` as the VM computes it (operator one of isa.ALU_OPERATORS):
     what the optimizer folds a constant expression to."""
@@ -170,6 +179,8 @@ class Machine:
         self.cells: list[int] = [0] * (R_CELL + 1)
         self._immediates: dict[int, int] = {}
         self.sites: list[_CallSite] = []
+        # The load-and-operate instructions: (first cell, operator, second cell) each.
+        self.computes: list[tuple[int, int, int]] = []
         self.code = [self._decode(instruction) for instruction in program.instructions]
         self.code.append((END, 0, 0))  # running off the end is (END)
         self.plain = self.code[:]  # every instruction alone, before EXPRESSION steps
@@ -215,7 +226,7 @@ class Machine:
             return (_SIMPLE[name], operands[0], 0)
         if name == "MOVV":
             return (MOVE, operands[0], operands[1])
-        if name == "MOVI":
+        if name in ("MOVI", "MOVB"):
             return (MOVE, operands[0], self._immediate(operands[1]))
         if name == "MOVR":
             return (MOVE, operands[0], R_CELL)
@@ -223,6 +234,9 @@ class Machine:
             *condition, target = operands
             return (_JUMPS[name], condition[0] if condition else 0,
                     self.program.index_of[target])
+        if info.opcode & ~7 in _COMPUTE_BASES:  # load-and-operate: base + operator index
+            self.computes.append(self._compute(info.opcode, operands))
+            return (COMPUTE, len(self.computes) - 1, 0)
         if info.form is None:  # an ALU instruction: base + operator index
             base = next(base for base in _ALU_BASES if info.opcode >= base)
             op = _ALU[info.opcode - base]
@@ -238,19 +252,38 @@ class Machine:
                                     form.returns_value, BUILTINS[info.builtin[0]].waits))
         return (CALL, len(self.sites) - 1, 0)
 
+    def _compute(self, opcode: int, operands: tuple[int, ...]) -> tuple[int, int, int]:
+        """A load-and-operate instruction as (first cell, operator, second cell)."""
+        base = opcode & ~7
+        if base == isa.COMPUTE_VAR_VAR:
+            first, second = operands
+        elif base == isa.COMPUTE_VAR_IMM:
+            first, second = operands[0], self._immediate(operands[1])
+        elif base == isa.COMPUTE_RESULT_VAR:
+            first, second = R_CELL, operands[0]
+        else:
+            first, second = R_CELL, self._immediate(operands[0])
+        return first, _ALU[opcode - base], second
+
     def _group_expressions(self) -> None:
-        """Put an EXPRESSION step at each load that starts a load-operators-store run;
-        its b is the index after the store."""
+        """Put an EXPRESSION step at each load (or load-and-operate) that starts a
+        load-operators-store run; its b is the index after the store."""
         code = self.code
+        steps: tuple[tuple[int, int], ...]
         for index, (op, a, _) in enumerate(code):
-            if op != LOAD:
+            if op == LOAD:
+                first, steps = a, ()
+            elif op == COMPUTE:
+                first, operator, cell = self.computes[a]
+                steps = ((operator, cell),)
+            else:
                 continue
             end = index + 1
             while code[end][0] in _ALU:
                 end += 1
             if code[end][0] == STORE:
-                steps = tuple((step[0], step[1]) for step in code[index + 1:end])
-                self.expressions.append(_Expression(a, steps, code[end][1]))
+                steps += tuple((step[0], step[1]) for step in code[index + 1:end])
+                self.expressions.append(_Expression(first, steps, code[end][1]))
                 code[index] = (EXPRESSION, len(self.expressions) - 1, end + 1)
                 self.fused_at[index + 1:end + 1] = [index] * (end - index)
 
@@ -295,7 +328,7 @@ class Machine:
 
     def _execute(self, limit: int) -> State:
         code, expressions, budget, reach = self.code, self.expressions, self.budget, self.reach
-        cells, sites = self.cells, self.sites
+        cells, sites, computes = self.cells, self.sites, self.computes
         last = len(self.program.instructions)  # the END that running off the end runs
         hardware = self.hardware
         take, divert = hardware.take_event, self._divert
@@ -405,6 +438,9 @@ class Machine:
                         check = self._bound(pc, executed, stop_at)
                 elif op == LOAD:
                     acc = cells[a]
+                elif op == COMPUTE:
+                    first, operator, cell = computes[a]
+                    acc = _operate(operator, cells[first], cells[cell])
                 elif op == STORE:
                     cells[a] = ((acc + 0x8000) & 0xFFFF) - 0x8000
                 elif op == ADD:

@@ -102,6 +102,9 @@ class _CodeVerifier:
             elif operand is isa.Operand.IMM:
                 next(values)
                 position += 2
+            elif operand is isa.Operand.BYTE:
+                next(values)
+                position += 1
             else:
                 self.check_call(instruction, position)
         self.check_feature(instruction)

@@ -141,11 +141,27 @@ def _instruction(instruction: ir.Instruction) -> _MachineOp:
                           (), line)
     if isinstance(instruction, ir.Move):
         kind, operands = _source(instruction.source)
+        if isinstance(instruction.source, ir.Imm) and -0x80 <= instruction.source.value <= 0x7F:
+            return _MachineOp(isa.BY_NAME["MOVB"], (VARIABLE_INDEX[instruction.target.name],
+                                                     instruction.source.value), (), line)
         return _MachineOp(isa.BY_NAME[("MOVV", "MOVI", "MOVR")[kind]],
                           (VARIABLE_INDEX[instruction.target.name], *operands), (), line)
+    if isinstance(instruction, ir.Compute):
+        return _compute(instruction)
     args = tuple(isa.Arg(True, VARIABLE_INDEX[arg.name]) if isinstance(arg, ir.Var)
                  else isa.Arg(False, arg.value) for arg in instruction.args)
     return _MachineOp(isa.BY_FORM[instruction.mnemonic, instruction.selector], (), args, line)
+
+
+def _compute(compute: ir.Compute) -> _MachineOp:
+    """A load-and-operate: its block by the kinds of its two operands."""
+    first = () if isinstance(compute.first, ir.Result) else (VARIABLE_INDEX[compute.first.name],)
+    second_kind, second = _source(compute.second)
+    base = {(False, 0): isa.COMPUTE_VAR_VAR, (False, 1): isa.COMPUTE_VAR_IMM,
+            (True, 0): isa.COMPUTE_RESULT_VAR, (True, 1): isa.COMPUTE_RESULT_IMM}[
+        isinstance(compute.first, ir.Result), second_kind]
+    opcode = base + isa.ALU_OPERATORS.index(compute.op)
+    return _MachineOp(isa.OPCODES[opcode], (*first, *second), (), compute.line)
 
 
 def _source(source: ir.Operand) -> tuple[int, tuple[int, ...]]:

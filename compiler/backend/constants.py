@@ -13,7 +13,9 @@ followed, so that code behind a branch that never goes that way learns nothing f
 Within a block, an expression whose operands are known is folded left to right with the
 VM's own arithmetic (16-bit wrap, the shift rules of spec/language.md 7.2). A known
 value is kept out of the accumulator until something needs it there (a store, an
-operation on an unknown operand), so a folded expression costs one load at most; an
+operation on an unknown operand), so a folded expression costs one load at most (of the
+variable the source loaded when that variable holds the value, a byte shorter than
+the constant); an
 operation with a known operand that changes nothing (`+0`, `|0`, `&-1`, `<0`) goes; a
 store of the value the variable already holds goes; a variable argument with a known
 value in its parameter's range becomes a constant (out of range, it must stay a
@@ -26,7 +28,7 @@ from __future__ import annotations
 from collections import deque
 from dataclasses import dataclass
 
-from rl1.vm.language import BUILTINS, VARIABLES
+from rl1.vm.language import VARIABLES
 from rl1.vm.machine import evaluate
 
 from . import flow, ir
@@ -111,17 +113,24 @@ def _fold(block: ir.Block, known: Known) -> _Folded:
     out: list[ir.Instruction] = []
     acc: int | None = None  # the accumulator's value, when known
     pending = False  # whether that known value has yet to be loaded into the accumulator
+    loaded_from: ir.Var | None = None  # the variable the expression's first load named
 
     def materialize(line: int) -> None:
+        """Load the pending value: from the variable the source loaded when it holds
+        the value still (LDV is a byte shorter than LDI), else as a constant."""
         nonlocal pending
         if pending:
             assert acc is not None
-            out.append(ir.Load(ir.Imm(acc), line))
+            holder = loaded_from if loaded_from is not None \
+                and known.get(loaded_from.name) == acc else _holding(known, acc)
+            out.append(ir.Load(holder or ir.Imm(acc), line))
             pending = False
 
     for instruction in block.instructions:
         if isinstance(instruction, ir.Load):
-            acc = _value(instruction.source, known)
+            source = instruction.source
+            loaded_from = source if isinstance(source, ir.Var) else None
+            acc = _value(source, known)
             pending = acc is not None
             if not pending:
                 out.append(instruction)
@@ -157,13 +166,18 @@ def _fold(block: ir.Block, known: Known) -> _Folded:
         elif isinstance(instruction, ir.Move):
             out.append(instruction)
             _set(known, instruction.target.name, _value(instruction.source, known))
+        elif isinstance(instruction, ir.Compute):
+            out.append(instruction)  # -O2's, after this pass: left as it is
+            acc, pending = None, False
         else:
             out.append(_call(instruction, known))
-            form = BUILTINS[instruction.mnemonic].form(instruction.selector)
-            assert form is not None
-            for name in form.writes:
+            for name in instruction.form.writes:
                 known.pop(name, None)
     return _Folded(out, _terminator(block.terminator, known), known)
+
+
+def _holding(known: Known, value: int) -> ir.Var | None:
+    return next((ir.Var(name) for name, held in known.items() if held == value), None)
 
 
 def _set(known: Known, name: str, value: int | None) -> None:
@@ -176,10 +190,10 @@ def _set(known: Known, name: str, value: int | None) -> None:
 def _call(call: ir.Call, known: Known) -> ir.Call:
     """The call with each variable argument whose known value its parameter accepts
     replaced by that value."""
-    form = BUILTINS[call.mnemonic].form(call.selector)
-    assert form is not None
+    if all(isinstance(arg, ir.Imm) for arg in call.args):
+        return call
     args: list[ir.Argument] = []
-    for arg, param in zip(call.args, form.params, strict=True):
+    for arg, param in zip(call.args, call.form.params, strict=True):
         value = _value(arg, known)
         in_range = value is not None and param.low <= value <= param.high
         args.append(ir.Imm(value) if in_range and value is not None else arg)

@@ -7,14 +7,16 @@ after every instruction that remains.
 Walking a block, it remembers the variables whose value the accumulator holds (after
 `load A` or `store A`, until A or the accumulator changes). A load of one of them
 (`STV A; LDV A`, as `A=B+1; C=A` compiles) and a store into one of them (`A=A`, or
-`B=A` after `A=B`) do nothing, and go.
+`B=A` after `A=B`) do nothing, and go. A load followed by a commutative operation on
+one of them (`store d; load D; add d`, as `D=D+d` compiles after `d=...`) becomes that
+operation on what the load named (`add D`): one instruction instead of two.
 """
 
 from __future__ import annotations
 
-from rl1.vm.language import BUILTINS
-
 from . import ir
+
+COMMUTATIVE = "+&|^"
 
 
 def propagate_copies(program: ir.Program) -> ir.Program:
@@ -26,23 +28,32 @@ def propagate_copies(program: ir.Program) -> ir.Program:
 def _without_copies(instructions: list[ir.Instruction]) -> list[ir.Instruction]:
     out: list[ir.Instruction] = []
     holds: set[str] = set()  # the variables equal to the accumulator
-    for instruction in instructions:
+    index = 0
+    while index < len(instructions):
+        instruction = instructions[index]
+        after = instructions[index + 1] if index + 1 < len(instructions) else None
+        index += 1
         if isinstance(instruction, ir.Load):
             source = instruction.source
             if isinstance(source, ir.Var) and source.name in holds:
+                continue
+            if (isinstance(after, ir.Operate) and after.op in COMMUTATIVE
+                    and isinstance(after.source, ir.Var) and after.source.name in holds):
+                # `store d; load D; add d`: the accumulator holds d, so `add D`.
+                out.append(ir.Operate(after.op, source, instruction.line))
+                holds = set()
+                index += 1
                 continue
             holds = {source.name} if isinstance(source, ir.Var) else set()
         elif isinstance(instruction, ir.Store):
             if instruction.target.name in holds:
                 continue
             holds.add(instruction.target.name)
-        elif isinstance(instruction, ir.Operate):
+        elif isinstance(instruction, ir.Operate | ir.Compute):
             holds = set()
         elif isinstance(instruction, ir.StepVar | ir.Move):
             holds.discard(instruction.target.name)
         else:
-            form = BUILTINS[instruction.mnemonic].form(instruction.selector)
-            assert form is not None
-            holds.difference_update(form.writes)
+            holds.difference_update(instruction.form.writes)
         out.append(instruction)
     return out

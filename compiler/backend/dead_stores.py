@@ -43,14 +43,17 @@ def _live_out(block: ir.Block, live_in: dict[ir.BlockId, frozenset[str]],
 def _live_in(program: ir.Program, events: bool) -> dict[ir.BlockId, frozenset[str]]:
     preds = program.predecessors()
     live_in: dict[ir.BlockId, frozenset[str]] = {}
-    work = list(program.blocks)
+    work = list(program.blocks)  # popped from the end: the last block first
+    queued = set(work)
     while work:
         block_id = work.pop()
+        queued.discard(block_id)
         block = program.blocks[block_id]
         _, live = _sweep(block, _live_out(block, live_in, events))
         if live_in.get(block_id) != live:
             live_in[block_id] = live
-            work.extend(preds[block_id])
+            work.extend(pred for pred in preds[block_id] if pred not in queued)
+            queued.update(preds[block_id])
     return live_in
 
 
@@ -87,6 +90,10 @@ def _sweep(block: ir.Block, live_out: frozenset[str]
                 continue
         elif not acc_used:
             continue  # a load or operation whose result no one reads
+        elif isinstance(instruction, ir.Compute):
+            live.update(operand.name for operand in (instruction.first, instruction.second)
+                        if isinstance(operand, ir.Var))
+            acc_used = False
         else:
             if isinstance(instruction.source, ir.Var):
                 live.add(instruction.source.name)

@@ -47,7 +47,7 @@ def acc_dead_after(instructions: list[ir.Instruction], index: int,
     """Whether nothing from `instructions[index]` on (the terminator included) reads
     the accumulator before loading it again."""
     for instruction in instructions[index:]:
-        if isinstance(instruction, ir.Load):
+        if isinstance(instruction, ir.Load | ir.Compute):
             return True
         if isinstance(instruction, ir.Operate | ir.Store):
             return False

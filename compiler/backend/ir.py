@@ -18,9 +18,10 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+from functools import cache
 
 from rl1.compiler.frontend.ast import BinaryOperator, Relation, Step
-from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES
+from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES, Form
 
 BlockId = str
 """`Lnn` for the block a source label `:nn` starts, `Bn` for the others."""
@@ -131,14 +132,27 @@ class Call:
     line: int
 
     @property
+    def form(self) -> Form:
+        """The built-in form called (valid IR calls only forms that exist)."""
+        form = _call_form(self.mnemonic, self.selector)
+        assert form is not None
+        return form
+
+    @property
     def returns_value(self) -> bool:
-        form = BUILTINS[self.mnemonic].form(self.selector)
+        form = _call_form(self.mnemonic, self.selector)
         return form is not None and form.returns_value
 
     def __str__(self) -> str:
         words = [self.mnemonic, *([self.selector] if self.selector else [])]
         text = "call " + " ".join(words)
         return text + (" " + ", ".join(map(str, self.args)) if self.args else "")
+
+
+@cache
+def _call_form(mnemonic: str, selector: str | None) -> Form | None:
+    """BUILTINS' form lookup, which the passes make for every call they pass."""
+    return BUILTINS[mnemonic].form(selector)
 
 
 @dataclass(frozen=True, slots=True)
@@ -153,7 +167,21 @@ class Move:
         return f"move {self.target}, {self.source}"
 
 
-Instruction = Load | Operate | Store | StepVar | Call | Move
+@dataclass(frozen=True, slots=True)
+class Compute:
+    """acc = first op second: an expression's load and first operation in one (a
+    superinstruction of -O2)."""
+
+    first: Var | Result
+    op: BinaryOperator
+    second: Var | Imm
+    line: int
+
+    def __str__(self) -> str:
+        return f"load {self.first} {OPERATOR_NAMES[self.op]} {self.second}"
+
+
+Instruction = Load | Operate | Store | StepVar | Call | Move | Compute
 
 
 # Terminators ------------------------------------------------------------------------
@@ -314,7 +342,7 @@ def _block_problems(block: Block) -> Iterator[str]:
     result_set = False  # whether R holds a value here (only a call within the block sets it)
     loaded = False  # whether acc holds a value here: it is dead where a block starts
     for instruction in block.instructions:
-        if not isinstance(instruction, Load | Operate | Store | StepVar | Call | Move):
+        if not isinstance(instruction, Load | Operate | Store | StepVar | Call | Move | Compute):
             yield f"holds {instruction!r}, which is not an instruction"
             continue
         for operand in _operands(instruction):
@@ -326,7 +354,7 @@ def _block_problems(block: Block) -> Iterator[str]:
                 yield f"line {instruction.line}: `{instruction}` reads R before a call sets it"
         if isinstance(instruction, Operate | Store) and not loaded:
             yield f"line {instruction.line}: `{instruction}` reads acc before a load sets it"
-        loaded = loaded or isinstance(instruction, Load)
+        loaded = loaded or isinstance(instruction, Load | Compute)
         if isinstance(instruction, Call):
             yield from _call_problems(instruction)
             result_set = instruction.mnemonic in BUILTINS and instruction.returns_value
@@ -345,6 +373,8 @@ def _operands(instruction: Instruction) -> tuple[Operand, ...]:
         return (instruction.target,)
     if isinstance(instruction, Move):
         return (instruction.target, instruction.source)
+    if isinstance(instruction, Compute):
+        return (instruction.first, instruction.second)
     return instruction.args
 
 

@@ -46,18 +46,20 @@ def optimize(program: ir.Program, level: int, *, check: bool = False) -> ir.Prog
         return program
     shape = _shape(program)
     for _ in range(MAX_ROUNDS):
-        for run in passes:
-            program = run(program)
-            if check:
-                _validate(program, run.__name__)
+        program = _run(passes, program, check)
         before, shape = shape, _shape(program)
         if shape == before:
             break
-    for run in FINAL_PASSES[level]:
+    program = _run(FINAL_PASSES[level], program, check)
+    _validate(program, "the optimizer")
+    return program
+
+
+def _run(passes: tuple[Pass, ...], program: ir.Program, check: bool) -> ir.Program:
+    for run in passes:
         program = run(program)
         if check:
             _validate(program, run.__name__)
-    _validate(program, "the optimizer")
     return program
 
 

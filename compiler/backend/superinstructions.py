@@ -10,7 +10,13 @@ fused jump is a jump, where the budget is checked and an event taken); no path l
 - `dec V` then a branch on V > 0 (`@--; ?@>#14`, a counted loop) becomes one
   decrement-and-branch.
 - `load x` then stores of it, when nothing reads the accumulator after them, become
-  moves (`A=B`, `A=5`, `A=(IMG)`): one instruction per store instead of one more.
+  moves (`A=B`, `A=5`, `A=(IMG)`): one instruction per store instead of one more (the
+  code generator writes a constant move as MOVB, a byte shorter, when it fits a byte).
+- `load x` then an operation on y, x a variable or R and y a variable or a constant,
+  become one load-and-operate (`E=L-M`, `A=(IMG)-180`): an expression's first two
+  operands in one instruction. (A constant first is folded by -O1 or stays: `0-M`.)
+  A load whose value is also stored before the operation (`D=(ULT A); E=D-G`) becomes
+  the moves, then the load-and-operate: one instruction fewer again.
 """
 
 from __future__ import annotations
@@ -21,8 +27,33 @@ from . import flow, ir
 def fuse(program: ir.Program) -> ir.Program:
     for block in program:
         _fuse_branch(block)
-        block.instructions = _moves(block.instructions, block.terminator)
+        block.instructions = _computes(_moves(block.instructions, block.terminator))
     return program
+
+
+def _reloadable(load: ir.Load, stores: list[ir.Instruction],
+                following: list[ir.Instruction]) -> bool:
+    """Whether the load can come again after its stores became moves and fuse with the
+    operation after them: the stores leave its source as it was, and that operation
+    makes a load-and-operate (so the load costs nothing)."""
+    return (isinstance(load.source, ir.Var | ir.Result)
+            and all(isinstance(store, ir.Store) and store.target != load.source
+                    for store in stores)
+            and bool(following) and isinstance(following[0], ir.Operate)
+            and isinstance(following[0].source, ir.Var | ir.Imm))
+
+
+def _computes(instructions: list[ir.Instruction]) -> list[ir.Instruction]:
+    out: list[ir.Instruction] = []
+    for instruction in instructions:
+        load = out[-1] if out else None
+        if (isinstance(instruction, ir.Operate) and isinstance(load, ir.Load)
+                and isinstance(load.source, ir.Var | ir.Result)
+                and isinstance(instruction.source, ir.Var | ir.Imm)):
+            out[-1] = ir.Compute(load.source, instruction.op, instruction.source, load.line)
+        else:
+            out.append(instruction)
+    return out
 
 
 def _fuse_branch(block: ir.Block) -> None:
@@ -51,10 +82,13 @@ def _moves(instructions: list[ir.Instruction], terminator: ir.Terminator
         while end < len(instructions) and isinstance(instructions[end], ir.Store):
             end += 1
         stores = instructions[index + 1:end]
-        if (isinstance(load, ir.Load) and stores
-                and flow.acc_dead_after(instructions, end, terminator)):
+        if isinstance(load, ir.Load) and stores and (
+                flow.acc_dead_after(instructions, end, terminator)
+                or _reloadable(load, stores, instructions[end:end + 1])):
             out += [ir.Move(store.target, load.source, store.line)
                     for store in stores if isinstance(store, ir.Store)]
+            if not flow.acc_dead_after(instructions, end, terminator):
+                out.append(load)  # `D=(ULT A); E=D-G`: moves, then the load fuses on
             index = end
         else:
             out.append(load)

@@ -308,6 +308,10 @@ class _Assembler:
                 operands.append(_variable(operand_token))
                 position += 1
                 continue
+            if operand is isa.Operand.BYTE:
+                operands.append(_number(operand_token, -0x80, 0x7F, "byte constant"))
+                position += 1
+                continue
             if operand is isa.Operand.IMM:
                 operands.append(_number(operand_token, -0x8000, 0x7FFF, "constant"))
             elif operand_token.kind == "name":

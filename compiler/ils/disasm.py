@@ -73,7 +73,7 @@ def render(instruction: isa.Instruction) -> str:
     for operand in instruction.info.operands:
         if operand is isa.Operand.VAR:
             operands.append(VARIABLES[next(values)])
-        elif operand is isa.Operand.IMM:
+        elif operand in (isa.Operand.IMM, isa.Operand.BYTE):
             operands.append(str(next(values)))
         elif operand is isa.Operand.ADDR:
             operands.append(label_name(next(values)))

@@ -764,10 +764,10 @@ def _sample_variables(ending: dict[str, int]) -> dict[str, int]:
 
 
 def fused() -> Iterator[Case]:
-    yield Case("fused", "fused-moves", "MOVV, MOVI and MOVR: a variable copied, a "
-               "constant stored, a call's result stored (-O2)",
-               "A=(KYO); D=A+1; B=A; C=5; (FZO B,C); G=(ULT A)\n",
-               {"A": 42, "u": 40, "v": 44, "B": 42, "C": 5, "D": 43, "G": 7},
+    yield Case("fused", "fused-moves", "MOVV, MOVB, MOVI and MOVR: a variable copied, a "
+               "small and a large constant stored, a call's result stored (-O2)",
+               "A=(KYO); D=A+1; B=A; C=5; E=-1000; (FZO B,C); G=(ULT A)\n",
+               {"A": 42, "u": 40, "v": 44, "B": 42, "C": 5, "D": 43, "E": -1000, "G": 7},
                {"KYO": [{"centre": 42, "right": 40, "left": 44}], "ULT A": [7]}, level=2)
     yield Case("fused", "fused-counted-loop", "DJGT: a counted loop's decrement and jump "
                "(-O2)", "@=3\n:10 A=A+7; (TIM 1); @--; ?@>#10\n(END)\n", {"A": 21},
@@ -778,3 +778,18 @@ def fused() -> Iterator[Case]:
                ":20 E=(ULT C)-5; ?E>#30\nF=1\n:30 (END)\n",
                {"A": -50, "B": 0, "C": 0, "D": 0, "E": 5, "F": 0},
                {"ULT A": [50], "ULT B": [0], "ULT C": [10]}, level=2)
+    yield Case("fused", "fused-load-and-operate", "ADDVV ... SHRRI: every operator of the "
+               "load-and-operate blocks, on two variables, a variable and a constant, a call's "
+               "result and a variable, a call's result and a constant (-O2)",
+               "A=(ULT A); B=(ULT B)\n"
+               "D=A-B; C=A+B; E=A&B; F=A|B; G=A^B; H=A<B; I=A>B\n"
+               "J=A+5; K=A-5; L=A&6; M=A|6; N=A^6; O=A<2; P=A>2\n"
+               "Q=(ULT C)+B; R=(ULT C)-B; S=(ULT C)&B; T=(ULT C)|B; U=(ULT C)^B; "
+               "V=(ULT C)<B; W=(ULT C)>B\n"
+               "X=(ULT C)+5; Y=(ULT C)-5; Z=(ULT C)&6; a=(ULT C)|6; b=(ULT C)^6; "
+               "c=(ULT C)<2; d=(ULT C)>2\n",
+               {"A": 300, "B": 3, "C": 303, "D": 297, "E": 0, "F": 303, "G": 303,
+                "H": 2400, "I": 37, "J": 305, "K": 295, "L": 4, "M": 302, "N": 298,
+                "O": 1200, "P": 75, "Q": 103, "R": 97, "S": 0, "T": 103, "U": 103, "V": 800,
+                "W": 12, "X": 105, "Y": 95, "Z": 4, "a": 102, "b": 98, "c": 400, "d": 25},
+               {"ULT A": [300], "ULT B": [3], "ULT C": [100] * 14}, level=2)

@@ -136,7 +136,7 @@ def refused() -> list[FileCase]:
                  ilc_file(debug=debug_section(count=1, entries=b"\x00\x00")), 12, ENTRY),
         FileCase("left-over", "a byte left over after the last line entry",
                  ilc_file(debug=debug_section(entries=ENTRIES + b"\x00")), 12, ENTRY + 8),
-        FileCase("unknown-opcode", "opcode 0x0A is unused", _code(b"\x0a"), 13, 24),
+        FileCase("unknown-opcode", "opcode 0x0B is unused", _code(b"\x0b"), 13, 24),
         FileCase("newer-opcode", "MOVV, an instruction of version 1.2, in a 1.1 file",
                  ilc_file(bytes.fromhex("07000100"), debug=b"", minor=1), 13, 24),
         FileCase("fused-variable", "MOVV whose second variable is 53, in a 1.2 file",

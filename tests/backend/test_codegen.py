@@ -294,3 +294,14 @@ def test_programs_that_end_end_the_same_compiled_and_interpreted(
     assert vm_device.trace == interpreted_device.trace
     assert (ran.fault and (ran.fault.kind, ran.fault.line)) == (
         interpreted.fault and (interpreted.fault.kind, interpreted.fault.line))
+
+
+def test_a_move_of_a_constant_that_fits_a_byte_is_movb() -> None:
+    moves = [ir.Move(ir.Var("A"), ir.Imm(value), 1) for value in (127, 128, -128, -129)]
+    program = ir.Program({"B0": ir.Block("B0", list[ir.Instruction](moves), ir.End(1))}, "B0")
+    image = generate(program, "test.rob", debug=False)
+    assert names(image) == ["MOVB", "MOVI", "MOVB", "MOVI", "END"]
+    assert image.code[:3] == bytes([0x0A, var("A"), 127])
+    assert image.code[7:10] == bytes([0x0A, var("A"), 0x80])  # -128, signed
+    cells = machine.run(verify(ilc.encode(image)), ScriptedDevice(Script())).variables
+    assert cells[var("A")] == -129

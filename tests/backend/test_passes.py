@@ -29,9 +29,12 @@ from rl1.compiler.backend.ir import (
 from rl1.compiler.backend.lower import lower
 from rl1.compiler.backend.peephole import rewrite_steps
 from rl1.compiler.backend.superinstructions import fuse
+from rl1.compiler.differential import AstEngine, VmEngine, judge
 from rl1.compiler.frontend.parser import parse_program
+from rl1.compiler.strategies import Run
 
 A, B, C, X = Var("A"), Var("B"), Var("C"), Var("x")
+ENGINES = (AstEngine(), VmEngine(0), VmEngine(1), VmEngine(2))
 
 
 def lowered(text: str) -> Program:
@@ -87,7 +90,8 @@ def test_knowledge_crosses_blocks_and_a_known_branch_becomes_a_jump() -> None:
     program = after(fold_constants, "A=3\n:10 B=A+1\n?A=#20\nC=B\n:20 (END)")
     # A is 3 wherever :10 runs, so `?A=#20` never jumps: B1 (line 4) follows.
     assert code(program, "L10") == ["load 4", "store B", "jump B1"]
-    assert code(program, "B1") == ["load 4", "store C", "jump L20"]
+    # C=B loads B, which holds 4: the variable stays (LDV is a byte shorter than LDI).
+    assert code(program, "B1") == ["load B", "store C", "jump L20"]
 
 
 def test_a_loop_forgets_what_its_body_changes() -> None:
@@ -223,7 +227,7 @@ def test_a_branch_to_one_block_either_way_is_a_jump() -> None:
 
 def test_a_store_and_the_branch_on_it_fuse() -> None:
     program = after(fuse, "A=(KYO)-5; ?A<#10\n:10 (END)")
-    assert code(program) == ["call KYO", "load R", "sub 5",
+    assert code(program) == ["call KYO", "load R sub 5",
                              "store A; if A<0 then L10 else B1"]
 
 
@@ -235,7 +239,7 @@ def test_a_counted_loop_decrements_and_branches_at_once() -> None:
 
 def test_a_load_and_its_stores_become_moves_when_the_accumulator_is_dead() -> None:
     assert code(after(fuse, "A=B; C=5; D=C; E=A+1")) == [
-        "move A, B", "move C, 5", "move D, C", "load A", "add 1", "store E", "end"]
+        "move A, B", "move C, 5", "move D, C", "load A add 1", "store E", "end"]
     stores_then_branch = jumps(("B0", [], End(1)))
     stores_then_branch.blocks["B0"].instructions = [Load(Imm(5), 1), Store(A, 1)]
     stores_then_branch.blocks["B0"].terminator = ir.StoreBranch(B, "=", "B0", "B0", 1)
@@ -267,3 +271,51 @@ def test_level_0_changes_nothing_and_level_1_runs_until_nothing_changes() -> Non
     # A=1 is dead (A=B-2 follows before any call); then A=B-2 stores 0, which A holds.
     assert code(optimize.optimize(lowered(text), 1)) == [
         "load 2", "store B", "call MOV 0, 2", "end"]
+
+
+# The accumulator's value reused (issue 14's second round) ------------------------------------
+
+
+def test_a_folded_value_is_loaded_from_a_variable_that_holds_it() -> None:
+    # B=A loads A, which holds 7: LDV A is a byte shorter than LDI 7. C=7 names no
+    # variable, but A holds 7 too.
+    assert code(after(fold_constants, "A=7; B=A; C=7; D=A+1")) == [
+        "load 7", "store A", "load A", "store B", "load A", "store C", "load 8",
+        "store D", "end"]
+
+
+def test_a_commutative_operation_on_what_the_accumulator_holds_drops_the_load() -> None:
+    # d=...; D=D+d: the accumulator holds d, so `load D; add d` is `add D`.
+    assert code(after(propagate_copies, "d=(KYO)-1; D=D+d; E=E-d")) == [
+        "call KYO", "load R", "sub 1", "store d", "add D", "store D",
+        "load E", "sub d", "store E", "end"]  # - is not commutative: E-d stays
+
+
+def test_a_load_and_the_operation_after_it_become_one_load_and_operate() -> None:
+    assert code(after(fuse, "A=B-C; D=B+5; E=(KYO)&C; F=(IMG)>2; G=3-B; H=B+(KYO)")) == [
+        "load B sub C", "store A", "load B add 5", "store D",
+        "call KYO", "load R and C", "store E", "call IMG", "load R shr 2", "store F",
+        # A constant first has no load-and-operate; nor has a call's result second.
+        "load 3", "sub B", "store G", "load B", "call KYO", "add R", "store H", "end"]
+
+
+def test_stores_before_the_operation_become_moves_and_the_load_fuses_after_them() -> None:
+    assert code(fuse(after(propagate_copies, "D=(ULT A); E=D-G; ?E<#10\n:10 (END)"))) == [
+        "call ULT A", "move D, R", "load R sub G", "store E; if E<0 then L10 else B1"]
+    # A store into the loaded variable itself would change what the load reads again.
+    program = jumps(("B0", [], End(1)))
+    program.blocks["B0"].instructions = [Load(A, 1), Store(B, 1), Store(A, 1),
+                                         Operate("-", C, 1), Store(A, 1)]
+    assert code(fuse(program)) == ["load A", "store B", "store A", "sub C", "store A", "end"]
+
+
+def test_the_load_and_operate_instructions_run_as_their_two_instructions_do() -> None:
+    source = "A=(ULT A); B=(ULT B)\nC=A-B; D=A<B; E=(ULT C)>B; F=(ULT C)^5; G=A&12\n"
+    script: dict[str, object] = {"ULT A": [-300], "ULT B": [3], "ULT C": [1000, 1000]}
+    verdict = judge(Run(source, script), ENGINES, 20_000)
+    assert verdict.problems == []
+    assert verdict.observations["vm-O2"].document["variables"]["E"] == 125
+    # One instruction saved per expression (its load), and per A=(ULT A) (a move).
+    unoptimized = verdict.observations["vm-O0"].executed
+    assert unoptimized is not None
+    assert verdict.observations["vm-O2"].executed == unoptimized - 5 - 2

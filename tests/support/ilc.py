@@ -39,6 +39,8 @@ def instruction_bytes(draw: st.DrawFn, info: isa.OpInfo, offsets: list[int]) -> 
             operands.append(draw(variable_indexes))
         elif operand is isa.Operand.IMM:
             operands.append(draw(st.integers(-0x8000, 0x7FFF)))
+        elif operand is isa.Operand.BYTE:
+            operands.append(draw(st.integers(-0x80, 0x7F)))
         elif operand is isa.Operand.ADDR:
             operands.append(draw(st.sampled_from(offsets)))
     form = info.form

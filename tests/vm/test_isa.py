@@ -22,6 +22,8 @@ def instructions(draw: st.DrawFn) -> tuple[isa.OpInfo, tuple[int, ...], tuple[is
             operands.append(draw(st.integers(0, 52)))
         elif operand is isa.Operand.IMM:
             operands.append(draw(st.integers(-32768, 32767)))
+        elif operand is isa.Operand.BYTE:
+            operands.append(draw(st.integers(-128, 127)))
         elif operand is isa.Operand.ADDR:
             operands.append(draw(st.integers(0, 65535)))
     args = tuple(

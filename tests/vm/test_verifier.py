@@ -74,7 +74,7 @@ def test_container_refusals_come_as_verify_errors() -> None:
 
 
 @pytest.mark.parametrize(("code", "offset", "message", "kind"), [
-    (op("LDI", 0) + bytes([0x0A]), CODE + 3, "code offset 3: unknown opcode 0x0A",
+    (op("LDI", 0) + bytes([0x0B]), CODE + 3, "code offset 3: unknown opcode 0x0B",
      Refusal.UNKNOWN_OPCODE),
     (op("LDI", 0)[:2], CODE, "LDI needs 3 bytes, only 2 remain", Refusal.CUT_OFF),
     (op("LDI", 0) + op("MVI", args=(const(1), const(1), const(1)))[:5], CODE + 3,

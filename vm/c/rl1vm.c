@@ -236,6 +236,8 @@ static rl1_state resume(rl1_vm *vm)
 #define U8_AT(k) RL1_BYTE(ip + (k))
 #define U16_AT(k) RL1_U16(ip + (k))
 #define VAR_AT(k) V[U8_AT(k)]
+/* A signed byte, without the implementation-defined conversion to int8_t. */
+#define S8_AT(k) ((int16_t)((int16_t)U8_AT(k) - (int16_t)((U8_AT(k) & 0x80u) << 1)))
 
 /* The seven operators of one operand kind (spec/ilc.md 8.2: base + the operator's
  * index), each its own case: a second dispatch on the operator would cost as much. */
@@ -247,6 +249,19 @@ static rl1_state resume(rl1_vm *vm)
     case (base) + 4: acc = (uint16_t)(acc ^ (operand)); ip += (size); continue;          \
     case (base) + 5: acc = shifted(acc, (int16_t)(operand), true); ip += (size); continue; \
     case (base) + 6: acc = shifted(acc, (int16_t)(operand), false); ip += (size); continue
+
+/* The load-and-operate superinstructions (format 1.2): acc = first op second, the
+ * operator in the low 3 bits as in ALU_CASES. */
+#define COMPUTE_CASES(base, first, second, size)                                         \
+    case (base) + 0: acc = (uint16_t)((uint16_t)(first) + (second)); ip += (size); continue; \
+    case (base) + 1: acc = (uint16_t)((uint16_t)(first) - (second)); ip += (size); continue; \
+    case (base) + 2: acc = (uint16_t)((uint16_t)(first) & (second)); ip += (size); continue; \
+    case (base) + 3: acc = (uint16_t)((uint16_t)(first) | (second)); ip += (size); continue; \
+    case (base) + 4: acc = (uint16_t)((uint16_t)(first) ^ (second)); ip += (size); continue; \
+    case (base) + 5:                                                                      \
+        acc = shifted((uint16_t)(first), (int16_t)(second), true); ip += (size); continue; \
+    case (base) + 6:                                                                      \
+        acc = shifted((uint16_t)(first), (int16_t)(second), false); ip += (size); continue
 
 /* A conditional jump on V[v] (at ip + 1) to the target at ip + 2. */
 #define JUMP_IF(condition)                                                                \
@@ -311,6 +326,7 @@ static rl1_state run(rl1_vm *vm, uint32_t n)
         case 0x07: VAR_AT(1) = VAR_AT(2); ip += 3; continue;               /* MOVV v, w */
         case 0x08: VAR_AT(1) = (int16_t)U16_AT(2); ip += 4; continue;      /* MOVI v, i */
         case 0x09: VAR_AT(1) = vm->R; ip += 2; continue;                   /* MOVR v */
+        case 0x0A: VAR_AT(1) = S8_AT(2); ip += 3; continue;                /* MOVB v, b */
         ALU_CASES(0x10, (uint16_t)VAR_AT(1), 2);                             /* ...V */
         ALU_CASES(0x18, U16_AT(1), 3);                                       /* ...I */
         ALU_CASES(0x20, (uint16_t)vm->R, 1);                                 /* ...R */
@@ -324,6 +340,10 @@ static rl1_state run(rl1_vm *vm, uint32_t n)
         case 0x35: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) == 0);       /* SJZ v, a */
         case 0x36: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) > 0);        /* SJGT v, a */
         case 0x37: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) < 0);        /* SJLT v, a */
+        COMPUTE_CASES(0x60, VAR_AT(1), (uint16_t)VAR_AT(2), 3);            /* ...VV v, w */
+        COMPUTE_CASES(0x68, VAR_AT(1), U16_AT(2), 4);                       /* ...VI v, i */
+        COMPUTE_CASES(0x70, vm->R, (uint16_t)VAR_AT(1), 2);                 /* ...RV v */
+        COMPUTE_CASES(0x78, vm->R, U16_AT(1), 3);                           /* ...RI i */
         default:
             UNREACHABLE(); /* the verifier refuses every other opcode */
             break;

@@ -20,7 +20,7 @@
 #define FEATURE_SIZE 2u
 #define DIGEST_SIZE 16u
 #define DIGEST_MINOR 1u      /* the first minor version with a source digest */
-#define FUSED_MINOR 2u       /* the superinstructions, MOVV ... SJLT, came in 1.2 */
+#define FUSED_MINOR 2u       /* the superinstructions, MOVV ... SJLT and ADDVV ... SHRRI, came in 1.2 */
 #define KNOWN_MINOR 2u       /* the newest minor version this reader knows */
 #define REQUIRED_FLAGS 0x00FFu
 #define KNOWN_FEATURES 0x007Fu
@@ -122,9 +122,31 @@ uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape)
             *shape = VAR; /* MOVR */
             return 2;
         }
+        if (op == 0x0Au) {
+            *shape = VAR; /* MOVB: a variable, then a signed byte, which needs no check */
+            return 3;
+        }
         if (op >= 0x34u && op <= 0x37u) {
             *shape = VAR_ADDR; /* DJGT, SJZ, SJGT, SJLT */
             return 4;
+        }
+        /* The load-and-operate blocks, operator in the low 3 bits (7 is unused).
+         * No table: on AVR it would be copied to RAM. */
+        if (op >= 0x60u && op <= 0x7Eu && (op & 7u) != 7u) {
+            if (op < 0x68u) {
+                *shape = VAR_VAR; /* ADDVV ... SHRVV */
+                return 3;
+            }
+            if (op < 0x70u) {
+                *shape = VAR_IMM; /* ADDVI ... SHRVI */
+                return 4;
+            }
+            if (op < 0x78u) {
+                *shape = VAR; /* ADDRV ... SHRRV */
+                return 2;
+            }
+            *shape = IMM; /* ADDRI ... SHRRI */
+            return 3;
         }
     }
     if (op == 0x00u || op == 0x03u || (op >= 0x20u && op <= 0x26u)) {
