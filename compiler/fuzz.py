@@ -11,6 +11,7 @@ long. `judge` in differential.py decides what disagrees (spec/optimization.md).
 from __future__ import annotations
 
 import contextlib
+import gc
 import json
 import os
 import re
@@ -40,6 +41,10 @@ from rl1.compiler.strategies import Run, runs
 
 SHRINK_SECONDS = 20.0  # Hypothesis' shrinking stops here, with the smallest run so far
 SHRINK_ATTEMPTS = 10_000  # or after trying so many runs, whichever comes first
+# Programs per Hypothesis search. Its runner keeps what it learnt of every run it
+# generated (about 130 KB each) until the search ends, so a long campaign is many short
+# searches, each seeded from --seed, with their garbage collected in between.
+BATCH = 500
 LABEL = re.compile(r"[ \t\f\v]*:[0-9]*")  # a label where a line starts (language 3.1)
 SOURCE = "program.rob"
 SCRIPT = "program.sensors.json"
@@ -94,11 +99,20 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
         smallest = case
         return True
 
-    limits = settings(max_examples=count or 10**9, database=None, deadline=None,
-                      suppress_health_check=list(HealthCheck),
-                      phases=(Phase.generate, Phase.shrink))
-    with contextlib.suppress(NoSuchExample, _TimeUp):
-        smallest = find(runs(), disagrees, settings=limits, random=Random(seed))
+    seeds = Random(seed)
+    with contextlib.suppress(_TimeUp):
+        while smallest is None and (count is None or programs < count):
+            before = programs
+            batch = BATCH if count is None else min(BATCH, count - programs)
+            limits = settings(max_examples=batch, database=None, deadline=None,
+                              suppress_health_check=list(HealthCheck),
+                              phases=(Phase.generate, Phase.shrink))
+            with contextlib.suppress(NoSuchExample):
+                smallest = find(runs(), disagrees, settings=limits,
+                                random=Random(seeds.getrandbits(64)))
+            if programs == before:  # Hypothesis generated nothing more: stop, not spin
+                break
+            gc.collect()  # a finished search is cyclic garbage: collect it now
     elapsed = time.monotonic() - start if found_after is None else found_after
     if smallest is None:
         return Outcome(programs, elapsed, None)

@@ -13,8 +13,9 @@ from support import ROOT
 from support.cli import rl1c
 
 from rl1.compiler import fuzz
-from rl1.compiler.differential import Observation, differences
+from rl1.compiler.differential import Observation, differences, engine_named
 from rl1.compiler.frontend.source import split_lines
+from rl1.compiler.strategies import Run
 
 PYTHON = shlex.quote(sys.executable)
 RL1C = shlex.quote(str(Path(sys.executable).with_name("rl1c")))
@@ -27,6 +28,35 @@ def test_the_built_in_engines_agree_and_the_summary_says_so() -> None:
     assert result.exit_code == 0, result.output
     assert result.stdout.startswith("fuzz: 25 programs in ")
     assert "engines ast, vm-O0, vm-O1, vm-O2; seed 5: all agreed" in result.stdout
+
+
+def test_a_long_campaign_is_many_searches_with_the_same_programs_for_a_seed(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # Each Hypothesis search keeps what it learnt of every run until it ends (a campaign
+    # of 50,000 in one search grew past 10 GB), so a campaign is searches of BATCH runs.
+    monkeypatch.setattr(fuzz, "BATCH", 4)
+    engines = [engine_named("ast"), engine_named("vm-O0")]
+    sources: list[list[str]] = [[], []]
+    searches: list[int] = []
+    real_find = fuzz.find
+
+    def counted_find(*args: object, **kwargs: object) -> object:
+        searches.append(1)
+        return real_find(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(fuzz, "find", counted_find)
+    real_judge = fuzz.judge
+    for seen in sources:
+        def judged(case: Run, *args: object, seen: list[str] = seen) -> object:
+            seen.append(case.source)
+            return real_judge(case, *args)  # type: ignore[arg-type]
+
+        monkeypatch.setattr(fuzz, "judge", judged)
+        outcome = fuzz.campaign([e for e in engines if e is not None], 20_000, count=10,
+                                seconds=None, seed=7, progress=lambda programs, elapsed: None)
+        assert outcome.programs == 10 and outcome.finding is None
+    assert len(searches) == 2 * 3  # 4 + 4 + 2 programs, twice
+    assert sources[0] == sources[1] and len(sources[0]) == 10
 
 
 def test_rl1c_run_itself_is_an_exec_engine_as_the_spec_shows(tmp_path: Path) -> None:
