@@ -9,11 +9,12 @@ import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import find
 from support import ROOT
 from support.cli import rl1c
 
 from rl1.compiler import fuzz
-from rl1.compiler.differential import Observation, differences, engine_named
+from rl1.compiler.differential import Observation, differences, engine_named, judge
 from rl1.compiler.frontend.source import split_lines
 from rl1.compiler.strategies import Run
 
@@ -38,18 +39,16 @@ def test_a_long_campaign_is_many_searches_with_the_same_programs_for_a_seed(
     engines = [engine_named("ast"), engine_named("vm-O0")]
     sources: list[list[str]] = [[], []]
     searches: list[int] = []
-    real_find = fuzz.find
 
     def counted_find(*args: object, **kwargs: object) -> object:
         searches.append(1)
-        return real_find(*args, **kwargs)  # type: ignore[arg-type]
+        return find(*args, **kwargs)  # type: ignore[arg-type]
 
     monkeypatch.setattr(fuzz, "find", counted_find)
-    real_judge = fuzz.judge
     for seen in sources:
         def judged(case: Run, *args: object, seen: list[str] = seen) -> object:
             seen.append(case.source)
-            return real_judge(case, *args)  # type: ignore[arg-type]
+            return judge(case, *args)  # type: ignore[arg-type]
 
         monkeypatch.setattr(fuzz, "judge", judged)
         outcome = fuzz.campaign([e for e in engines if e is not None], 20_000, count=10,
