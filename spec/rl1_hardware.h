@@ -94,7 +94,7 @@ typedef enum {
     RL1_RUNNING = 0,  /* the step ran its n instructions: step again */
     RL1_WAITING = 1,  /* a built-in is taking device time: step again to poll it */
     RL1_ENDED = 2,    /* (END), or past the last instruction */
-    RL1_FAULTED = 3   /* `fault` and `fault_pc` say what and where */
+    RL1_FAULTED = 3   /* `fault` and `pc` say what and where */
 } rl1_state;
 
 typedef enum {  /* the values are rl1c run's exit statuses */
@@ -105,33 +105,36 @@ typedef enum {  /* the values are rl1c run's exit statuses */
     RL1_FAULT_DEVICE = 13
 } rl1_fault;
 
-/* Everything a run needs to resume, and nothing else (about 140 bytes). Zero it, set
- * the program, the budget and the hardware, then step. */
+/* The verified program (spec/ilc.md 10), as the implementation's loader makes it
+ * (vm/c/rl1vm.h defines ours): the VM reads its code and its handler table. Read only,
+ * so it may sit wherever the firmware likes; so may the rl1_hardware table (in flash). */
+typedef struct rl1_program rl1_program;
+
+/* Everything a run needs to resume, and nothing else: 128 bytes with 32-bit pointers
+ * and alignment, 127 on AVR. What is read only (the program, the hardware table) is not
+ * in it, but given to every step. Zero it, set the budget, then step. */
 typedef struct {
-    /* the verified program (spec/ilc.md 10), read only */
-    const uint8_t *code;
-    uint16_t code_size;
-    uint16_t handlers[4];       /* :96..:99, 0xFFFF absent */
-    uint32_t budget;            /* 1 .. 2^31 - 1 (12.6) */
-    const rl1_hardware *hw;
-    rl1_mailbox mailbox;        /* the device posts here */
     /* the machine (spec/ilc.md 8.1) */
     int16_t V[53];
     int16_t acc;
     int16_t R;
-    uint16_t pc;                /* code offset of the next instruction */
+    uint16_t pc;                /* code offset of the next instruction; after a fault, of
+                                   the faulting one (0xFFFF: before the first) */
     uint32_t executed;          /* instructions run, the one that faulted included */
+    uint32_t budget;            /* 1 .. 2^31 - 1 (12.6) */
+    rl1_mailbox mailbox;        /* the device posts here */
     /* the run */
-    uint8_t begun;              /* begin() has been called */
     uint8_t waiting;            /* opcode of the call in progress, 0 for none */
-    rl1_state state;
-    rl1_fault fault;
-    uint16_t fault_pc;          /* code offset of the faulting instruction; 0xFFFF: before the first */
+    uint8_t state;              /* an rl1_state */
+    uint8_t fault;              /* an rl1_fault: what went wrong, at pc */
+    uint8_t begun;              /* begin() has been called */
     uint8_t stop_failed;        /* the stop after the fault answered RL1_ERROR */
 } rl1_vm;
 
-/* Run at most n instructions (n = 0: only poll a call in progress) and say where the
- * run stands. Once RL1_ENDED or RL1_FAULTED, a step does nothing and says so again. */
-rl1_state rl1_step(rl1_vm *vm, uint32_t n);
+/* Run at most n instructions of `program` on `hw` (n = 0: only poll a call in progress)
+ * and say where the run stands. Every step of a run must be given the same program and
+ * hardware. Once RL1_ENDED or RL1_FAULTED, a step does nothing and says so again. */
+rl1_state rl1_step(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
+                   uint32_t n);
 
 #endif /* RL1_HARDWARE_H */

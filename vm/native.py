@@ -12,7 +12,7 @@ hardware's callbacks through function pointers; lost lines go through the C VM's
 mailbox, kept equal to the hardware's `pending` event at every crossing (a step's start
 and each callback): an event the device holds is posted, an event the VM took is taken
 from the device. Faults get the reference VM's messages, from the fault's kind, the
-instruction at `fault_pc` and what the callbacks answered.
+instruction at `pc` and what the callbacks answered.
 """
 
 from __future__ import annotations
@@ -130,20 +130,26 @@ class _Mailbox(ctypes.Structure):
 
 
 class _Vm(ctypes.Structure):
-    _fields_ = [("code", ctypes.c_void_p), ("code_size", ctypes.c_uint16),
-                ("handlers", ctypes.c_uint16 * 4), ("budget", ctypes.c_uint32),
-                ("hw", ctypes.c_void_p), ("mailbox", _Mailbox),
-                ("V", ctypes.c_int16 * len(VARIABLES)), ("acc", ctypes.c_int16),
+    _fields_ = [("V", ctypes.c_int16 * len(VARIABLES)), ("acc", ctypes.c_int16),
                 ("R", ctypes.c_int16), ("pc", ctypes.c_uint16),
-                ("executed", ctypes.c_uint32), ("begun", ctypes.c_uint8),
-                ("waiting", ctypes.c_uint8), ("state", ctypes.c_int),
-                ("fault", ctypes.c_int), ("fault_pc", ctypes.c_uint16),
-                ("stop_failed", ctypes.c_uint8)]
+                ("executed", ctypes.c_uint32), ("budget", ctypes.c_uint32),
+                ("mailbox", _Mailbox), ("waiting", ctypes.c_uint8),
+                ("state", ctypes.c_uint8), ("fault", ctypes.c_uint8),
+                ("begun", ctypes.c_uint8), ("stop_failed", ctypes.c_uint8)]
 
 
-_LAYOUT = (ctypes.sizeof(_Vm), _Vm.mailbox.offset, _Vm.V.offset, _Vm.executed.offset,
-           _Vm.state.offset, _Vm.fault_pc.offset, _Vm.stop_failed.offset,
-           ctypes.sizeof(_Hardware), ctypes.sizeof(_Reading))
+class _Program(ctypes.Structure):  # vm/c/rl1vm.h; only the C side reads its fields
+    _fields_ = [("code", ctypes.c_void_p), ("lines", ctypes.c_void_p),
+                ("source_name", ctypes.c_void_p), ("digest", ctypes.c_void_p),
+                ("code_size", ctypes.c_uint16), ("handlers", ctypes.c_uint16 * 4),
+                ("features", ctypes.c_uint16), ("flags", ctypes.c_uint16),
+                ("line_count", ctypes.c_uint16), ("source_name_size", ctypes.c_uint8),
+                ("minor", ctypes.c_uint8)]
+
+
+_LAYOUT = (ctypes.sizeof(_Vm), _Vm.mailbox.offset, _Vm.pc.offset, _Vm.executed.offset,
+           _Vm.state.offset, _Vm.fault.offset, _Vm.stop_failed.offset,
+           ctypes.sizeof(_Hardware), ctypes.sizeof(_Reading), ctypes.sizeof(_Program))
 
 _FAULTS = {kind.exit_status: kind for kind in FaultKind}
 _STATUS = {Status.OK: 0, Status.BUSY: 1, Status.ERROR: 2}
@@ -158,13 +164,14 @@ def load(path: Path) -> ctypes.CDLL:
         return _libraries[path]
     lib = ctypes.CDLL(str(path))
     lib.rl1_ffi_layout.argtypes = [ctypes.POINTER(ctypes.c_uint32)]
-    lib.rl1_ffi_start.argtypes = [ctypes.POINTER(_Vm), ctypes.c_char_p, ctypes.c_uint32,
-                                  ctypes.POINTER(_Hardware), ctypes.c_uint32,
+    lib.rl1_ffi_start.argtypes = [ctypes.POINTER(_Vm), ctypes.POINTER(_Program),
+                                  ctypes.c_char_p, ctypes.c_uint32, ctypes.c_uint32,
                                   ctypes.POINTER(ctypes.c_uint32)]
     lib.rl1_ffi_post.argtypes = [ctypes.POINTER(_Vm), ctypes.c_uint8, ctypes.c_uint8]
-    lib.rl1_step.argtypes = [ctypes.POINTER(_Vm), ctypes.c_uint32]
-    lib.rl1_test_line_at.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_uint16]
-    lib.rl1_test_line_at.restype = ctypes.c_uint16
+    lib.rl1_step.argtypes = [ctypes.POINTER(_Vm), ctypes.POINTER(_Program),
+                             ctypes.POINTER(_Hardware), ctypes.c_uint32]
+    lib.rl1_line_at.argtypes = [ctypes.POINTER(_Program), ctypes.c_uint16]
+    lib.rl1_line_at.restype = ctypes.c_uint16
     lib.rl1_test_load.argtypes = [ctypes.c_char_p, ctypes.c_uint32, ctypes.c_size_t,
                                   ctypes.POINTER(ctypes.c_uint32)]
     layout = (ctypes.c_uint32 * len(_LAYOUT))()
@@ -186,6 +193,7 @@ class NativeMachine:
         self._file = ctypes.create_string_buffer(data, len(data))  # the VM reads it in place
         self._size = len(data)
         self._vm = _Vm()
+        self._program = _Program()  # points into self._file
         self._error: BaseException | None = None  # raised in a callback, raised again
         self._posted = False  # the hardware's pending event is in the mailbox
         self._message = ""  # why the device failed, for the fault's message
@@ -198,8 +206,8 @@ class NativeMachine:
                                     _BEGIN(self._guard(self._stop)),
                                     _BEGIN(self._guard(self._end)))
         where = ctypes.c_uint32(0)
-        refusal = lib.rl1_ffi_start(ctypes.byref(self._vm), self._file, self._size,
-                                    ctypes.byref(self._callbacks), budget, ctypes.byref(where))
+        refusal = lib.rl1_ffi_start(ctypes.byref(self._vm), ctypes.byref(self._program),
+                                    self._file, self._size, budget, ctypes.byref(where))
         if refusal:
             raise ValueError(f"the C loader refuses the file (refusal {refusal} at file "
                              f"offset {where.value}), which the caller was to verify")
@@ -221,15 +229,16 @@ class NativeMachine:
         steps (as Machine.current_line): the line entry at or before the byte before pc;
         None before the first instruction, or without a line map."""
         pc = int(self._vm.pc)
-        if pc == 0:
+        if pc in (0, NO_PC):  # before the first instruction, or a fault there
             return None
-        line = int(self.lib.rl1_test_line_at(self._file, self._size, pc - 1))
+        line = int(self.lib.rl1_line_at(ctypes.byref(self._program), pc - 1))
         return line or None
 
     def step(self, limit: int) -> State:
         """Run at most `limit` instructions and say where the run stands."""
         self._sync()
-        state = State(self.lib.rl1_step(ctypes.byref(self._vm), limit))
+        state = State(self.lib.rl1_step(ctypes.byref(self._vm), ctypes.byref(self._program),
+                                        ctypes.byref(self._callbacks), limit))
         if self._error is not None:
             error, self._error = self._error, None
             raise error
@@ -322,9 +331,9 @@ class NativeMachine:
         kind = _FAULTS.get(vm.fault)
         if kind is None:
             return None
-        at = int(vm.fault_pc)
+        at = int(vm.pc)
         line = None if at == NO_PC else (
-            self.lib.rl1_test_line_at(self._file, self._size, at) or None)
+            self.lib.rl1_line_at(ctypes.byref(self._program), at) or None)
         message = self._message
         if kind is FaultKind.BUDGET:
             message = budget_message(self.budget)

@@ -12,7 +12,7 @@
  */
 #include "rl1vm.h"
 
-#define NO_PC 0xFFFFu  /* fault_pc of a fault before the first instruction */
+#define NO_PC 0xFFFFu  /* pc of a fault before the first instruction */
 
 /* The reserved variables the sensing calls write (spec/ilc.md 8.3), by index. */
 #define VAR_S 44u
@@ -28,22 +28,14 @@
 #define OP_INP 0x5Au
 #define OP_FZI 0x5Du
 
-void rl1_vm_init(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hardware,
-                 uint32_t budget)
+void rl1_vm_init(rl1_vm *vm, uint32_t budget)
 {
     unsigned char *byte = (unsigned char *)vm;
     size_t i;
-    uint8_t k;
     for (i = 0; i < sizeof *vm; i++) { /* no memset: freestanding */
         byte[i] = 0;
     }
-    vm->code = program->code;
-    vm->code_size = program->code_size;
-    for (k = 0; k < 4u; k++) {
-        vm->handlers[k] = program->handlers[k];
-    }
     vm->budget = budget;
-    vm->hw = hardware;
 }
 
 /* x shifted by `count` places, left or right (spec/language.md 7.2): a count of 16 or
@@ -110,9 +102,9 @@ static bool finish(rl1_vm *vm, uint8_t op, rl1_status status, const rl1_reading 
 /* The call `op`, `length` bytes long, whose operands start at `operands` (section 9,
  * steps 2-6): a fault, or RL1_FAULT_NONE with vm->waiting set when its first poll
  * answered busy. */
-static rl1_fault call(rl1_vm *vm, uint8_t op, uint8_t length, const uint8_t *operands)
+static rl1_fault call(rl1_vm *vm, const rl1_hardware *hw, uint8_t op, uint8_t length,
+                      const uint8_t *operands)
 {
-    const rl1_hardware *hw = vm->hw;
     int16_t args[3];
     rl1_reading out = {0, {0, 0, 0, 0}};
     rl1_status status;
@@ -150,7 +142,7 @@ static rl1_fault call(rl1_vm *vm, uint8_t op, uint8_t length, const uint8_t *ope
 /* The event point (section 9): takes a pending lost line and moves *pc to the handler
  * Table 4 names for it (mode 2: MOV :98, MVI :99; mode 3: MOV :96, MVI :97; no other
  * mode jumps). False when that handler is absent: the fault missing-handler. */
-static bool take_event(rl1_vm *vm, uint16_t *pc)
+static bool take_event(rl1_vm *vm, const rl1_program *program, uint16_t *pc)
 {
     uint8_t event, mode, entry;
     if (!rl1_take_line_lost(&vm->mailbox, &event)) {
@@ -161,37 +153,36 @@ static bool take_event(rl1_vm *vm, uint16_t *pc)
         return true;
     }
     entry = (uint8_t)((mode == 2u ? 2u : 0u) + RL1_EVENT_COMMAND(event));
-    if (vm->handlers[entry] == RL1_ABSENT) {
+    if (program->handlers[entry] == RL1_ABSENT) {
         return false;
     }
-    *pc = vm->handlers[entry];
+    *pc = program->handlers[entry];
     return true;
 }
 
 /* Stops the vehicle and ends the run with fault `kind` at code offset `at` (12.3); `end`
  * is not called again when it is its answer that faulted. */
-static rl1_state fault(rl1_vm *vm, rl1_fault kind, uint16_t at, bool ended)
+static rl1_state fault(rl1_vm *vm, const rl1_hardware *hw, rl1_fault kind, uint16_t at,
+                       bool ended)
 {
-    const rl1_hardware *hw = vm->hw;
     if (hw->stop(hw->ctx) != RL1_OK) {
         vm->stop_failed = 1;
     }
     if (!ended) {
         (void)hw->end(hw->ctx); /* the fault is reported whatever it answers */
     }
-    vm->fault = kind;
-    vm->fault_pc = at;
+    vm->fault = (uint8_t)kind;
+    vm->pc = at;
     vm->state = RL1_FAULTED;
     return RL1_FAULTED;
 }
 
 /* The run has reached END at `at` (or the code's end: `at` is then code_size). */
-static rl1_state ended(rl1_vm *vm, uint16_t at)
+static rl1_state ended(rl1_vm *vm, const rl1_hardware *hw, uint16_t at)
 {
-    const rl1_hardware *hw = vm->hw;
     vm->state = RL1_ENDED;
     if (hw->end(hw->ctx) != RL1_OK) {
-        return fault(vm, RL1_FAULT_DEVICE, at, true);
+        return fault(vm, hw, RL1_FAULT_DEVICE, at, true);
     }
     return RL1_ENDED;
 }
@@ -204,9 +195,8 @@ static uint8_t call_length(uint8_t op)
 }
 
 /* Resumes a call in progress (12.2): polls it once. */
-static rl1_state resume(rl1_vm *vm)
+static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw)
 {
-    const rl1_hardware *hw = vm->hw;
     rl1_reading out = {0, {0, 0, 0, 0}};
     uint8_t op = vm->waiting;
     uint16_t at = (uint16_t)(vm->pc - call_length(op));
@@ -217,10 +207,10 @@ static rl1_state resume(rl1_vm *vm)
     vm->waiting = 0;
     vm->state = RL1_RUNNING;
     if (!finish(vm, op, status, &out)) {
-        return fault(vm, RL1_FAULT_DEVICE, at, false);
+        return fault(vm, hw, RL1_FAULT_DEVICE, at, false);
     }
-    if (!take_event(vm, &vm->pc)) {
-        return fault(vm, RL1_FAULT_MISSING_HANDLER, at, false);
+    if (!take_event(vm, program, &vm->pc)) {
+        return fault(vm, hw, RL1_FAULT_MISSING_HANDLER, at, false);
     }
     return RL1_RUNNING;
 }
@@ -281,9 +271,10 @@ static rl1_state resume(rl1_vm *vm)
 /* Runs at most n instructions from vm->pc. The hot state lives in locals and goes back
  * into *vm at every exit: pc, acc, and the instructions run (n - left). `ip` stays on an
  * instruction's first byte until it is done, so that a fault or an end points at it. */
-static rl1_state run(rl1_vm *vm, uint32_t n)
+static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
+                     uint32_t n)
 {
-    const uint8_t *const code = vm->code, *const end = code + vm->code_size;
+    const uint8_t *const code = program->code, *const end = code + program->code_size;
     const uint8_t *ip = code + vm->pc;
     int16_t *const V = vm->V;
     uint16_t acc = (uint16_t)vm->acc, target = 0;
@@ -360,7 +351,7 @@ static rl1_state run(rl1_vm *vm, uint32_t n)
             length = call_length(op);
             vm->executed = before + (n - left);
             vm->pc = (uint16_t)(ip - code + length);
-            kind = call(vm, op, length, ip + 1);
+            kind = call(vm, hw, op, length, ip + 1);
             if (kind != RL1_FAULT_NONE) {
                 break;
             }
@@ -370,7 +361,7 @@ static rl1_state run(rl1_vm *vm, uint32_t n)
                 return RL1_WAITING;
             }
             target = vm->pc;
-            if (!take_event(vm, &target)) {
+            if (!take_event(vm, program, &target)) {
                 kind = RL1_FAULT_MISSING_HANDLER;
                 break;
             }
@@ -385,7 +376,7 @@ static rl1_state run(rl1_vm *vm, uint32_t n)
             kind = RL1_FAULT_BUDGET;
             break;
         }
-        if (vm->mailbox.posted != vm->mailbox.taken && !take_event(vm, &target)) {
+        if (vm->mailbox.posted != vm->mailbox.taken && !take_event(vm, program, &target)) {
             kind = RL1_FAULT_MISSING_HANDLER;
             break;
         }
@@ -396,29 +387,29 @@ static rl1_state run(rl1_vm *vm, uint32_t n)
     vm->acc = (int16_t)acc;
     vm->executed = before + (n - left);
     if (kind != RL1_FAULT_NONE) {
-        return fault(vm, kind, vm->pc, false);
+        return fault(vm, hw, kind, vm->pc, false);
     }
-    return state == RL1_ENDED ? ended(vm, vm->pc) : state;
+    return state == RL1_ENDED ? ended(vm, hw, vm->pc) : state;
 }
 
-rl1_state rl1_step(rl1_vm *vm, uint32_t n)
+rl1_state rl1_step(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
+                   uint32_t n)
 {
-    const rl1_hardware *hw = vm->hw;
     if (vm->state == RL1_ENDED || vm->state == RL1_FAULTED) {
-        return vm->state;
+        return (rl1_state)vm->state;
     }
     if (!vm->begun) {
         vm->begun = 1;
         if (hw->begin(hw->ctx) != RL1_OK) {
-            return fault(vm, RL1_FAULT_DEVICE, NO_PC, false);
+            return fault(vm, hw, RL1_FAULT_DEVICE, NO_PC, false);
         }
         vm->mailbox.taken = vm->mailbox.posted; /* a loss before the program is not its own */
     }
     if (vm->waiting) {
-        rl1_state state = resume(vm);
+        rl1_state state = resume(vm, program, hw);
         if (state != RL1_RUNNING) {
             return state;
         }
     }
-    return run(vm, n);
+    return run(vm, program, hw, n);
 }

@@ -54,7 +54,7 @@ typedef enum rl1_refusal {
 
 /* A verified file, its sections found: everything the VM needs, pointing into the
  * caller's file (which must stay in place while the program is used). */
-typedef struct rl1_program {
+struct rl1_program {  /* rl1_hardware.h names it rl1_program */
     const uint8_t *code;        /* the code section */
     const uint8_t *lines;       /* the first line entry; NULL without a debug section */
     const uint8_t *source_name; /* UTF-8, not NUL-terminated; NULL without debug */
@@ -66,7 +66,7 @@ typedef struct rl1_program {
     uint16_t line_count;
     uint8_t source_name_size;
     uint8_t minor;              /* the format's minor version the file says */
-} rl1_program;
+};
 
 #define RL1_ABSENT 0xFFFFu     /* a handler table entry for a label not defined */
 
@@ -93,12 +93,11 @@ rl1_refusal rl1_load(rl1_program *program, const uint8_t *file, uint32_t size,
  * before it). It walks the line map, so it costs one pass over it: for fault reports. */
 uint16_t rl1_line_at(const rl1_program *program, uint16_t code_offset);
 
-/* Makes `vm` ready to run `program` (loaded by rl1_load) on `hardware` with the
- * watchdog `budget` (1 .. 2^31 - 1, spec/ilc.md 12.6): every other field zero. Then call
- * rl1_step until it answers RL1_ENDED or RL1_FAULTED; the device posts lost lines into
- * vm->mailbox with rl1_post_line_lost. */
-void rl1_vm_init(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hardware,
-                 uint32_t budget);
+/* Makes `vm` ready for a run with the watchdog `budget` (1 .. 2^31 - 1, spec/ilc.md
+ * 12.6): every other field zero. Then call rl1_step with the program (loaded by
+ * rl1_load) and the hardware until it answers RL1_ENDED or RL1_FAULTED; the device
+ * posts lost lines into vm->mailbox with rl1_post_line_lost. */
+void rl1_vm_init(rl1_vm *vm, uint32_t budget);
 
 /* --- Internal: the instruction set, shared by the loader and the VM ----------------- */
 

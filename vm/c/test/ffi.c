@@ -9,8 +9,8 @@ int rl1_test_load(const uint8_t *file, uint32_t size, size_t bitmap_size,
                   uint32_t *error_offset);
 uint16_t rl1_test_line_at(const uint8_t *file, uint32_t size, uint16_t code_offset);
 void rl1_ffi_layout(uint32_t *out);
-int rl1_ffi_start(rl1_vm *vm, const uint8_t *file, uint32_t size,
-                  const rl1_hardware *hardware, uint32_t budget, uint32_t *error_offset);
+int rl1_ffi_start(rl1_vm *vm, rl1_program *program, const uint8_t *file, uint32_t size,
+                  uint32_t budget, uint32_t *error_offset);
 int rl1_ffi_post(rl1_vm *vm, uint8_t mode, uint8_t command);
 
 static uint8_t bitmap[RL1_BITMAP_SIZE(0xFFFFu)];
@@ -41,25 +41,25 @@ void rl1_ffi_layout(uint32_t *out)
 {
     out[0] = sizeof(rl1_vm);
     out[1] = offsetof(rl1_vm, mailbox);
-    out[2] = offsetof(rl1_vm, V);
+    out[2] = offsetof(rl1_vm, pc);
     out[3] = offsetof(rl1_vm, executed);
     out[4] = offsetof(rl1_vm, state);
-    out[5] = offsetof(rl1_vm, fault_pc);
+    out[5] = offsetof(rl1_vm, fault);
     out[6] = offsetof(rl1_vm, stop_failed);
     out[7] = sizeof(rl1_hardware);
     out[8] = sizeof(rl1_reading);
+    out[9] = sizeof(rl1_program);
 }
 
-/* Loads `file` (which must stay in place) and makes `vm` ready to run it; the loader's
- * refusal otherwise. */
-int rl1_ffi_start(rl1_vm *vm, const uint8_t *file, uint32_t size,
-                  const rl1_hardware *hardware, uint32_t budget, uint32_t *error_offset)
+/* Loads `file` (which must stay in place) into *program and makes `vm` ready to run
+ * it; the loader's refusal otherwise. */
+int rl1_ffi_start(rl1_vm *vm, rl1_program *program, const uint8_t *file, uint32_t size,
+                  uint32_t budget, uint32_t *error_offset)
 {
-    rl1_program program;
-    rl1_refusal refusal = rl1_load(&program, file, size, bitmap, sizeof bitmap,
+    rl1_refusal refusal = rl1_load(program, file, size, bitmap, sizeof bitmap,
                                    error_offset);
     if (refusal == RL1_ACCEPTED) {
-        rl1_vm_init(vm, &program, hardware, budget);
+        rl1_vm_init(vm, budget);
     }
     return (int)refusal;
 }

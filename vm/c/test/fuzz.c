@@ -117,25 +117,25 @@ static void run(const rl1_program *program, uint32_t seed, bool sliced, rl1_vm *
     hw.ctx = &d;
     hw.stop = begin;
     hw.end = begin;
-    rl1_vm_init(vm, program, &hw, budget);
+    rl1_vm_init(vm, budget);
     d.mailbox = &vm->mailbox;
     slicer.state |= 1u;
     while (GOING(state)) {
         n = sliced ? next(&slicer) % 9u : 0xFFFFFFFFu;
         before = vm->executed;
-        state = rl1_step(vm, n);
+        state = rl1_step(vm, program, &hw, n);
         if ((state == RL1_RUNNING && vm->executed - before != n) || vm->executed - before > n
-            || vm->pc > program->code_size || ++steps > MAX_STEPS) {
+            || (vm->pc > program->code_size && vm->pc != 0xFFFFu) || ++steps > MAX_STEPS) {
             __builtin_trap();
         }
     }
     /* The budget is passed by less than the code's instructions (spec/ilc.md 9). */
     if (vm->executed > budget + program->code_size
         || (vm->fault != RL1_FAULT_NONE) != (state == RL1_FAULTED)
-        || (vm->fault_pc != 0xFFFFu && vm->fault_pc > program->code_size)) {
+        || (vm->pc == 0xFFFFu && (state != RL1_FAULTED || vm->executed != 0u))) {
         __builtin_trap();
     }
-    again = rl1_step(vm, 5);
+    again = rl1_step(vm, program, &hw, 5);
     if (again != state) {
         __builtin_trap();
     }
@@ -180,7 +180,7 @@ static void check(const uint8_t *data, uint32_t size)
     run(&program, crc32_of(data, size), false, &whole);
     run(&program, crc32_of(data, size), true, &sliced);
     if (whole.executed != sliced.executed || whole.fault != sliced.fault
-        || whole.fault_pc != sliced.fault_pc || whole.stop_failed != sliced.stop_failed
+        || whole.pc != sliced.pc || whole.stop_failed != sliced.stop_failed
         || memcmp(whole.V, sliced.V, sizeof whole.V) != 0) {
         __builtin_trap();
     }

@@ -53,9 +53,9 @@ static uint32_t own_stack(const vector *v)
         != RL1_ACCEPTED) {
         return 0;
     }
-    rl1_vm_init(&vm, &program, &hw, v->budget);
+    rl1_vm_init(&vm, v->budget);
     target_stack_paint();
-    while (rl1_step(&vm, 1000u) <= RL1_WAITING) {
+    while (rl1_step(&vm, &program, &hw, 1000u) <= RL1_WAITING) {
     }
     depth = target_stack_depth();
     return depth;

@@ -87,24 +87,26 @@ static void read_item(script_item *to, const script_item *from)
 
 /* Steps until `count` instructions have run (a call in progress polled to its end),
  * or the run is over. */
-static rl1_state step_to(rl1_vm *vm, uint32_t count, uint32_t slice)
+static rl1_state step_to(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
+                         uint32_t count, uint32_t slice)
 {
-    rl1_state state = vm->state;
+    rl1_state state = (rl1_state)vm->state;
     while (GOING(state) && (vm->executed < count || state == RL1_WAITING)) {
         uint32_t n = count - vm->executed;
-        state = rl1_step(vm, n < slice ? n : slice);
+        state = rl1_step(vm, program, hw, n < slice ? n : slice);
     }
     return state;
 }
 
 /* Loses the line after each instruction count the script names, in increasing order. */
-static rl1_state drive(rl1_vm *vm, scripted *device, uint32_t slice)
+static rl1_state drive(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
+                       scripted *device, uint32_t slice)
 {
     script_item item;
     uint32_t last = 0, at;
     bool first = true, found;
     uint16_t i;
-    rl1_state state = vm->state;
+    rl1_state state = (rl1_state)vm->state;
     for (;;) {
         found = false;
         at = 0;
@@ -119,7 +121,7 @@ static rl1_state drive(rl1_vm *vm, scripted *device, uint32_t slice)
         if (!found) {
             break;
         }
-        state = step_to(vm, at, slice);
+        state = step_to(vm, program, hw, at, slice);
         if (!GOING(state)) {
             return state;
         }
@@ -133,7 +135,7 @@ static rl1_state drive(rl1_vm *vm, scripted *device, uint32_t slice)
         first = false;
     }
     while (GOING(state)) {
-        state = rl1_step(vm, slice);
+        state = rl1_step(vm, program, hw, slice);
     }
     return state;
 }
@@ -163,21 +165,21 @@ bool vector_run(const vector *v, const char *name, uint32_t slice, uint8_t busy_
     c.v = v;
     c.received = 0;
     c.differs_at = NO_DIFFERENCE;
-    rl1_vm_init(&vm, &program, &hw, v->budget);
+    rl1_vm_init(&vm, v->budget);
     scripted_init(&device, &s, &vm.mailbox);
     device.record = check_entry;
     device.sink = &c;
     device.busy_polls = busy_polls;
     scripted_hardware(&hw, &device);
     harness_stack_paint();
-    (void)drive(&vm, &device, slice);
+    (void)drive(&vm, &program, &hw, &device, slice);
     *stack = harness_stack_depth();
-    if (vm.fault != (rl1_fault)v->fault) {
+    if (vm.fault != v->fault) {
         say(name, "fault", (uint32_t)vm.fault, v->fault);
         ok = false;
     }
-    if (vm.fault != RL1_FAULT_NONE && vm.fault_pc != 0xFFFFu) {
-        line = rl1_line_at(&program, vm.fault_pc);
+    if (vm.fault != RL1_FAULT_NONE && vm.pc != 0xFFFFu) {
+        line = rl1_line_at(&program, vm.pc);
     }
     if (line != v->line) {
         say(name, "fault line", line, v->line);
