@@ -27,7 +27,7 @@ from rl1.vm.faults import FaultKind
 from rl1.vm.hardware import Blocking
 from rl1.vm.language import VARIABLES
 from rl1.vm.machine import Machine
-from rl1.vm.native import NativeMachine, library, load
+from rl1.vm.native import BuildError, NativeMachine, library, load
 from rl1.vm.scripted import IGNORED, ScriptedDevice, parse_script, run_document
 from rl1.vm.verifier import verify
 
@@ -35,6 +35,7 @@ SOURCE_NAME = "fuzz.rob"
 _ENTRY_KEYS = ("time", "call", "args", "result")
 EXEC_TIMEOUT = 10.0  # seconds an exec: engine may take for one run
 BUDGET_CODE = FaultKind.BUDGET.code
+CRASH_CODE = "crash"  # the status of an engine that raised (a bug in it, not a run)
 
 
 @dataclass(frozen=True)
@@ -45,6 +46,11 @@ class Observation:
     document: dict[str, Any]  # as scripted.run_document gives it
     executed: int | None = None
     call_counts: tuple[int, ...] | None = None
+
+    @property
+    def crashed(self) -> bool:
+        status = self.document.get("status")
+        return isinstance(status, dict) and status.get("code") == CRASH_CODE
 
     @property
     def ran_away(self) -> bool:
@@ -263,14 +269,29 @@ class Verdict:
     problems: list[str]
 
 
+def _observed(engine: Engine, case: Run, budget: int) -> Observation:
+    """The engine's run, or the status `crash` when its compiler or VM raised: a crash
+    is a finding that `rl1c fuzz` shrinks and writes down like a disagreement."""
+    try:
+        return engine.run(case, budget)
+    except BuildError:  # this machine cannot build the C VM: not the program's doing
+        raise
+    except Exception as error:  # whatever it raised is what was found
+        return Observation({"status": {"code": CRASH_CODE, "line": None,
+                                       "message": f"{type(error).__name__}: {error}"},
+                            "variables": {}, "trace": []})
+
+
 def judge(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
     """Run `case` on every engine; compare each with the first, and the optimized VM
     runs with the -O0 one."""
-    observations = {engine.name: engine.run(case, budget) for engine in engines}
+    observations = {engine.name: _observed(engine, case, budget) for engine in engines}
     names = list(observations)
     reference = observations[names[0]]
-    problems = [f"{name}: {line}" for name in names[1:]
-                for line in differences(reference, observations[name])]
+    problems = [f"{name}: crashed: {observation.document['status']['message']}"
+                for name, observation in observations.items() if observation.crashed]
+    problems += [f"{name}: {line}" for name in names[1:]
+                 for line in differences(reference, observations[name])]
     unoptimized = observations.get("vm-O0")
     if unoptimized is not None:
         problems += [f"{name}: {line}" for name in names

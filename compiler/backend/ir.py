@@ -328,12 +328,31 @@ def validate(program: Program) -> list[str]:
             f"{block_id}: jumps to {target}, which is not a block"
             for target in block.successors if target not in program.blocks
         )
+    problems.extend(_decreasing_lines(program))
     for label, block_id in program.handlers.items():
         if label not in HANDLER_LABELS:
             problems.append(f"handler :{label} is not one of :96-:99")
         if block_id not in program.blocks:
             problems.append(f"handler :{label} names {block_id}, which is not a block")
     return problems
+
+
+def _decreasing_lines(program: Program) -> Iterator[str]:
+    """Lines never decrease along the code as the generator lays it out (spec/ilc.md
+    4.4): the blocks in order, each one's instructions, then its terminator unless that
+    is a jump to the next block, which is left out."""
+    order = list(program.blocks)
+    previous = 0
+    for block_id, following in zip(order, [*order[1:], None], strict=True):
+        block = program.blocks[block_id]
+        terminator = block.terminator
+        emitted: list[Instruction | Terminator] = [*block.instructions]
+        if not (isinstance(terminator, Jump) and terminator.target == following):
+            emitted.append(terminator)
+        for item in emitted:
+            if item.line < previous:
+                yield f"{block_id}: line {item.line} comes after line {previous}"
+            previous = max(previous, item.line)
 
 
 def _block_problems(block: Block) -> Iterator[str]:

@@ -88,7 +88,9 @@ def _moves(instructions: list[ir.Instruction], terminator: ir.Terminator
             out += [ir.Move(store.target, load.source, store.line)
                     for store in stores if isinstance(store, ir.Store)]
             if not flow.acc_dead_after(instructions, end, terminator):
-                out.append(load)  # `D=(ULT A); E=D-G`: moves, then the load fuses on
+                # `D=(ULT A); E=D-G`: moves, then the load fuses on with the operation,
+                # on that operation's line (the stores' lines came after the load's)
+                out.append(ir.Load(load.source, instructions[end].line))
             index = end
         else:
             out.append(load)

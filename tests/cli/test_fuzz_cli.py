@@ -58,6 +58,32 @@ def test_a_long_campaign_is_many_searches_with_the_same_programs_for_a_seed(
     assert sources[0] == sources[1] and len(sources[0]) == 10
 
 
+class _CrashesOnLess:
+    """An engine whose compiler fails on any program with a `<` (a shift or a branch),
+    as the optimizer once failed on a line map: a crash is a finding, not the end of
+    the campaign."""
+
+    name = "crashes"
+
+    def run(self, case: Run, budget: int) -> Observation:
+        if "<" in case.source:
+            raise ValueError("line entry (10, 5): lines must not decrease")
+        return engine_named("ast").run(case, budget)  # type: ignore[union-attr]
+
+
+def test_an_engine_that_crashes_is_a_finding_shrunk_like_a_disagreement(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 40)
+    reference = engine_named("ast")
+    assert reference is not None
+    outcome = fuzz.campaign([reference, _CrashesOnLess()], 20_000, count=300,
+                            seconds=None, seed=3, progress=lambda programs, elapsed: None)
+    assert outcome.finding is not None
+    assert "crashes: crashed: ValueError: line entry (10, 5): lines must not decrease" \
+        in outcome.finding.verdict.problems
+    assert len(split_lines(outcome.finding.case.source)) <= 5
+
+
 def test_rl1c_run_itself_is_an_exec_engine_as_the_spec_shows(tmp_path: Path) -> None:
     command = f"exec:{RL1C} run {{ilc}} --sensors {{sensors}} --budget {{budget}} --format json"
     result = rl1c("fuzz", "--engine", "vm-O0", "--engine", command, "--count", "4",
