@@ -38,6 +38,13 @@ class Answer:
 
 OK = Answer(Status.OK)
 BUSY = Answer(Status.BUSY)
+BUSY_OUT_OF_TURN = "the device answered busy where only a poll may (spec/ilc.md 12.5)"
+
+
+def refusal(answer: Answer) -> str:
+    """Why an answer other than OK fails the run: its message, or for BUSY from any
+    callback but poll, that it came out of turn (a device error, as in C)."""
+    return BUSY_OUT_OF_TURN if answer.status is Status.BUSY else answer.message
 
 
 class Hardware(Protocol):

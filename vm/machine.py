@@ -62,7 +62,7 @@ from .faults import (
     budget_message,
     missing_handler_message,
 )
-from .hardware import Answer, Blocking, Hardware, Status
+from .hardware import Answer, Blocking, Hardware, Status, refusal
 from .language import BUILTINS, VARIABLE_INDEX, VARIABLES, Param, lost_line_handler
 from .verifier import VerifiedProgram
 
@@ -310,7 +310,7 @@ class Machine:
             self._begun = True
             answer = self.hardware.begin()
             if answer.status is not Status.OK:
-                return self._faulted(_Faulted(FaultKind.DEVICE, answer.message), None)
+                return self._faulted(_Faulted(FaultKind.DEVICE, refusal(answer)), None)
             try:
                 self.hardware.take_event()  # a loss from before the program is not its own
             except DeviceError as error:
@@ -423,13 +423,16 @@ class Machine:
                     if site.waits:
                         started = hardware.start(site.form, args)
                         if started.status is not Status.OK:
-                            raise DeviceError(started.message)
+                            raise DeviceError(refusal(started))
                         if not self._finish(site, hardware.poll()):
                             self.state, self.waiting = State.WAITING, site
                             self.acc, self.pc, self.executed = acc, pc, executed + pc - start
                             return State.WAITING
                     else:
-                        self._finish(site, hardware.call(site.form, args))
+                        answer = hardware.call(site.form, args)
+                        if answer.status is Status.BUSY:  # only a poll may
+                            raise DeviceError(refusal(answer))
+                        self._finish(site, answer)
                     event = take()
                     if event is not None:
                         executed += pc - start
@@ -492,7 +495,7 @@ class Machine:
                     self.state = State.ENDED
                     ended = hardware.end()
                     if ended.status is not Status.OK:
-                        return self._faulted(_Faulted(FaultKind.DEVICE, ended.message), pc - 1,
+                        return self._faulted(_Faulted(FaultKind.DEVICE, refusal(ended)), pc - 1,
                                              ended=True)
                     self.result = RunResult(tuple(cells[:R_CELL]))
                     return State.ENDED
@@ -584,7 +587,7 @@ class Machine:
         message = fault.message
         stopped = self.hardware.stop()
         if stopped.status is not Status.OK:
-            message += STOP_FAILED + stopped.message
+            message += STOP_FAILED + refusal(stopped)
         if not ended:
             self.hardware.end()  # the fault is reported whatever the end answers
         self.state = State.FAULTED

@@ -38,7 +38,7 @@ from .faults import (
     budget_message,
     missing_handler_message,
 )
-from .hardware import Answer, Hardware, Status
+from .hardware import Answer, Hardware, Status, refusal
 from .language import VARIABLES, lost_line_handler
 from .machine import SLICE, State
 
@@ -282,7 +282,8 @@ class NativeMachine:
                 return _STATUS[Status.ERROR]
         return guarded  # type: ignore[return-value]
 
-    def _answer(self, answer: Answer, form: FormKey | None, out: _Out | None) -> int:
+    def _answer(self, answer: Answer, form: FormKey | None, out: _Out | None,
+                polled: bool = False) -> int:
         """A callback's status; an ERROR's message kept; what a finished call read put in
         `out` (a value that is no 16-bit integer is the device's error, as machine.py's
         device.checked says, and so is one outside its range, which the C VM finds)."""
@@ -294,8 +295,8 @@ class NativeMachine:
                 if not all(-0x8000 <= value <= 0x7FFF for value in _values(answer.outcome)):
                     return _STATUS[Status.ERROR]
             _fill(out.contents, answer.outcome)
-        if answer.status is Status.ERROR:
-            self._message = answer.message
+        if answer.status is Status.ERROR or (answer.status is Status.BUSY and not polled):
+            self._message = refusal(answer)
         return _STATUS[answer.status]
 
     def _begin(self, _ctx: object) -> int:
@@ -311,11 +312,11 @@ class NativeMachine:
         return self._answer(self.hardware.start(form, values), None, None)
 
     def _poll(self, _ctx: object, out: _Out) -> int:
-        return self._answer(self.hardware.poll(), self._form, out)
+        return self._answer(self.hardware.poll(), self._form, out, polled=True)
 
     def _stop(self, _ctx: object) -> int:
         answer = self.hardware.stop()
-        self._stop_message = answer.message if answer.status is not Status.OK else None
+        self._stop_message = refusal(answer) if answer.status is not Status.OK else None
         return _STATUS[answer.status]
 
     def _end(self, _ctx: object) -> int:
