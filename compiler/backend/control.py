@@ -24,8 +24,7 @@ from . import flow, ir
 
 def simplify_control(program: ir.Program) -> ir.Program:
     _remove_unreachable(program)
-    order = list(program.blocks)
-    following = dict(zip(order, [*order[1:], None], strict=True))
+    following = program.following()
     for block in program:
         block.terminator = _threaded(program, following, block.terminator)
     _remove_unreachable(program)

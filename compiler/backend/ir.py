@@ -300,6 +300,12 @@ class Program:
     def successors(self, block_id: BlockId) -> tuple[BlockId, ...]:
         return self.blocks[block_id].successors
 
+    def following(self) -> dict[BlockId, BlockId | None]:
+        """The block laid out after each one (None after the last): where it falls
+        through, so that a jump to it costs no instruction."""
+        order = list(self.blocks)
+        return dict(zip(order, [*order[1:], None], strict=True))
+
     def predecessors(self) -> dict[BlockId, list[BlockId]]:
         """Each block's predecessors in layout order (a block that jumps to itself is
         its own predecessor; the handler table is not an edge)."""
@@ -341,9 +347,8 @@ def _decreasing_lines(program: Program) -> Iterator[str]:
     """Lines never decrease along the code as the generator lays it out (spec/ilc.md
     4.4): the blocks in order, each one's instructions, then its terminator unless that
     is a jump to the next block, which is left out."""
-    order = list(program.blocks)
     previous = 0
-    for block_id, following in zip(order, [*order[1:], None], strict=True):
+    for block_id, following in program.following().items():
         block = program.blocks[block_id]
         terminator = block.terminator
         emitted: list[Instruction | Terminator] = [*block.instructions]
