@@ -120,7 +120,9 @@ class Flaky:
         return self.plan[(self.calls - 1) % len(self.plan)] if self.plan else PASS
 
     def _answer(self, answer: Answer) -> Answer:
-        action = self._action()
+        return self._misbehaved(self._action(), answer)
+
+    def _misbehaved(self, action: int, answer: Answer) -> Answer:
         if action == ERROR:
             return Answer(Status.ERROR, message=f"callback {self.calls} fails")
         if action == BUSY_OUT_OF_TURN:
@@ -148,15 +150,13 @@ class Flaky:
         if self.released:
             self.released = False
             return self.inner.poll()
-        if self.plan and self.plan[self.calls % len(self.plan)] == BUSY_TWICE:
-            self.calls += 1
+        action = self._action()
+        if action == BUSY_TWICE:
             self.busy, self.released = 1, True
             return BUSY
+        # BUSY from a poll would be no misbehaviour: that action passes here
         answer = self.inner.poll()
-        if self.plan and self.plan[self.calls % len(self.plan)] == BUSY_OUT_OF_TURN:
-            self.calls += 1  # BUSY from a poll would be no misbehaviour: pass instead
-            return answer
-        return self._answer(answer)
+        return answer if action == BUSY_OUT_OF_TURN else self._misbehaved(action, answer)
 
     def stop(self) -> Answer:
         return self._answer(self.inner.stop())
