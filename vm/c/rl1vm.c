@@ -229,16 +229,58 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
 /* A signed byte, without the implementation-defined conversion to int8_t. */
 #define S8_AT(k) ((int16_t)((int16_t)U8_AT(k) - (int16_t)((U8_AT(k) & 0x80u) << 1)))
 
-/* The seven operators of one operand kind (spec/ilc.md 8.2: base + the operator's
- * index), each its own case: a second dispatch on the operator would cost as much. */
-#define ALU_CASES(base, operand, size)                                                   \
-    case (base) + 0: acc = (uint16_t)(acc + (operand)); ip += (size); continue;          \
-    case (base) + 1: acc = (uint16_t)(acc - (operand)); ip += (size); continue;          \
-    case (base) + 2: acc = (uint16_t)(acc & (operand)); ip += (size); continue;          \
-    case (base) + 3: acc = (uint16_t)(acc | (operand)); ip += (size); continue;          \
-    case (base) + 4: acc = (uint16_t)(acc ^ (operand)); ip += (size); continue;          \
-    case (base) + 5: acc = shifted(acc, (int16_t)(operand), true); ip += (size); continue; \
-    case (base) + 6: acc = shifted(acc, (int16_t)(operand), false); ip += (size); continue
+/* How one instruction hands over to the next. A switch in a loop has one indirect jump
+ * for all instructions, which the host's branch predictor guesses from little; GCC and
+ * clang can instead end each case with a jump of its own through a table of label
+ * addresses ("threaded" dispatch, as Lua and CPython do), each predicted from the case
+ * it ends. On the computation of bench/c_speed.py that is 25 ms against 35 (gcc 12,
+ * x86-64). Built for size the table is not worth its flash; define RL1_THREADED as 0 to
+ * keep the switch anyway.
+ *
+ * Every case is CASE(opcode): a case label and, threaded, the label op_<opcode> the
+ * table points at (the compiler refuses a table entry without its case, and
+ * -Wunused-label a case missing from the table). Threaded, each case counts itself
+ * (left--), which leaves the jump that ends a case three instructions long: short
+ * enough for GCC to keep one in each case rather than merge them all into one, which
+ * would give the gain back. */
+#if defined(__OPTIMIZE_SIZE__) && !defined(RL1_COMPACT)
+#define RL1_COMPACT 1
+#endif
+#if !defined(RL1_THREADED)
+#if defined(__GNUC__) && !defined(RL1_COMPACT)
+#define RL1_THREADED 1
+#else
+#define RL1_THREADED 0
+#endif
+#endif
+#if RL1_THREADED && defined(RL1_COMPACT)
+#error "RL1_THREADED needs a case of its own for each instruction: not with RL1_COMPACT"
+#endif
+#if RL1_THREADED
+#define COUNTED(label) label: left--;
+#define CASE(op) case op: COUNTED(op_##op)
+#define NEXT()                                                                           \
+    if (ip >= stop) { /* the limit or the end is near: the loop's head looks */          \
+        continue;                                                                        \
+    }                                                                                    \
+    __extension__({ goto *targets[RL1_BYTE(ip)]; })
+#else
+#define COUNTED(label)
+#define CASE(op) case op:
+#define NEXT() continue
+#endif
+
+/* The seven operators of one operand kind, opcodes `o0`..`o6` (spec/ilc.md 8.2: base +
+ * the operator's index), each its own case: a second dispatch on the operator would cost
+ * as much. */
+#define ALU_CASES(o0, o1, o2, o3, o4, o5, o6, operand, size)                              \
+    CASE(o0) acc = (uint16_t)(acc + (operand)); ip += (size); NEXT();                    \
+    CASE(o1) acc = (uint16_t)(acc - (operand)); ip += (size); NEXT();                    \
+    CASE(o2) acc = (uint16_t)(acc & (operand)); ip += (size); NEXT();                    \
+    CASE(o3) acc = (uint16_t)(acc | (operand)); ip += (size); NEXT();                    \
+    CASE(o4) acc = (uint16_t)(acc ^ (operand)); ip += (size); NEXT();                    \
+    CASE(o5) acc = shifted(acc, (int16_t)(operand), true); ip += (size); NEXT();         \
+    CASE(o6) acc = shifted(acc, (int16_t)(operand), false); ip += (size); NEXT()
 
 /* The load-and-operate superinstructions (format 1.2): acc = first op second, the
  * operator in the low 3 bits as in ALU_CASES; also the operations on R (`first` is then
@@ -246,45 +288,42 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
  * operands and the operators are one switch for all of them: on Cortex-M3 that is 296
  * bytes of flash fewer, which keeps the VM and verifier within 4 KB. Otherwise each is a
  * case of its own, which the host's branch predictor prefers (the computation of
- * bench/c_speed.py at -O2: 67 ms against 79). The vectors run both ways: the targets
- * build with -Os, and the clang sanitizer build defines RL1_COMPACT. */
-#if defined(__OPTIMIZE_SIZE__) && !defined(RL1_COMPACT)
-#define RL1_COMPACT 1
-#endif
+ * bench/c_speed.py at -O2, with the switch: 67 ms against 79). The vectors run every
+ * way: the targets build with -Os, the clang sanitizer build defines RL1_COMPACT, and
+ * gcc's runs threaded and with RL1_THREADED=0. */
 #ifdef RL1_COMPACT
-#define COMPUTE_CASES(base, first, second, size)                                         \
-    case (base) + 0: case (base) + 1: case (base) + 2: case (base) + 3: case (base) + 4:  \
-    case (base) + 5: case (base) + 6:                                                    \
+#define COMPUTE_CASES(o0, o1, o2, o3, o4, o5, o6, first, second, size)                   \
+    CASE(o0) CASE(o1) CASE(o2) CASE(o3) CASE(o4) CASE(o5) CASE(o6)                \
         acc = (uint16_t)(first);                                                         \
         operand = (second);                                                              \
         ip += (size);                                                                    \
         goto compute
 #else
-#define COMPUTE_CASES(base, first, second, size)                                         \
-    case (base) + 0: acc = (uint16_t)((uint16_t)(first) + (second)); ip += (size); continue; \
-    case (base) + 1: acc = (uint16_t)((uint16_t)(first) - (second)); ip += (size); continue; \
-    case (base) + 2: acc = (uint16_t)((uint16_t)(first) & (second)); ip += (size); continue; \
-    case (base) + 3: acc = (uint16_t)((uint16_t)(first) | (second)); ip += (size); continue; \
-    case (base) + 4: acc = (uint16_t)((uint16_t)(first) ^ (second)); ip += (size); continue; \
-    case (base) + 5:                                                                      \
-        acc = shifted((uint16_t)(first), (int16_t)(second), true); ip += (size); continue; \
-    case (base) + 6:                                                                      \
-        acc = shifted((uint16_t)(first), (int16_t)(second), false); ip += (size); continue
+#define COMPUTE_CASES(o0, o1, o2, o3, o4, o5, o6, first, second, size)                   \
+    CASE(o0) acc = (uint16_t)((uint16_t)(first) + (second)); ip += (size); NEXT();       \
+    CASE(o1) acc = (uint16_t)((uint16_t)(first) - (second)); ip += (size); NEXT();       \
+    CASE(o2) acc = (uint16_t)((uint16_t)(first) & (second)); ip += (size); NEXT();       \
+    CASE(o3) acc = (uint16_t)((uint16_t)(first) | (second)); ip += (size); NEXT();       \
+    CASE(o4) acc = (uint16_t)((uint16_t)(first) ^ (second)); ip += (size); NEXT();       \
+    CASE(o5) acc = shifted((uint16_t)(first), (int16_t)(second), true); ip += (size); NEXT(); \
+    CASE(o6) acc = shifted((uint16_t)(first), (int16_t)(second), false); ip += (size); NEXT()
 #endif
 
-/* A conditional jump on V[v] (at ip + 1) to the target at ip + 2. */
-#define JUMP_IF(condition)                                                                \
-    if (condition) {                                                                     \
+/* A conditional jump to the target at ip + 2 when `value` (V[v], v at ip + 1) passes
+ * `test`. `value` is a local: the code is uint8_t, a character type that may alias V, so
+ * reading V[v] back after a store would reload both. */
+#define JUMP_IF(value, test)                                                              \
+    if ((value) test 0) {                                                                \
         target = U16_AT(2);                                                              \
         goto jump;                                                                       \
     }                                                                                    \
     ip += 4;                                                                             \
-    continue
+    NEXT()
 
 /* Where the dispatch loop must look at the step's limit and the code's end: at the end
  * when the limit cannot come first (each instruction takes at least a byte, so a
  * straight run from ip meets the end within end - ip instructions); else at every
- * instruction (`code`, which every ip passes). Set again wherever a jump lands. */
+ * instruction (`code`, which every ip passes). */
 #define STOP (left >= (uint32_t)(end - ip) ? end : code)
 
 /* Runs at most n instructions from vm->pc. The hot state lives in locals and goes back
@@ -293,9 +332,43 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
 static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
                      uint32_t n)
 {
+#if RL1_THREADED
+    /* Each valid opcode's case (the verifier refuses the others). The empty asm makes
+     * the table's address opaque, so that it stays in a register rather than being
+     * remade in each case's jump, which would then be too long to keep in the case. */
+    __extension__ static const void *const table[128] = {
+        [0x00] = &&op_0x00, [0x01] = &&op_0x01, [0x02] = &&op_0x02, [0x03] = &&op_0x03,
+        [0x04] = &&op_0x04, [0x05] = &&op_0x05, [0x06] = &&op_0x06, [0x07] = &&op_0x07,
+        [0x08] = &&op_0x08, [0x09] = &&op_0x09, [0x0A] = &&op_0x0A,
+#define TARGETS7(o0, o1, o2, o3, o4, o5, o6)                                                  \
+        [o0] = &&op_##o0, [o1] = &&op_##o1, [o2] = &&op_##o2, [o3] = &&op_##o3,             \
+        [o4] = &&op_##o4, [o5] = &&op_##o5, [o6] = &&op_##o6
+        TARGETS7(0x10, 0x11, 0x12, 0x13, 0x14, 0x15, 0x16),
+        TARGETS7(0x18, 0x19, 0x1A, 0x1B, 0x1C, 0x1D, 0x1E),
+        TARGETS7(0x20, 0x21, 0x22, 0x23, 0x24, 0x25, 0x26),
+        [0x30] = &&op_0x30, [0x31] = &&op_0x31, [0x32] = &&op_0x32, [0x33] = &&op_0x33,
+        [0x34] = &&op_0x34, [0x35] = &&op_0x35, [0x36] = &&op_0x36, [0x37] = &&op_0x37,
+        [0x40] = &&op_call, [0x41] = &&op_call, [0x42] = &&op_call, [0x43] = &&op_call,
+        [0x44] = &&op_call, [0x45] = &&op_call, [0x46] = &&op_call, [0x47] = &&op_call,
+        [0x48] = &&op_call, [0x49] = &&op_call, [0x4A] = &&op_call, [0x4B] = &&op_call,
+        [0x4C] = &&op_call, [0x4D] = &&op_call, [0x4E] = &&op_call, [0x4F] = &&op_call,
+        [0x50] = &&op_call, [0x51] = &&op_call, [0x52] = &&op_call, [0x53] = &&op_call,
+        [0x54] = &&op_call, [0x55] = &&op_call, [0x56] = &&op_call, [0x57] = &&op_call,
+        [0x58] = &&op_call, [0x59] = &&op_call, [0x5A] = &&op_call, [0x5B] = &&op_call,
+        [0x5C] = &&op_call, [0x5D] = &&op_call,
+        TARGETS7(0x60, 0x61, 0x62, 0x63, 0x64, 0x65, 0x66),
+        TARGETS7(0x68, 0x69, 0x6A, 0x6B, 0x6C, 0x6D, 0x6E),
+        TARGETS7(0x70, 0x71, 0x72, 0x73, 0x74, 0x75, 0x76),
+        TARGETS7(0x78, 0x79, 0x7A, 0x7B, 0x7C, 0x7D, 0x7E)
+#undef TARGETS7
+    };
+    const void *const *targets = table;
+    __asm__("" : "+r"(targets));
+#endif
     const uint8_t *const code = program->code, *const end = code + program->code_size;
     const uint8_t *ip = code + vm->pc;
     int16_t *const V = vm->V;
+    int16_t *variable, value;
     uint16_t acc = (uint16_t)vm->acc, target = 0;
     uint32_t left = n, before = vm->executed;
     /* The watchdog (section 9): more than `budget` run in all once left < over_below. */
@@ -318,46 +391,60 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
                 break;
             }
         }
-        left--;
         op = RL1_BYTE(ip);
+#if RL1_THREADED
+        __extension__({ goto *targets[op]; }); /* each case counts itself */
+#else
+        left--;
+#endif
         switch (op) {
-        case 0x00: /* END */
+        CASE(0x00) /* END */
             state = RL1_ENDED;
             break;
-        case 0x01: acc = (uint16_t)VAR_AT(1); ip += 2; continue;           /* LDV v */
-        case 0x02: acc = U16_AT(1); ip += 3; continue;                     /* LDI i */
-        case 0x03: acc = (uint16_t)vm->R; ip += 1; continue;               /* LDR */
-        case 0x04: VAR_AT(1) = (int16_t)acc; ip += 2; continue;            /* STV v */
-        case 0x05:                                                           /* INC v */
-            VAR_AT(1) = (int16_t)(uint16_t)((uint16_t)VAR_AT(1) + 1u);
+        CASE(0x01) acc = (uint16_t)VAR_AT(1); ip += 2; NEXT();            /* LDV v */
+        CASE(0x02) acc = U16_AT(1); ip += 3; NEXT();                      /* LDI i */
+        CASE(0x03) acc = (uint16_t)vm->R; ip += 1; NEXT();                /* LDR */
+        CASE(0x04) VAR_AT(1) = (int16_t)acc; ip += 2; NEXT();             /* STV v */
+        CASE(0x05)                                                          /* INC v */
+            variable = &VAR_AT(1);
+            *variable = (int16_t)(uint16_t)((uint16_t)*variable + 1u);
             ip += 2;
-            continue;
-        case 0x06:                                                           /* DEC v */
-            VAR_AT(1) = (int16_t)(uint16_t)((uint16_t)VAR_AT(1) - 1u);
+            NEXT();
+        CASE(0x06)                                                          /* DEC v */
+            variable = &VAR_AT(1);
+            *variable = (int16_t)(uint16_t)((uint16_t)*variable - 1u);
             ip += 2;
-            continue;
+            NEXT();
         /* The superinstructions of format 1.2 (the verifier refuses them in older files). */
-        case 0x07: VAR_AT(1) = VAR_AT(2); ip += 3; continue;               /* MOVV v, w */
-        case 0x08: VAR_AT(1) = (int16_t)U16_AT(2); ip += 4; continue;      /* MOVI v, i */
-        case 0x09: VAR_AT(1) = vm->R; ip += 2; continue;                   /* MOVR v */
-        case 0x0A: VAR_AT(1) = S8_AT(2); ip += 3; continue;                /* MOVB v, b */
-        ALU_CASES(0x10, (uint16_t)VAR_AT(1), 2);                             /* ...V */
-        ALU_CASES(0x18, U16_AT(1), 3);                                       /* ...I */
-        COMPUTE_CASES(0x20, acc, (uint16_t)vm->R, 1);                      /* ...R */
-        case 0x30: target = U16_AT(1); goto jump;                          /* JMP a */
-        case 0x31: JUMP_IF(VAR_AT(1) == 0);                                  /* JZ v, a */
-        case 0x32: JUMP_IF(VAR_AT(1) > 0);                                   /* JGT v, a */
-        case 0x33: JUMP_IF(VAR_AT(1) < 0);                                   /* JLT v, a */
-        case 0x34:                                                           /* DJGT v, a */
-            VAR_AT(1) = (int16_t)(uint16_t)((uint16_t)VAR_AT(1) - 1u);
-            JUMP_IF(VAR_AT(1) > 0);
-        case 0x35: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) == 0);       /* SJZ v, a */
-        case 0x36: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) > 0);        /* SJGT v, a */
-        case 0x37: VAR_AT(1) = (int16_t)acc; JUMP_IF(VAR_AT(1) < 0);        /* SJLT v, a */
-        COMPUTE_CASES(0x60, VAR_AT(1), (uint16_t)VAR_AT(2), 3);            /* ...VV v, w */
-        COMPUTE_CASES(0x68, VAR_AT(1), U16_AT(2), 4);                       /* ...VI v, i */
-        COMPUTE_CASES(0x70, vm->R, (uint16_t)VAR_AT(1), 2);                 /* ...RV v */
-        COMPUTE_CASES(0x78, vm->R, U16_AT(1), 3);                           /* ...RI i */
+        CASE(0x07) VAR_AT(1) = VAR_AT(2); ip += 3; NEXT();                /* MOVV v, w */
+        CASE(0x08) VAR_AT(1) = (int16_t)U16_AT(2); ip += 4; NEXT();       /* MOVI v, i */
+        CASE(0x09) VAR_AT(1) = vm->R; ip += 2; NEXT();                    /* MOVR v */
+        CASE(0x0A) VAR_AT(1) = S8_AT(2); ip += 3; NEXT();                 /* MOVB v, b */
+        ALU_CASES(0x10, 0x11, 0x12, 0x13, 0x14, 0x15, 0x16,
+                  (uint16_t)VAR_AT(1), 2);                                   /* ADDV ... */
+        ALU_CASES(0x18, 0x19, 0x1A, 0x1B, 0x1C, 0x1D, 0x1E, U16_AT(1), 3);  /* ADDI ... */
+        COMPUTE_CASES(0x20, 0x21, 0x22, 0x23, 0x24, 0x25, 0x26,
+                      acc, (uint16_t)vm->R, 1);                              /* ADDR ... */
+        CASE(0x30) target = U16_AT(1); goto jump;                         /* JMP a */
+        CASE(0x31) JUMP_IF(VAR_AT(1), ==);                                  /* JZ v, a */
+        CASE(0x32) JUMP_IF(VAR_AT(1), >);                                   /* JGT v, a */
+        CASE(0x33) JUMP_IF(VAR_AT(1), <);                                   /* JLT v, a */
+        CASE(0x34)                                                          /* DJGT v, a */
+            variable = &VAR_AT(1);
+            value = (int16_t)(uint16_t)((uint16_t)*variable - 1u);
+            *variable = value;
+            JUMP_IF(value, >);
+        CASE(0x35) value = (int16_t)acc; VAR_AT(1) = value; JUMP_IF(value, ==); /* SJZ */
+        CASE(0x36) value = (int16_t)acc; VAR_AT(1) = value; JUMP_IF(value, >); /* SJGT */
+        CASE(0x37) value = (int16_t)acc; VAR_AT(1) = value; JUMP_IF(value, <); /* SJLT */
+        COMPUTE_CASES(0x60, 0x61, 0x62, 0x63, 0x64, 0x65, 0x66,
+                      VAR_AT(1), (uint16_t)VAR_AT(2), 3);                    /* ADDVV ... */
+        COMPUTE_CASES(0x68, 0x69, 0x6A, 0x6B, 0x6C, 0x6D, 0x6E,
+                      VAR_AT(1), U16_AT(2), 4);                              /* ADDVI ... */
+        COMPUTE_CASES(0x70, 0x71, 0x72, 0x73, 0x74, 0x75, 0x76,
+                      vm->R, (uint16_t)VAR_AT(1), 2);                        /* ADDRV ... */
+        COMPUTE_CASES(0x78, 0x79, 0x7A, 0x7B, 0x7C, 0x7D, 0x7E,
+                      vm->R, U16_AT(1), 3);                                  /* ADDRI ... */
         default:
             UNREACHABLE(); /* the verifier refuses every other opcode */
             break;
@@ -366,10 +453,12 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
         case 0x4E: case 0x4F: case 0x50: case 0x51: case 0x52: case 0x53: case 0x54:
         case 0x55: case 0x56: case 0x57: case 0x58: case 0x59: case 0x5A: case 0x5B:
         case 0x5C: case 0x5D: /* the calls */
+            COUNTED(op_call)
             if (left < over_below) {
                 kind = RL1_FAULT_BUDGET;
                 break;
             }
+            op = RL1_BYTE(ip); /* not set by a threaded jump */
             length = call_length(op);
             vm->executed = before + (n - left);
             vm->pc = (uint16_t)(ip - code + length);
@@ -389,7 +478,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
             }
             ip = code + target;
             stop = STOP;
-            continue;
+            NEXT();
         }
         break;
 
@@ -404,7 +493,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
         case 5: acc = shifted(acc, (int16_t)operand, true); break;
         default: acc = shifted(acc, (int16_t)operand, false); break; /* 6 */
         }
-        continue;
+        NEXT();
 #endif
 
     jump: /* a jump taken: the watchdog, then the event point (section 9) */
@@ -418,6 +507,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
         }
         ip = code + target;
         stop = STOP;
+        NEXT();
     }
     vm->pc = (uint16_t)(ip - code);
     vm->acc = (int16_t)acc;
