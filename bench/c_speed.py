@@ -40,7 +40,7 @@ from rl1.vm.drive import drive
 from rl1.vm.hardware import Blocking
 from rl1.vm.language import Feature
 from rl1.vm.machine import Machine
-from rl1.vm.scripted import ScriptedDevice, parse_script
+from rl1.vm.scripted import LOST, ScriptedDevice, parse_script
 from rl1.vm.verifier import verify
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -74,6 +74,8 @@ repeat
 until not (b > 0)
 print(a)
 """
+# Trace entries that no call instruction made: the device's stop after a fault, a loss.
+NOT_CALLS = ("STOP", LOST)
 # The callbacks of vm/c/test/scripted.c: their cost is the device's, not the VM's.
 CALLBACKS = ("begin", "call", "start", "poll", "stop", "end")
 
@@ -169,11 +171,13 @@ def speed(runner: Path, folder: Path, repeat: int) -> None:
 def instructions(runner: Path, folder: Path) -> None:
     print("2. host instructions per bytecode instruction (callgrind, rl1_step without the "
           "device's callbacks)")
-    computation = folder / "computation.txt"
-    executed = write_vectors(computation, [vector("computation", compiled(
-        COMPUTATION.replace(str(OUTER), "300"), "c.rob"), {})])
-    cost = callgrind_cost(runner, computation, folder)
-    print(f"   the computation          {cost / executed:6.2f}  ({cost:,} / {executed:,})")
+    for level in (0, 2):
+        computation = folder / f"small-O{level}.txt"
+        executed = write_vectors(computation, [vector("computation", compiled(
+            COMPUTATION.replace(str(OUTER), "300"), "c.rob", level), {})])
+        cost = callgrind_cost(runner, computation, folder)
+        print(f"   the computation at -O{level}       {cost / executed:6.2f}  "
+              f"({cost:,} / {executed:,})")
     for level in (0, 2):
         vectors = []
         for path in CORPUS:
@@ -184,9 +188,12 @@ def instructions(runner: Path, folder: Path) -> None:
                                                       path.name, level), sensors))
         corpus = folder / f"corpus-O{level}.txt"
         executed = write_vectors(corpus, vectors)
+        calls = sum(1 for v in vectors if isinstance(trace := v["trace"], list)
+                    for entry in trace if entry["call"] not in NOT_CALLS)
         cost = callgrind_cost(runner, corpus, folder)
         print(f"   the corpus at -O{level} ({len(vectors)} programs) {cost / executed:6.2f}  "
-              f"({cost:,} / {executed:,})   (goal: at most 10)")
+              f"({cost:,} / {executed:,}, {calls:,} of them device calls)   "
+              "(goal: at most 10)")
 
 
 def big_program() -> bytes:
