@@ -60,13 +60,16 @@ static uint16_t shifted(uint16_t x, int16_t count, bool left)
     return (uint16_t)(x >> places);
 }
 
-/* Whether built-in `op` takes device time, so is started and polled (12.2): ORG MVI
- * STR STL STX ROT TIM IMG, every CAM and ULT form. */
-static bool takes_time(uint8_t op)
-{
-    return op == 0x42u || op == 0x43u || (op >= 0x45u && op <= 0x48u) || op == 0x4Au
-           || (op >= OP_IMG && op <= OP_ULTD);
-}
+/* Sets of calls (0x40..0x5D), as bit op - 0x40 of a word: a test is one AND. */
+#define CALL_BIT(op) ((uint32_t)1 << ((op) - 0x40u))
+/* The calls that take device time, so are started and polled (12.2): ORG MVI STR STL
+ * STX ROT TIM, and IMG through ULT D (every CAM and ULT form). */
+#define TAKE_TIME (CALL_BIT(0x42) | CALL_BIT(0x43) | CALL_BIT(0x45) | CALL_BIT(0x46)       \
+                   | CALL_BIT(0x47) | CALL_BIT(0x48) | CALL_BIT(0x4A)                      \
+                   | (CALL_BIT(OP_ULTD + 1u) - CALL_BIT(OP_IMG)))
+/* The calls whose result goes into R: KYO, IMG, CAM R, every ULT form, INP. */
+#define SET_R (CALL_BIT(OP_KYO) | CALL_BIT(OP_IMG) | CALL_BIT(OP_INP)                      \
+               | (CALL_BIT(OP_ULTD + 1u) - CALL_BIT(OP_CAMR)))
 
 /* Takes a finished call's answer: false for a device error (an ERROR, or a value out of
  * its documented range, 12.5: then nothing is written); else writes the reserved
@@ -74,7 +77,8 @@ static bool takes_time(uint8_t op)
 static bool finish(rl1_vm *vm, uint8_t op, rl1_status status, const rl1_reading *out)
 {
     uint8_t first = 0, count = 0, k;
-    if (status != RL1_OK) {
+    if (status != RL1_OK || (op == OP_CAMR && (out->result < 0 || out->result > 784))
+        || (op == OP_INP && (out->result < 0 || out->result > 255))) {
         return false;
     }
     if (op == OP_KYO) {
@@ -86,30 +90,26 @@ static bool finish(rl1_vm *vm, uint8_t op, rl1_status status, const rl1_reading 
     } else if (op == OP_FZI) {
         first = VAR_S; /* s, t */
         count = 2;
-    } else if ((op == OP_CAMR && (out->result < 0 || out->result > 784))
-               || (op == OP_INP && (out->result < 0 || out->result > 255))) {
-        return false;
     }
     for (k = 0; k < count; k++) {
         vm->V[first + k] = out->writes[k];
     }
-    if (op == OP_KYO || op == OP_IMG || (op >= OP_CAMR && op <= OP_ULTD) || op == OP_INP) {
+    if (CALL_BIT(op) & SET_R) {
         vm->R = out->result;
     }
     return true;
 }
 
-/* The call `op`, `length` bytes long, whose operands start at `operands` (section 9,
- * steps 2-6): a fault, or RL1_FAULT_NONE with vm->waiting set when its first poll
- * answered busy. */
-static rl1_fault call(rl1_vm *vm, const rl1_hardware *hw, uint8_t op, uint8_t length,
+/* The call `op`, with `arity` arguments after the mask at `operands` (section 9, steps
+ * 2-6): a fault, or RL1_FAULT_NONE with vm->waiting set when its first poll answered
+ * busy. */
+static rl1_fault call(rl1_vm *vm, const rl1_hardware *hw, uint8_t op, uint8_t arity,
                       const uint8_t *operands)
 {
     int16_t args[3];
     rl1_reading out = {0, {0, 0, 0, 0}};
     rl1_status status;
     uint8_t mask, k;
-    uint8_t arity = length > 1u ? (uint8_t)((length - 2u) / 2u) : 0u; /* mask, 2 bytes each */
     if (arity) {
         mask = RL1_BYTE(operands);
         for (k = 0; k < arity; k++) { /* left to right; the first out of range faults */
@@ -124,7 +124,7 @@ static rl1_fault call(rl1_vm *vm, const rl1_hardware *hw, uint8_t op, uint8_t le
             }
         }
     }
-    if (takes_time(op)) {
+    if (CALL_BIT(op) & TAKE_TIME) {
         if (hw->start(hw->ctx, op, arity ? args : NULL) != RL1_OK) {
             return RL1_FAULT_DEVICE;
         }
@@ -190,8 +190,8 @@ static rl1_state ended(rl1_vm *vm, const rl1_hardware *hw, uint16_t at)
 /* The length of the call instruction `op` (a call in progress is at pc minus it). */
 static uint8_t call_length(uint8_t op)
 {
-    uint8_t shape;
-    return rl1_op_length(op, 0, &shape);
+    uint8_t arity = rl1_call_arity(op);
+    return arity ? (uint8_t)(2u + 2u * arity) : 1u;
 }
 
 /* Resumes a call in progress (12.2): polls it once. */
@@ -377,7 +377,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
     const uint8_t *stop = STOP;
     rl1_fault kind = RL1_FAULT_NONE;
     rl1_state state = RL1_RUNNING;
-    uint8_t op, length;
+    uint8_t op;
 #ifdef RL1_COMPACT
     uint16_t operand;
 #endif
@@ -459,10 +459,9 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
                 break;
             }
             op = RL1_BYTE(ip); /* not set by a threaded jump */
-            length = call_length(op);
             vm->executed = before + (n - left);
-            vm->pc = (uint16_t)(ip - code + length);
-            kind = call(vm, hw, op, length, ip + 1);
+            vm->pc = (uint16_t)(ip - code + call_length(op));
+            kind = call(vm, hw, op, rl1_call_arity(op), ip + 1);
             if (kind != RL1_FAULT_NONE) {
                 break;
             }

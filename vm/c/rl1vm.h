@@ -124,6 +124,23 @@ void rl1_vm_init(rl1_vm *vm, uint32_t budget);
  * operands' shape; 0 for an opcode unknown in that version. */
 uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape);
 
+/* How many arguments call `op` (0x40..0x5D) takes, 0 to 3: two bits a call, the calls
+ * from 0x40 in one word and from 0x50 in the other (a table would be copied to RAM on
+ * AVR). The call is then 1 byte long without arguments, else 2 + 2 * arity. */
+#define RL1_ARITY(op, n) ((uint32_t)(n) << (2u * ((op) & 0x0Fu)))
+static inline uint8_t rl1_call_arity(uint8_t op)
+{
+    uint32_t arities = op < 0x50u
+        ? RL1_ARITY(0x43, 3) | RL1_ARITY(0x44, 2) /* MVI l, r, cm; MOV l, r */
+          | RL1_ARITY(0x45, 1) | RL1_ARITY(0x46, 1) | RL1_ARITY(0x47, 1) /* STR STL STX */
+          | RL1_ARITY(0x48, 1) | RL1_ARITY(0x49, 1) | RL1_ARITY(0x4A, 1) /* ROT TRC TIM */
+          | RL1_ARITY(0x4D, 1)                                          /* SCN */
+        : RL1_ARITY(0x52, 1) | RL1_ARITY(0x53, 1) /* CAM A, CAM P */
+          | RL1_ARITY(0x59, 1) | RL1_ARITY(0x5A, 1) /* LMP, INP */
+          | RL1_ARITY(0x5B, 2) | RL1_ARITY(0x5C, 2); /* OUT port, data; FZO a, b */
+    return (uint8_t)((arities >> (2u * (op & 0x0Fu))) & 3u);
+}
+
 /* Whether `value` lies in the range of parameter `index` of call `op`. */
 bool rl1_arg_in_range(uint8_t op, uint8_t index, int32_t value);
 

@@ -168,22 +168,12 @@ uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape)
         *shape = VAR_ADDR; /* JZ, JGT, JLT */
         return 4;
     }
-    switch (op) {
-    case 0x43: /* MVI l, r, cm */
-        *shape = ARGS;
-        return 8;
-    case 0x44: case 0x5B: case 0x5C: /* MOV l, r; OUT port, data; FZO a, b */
-        *shape = ARGS;
-        return 6;
-    case 0x45: case 0x46: case 0x47: case 0x48: case 0x49: case 0x4A: case 0x4D:
-    case 0x52: case 0x53: case 0x59: case 0x5A:
-        /* STR, STL, STX, ROT, TRC, TIM, SCN, CAM A, CAM P, LMP, INP: one argument */
-        *shape = ARGS;
-        return 4;
-    default:
-        /* The calls without arguments, 0x40..0x5D, and nothing else. */
-        return (op >= 0x40u && op <= 0x5Du) ? 1u : 0u;
+    if (op >= 0x40u && op <= 0x5Du) { /* the calls */
+        uint8_t arity = rl1_call_arity(op);
+        *shape = arity ? ARGS : NONE;
+        return arity ? (uint8_t)(2u + 2u * arity) : 1u;
     }
+    return 0;
 }
 
 /* The device feature bit a call needs (spec/ilc.md 4.3); NO_FEATURE for END, TIM and
