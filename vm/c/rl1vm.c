@@ -8,7 +8,8 @@
  *
  * Portability: `int` may be 16 bits (AVR). `acc` is kept as a uint16_t bit pattern, so
  * that +, - and the shifts wrap without signed overflow; a value becomes an int16_t
- * only when stored (two's complement, spec/ilc.md section 13). No table in static data.
+ * only when stored (two's complement, spec/ilc.md section 13). No table in static data
+ * but the threaded dispatch's (RL1_THREADED, never built for size), which is constant.
  */
 #include "rl1vm.h"
 

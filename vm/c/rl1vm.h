@@ -7,8 +7,9 @@
  * the VM (rl1vm.c), which steps a verified program (spec/ilc.md section 12) and drives
  * the vehicle through the callbacks of rl1_hardware.h.
  *
- * No allocation, no recursion, no floating point, no static data: all state is in
- * the caller's rl1_program and rl1_vm. Sizes are u32 and every sum of them is checked
+ * No allocation, no recursion, no floating point, no static data (but the constant
+ * table of the threaded dispatch, in builds for speed: rl1vm.c): all state is in the
+ * caller's rl1_program and rl1_vm. Sizes are u32 and every sum of them is checked
  * before it is made, so no file, however damaged, makes the loader read outside it.
  */
 #ifndef RL1VM_H
