@@ -260,11 +260,12 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
 #if RL1_THREADED
 #define COUNTED(label) label: left--;
 #define CASE(op) case op: COUNTED(op_##op)
+/* One statement (no do-while, whose body would take the `continue`). */
 #define NEXT()                                                                           \
     if (ip >= stop) { /* the limit or the end is near: the loop's head looks */          \
         continue;                                                                        \
-    }                                                                                    \
-    __extension__({ goto *targets[RL1_BYTE(ip)]; })
+    } else                                                                               \
+        __extension__({ goto *targets[RL1_BYTE(ip)]; })
 #else
 #define COUNTED(label)
 #define CASE(op) case op:
