@@ -50,6 +50,7 @@ from generate import render_text  # noqa: E402
 C_FOLDER = ROOT / "vm" / "c"
 CORPUS = [ROOT / "examples" / "sample.rob", *sorted((ROOT / "bench" / "corpus").glob("*.rob"))]
 BUDGET = 2**31 - 1
+SPEED_LEVELS = (0, 1, 2)  # -O1: what rl1c compiles at unless told
 OUTER = 30000  # iterations of the computation's outer loop (200 inner ones each)
 
 # The same computation twice: A=((A^C)+B)&4095 over C=200..1 for B=OUTER..1. The AND
@@ -148,7 +149,7 @@ def speed(runner: Path, folder: Path, repeat: int) -> None:
     commands = [["lua5.4", str(lua_work)], ["lua5.4", str(lua_empty)],
                 [str(runner), "--once", str(empty)]]
     executed = []
-    for level in (0, 2):
+    for level in SPEED_LEVELS:
         data = compiled(COMPUTATION, "c.rob", level)
         answer = Machine(verify(data), Blocking(ScriptedDevice()), BUDGET).run().variables[0]
         assert lua_said == str(answer), f"Lua computes {lua_said}, the VM {answer}"
@@ -161,7 +162,7 @@ def speed(runner: Path, folder: Path, repeat: int) -> None:
           "start-up subtracted)")
     print(f"   Lua 5.4       {lua_net * 1000:8.1f} ms  ({lua_time * 1000:.1f} - "
           f"{lua_start * 1000:.1f})")
-    for level, c_time, count in zip((0, 2), c_times, executed, strict=True):
+    for level, c_time, count in zip(SPEED_LEVELS, c_times, executed, strict=True):
         c_net = c_time - c_start
         print(f"   C VM, -O{level}    {c_net * 1000:8.1f} ms  ({c_time * 1000:.1f} - "
               f"{c_start * 1000:.1f}; {count:,} instructions, {count / c_net / 1e6:.0f} M/s): "
