@@ -235,20 +235,20 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
  * clang can instead end each case with a jump of its own through a table of label
  * addresses ("threaded" dispatch, as Lua and CPython do), each predicted from the case
  * it ends. On the computation of bench/c_speed.py that is 25 ms against 35 (gcc 12,
- * x86-64). Built for size the table is not worth its flash; define RL1_THREADED as 0 to
- * keep the switch anyway.
+ * x86-64). Built for size the table is not worth its flash, nor on AVR, whose start-up
+ * code would copy it to RAM; define RL1_THREADED as 0 to keep the switch anyway.
  *
  * Every case is CASE(opcode): a case label and, threaded, the label op_<opcode> the
  * table points at (the compiler refuses a table entry without its case, and
  * -Wunused-label a case missing from the table). Threaded, each case counts itself
- * (left--), which leaves the jump that ends a case three instructions long: short
- * enough for GCC to keep one in each case rather than merge them all into one, which
- * would give the gain back. */
+ * (left--), which leaves the jump that ends a case two instructions long, a byte's load
+ * and the jump: short enough for GCC to keep one in each case rather than merge them
+ * all into one, which would give the gain back. */
 #if defined(__OPTIMIZE_SIZE__) && !defined(RL1_COMPACT)
 #define RL1_COMPACT 1
 #endif
 #if !defined(RL1_THREADED)
-#if defined(__GNUC__) && !defined(RL1_COMPACT)
+#if defined(__GNUC__) && !defined(RL1_COMPACT) && !defined(__AVR__)
 #define RL1_THREADED 1
 #else
 #define RL1_THREADED 0
