@@ -272,17 +272,21 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
 #define NEXT() continue
 #endif
 
-/* The seven operators of one operand kind, opcodes `o0`..`o6` (spec/ilc.md 8.2: base +
- * the operator's index), each its own case: a second dispatch on the operator would cost
- * as much. */
+/* acc = first op second, for the seven operators of one operand kind, opcodes `o0`..`o6`
+ * (spec/ilc.md 8.2: base + the operator's index), each its own case: a second dispatch
+ * on the operator would cost as much. */
+#define OPERATOR_CASES(o0, o1, o2, o3, o4, o5, o6, first, second, size)                  \
+    CASE(o0) acc = (uint16_t)((uint16_t)(first) + (second)); ip += (size); NEXT();       \
+    CASE(o1) acc = (uint16_t)((uint16_t)(first) - (second)); ip += (size); NEXT();       \
+    CASE(o2) acc = (uint16_t)((uint16_t)(first) & (second)); ip += (size); NEXT();       \
+    CASE(o3) acc = (uint16_t)((uint16_t)(first) | (second)); ip += (size); NEXT();       \
+    CASE(o4) acc = (uint16_t)((uint16_t)(first) ^ (second)); ip += (size); NEXT();       \
+    CASE(o5) acc = shifted((uint16_t)(first), (int16_t)(second), true); ip += (size); NEXT(); \
+    CASE(o6) acc = shifted((uint16_t)(first), (int16_t)(second), false); ip += (size); NEXT()
+
+/* The operators on acc and a variable or an immediate (format 1.0). */
 #define ALU_CASES(o0, o1, o2, o3, o4, o5, o6, operand, size)                              \
-    CASE(o0) acc = (uint16_t)(acc + (operand)); ip += (size); NEXT();                    \
-    CASE(o1) acc = (uint16_t)(acc - (operand)); ip += (size); NEXT();                    \
-    CASE(o2) acc = (uint16_t)(acc & (operand)); ip += (size); NEXT();                    \
-    CASE(o3) acc = (uint16_t)(acc | (operand)); ip += (size); NEXT();                    \
-    CASE(o4) acc = (uint16_t)(acc ^ (operand)); ip += (size); NEXT();                    \
-    CASE(o5) acc = shifted(acc, (int16_t)(operand), true); ip += (size); NEXT();         \
-    CASE(o6) acc = shifted(acc, (int16_t)(operand), false); ip += (size); NEXT()
+    OPERATOR_CASES(o0, o1, o2, o3, o4, o5, o6, acc, operand, size)
 
 /* The load-and-operate superinstructions (format 1.2): acc = first op second, the
  * operator in the low 3 bits as in ALU_CASES; also the operations on R (`first` is then
@@ -295,20 +299,13 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
  * gcc's runs threaded and with RL1_THREADED=0. */
 #ifdef RL1_COMPACT
 #define COMPUTE_CASES(o0, o1, o2, o3, o4, o5, o6, first, second, size)                   \
-    CASE(o0) CASE(o1) CASE(o2) CASE(o3) CASE(o4) CASE(o5) CASE(o6)                \
+    CASE(o0) CASE(o1) CASE(o2) CASE(o3) CASE(o4) CASE(o5) CASE(o6)                       \
         acc = (uint16_t)(first);                                                         \
         operand = (second);                                                              \
         ip += (size);                                                                    \
         goto compute
 #else
-#define COMPUTE_CASES(o0, o1, o2, o3, o4, o5, o6, first, second, size)                   \
-    CASE(o0) acc = (uint16_t)((uint16_t)(first) + (second)); ip += (size); NEXT();       \
-    CASE(o1) acc = (uint16_t)((uint16_t)(first) - (second)); ip += (size); NEXT();       \
-    CASE(o2) acc = (uint16_t)((uint16_t)(first) & (second)); ip += (size); NEXT();       \
-    CASE(o3) acc = (uint16_t)((uint16_t)(first) | (second)); ip += (size); NEXT();       \
-    CASE(o4) acc = (uint16_t)((uint16_t)(first) ^ (second)); ip += (size); NEXT();       \
-    CASE(o5) acc = shifted((uint16_t)(first), (int16_t)(second), true); ip += (size); NEXT(); \
-    CASE(o6) acc = shifted((uint16_t)(first), (int16_t)(second), false); ip += (size); NEXT()
+#define COMPUTE_CASES OPERATOR_CASES
 #endif
 
 /* A conditional jump to the target at ip + 2 when `value` (V[v], v at ip + 1) passes
