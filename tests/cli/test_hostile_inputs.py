@@ -47,6 +47,13 @@ def test_sim_survives_hostile_world_files(data: bytes, tmp_path: Path) -> None:
     assert world_attack(data, tmp_path) == []
 
 
+def test_sim_survives_a_line_as_wide_as_a_world_allows(tmp_path: Path) -> None:
+    """A line 1e6 cm wide once made every tracing tick look through 10^9 cells."""
+    world = (Path(__file__).parents[2] / "examples" / "sample.world.toml").read_bytes()
+    assert b"width = 2\n" in world
+    assert world_attack(world.replace(b"width = 2\n", b"width = 1e6\n", 1), tmp_path) == []
+
+
 @pytest.mark.parametrize("value", [b"nan", b"inf", b"1e308", b"[[0, 0], [1e6, 1e6]]",
                                    b"[" * 600 + b"]" * 600, b"9" * 5000])
 def test_sim_survives_known_hard_world_values(value: bytes, tmp_path: Path) -> None:

@@ -7,11 +7,15 @@ import math
 from dataclasses import replace
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from support.worlds import line_world, round_track
 
 from rl1.vm.device import LineLost
 from rl1.vm.sim.device import SimDevice
-from rl1.vm.sim.tracing import LineView, correct
+from rl1.vm.sim.geometry import segment_nearest
+from rl1.vm.sim.tracing import LineIndex, LineView, correct
+from rl1.vm.sim.world import Line
 
 
 def _tracing(offset: float, angle: float, mode: int = 3, end: float = 1000.0) -> SimDevice:
@@ -121,3 +125,19 @@ def test_halving_the_step_leaves_a_patrol_where_it_was() -> None:
     assert device.sim.time > 60
     assert math.hypot(ends[0].x - ends[1].x, ends[0].y - ends[1].y) < 1.0
     assert abs(ends[0].heading - ends[1].heading) < math.radians(0.5)
+
+
+_coordinates = st.floats(-2000, 2000)
+_points = st.tuples(_coordinates, _coordinates)
+
+
+@given(lines=st.lists(st.lists(_points, min_size=2, max_size=5), min_size=1, max_size=4),
+       x=_coordinates, y=_coordinates, reach=st.floats(0, 1e6))
+def test_the_line_index_finds_every_piece_within_reach(
+        lines: list[list[tuple[float, float]]], x: float, y: float, reach: float) -> None:
+    """Whatever the reach, a few centimetres or more than the floor (a line 10 km wide
+    makes one), and whichever way near() looks, it misses no piece that comes so near."""
+    index = LineIndex([Line(f"line {n}", tuple(points), 2.0) for n, points in enumerate(lines)])
+    within = {number for number, piece in enumerate(index.pieces)
+              if segment_nearest(x, y, piece.a, piece.b)[2] <= reach}
+    assert within <= index.near(x, y, reach)

@@ -67,12 +67,20 @@ class LineIndex:
     def near(self, x: float, y: float, reach: float) -> set[int]:
         """The pieces filed within `reach` of (x, y), widened by the samples' spacing:
         every piece that comes that near is among them, since each of its points is
-        within the spacing of a sample."""
+        within the spacing of a sample. A reach wider than the filed cells (a line
+        a kilometre wide makes one) looks at those cells rather than at the square's."""
         reach += self.spacing
         cell = self.cell
+        low_i, high_i = math.floor((x - reach) / cell), math.floor((x + reach) / cell)
+        low_j, high_j = math.floor((y - reach) / cell), math.floor((y + reach) / cell)
         found: set[int] = set()
-        for i in range(math.floor((x - reach) / cell), math.floor((x + reach) / cell) + 1):
-            for j in range(math.floor((y - reach) / cell), math.floor((y + reach) / cell) + 1):
+        if (high_i - low_i + 1) * (high_j - low_j + 1) > len(self.cells):
+            for (i, j), numbers in self.cells.items():
+                if low_i <= i <= high_i and low_j <= j <= high_j:
+                    found.update(numbers)
+            return found
+        for i in range(low_i, high_i + 1):
+            for j in range(low_j, high_j + 1):
                 found.update(self.cells.get((i, j), ()))
         return found
 
