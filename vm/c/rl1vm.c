@@ -188,19 +188,12 @@ static rl1_state ended(rl1_vm *vm, const rl1_hardware *hw, uint16_t at)
     return RL1_ENDED;
 }
 
-/* The length of the call instruction `op` (a call in progress is at pc minus it). */
-static uint8_t call_length(uint8_t op)
-{
-    uint8_t arity = rl1_call_arity(op);
-    return arity ? (uint8_t)(2u + 2u * arity) : 1u;
-}
-
 /* Resumes a call in progress (12.2): polls it once. */
 static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw)
 {
     rl1_reading out = {0, {0, 0, 0, 0}};
     uint8_t op = vm->waiting;
-    uint16_t at = (uint16_t)(vm->pc - call_length(op));
+    uint16_t at = (uint16_t)(vm->pc - rl1_call_length(rl1_call_arity(op)));
     rl1_status status = hw->poll(hw->ctx, &out);
     if (status == RL1_BUSY) {
         return RL1_WAITING;
@@ -376,7 +369,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
     const uint8_t *stop = STOP;
     rl1_fault kind = RL1_FAULT_NONE;
     rl1_state state = RL1_RUNNING;
-    uint8_t op;
+    uint8_t op, arity;
 #ifdef RL1_COMPACT
     uint16_t operand;
 #endif
@@ -458,9 +451,10 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
                 break;
             }
             op = RL1_BYTE(ip); /* not set by a threaded jump */
+            arity = rl1_call_arity(op);
             vm->executed = before + (n - left);
-            vm->pc = (uint16_t)(ip - code + call_length(op));
-            kind = call(vm, hw, op, rl1_call_arity(op), ip + 1);
+            vm->pc = (uint16_t)(ip - code + rl1_call_length(arity));
+            kind = call(vm, hw, op, arity, ip + 1);
             if (kind != RL1_FAULT_NONE) {
                 break;
             }

@@ -127,7 +127,7 @@ uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape);
 
 /* How many arguments call `op` (0x40..0x5D) takes, 0 to 3: two bits a call, the calls
  * from 0x40 in one word and from 0x50 in the other (a table would be copied to RAM on
- * AVR). The call is then 1 byte long without arguments, else 2 + 2 * arity. */
+ * AVR). */
 #define RL1_ARITY(op, n) ((uint32_t)(n) << (2u * ((op) & 0x0Fu)))
 static inline uint8_t rl1_call_arity(uint8_t op)
 {
@@ -140,6 +140,13 @@ static inline uint8_t rl1_call_arity(uint8_t op)
           | RL1_ARITY(0x59, 1) | RL1_ARITY(0x5A, 1) /* LMP, INP */
           | RL1_ARITY(0x5B, 2) | RL1_ARITY(0x5C, 2); /* OUT port, data; FZO a, b */
     return (uint8_t)((arities >> (2u * (op & 0x0Fu))) & 3u);
+}
+
+/* The length of a call with `arity` arguments: the opcode alone, or the opcode, the
+ * mask and two bytes an argument. */
+static inline uint8_t rl1_call_length(uint8_t arity)
+{
+    return arity ? (uint8_t)(2u + 2u * arity) : 1u;
 }
 
 /* Whether `value` lies in the range of parameter `index` of call `op`. */

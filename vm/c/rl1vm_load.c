@@ -171,7 +171,7 @@ uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape)
     if (op >= 0x40u && op <= 0x5Du) { /* the calls */
         uint8_t arity = rl1_call_arity(op);
         *shape = arity ? ARGS : NONE;
-        return arity ? (uint8_t)(2u + 2u * arity) : 1u;
+        return rl1_call_length(arity);
     }
     return 0;
 }
