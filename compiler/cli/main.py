@@ -45,6 +45,7 @@ MODULES: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("build", ("compile", "run", "dis", "asm")),
     ("sim", ("sim",)),
     ("fuzz", ("fuzz",)),
+    ("docs", ("docs",)),
 )
 COMMAND_NAMES = tuple(name for _, names in MODULES for name in names)
 
@@ -183,7 +184,14 @@ def _escape_unprintable_output() -> None:
             reconfigure(errors="backslashreplace")
 
 
-@click.group(cls=Toolchain, context_settings=CONTEXT_SETTINGS,
+# Where a newcomer goes next; `rl1c docs` prints each of them in an installed package too.
+EPILOG = """Read next: a first program and world of your own (`rl1c docs tutorial`), every
+command (`rl1c docs commands`), editors (`rl1c docs editors`), firmware (`rl1c docs
+firmware`). `rl1c docs` lists the documents; `rl1c docs NAME` prints one, such as one
+that a help text names (`rl1c docs spec/sensors.md`)."""
+
+
+@click.group(cls=Toolchain, context_settings=CONTEXT_SETTINGS, epilog=EPILOG,
              subcommand_metavar="COMMAND [ARGS]... | FILE.rob [OPTIONS]")
 @click.version_option(package_name="rl1", prog_name="rl1c")
 def rl1c() -> None:

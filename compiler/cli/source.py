@@ -103,8 +103,8 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
                                                                error.detail),
                                             error.help)) from None
         raise invalid_file(role, error.path, error.detail,
-                           "correct the file (README.md, \"Controlling `rl1c check`\", shows "
-                           "its form), or move it aside") from None
+                           "correct the file (`rl1c docs commands`, \"Controlling `rl1c check`\", "
+                           "shows its form), or move it aside") from None
     if diff:
         return _fix_diff(inputs)
     checked: list[FileDiagnostics] = []

@@ -1,4 +1,4 @@
-"""The set-up the READMEs give for editors matches what the code needs: the commands that
+"""The set-up the guides give for editors matches what the code needs: the commands that
 pipx puts on the PATH, the Neovim versions that editors/nvim tells apart, and eglot,
 which Emacs before 29 does not have."""
 
@@ -17,14 +17,14 @@ def _section(markdown: str, title: str) -> str:
     return found[1]
 
 
-def test_the_readme_installs_every_command_with_pipx() -> None:
+def test_the_editors_guide_installs_every_command_with_pipx() -> None:
     scripts = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))[
         "project"]["scripts"]
-    section = _section((ROOT / "README.md").read_text(encoding="utf-8"),
+    section = _section((ROOT / "docs" / "editors.md").read_text(encoding="utf-8"),
                        "Installing `rl1c` and `rl1-lsp` on the PATH")
     assert "pipx install /path/to/rl1" in section and "pipx install -e" in section
     missing = [name for name in scripts if f"`{name}`" not in section]
-    assert not missing, f"the README's pipx section does not name {missing}"
+    assert not missing, f"the pipx section of docs/editors.md does not name {missing}"
 
 
 def test_the_neovim_readme_names_every_version_the_plugin_tells_apart() -> None:
