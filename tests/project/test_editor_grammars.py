@@ -267,13 +267,14 @@ echo 'case.rob:3:17: error[E0100]: unexpected `*`'
 echo '2 files checked: 1 error, 1 warning'
 exit 1
 """
-# Writes makeprg, then each valid quickfix entry as line|column|type|text.
+# Writes makeprg, then each quickfix entry as valid|line|column|type|text: an entry that
+# is not valid (a line no pattern matched) still shows in the list, as `|| text`.
 _DUMP_QUICKFIX = """
 compiler rl1c
 let rows = [&makeprg]
 silent make
-for item in filter(getqflist(), 'v:val.valid')
-  call add(rows, join([item.lnum, item.col, item.type, item.text], '|'))
+for item in getqflist()
+  call add(rows, join([item.valid, item.lnum, item.col, item.type, item.text], '|'))
 endfor
 call writefile(rows, 'quickfix.txt')
 """
@@ -295,5 +296,15 @@ def test_the_neovim_compiler_file_fills_the_quickfix_list_from_concise_lines(
     assert makeprg == "rl1c check --format concise %:S"
     assert (tmp_path / "arguments.txt").read_text(encoding="utf-8").split() == [
         "check", "--format", "concise", "case.rob"]
-    assert entries == ["12|5|w|[W0301]: a lost line can jump to `:97`: add it",
-                       "3|17|e|[E0100]: unexpected `*`"]
+    # The summary line is no entry.
+    assert entries == ["1|12|5|w|[W0301]: a lost line can jump to `:97`: add it",
+                       "1|3|17|e|[E0100]: unexpected `*`"]
+
+
+def test_the_neovim_workspace_root_is_the_folder_of_rl1_toml_first() -> None:
+    """The server reads rl1.toml from the workspace (as `rl1c check` does from the file's
+    folder up), so a folder with rl1.toml is a root even inside a bigger repository."""
+    plugin = (EDITORS / "nvim" / "lua" / "rl1" / "init.lua").read_text(encoding="utf-8")
+    found = re.search(r"root_markers = \{([^}]*)\}", plugin)
+    assert found is not None, "init.lua sets no root_markers"
+    assert re.findall(r"'([^']+)'", found[1])[0] == "rl1.toml"

@@ -7,5 +7,6 @@ endif
 let current_compiler = 'rl1c'
 
 CompilerSet makeprg=rl1c\ check\ --format\ concise\ %:S
-" %t takes the severity's first letter (e, w or i); the text keeps the code.
-CompilerSet errorformat=%f:%l:%c:\ %t%*[a-z]%m
+" %t takes the severity's first letter (e, w or i); the text keeps the code. Every other
+" line (the summary, `1 file checked: ...`) is left out of the list (%-G).
+CompilerSet errorformat=%f:%l:%c:\ %t%*[a-z]%m,%-G%.%#

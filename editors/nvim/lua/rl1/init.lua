@@ -4,8 +4,9 @@ local M = {}
 
 M.defaults = {
   cmd = { 'rl1-lsp' },
-  -- The folder that holds one of these is the workspace root.
-  root_markers = { 'pyproject.toml', '.git' },
+  -- The folder that holds one of these is the workspace root: the project file of
+  -- `rl1c check` first (the server reads it from there), then the usual ones.
+  root_markers = { 'rl1.toml', 'pyproject.toml', '.git' },
 }
 
 local function root_dir(markers, buffer)
