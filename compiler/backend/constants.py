@@ -92,13 +92,14 @@ def _solve(program: ir.Program) -> dict[ir.BlockId, _Folded]:
 
 
 def _meet(states: list[Known]) -> Known:
-    if len(states) < 2:
-        return dict(states[0]) if states else {}
+    """What every state knows alike, in the first state's order (a set of items would
+    order it by hash, and the variable _holding picks with it: PYTHONHASHSEED would
+    change the bytes)."""
+    if not states:
+        return {}
     first, *rest = states
-    common = first.items() & rest[0].items()
-    for state in rest[1:]:
-        common &= state.items()
-    return dict(common)
+    return {name: value for name, value in first.items()
+            if all(state.get(name) == value for state in rest)}
 
 
 def _value(operand: ir.Operand, known: Known) -> int | None:
@@ -177,7 +178,9 @@ def _fold(block: ir.Block, known: Known) -> _Folded:
 
 
 def _holding(known: Known, value: int) -> ir.Var | None:
-    return next((ir.Var(name) for name, held in known.items() if held == value), None)
+    """The first variable, in the language's order, that holds the value: one rule, so
+    that the same source gives the same bytes."""
+    return next((ir.Var(name) for name in VARIABLES if known.get(name) == value), None)
 
 
 def _set(known: Known, name: str, value: int | None) -> None:
