@@ -3,8 +3,9 @@ c`, and the differential tests that hold it to the reference VM (machine.py).
 
 ctypes rather than cffi: it is in the standard library, so the only build step is the
 shared library, which `library()` compiles on first use with the machine's C compiler
-(cc, gcc or clang, or $CC) from the checkout's vm/c and spec/rl1_hardware.h, into a cache
-folder keyed by the sources' digest; no make, no Python headers, nothing installed.
+(cc, gcc or clang, or $CC) from the checkout's vm/c and spec/rl1_hardware.h, into a
+private cache folder keyed by the sources' digest, and loads again only while its bytes
+keep the digest recorded at its build; no make, no Python headers, nothing installed.
 
 `NativeMachine` has Machine's stepping interface (`step`, `run`, `executed`, `state`,
 `result`) over a `hardware.Hardware`, so that drive.py steps either. The C VM calls the
@@ -17,11 +18,16 @@ instruction at `pc` and what the callbacks answered.
 
 from __future__ import annotations
 
+import atexit
+import contextlib
 import ctypes
 import hashlib
 import os
+import shlex
 import shutil
+import stat
 import subprocess
+import sys
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -57,48 +63,190 @@ class BuildError(Exception):
     to do."""
 
 
-def _compiler() -> str:
-    for name in (os.environ.get("CC", ""), "cc", "gcc", "clang"):
-        if name and shutil.which(name):
-            return name
+class _Unusable(Exception):
+    """A build cache folder this process must not, or cannot, use; the message says why."""
+
+
+CACHE_LIMIT = 64 * 2**20  # bytes of a cached library read to check it (ours: about 60 KB)
+DIGEST_SUFFIX = ".sha256"  # beside each library: the SHA-256 of its bytes, from its build
+_ready: dict[Path, Path] = {}  # a build cache folder and key -> the library checked there
+_temporary: list[str] = []  # folders of this process's temporary builds, removed at exit
+
+
+def _warn(message: str) -> None:
+    print(f"rl1: warning: {message}", file=sys.stderr)
+
+
+def _given_compiler() -> tuple[str, ...]:
+    """$CC as words (`CC="gcc -m32"` is a compiler and its arguments), () when unset."""
+    given = os.environ.get("CC", "")
+    try:
+        return tuple(shlex.split(given))
+    except ValueError as error:
+        raise BuildError(f"CC={given!r} is not a command line ({error}); set CC to a C "
+                         "compiler and its arguments, quoted as in a shell, or unset it"
+                         ) from None
+
+
+def _compiler(given: tuple[str, ...]) -> tuple[str, ...]:
+    if given:
+        if shutil.which(given[0]) is None:
+            raise BuildError(f"CC={shlex.join(given)!r} names {given[0]!r}, which is no "
+                             "command here; set CC to a C compiler, or unset it to use cc, "
+                             "gcc or clang")
+        return given
+    for name in ("cc", "gcc", "clang"):
+        if shutil.which(name):
+            return (name,)
     raise BuildError("the C engine needs a C compiler to build vm/c, and this machine has "
                      "none (cc, gcc or clang, or $CC); install one (Debian: apt-get install "
                      "gcc), or run with --engine vm")
 
 
-def _cache() -> Path:
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "rl1"
+def _cache() -> Path | None:
+    """$XDG_CACHE_HOME/rl1, or ~/.cache/rl1; a relative XDG_CACHE_HOME is ignored, as the
+    XDG Base Directory specification says. None when there is no home to hold it."""
+    base = os.environ.get("XDG_CACHE_HOME", "")
+    if os.path.isabs(base):
+        return Path(base) / "rl1"
+    try:
+        return Path.home() / ".cache" / "rl1"
+    except (RuntimeError, KeyError):  # no $HOME, and no entry in the password database
+        return None
 
 
-def library(folder: Path | None = None, sanitize: bool = False) -> Path:
+def library(folder: Path | None = None, sanitize: bool = False,
+            warn: Callable[[str], None] = _warn) -> Path:
     """The shared library of the C VM, built into `folder` (default: the user's cache,
-    ~/.cache/rl1) unless a build of the same sources is there. With `sanitize`,
-    undefined behaviour aborts the process (for the tests)."""
+    ~/.cache/rl1) unless a build of the same sources, flags and $CC is there and intact.
+    With `sanitize`, undefined behaviour aborts the process (for the tests).
+
+    Whatever is in a cache may have been damaged (a full disk, a restored CI cache) or
+    planted, and loading a library runs its code, so: the folder must be this user's
+    and writable by no one else (a missing one is made owner-only); a library is written
+    whole under another name and renamed, with the SHA-256 of its bytes beside it; and a
+    library found there is used only when its bytes have that digest (checked before
+    anything loads it), and built again, with a warning, when not. A cache folder that
+    cannot be used gets a warning and a build into a private temporary folder instead."""
     missing = [str(path) for path in (*SOURCES, *HEADERS) if not path.is_file()]
     if missing:
         raise BuildError("the C engine builds vm/c from a checkout of rl1, and these files "
                          f"are missing: {', '.join(missing)}")
+    given = _given_compiler()
     flags = (*FLAGS, *(SANITIZE if sanitize else ()))
-    digest = hashlib.sha256(" ".join(flags).encode())
+    key = hashlib.sha256("\0".join((*given, "", *flags)).encode())
     for path in (*SOURCES, *HEADERS):
-        digest.update(path.read_bytes())
-    folder = folder or _cache()
-    target = folder / f"librl1vm-{digest.hexdigest()[:16]}.so"
-    if target.is_file():
-        return target
-    compiler = _compiler()
-    folder.mkdir(parents=True, exist_ok=True)
-    # Built under another name, then renamed: a concurrent build never sees half a file.
-    with tempfile.TemporaryDirectory(dir=folder) as scratch:
+        key.update(path.read_bytes())
+    name = f"librl1vm-{key.hexdigest()[:16]}.so"
+    cache = folder or _cache()
+    where = Path(os.path.abspath(cache or tempfile.gettempdir())) / name
+    if where in _ready:  # built or checked already by this process
+        return _ready[where]
+    try:
+        if cache is None:
+            raise _Unusable("there is no home folder (set HOME or XDG_CACHE_HOME)")
+        target = _private(cache) / name
+        if _intact(target):
+            _ready[where] = target
+            return target
+        if os.path.lexists(target):
+            warn(f"the C VM's library in the build cache, {target}, is damaged or was not "
+                 "built there (its bytes do not have the digest recorded when it was "
+                 "built); building it again")
+        built = _build(target, given, flags)
+    except (_Unusable, OSError) as error:
+        reason = (f"it cannot be written: {error.strerror or error}"
+                  if isinstance(error, OSError) else str(error))
+        warn(f"cannot use {cache} as the C VM's build cache ({reason}); building the "
+             "C VM in a temporary folder, again on each run until XDG_CACHE_HOME names a "
+             "folder of your own")
+        built = _temporary_build(name, given, flags)
+    _ready[where] = built
+    return built
+
+
+def _private(folder: Path) -> Path:
+    """`folder`, made owner-only if missing; _Unusable when it is no folder of this
+    user's alone (another user owns it, or others may write to it)."""
+    try:
+        folder.parent.mkdir(parents=True, exist_ok=True)
+        with contextlib.suppress(FileExistsError):
+            folder.mkdir(mode=0o700)
+        status = folder.stat()  # a symbolic link is judged by what it leads to
+    except FileExistsError:
+        raise _Unusable(f"{folder.parent} is not a folder") from None
+    except OSError as error:
+        raise _Unusable(f"it cannot be made: {error.strerror or error}") from None
+    if not stat.S_ISDIR(status.st_mode):
+        raise _Unusable("it is not a folder")
+    if status.st_uid != os.getuid():
+        raise _Unusable(f"user {status.st_uid} owns it, not you")
+    if status.st_mode & (stat.S_IWGRP | stat.S_IWOTH):
+        raise _Unusable(f"other users may write to it (chmod go-w {shlex.quote(str(folder))} "
+                        "makes it yours alone)")
+    return folder
+
+
+def _intact(target: Path) -> bool:
+    """`target` is a regular file whose bytes have the digest recorded beside it."""
+    recorded = _bytes_of(target.with_name(target.name + DIGEST_SUFFIX), 128)
+    data = _bytes_of(target, CACHE_LIMIT)
+    return (recorded is not None and data is not None
+            and recorded.decode("ascii", "replace").strip() == hashlib.sha256(data).hexdigest())
+
+
+def _bytes_of(path: Path, limit: int) -> bytes | None:
+    """The bytes of the regular file `path` (never a link, a FIFO or a device, which
+    could block), or None when it is none or larger than `limit`."""
+    try:
+        status = os.lstat(path)
+        if not stat.S_ISREG(status.st_mode) or status.st_size > limit:
+            return None
+        with open(path, "rb") as stream:
+            return stream.read(limit + 1)
+    except OSError:
+        return None
+
+
+def _temporary_build(name: str, given: tuple[str, ...], flags: tuple[str, ...]) -> Path:
+    """The library built into a new private temporary folder, removed at exit."""
+    try:
+        folder = tempfile.mkdtemp(prefix="rl1-vm-")  # owner-only
+    except OSError as error:
+        raise BuildError(f"no folder to build the C VM in: the cache cannot be used, nor "
+                         f"the temporary folder ({error.strerror or error}); set "
+                         "XDG_CACHE_HOME or TMPDIR to a folder of your own") from None
+    _temporary.append(folder)
+    return _build(Path(folder) / name, given, flags)
+
+
+@atexit.register
+def _remove_temporary_builds() -> None:
+    for folder in _temporary:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _build(target: Path, given: tuple[str, ...], flags: tuple[str, ...]) -> Path:
+    """Compile the library to `target`, and its digest beside it. Built under another
+    name, then renamed: no one ever sees half a file; the digest goes last, so a library
+    without its digest (a build cut short) is built again."""
+    compiler = _compiler(given)
+    with tempfile.TemporaryDirectory(dir=target.parent) as scratch:
         built = Path(scratch) / target.name
-        command = [compiler, *flags, f"-I{HEADER_FOLDER}", "-o", str(built),
+        command = [*compiler, *flags, f"-I{HEADER_FOLDER}", "-o", str(built),
                    *map(str, SOURCES)]
         process = subprocess.run(command, capture_output=True, text=True, check=False)
         if process.returncode != 0:
-            raise BuildError(f"{compiler} could not build the C VM ({' '.join(command)}):\n"
-                             f"{process.stderr.strip()}")
+            raise BuildError(f"{compiler[0]} could not build the C VM ({shlex.join(command)}):"
+                             f"\n{process.stderr.strip()}")
+        digest = built.with_name(built.name + DIGEST_SUFFIX)
+        digest.write_text(hashlib.sha256(built.read_bytes()).hexdigest() + "\n",
+                          encoding="ascii")
+        for path in (built, digest):
+            with open(path, "rb") as stream:
+                os.fsync(stream.fileno())
         built.replace(target)
+        digest.replace(target.with_name(digest.name))
     return target
 
 
@@ -162,7 +310,11 @@ def load(path: Path) -> ctypes.CDLL:
     """The library at `path` (library()), its functions typed, its layout checked."""
     if path in _libraries:
         return _libraries[path]
-    lib = ctypes.CDLL(str(path))
+    try:
+        lib = ctypes.CDLL(str(path))
+    except OSError as error:  # such as a library for another machine (CC="gcc -m32")
+        raise BuildError(f"cannot load the C VM's library {path}: {error}; if $CC builds "
+                         "for another machine, set CC to a compiler for this one") from None
     lib.rl1_ffi_layout.argtypes = [ctypes.POINTER(ctypes.c_uint32)]
     lib.rl1_ffi_start.argtypes = [ctypes.POINTER(_Vm), ctypes.POINTER(_Program),
                                   ctypes.c_char_p, ctypes.c_uint32, ctypes.c_uint32,
