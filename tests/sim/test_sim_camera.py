@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+import msgspec
 import numpy as np
 import pytest
 from support.worlds import line_world, open_floor, stand_world
@@ -110,7 +111,7 @@ def test_ultrasonic_reads_the_nearest_wall_in_its_cone(sensor: str, dx: int, dy:
 
 def test_a_sensor_delay_reports_where_the_vehicle_was() -> None:
     world = stand_world(150)
-    delayed = replace(world, noise=replace(world.noise, delay=2.0))
+    delayed = replace(world, noise=msgspec.structs.replace(world.noise, delay=2.0))
     readings = []
     for each in (world, delayed):
         device = SimDevice(each)

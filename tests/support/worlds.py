@@ -6,6 +6,8 @@ import math
 from dataclasses import replace
 from typing import Any
 
+import msgspec
+
 from rl1.vm.sim.world import Line, Scene, Stand, Vehicle, World
 
 
@@ -13,7 +15,7 @@ def open_floor(x: float = 500.0, y: float = 500.0, heading: float = 0.0,
                **vehicle: Any) -> World:
     """A 1000 x 1000 cm floor with nothing on it, the vehicle at (x, y)."""
     return World(floor=(1000.0, 1000.0), start=(x, y, heading),
-                 vehicle=replace(Vehicle(), **vehicle))
+                 vehicle=msgspec.structs.replace(Vehicle(), **vehicle))
 
 
 def line_world(offset: float = 0.0, angle: float = 0.0) -> World:

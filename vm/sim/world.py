@@ -2,18 +2,32 @@
 their markers, walls and obstacles, the scenes, the values behind INP and FZI, the
 vehicle's geometry and calibration, noise and the time limit (spec/simulator.md).
 
-Loading never raises anything but WorldError, whose message reads
-`file:line: where: what is wrong; what to write`.
+The file's schema is the msgspec Structs below (`WorldFile`, with `Vehicle` and `Noise`,
+which the simulator uses as they are); each number carries its physical range, so that
+every world that loads can be simulated. Loading never raises anything but WorldError,
+whose message reads `file:line: where: what is wrong; what to write`
+(rl1.vm.config, the configuration files' one validation layer).
 """
 
 from __future__ import annotations
 
 import math
-import re
-import tomllib
-from dataclasses import dataclass, field, fields, replace
-from typing import Any
+from dataclasses import dataclass, field
+from typing import Annotated, Any
 
+import msgspec
+from msgspec import Meta, Struct
+
+from ..config import (
+    SENSOR_SCRIPT,
+    WORLD,
+    ConfigError,
+    convert,
+    describe_path,
+    read_document,
+)
+from ..config_lines import KeyPath, line_of
+from ..language import BUILTINS
 from .geometry import Point, rectangle
 
 
@@ -21,32 +35,55 @@ class WorldError(Exception):
     """A world file that cannot be used; the message says where and what to write."""
 
 
-@dataclass(frozen=True, slots=True)
-class Vehicle:
-    """The vehicle's geometry and calibration. Lengths in cm, angles in degrees, times
-    in seconds; every field may be set in the world file's [vehicle] table."""
+def _in(low: float, high: float, unit: str, meaning: str) -> Meta:
+    """A number's physical range, low..high (spec/simulator.md), and what it is."""
+    return Meta(ge=low, le=high, description=f"{meaning} ({unit})")
 
-    length: float = 80.0  # body, along the heading
-    width: float = 60.0
-    tread: float = 50.0  # between the two drive wheels
-    wheel_unit: float = 5.0  # cm/s of one unit of wheel speed
-    rotate_speed: int = 3  # wheel speed units of each wheel while ROT turns in place
-    steer_rate: float = 90.0  # degrees/s of the steering motor
-    k1: float = 0.02  # the tracing law's gain on the offset, 1/cm
-    k2: float = 0.3  # the tracing law's gain on tan of the angle error
-    trace_interval: float = 0.05  # s between two corrections of the tracing law
-    camera_ahead: float = 30.0  # the camera's pan axis, ahead of the centre
-    camera_height: float = 40.0  # the optical centre above the floor
-    camera_fov: float = 22.0  # horizontal field of view
-    image_width: int = 256
-    image_height: int = 240
-    tilt_down: float = 50.0  # below the horizontal, after (CAM D); (CAM U) is level
-    pan_rate: float = 180.0  # degrees/s of the pan motor
-    tilt_time: float = 0.2  # s for (CAM U) or (CAM D)
-    image_time: float = 0.04  # s for one (IMG): a frame and its processing
-    ultrasonic_time: float = 0.02  # s for one (ULT)
-    ultrasonic_range: float = 100.0  # cm; nothing nearer reads this
-    ultrasonic_cone: float = 15.0  # half-angle of each sensor's cone
+
+_LIMIT = 1e6  # no coordinate in a world is near this; larger is a typo
+Coordinate = Annotated[float, _in(-_LIMIT, _LIMIT, "cm", "a coordinate")]
+Angle = Annotated[float, _in(-360, 360, "degrees", "from +x, counterclockwise")]
+PointValue = Annotated[tuple[Coordinate, Coordinate],
+                       Meta(extra={"expected": "a point [x, y] in cm", "plural": "points [x, y]"})]
+Name = Annotated[str, Meta(min_length=1, max_length=64, description="what scenes see it by")]
+
+
+class Vehicle(Struct, frozen=True, forbid_unknown_fields=True):
+    """The vehicle's geometry and calibration. Lengths in cm, angles in degrees, times
+    in seconds; every field may be set in the world file's [vehicle] table, within its
+    physical range."""
+
+    length: Annotated[float, _in(10, 1000, "cm", "body, along the heading")] = 80.0
+    width: Annotated[float, _in(10, 1000, "cm", "body, across")] = 60.0
+    tread: Annotated[float, _in(10, 1000, "cm", "between the two drive wheels")] = 50.0
+    wheel_unit: Annotated[float, _in(0.1, 100, "cm/s", "one unit of wheel speed")] = 5.0
+    rotate_speed: Annotated[int, Meta(ge=1, le=12, description=(
+        "wheel speed units of each wheel while ROT turns in place"))] = 3
+    steer_rate: Annotated[float, _in(1, 3600, "deg/s", "the steering motor")] = 90.0
+    k1: Annotated[float, _in(0, 100, "1/cm", "the tracing law's gain on the offset")] = 0.02
+    k2: Annotated[float, _in(0, 100, "1", "the tracing law's gain on tan(angle)")] = 0.3
+    trace_interval: Annotated[float, _in(0.001, 1, "s", "between two corrections")] = 0.05
+    camera_ahead: Annotated[float, _in(0, 1000, "cm", "pan axis ahead of the centre")] = 30.0
+    camera_height: Annotated[float, _in(1, 1000, "cm", "optical centre's height")] = 40.0
+    camera_fov: Annotated[float, _in(1, 170, "deg", "horizontal field of view")] = 22.0
+    image_width: Annotated[int, Meta(ge=1, le=1024, description="pixels")] = 256
+    image_height: Annotated[int, Meta(ge=1, le=1024, description="pixels")] = 240
+    tilt_down: Annotated[float, _in(1, 89, "deg", "below level after (CAM D)")] = 50.0
+    pan_rate: Annotated[float, _in(1, 3600, "deg/s", "the pan motor")] = 180.0
+    tilt_time: Annotated[float, _in(0.01, 10, "s", "(CAM U) or (CAM D)")] = 0.2
+    image_time: Annotated[float, _in(0.001, 10, "s", "one (IMG), frame and processing")] = 0.04
+    ultrasonic_time: Annotated[float, _in(0.001, 10, "s", "one (ULT)")] = 0.02
+    ultrasonic_range: Annotated[float, _in(1, 1000, "cm", "the sensors' reach")] = 100.0
+    ultrasonic_cone: Annotated[float, _in(1, 89, "deg", "half-angle of each cone")] = 15.0
+
+
+class Noise(Struct, frozen=True, forbid_unknown_fields=True):
+    """Standard deviations of the sensor noise; all 0 (off) unless the world sets them."""
+
+    image_px: Annotated[float, _in(0, 100, "px", "on the centroid")] = 0.0
+    odometry: Annotated[float, _in(0, 1, "1", "relative, on each wheel's count")] = 0.0
+    ultrasonic_cm: Annotated[float, _in(0, 100, "cm", "on each distance")] = 0.0
+    delay: Annotated[float, _in(0, 10, "s", "how late the camera and ultrasonic report")] = 0.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -108,16 +145,6 @@ class Scene:
 
 
 @dataclass(frozen=True, slots=True)
-class Noise:
-    """Standard deviations of the sensor noise; all 0 (off) unless the world sets them."""
-
-    image_px: float = 0.0  # on the centroid
-    odometry: float = 0.0  # relative, on each wheel's count
-    ultrasonic_cm: float = 0.0
-    delay: float = 0.0  # s: the camera, image processor and ultrasonic report this late
-
-
-@dataclass(frozen=True, slots=True)
 class World:
     floor: tuple[float, float]  # x from 0 to floor[0], y from 0 to floor[1], cm
     start: tuple[float, float, float]  # x, y (cm), heading (degrees from +x, counterclockwise)
@@ -133,292 +160,218 @@ class World:
     time_limit: float = 600.0  # s of simulated time before the run is stopped
 
 
-# Loading --------------------------------------------------------------------------------
-
-_TOP = ("floor", "start", "vehicle", "lines", "marks", "stands", "walls", "obstacles",
-        "scenes", "ports", "fuzzy", "noise", "limits")
-_LIMIT = 1e6  # no length, angle or time in a world is near this; larger is a typo
-MAX_POINTS = 10_000  # in all lines and polygons: a floor of a few metres needs far fewer
 
 
-class _Reader:
-    """Validates values, naming where they are: `file:line: path`."""
+# The file -------------------------------------------------------------------------------
 
-    def __init__(self, text: str, name: str) -> None:
-        self.lines = text.splitlines()
-        self.name = name
-        self.points_seen = 0
+MAX_TICKS = 2_000_000
+"""The most ticks of the tracing timer a run may take (its time limit over the trace
+interval): with the simulator's fixed step, this bounds the steps of any run."""
 
-    def line_of(self, path: tuple[str | int, ...]) -> int | None:
-        """The line where `path` is written, found from the table headers: a best
-        effort, since tomllib gives no positions."""
-        start, end, depth = 0, len(self.lines), 0
-        for step, part in enumerate(path):
-            if isinstance(part, int):
-                continue
-            following = path[step + 1] if step + 1 < len(path) else None
-            array = isinstance(following, int)
-            header = re.compile(r"^\s*\[\[\s*" + re.escape(part) + r"\s*\]\]" if array
-                                else r"^\s*\[\s*" + re.escape(part) + r"\s*\]")
-            key = re.compile(r"^\s*\"?" + re.escape(part) + r"\"?\s*=")
-            wanted = following if isinstance(following, int) else 0
-            found = [i for i in range(start, end) if header.match(self.lines[i])]
-            if depth == 0 and len(found) > wanted:
-                start = found[wanted] + 1
-                end = next((i for i in range(start, len(self.lines))
-                            if self.lines[i].lstrip().startswith("[")), len(self.lines))
-                depth = 1
-                continue
-            hit = next((i for i in range(start, end) if key.match(self.lines[i])), None)
-            if hit is None:
-                return start if depth else None
-            return hit + 1
-        return start if depth else None
+MAX_POINTS = 10_000
+"""The most points in all lines and polygons together, each stand counting its four
+corners: a floor of a few metres needs far fewer, and it bounds what loading and each
+step of the simulation cost."""
 
-    def fail(self, path: tuple[str | int, ...], message: str) -> WorldError:
-        where = ".".join(str(p) if isinstance(p, str) else f"[{p}]" for p in path)
-        where = where.replace(".[", "[")
-        line = self.line_of(path)
-        at = f"{self.name}:{line}" if line is not None else self.name
-        return WorldError(f"{at}: {where}: {message}" if where else f"{at}: {message}")
-
-    def table(self, value: object, path: tuple[str | int, ...],
-              keys: tuple[str, ...], required: tuple[str, ...] = ()) -> dict[str, Any]:
-        if not isinstance(value, dict):
-            raise self.fail(path, f"expected a table with {', '.join(keys)}, "
-                                  f"found {_kind(value)}")
-        for key in value:
-            if key not in keys:
-                raise self.fail((*path, key), "unknown key; expected one of "
-                                + ", ".join(keys))
-        for key in required:
-            if key not in value:
-                raise self.fail(path, f"missing `{key}`; write `{key} = ...`" if path
-                                else f"missing the [{key}] table; add one (spec/simulator.md)")
-        return value
-
-    def number(self, value: object, path: tuple[str | int, ...], low: float = -_LIMIT,
-               high: float = _LIMIT, positive: bool = False) -> float:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.fail(path, f"expected a number, found {_kind(value)}")
-        if positive:
-            low = max(low, 0.0)
-        if isinstance(value, int) and value.bit_length() > 64:  # too long for a float
-            raise self.fail(path, f"a number that long is outside {low:g}..{high:g}; "
-                                  "write one within it")
-        number = float(value)
-        if not math.isfinite(number):
-            raise self.fail(path, f"{value} is not a finite number; write one in "
-                                  f"{low:g}..{high:g}")
-        if positive and number <= 0:
-            raise self.fail(path, f"{value} must be greater than 0")
-        if not low <= number <= high:
-            raise self.fail(path, f"{value} is outside {low:g}..{high:g}; write one within it")
-        return number
-
-    def integer(self, value: object, path: tuple[str | int, ...], low: int,
-                high: int) -> int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise self.fail(path, f"expected an integer in {low}..{high}, found {_kind(value)}")
-        if not low <= value <= high:
-            raise self.fail(path, f"{value} is outside {low}..{high}")
-        return value
-
-    def text(self, value: object, path: tuple[str | int, ...]) -> str:
-        if not isinstance(value, str):
-            raise self.fail(path, f"expected a string, found {_kind(value)}")
-        return value
-
-    def array(self, value: object, path: tuple[str | int, ...], what: str) -> list[Any]:
-        if not isinstance(value, list):
-            raise self.fail(path, f"expected an array of {what}, found {_kind(value)}")
-        return value
-
-    def points(self, value: object, path: tuple[str | int, ...], least: int) -> tuple[Point, ...]:
-        items = self.array(value, path, "points [x, y]")
-        if len(items) < least:
-            raise self.fail(path, f"expected at least {least} points [x, y], found {len(items)}")
-        result = []
-        for i, item in enumerate(items):
-            pair = self.array(item, (*path, i), "two numbers")
-            if len(pair) != 2:
-                raise self.fail((*path, i), f"expected a point [x, y], found {len(pair)} numbers")
-            result.append((self.number(pair[0], (*path, i)), self.number(pair[1], (*path, i))))
-        return tuple(result)
-
-    def tables(self, document: dict[str, Any], key: str) -> list[Any]:
-        items = self.array(document.get(key, []), (key,), f"tables ([[{key}]])")
-        return items
-
-    def count(self, points: tuple[Point, ...], path: tuple[str | int, ...]) -> tuple[Point, ...]:
-        """`points`, counted against MAX_POINTS for the whole world."""
-        self.points_seen += len(points)
-        if self.points_seen > MAX_POINTS:
-            raise self.fail(path, f"the world's lines and polygons have more than "
-                                  f"{MAX_POINTS} points; simplify them (a straight run "
-                                  "needs only its two ends)")
-        return points
+FloorLength = Annotated[float, _in(10, _LIMIT, "cm", "the floor's extent")]
+Pixel = Annotated[int, Meta(ge=0, le=1024)]
+Int16 = Annotated[int, Meta(ge=-32768, le=32767)]
+PortName = Annotated[str, Meta(pattern=r"^[0-9]{1,6}$", extra={
+    "expected": 'a port, a decimal number in quotes such as "3"'})]
+Byte = Annotated[int, Meta(ge=0, le=255)]
+PORTS = BUILTINS["INP"].forms[0].params[0]
 
 
-def _kind(value: object) -> str:
-    if isinstance(value, bool):
-        return "true/false"
-    if isinstance(value, dict):
-        return "a table"
-    if isinstance(value, list):
-        return "an array"
-    if isinstance(value, str):
-        return f'the string "{value[:40]}"'
-    return repr(value)
+class FloorTable(Struct, forbid_unknown_fields=True):
+    """The floor runs from (0, 0) to `size`, cm."""
+
+    size: Annotated[tuple[FloorLength, FloorLength], Meta(extra={
+        "expected": "[width, depth] in cm, e.g. size = [600, 400]"})]
+
+
+class StartTable(Struct, forbid_unknown_fields=True):
+    """Where the vehicle starts, and its heading."""
+
+    x: Coordinate
+    y: Coordinate
+    heading: Angle = 0.0
+
+
+class LineTable(Struct, forbid_unknown_fields=True, kw_only=True):
+    """A guidance line: a polyline."""
+
+    name: Name | None = None
+    points: Annotated[list[PointValue], Meta(min_length=2)]
+    width: Annotated[float, _in(0.1, 1000, "cm", "the line's width")] = 2.0
+
+
+class PolygonTable(Struct, forbid_unknown_fields=True, kw_only=True):
+    """A mark on the floor, a wall or an obstacle: a polygon."""
+
+    name: Name | None = None
+    points: Annotated[list[PointValue], Meta(min_length=3)]
+
+
+class StandTable(Struct, forbid_unknown_fields=True, kw_only=True):
+    """A work stand: a rectangle with a marker in the middle of the face it looks out
+    of."""
+
+    name: Name | None = None
+    x: Coordinate
+    y: Coordinate
+    width: Annotated[float, _in(1, 1000, "cm", "across the face")] = 40.0
+    depth: Annotated[float, _in(1, 1000, "cm", "along facing")] = 40.0
+    facing: Angle
+
+
+class SceneTable(Struct, forbid_unknown_fields=True, kw_only=True):
+    """A recognition set-up of the image processor, selected by (SCN number)."""
+
+    number: Annotated[int, Meta(ge=0, le=7)]
+    sees: Annotated[list[Annotated[str, Meta(max_length=64)]], Meta(max_length=64, description=(
+        'kinds ("lines", "marks", "markers") or names of lines, marks and stands'))]
+    window: Annotated[tuple[Pixel, Pixel, Pixel, Pixel], Meta(extra={
+        "expected": "[x0, y0, x1, y1] in pixels"})] = (0, 0, 1024, 1024)
+
+
+class FuzzyTable(Struct, forbid_unknown_fields=True):
+    """What (FZI) reads into s and t."""
+
+    s: Int16 = 0
+    t: Int16 = 0
+
+
+class LimitsTable(Struct, forbid_unknown_fields=True):
+    """What a run may ask for."""
+
+    time: Annotated[float, _in(0.1, 86400, "s", "simulated time before the run is "
+                               "stopped")] = 600.0
+
+
+class WorldFile(Struct, forbid_unknown_fields=True, kw_only=True):
+    """A world file of `rl1c sim --world` (spec/simulator.md)."""
+
+    floor: FloorTable
+    start: StartTable
+    vehicle: Vehicle = msgspec.field(default_factory=Vehicle)
+    lines: list[LineTable] = []
+    marks: list[PolygonTable] = []
+    stands: list[StandTable] = []
+    walls: list[PolygonTable] = []
+    obstacles: list[PolygonTable] = []
+    scenes: list[SceneTable] = []
+    ports: dict[PortName, Byte] = {}
+    fuzzy: FuzzyTable = msgspec.field(default_factory=FuzzyTable)
+    noise: Noise = msgspec.field(default_factory=Noise)
+    limits: LimitsTable = msgspec.field(default_factory=LimitsTable)
 
 
 def decode_world(data: bytes, name: str) -> World:
     """A World from the bytes of a world file; WorldError says what is wrong."""
     try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as error:
-        raise WorldError(f"{name}: not UTF-8 text (byte {error.start})") from None
-    try:
-        document = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        raise WorldError(f"{name}: invalid TOML: {error}") from None
-    except (RecursionError, ValueError):  # nesting, or an integer of thousands of digits
-        raise WorldError(f"{name}: invalid TOML: nested too deeply or a number far "
-                         "too long") from None
+        document, text = read_document(data, name, "toml")
+    except ConfigError as error:
+        if data.lstrip().startswith(b"{"):
+            raise WorldError(f"{name}: {WORLD.mistaken_for(SENSOR_SCRIPT)}") from None
+        raise WorldError(str(error)) from None
     return parse_world(document, text, name)
 
 
 def parse_world(document: dict[str, Any], text: str = "", name: str = "<world>") -> World:
-    r = _Reader(text, name)
-    r.table(document, (), _TOP, required=("floor", "start"))
-    floor_table = r.table(document["floor"], ("floor",), ("size",), ("size",))
-    size = r.array(floor_table["size"], ("floor", "size"), "two numbers")
-    if len(size) != 2:
-        raise r.fail(("floor", "size"), "expected [width, depth] in cm, e.g. size = [600, 400]")
-    floor = (r.number(size[0], ("floor", "size"), positive=True),
-             r.number(size[1], ("floor", "size"), positive=True))
-    start_table = r.table(document["start"], ("start",), ("x", "y", "heading"), ("x", "y"))
-    start = (r.number(start_table["x"], ("start", "x")), r.number(start_table["y"], ("start", "y")),
-             r.number(start_table.get("heading", 0.0), ("start", "heading"), -360, 360))
-    if not (0 <= start[0] <= floor[0] and 0 <= start[1] <= floor[1]):
-        raise r.fail(("start",), f"({start[0]:g}, {start[1]:g}) is off the floor, "
-                                 f"which runs from (0, 0) to ({floor[0]:g}, {floor[1]:g})")
-    return World(
-        floor=floor, start=start, vehicle=_vehicle(r, document.get("vehicle", {})),
-        lines=tuple(_line(r, item, i) for i, item in enumerate(r.tables(document, "lines"))),
-        marks=tuple(Mark(_name(r, item, ("marks", i), ("name", "points"), f"mark{i}"),
-                         r.count(r.points(item["points"], ("marks", i, "points"), 3),
-                                 ("marks", i, "points")))
-                    for i, item in enumerate(r.tables(document, "marks"))),
-        stands=tuple(_stand(r, item, i) for i, item in enumerate(r.tables(document, "stands"))),
-        blocks=tuple(Block(_name(r, item, (kind, i), ("name", "points"), f"{kind}{i}"),
-                           r.count(r.points(item["points"], (kind, i, "points"), 3),
-                                   (kind, i, "points")))
-                     for kind in ("walls", "obstacles")
-                     for i, item in enumerate(r.tables(document, kind))),
-        scenes=_scenes(r, document.get("scenes", []), document),
-        ports=_ports(r, document.get("ports", {})),
-        fuzzy=_fuzzy(r, document.get("fuzzy", {})),
-        noise=_noise(r, document.get("noise", {})),
-        time_limit=r.number(r.table(document.get("limits", {}), ("limits",), ("time",))
-                            .get("time", 600.0), ("limits", "time"), 0, 86400, positive=True),
-    )
+    """A World from the data of a world file (its `text` gives the lines of messages)."""
+    try:
+        WORLD.refuse_other(document, name, SENSOR_SCRIPT)
+        return _World(convert(document, WorldFile, name, text), text, name).build()
+    except ConfigError as error:
+        raise WorldError(str(error)) from None
 
 
-def _name(r: _Reader, item: object, path: tuple[str | int, ...], keys: tuple[str, ...],
-          default: str) -> str:
-    table = r.table(item, path, keys, tuple(k for k in keys if k == "points"))
-    return r.text(table.get("name", default), (*path, "name"))
+class _World:
+    """The checks that span fields (the start on the floor, the scenes' names, the
+    world's size), and the World they give."""
 
+    def __init__(self, file: WorldFile, text: str, name: str) -> None:
+        self.file = file
+        self.text = text
+        self.name = name
+        self.points = 0
 
-def _vehicle(r: _Reader, value: object) -> Vehicle:
-    names = tuple(f.name for f in fields(Vehicle))
-    table = r.table(value, ("vehicle",), names)
-    vehicle = Vehicle()
-    changes: dict[str, Any] = {}
-    for key, item in table.items():
-        path = ("vehicle", key)
-        if isinstance(getattr(vehicle, key), int):
-            high = {"rotate_speed": 12, "image_width": 1024, "image_height": 1024}[key]
-            changes[key] = r.integer(item, path, 1, high)
-        elif key in ("k1", "k2"):
-            changes[key] = r.number(item, path, 0, 100)
-        elif key in ("camera_fov", "tilt_down", "ultrasonic_cone"):
-            changes[key] = r.number(item, path, 0, 89.9 if key != "camera_fov" else 170,
-                                    positive=True)
-        else:
-            changes[key] = r.number(item, path, positive=True)
-    return replace(vehicle, **changes)
+    def fail(self, path: KeyPath, detail: str) -> ConfigError:
+        return ConfigError(self.name, line_of(self.text, path, "toml"), describe_path(path),
+                           detail)
 
+    def count(self, points: int, path: KeyPath) -> None:
+        """Count `points` against MAX_POINTS for the whole world."""
+        self.points += points
+        if self.points > MAX_POINTS:
+            raise self.fail(path, f"the world's lines, polygons and stands have more than "
+                                  f"{MAX_POINTS} points (a stand counts its 4 corners); "
+                                  "simplify them (a straight run needs only its two ends)")
 
-def _line(r: _Reader, item: object, i: int) -> Line:
-    path: tuple[str | int, ...] = ("lines", i)
-    table = r.table(item, path, ("name", "points", "width"), ("points",))
-    return Line(r.text(table.get("name", f"line{i}"), (*path, "name")),
-                r.count(r.points(table["points"], (*path, "points"), 2), (*path, "points")),
-                r.number(table.get("width", 2.0), (*path, "width"), positive=True))
+    def build(self) -> World:
+        file = self.file
+        floor, start = file.floor.size, file.start
+        if not (0 <= start.x <= floor[0] and 0 <= start.y <= floor[1]):
+            raise self.fail(("start",), f"({start.x:g}, {start.y:g}) is off the floor, "
+                                        f"which runs from (0, 0) to ({floor[0]:g}, "
+                                        f"{floor[1]:g})")
+        ticks = file.limits.time / file.vehicle.trace_interval
+        if ticks > MAX_TICKS:
+            raise self.fail(("limits", "time"), f"a run of {file.limits.time:g} s with a "
+                            f"tracing tick every {file.vehicle.trace_interval:g} s takes "
+                            f"{ticks:.3g} ticks, more than {MAX_TICKS:,}; shorten the time "
+                            "limit or lengthen vehicle.trace_interval")
+        lines = []
+        for i, line in enumerate(file.lines):
+            self.count(len(line.points), ("lines", i, "points"))
+            lines.append(Line(line.name or f"line{i}", tuple(line.points), line.width))
+        marks = []
+        for i, mark in enumerate(file.marks):
+            self.count(len(mark.points), ("marks", i, "points"))
+            marks.append(Mark(mark.name or f"mark{i}", tuple(mark.points)))
+        stands = []
+        for i, stand in enumerate(file.stands):
+            self.count(4, ("stands", i))
+            stands.append(Stand(stand.name or f"stand{i}", stand.x, stand.y, stand.width,
+                                stand.depth, stand.facing))
+        blocks = []
+        for kind, polygons in (("walls", file.walls), ("obstacles", file.obstacles)):
+            for i, block in enumerate(polygons):
+                self.count(len(block.points), (kind, i, "points"))
+                blocks.append(Block(block.name or f"{kind}{i}", tuple(block.points)))
+        return World(floor=floor, start=(start.x, start.y, start.heading),
+                     vehicle=file.vehicle, lines=tuple(lines), marks=tuple(marks),
+                     stands=tuple(stands), blocks=tuple(blocks), scenes=self.scenes(),
+                     ports=self.ports(), fuzzy=(file.fuzzy.s, file.fuzzy.t),
+                     noise=file.noise, time_limit=file.limits.time)
 
+    def scenes(self) -> dict[int, Scene]:
+        file = self.file
+        named = [*(line.name for line in file.lines), *(mark.name for mark in file.marks),
+                 *(stand.name for stand in file.stands)]
+        known = {"lines", "marks", "markers", *(name for name in named if name)}
+        scenes: dict[int, Scene] = {}
+        for i, scene in enumerate(file.scenes):
+            if scene.number in scenes:
+                raise self.fail(("scenes", i, "number"), f"scene {scene.number} is defined "
+                                "twice; give each [[scenes]] its own number")
+            x0, y0, x1, y1 = scene.window
+            if x1 <= x0 or y1 <= y0:
+                raise self.fail(("scenes", i, "window"), "expected x0 < x1 and y0 < y1")
+            for j, seen in enumerate(scene.sees):
+                if seen not in known:
+                    raise self.fail(("scenes", i, "sees", j), f'"{seen}" is not a kind '
+                                    '("lines", "marks", "markers") nor the name of a line, '
+                                    "mark or stand")
+            scenes[scene.number] = Scene(tuple(scene.sees), scene.window)
+        return scenes
 
-def _stand(r: _Reader, item: object, i: int) -> Stand:
-    path: tuple[str | int, ...] = ("stands", i)
-    table = r.table(item, path, ("name", "x", "y", "width", "depth", "facing"),
-                    ("x", "y", "facing"))
-    return Stand(r.text(table.get("name", f"stand{i}"), (*path, "name")),
-                 r.number(table["x"], (*path, "x")), r.number(table["y"], (*path, "y")),
-                 r.number(table.get("width", 40.0), (*path, "width"), positive=True),
-                 r.number(table.get("depth", 40.0), (*path, "depth"), positive=True),
-                 r.number(table["facing"], (*path, "facing"), -360, 360))
-
-
-def _scenes(r: _Reader, value: object, document: dict[str, Any]) -> dict[int, Scene]:
-    scenes: dict[int, Scene] = {}
-    for i, item in enumerate(r.array(value, ("scenes",), "tables ([[scenes]])")):
-        path: tuple[str | int, ...] = ("scenes", i)
-        table = r.table(item, path, ("number", "sees", "window"), ("number", "sees"))
-        number = r.integer(table["number"], (*path, "number"), 0, 7)
-        if number in scenes:
-            raise r.fail((*path, "number"), f"scene {number} is defined twice; give each "
-                                            "[[scenes]] its own number")
-        sees = tuple(r.text(s, (*path, "sees", j))
-                     for j, s in enumerate(r.array(table["sees"], (*path, "sees"), "names")))
-        window = r.array(table.get("window", [0, 0, 1024, 1024]), (*path, "window"),
-                         "four integers")
-        if len(window) != 4:
-            raise r.fail((*path, "window"), "expected [x0, y0, x1, y1] in pixels")
-        x0, y0, x1, y1 = (r.integer(v, (*path, "window"), 0, 1024) for v in window)
-        if x1 <= x0 or y1 <= y0:
-            raise r.fail((*path, "window"), "expected x0 < x1 and y0 < y1")
-        scenes[number] = Scene(sees, (x0, y0, x1, y1))
-    known = {"lines", "marks", "markers"} | {
-        str(t.get("name")) for kind in ("lines", "marks", "stands")
-        for t in document.get(kind, []) if isinstance(t, dict) and "name" in t}
-    for i, scene in enumerate(scenes.values()):
-        for j, seen in enumerate(scene.sees):
-            if seen not in known:
-                raise r.fail(("scenes", i, "sees", j),
-                             f'"{seen}" is not a kind ("lines", "marks", "markers") nor the '
-                             "name of a line, mark or stand")
-    return scenes
-
-
-def _ports(r: _Reader, value: object) -> dict[int, int]:
-    if not isinstance(value, dict):
-        raise r.fail(("ports",), f'expected a table of port = byte, e.g. "3" = 1, '
-                                 f"found {_kind(value)}")
-    ports = {}
-    for key, item in value.items():
-        if not (key.isascii() and key.isdigit() and int(key) <= 125):
-            raise r.fail(("ports", key), 'a port is a decimal number 0..125, e.g. "3" = 1')
-        ports[int(key)] = r.integer(item, ("ports", key), 0, 255)
-    return ports
-
-
-def _fuzzy(r: _Reader, value: object) -> tuple[int, int]:
-    table = r.table(value, ("fuzzy",), ("s", "t"))
-    return (r.integer(table.get("s", 0), ("fuzzy", "s"), -32768, 32767),
-            r.integer(table.get("t", 0), ("fuzzy", "t"), -32768, 32767))
-
-
-def _noise(r: _Reader, value: object) -> Noise:
-    table = r.table(value, ("noise",), ("image_px", "odometry", "ultrasonic_cm", "delay"))
-    return Noise(**{key: r.number(item, ("noise", key), 0, 1000) for key, item in table.items()})
+    def ports(self) -> dict[int, int]:
+        ports = {}
+        for key, data in self.file.ports.items():
+            port = int(key)
+            if not PORTS.low <= port <= PORTS.high:
+                raise self.fail(("ports", key), f"{port} is not a port; ports are "
+                                                f"{PORTS.low}..{PORTS.high}")
+            ports[port] = data
+        return ports
