@@ -66,7 +66,8 @@ pytest: $(STAMP)
 	$(BIN)/pytest -n 2
 
 # The VS Code extension (editors/vscode): its exact dependencies from the npm lock file
-# (none needs an install script), then tsc, then its grammar and settings tests on node.
+# (none needs its install script: esbuild's binary comes in its platform's package), then
+# tsc, then its grammar and settings tests on node. The package is esbuild's bundle.
 VSCODE := editors/vscode
 VSCODE_STAMP := $(VSCODE)/node_modules/.installed
 
@@ -82,5 +83,5 @@ vscode-package: vscode-test
 
 clean:
 	rm -rf $(VENV) .typecheck .mypy_cache .pytest_cache .ruff_cache .hypothesis
-	rm -rf $(VSCODE)/node_modules $(VSCODE)/out $(VSCODE)/rl1.vsix
+	rm -rf $(VSCODE)/node_modules $(VSCODE)/out $(VSCODE)/dist $(VSCODE)/rl1.vsix
 	$(MAKE) -C vm/c clean
