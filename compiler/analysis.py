@@ -3,12 +3,13 @@ program's comments allow left out); `fix` makes the checker's fixes."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import itertools
+from collections.abc import Callable, Iterator
 from typing import NamedTuple
 
 from .checker import apply_suppressions, check
 from .frontend.ast import Program
-from .frontend.diagnostics import Diagnostic, sort_key
+from .frontend.diagnostics import Diagnostic, Fix, sort_key
 from .frontend.edits import apply_edits, compatible
 from .frontend.parser import parse_program
 
@@ -36,24 +37,46 @@ MAX_FIX_ROUNDS = 10
 
 
 class Fixed(NamedTuple):
-    """The text with the fixes made, how many were made, and its analysis."""
+    """The text with the fixes made, how many were made, its analysis, and how many of
+    the diagnostics `keep` accepts are left with a fix (without `unsafe`: an unsafe one;
+    with it: one that would be made over an unsafe fix's result, in another run)."""
 
     text: str
     fixes: int
     analysis: Analysis
+    left: int
 
 
-def fix(text: str, keep: Callable[[Diagnostic], bool] = lambda _: True) -> Fixed:
-    """`text` with the automatic fixes of the diagnostics `keep` accepts made, round
-    after round, until no such fix is left (or MAX_FIX_ROUNDS)."""
+def fix(text: str, keep: Callable[[Diagnostic], bool] = lambda _: True, *,
+        unsafe: bool = False) -> Fixed:
+    """`text` with the fixes of the diagnostics `keep` accepts made, round after round,
+    until none is left (or MAX_FIX_ROUNDS): the safe ones, and with `unsafe` the unsafe
+    ones of the text as given. A fix is never made over the result of another in one
+    run unless both are safe: the fixes of the first round are made on what the user
+    wrote, a later round's only when they and every fix before them are safe. So an
+    unsafe fix is judged on what was written (the E0201 fix writes `:05`, and W0205's
+    removal of a label nobody jumps to must not be made on it), and an unsafe fix's
+    consequences wait for another run. `rl1c check --fix` and the language server's
+    "fix all" both make their fixes through this function."""
     analysis = analyze(text)
     made = 0
-    for _ in range(MAX_FIX_ROUNDS):
-        fixes = compatible(next(f for f in d.fixes if f.automatic) for d in analysis.diagnostics
-                           if keep(d) and any(f.automatic for f in d.fixes))
+    for done in range(MAX_FIX_ROUNDS):
+        fixes = compatible(_fixes(analysis, keep, unsafe and done == 0))
         if not fixes:
             break
         text = apply_edits(text, [edit for one in fixes for edit in one.edits])
         made += len(fixes)
         analysis = analyze(text)
-    return Fixed(text, made, analysis)
+        if not all(one.safe for one in fixes):
+            break
+    left = sum(1 for d in analysis.diagnostics if keep(d) and d.fixes)
+    return Fixed(text, made, analysis, left)
+
+
+def _fixes(analysis: Analysis, keep: Callable[[Diagnostic], bool], unsafe: bool
+           ) -> Iterator[Fix]:
+    """The first fix that may be made of each diagnostic `keep` accepts."""
+    for diagnostic in analysis.diagnostics:
+        if keep(diagnostic):
+            yield from itertools.islice((one for one in diagnostic.fixes
+                                         if one.safe or unsafe), 1)

@@ -1,5 +1,6 @@
 """Code actions: the checker's fixes as quick fixes, a comment that allows a warning on
-its line, and all the fixes at once as `source.fixAll`."""
+its line, and the safe fixes at once as `source.fixAll`, which `rl1c check --fix` makes
+(both through `analysis.fix`)."""
 
 from __future__ import annotations
 
@@ -7,14 +8,20 @@ from collections.abc import Sequence
 
 from lsprotocol import types
 
+from rl1.compiler.analysis import fix as fix_text
 from rl1.compiler.checker.suppression import MARK
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Severity
-from rl1.compiler.frontend.edits import compatible
+from rl1.compiler.frontend.source import LINE_BREAK
+from rl1.compiler.reporting.selection import Selection
 
 from .checking import to_lsp
 from .document import Document
 from .positions import Columns
+from .project import ProjectFiles
+
+# The rl1.toml selections that decide which fixes "fix all" makes, as for the checks.
+_PROJECTS = ProjectFiles()
 
 
 def _edit(document: Document, fix: Fix, columns: Columns) -> types.WorkspaceEdit:
@@ -46,7 +53,8 @@ def code_actions(document: Document, diagnostics: list[Diagnostic], requested: t
                     kind=types.CodeActionKind.QuickFix,
                     diagnostics=[to_lsp(diagnostic, document, columns)],
                     edit=_edit(document, fix, columns),
-                    is_preferred=len(diagnostic.fixes) == 1,
+                    # An editor may make a preferred fix unasked: only a safe one.
+                    is_preferred=len(diagnostic.fixes) == 1 and fix.safe,
                 ))
             allow = _allow(document, diagnostic)
             if allow is not None:
@@ -55,11 +63,9 @@ def code_actions(document: Document, diagnostics: list[Diagnostic], requested: t
                     diagnostics=[to_lsp(diagnostic, document, columns)],
                     edit=_edit(document, allow, columns)))
     if only is None or any(types.CodeActionKind.SourceFixAll.startswith(kind) for kind in only):
-        fix_all = _fix_all(diagnostics)
-        if fix_all.edits:
-            actions.append(types.CodeAction(
-                title=fix_all.title, kind=types.CodeActionKind.SourceFixAll,
-                edit=_edit(document, fix_all, columns)))
+        fix_all = _fix_all(document, diagnostics, columns)
+        if fix_all is not None:
+            actions.append(fix_all)
     return actions
 
 
@@ -80,9 +86,52 @@ def _allow(document: Document, diagnostic: Diagnostic) -> Fix | None:
                      f"{lead}rl1: allow {diagnostic.code}"),))
 
 
-def _fix_all(diagnostics: list[Diagnostic]) -> Fix:
-    """The only fix of each diagnostic that has exactly one, skipping any whose edits
-    overlap an earlier one's (an editor cannot apply overlapping edits)."""
-    fixes = compatible(d.fixes[0] for d in diagnostics if len(d.fixes) == 1)
-    return Fix("Apply every fix the checker suggests",
-               tuple(edit for fix in fixes for edit in fix.edits))
+def _fix_all(document: Document, diagnostics: list[Diagnostic],
+             columns: Columns) -> types.CodeAction | None:
+    """The safe fixes, made as `rl1c check --fix` makes them, as one edit of the lines
+    they change; None when the document has none (then no check is run again)."""
+    if not any(one.safe for diagnostic in diagnostics for one in diagnostic.fixes):
+        return None
+    selection = _PROJECTS.selection(document.uri)
+    keep = selection.reports if isinstance(selection, Selection) else Selection().reports
+    before = document.text()
+    after = fix_text(before, keep).text
+    if after == before:
+        return None
+    return types.CodeAction(
+        title="Apply every safe fix (as `rl1c check --fix`)",
+        kind=types.CodeActionKind.SourceFixAll,
+        edit=types.WorkspaceEdit(changes={document.uri: [
+            _changed_lines(document, before, after, columns)]}))
+
+
+def _changed_lines(document: Document, before: str, after: str,
+                   columns: Columns) -> types.TextEdit:
+    """One edit that turns `before` (the document's text) into `after`: the lines from
+    the first that differs to the last that differs, with their line ends."""
+    old, new = _with_ends(before), _with_ends(after)
+    same_start = 0
+    while same_start < min(len(old), len(new)) and old[same_start] == new[same_start]:
+        same_start += 1
+    same_end = 0
+    while same_end < min(len(old), len(new)) - same_start \
+            and old[-1 - same_end] == new[-1 - same_end]:
+        same_end += 1
+
+    def start_of(index: int) -> types.Position:
+        # Past the last line: the document's end (after its last line end, if any).
+        ends_in_break = bool(old) and LINE_BREAK.search(old[-1]) is not None
+        if index < len(old) or ends_in_break or not old:
+            return types.Position(index, 0)
+        return document.end_position(columns)
+
+    return types.TextEdit(
+        range=types.Range(start_of(same_start), start_of(len(old) - same_end)),
+        new_text="".join(new[same_start:len(new) - same_end]))
+
+
+def _with_ends(text: str) -> list[str]:
+    """The lines of `text`, each with its line end (the last one may have none)."""
+    starts = [0, *(found.end() for found in LINE_BREAK.finditer(text))]
+    return [line for line in (text[a:b] for a, b in zip(starts, [*starts[1:], len(text)],
+                                                        strict=True)) if line]

@@ -53,7 +53,7 @@ def _malformed_label(text: str, span: ast.Span, what: str, sigil: str) -> Diagno
     elif len(digits.lstrip("0")) <= 2:
         fixed = f"{sigil}{int(digits):02d}"
         help_text = f"write `{fixed}`"
-        fixes = (Fix(f"write `{fixed}`", (Edit(span, fixed),)),)
+        fixes = (Fix(f"write `{fixed}`", (Edit(span, fixed),), safe=True),)
     else:
         help_text = f"labels run from `{sigil}00` to `{sigil}99`"
     code = "E0201" if sigil == ":" else "E0202"
@@ -186,8 +186,7 @@ def _unknown_function(call: ast.Call) -> Diagnostic:
     return Diagnostic(
         "E0501", E, message, call.mnemonic_span,
         help=f"did you mean `{guess.mnemonic}`? {guess.forms[0].summary}",
-        fixes=(Fix(f"write `{guess.mnemonic}`", (Edit(call.mnemonic_span, guess.mnemonic),),
-                   automatic=False),),
+        fixes=(Fix(f"write `{guess.mnemonic}`", (Edit(call.mnemonic_span, guess.mnemonic),)),),
     )
 
 
@@ -195,7 +194,7 @@ def _lower_case(text: str, span: ast.Span, what: str) -> Diagnostic:
     return Diagnostic(
         "W0502", W, f"the {what} `{text}` is not in upper case", span,
         help=f"built-in names and selectors are written in upper case: `{text.upper()}`",
-        fixes=(Fix(f"write `{text.upper()}`", (Edit(span, text.upper()),)),),
+        fixes=(Fix(f"write `{text.upper()}`", (Edit(span, text.upper()),), safe=True),),
     )
 
 

@@ -90,7 +90,7 @@ def _no_end(program: ast.Program, graph: ControlFlowGraph) -> list[Diagnostic]:
         "last line", span,
         help="running off the end behaves as `(END)`; write `(END)` where the program stops, "
              "so that a reader sees it",
-        fixes=(Fix("add `(END)` at the end", (append_line(program, "(END)"),)),),
+        fixes=(Fix("add `(END)` at the end", (append_line(program, "(END)"),), safe=True),),
     )]
 
 

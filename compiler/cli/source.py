@@ -20,6 +20,7 @@ from rl1.compiler.reporting.render import (
     ColorChoice,
     FileDiagnostics,
     Format,
+    fixes_not_made,
     summary,
 )
 
@@ -61,8 +62,12 @@ SECTION = "RL/I programs"
               help="report warnings as errors, so that any warning fails the check (exit "
                    "status 1), as CI wants")
 @click.option("--fix", is_flag=True,
-              help="make the fixes the checker suggests in the files, then report what is "
-                   "left (a guess at a misspelt name is left for you to confirm)")
+              help="make the checker's safe fixes in the files (those that keep what the "
+                   "program means and everything written), then report what is left")
+@click.option("--unsafe-fixes", is_flag=True,
+              help="with --fix or --diff, make the unsafe fixes too: guesses at a misspelt "
+                   "name, removals, changes to what the vehicle does (`rl1c explain CODE` "
+                   "says which a code's fix is)")
 @click.option("--diff", is_flag=True,
               help="change nothing; print what --fix would change as a unified diff (exit "
                    "status 1 when it would change a file)")
@@ -70,7 +75,7 @@ SECTION = "RL/I programs"
 @force_option
 def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
           select: tuple[str, ...], ignore: tuple[str, ...], warnings_as_errors: bool | None,
-          fix: bool, diff: bool, isolated: bool, force: bool) -> int:
+          fix: bool, unsafe_fixes: bool, diff: bool, isolated: bool, force: bool) -> int:
     """Check RL/I programs and report every problem found.
 
     PATH is an RL/I program, or a folder: every .rob file below it is checked; `-` reads
@@ -83,6 +88,9 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
     from rl1.compiler.reporting.project import ProjectFileError, project_selection
     from rl1.compiler.reporting.selection import Selection
 
+    if unsafe_fixes and not (fix or diff):
+        raise click.UsageError("--unsafe-fixes says which fixes --fix or --diff make: give "
+                               "it with one of them")
     if fix and not diff and "-" in files:
         raise click.UsageError("--fix rewrites files, and standard input is none: give the "
                                "file, or --diff to see the fixes")
@@ -106,9 +114,9 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
                            "correct the file (`rl1c docs commands`, \"Controlling `rl1c check`\", "
                            "shows its form), or move it aside") from None
     if diff:
-        return _fix_diff(inputs)
+        return _fix_diff(inputs, unsafe_fixes)
     checked: list[FileDiagnostics] = []
-    fixed = 0
+    fixed = left = 0
     status = 0
     for item, selection in inputs:
         source = read_input(item) if isinstance(item, str) else item
@@ -117,12 +125,13 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
             continue
         text, diagnostics = source.text, None
         if fix:
-            fixing = analysis.fix(source.text, keep=selection.reports)
+            fixing = analysis.fix(source.text, keep=selection.reports, unsafe=unsafe_fixes)
             text, diagnostics = fixing.text, fixing.analysis.diagnostics
             try:
                 if fixing.fixes:
                     write_back(source, fixing.text, force=force)
                     fixed += fixing.fixes
+                left += fixing.left
             except OSError as error:
                 print(problem_text(cannot_write(source.name, "source file", error,
                                                 "to make its fixes")), file=sys.stderr)
@@ -131,9 +140,9 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
         if diagnostics is None:
             diagnostics = analysis.analyze(text).diagnostics
         checked.append(FileDiagnostics(source.name, text, selection.apply(diagnostics)))
-    status = max(status, emit(checked, output_format, color, "check"))
+    status = max(status, emit(checked, output_format, color, None))
     if output_format in ("human", "concise"):
-        sys.stdout.write(summary(checked, fixed))
+        sys.stdout.write(summary(checked, fixed, left, unsafe_fixes))
     return status
 
 
@@ -148,27 +157,29 @@ def _codes(option: str, words: tuple[str, ...]) -> tuple[str, ...] | None:
         raise click.UsageError(f"argument {option}: {error}") from None
 
 
-def _fix_diff(inputs: Sequence[tuple[str | FileDiagnostics, Selection]]) -> int:
+def _fix_diff(inputs: Sequence[tuple[str | FileDiagnostics, Selection]], unsafe: bool) -> int:
     """`rl1c check --diff`: what --fix would change, as diffs; exit status 1 when it
     would change a file, 2 when a file cannot be read."""
     from rl1.compiler import analysis
 
-    changed = 0
-    fixes = 0
+    changed = fixes = left = 0
     unreadable = False
     for item, selection in inputs:
         source = read_input(item) if isinstance(item, str) else item
         if not isinstance(source, Source):
-            emit([source], "human", "auto", "check", err=True)
+            emit([source], "human", "auto", None, err=True)
             unreadable = True
             continue
-        fixing = analysis.fix(source.text, keep=selection.reports)
+        fixing = analysis.fix(source.text, keep=selection.reports, unsafe=unsafe)
+        left += fixing.left
         if fixing.fixes:
             sys.stdout.write(unified_diff(source.name, source.text, fixing.text, "fixed"))
             changed += 1
             fixes += fixing.fixes
-    print(f"--fix would make {_plural(fixes, 'fix', 'fixes')} in "
-          f"{_plural(changed, 'file')}", file=sys.stderr)
+    flags = "--fix --unsafe-fixes" if unsafe else "--fix"
+    not_made = f"; {fixes_not_made(left, unsafe)}" if left else ""
+    print(f"{flags} would make {_plural(fixes, 'fix', 'fixes')} in "
+          f"{_plural(changed, 'file')}{not_made}", file=sys.stderr)
     return EXIT_USAGE if unreadable else EXIT_ERRORS if changed else 0
 
 

@@ -134,9 +134,10 @@ def invalid_file(role: str, name: str, detail: str, help: str = "",
 
 
 def emit(files: list[FileDiagnostics], output_format: Format, color: ColorChoice,
-         action: str, *, err: bool = False) -> int:
-    """Print the diagnostics of `files` on standard output (`err`: standard error);
-    the exit status they call for."""
+         action: str | None, *, err: bool = False) -> int:
+    """Print the diagnostics of `files` on standard output (`err`: standard error),
+    each file closed by a line that says it could not `action` (None: no such line,
+    the command prints its own summary); the exit status they call for."""
     stream = sys.stderr if err else sys.stdout
     colored = output_format == "human" and use_color(color, stream)
     stream.write(report(files, output_format, color=colored, action=action))

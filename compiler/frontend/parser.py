@@ -172,7 +172,7 @@ def _syntax_help(row: ast.Row, kinds: Kinds, lexemes: list[Lexeme],
         if index + 1 < len(kinds) and kinds[index + 1] == "NUMBER" \
                 and lexemes[index + 1][1] == lexemes[index][1] + 1:
             fixes = (Fix("write a comma before the negative number",
-                         (_between(row, lexemes, index, ","),)),)
+                         (_between(row, lexemes, index, ","),), safe=True),)
         return ("separate a negative argument with a comma, as in `(MOV 3,-3)`: after an "
                 "argument, ` -3` reads as a subtraction, which a call's arguments cannot "
                 "hold"), fixes
@@ -181,7 +181,7 @@ def _syntax_help(row: ast.Row, kinds: Kinds, lexemes: list[Lexeme],
     if "_SEMI" in expected and index is not None and kinds[index] in _STARTS_STATEMENT:
         return ("statements on one line are separated by `;`, as in `A=1; B=2`",
                 (Fix("separate the statements with `;`",
-                     (_between(row, lexemes, index, "; "),)),))
+                     (_between(row, lexemes, index, "; "),), safe=True),))
     if expected == {"RPAR"} or ("RPAR" in expected and "_COMMA" in expected):
         return "close the call with `)`", ()
     if "LABELREF" in expected:

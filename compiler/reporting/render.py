@@ -61,11 +61,12 @@ def report(
     output_format: Format = "human",
     *,
     color: bool = False,
-    action: str = "check",
+    action: str | None = "check",
 ) -> str:
     """The diagnostics of `files`, in the order given, as one text ending in a newline
     (empty for people when there is nothing to say). `action` names what failed in the
-    human summary: "could not check `x.rob`"."""
+    human closing line of each file: "could not check `x.rob`"; None leaves those lines
+    out, for a command that ends with one `summary` of every file."""
     if output_format == "json":
         return _json_report(files)
     if output_format == "sarif":
@@ -73,7 +74,8 @@ def report(
     if output_format == "concise":
         return "".join(concise_line(file, d) for file in files for d in _ordered(file.diagnostics))
     rendered = (_HumanRenderer(file, color).render(action) for file in files)
-    return "\n".join(text for text in rendered if text)
+    # Each diagnostic ends in a blank line; a file's closing line needs one after it.
+    return ("" if action is None else "\n").join(text for text in rendered if text)
 
 
 def diagnostic_blocks(file: FileDiagnostics, *, color: bool = False) -> str:
@@ -84,15 +86,35 @@ def diagnostic_blocks(file: FileDiagnostics, *, color: bool = False) -> str:
     return "".join(renderer.diagnostic(d) for d in _ordered(file.diagnostics)).rstrip("\n") + "\n"
 
 
-def summary(files: Sequence[FileDiagnostics], fixed: int = 0) -> str:
+def summary(files: Sequence[FileDiagnostics], fixed: int = 0, left: int = 0,
+            unsafe: bool = False) -> str:
     """One line that counts the files and what was found in them: "3 files checked:
-    0 errors, 1 warning" (a file that could not be read counts its E0100 error), and
-    the problems `fixed` before, if any."""
-    errors = sum(d.is_error for file in files for d in file.diagnostics)
-    warnings = sum(d.severity is Severity.WARNING for file in files for d in file.diagnostics)
-    made = f" ({_plural(fixed, 'problem')} fixed)" if fixed else ""
-    return (f"{_plural(len(files), 'file')} checked: {_plural(errors, 'error')}, "
-            f"{_plural(warnings, 'warning')}{made}\n")
+    0 errors, 1 warning", the files that could not be read (their E0100 is said above
+    it), the problems `fixed` before, if any, and the `left` ones whose fix was not
+    made: an unsafe one (without `unsafe`: --unsafe-fixes makes it), or one that
+    follows from another fix (a second run makes it)."""
+    read = [file for file in files if file.text is not None]
+    unread = len(files) - len(read)
+    if unread and not read:
+        return f"no file checked: {_plural(unread, 'file')} could not be read\n"
+    errors = sum(d.is_error for file in read for d in file.diagnostics)
+    warnings = sum(d.severity is Severity.WARNING for file in read for d in file.diagnostics)
+    notes = [f"{_plural(fixed, 'problem')} fixed"] if fixed else []
+    if left:
+        notes.append(fixes_not_made(left, unsafe))
+    return (f"{_plural(len(read), 'file')} checked: {_plural(errors, 'error')}, "
+            f"{_plural(warnings, 'warning')}"
+            + (f"; {_plural(unread, 'file')} could not be read" if unread else "")
+            + (f" ({'; '.join(notes)})" if notes else "") + "\n")
+
+
+def fixes_not_made(left: int, unsafe: bool) -> str:
+    """Why `left` fixes were not made: unsafe (without `unsafe`), or, being unsafe or
+    coming after an unsafe fix, they wait for another run (analysis.fix)."""
+    if unsafe:
+        return (f"{_plural(left, 'fix', 'fixes')} not made: they follow from other "
+                "fixes; run again to make them")
+    return f"{_plural(left, 'unsafe fix', 'unsafe fixes')} not made: --unsafe-fixes makes them"
 
 
 def exit_status(files: Sequence[FileDiagnostics]) -> int:
@@ -209,9 +231,9 @@ class _HumanRenderer:
     def paint(self, text: str, role: str) -> str:
         return f"{_STYLES[role]}{text}{_RESET}" if self.color else text
 
-    def render(self, action: str) -> str:
+    def render(self, action: str | None) -> str:
         blocks = [self.diagnostic(d) for d in _ordered(self.file.diagnostics)]
-        summary = self.summary(action)
+        summary = self.summary(action) if action is not None else ""
         if summary:
             blocks.append(summary)
         return "".join(blocks)
@@ -287,8 +309,8 @@ def _visible_lines(text: str) -> list[str]:
     return [_visible(line) for line in split_lines(text)] or [""]
 
 
-def _plural(count: int, noun: str) -> str:
-    return f"{count} {noun}" if count == 1 else f"{count} {noun}s"
+def _plural(count: int, noun: str, nouns: str | None = None) -> str:
+    return f"{count} {noun}" if count == 1 else f"{count} {nouns or noun + 's'}"
 
 
 # Concise ----------------------------------------------------------------------------
@@ -337,7 +359,7 @@ def _json_span(span: Span) -> dict[str, int]:
 
 
 def _json_fix(fix: Fix) -> dict[str, Any]:
-    return {"title": fix.title,
+    return {"title": fix.title, "applicability": "safe" if fix.safe else "unsafe",
             "edits": [{**_json_span(edit.span), "text": edit.text} for edit in fix.edits]}
 
 

@@ -1,26 +1,46 @@
-"""`analysis.fix`, what `rl1c check --fix` runs: the checker's automatic fixes made round
-after round until none is left, keeping the text's line ends, never a guess."""
+"""`analysis.fix`, what `rl1c check --fix` and the language server's "fix all" run: the
+checker's safe fixes made round after round until none is left, keeping the text's line
+ends and everything written; the unsafe ones only when asked, and never over what another
+fix of the run wrote."""
 
 from __future__ import annotations
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rl1.compiler.analysis import analyze, fix
-from rl1.compiler.frontend.ast import Span
+from rl1.compiler.frontend.ast import Program, Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix
 from rl1.compiler.frontend.edits import apply_edits, compatible
+from rl1.compiler.frontend.parser import parse_program
 from rl1.compiler.frontend.source import LINE_BREAK
 from rl1.compiler.strategies import programs
 
 
 def fixable(diagnostic: Diagnostic) -> bool:
-    return any(one.automatic for one in diagnostic.fixes)
+    return any(one.safe for one in diagnostic.fixes)
+
+
+# Lines that draw out each fix the checker has, safe and unsafe, and fixes that follow
+# from others (a label fixed to one nobody jumps to, an `(END)` reached still moving).
+FIXABLE_LINES = (":5 (TIM 10)", ":7", "#5", "(mov 3,3)", "(CAM p 10)", "A=1 B=2",
+                 "(MOV 3 -3)", "(HLB)", "(MOVE 3,3)", "A=40000", "GOTO 10", "(TIM 1,2)",
+                 ":10 A=1", ":20 (MOV 3,3)", "(TRC 3)", "(END)", ":97 (MOV 0,0); (END)")
+
+
+@st.composite
+def fixable_programs(draw: st.DrawFn) -> str:
+    """A program of generated lines and lines with fixes, in any order and line ends."""
+    lines = draw(st.lists(st.sampled_from(FIXABLE_LINES) | programs(max_lines=3),
+                          min_size=1, max_size=12))
+    ending = draw(st.sampled_from(["\n", "\r\n"]))
+    return ending.join(lines) + draw(st.sampled_from(["", ending]))
 
 
 @settings(deadline=None)
-@given(programs())
-def test_after_fix_no_diagnostic_with_an_automatic_fix_is_left(text: str) -> None:
+@given(programs() | fixable_programs())
+def test_after_fix_no_diagnostic_with_a_safe_fix_is_left(text: str) -> None:
     fixed = fix(text)
     assert [d.code for d in fixed.analysis.diagnostics if fixable(d)] == []
     assert fixed.analysis.diagnostics == analyze(fixed.text).diagnostics
@@ -28,7 +48,7 @@ def test_after_fix_no_diagnostic_with_an_automatic_fix_is_left(text: str) -> Non
 
 
 @settings(deadline=None)
-@given(programs())
+@given(programs() | fixable_programs())
 def test_fix_keeps_the_line_ends_and_changes_nothing_a_second_time(text: str) -> None:
     fixed = fix(text)
     before = set(LINE_BREAK.findall(text)) or {"\n"}
@@ -46,19 +66,71 @@ def test_fix_makes_only_the_fixes_of_what_it_keeps(text: str, prefix: str) -> No
         assert fixed.text == text
 
 
-def test_a_guess_at_a_misspelt_name_is_not_made() -> None:
-    text = "A=1; (TIN 5)\n(END)\n"
-    (guess,) = [d for d in analyze(text).diagnostics if d.code == "E0501"]
-    assert guess.fixes and not any(one.automatic for one in guess.fixes)
-    assert fix(text).text == text
+def written(program: Program) -> list[tuple[bool, int | None, int]]:
+    """Each line's label (whether it has one, and its number) and its statement count,
+    for a line that parsed (a line with a syntax error keeps nothing yet)."""
+    return [(line.label is not None, line.label.number if line.label else None,
+             len(line.statements)) for line in program.lines]
+
+
+@settings(deadline=None, max_examples=300)
+@given(programs() | fixable_programs())
+def test_safe_fixes_never_remove_a_label_or_a_statement_written(text: str) -> None:
+    before = written(parse_program(text)[0])
+    after = written(parse_program(fix(text).text)[0])
+    assert len(after) >= len(before)  # lines are added only after the last one
+    for (label, number, statements), (label_now, number_now, statements_now) in zip(
+            before, after, strict=False):
+        assert label <= label_now, "a label written is kept"
+        assert number is None or number == number_now, "a label's number is kept"
+        assert statements <= statements_now, "every statement written is kept"
+
+
+def test_a_label_fixed_to_two_digits_is_kept_though_nothing_jumps_to_it() -> None:
+    # Issue 22: the E0201 fix wrote `:05`, then W0205's removed it as never jumped to.
+    text = ":5 (TIM 10)\n(END)\n"
+    assert fix(text).text == ":05 (TIM 10)\n(END)\n"
+    # Unsafe fixes too: W0205's removal would change what the E0201 fix wrote.
+    unsafe = fix(text, unsafe=True)
+    assert unsafe.text == ":05 (TIM 10)\n(END)\n"
+    assert [d.code for d in unsafe.analysis.diagnostics] == ["W0205"] and unsafe.left == 1
+    # A second run judges the label as it now stands.
+    assert fix(unsafe.text, unsafe=True).text == "(TIM 10)\n(END)\n"
+
+
+def test_a_guess_at_a_misspelt_name_is_made_only_with_unsafe_fixes() -> None:
+    text = "A=1; (MOVE 3,3)\n(HLB); (END)\n"
+    guesses = [d for d in analyze(text).diagnostics if d.code == "E0501"]
+    assert len(guesses) == 2 and not any(fixable(d) for d in guesses)
+    safe = fix(text)
+    assert (safe.text, safe.fixes, safe.left) == (text, 0, 2)
+    assert fix(text, unsafe=True).text == "A=1; (MOV 3,3)\n(HLD); (END)\n"
+
+
+@pytest.mark.parametrize("text, code", [
+    (":10 A=1\n(END)\n", "W0205"),  # removes a label written
+    ("(TIM 1,2)\n(END)\n", "E0503"),  # removes an argument written
+    ("A=40000\n(END)\n", "E0507"),  # a guess at the constant meant
+    ("GOTO 10\n(END)\n", "E0103"),  # BASIC's 10 is a line, RL/I's #10 a label
+    ("(TRC 3); (MOV 3,3)\n(END)\n", "W0301"),  # a handler: a change of what it does
+    ("(MOV 3,3); (END)\n", "W0701"),  # a stop: a change of what the vehicle does
+])
+def test_fixes_that_remove_or_change_what_the_program_does_are_unsafe(text: str,
+                                                                       code: str) -> None:
+    (found,) = [d for d in analyze(text).diagnostics if d.code == code]
+    assert found.fixes and not any(one.safe for one in found.fixes)
+    assert code not in {d.code for d in fix(text, unsafe=True).analysis.diagnostics}
 
 
 def test_fixes_that_meet_at_one_place_wait_for_the_next_round() -> None:
-    # No (END) and still moving at the end: both fixes add a line there. The (END) comes
-    # first; the next round stops the vehicle before it.
-    fixed = fix("(MOV 3,3)\r\n")
-    assert fixed.text == "(MOV 3,3)\r\n(MOV 0,0); (END)\r\n"
-    assert fixed.fixes == 2
+    # Two safe fixes on one place: the `;` first, then the label's two digits.
+    fixed = fix(":5 A=1 B=2\r\n(END)\r\n")
+    assert fixed.text == ":05 A=1; B=2\r\n(END)\r\n"
+    # No (END) and still moving at the end: the (END) is added (safe); stopping before
+    # it (unsafe) would touch what that fix wrote, so it waits for another run.
+    once = fix("(MOV 3,3)\r\n", unsafe=True)
+    assert (once.text, once.fixes, once.left) == ("(MOV 3,3)\r\n(END)\r\n", 1, 1)
+    assert fix(once.text, unsafe=True).text == "(MOV 3,3)\r\n(MOV 0,0); (END)\r\n"
 
 
 def test_apply_edits_writes_line_breaks_as_the_text_ends_its_lines() -> None:

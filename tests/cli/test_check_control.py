@@ -64,7 +64,7 @@ def test_concise_places_an_unreadable_file_at_its_start(tmp_path: Path) -> None:
     assert result.stdout == (f"{tmp_path / 'gone.rob'}:1:1: error[E0100]: "
                              f"cannot read the source file `{tmp_path / 'gone.rob'}`: "
                              "no such file\n"
-                             "1 file checked: 1 error, 0 warnings\n")
+                             "no file checked: 1 file could not be read\n")
 
 
 def test_the_summary_counts_every_file_and_machine_formats_have_none(tmp_path: Path) -> None:
@@ -223,8 +223,24 @@ def test_fix_writes_what_fix_makes_in_the_files_own_encoding(
 
 def test_fix_makes_only_the_fixes_of_selected_warnings(tmp_path: Path) -> None:
     program = write(tmp_path, "a.rob", MOVING)
-    assert check("--fix", "--ignore", "W0603", program).exit_code == 0
+    assert check("--fix", "--unsafe-fixes", "--ignore", "W0603", program).exit_code == 0
     assert program.read_text(encoding="utf-8") == "(MOV 3,3)\n(MOV 0,0)\n"
+
+
+def test_fix_makes_the_safe_fixes_and_says_how_many_unsafe_ones_it_left(
+        tmp_path: Path) -> None:
+    program = write(tmp_path, "a.rob", ":5 (TIM 10); (MOVE 3,3)\n(END)\n")
+    result = check("--fix", program)
+    assert result.exit_code == 1
+    assert program.read_text(encoding="utf-8") == ":05 (TIM 10); (MOVE 3,3)\n(END)\n"
+    assert result.stdout.endswith(
+        "1 file checked: 1 error, 1 warning (1 problem fixed; 2 unsafe fixes not made: "
+        "--unsafe-fixes makes them)\n")
+    unsafe = check("--fix", "--unsafe-fixes", program)
+    assert unsafe.exit_code == 0, unsafe.output
+    assert program.read_text(encoding="utf-8") == "(TIM 10); (MOV 3,3)\n(END)\n"
+    alone = check("--unsafe-fixes", program)
+    assert alone.exit_code == 2 and "give it with one of them" in alone.stderr
 
 
 def test_fix_refuses_a_read_only_file_unless_forced(tmp_path: Path) -> None:
@@ -237,7 +253,7 @@ def test_fix_refuses_a_read_only_file_unless_forced(tmp_path: Path) -> None:
     assert program.read_text(encoding="utf-8") == MOVING
     assert "warning[W0603]" in result.stdout  # what the file still has is reported
     assert check("--fix", "--force", program).exit_code == 0
-    assert program.read_text(encoding="utf-8") == "(MOV 3,3)\n(MOV 0,0); (END)\n"
+    assert program.read_text(encoding="utf-8") == "(MOV 3,3)\n(END)\n"
 
 
 def test_diff_shows_what_fix_would_change_and_changes_nothing(tmp_path: Path) -> None:
@@ -246,8 +262,9 @@ def test_diff_shows_what_fix_would_change_and_changes_nothing(tmp_path: Path) ->
     result = check("--diff", program, clean)
     assert result.exit_code == 1
     assert result.stdout == (f"--- {program}\n+++ {program} (fixed)\n@@ -1 +1,2 @@\n"
-                             " (MOV 3,3)\n+(MOV 0,0); (END)\n")
-    assert result.stderr == "--fix would make 2 fixes in 1 file\n"
+                             " (MOV 3,3)\n+(END)\n")
+    assert result.stderr == ("--fix would make 1 fix in 1 file; 1 unsafe fix not made: "
+                             "--unsafe-fixes makes them\n")
     assert program.read_text(encoding="utf-8") == MOVING
     nothing = check("--diff", clean)
     assert (nothing.exit_code, nothing.stdout) == (0, "")
@@ -257,7 +274,7 @@ def test_diff_reads_standard_input_and_fix_refuses_it(tmp_path: Path,
                                                       monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.chdir(tmp_path)
     result = check("--diff", "-", stdin=MOVING.encode())
-    assert result.exit_code == 1 and "+(MOV 0,0); (END)" in result.stdout
+    assert result.exit_code == 1 and "+(END)" in result.stdout
     refused = check("--fix", "-", stdin=MOVING.encode())
     assert refused.exit_code == 2
     assert "--fix rewrites files, and standard input is none" in refused.stderr

@@ -65,8 +65,22 @@ def test_errors_exit_1_with_the_place_and_the_line(tmp_path: Path) -> None:
     assert result.exit_code == 1
     assert result.stdout.startswith("error[E0101]: ")
     assert f" --> {name}:2:5\n  |\n2 | A=B+\n  |     ^\n" in result.stdout
-    assert result.stdout.endswith(f"error: could not check `{name}`: 1 error emitted\n"
-                                  "1 file checked: 1 error, 0 warnings\n")
+    # One summary, of the whole check (issue 22: a line per file came before it).
+    assert result.stdout.endswith("  |     ^\n\n1 file checked: 1 error, 0 warnings\n")
+    assert "could not check" not in result.stdout
+
+
+def test_a_file_that_cannot_be_read_is_not_counted_as_checked(tmp_path: Path) -> None:
+    missing = str(tmp_path / "nosuch.rob")
+    alone = run("check", missing)
+    assert alone.exit_code == 2
+    assert alone.stdout.startswith(f"error[E0100]: cannot read the source file `{missing}`")
+    assert alone.stdout.endswith("\n\nno file checked: 1 file could not be read\n")
+    name = write(tmp_path, "(MOV 3,3)\nA=B+\n")
+    both = run("check", missing, name)
+    assert both.exit_code == 2
+    assert both.stdout.endswith("\n1 file checked: 1 error, 0 warnings; 1 file could not "
+                                "be read\n")
 
 
 def test_warnings_alone_exit_0(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -7,7 +7,7 @@ from conftest import Client, position_of
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException
 
-from rl1.compiler.analysis import analyze
+from rl1.compiler.analysis import analyze, fix
 from rl1.compiler.formatter import format_text
 from rl1.vm.language import BUILTINS, VARIABLES
 
@@ -399,13 +399,39 @@ async def test_a_warning_can_be_allowed_on_its_line(client: Client, line: str,
     assert not [a for a in await actions_at(client, directive, 0) if a.title.startswith("Allow")]
 
 
-async def test_fix_all_applies_every_single_fix(client: Client) -> None:
-    uri = await open_program(client)
+def applied(text: str, edit: types.TextEdit) -> str:
+    """`text` with one LSP edit whose range starts and ends at the start of a line (or
+    the end of the text), as the fix-all edit does."""
+    lines = text.splitlines(keepends=True)
+
+    def offset(position: types.Position) -> int:
+        return sum(len(line) for line in lines[:position.line]) + position.character
+
+    return text[:offset(edit.range.start)] + edit.new_text + text[offset(edit.range.end):]
+
+
+@pytest.mark.parametrize("text, fixed", [
+    # Issue 22: "fix all" made the guesses at misspelt names that --fix leaves alone.
+    (":5 (TIM 10); (MOVE 3,3)\n(HLB)\n", ":05 (TIM 10); (MOVE 3,3)\n(HLB)\n"),
+    (PROGRAM, PROGRAM.replace("(mov 1,1)", "(MOV 1,1)").replace("(ULT b)", "(ULT B)")),
+    ("(mov 3,3)\r\nA=1", "(MOV 3,3)\r\nA=1\r\n(END)"),
+])
+async def test_fix_all_makes_the_safe_fixes_check_fix_makes(client: Client, text: str,
+                                                            fixed: str) -> None:
+    uri = await open_program(client, text)
     actions = await actions_at(client, uri, 0)
     (fix_all,) = [a for a in actions if a.kind == types.CodeActionKind.SourceFixAll]
     assert fix_all.edit is not None and fix_all.edit.changes is not None
-    texts = {edit.new_text for edit in fix_all.edit.changes[uri]}
-    assert {"MVI", "MOV", "B"} <= texts
+    (edit,) = fix_all.edit.changes[uri]
+    assert applied(text, edit) == fixed == fix(text).text
+    guesses = [a for a in actions if a.diagnostics and a.diagnostics[0].code == "E0501"]
+    assert not any(a.is_preferred for a in guesses), "a guess is never made unasked"
+
+
+async def test_no_fix_all_when_no_safe_fix_is_left(client: Client) -> None:
+    uri = await open_program(client, "(HLB)\n(END)\n")
+    assert not [a for a in await actions_at(client, uri, 0)
+                if a.kind == types.CodeActionKind.SourceFixAll]
 
 
 async def test_inlay_hints_name_the_arguments(client: Client) -> None:

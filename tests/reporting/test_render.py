@@ -247,7 +247,7 @@ def test_a_huge_message_is_cut_for_people_but_not_for_machines() -> None:
 
 
 def test_json_has_every_key_with_one_based_exclusive_spans() -> None:
-    fix = Fix("close the call", (Edit(Span(1, 9, 1, 9), ")"),))
+    fix = Fix("close the call", (Edit(Span(1, 9, 1, 9), ")"),), safe=True)
     files = [
         FileDiagnostics("a.rob", "(MOV 3,3\n", [
             error_at(Span(1, 9, 1, 10), "expected `)`", help="close the call with `)`",
@@ -262,7 +262,7 @@ def test_json_has_every_key_with_one_based_exclusive_spans() -> None:
         {"file": "a.rob", "line": 1, "column": 9, "end_line": 1, "end_column": 10,
          "severity": "error", "code": "E0101", "message": "expected `)`",
          "help": "close the call with `)`",
-         "fixes": [{"title": "close the call", "edits": [
+         "fixes": [{"title": "close the call", "applicability": "safe", "edits": [
              {"line": 1, "column": 9, "end_line": 1, "end_column": 9, "text": ")"}]}],
          "related": []},
         {"file": "b.rob", "line": 2, "column": 1, "end_line": 2, "end_column": 4,
