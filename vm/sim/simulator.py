@@ -1,13 +1,12 @@
 """The physics of a simulated run (spec/simulator.md): the vehicle's state, the clock
 that advances it in fixed steps, the tracing timer, the safety checks, and the record
-of the run (pose track and events) that the pictures draw.
+of the run (the pose track, bounded by track.py, and events) that the pictures draw.
 
 This module knows nothing of the Device protocol: device.py adapts it.
 """
 
 from __future__ import annotations
 
-import bisect
 import math
 from dataclasses import dataclass, field
 from typing import Literal
@@ -17,11 +16,15 @@ import numpy as np
 from . import camera, tracing, ultrasonic
 from .geometry import Point, overlap, rectangle
 from .motion import Odometer, Pose, advance, count, time_to_cover
+from .track import History, Track
 from .world import Scene, World
 
 Command = Literal["MOV", "MVI"]
 DEFAULT_STEP = 0.05  # s between two safety checks; the tracing timer has its own interval
 _EMPTY_SCENE = Scene((), (0, 0, 1, 1))
+MAX_EVENTS = 10_000
+"""Lost lines, found lines and handlers taken that a run records (a fault and the end
+are always recorded): more are counted in `events_left_out`."""
 
 
 class SafetyFault(Exception):
@@ -70,8 +73,9 @@ class Simulator:
     tilted_down: bool = False
     scene: int = 0
     odometer: Odometer = field(default_factory=Odometer)
-    track: list[tuple[float, Pose]] = field(default_factory=list)
+    track: list[tuple[float, Pose]] = field(init=False)  # decimated: track.py
     events: list[Event] = field(default_factory=list)
+    events_left_out: int = 0
     _speeds: tuple[float, float] = (0.0, 0.0)  # the wheels' speeds now, units
     _tick: int = 1  # the tracing timer's next tick
     _rng: np.random.Generator = field(init=False)
@@ -80,12 +84,15 @@ class Simulator:
     _echoes: ultrasonic.Echoes = field(init=False)
     _sceneries: dict[int, camera.Scenery] = field(default_factory=dict)  # built when used
     _reach: float = field(init=False)  # from the centre to the outline's corners
-    _times: list[float] = field(default_factory=lambda: [0.0])  # the track's times
+    _track: Track = field(init=False)
+    _history: History | None = field(init=False)  # the recent poses, with a sensor delay
 
     def __post_init__(self) -> None:
         x, y, heading = self.world.start
         self.pose = Pose(x, y, math.radians(heading))
-        self.track.append((0.0, self.pose))
+        self._track = Track(self.pose)
+        self.track = self._track.points
+        self._history = History(self.pose) if self.world.noise.delay else None
         self._rng = np.random.default_rng(self.seed)
         self._lines = tracing.LineIndex(self.world.lines)
         self._obstacles = []
@@ -138,11 +145,9 @@ class Simulator:
     def sensed_pose(self) -> Pose:
         """The pose the sensors report on: the present one, or the one `noise.delay`
         seconds ago (the last recorded at or before then)."""
-        delay = self.world.noise.delay
-        if not delay:
+        if self._history is None:
             return self.pose
-        index = bisect.bisect_right(self._times, self.time - delay) - 1
-        return self.track[max(index, 0)][1]
+        return self._history.at(self.time - self.world.noise.delay)
 
     def view(self) -> camera.View:
         tilt = math.radians(self.world.vehicle.tilt_down) if self.tilted_down else 0.0
@@ -236,8 +241,9 @@ class Simulator:
         count(self.odometer, left, right, seconds)
         if self.motion is not None and self.motion.command == "MVI":
             self.motion.remaining -= abs(left + right) / 2 * seconds
-        self.track.append((self.time + seconds, self.pose))
-        self._times.append(self.time + seconds)
+        self._track.add(self.time + seconds, self.pose)
+        if self._history is not None:
+            self._history.add(self.time + seconds, self.pose)
 
     def _trace(self) -> Command | None:
         """One tick of the tracing timer; the command the line was lost during, when the
@@ -267,6 +273,9 @@ class Simulator:
 
     def note(self, kind: str, text: str) -> None:
         """Record an event at the present time and pose, for the pictures."""
+        if len(self.events) >= MAX_EVENTS and kind not in ("fault", "end"):
+            self.events_left_out += 1
+            return
         self.events.append(Event(self.time, kind, text, self.pose))
 
     # Safety -------------------------------------------------------------------------------

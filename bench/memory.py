@@ -1,0 +1,132 @@
+"""Peak memory of `rl1c` on the largest inputs it accepts: `rl1c sim` on the worst valid
+worlds (the longest time limit, the shortest tracing interval), against the bound of
+spec/simulator.md (200 MB), and `rl1c check` and `rl1c compile` on 8 MiB sources of
+several shapes, in bytes per source byte, against the bound of spec/language.md (64).
+
+Each figure is the peak resident set of one `rl1c` process (os.wait4's ru_maxrss), with
+the peak of `rl1c check` on an empty file printed as the reference (the interpreter and
+the modules). A run that has not ended after --seconds is stopped, and its peak so far
+is printed with "(stopped)".
+
+    .venv/bin/python bench/memory.py [--only sim|source] [--seconds 60]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+RL1C = [sys.executable, "-c", "import sys; from rl1.compiler.cli.main import rl1c; "
+        "sys.argv[0] = 'rl1c'; sys.exit(rl1c())"]
+MIB = 2**20
+SOURCE_BYTES = 8 * MIB
+
+# The program drives on for as long as the world lets it: a straight run at the slowest
+# speed, then waits of 10 s (few calls, so that the figure is the simulator's own).
+DRIVE_ON = "(MOV 1,1)\n:10 (TIM 100); #10\n"
+
+
+def world(trace_interval: float, time_limit: float) -> str:
+    """A floor as large as a world allows, the vehicle in the middle heading along it."""
+    return (f"[floor]\nsize = [1000000, 1000000]\n\n"
+            f"[start]\nx = 1000\ny = 500000\nheading = 0\n\n"
+            f"[vehicle]\ntrace_interval = {trace_interval!r}\n\n"
+            f"[limits]\ntime = {time_limit!r}\n")
+
+
+def peak(arguments: list[str], seconds: float) -> tuple[float, str]:
+    """The peak resident set in MB of `rl1c ARGUMENTS`, and how it ended."""
+    process = subprocess.Popen([*RL1C, *arguments], stdout=subprocess.DEVNULL,
+                               stderr=subprocess.PIPE, start_new_session=True)
+    deadline = time.monotonic() + seconds
+    while True:
+        pid, status, usage = os.wait4(process.pid, os.WNOHANG)
+        if pid:
+            break
+        if time.monotonic() > deadline:
+            os.killpg(process.pid, signal.SIGKILL)
+            pid, status, usage = os.wait4(process.pid, 0)
+            return usage.ru_maxrss / 1024, "(stopped)"
+        time.sleep(0.05)
+    ending = f"exit {os.waitstatus_to_exitcode(status)}"
+    return usage.ru_maxrss / 1024, ending
+
+
+def sim_cases(folder: Path, seconds: float) -> None:
+    program = folder / "drive.rob"
+    program.write_text(DRIVE_ON)
+    print("rl1c sim: peak resident MB (bound: 200)")
+    cases = [
+        ("default interval 0.05 s, time limit 24 h", world(0.05, 86400.0)),
+        ("interval 1e-4 s, time limit 24 h", world(1e-4, 86400.0)),
+        ("interval 1e-9 s, time limit 24 h", world(1e-9, 86400.0)),
+    ]
+    for name, text in cases:
+        path = folder / "case.world.toml"
+        path.write_text(text)
+        started = time.monotonic()
+        megabytes, ending = peak(["sim", str(program), "--world", str(path), "--format",
+                                  "json", "--svg", str(folder / "run.svg"), "--html",
+                                  str(folder / "run.html")], seconds)
+        sizes = ", ".join(f"{kind} {(folder / f'run.{kind}').stat().st_size / MIB:.1f} MiB"
+                          for kind in ("svg", "html") if (folder / f"run.{kind}").exists())
+        print(f"  {name:<44} {megabytes:8.1f} MB  {ending} after "
+              f"{time.monotonic() - started:.0f} s  {sizes}")
+        for kind in ("svg", "html"):
+            (folder / f"run.{kind}").unlink(missing_ok=True)
+
+
+def sources() -> list[tuple[str, bytes]]:
+    """8 MiB sources that are each costly in their own way."""
+    def filled(line: bytes) -> bytes:
+        return line * (SOURCE_BYTES // len(line))
+
+    statements = b";".join([b"A=1"] * 4999)  # 19,999 characters of code
+    return [
+        ("lines of 19,999 characters", filled(statements + b"\n")),
+        ("`A=1` lines", filled(b"A=1\n")),
+        ("65,535 lines, then 1-statement lines", filled(b"A=1;B=2\n")),
+        ("lines with a syntax error", filled(b"A=1 B=2\n")),
+        ("comment lines", filled(b"' a remark that takes up some room, and then more\n")),
+    ]
+
+
+def source_cases(folder: Path, seconds: float) -> None:
+    empty = folder / "empty.rob"
+    empty.write_bytes(b"")
+    reference, _ = peak(["check", str(empty)], seconds)
+    print(f"rl1c check and compile on 8 MiB sources: peak resident MB, and bytes per source "
+          f"byte above `rl1c check` on an empty file ({reference:.1f} MB); bound: 64")
+    for name, data in sources():
+        path = folder / "big.rob"
+        path.write_bytes(data)
+        for command in (["check"], ["compile", "-o", str(folder / "big.ilc")]):
+            started = time.monotonic()
+            megabytes, ending = peak([*command, str(path)], seconds)
+            per_byte = (megabytes - reference) * MIB / len(data)
+            print(f"  {command[0]:<8} {name:<38} {megabytes:8.1f} MB {per_byte:6.1f} B/B  "
+                  f"{ending} after {time.monotonic() - started:.0f} s")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", choices=("sim", "source"))
+    parser.add_argument("--seconds", type=float, default=60.0,
+                        help="stop a run after this long and print its peak so far")
+    options = parser.parse_args()
+    with tempfile.TemporaryDirectory() as name:
+        folder = Path(name)
+        if options.only in (None, "sim"):
+            sim_cases(folder, options.seconds)
+        if options.only in (None, "source"):
+            source_cases(folder, options.seconds)
+
+
+if __name__ == "__main__":
+    main()
