@@ -3,9 +3,13 @@ and finding that file again for `rl1c dis`, which shows its lines only when its 
 matches (a source edited since would put every line beside the wrong instructions).
 
 The recorded name is the source's path relative to the .ilc file's folder, so that a
-file compiled with `rl1c examples/sample.rob -o sample.ilc` finds its source from
-wherever it is read. `dis` follows a recorded name only within the .ilc file's folder:
-a hand-made file could name any file on the machine, or a FIFO that would hang it.
+file compiled with `rl1c examples/sample.rob -o build/sample.ilc` finds its source
+(`../examples/sample.rob`) from wherever it is read. A hand-made or cloned .ilc file
+may name any file (a link beside it may point at `/etc/passwd`), so the file is shown
+only when its digest is the one recorded: a file is then shown only to someone who
+already had its text. `dis` follows a relative name to a regular file (never a FIFO
+that would hang it), reads it within the source size bound, refuses an absolute name,
+and takes no source by name from a file without a digest (format 1.0).
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path, PurePath, PurePosixPath
 
 from rl1.compiler.files import SourceError
-from rl1.compiler.frontend.source import Source, read_source
+from rl1.compiler.frontend.source import MAX_SOURCE_BYTES, Source, decode, read_source
 from rl1.vm import ilc
 
 
@@ -49,32 +53,65 @@ class FoundSource:
 def find_source(debug: ilc.DebugInfo | None, ilc_path: str, named: str | None) -> FoundSource:
     """The source lines of the .ilc file at `ilc_path`: from `named` (the user's
     --source, read whatever the .ilc records: SourceError if unreadable), else from the
-    file the debug section records, looked for in the .ilc file's folder."""
+    file the debug section records, from the .ilc file's folder, when its digest is
+    the one recorded."""
     if debug is None:
         return FoundSource(None, f"note: {ilc_path} has no debug section (it was compiled "
                                  "with -s), so no source lines are shown")
     if named is not None:
         return _checked(read_source(named), debug, ilc_path)
+    give = "give the source with --source FILE.rob"
     if ilc_path == "-":
         return FoundSource(None, "note: source lines not shown: an .ilc file read from "
-                                 "standard input has no folder to find its source in: give "
-                                 "the source with --source FILE.rob")
+                                 f"standard input has no folder to find its source in: {give}")
     recorded = PurePath(debug.source_name)
-    if recorded.is_absolute() or ".." in recorded.parts or not recorded.name:
+    if recorded.is_absolute() or not recorded.name:
         return FoundSource(None, f"note: source lines not shown: {ilc_path} records its "
-                                 f"source as `{debug.source_name}`, outside its folder, "
-                                 "which dis does not open unless asked: give the source "
-                                 "with --source FILE.rob")
+                                 f"source as `{debug.source_name}`, which is not a path "
+                                 f"from its folder, so dis does not open it: {give}")
+    if debug.source_digest is None:
+        return FoundSource(None, f"note: source lines not shown: {ilc_path} has no source "
+                                 "digest (format 1.0), so the file it names, "
+                                 f"`{debug.source_name}`, cannot be told from another: {give}")
     folder = Path(ilc_path).parent
+    first_problem = ""
     for candidate in dict.fromkeys((folder / recorded, folder / recorded.name)):
+        found, reason = _regular_source(candidate)
+        if found is None:
+            problem = (f"note: source lines not shown: `{candidate}`, the source {ilc_path} "
+                       f"records, {reason}; {give}")
+        else:
+            shown = _checked(found, debug, ilc_path)
+            if shown.lines is not None:
+                return shown
+            problem = f"{shown.note}, or {give}"
+        first_problem = first_problem or problem
+    return FoundSource(None, first_problem)
+
+
+def _regular_source(path: Path) -> tuple[Source | None, str]:
+    """The source at `path` (links followed) when it is a regular file that reads as
+    RL/I source within the size bound; else None and why not, as a clause."""
+    try:  # O_NONBLOCK: opening a FIFO must not wait for a writer (Windows has none)
+        descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except FileNotFoundError:
+        return None, "was not found"
+    except (OSError, ValueError) as error:  # ValueError: a NUL in the name
+        return None, f"cannot be opened ({getattr(error, 'strerror', None) or error})"
+    if not stat.S_ISREG(os.fstat(descriptor).st_mode):
+        os.close(descriptor)
+        return None, "is not a regular file"
+    with os.fdopen(descriptor, "rb") as stream:
         try:
-            if stat.S_ISREG(candidate.stat().st_mode):
-                return _checked(read_source(str(candidate)), debug, ilc_path)
-        except (OSError, SourceError, ValueError):  # ValueError: a NUL in the name
-            continue
-    return FoundSource(None, f"note: source lines not shown: `{folder / recorded}`, the "
-                             f"source {ilc_path} records, was not found or cannot be read; "
-                             "give the source with --source FILE.rob")
+            data = stream.read(MAX_SOURCE_BYTES + 1)
+        except OSError as error:
+            return None, f"cannot be read ({error.strerror or error})"
+    if len(data) > MAX_SOURCE_BYTES:
+        return None, f"is larger than {MAX_SOURCE_BYTES // 2**20} MiB, the bound of a source"
+    try:
+        return decode(data, str(path)), ""
+    except SourceError as error:
+        return None, f"is not RL/I source ({error.reason})"
 
 
 def _checked(source: Source, debug: ilc.DebugInfo, ilc_path: str) -> FoundSource:

@@ -163,8 +163,12 @@ def test_dis_then_asm_on_the_command_line(tmp_path: Path) -> None:
     (tmp_path / "count.ilc").write_bytes(assemble(HAND_WRITTEN))
     shown = rl1c("dis", tmp_path / "count.ilc")
     assert shown.exit_code == 0
-    assert ";    3 | :10 A--; ?A>#10" in shown.stdout  # found beside the .ilc
-    assert "no source digest (format 1.0)" in shown.stderr  # so not checked
+    # No digest (format 1.0): the file beside it could be any file, so it is not shown.
+    assert " | " not in shown.stdout
+    assert "no source digest (format 1.0)" in shown.stderr and "--source" in shown.stderr
+    named = rl1c("dis", tmp_path / "count.ilc", "--source", tmp_path / "count.rob")
+    assert ";    3 | :10 A--; ?A>#10" in named.stdout  # what the user names is shown
+    assert "cannot be checked against the source compiled" in named.stderr
     (tmp_path / "count.ils").write_text(shown.stdout)
     built = rl1c("asm", tmp_path / "count.ils", "-o", tmp_path / "again.ilc")
     assert built.exit_code == 0
@@ -200,23 +204,63 @@ def test_dis_refuses_an_invalid_file_with_its_offset(tmp_path: Path) -> None:
     assert "byte 0: not an .ilc file" in result.output
 
 
-def _ilc_naming(tmp_path: Path, source_name: str) -> Path:
+def _ilc_naming(tmp_path: Path, source_name: str, source: str | None = None) -> Path:
+    """An .ilc file in `tmp_path` recording `source_name`, with the digest of `source`
+    (None: no digest, format 1.0)."""
     target = tmp_path / "named.ilc"
-    target.write_bytes(assemble(f".source {json.dumps(source_name)}\n.line 1\nLDI 1\nEND\n"))
+    digest = "" if source is None else f'.digest "{ilc.source_digest(source).hex()}"\n'
+    target.write_bytes(assemble(f".source {json.dumps(source_name)}\n{digest}"
+                                ".line 1\nLDI 1\nEND\n"))
     return target
 
 
-@pytest.mark.parametrize("name", ["/etc/passwd", "../secret.rob", "sub/../../secret.rob"])
-def test_dis_does_not_follow_a_recorded_name_out_of_its_folder(tmp_path: Path,
-                                                                name: str) -> None:
-    (tmp_path / "secret.rob").write_text("SECRET=1\n", encoding="utf-8")
+SECRET = "SECRET=1\n"
+
+
+@pytest.mark.parametrize("name", ["/etc/passwd", "../secret.rob", "sub/../../secret.rob",
+                                  "link.rob"])
+def test_dis_shows_no_file_a_recorded_name_leads_to_without_its_digest(
+        tmp_path: Path, name: str) -> None:
+    # Issue 23: a cloned repository holding an .ilc and a link named as its source.
+    (tmp_path / "secret.rob").write_text(SECRET, encoding="utf-8")
     folder = tmp_path / "build"
-    folder.mkdir()
-    shown = rl1c("dis", _ilc_naming(folder, name))
-    assert shown.exit_code == 0
-    assert "SECRET" not in shown.stdout and "root:" not in shown.stdout
-    assert "        .line 1" in shown.stdout
-    assert "outside its folder" in shown.stderr and "--source" in shown.stderr
+    (folder / "sub").mkdir(parents=True)
+    (folder / "link.rob").symlink_to(tmp_path / "secret.rob")
+    for digest_of in (None, "A=1\n"):  # none, or another file's
+        shown = rl1c("dis", _ilc_naming(folder, name, digest_of))
+        assert shown.exit_code == 0
+        assert "SECRET" not in shown.stdout and "root:" not in shown.stdout
+        assert "        .line 1" in shown.stdout and "--source" in shown.stderr
+    assert "not a path from its folder" in shown.stderr if name.startswith("/") \
+        else "is not the source" in shown.stderr
+
+
+@pytest.mark.parametrize("name", ["../secret.rob", "sub/../../secret.rob", "link.rob"])
+def test_dis_follows_a_relative_name_to_the_source_whose_digest_is_recorded(
+        tmp_path: Path, name: str) -> None:
+    (tmp_path / "secret.rob").write_text(SECRET, encoding="utf-8")
+    folder = tmp_path / "build"
+    (folder / "sub").mkdir(parents=True)
+    (folder / "link.rob").symlink_to(tmp_path / "secret.rob")
+    shown = rl1c("dis", _ilc_naming(folder, name, SECRET))
+    assert (shown.exit_code, shown.stderr) == (0, "")
+    assert ";    1 | SECRET=1" in shown.stdout
+
+
+def test_dis_finds_the_source_in_the_layout_of_make_demo(tmp_path: Path,
+                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 22: `rl1c examples/sample.rob -o build/sample.ilc` records
+    `../examples/sample.rob`, which dis called outside its folder."""
+    for folder in ("examples", "build"):
+        (tmp_path / folder).mkdir()
+    (tmp_path / "examples" / "sample.rob").write_bytes(SAMPLE.read_bytes())
+    monkeypatch.chdir(tmp_path)
+    assert rl1c("examples/sample.rob", "-o", "build/sample.ilc").exit_code == 0
+    debug = ilc.decode(Path("build/sample.ilc").read_bytes()).debug
+    assert debug is not None and debug.source_name == "../examples/sample.rob"
+    shown = rl1c("dis", "build/sample.ilc")
+    assert (shown.exit_code, shown.stderr) == (0, "")
+    assert "| :10 A=(IMG)-180; ?A<#10" in shown.stdout
 
 
 def test_the_readme_first_session_shows_the_source(tmp_path: Path,
@@ -257,10 +301,24 @@ def test_dis_says_when_the_source_is_missing_or_stripped(tmp_path: Path) -> None
     assert stripped.exit_code == 0 and "no debug section" in stripped.stderr
 
 
-def test_dis_reads_no_fifo_the_file_names(tmp_path: Path) -> None:
-    os.mkfifo(tmp_path / "hang.rob")
-    shown = rl1c("dis", _ilc_naming(tmp_path, "hang.rob"))  # would block if opened
+@pytest.mark.parametrize("kind", ["fifo", "folder", "large", "binary"])
+def test_dis_reads_no_fifo_nor_anything_but_a_source_the_file_names(tmp_path: Path,
+                                                                     kind: str) -> None:
+    named = tmp_path / "odd.rob"
+    reasons = {"fifo": "is not a regular file", "folder": "is not a regular file",
+               "large": "is larger than 8 MiB", "binary": "is not RL/I source"}
+    match kind:
+        case "fifo":
+            os.mkfifo(named)
+        case "folder":
+            named.mkdir()
+        case "large":
+            named.write_bytes(b"A=1\n" * (2 * 2**20 + 1))
+        case "binary":
+            named.write_bytes(b"\x00\x01")
+    shown = rl1c("dis", _ilc_naming(tmp_path, "odd.rob", "A=1\n"))  # a FIFO would block
     assert shown.exit_code == 0 and "        .line 1" in shown.stdout
+    assert f"`{named}`, the source" in shown.stderr and reasons[kind] in shown.stderr
 
 
 def test_dis_source_option_names_the_source_whatever_the_file_records(tmp_path: Path) -> None:
