@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test lint typecheck pytest clean vscode-test vscode-package c-test
+.PHONY: demo test quick lint typecheck pytest clean vscode-test vscode-package c-test
 
 # pip byte-compiles what it installs, but an editable install leaves rl1 to its first
 # run, which cannot write bytecode where PYTHONDONTWRITEBYTECODE is set: compileall.
@@ -39,6 +39,13 @@ demo: $(STAMP)
 	@echo 'Next: `. .venv/bin/activate`, then the first session in README.md.'
 
 test: lint typecheck vscode-test c-test pytest
+
+# The fast tests alone, in under a minute, while working: no test marked slow or needing
+# a C compiler, Node.js or a browser (tests/conftest.py marks them). `make test` runs all.
+QUICK := not slow and not needs_cc and not needs_node and not needs_browser
+
+quick: $(STAMP)
+	$(BIN)/pytest -n 2 -m '$(QUICK)'
 
 # The C VM (vm/c/): the Debian packages it needs when missing (CI runs as root),
 # then its builds, the conformance vectors under sanitizers and on emulated targets,

@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from support import ROOT
 from support.cli import rl1c
+from support.documents import DOCUMENT_NAME
 
 from rl1.compiler.cli import docs
 
@@ -22,9 +23,6 @@ PAGES = [README, *sorted(DOCS.glob("*.md"))]
 LINK = re.compile(r"!?\[(?:[^\[\]]|\[[^\]]*\])*\]\(([^)\s]+)\)")
 FENCE = re.compile(r"^```.*?^```", re.MULTILINE | re.DOTALL)
 HEADING = re.compile(r"^#{1,6} +(.+?) *#*$", re.MULTILINE)
-# A document named in a message or a help text: spec/sensors.md, docs/commands.md, and
-# README.md, which is not installed.
-DOCUMENT_NAME = re.compile(r"\b(?:(?:spec|docs)/[\w.-]+\.(?:md|h)|README\.md)\b")
 
 
 def _prose(markdown: str) -> str:

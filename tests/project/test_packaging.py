@@ -10,7 +10,11 @@ import tomllib
 import zipfile
 from pathlib import Path
 
+import pytest
 from support import ROOT
+
+from rl1.compiler.cli import docs
+from rl1.vm import native
 
 CONFIG = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["setuptools"]
 
@@ -38,9 +42,11 @@ def test_data_files_the_code_reads_are_package_data() -> None:
     assert list((ROOT / "compiler" / "reporting" / "explanations").glob("*.md"))
 
 
+@pytest.mark.slow  # a wheel build: seconds
 def test_a_wheel_builds_without_warnings_and_holds_the_data(tmp_path: Path) -> None:
     """`pip install .` builds this wheel: setuptools warns of a data folder that is not
-    a listed package ("would be ignored"), and a missing data file breaks `rl1c explain`."""
+    a listed package ("would be ignored"), and a missing data file breaks `rl1c explain`,
+    `rl1c run --engine c` or `rl1c docs`."""
     for name in ("pyproject.toml", "README.md", "LICENSE"):
         shutil.copy(ROOT / name, tmp_path / name)
     for top in CONFIG["package-dir"].values():
@@ -58,3 +64,9 @@ def test_a_wheel_builds_without_warnings_and_holds_the_data(tmp_path: Path) -> N
     assert explanations <= names
     assert "rl1/compiler/frontend/grammar.lark" in names
     assert "rl1/compiler/frontend/lalr_tables.py" in names
+    # What `rl1c run --engine c` builds the C VM from, where vm/native.py looks for it.
+    for path in (*native.SOURCES, *native.HEADERS):
+        assert f"rl1/{path.relative_to(ROOT).as_posix()}" in names, path
+    # What `rl1c docs` prints.
+    for path in docs.documents().values():
+        assert f"rl1/{path.relative_to(ROOT).as_posix()}" in names, path

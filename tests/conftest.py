@@ -1,0 +1,37 @@
+"""Marks tests by what they need beyond Python and by how long they take, so that
+`make quick` can leave out the tests marked `slow`, `needs_cc`, `needs_node` or
+`needs_browser` (pyproject.toml registers them) and run the rest in under a minute.
+
+A test is marked here by where it is (a folder, a module, or one test of a module), so
+that the test files stay about what they test; a module may also mark itself with
+`pytestmark`. tests/project/test_markers.py checks that every place named here exists.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+# Where a test is, as pytest names it from the project's folder, to its marks. A key
+# ending in `/` is a folder, one with `::` a test (every parameter of it), any other a
+# module.
+MARKS: dict[str, tuple[str, ...]] = {
+    # The C VM through ctypes, built with UBSan: every vector, loader refusals, the cache.
+    "tests/c/": ("needs_cc", "slow"),
+    "tests/backend/test_firmware.py::test_the_c_array_compiles_and_holds_the_ilc_bytes":
+        ("needs_cc",),
+}
+
+
+def marks_of(nodeid: str) -> tuple[str, ...]:
+    """The marks MARKS gives the test `nodeid` (tests/c/test_c_vm.py::test_x[case])."""
+    test = nodeid.split("[", 1)[0]
+    return tuple(mark for where, marks in MARKS.items()
+                 if test == where or test.startswith(where if where.endswith("/")
+                                                     else where + "::")
+                 for mark in marks)
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        for mark in marks_of(item.nodeid):
+            item.add_marker(mark)

@@ -1,0 +1,65 @@
+"""The markers `make quick` leaves out: registered in pyproject.toml, applied by path in
+tests/conftest.py to places that exist, and every one of them left out by the Makefile's
+quick target."""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+import tomllib
+from types import ModuleType
+
+import pytest
+from support import ROOT
+
+PYTEST = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))[
+    "tool"]["pytest"]["ini_options"]
+REGISTERED = {line.split(":", 1)[0] for line in PYTEST["markers"]}
+
+
+def _conftest() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("tests_conftest", ROOT / "tests" / "conftest.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+CONFTEST = _conftest()
+
+
+@pytest.mark.parametrize("where", list(CONFTEST.MARKS))
+def test_every_place_marked_exists(where: str) -> None:
+    path, _, test = where.partition("::")
+    assert (ROOT / path).exists(), f"tests/conftest.py marks {path}, which does not exist"
+    if test:
+        source = (ROOT / path).read_text(encoding="utf-8")
+        assert re.search(rf"^(?:async )?def {re.escape(test)}\(", source, re.MULTILINE), (
+            f"tests/conftest.py marks {where}, which {path} does not define")
+
+
+def test_every_mark_given_is_registered() -> None:
+    given = {mark for marks in CONFTEST.MARKS.values() for mark in marks}
+    assert given <= REGISTERED
+
+
+@pytest.mark.parametrize(("nodeid", "marks"), [
+    ("tests/c/test_c_vm.py::test_vector[calls-3]", {"needs_cc", "slow"}),
+    ("tests/backend/test_firmware.py::test_the_c_array_compiles_and_holds_the_ilc_bytes[x]",
+     {"needs_cc"}),
+    ("tests/backend/test_firmware.py::test_the_c_array_spells_every_byte_in_order", set()),
+    ("tests/cli/test_cli_check.py::test_something", set()),
+])
+def test_a_test_gets_the_marks_of_its_folder_module_and_name(nodeid: str,
+                                                             marks: set[str]) -> None:
+    assert set(CONFTEST.marks_of(nodeid)) == marks
+
+
+def test_make_quick_leaves_out_every_marker_and_make_test_none() -> None:
+    makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
+    quick = re.search(r"^QUICK := (.*)$", makefile, re.MULTILINE)
+    assert quick is not None, "the Makefile has no QUICK expression"
+    assert re.fullmatch(r"not \w+(?: and not \w+)*", quick[1])
+    assert set(re.findall(r"not (\w+)", quick[1])) == REGISTERED
+    pytest_rule = re.search(r"^pytest:.*\n\t(.*)$", makefile, re.MULTILINE)
+    assert pytest_rule is not None and "-m" not in pytest_rule[1].split()
