@@ -55,6 +55,8 @@ def _node_builtins() -> set[str]:
     return set(json.loads(listed.stdout))
 
 
+@pytest.mark.slow  # npm runs tsc, esbuild and vsce
+@pytest.mark.needs_node
 def test_the_package_holds_the_bundle_and_few_files(vsix: Path) -> None:
     names = zipfile.ZipFile(vsix).namelist()
     content = {name.removeprefix("extension/") for name in names
@@ -63,6 +65,8 @@ def test_the_package_holds_the_bundle_and_few_files(vsix: Path) -> None:
     assert not [name for name in names if "node_modules" in name or "/out/" in name]
 
 
+@pytest.mark.slow  # npm runs tsc, esbuild and vsce
+@pytest.mark.needs_node
 def test_the_bundle_needs_only_vscode_and_node(vsix: Path) -> None:
     with zipfile.ZipFile(vsix) as archive:
         bundle = archive.read("extension/dist/extension.js").decode("utf-8")
