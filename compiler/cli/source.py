@@ -205,7 +205,7 @@ def fmt(files: tuple[str, ...], check: bool, diff: bool, force: bool) -> int:
     for item in source_files(files, "fmt"):
         source = read_input(item) if isinstance(item, str) else item
         if not isinstance(source, Source):
-            emit([source], "human", "auto", "format", err=True)
+            emit([source], "human", "auto", None, err=True)
             failed += 1
             continue
         formatted = formatter.format_text(source.text)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from rl1.compiler.files import SourceError, TooLargeError, read_bounded, write_atomically
 from rl1.compiler.frontend.ast import Span
@@ -16,7 +17,6 @@ from rl1.compiler.frontend.source import (
     UTF8_BOM,
     Source,
     decode,
-    read_source,
     split_lines,
 )
 from rl1.compiler.reporting.render import (
@@ -33,6 +33,9 @@ from rl1.compiler.reporting.render import (
 
 from .command import Failure
 
+if TYPE_CHECKING:  # the .ilc module loads only when an .ilc file is read
+    from rl1.vm.ilc import IlcFormatError
+
 STDIN_NAME = "<stdin>"
 SOURCE_SUFFIX = ".rob"  # in any case: DOS wrote SAMPLE.ROB
 MAX_ILC_BYTES = 16 * 1024 * 1024  # far more than any .ilc file holds
@@ -41,16 +44,32 @@ MAX_ILC_BYTES = 16 * 1024 * 1024  # far more than any .ilc file holds
 def read_input(name: str, role: str = "source file") -> Source | FileDiagnostics:
     """The source file `name` (`-` is standard input), or the E0100 report of why it
     cannot be read; `role` names it there."""
+    shown = STDIN_NAME if name == "-" else name
+    data: bytes | None = None
     try:
         if name != "-":
-            return read_source(name)
-        data = sys.stdin.buffer.read(MAX_SOURCE_BYTES + 1)
-        if len(data) > MAX_SOURCE_BYTES:
-            raise SourceError(STDIN_NAME, f"it holds more than {MAX_SOURCE_BYTES} bytes",
-                              "RL/I sources are limited to that size")
-        return decode(data, STDIN_NAME)
+            data = read_bounded(name, MAX_SOURCE_BYTES, "an RL/I source file")
+        else:
+            data = sys.stdin.buffer.read(MAX_SOURCE_BYTES + 1)
+            if len(data) > MAX_SOURCE_BYTES:
+                raise SourceError(STDIN_NAME, f"it holds more than {MAX_SOURCE_BYTES} bytes",
+                                  "RL/I sources are limited to that size")
+        return decode(data, shown)
     except SourceError as error:
-        return unreadable(STDIN_NAME if name == "-" else name, error, role)
+        return unreadable(shown, _compiled_code(name, data) or error, role)
+
+
+def _compiled_code(name: str, data: bytes | None) -> SourceError | None:
+    """Why `data`, read where a source was expected, is not one when it is an .ilc
+    file (said instead of "a binary file"); None when it is not."""
+    from rl1.vm.ilc import MAGIC  # only for a file that is not source: 40 ms to load
+
+    if data is None or not data.startswith(MAGIC):
+        return None
+    run = f"`rl1c run {name}`" if name.lower().endswith(".ilc") else \
+        "`rl1c run`, under a name that ends in .ilc"
+    return SourceError(name, "it is compiled code (an .ilc file), not RL/I source",
+                       f"run it with {run}, or show it as text with `rl1c dis {name}`")
 
 
 def source_files(names: Sequence[str], command: str) -> list[str | FileDiagnostics]:
@@ -191,6 +210,28 @@ def read_ilc(file: str) -> bytes:
         raise invalid_file(ILC_ROLE, name, f"it is larger than {MAX_ILC_BYTES} bytes",
                            "check that this is the .ilc file you meant", EXIT_ERRORS)
     return data
+
+
+def refused_ilc(file: str, data: bytes, error: IlcFormatError, help: str) -> Failure:
+    """The Failure (exit status 1) of the .ilc file `file` whose bytes `data` the
+    verifier refused with `error`; `help` says what to do. A file that does not start
+    as an .ilc file does is said to be source text when it is one, else its first
+    bytes are shown in hex."""
+    from rl1.vm.ilc import MAGIC, Refusal
+
+    name = STDIN_NAME if file == "-" else file
+    detail = f"byte {error.offset}: {error.message}"
+    if error.refusal is Refusal.BAD_MAGIC:
+        try:
+            decode(data, name)
+        except SourceError:
+            detail = (f"it does not start with `{MAGIC.decode()}` as an .ilc file does (its "
+                      f"first bytes are {data[:len(MAGIC)].hex(' ').upper()})")
+        else:
+            detail = "it is RL/I source text, not compiled code"
+            output = with_suffix(file, ".ilc") if file != "-" else "FILE.ilc"
+            help = f"compile it first, `rl1c compile {file} -o {output}`, then give {output}"
+    return invalid_file(ILC_ROLE, name, detail, help, EXIT_ERRORS)
 
 
 def with_suffix(path: str, suffix: str) -> str:

@@ -5,6 +5,8 @@ fix of the run wrote."""
 
 from __future__ import annotations
 
+import re
+
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -15,6 +17,7 @@ from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix
 from rl1.compiler.frontend.edits import apply_edits, compatible
 from rl1.compiler.frontend.parser import parse_program
 from rl1.compiler.frontend.source import LINE_BREAK
+from rl1.compiler.reporting.catalogue import CODES
 from rl1.compiler.strategies import programs
 
 
@@ -146,3 +149,22 @@ def test_compatible_drops_a_fix_that_overlaps_or_meets_one_kept_before() -> None
     same_place = Fix("c", (Edit(Span(1, 1, 1, 1), "z"),))
     after = Fix("d", (Edit(Span(1, 4, 1, 5), "w"),))
     assert compatible([first, overlapping, same_place, after]) == [first, after]
+
+
+def example_fixes(code: str) -> list[Fix]:
+    """The fixes of `code`'s diagnostics in the examples of its explanation (`rl1c
+    explain`), each code block checked as a program."""
+    blocks = CODES[code].explanation().split("```")[1::2]
+    return [one for block in blocks for d in analyze(block).diagnostics if d.code == code
+            for one in d.fixes]
+
+
+@pytest.mark.parametrize("code", sorted(CODES))
+def test_explain_says_whether_a_codes_fix_is_safe(code: str) -> None:
+    stated = re.findall(r"\*\*Fix: (safe|unsafe)\b", CODES[code].explanation())
+    fixes = example_fixes(code)
+    if not fixes:
+        assert stated == [], f"{code} states a class of fix but its examples have none"
+        return
+    assert len(stated) == 1, f"`rl1c explain {code}` must say whether its fix is safe"
+    assert {one.safe for one in fixes} == {stated[0] == "safe"}

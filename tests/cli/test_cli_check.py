@@ -70,6 +70,25 @@ def test_errors_exit_1_with_the_place_and_the_line(tmp_path: Path) -> None:
     assert "could not check" not in result.stdout
 
 
+def test_compiled_code_given_as_a_source_is_named_so(tmp_path: Path) -> None:
+    # Issue 22: an .ilc file renamed .rob was "a binary file".
+    compiled = tmp_path / "p.ilc"
+    assert run(write(tmp_path, "A=1\n(END)\n"), "-o", str(compiled)).exit_code == 0
+    renamed = write(tmp_path, compiled.read_bytes(), "renamed.rob")
+    for args, stdin, name, shown in ((("check", renamed), b"", renamed, renamed),
+                                     (("check", "-"), compiled.read_bytes(), "<stdin>", "-"),
+                                     (("fmt", str(compiled)), b"", str(compiled), None)):
+        result = run(*args, stdin=stdin)
+        assert result.exit_code == 2
+        assert f"cannot read the source file `{name}`: it is compiled code (an .ilc file), " \
+               "not RL/I source\n" in result.output
+        assert "binary" not in result.output
+        run_it = f"`rl1c run {name}`" if shown is None else "`rl1c run`, under a name"
+        assert run_it in result.output and f"`rl1c dis {shown or name}`" in result.output
+        assert "could not check" not in result.output
+        assert "could not format" not in result.output  # fmt has its own summary line
+
+
 def test_a_file_that_cannot_be_read_is_not_counted_as_checked(tmp_path: Path) -> None:
     missing = str(tmp_path / "nosuch.rob")
     alone = run("check", missing)

@@ -201,7 +201,23 @@ def test_dis_refuses_an_invalid_file_with_its_offset(tmp_path: Path) -> None:
     (tmp_path / "x.ilc").write_bytes(b"RLIX" + assemble("END")[4:])
     result = rl1c("dis", tmp_path / "x.ilc")
     assert result.exit_code == 1
-    assert "byte 0: not an .ilc file" in result.output
+    assert "it does not start with `RLIC` as an .ilc file does (its first bytes are " \
+        "52 4C 49 58)" in result.output
+    (tmp_path / "y.ilc").write_bytes(assemble("END")[:-1])
+    cut = rl1c("dis", tmp_path / "y.ilc")
+    assert cut.exit_code == 1 and "is not valid: byte " in cut.output
+
+
+def test_dis_says_a_source_is_source_text_and_what_to_run(tmp_path: Path) -> None:
+    # Issue 22: "it starts with b"' ob"", a Python bytes repr.
+    source = tmp_path / "p.rob"
+    source.write_text("' obstacle course\nA=1\n", encoding="utf-8")
+    result = rl1c("dis", source)
+    assert result.exit_code == 1
+    assert result.stderr.startswith(f"error[E0100]: the intermediate code file `{source}` is "
+                                    "not valid: it is RL/I source text, not compiled code\n")
+    assert f"`rl1c compile {source} -o {tmp_path / 'p.ilc'}`" in result.stderr
+    assert "b'" not in result.stderr and 'b"' not in result.stderr
 
 
 def _ilc_naming(tmp_path: Path, source_name: str, source: str | None = None) -> Path:
