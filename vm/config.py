@@ -26,8 +26,10 @@ from typing import Annotated, Any, Literal, TypeVar, Union, get_args, get_origin
 
 import msgspec
 import msgspec.inspect as mi
+from msgspec import Meta
 
 from .config_lines import KeyPath, first_long_number, line_of
+from .language import BUILTINS
 
 T = TypeVar("T")
 Syntax = Literal["toml", "json"]
@@ -39,6 +41,14 @@ readers hit past it. No value of these files is near that long; the range checks
 the long ones that remain, quoting only a few digits."""
 
 _EXCERPT = 40  # characters of a key or string quoted in a message
+
+# The types that more than one file's schema uses.
+Int16 = Annotated[int, Meta(ge=-32768, le=32767)]
+Byte = Annotated[int, Meta(ge=0, le=255)]
+INPUT_PORTS = BUILTINS["INP"].forms[0].params[0]
+"""The ports (INP p) reads: what a port's name (PortName) may number."""
+PortName = Annotated[str, Meta(pattern=r"^[0-9]{1,6}$", extra={
+    "expected": f'a port number {INPUT_PORTS.low}..{INPUT_PORTS.high} in quotes, such as "3"'})]
 
 
 class ConfigError(Exception):
@@ -169,7 +179,7 @@ def convert(document: object, schema: type[T], name: str, text: str,
     what = message[:at.start()] if at else message
     value = _value_at(document, path)
     if what.startswith(_MISSING):
-        detail = _missing(kind, path, what[len(_MISSING):-1], syntax)
+        detail = _missing(kind, path, value, syntax)
     elif what.startswith(_UNKNOWN):
         detail = _unknown(kind, syntax)
         path = (*path, what[len(_UNKNOWN):-1])
@@ -225,6 +235,15 @@ def _strip(kind: Any) -> Any:
             return kind
 
 
+def _without_none(kind: Any) -> Any:
+    """`kind` without None in a union, its constraints kept."""
+    if get_origin(kind) in (Union, types.UnionType):
+        rest = [arg for arg in get_args(kind) if arg is not type(None)]
+        if len(rest) == 1:
+            return rest[0]
+    return kind
+
+
 def _child(kind: Any, part: str | int) -> Any:
     """The schema's type at `part` inside a value of type `kind`."""
     kind = _strip(kind)
@@ -261,12 +280,15 @@ def _is_table(kind: Any) -> bool:
     return isinstance(kind, type) and issubclass(kind, msgspec.Struct)
 
 
-def _missing(kind: Any, path: KeyPath, key: str, syntax: Syntax) -> str:
+def _missing(kind: Any, path: KeyPath, value: object, syntax: Syntax) -> str:
+    """What to add to the table `value` of schema type `kind` at `path`."""
+    keys = [field.encode_name for field in msgspec.structs.fields(_strip(kind))
+            if field.required and not (isinstance(value, Mapping) and field.encode_name in value)]
     if syntax == "json":
-        return f'missing "{key}"; add it (spec/sensors.md)'
-    if _is_table(_child(kind, key)):
-        return f"missing the [{describe_path((*path, key))}] table; add one"
-    return f"missing `{key}`; write `{key} = ...`"
+        return "missing " + ", ".join(f'"{key}"' for key in keys)
+    if _is_table(_child(kind, keys[0])):
+        return f"missing the [{describe_path((*path, keys[0]))}] table; add one"
+    return "missing " + ", ".join(f"`{key}`" for key in keys) + f"; write `{keys[0]} = ...`"
 
 
 def _unknown(kind: Any, syntax: Syntax) -> str:
@@ -277,7 +299,7 @@ def _unknown(kind: Any, syntax: Syntax) -> str:
 
 
 def _mismatch(kind: Any, value: object, syntax: Syntax) -> str:
-    info = mi.type_info(kind)
+    info = mi.type_info(_without_none(kind))
     bare = info.type if isinstance(info, mi.Metadata) else info
     number = isinstance(value, int | float) and not isinstance(value, bool)
     if number and isinstance(bare, mi.IntType | mi.FloatType) and (
@@ -293,14 +315,18 @@ def _mismatch(kind: Any, value: object, syntax: Syntax) -> str:
 
 def _range(info: mi.IntType | mi.FloatType) -> str:
     """`in 0..255`, `of at least 1`, or nothing: the range a number has to be in."""
-    low = (f"{info.ge:g}" if info.ge is not None else
-           f"(more than {info.gt:g})" if info.gt is not None else None)
-    high = f"{info.le:g}" if info.le is not None else None
+    low = (_number(info.ge) if info.ge is not None else
+           f"(more than {_number(info.gt)})" if info.gt is not None else None)
+    high = _number(info.le) if info.le is not None else None
     if low is not None and high is not None:
         return f" in {low}..{high}"
     if low is not None:
         return f" of at least {low}"
     return f" of at most {high}" if high is not None else ""
+
+
+def _number(bound: float) -> str:
+    return str(bound) if isinstance(bound, int) else f"{bound:g}"
 
 
 def expected(info: mi.Type, syntax: Syntax) -> str:
@@ -362,6 +388,8 @@ def found(value: object, syntax: Syntax) -> str:
             return f'the string "{excerpt(value)}"'
         case Mapping():
             return "a table" if syntax == "toml" else "an object"
+        case []:
+            return "an empty array"
         case list():
             return f"an array of {len(value)} item{'' if len(value) == 1 else 's'}"
         case None:

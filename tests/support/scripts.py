@@ -6,7 +6,7 @@ from __future__ import annotations
 from hypothesis import strategies as st
 
 from rl1.vm.device import FuzzyReading, ImageReading, Odometry
-from rl1.vm.scripted import AFTER_LAST, LossAt, LossDuring, Script
+from rl1.vm.sensor_script import AFTER_LAST, LossAt, LossDuring, Script
 
 INT16 = st.integers(-32768, 32767)
 

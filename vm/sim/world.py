@@ -19,15 +19,18 @@ import msgspec
 from msgspec import Meta, Struct
 
 from ..config import (
+    INPUT_PORTS,
     SENSOR_SCRIPT,
     WORLD,
+    Byte,
     ConfigError,
+    Int16,
+    PortName,
     convert,
     describe_path,
     read_document,
 )
 from ..config_lines import KeyPath, line_of
-from ..language import BUILTINS
 from .geometry import Point, rectangle
 
 
@@ -175,11 +178,6 @@ step of the simulation cost."""
 
 FloorLength = Annotated[float, _in(10, _LIMIT, "cm", "the floor's extent")]
 Pixel = Annotated[int, Meta(ge=0, le=1024)]
-Int16 = Annotated[int, Meta(ge=-32768, le=32767)]
-PortName = Annotated[str, Meta(pattern=r"^[0-9]{1,6}$", extra={
-    "expected": 'a port, a decimal number in quotes such as "3"'})]
-Byte = Annotated[int, Meta(ge=0, le=255)]
-PORTS = BUILTINS["INP"].forms[0].params[0]
 
 
 class FloorTable(Struct, forbid_unknown_fields=True):
@@ -370,8 +368,8 @@ class _World:
         ports = {}
         for key, data in self.file.ports.items():
             port = int(key)
-            if not PORTS.low <= port <= PORTS.high:
-                raise self.fail(("ports", key), f"{port} is not a port; ports are "
-                                                f"{PORTS.low}..{PORTS.high}")
+            if not INPUT_PORTS.low <= port <= INPUT_PORTS.high:
+                raise self.fail(("ports", key), f"{port} is outside {INPUT_PORTS.low}.."
+                                                f"{INPUT_PORTS.high}, the input ports")
             ports[port] = data
         return ports
