@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from typing import Any
 
 from rl1.compiler.files import SourceError, read_bounded
 
@@ -53,57 +52,33 @@ def find_project_file(folder: str) -> str | None:
 
 def load_project_file(path: str) -> Selection:
     """The selection an rl1.toml sets (what it leaves out stays unset)."""
-    import tomllib  # only when a project has the file
+    # Only when a project has the file: the validation layer loads msgspec.
+    from rl1.vm.config import ConfigError, convert, describe_path, read_document
+    from rl1.vm.config_lines import line_of
+
+    from .project_schema import ProjectFile
 
     try:
         data = read_bounded(path, MAX_PROJECT_FILE_BYTES, "a project file")
-        document = tomllib.loads(data.decode("utf-8"))
     except SourceError as error:
         raise ProjectFileError(error.path, error.reason, unreadable=True,
                                help=error.help) from None
-    except UnicodeDecodeError as error:
-        raise ProjectFileError(path, f"not UTF-8 text (byte {error.start}); TOML files are "
-                               "UTF-8") from None
-    except tomllib.TOMLDecodeError as error:
-        raise ProjectFileError(path, f"not valid TOML: {error}") from None
-    except RecursionError:  # tomllib reads nested arrays recursively
-        raise ProjectFileError(path, "arrays or tables nested too deeply to read") from None
-    unknown = sorted(set(document) - {TABLE})
-    if unknown:
-        raise ProjectFileError(path, f"unknown table or key `{unknown[0]}`: rl1.toml has "
-                               f"a `[{TABLE}]` table only")
-    table = document.get(TABLE, {})
-    if not isinstance(table, dict):
-        raise ProjectFileError(path, f"`{TABLE}` must be a table, `[{TABLE}]`")
-    return _selection(path, table)
-
-
-_KEYS = ("select", "ignore", "warnings-as-errors")
-
-
-def _selection(path: str, table: dict[str, Any]) -> Selection:
-    for key in table:
-        if key not in _KEYS:
-            raise ProjectFileError(path, f"unknown key `{key}` in `[{TABLE}]`; the keys are "
-                                   + ", ".join(f"`{known}`" for known in _KEYS))
-
-    def codes(key: str) -> tuple[str, ...] | None:
-        value = table.get(key)
-        if value is None:
-            return None
-        if not isinstance(value, list) or not all(isinstance(item, str) for item in value):
-            raise ProjectFileError(path, f"`{key}` in `[{TABLE}]` must be a list of codes, "
-                                   f'such as {key} = ["W0601", "W06"]')
-        try:
-            return parse_codes(value)
-        except SelectionError as error:
-            raise ProjectFileError(path, f"`{key}` in `[{TABLE}]`: {error}") from None
-
-    strict = table.get("warnings-as-errors")
-    if strict is not None and not isinstance(strict, bool):
-        raise ProjectFileError(path, f"`warnings-as-errors` in `[{TABLE}]` must be true or "
-                               "false")
-    return Selection(codes("select"), codes("ignore"), strict)
+    try:
+        document, text = read_document(data, path, "toml")
+        check = convert(document, ProjectFile, path, text).check
+        codes = {}
+        for key, value in (("select", check.select), ("ignore", check.ignore)):
+            try:
+                codes[key] = parse_codes(value) if value is not None else None
+            except SelectionError as error:
+                codes_at = (TABLE, key)
+                raise ConfigError(path, line_of(text, codes_at, "toml"),
+                                  describe_path(codes_at), str(error)) from None
+    except ConfigError as error:
+        at = f"line {error.line}: " if error.line is not None else ""
+        where = f"{error.where}: " if error.where else ""
+        raise ProjectFileError(path, at + where + error.detail) from None
+    return Selection(codes["select"], codes["ignore"], check.warnings_as_errors)
 
 
 def project_selection() -> Callable[[str], Selection]:

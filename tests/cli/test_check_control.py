@@ -295,6 +295,11 @@ def test_the_nearest_project_file_sets_the_options(tmp_path: Path) -> None:
         ("W0701", "error"), ("W0603", "warning")]
 
 
+def test_a_project_file_may_start_with_a_byte_order_mark(tmp_path: Path) -> None:
+    write(tmp_path, "rl1.toml", '\ufeff[check]\nignore = ["W0603", "W0701"]\n'.encode())
+    assert check(write(tmp_path, "a.rob", MOVING)).exit_code == 0  # refused before
+
+
 def test_options_given_win_over_the_project_file(tmp_path: Path) -> None:
     write(tmp_path, "rl1.toml", '[check]\nselect = ["W06"]\nwarnings-as-errors = true\n')
     program = write(tmp_path, "a.rob", MOVING)
@@ -322,13 +327,19 @@ def test_standard_input_takes_the_working_directorys_project_file(
 
 
 @pytest.mark.parametrize("content, says", [
-    ("[check\n", "not valid TOML: "),
-    ('[check]\nselct = ["W06"]\n', "unknown key `selct` in `[check]`; the keys are `select`"),
-    ('[lint]\nselect = ["W06"]\n', "unknown table or key `lint`"),
-    ("check = 3\n", "`check` must be a table"),
-    ('[check]\nselect = "W06"\n', "`select` in `[check]` must be a list of codes"),
-    ('[check]\nignore = ["E0101"]\n', "`ignore` in `[check]`: `E0101` names only errors"),
-    ("[check]\nwarnings-as-errors = 1\n", "must be true or false"),
+    ("[check\n", "invalid TOML: "),
+    ('[check]\nselct = ["W06"]\n',
+     "line 2: check.selct: unknown key; expected one of select, ignore, warnings-as-errors"),
+    ('[lint]\nselect = ["W06"]\n', "line 1: lint: unknown key; expected one of check"),
+    ("check = 3\n", "line 1: check: expected a table, found 3"),
+    ('[check]\nselect = "W06"\n', 'line 2: check.select: expected a list of codes, such as ["W06'),
+    ('[check]\nignore = ["E0101"]\n', "line 2: check.ignore: `E0101` names only errors"),
+    ("[check]\nwarnings-as-errors = 1\n",
+     "line 2: check.warnings-as-errors: expected true or false"),
+    # Every number goes through the one bounded reader: an internal error before.
+    ("[check]\nwarnings-as-errors = " + "9" * 5000 + "\n",
+     "line 2: check.warnings-as-errors: a number of more than 4300 digits"),
+    ("[check]\nselect = [" + "1" * 4000 + "]\n", "found a number of 4000 digits"),
     (b"[check]\n# \xff\n", "not UTF-8 text"),
     ("x = " + "[" * 100_000 + "]" * 100_000 + "\n", "nested too deeply"),
 ])

@@ -104,7 +104,7 @@ async def test_the_nearest_rl1_toml_selects_as_for_rl1c_check(client: Client,
     project.write_text("[check]\nselct = 1\n", encoding="utf-8")
     client.change(uri, 2, ((0, 9, 0, 9), " "))
     shown = await client.diagnostics_of(uri, 2)
-    assert "unknown key `selct`" in shown[0].message and shown[0].code is None
+    assert "check.selct: unknown key" in shown[0].message and shown[0].code is None
     assert [(d.code, d.severity) for d in shown[1:]] == [
         ("W0603", types.DiagnosticSeverity.Warning), ("W0701", types.DiagnosticSeverity.Warning)]
 
