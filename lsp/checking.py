@@ -127,6 +127,15 @@ def too_large_notice(document: Document) -> types.Diagnostic:
                   "Check it with `rl1c check FILE`.")
 
 
+def over_limits_notice(held: tuple[int, int], limits: tuple[int, int]) -> types.Diagnostic:
+    """Why a document opened is not held: the documents and characters held, and the
+    most the server holds of each."""
+    return notice(f"rl1-lsp holds at most {limits[0]:,} open documents of {limits[1]:,} "
+                  f"characters in all, and {held[0]:,} of {held[1]:,} are open, so "
+                  "it does not analyse this one. Close some documents and reopen this "
+                  "one, or check it with `rl1c check FILE`.")
+
+
 def project_notice(problem: str) -> types.Diagnostic:
     return notice(f"rl1-lsp: {problem}. Until it is corrected, every diagnostic is shown "
                   "as if there were no rl1.toml.")
@@ -191,6 +200,11 @@ class DiagnosticsScheduler:
         self.cancel(uri)
         self._last_change.pop(uri, None)
         self._publish(types.PublishDiagnosticsParams(uri=uri, diagnostics=[]))
+
+    def stop(self) -> None:
+        """The session is over: cancel every check."""
+        for uri in list(self._tasks):
+            self.cancel(uri)
 
     def current(self, document: Document) -> list[Diagnostic]:
         """The diagnostics of the document's current version, checking it now if the

@@ -1,23 +1,18 @@
-"""The base protocol's framing on standard input: `Content-Length` headers, each
-message's body, and what to do when a client breaks them.
+"""The base protocol's framing on a byte stream (standard input and output, a TCP
+connection): `Content-Length` headers, each message's body, and what to do when a
+client breaks them.
 
 pygls' reader trusts its client: a huge `Content-Length` is read in one allocation
-(MemoryError), and a header it does not recognise leaves it waiting for a header that
-never comes. This reader bounds every read (a header line, a message), accepts LF as
-well as CRLF line ends, and after broken framing skips to the next `Content-Length`
-header, saying on standard error what it skipped.
+(MemoryError) or grows without bound as the data streams in, a header line longer than
+64 KiB drops a TCP connection, and a header it does not recognise leaves it waiting for
+a header that never comes. This reader bounds every read (a header line, a message),
+accepts LF as well as CRLF line ends, and after broken framing skips to the next
+`Content-Length` header; the transport says on standard error what it skipped.
 """
 
 from __future__ import annotations
 
-import asyncio
-import logging
-import os
 import re
-import threading
-from collections.abc import Callable
-
-log = logging.getLogger(__name__)
 
 MAX_MESSAGE = 64 * 2**20
 """The largest body accepted, in bytes: 6 times the largest document analysed, which
@@ -102,36 +97,6 @@ class Framer:
         self.problems.append(problem)
 
 
-async def read_messages(fd: int, handle: Callable[[bytes], None],
-                        stop: threading.Event) -> None:
-    """Hands each message body read from file descriptor `fd` to `handle`, until the
-    end of the input or `stop`."""
-    loop = asyncio.get_running_loop()
-    chunks: asyncio.Queue[bytes] = asyncio.Queue(maxsize=4)
-
-    def read() -> None:
-        # A daemon thread with os.read: a blocked read neither holds a lock nor delays
-        # the exit that LSP's `exit` asks for.
-        while True:
-            chunk = os.read(fd, CHUNK)
-            put = chunks.put(chunk)
-            try:
-                asyncio.run_coroutine_threadsafe(put, loop).result()
-            except RuntimeError:  # the loop has ended: the server is exiting
-                put.close()
-                return
-            if not chunk:
-                return
-
-    threading.Thread(target=read, name="rl1-lsp stdin", daemon=True).start()
-    framer = Framer()
-    while not stop.is_set():
-        chunk = await chunks.get()
-        if not chunk:
-            return
-        for body in framer.feed(chunk):
-            handle(body)
-        for problem in framer.problems:
-            log.warning("skipped %s; reading on from the next Content-Length header. "
-                        "The client is breaking LSP's framing: please report it", problem)
-        framer.problems.clear()
+def frame(body: bytes) -> bytes:
+    """A message as the server writes it: its length in bytes, then the body."""
+    return b"Content-Length: %d\r\n\r\n%s" % (len(body), body)

@@ -12,11 +12,9 @@ import asyncio
 import json
 import logging
 import sys
-from collections.abc import Callable, Generator
-from functools import partial
+from collections.abc import Callable
 from importlib.metadata import version
-from threading import Event
-from typing import Any, BinaryIO
+from typing import Any
 
 import click
 from lsprotocol import types
@@ -26,33 +24,61 @@ from pygls.exceptions import (
     JsonRpcParseError,
     JsonRpcServerNotInitialized,
 )
-from pygls.io_ import StdoutWriter
 from pygls.lsp.server import LanguageServer
 from pygls.protocol import LanguageServerProtocol
-from pygls.protocol.language_server import lsp_method
 
-from . import actions, checking, completion, formatting, framing, hints, hover, navigation, tokens
-from .document import Document
+from . import (
+    actions,
+    checking,
+    completion,
+    formatting,
+    hints,
+    hover,
+    navigation,
+    tokens,
+    transports,
+)
+from .document import MAX_ANALYSED_CHARACTERS, Document
 from .positions import UTF16, Columns
+
+log = logging.getLogger(__name__)
 
 NAME = "rl1-lsp"
 
+MAX_OPEN_DOCUMENTS = 500
+MAX_OPEN_CHARACTERS = 8 * MAX_ANALYSED_CHARACTERS
+"""What one session holds: a document past either limit is turned away with a notice.
+About 10 KB a small document, and some 100 bytes a character of an analysed one
+(bench/lsp_burst.py's figures), so that a session stays within a few hundred MB."""
+
 
 class Rl1Protocol(LanguageServerProtocol):
-    """Passes document synchronisation straight to the server's handlers, leaving
-    pygls' own copy of the documents out, and answers what pygls leaves unanswered,
-    which leaves the client waiting forever: requests whose parameters do not fit the
-    protocol, malformed JSON, JSON that is no message, and requests out of the
-    session's order (before `initialize`, after `shutdown`)."""
+    """One session's end of JSON-RPC, fed each message's body by a transport
+    (transports.py). pygls runs the requests (dispatch, cancellation, responses); this
+    class answers what pygls leaves unanswered, which leaves the client waiting
+    forever: malformed JSON (nested too deeply included), JSON that is no message,
+    requests whose parameters do not fit the protocol, and requests out of the
+    session's order (before `initialize`, after `shutdown`). It hands notifications to
+    their handlers itself: pygls' dispatch of a notification costs five times a
+    keystroke's edit, files a future that nothing removes (no upstream issue as of pygls
+    2.1.1; the nearest are openlawlibrary/pygls#611 and #608), and its `exit` ends the
+    process, where over TCP or a WebSocket it ends one session of many."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
-        self.initialize_received = False  # before pygls' __init__, which reads `ready`
         super().__init__(*args, **kwargs)
+        self.initialize_received = False
+        self.shutdown_received = False
+        self.exit_status: int | None = None
+        """Set by `exit`, as LSP gives it: the session is over."""
 
     def receive(self, body: bytes) -> None:
-        """Handle one message's body, as read by framing.read_messages."""
+        """Handle one message's body."""
         try:
             data = json.loads(body)
+        except RecursionError:
+            self._refuse(None, JsonRpcParseError(
+                "the message is nested too deeply to read: send a JSON-RPC message"))
+            return
         except ValueError as error:  # JSONDecodeError and UnicodeDecodeError
             self._refuse(None, JsonRpcParseError(
                 f"the message is not JSON in UTF-8 ({error}): send a JSON-RPC message"))
@@ -65,28 +91,33 @@ class Rl1Protocol(LanguageServerProtocol):
         try:
             message = self.structure_message(data)
         except JsonRpcException as error:  # answered by structure_message if a request
-            logging.warning("a message that does not fit LSP: %s", error)
+            log.warning("a message that does not fit LSP: %s", error)
             return
         try:
-            if type(message) is types.DidChangeTextDocumentNotification and self.ready:
-                # The one message a burst repeats a thousand times: pygls' dispatch
-                # costs five times the edit itself.
-                self.fm.features[types.TEXT_DOCUMENT_DID_CHANGE](message.params)
+            if hasattr(message, "method") and not hasattr(message, "id"):
+                self._notified(message.method, message)
             else:
                 self.handle_message(message)
-        except Exception as error:  # as pygls' reader does: log, tell the client, go on
-            logging.exception("handling a message failed")
-            self._server._report_server_error(error, JsonRpcException)
+        except Exception:  # a bug in a handler: log it and go on serving
+            log.exception("handling a message failed")
 
-    @property
-    def ready(self) -> bool:
-        """Between `initialize` and `shutdown`: notifications are handled."""
-        return self.initialize_received and not self._shutdown
+    def _notified(self, method: str, message: Any) -> None:
+        if method == types.EXIT:
+            self.exit_status = 0 if self.shutdown_received else 1
+        elif method == types.CANCEL_REQUEST:
+            self.handle_message(message)  # pygls cancels the request it runs
+        elif not self.initialize_received or self.shutdown_received:
+            log.warning("%s %s: dropped, as LSP asks", method,
+                        "after shutdown" if self.shutdown_received else "before initialize")
+        elif (handler := self.fm.features.get(method)) is not None:
+            handler(message.params)
+        else:  # such as $/setTrace and initialized, which need nothing done
+            log.debug("%s: nothing to do", method)
 
     def handle_message(self, message: Any) -> None:
         method = getattr(message, "method", None)
         if method is not None and hasattr(message, "id"):  # a request
-            if self._shutdown:
+            if self.shutdown_received:
                 self._refuse(message.id, JsonRpcInvalidRequest(
                     f"{method} after shutdown: the server only accepts exit now"))
                 return
@@ -99,63 +130,37 @@ class Rl1Protocol(LanguageServerProtocol):
                     f"{method} before initialize: send initialize first"))
                 return
             self.initialize_received = True
-        elif method not in (None, types.EXIT) and not self.initialize_received:
-            logging.warning("%s before initialize: dropped, as LSP asks", method)
-            return
+            self.shutdown_received = method == types.SHUTDOWN
         super().handle_message(message)
-
-    def _handle_notification(self, method_name: str, params: Any) -> None:
-        # pygls files the future of a notification's handler under a fresh id that no
-        # response ever removes: one entry per didChange, megabytes per burst of edits.
-        outstanding = set(self._request_futures)
-        super()._handle_notification(method_name, params)
-        for msg_id in self._request_futures.keys() - outstanding:
-            future = self._request_futures[msg_id]
-            if future.done():
-                del self._request_futures[msg_id]
-            else:
-                future.add_done_callback(partial(self._forget_future, msg_id))
-
-    def _forget_future(self, msg_id: int | str, _: object) -> None:
-        self._request_futures.pop(msg_id, None)
-
-    def _refuse(self, msg_id: int | str | None, error: JsonRpcException) -> None:
-        logging.warning("%s", error.message)
-        self._send_response(msg_id, error=error.to_response_error())  # type: ignore[arg-type]
 
     def structure_message(self, data: dict[str, Any]) -> Any:
         try:
             return super().structure_message(data)
         except JsonRpcException as error:
             if "id" in data and "method" in data:
-                self._send_response(data["id"], error=error.to_response_error())
+                self._refuse(data["id"], error)
             raise
 
-    def _user(self, method: str, params: object) -> Generator[Any, Any, None]:
-        if (handler := self.fm.features.get(method)) is not None:
-            yield handler, (params,), None
-
-    @lsp_method(types.TEXT_DOCUMENT_DID_OPEN)
-    def lsp_text_document__did_open(
-            self, params: types.DidOpenTextDocumentParams) -> Generator[Any, Any, None]:
-        yield from self._user(types.TEXT_DOCUMENT_DID_OPEN, params)
-
-    @lsp_method(types.TEXT_DOCUMENT_DID_CHANGE)
-    def lsp_text_document__did_change(
-            self, params: types.DidChangeTextDocumentParams) -> Generator[Any, Any, None]:
-        yield from self._user(types.TEXT_DOCUMENT_DID_CHANGE, params)
-
-    @lsp_method(types.TEXT_DOCUMENT_DID_CLOSE)
-    def lsp_text_document__did_close(
-            self, params: types.DidCloseTextDocumentParams) -> Generator[Any, Any, None]:
-        yield from self._user(types.TEXT_DOCUMENT_DID_CLOSE, params)
+    def _refuse(self, msg_id: object, error: JsonRpcException) -> None:
+        """Answer a request (or, without an id, a message that could not be read) with
+        an error: the writer is the transport's, which frames each message itself."""
+        log.warning("%s", error.message)
+        answer = {"jsonrpc": "2.0", "id": msg_id,
+                  "error": {"code": error.code, "message": error.message}}
+        if self.writer is not None:
+            self.writer.write(json.dumps(answer).encode())
 
 
 class Rl1Server(LanguageServer):
+    """One session: a client's documents and their analysis."""
+
+    protocol: Rl1Protocol
+
     def __init__(self) -> None:
         super().__init__(NAME, version("rl1"), protocol_cls=Rl1Protocol,
                          text_document_sync_kind=types.TextDocumentSyncKind.Incremental)
         self.documents: dict[str, Document] = {}
+        self.open_characters = 0  # in all the documents held
         self.columns = Columns(UTF16)
         self.snippets = False  # what the client's completion accepts
         self.markdown = False
@@ -163,25 +168,59 @@ class Rl1Server(LanguageServer):
             self.text_document_publish_diagnostics, lambda: self.columns)
         self.token_history = tokens.TokenHistory()
 
-    def start_io(self, stdin: BinaryIO | None = None, stdout: BinaryIO | None = None) -> None:
-        """Serve over standard input and output, with framing.py's reader in place of
-        pygls' (the rest as pygls' own start_io). LSP's `exit` ends the process with
-        the status LSP gives it."""
-        self._stop_event = Event()
-        self.protocol.set_writer(StdoutWriter(stdout or sys.stdout.buffer))
-        fd = (stdin or sys.stdin.buffer).fileno()
-        assert isinstance(self.protocol, Rl1Protocol)
-        try:
-            asyncio.run(framing.read_messages(fd, self.protocol.receive, self._stop_event))
-        except BrokenPipeError:
-            logging.error("the client closed its end of the connection: exiting")
-        finally:
-            self.shutdown()  # type: ignore[no-untyped-call]  # pygls has no hints here
-
     def document(self, uri: str) -> Document | None:
         """An open document the server analyses; None for unknown or huge ones."""
         document = self.documents.get(uri)
         return None if document is None or document.too_large else document
+
+    def hold(self, document: Document) -> None:
+        """Keep an opened document, or, beyond the limits, tell its client why not."""
+        self.forget(document.uri)
+        if len(self.documents) >= MAX_OPEN_DOCUMENTS or (
+                self.open_characters + document.size > MAX_OPEN_CHARACTERS):
+            self._turn_away(document)
+            return
+        self.documents[document.uri] = document
+        self.open_characters += document.size
+        self.checks.schedule(document)
+
+    def changed(self, document: Document, size_before: int) -> None:
+        """A held document was edited: check it, or drop it if it grew past the limit."""
+        self.open_characters += document.size - size_before
+        if self.open_characters > MAX_OPEN_CHARACTERS:
+            self.forget(document.uri)
+            self._turn_away(document)
+            return
+        self.checks.schedule(document)
+
+    def forget(self, uri: str) -> None:
+        if (document := self.documents.pop(uri, None)) is not None:
+            self.open_characters -= document.size
+        self.token_history.forget(uri)
+        self.checks.cancel(uri)
+
+    def _turn_away(self, document: Document) -> None:
+        log.warning("%s is not analysed: over the limits of open documents", document.uri)
+        self.text_document_publish_diagnostics(types.PublishDiagnosticsParams(
+            uri=document.uri, version=document.version, diagnostics=[checking.over_limits_notice(
+                (len(self.documents), self.open_characters),
+                (MAX_OPEN_DOCUMENTS, MAX_OPEN_CHARACTERS))]))
+
+    # The session, as transports.py serves it ------------------------------------------
+
+    @property
+    def exit_status(self) -> int | None:
+        return self.protocol.exit_status
+
+    def attach(self, writer: transports.Writer) -> None:
+        self.protocol.set_writer(writer, include_headers=False)  # the writer frames
+
+    def receive(self, body: bytes) -> None:
+        self.protocol.receive(body)
+
+    def end(self) -> None:
+        """The session is over: stop its checks, which would publish to no one."""
+        self.checks.stop()
 
 
 def create_server() -> Rl1Server:
@@ -205,27 +244,24 @@ def create_server() -> Rl1Server:
     @server.feature(types.TEXT_DOCUMENT_DID_OPEN)
     def did_open(params: types.DidOpenTextDocumentParams) -> None:
         item = params.text_document
-        document = Document(item.uri, item.text, item.version)
-        server.documents[item.uri] = document
-        server.checks.schedule(document)
+        server.hold(Document(item.uri, item.text, item.version))
 
     @server.feature(types.TEXT_DOCUMENT_DID_CHANGE)
     def did_change(params: types.DidChangeTextDocumentParams) -> None:
         document = server.documents.get(params.text_document.uri)
         if document is None:
-            logging.warning("change to %s, which is not open: ignored", params.text_document.uri)
+            log.warning("change to %s, which is not open: ignored", params.text_document.uri)
             return
+        size_before = document.size
         for change in params.content_changes:
             document.apply(change, server.columns)
         document.version = params.text_document.version
-        server.checks.schedule(document)
+        server.changed(document, size_before)
 
     @server.feature(types.TEXT_DOCUMENT_DID_CLOSE)
     def did_close(params: types.DidCloseTextDocumentParams) -> None:
-        uri = params.text_document.uri
-        server.documents.pop(uri, None)
-        server.token_history.forget(uri)
-        server.checks.close(uri)
+        server.forget(params.text_document.uri)
+        server.checks.close(params.text_document.uri)
 
     # Everything else reads one document -----------------------------------------------
 
@@ -321,21 +357,40 @@ def create_server() -> Rl1Server:
 @click.option("--stdio", is_flag=True,
               help="talk LSP over standard input and output (the default)")
 @click.option("--tcp", metavar="HOST:PORT", callback=lambda ctx, param, value: _host_port(value),
-              help="listen for one client on a TCP port instead")
+              help="listen on a TCP port instead: each connection is a session of its own, "
+                   f"up to {transports.MAX_SESSIONS} at once")
+@click.option("--ws", metavar="HOST:PORT", callback=lambda ctx, param, value: _host_port(value),
+              help="listen for WebSocket connections instead (one LSP message a WebSocket "
+                   "message; programs and pages served from this machine only), each a "
+                   "session of its own; needs the websockets package: pip install 'rl1[ws]'")
 @click.option("--log-level", type=click.Choice(["debug", "info", "warning", "error"]),
               default="warning", show_default=True, help="what to log on standard error")
-def command(stdio: bool, tcp: tuple[str, int] | None, log_level: str) -> None:
+def command(stdio: bool, tcp: tuple[str, int] | None, ws: tuple[str, int] | None,
+            log_level: str) -> None:
     """The RL/I language server: diagnostics, hover, completion, navigation, renaming of
     labels, formatting and quick fixes for .rob files in any LSP editor."""
-    if tcp is not None and stdio:
-        raise click.UsageError("--stdio and --tcp exclude each other: choose one of --stdio "
-                               "and --tcp")
+    if sum((stdio, tcp is not None, ws is not None)) > 1:
+        raise click.UsageError("--stdio, --tcp and --ws exclude each other: choose one of "
+                               "--stdio, --tcp and --ws")
     logging.basicConfig(level=log_level.upper(), format="rl1-lsp %(levelname)s: %(message)s")
-    server = create_server()
-    if tcp is None:
-        server.start_io()
-    else:
-        server.start_tcp(*tcp)
+    if tcp is None and ws is None:
+        sys.exit(transports.serve_stdio(create_server(), sys.stdin.buffer, sys.stdout.buffer))
+    if ws is not None:
+        try:
+            import websockets  # noqa: F401
+        except ImportError:
+            raise click.ClickException(
+                "--ws needs the websockets package: pip install 'rl1[ws]'") from None
+    serve = transports.serve_tcp if tcp is not None else transports.serve_websocket
+    host, port = tcp or ws  # type: ignore[misc]
+    try:
+        asyncio.run(serve(create_server, host, port))
+    except OSError as error:
+        raise click.ClickException(
+            f"cannot listen on {host}:{port}: {error.strerror or error}. Choose another "
+            "port, or stop the program that listens on it") from None
+    except KeyboardInterrupt:
+        sys.exit(130)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -10,6 +10,7 @@ import sys
 from importlib.metadata import version
 
 import pytest
+from sockets import free_port
 
 COMMAND = [sys.executable, "-m", "rl1.lsp"]
 
@@ -26,26 +27,35 @@ def test_version_and_help() -> None:
     helped = run("--help")
     assert helped.returncode == 0
     assert "--tcp HOST:PORT" in helped.stdout and "--stdio" in helped.stdout
+    assert "--ws HOST:PORT" in helped.stdout
 
 
+@pytest.mark.parametrize("option", ["--tcp", "--ws"])
 @pytest.mark.parametrize("value", ["2087", "localhost:", "host:port", "h:70000"])
-def test_a_bad_tcp_address_is_a_usage_error(value: str) -> None:
-    failed = run("--tcp", value)
+def test_a_bad_address_is_a_usage_error(option: str, value: str) -> None:
+    failed = run(option, value)
     assert failed.returncode == 2
     assert "HOST:PORT" in failed.stderr and "Traceback" not in failed.stderr
 
 
-def test_stdio_and_tcp_together_are_a_usage_error() -> None:
-    failed = run("--stdio", "--tcp", "127.0.0.1:2087")
+@pytest.mark.parametrize("options", [
+    ["--stdio", "--tcp", "127.0.0.1:2087"], ["--tcp", "127.0.0.1:2087", "--ws", "127.0.0.1:2088"],
+    ["--stdio", "--ws", "127.0.0.1:2087"]])
+def test_two_transports_together_are_a_usage_error(options: list[str]) -> None:
+    failed = run(*options)
     assert failed.returncode == 2
-    assert "choose one of --stdio and --tcp" in failed.stderr
+    assert "choose one of --stdio, --tcp and --ws" in failed.stderr
 
 
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port: int = probe.getsockname()[1]
-        return port
+@pytest.mark.parametrize("option", ["--tcp", "--ws"])
+def test_a_port_in_use_is_a_clear_error(option: str) -> None:
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        failed = run(option, f"127.0.0.1:{taken.getsockname()[1]}")
+    assert failed.returncode == 1
+    assert "cannot listen on 127.0.0.1:" in failed.stderr and "another port" in failed.stderr
+    assert "Traceback" not in failed.stderr
 
 
 def frame(message: dict[str, object]) -> bytes:

@@ -1,0 +1,105 @@
+"""`rl1-lsp --ws` on real sockets, as the studio will serve it: each connection a session
+of its own, a message over the limit closing that connection only, malformed JSON a
+parse error, and pages from other sites refused (Cross-Site WebSocket Hijacking)."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+from collections.abc import Iterator
+
+import pytest
+from raw import INITIALIZE, INITIALIZED, notification, request
+from sockets import Listening, listening
+
+websockets = pytest.importorskip("websockets")
+from websockets.sync.client import ClientConnection, connect  # noqa: E402
+from websockets.typing import Origin  # noqa: E402
+
+from rl1.lsp.framing import MAX_MESSAGE  # noqa: E402
+
+PARSE_ERROR = -32700
+
+
+@pytest.fixture(scope="module")
+def ws() -> Iterator[Listening]:
+    with listening("ws") as server:
+        yield server
+
+
+@contextlib.contextmanager
+def ws_session(server: Listening) -> Iterator[ClientConnection]:
+    """A fresh, initialized connection."""
+    with connect(f"ws://127.0.0.1:{server.port}", max_size=None, open_timeout=30) as client:
+        client.send(json.dumps(INITIALIZE))
+        assert "capabilities" in ws_reply(client, 1)["result"]  # type: ignore[operator]
+        client.send(json.dumps(INITIALIZED))
+        yield client
+
+
+def hover(msg_id: int, uri: str) -> str:
+    return json.dumps(request(msg_id, "textDocument/hover", {
+        "textDocument": {"uri": uri}, "position": {"line": 0, "character": 2}}))
+
+
+def ws_reply(client: ClientConnection, msg_id: int | None) -> dict[str, object]:
+    while True:
+        message = json.loads(client.recv(timeout=30))
+        if "method" not in message and message.get("id") == msg_id:
+            reply: dict[str, object] = message
+            return reply
+
+
+def test_websocket_connections_are_sessions_of_their_own(ws: Listening) -> None:
+    secret = "file:///home/first/secret.rob"
+    with ws_session(ws) as first, ws_session(ws) as second:
+        first.send(json.dumps(notification("textDocument/didOpen", {"textDocument": {
+            "uri": secret, "languageId": "rl1", "version": 1, "text": "(MOV 3,3)\n"}})))
+        while (message := json.loads(first.recv(timeout=30))).get("method") is None:
+            pass
+        assert message["params"]["uri"] == secret
+        second.send(hover(2, secret))
+        assert ws_reply(second, 2)["result"] is None  # not its document
+        second.send(json.dumps(request(3, "shutdown")))
+        ws_reply(second, 3)
+        second.send(json.dumps(notification("exit")))
+        with pytest.raises(websockets.ConnectionClosed):  # exit ends this session only
+            second.recv(timeout=30)
+        first.send(hover(4, secret))
+        assert ws_reply(first, 4)["result"] is not None
+
+
+@pytest.mark.parametrize("body", ['{"jsonrpc": "2.0", "id": 2, "method": ', "[" * 2000,
+                                  '"\\ud800'])
+def test_websocket_malformed_json_is_a_parse_error(ws: Listening, body: str) -> None:
+    with ws_session(ws) as client:
+        client.send(body)
+        assert ws_reply(client, None)["error"]["code"] == PARSE_ERROR  # type: ignore[index]
+        client.send(hover(3, "file:///nowhere.rob"))
+        assert ws_reply(client, 3)["result"] is None
+
+
+def test_websocket_message_over_the_limit_closes_that_connection_only(ws: Listening) -> None:
+    with ws_session(ws) as kept, ws_session(ws) as dropped:
+        dropped.send(b" " * (MAX_MESSAGE + 1))
+        with pytest.raises(websockets.ConnectionClosed) as closed:
+            dropped.recv(timeout=30)
+        assert closed.value.rcvd is not None and closed.value.rcvd.code == 1009  # too big
+        kept.send(json.dumps(request(2, "shutdown")))
+        assert ws_reply(kept, 2)["result"] is None
+
+
+def test_websocket_from_a_web_page_elsewhere_is_refused(ws: Listening) -> None:
+    with pytest.raises(websockets.InvalidStatus) as refused:
+        connect(f"ws://127.0.0.1:{ws.port}", origin=Origin("https://evil.example"), open_timeout=30)
+    assert refused.value.response.status_code == 403
+    with connect(f"ws://127.0.0.1:{ws.port}", origin=Origin("http://localhost:8000"),
+                 open_timeout=30) as local:
+        local.send(json.dumps(INITIALIZE))
+        assert "result" in ws_reply(local, 1)
+
+
+def test_the_server_still_runs_and_wrote_no_traceback(ws: Listening) -> None:
+    """Run last in this module: everything above left it running, and no traceback."""
+    assert ws.process.poll() is None
+    assert "Traceback" not in ws.stderr()
