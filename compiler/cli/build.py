@@ -45,6 +45,7 @@ from .streams import (
     read_failure,
     read_ilc,
     read_input,
+    refused_ilc,
     same_file,
     with_suffix,
     write_file,
@@ -341,14 +342,15 @@ def _recorded_source(program: VerifiedProgram, file: str) -> tuple[str, str | No
 @click.argument("file", metavar="FILE", type=PATH)
 @click.option("--source", "source_file", metavar="FILE.rob", type=PATH,
               help="the program's source, to show its lines; default: the file the .ilc "
-                   "records, when it is in the .ilc file's folder")
+                   "records (a path from its folder), when its digest is the one recorded")
 def dis(file: str, source_file: str | None) -> int:
     """Disassemble an .ilc file (`-`: standard input) into .ils text on standard output.
 
     The program's source lines are shown when its source file is found (the one
-    --source names, or the path the .ilc records, from the .ilc file's folder; a name
-    that is absolute or leads out of the folder is not followed) and is the source that
-    was compiled (its digest matches). Why no lines are shown is said on standard
+    --source names, or the relative path the .ilc records, from the .ilc file's folder,
+    to a regular file; an absolute one is not followed) and is the source that was
+    compiled: its digest is the one the .ilc records (a file without one, format 1.0,
+    takes its source only from --source). Why no lines are shown is said on standard
     error. Exit status: 0 done, 1 the file is not valid intermediate code, 2 an
     unreadable file."""
     from rl1.compiler.ils.disasm import disassemble
@@ -359,10 +361,8 @@ def dis(file: str, source_file: str | None) -> int:
     try:
         debug = verify(data).image.debug  # an invalid file is refused before any source is read
     except VerifyError as error:
-        raise invalid_file(ILC_ROLE, STDIN_NAME if file == "-" else file,
-                           f"byte {error.offset}: {error.message}",
-                           "compile the program again, or assemble it with `rl1c asm`",
-                           EXIT_ERRORS) from None
+        raise refused_ilc(file, data, error, "compile the program again, or assemble it "
+                                             "with `rl1c asm`") from None
     try:
         found = find_source(debug, file, source_file)
     except SourceError as error:
