@@ -189,7 +189,7 @@ def _request_id(body: bytes) -> object:
 
 async def _refuse_tcp(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
     """Answer the first request of a client beyond MAX_SESSIONS with BUSY, and close."""
-    framer = Framer(limit=CHUNK * 16)  # an initialize is a few KB
+    framer = Framer(limit=CHUNK)  # an initialize is a few KB
     with contextlib.suppress(TimeoutError):
         async with asyncio.timeout(REFUSAL_SECONDS):
             async for chunk in _read_tcp(reader, writer):
@@ -205,12 +205,18 @@ async def _refuse_tcp(reader: asyncio.StreamReader, writer: asyncio.StreamWriter
 async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) -> None:
     """Serve each connection to HOST:PORT as a session of its own, until stopped."""
     sessions: set[Session] = set()
+    refusing: set[asyncio.StreamWriter] = set()  # bounded too: beyond, closed at once
 
     async def connected(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         try:
             if len(sessions) >= MAX_SESSIONS:
                 log.warning("a client beyond the %d served at once: refused", MAX_SESSIONS)
-                await _refuse_tcp(reader, writer)
+                if len(refusing) < MAX_SESSIONS:
+                    refusing.add(writer)
+                    try:
+                        await _refuse_tcp(reader, writer)
+                    finally:
+                        refusing.discard(writer)
                 return
             session = new_session()
             sessions.add(session)

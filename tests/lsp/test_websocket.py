@@ -17,6 +17,7 @@ from websockets.sync.client import ClientConnection, connect  # noqa: E402
 from websockets.typing import Origin  # noqa: E402
 
 from rl1.lsp.framing import MAX_MESSAGE  # noqa: E402
+from rl1.lsp.transports import MAX_SESSIONS  # noqa: E402
 
 PARSE_ERROR = -32700
 
@@ -87,6 +88,20 @@ def test_websocket_message_over_the_limit_closes_that_connection_only(ws: Listen
         assert closed.value.rcvd is not None and closed.value.rcvd.code == 1009  # too big
         kept.send(json.dumps(request(2, "shutdown")))
         assert ws_reply(kept, 2)["result"] is None
+
+
+def test_websocket_connections_beyond_the_limit_are_refused_clearly(ws: Listening) -> None:
+    with contextlib.ExitStack() as stack:
+        for _ in range(MAX_SESSIONS):
+            stack.enter_context(ws_session(ws))
+        with connect(f"ws://127.0.0.1:{ws.port}", open_timeout=30) as extra, \
+                pytest.raises(websockets.ConnectionClosed) as closed:
+            extra.recv(timeout=30)
+        assert closed.value.rcvd is not None and closed.value.rcvd.code == 1013
+        assert f"{MAX_SESSIONS} clients" in closed.value.rcvd.reason
+    with ws_session(ws) as again:  # the places are given back
+        again.send(hover(2, "file:///nowhere.rob"))
+        assert ws_reply(again, 2)["result"] is None
 
 
 def test_websocket_from_a_web_page_elsewhere_is_refused(ws: Listening) -> None:
