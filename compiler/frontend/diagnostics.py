@@ -27,7 +27,7 @@ class Edit(NamedTuple):
 
 class Fix(NamedTuple):
     """A machine-applicable fix: the editor's quick fix, the help line's suggestion.
-    `safe` (ruff's model, spec/language.md section 12): the program after it means what
+    `safe` (ruff's model, spec/language.md section 5.8): the program after it means what
     the text before it already meant, and keeps every label and statement written, so
     `rl1c check --fix` and the editor's "fix all" make it; an unsafe fix (a guess at a
     misspelt name, a removal, a change of what the vehicle does) is made only when
