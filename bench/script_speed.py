@@ -14,7 +14,8 @@ import json
 
 from timing import best_time
 
-from rl1.compiler.cli.run import run_source
+from rl1.compiler.runner import Finished
+from rl1.compiler.runner import run as run_program
 from rl1.vm.scripted import ScriptedDevice, decode_script
 
 PROGRAM = """(TRC 1); N=50
@@ -32,8 +33,8 @@ def script_of(losses: int) -> bytes:
 
 def run(data: bytes) -> None:
     device = ScriptedDevice(decode_script(data, "losses.json"))
-    result = run_source(PROGRAM, "loop.rob", device)
-    assert not isinstance(result, list) and result.fault is None, result
+    finished = run_program(PROGRAM, device)
+    assert isinstance(finished, Finished) and finished.result.fault is None, finished
 
 
 def main() -> None:

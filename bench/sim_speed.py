@@ -15,8 +15,7 @@ from pathlib import Path
 
 from timing import best_time
 
-from rl1.compiler.cli.run import run_source
-from rl1.vm.faults import RunResult
+from rl1.compiler.runner import Finished, run
 from rl1.vm.sim.device import SimDevice
 from rl1.vm.sim.world import Scene, World, decode_world
 
@@ -41,9 +40,9 @@ def simulate(text: str, world: World) -> tuple[float, float]:
     """Simulated and wall-clock seconds of one run."""
     device = SimDevice(world)
     started = time.perf_counter()
-    result = run_source(text, "bench.rob", device)
+    finished = run(text, device)
     wall = time.perf_counter() - started
-    assert isinstance(result, RunResult) and result.fault is None, result
+    assert isinstance(finished, Finished) and finished.result.fault is None, finished
     return device.sim.time, wall
 
 

@@ -191,6 +191,7 @@ class Interpreter:
 
     def _fault(self, fault: _Faulted, line: int | None) -> Fault:
         message = fault.message
+        self.device.line = line  # what the device records of the stop says where it was
         try:
             self.device.stop()
         except DeviceError as error:
@@ -253,7 +254,7 @@ class Interpreter:
                                f"argument {param.name} of ({form_name(resolved.form)}) is "
                                f"{value}{source}, outside {param.low}..{param.high}")
         try:
-            outcome = perform(self.device, resolved.form, values)
+            outcome = perform(self.device, resolved.form, values, self.line)
         except DeviceError as error:
             raise _Faulted(FaultKind.DEVICE, str(error)) from None
         for name, value in zip(resolved.spec.writes, outcome.writes, strict=True):

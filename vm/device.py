@@ -73,6 +73,14 @@ class FuzzyReading:
     t: int
 
 
+READING_NAMES: dict[str, tuple[str, ...]] = {
+    "IMG": ("area", "x", "y", "angle"),
+    "KYO": ("centre", "right", "left"),
+    "FZI": ("s", "t"),
+}
+"""What each value of a reading of several values is, in order, as reports name them."""
+
+
 class Device(Protocol):
     """A vehicle. Arguments arrive already range-checked against language.py; values
     returned must be 16-bit signed integers. Any method may raise DeviceError."""
@@ -114,6 +122,11 @@ class Device(Protocol):
 
     pending: LineLost | None
     """The lost-line event waiting to be taken, if any; reading it takes nothing."""
+
+    line: int | None
+    """The source line the engine is running (None when unknown: code without a line
+    map): the engine's adapter (`perform`, `hardware.Blocking`) sets it before each call
+    and `stop`, so that what the device records says where it came from."""
 
     def poll_event(self) -> LineLost | None:
         """The pending lost-line event, if any, removing it."""
@@ -218,6 +231,9 @@ def checked(form: FormKey, outcome: Outcome) -> Outcome:
     return outcome
 
 
-def perform(device: Device, form: FormKey, args: tuple[int, ...]) -> Outcome:
-    """Carry out one built-in call on `device`, checking what comes back (`checked`)."""
+def perform(device: Device, form: FormKey, args: tuple[int, ...],
+            line: int | None = None) -> Outcome:
+    """Carry out one built-in call, made on source line `line`, on `device`, checking
+    what comes back (`checked`)."""
+    device.line = line
     return checked(form, BINDINGS[form](device, args))

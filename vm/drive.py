@@ -32,6 +32,8 @@ class Stepper(Protocol):
 
     def run(self) -> RunResult: ...
 
+    def current_line(self) -> int | None: ...
+
 
 def drive(machine: Stepper, device: ScriptedDevice) -> RunResult:
     """Run `machine`, whose hardware is `device`, to its end."""
@@ -40,5 +42,5 @@ def drive(machine: Stepper, device: ScriptedDevice) -> RunResult:
             pass
         if machine.state not in _GOING:
             break
-        device.lose_line_after(count)
+        device.lose_line_after(count, machine.current_line())
     return machine.run()

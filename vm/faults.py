@@ -11,14 +11,8 @@ from dataclasses import dataclass
 from enum import Enum
 from typing import Any
 
+from .defaults import DEFAULT_BUDGET as DEFAULT_BUDGET  # the engines' default, named here too
 from .language import VARIABLES
-
-DEFAULT_BUDGET = 10_000_000
-"""Steps a run may take before the watchdog ends it: VM instructions, or interpreter
-statements. Both engines look at the count when a jump is taken and before a device call
-runs (every loop takes a jump); since they count different steps, they stop a runaway
-program at different points."""
-
 
 MAX_BUDGET = 2**31 - 1
 """The largest budget: a run passes its budget by less than 65536 instructions (spec/ilc.md,
@@ -26,14 +20,19 @@ section 9), so a 32-bit counter never wraps."""
 
 
 class FaultKind(Enum):
-    ARGUMENT_RANGE = ("argument-range", 10)  # a variable argument outside its range
-    MISSING_HANDLER = ("missing-handler", 11)  # a lost line jumps to an undefined :96-:99
-    BUDGET = ("budget", 12)  # the watchdog: the step budget is used up
-    DEVICE = ("device-error", 13)  # the device failed (DeviceError)
+    """A kind of fault: its name in JSON and the vectors (`code`), the exit status of
+    `rl1c run` and `rl1c sim`, and its code in the catalogue of `rl1c explain` (E10xx,
+    xx the exit status), which the report of a fault shows as a diagnostic's."""
 
-    def __init__(self, code: str, exit_status: int) -> None:
+    ARGUMENT_RANGE = ("argument-range", 10, "E1010")  # a variable argument outside its range
+    MISSING_HANDLER = ("missing-handler", 11, "E1011")  # a lost line jumps to an undefined :96-:99
+    BUDGET = ("budget", 12, "E1012")  # the watchdog: the step budget is used up
+    DEVICE = ("device-error", 13, "E1013")  # the device failed (DeviceError)
+
+    def __init__(self, code: str, exit_status: int, diagnostic_code: str) -> None:
         self.code = code
         self.exit_status = exit_status
+        self.diagnostic_code = diagnostic_code
 
 
 @dataclass(frozen=True, slots=True)

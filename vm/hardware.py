@@ -9,11 +9,12 @@ one-slot mailbox: `pending` looks at it, `take_event` empties it.
 
 `Blocking` adapts a blocking `Device` (device.py): it carries out the whole built-in
 when it is started, so its first poll answers done, or the error the device raised
-meanwhile.
+meanwhile; it tells the device the source line of each call (Device.line).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from enum import Enum
 from typing import Protocol
@@ -77,14 +78,21 @@ class Hardware(Protocol):
         """The lost-line event in the mailbox, if any, emptying it."""
 
 
-class Blocking:
-    """A blocking Device as Hardware: a started built-in runs to its end at once."""
+def _no_line() -> int | None:
+    return None
 
-    def __init__(self, device: Device) -> None:
+
+class Blocking:
+    """A blocking Device as Hardware: a started built-in runs to its end at once.
+    `line` says the source line of the VM's call under way (Machine.current_line)."""
+
+    def __init__(self, device: Device, line: Callable[[], int | None] = _no_line) -> None:
         self.device = device
+        self.line = line
         self._started = OK
 
     def _perform(self, form: FormKey, args: tuple[int, ...]) -> Answer:
+        self.device.line = self.line()
         try:
             return Answer(Status.OK, BINDINGS[form](self.device, args))
         except DeviceError as error:
@@ -105,6 +113,7 @@ class Blocking:
         return self._started
 
     def stop(self) -> Answer:
+        self.device.line = self.line()
         try:
             self.device.stop()
         except DeviceError as error:

@@ -14,6 +14,7 @@ from typing import Literal
 from rl1.compiler.analysis import analyze
 from rl1.compiler.frontend.diagnostics import Diagnostic, sort_key
 from rl1.vm import ilc
+from rl1.vm.defaults import DEFAULT_LEVEL
 
 from .codegen import CodegenError, generate
 from .ir import format_program
@@ -34,11 +35,11 @@ class Compilation:
 
 
 def compile_text(text: str, source_name: str, *, emit: Emit = "ilc",
-                 strip_debug: bool = False, level: int = 0,
+                 strip_debug: bool = False, level: int = DEFAULT_LEVEL,
                  check: bool = False) -> Compilation:
-    """Compile a program at optimization `level` (-O0 by default here: the command line
-    chooses optimize.DEFAULT_LEVEL); `source_name` is recorded in the debug section.
-    `check` validates the IR after every pass (optimize.optimize)."""
+    """Compile a program at optimization `level` (by default DEFAULT_LEVEL, as
+    `rl1c compile`); `source_name` is recorded in the debug section. `check` validates
+    the IR after every pass (optimize.optimize)."""
     analysis = analyze(text)
     if analysis.has_errors:
         return Compilation(analysis.diagnostics, None)

@@ -29,7 +29,6 @@ LEVELS: dict[int, tuple[Pass, ...]] = {0: (), 1: O1_PASSES, 2: O1_PASSES}
 # What runs once after a level's passes stop changing the program: -O2's fusion, which
 # the other passes need not know.
 FINAL_PASSES: dict[int, tuple[Pass, ...]] = {0: (), 1: (), 2: (fuse,)}
-DEFAULT_LEVEL = 1
 MAX_ROUNDS = 8  # a round seldom finds anything after the third
 
 

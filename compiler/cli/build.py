@@ -2,17 +2,14 @@
 `rl1c dis` and `rl1c asm`.
 
 Each command imports the stages it runs when it runs, so that `rl1c check` starts
-without loading the back end, the VM or the assembler (bench/cold_start.py). For the
-same reason these option values are spelled here; tests/cli/test_cli_imports.py holds
-them equal to driver.EMITS, runner.ENGINES, faults.DEFAULT_BUDGET,
-run_report.TRACE_CHOICES and scripted.DEFAULT_TIME_LIMIT_MS.
+without loading the back end, the VM or the assembler (bench/cold_start.py); the option
+defaults and choices come from rl1.vm.defaults, which imports nothing.
 """
 
 from __future__ import annotations
 
 import os
 import sys
-from typing import TYPE_CHECKING
 
 import click
 
@@ -24,6 +21,15 @@ from rl1.compiler.reporting.render import (
     FileDiagnostics,
     Format,
     use_color,
+)
+from rl1.vm.defaults import (
+    DEFAULT_BUDGET,
+    DEFAULT_LEVEL,
+    DEFAULT_TIME_LIMIT_MS,
+    ENGINES,
+    TRACE_CHOICES,
+    Engine,
+    TraceChoice,
 )
 
 from .command import (
@@ -37,8 +43,6 @@ from .command import (
     format_option,
 )
 from .streams import (
-    ILC_ROLE,
-    STDIN_NAME,
     emit,
     file_failure,
     invalid_file,
@@ -52,12 +56,6 @@ from .streams import (
     write_stdout_bytes,
 )
 
-if TYPE_CHECKING:  # the back end and the engines load only for the command that runs them
-    from rl1.vm.verifier import VerifiedProgram
-
-    from .run import Engine
-    from .run_report import TraceChoice
-
 SECTION = "Intermediate code"
 
 # What --emit writes: the driver's own outputs, then the forms of the .ilc bytes
@@ -65,11 +63,6 @@ SECTION = "Intermediate code"
 EMIT_CHOICES = ("ilc", "ir", "c", "ihex", "ils")
 # The file each --emit kind is written to beside the source (None: standard output).
 EMIT_SUFFIXES = {"ilc": ".ilc", "ir": None, "c": ".c", "ihex": ".hex", "ils": ".ils"}
-ENGINE_CHOICES = ("vm", "ast", "c")
-DEFAULT_BUDGET = 10_000_000
-DEFAULT_LEVEL = 1
-TRACE_CHOICES = ("short", "all", "calls", "none")  # run_report.TRACE_CHOICES
-DEFAULT_TIME_LIMIT = "3600"  # seconds: scripted.DEFAULT_TIME_LIMIT_MS
 SCRIPT_ROLE = "sensor script"
 
 
@@ -239,15 +232,17 @@ def _time_limit(ctx: click.Context, param: click.Parameter, value: str) -> int:
               metavar="N", show_default=True,
               help="instructions (statements with --engine ast) before the watchdog stops "
                    "a runaway program")
-@click.option("--time-limit", type=str, default=DEFAULT_TIME_LIMIT, callback=_time_limit,
+@click.option("--time-limit", type=str, default=f"{DEFAULT_TIME_LIMIT_MS / 1000:g}",
+              callback=_time_limit,
               metavar="SECONDS", show_default=True,
               help="device time before the run is stopped (a device error): a program "
                    "waiting in a loop for a reading that never comes")
-@choice_option("--engine", choices=ENGINE_CHOICES, default="vm",
+@choice_option("--engine", choices=ENGINES, default="vm",
                help="vm: compile, then run on the reference VM; ast: interpret the source; "
                     "c: run on the C VM of the firmware (vm/c, built on first use)")
+@color_option
 def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoice | None,
-        budget: int, time_limit: int, engine: Engine) -> int:
+        budget: int, time_limit: int, engine: Engine, color: ColorChoice) -> int:
     """Run a program (.rob source, or a compiled .ilc file) on the scripted device.
 
     Prints the device's trace with the source line of each entry, how the run ended and
@@ -258,12 +253,11 @@ def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoi
     budget exhausted, 13 device error (a sensing call past the script's readings, the
     time limit)."""
     from rl1.compiler.files import SourceError
-    from rl1.vm.native import BuildError
+    from rl1.compiler.runner import load_script
     from rl1.vm.scripted import Script, ScriptedDevice, ScriptError
-    from rl1.vm.verifier import VerifyError, verify
 
-    from .run import Finished, execute_program, execute_source, load_script
     from .run_report import RunReport, render_json, render_text, select_trace
+    from .running import run_file
 
     script = Script()
     if sensors is not None:
@@ -275,67 +269,21 @@ def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoi
             raise invalid_file(SCRIPT_ROLE, sensors, str(error),
                                "correct it as spec/sensors.md describes") from None
     device = ScriptedDevice(script, time_limit)
-    if file.lower().endswith(".ilc"):
-        if engine == "ast":
-            raise click.UsageError("--engine ast interprets RL/I source; an .ilc file runs "
-                                   "on the VM: leave out --engine, or run the .rob file")
-        data = read_ilc(file)
-        try:
-            program = verify(data)
-        except VerifyError as error:
-            raise invalid_file(ILC_ROLE, STDIN_NAME if file == "-" else file,
-                               f"byte {error.offset}: {error.message}",
-                               "compile the program again", EXIT_ERRORS) from None
-        source_name, source_text = _recorded_source(program, file)
-        try:
-            finished = execute_program(program, device, budget,
-                                       "c" if engine == "c" else "vm", data)
-        except BuildError as error:
-            raise Failure(f"error: {error}") from None
-    else:
-        source = read_input(file)
-        if not isinstance(source, Source):
-            return emit([source], "human", "auto", "run", err=True)
-        try:
-            outcome = execute_source(source.text, os.path.basename(source.name), device,
-                                     engine, budget)
-        except ScriptError as error:
-            raise click.UsageError(str(error)) from None
-        except BuildError as error:
-            raise Failure(f"error: {error}") from None
-        if not isinstance(outcome, Finished):
-            return emit([FileDiagnostics(source.name, source.text, outcome)], "human",
-                        "auto", "run", err=True)
-        if outcome.warnings:
-            emit([FileDiagnostics(source.name, source.text, outcome.warnings)], "human",
-                 "auto", "run", err=True)
-        finished, source_text, source_name = outcome, source.text, source.name
-    report = RunReport(file, source_name, source_text, finished.result,
+    ran = run_file(file, device, engine, budget, color, "run")
+    if isinstance(ran, int):
+        return ran
+    result = ran.finished.result
+    report = RunReport(file, ran.source_name, ran.source, result,
                        select_trace(device.log, trace_choice or
                                     ("short" if run_format == "text" else "all")),
-                       finished.instructions, device.time,
-                       device.motion if finished.result.fault is None else None,
+                       ran.finished.instructions, device.time,
+                       device.motion if result.fault is None else None,
                        device.losses_not_met())
     if run_format == "json":
         sys.stdout.write(render_json(report))
     else:
-        sys.stdout.write(render_text(report, color=use_color("auto", sys.stdout)))
-    fault = finished.result.fault
-    return fault.kind.exit_status if fault is not None else 0
-
-
-def _recorded_source(program: VerifiedProgram, file: str) -> tuple[str, str | None]:
-    """The name and text of the source the .ilc file `file` records, when it is found
-    beside it and is still the one compiled (as `dis` finds it); else `file` and None."""
-    from rl1.compiler.ils.sources import find_source
-
-    debug = program.image.debug
-    if file == "-" or debug is None:
-        return file, None
-    lines = find_source(debug, file, None).lines
-    if lines is None:
-        return file, None
-    return os.path.join(os.path.dirname(file), debug.source_name), "\n".join(lines)
+        sys.stdout.write(render_text(report, color=use_color(color, sys.stdout)))
+    return result.fault.kind.exit_status if result.fault is not None else 0
 
 
 @click.command(cls=Command)

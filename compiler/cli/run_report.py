@@ -1,7 +1,9 @@
 """What `rl1c run` prints: the device's trace (bounded, or chosen by --trace), how the
 run ended (a fault shown as the checker shows a diagnostic, with its source line and the
-call underlined), whether the vehicle still moves, and the final variables; or all of it
-as one JSON object (spec/sensors.md, "The report in JSON")."""
+call underlined), whether the vehicle still moves, the final variables, and last the
+device time and the instructions run; or all of it as one JSON object (spec/sensors.md,
+"The report in JSON"). `rl1c sim`'s report (sim_report.py) shares its trace's bounds,
+its calls' text, its faults and its last lines."""
 
 from __future__ import annotations
 
@@ -9,18 +11,17 @@ import json
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Generic, Literal, Protocol, TypeVar
+from typing import Any, Generic, Protocol, TypeVar
 
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.compiler.frontend.parser import parse_program
 from rl1.compiler.reporting.render import FileDiagnostics, diagnostic_blocks
+from rl1.vm.defaults import TraceChoice
+from rl1.vm.device import READING_NAMES
 from rl1.vm.faults import Fault, FaultKind, RunResult
 from rl1.vm.scripted import LOST, LossAfter, LossAt, LossDuring, TraceEntry
-
-TraceChoice = Literal["short", "all", "calls", "none"]
-TRACE_CHOICES: tuple[TraceChoice, ...] = ("short", "all", "calls", "none")
 
 HEAD = 40
 TAIL = 20
@@ -93,36 +94,59 @@ def render_text(report: RunReport, *, color: bool = False) -> str:
     lines = []
     trace = report.trace
     if trace.head:
-        lines.append(f"{'time ms':>9}  {'line':>4}  call")
+        lines.append(TRACE_HEADING)
         lines += trace.lines(_entry_line)
     fault = report.result.fault
     if fault is None:
-        lines.append(f"the program ended normally at {report.device_time} ms of device time"
-                     + _executed(report))
+        lines.append("the program ended normally")
         if report.moving is not None:
             lines.append(f"note: the program ended with {report.moving} in effect: the "
                          "vehicle is still moving")
     else:
         lines.append(fault_text(fault, report.name, report.source_name, report.source,
                                 color=color).rstrip("\n"))
-        lines.append(f"the run stopped at {report.device_time} ms of device time"
-                     + _executed(report))
     lines += [f"note: the sensor script's line_lost[{index}], {json.dumps(loss.to_json())}, "
               f"never happened: {why}" for index, loss, why in report.missed]
-    named = [f"{name}={value}" for name, value in report.result.named().items() if value]
-    lines.append("variables: " + (" ".join(named) + " (all others 0)" if named else "all 0"))
+    lines += closing_lines(report.result, report.device_time, report.instructions)
     return "\n".join(lines) + "\n"
 
 
+TRACE_HEADING = f"{'time ms':>9}  {'line':>4}  call"
+"""The trace's heading, in both reports: each call at the device time it was made."""
+
+
+def entry_start(time_ms: int, line: int | None) -> str:
+    """A trace line's first columns, in both reports: the time and the source line."""
+    return f"{time_ms:>9}  {line if line is not None else '-':>4}  "
+
+
+def call_text(call: str, args: Sequence[int], result: Sequence[int] | None) -> str:
+    """A call as both reports show it: `MOV 3,3`, `ULT B -> 40`, and the values of a
+    reading of several named (`IMG -> area 120, x 128, y 90, angle 0`)."""
+    text = call + (" " + ",".join(map(str, args)) if args else "")
+    if result is not None:
+        names = READING_NAMES.get(call)
+        text += " -> " + (", ".join(f"{name} {value}" for name, value
+                                    in zip(names, result, strict=True))
+                          if names is not None else " ".join(map(str, result)))
+    return text
+
+
 def _entry_line(entry: TraceEntry) -> str:
-    line = str(entry.line) if entry.line is not None else "-"
-    return f"{entry.time:>9}  {line:>4}  {entry.describe()}"
+    shown = entry.describe() if entry.call == LOST else call_text(entry.call, entry.args,
+                                                                  entry.result)
+    return entry_start(entry.time, entry.line) + shown
 
 
-def _executed(report: RunReport) -> str:
-    if report.instructions is None:
-        return ""
-    return f", after {report.instructions:,} instructions"
+def closing_lines(result: RunResult, device_time: int, instructions: int | None
+                  ) -> list[str]:
+    """How both reports end: the final variables, then the device time (ms) and the
+    instructions the VM ran (the interpreter counts none)."""
+    named = [f"{name}={value}" for name, value in result.named().items() if value]
+    executed = ("the interpreter counts no instructions" if instructions is None else
+                f"{instructions:,} instruction{'s' if instructions != 1 else ''}")
+    return ["variables: " + (" ".join(named) + " (all others 0)" if named else "all 0"),
+            f"{device_time} ms of device time, {executed}"]
 
 
 # A fault as a diagnostic ---------------------------------------------------------------
@@ -161,7 +185,7 @@ def fault_help(fault: Fault) -> str:
 def fault_text(fault: Fault, name: str, source_name: str, text: str | None, *,
                color: bool = False) -> str:
     """The fault of a run of the program `name` as the checker shows a diagnostic:
-    `error[argument-range]: message`, `--> file:line:col`, the source line (of `text`, the
+    `error[E1010]: message`, `--> file:line:col`, the source line (of `text`, the
     file `source_name`, when known) with the call underlined, and what to do."""
     lines = text.splitlines() if text is not None else []
     message = fault.message
@@ -174,7 +198,7 @@ def fault_text(fault: Fault, name: str, source_name: str, text: str | None, *,
         if fault.line is not None:
             message += f" (at line {fault.line})"
         shown = FileDiagnostics(name, None, [])
-    diagnostic = Diagnostic(fault.kind.code, Severity.ERROR, message, span,
+    diagnostic = Diagnostic(fault.kind.diagnostic_code, Severity.ERROR, message, span,
                             help=fault_help(fault))
     return diagnostic_blocks(FileDiagnostics(shown.name, shown.text, [diagnostic]),
                              color=color)

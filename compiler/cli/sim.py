@@ -9,34 +9,34 @@ import sys
 import click
 
 from rl1.compiler.files import SourceError, read_bounded
-from rl1.compiler.frontend.source import Source
-from rl1.compiler.reporting.render import EXIT_ERRORS, FileDiagnostics, use_color
-from rl1.vm.faults import DEFAULT_BUDGET
+from rl1.compiler.reporting.render import ColorChoice, use_color
+from rl1.vm.defaults import DEFAULT_BUDGET, ENGINES, TRACE_CHOICES, Engine, TraceChoice
 
-from .command import PATH, Command, a_budget, choice_option
-from .run_report import TRACE_CHOICES, TraceChoice
-from .streams import ILC_ROLE, emit, invalid_file, read_failure, read_ilc, read_input, write_file
+from .command import PATH, Command, a_budget, choice_option, color_option, force_option
+from .streams import invalid_file, read_failure, write_file
 
 SECTION = "Simulation"
 MAX_WORLD_BYTES = 4 * 2**20
 WORLD_ROLE = "world file"
+EXAMPLE_WORLD = "examples/sample.world.toml"
 
 
 @click.command(cls=Command)
 @click.argument("file", metavar="FILE", type=PATH)
-@click.option("--world", metavar="FILE", type=PATH, required=True,
-              help="the world file (TOML, spec/simulator.md): the floor, lines, marks, "
-                   "stands, walls, scenes and the vehicle")
+@click.option("--world", metavar="FILE", type=PATH,
+              help="required: the world file (TOML, spec/simulator.md): the floor, lines, "
+                   f"marks, stands, walls, scenes and the vehicle, such as {EXAMPLE_WORLD}")
 @click.option("--svg", "svg_file", metavar="FILE", type=PATH,
-              help="write a top view of the run (the paper's Fig. 9)")
+              help="write a top view of the run (the paper's Fig. 9) to FILE")
 @click.option("--html", "html_file", metavar="FILE", type=PATH,
-              help="write a page that replays the run, offline")
+              help="write a page that replays the run, offline, to FILE")
 @choice_option("--format", "sim_format", choices=("text", "json"), default="text",
                help="text: for people; json: one object with the pose track, for tools")
 @click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True,
               help="the seed of the sensor noise (the world sets the noise; off by default)")
-@choice_option("--engine", choices=("vm", "ast"), default="vm",
-               help="vm: compile, then run on the reference VM; ast: interpret the source")
+@choice_option("--engine", choices=ENGINES, default="vm",
+               help="vm: compile, then run on the reference VM; ast: interpret the source; "
+                    "c: run on the C VM of the firmware (vm/c, built on first use)")
 @click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget,
               metavar="N", show_default=True,
               help="instructions (statements with --engine ast) before the watchdog stops "
@@ -45,25 +45,35 @@ WORLD_ROLE = "world file"
                help="which calls to show, as `rl1c run --trace`: short: the first 40 and "
                     "the last 20 of a longer trace, with how many were left out; all; calls; "
                     "none. Default: short with --format text, all with json")
-def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_format: str,
-        seed: int, engine: str, budget: int, trace_choice: TraceChoice | None) -> int:
+@force_option
+@color_option
+def sim(file: str, world: str | None, svg_file: str | None, html_file: str | None,
+        sim_format: str, seed: int, engine: Engine, budget: int,
+        trace_choice: TraceChoice | None, force: bool, color: ColorChoice) -> int:
     """Run a program (.rob source, or an .ilc file) on the simulated vehicle and world.
 
-    Prints each call with the time and the vehicle's pose, how the run ended and the
-    final variables. A safety stop (off the floor, a collision, the time limit) is a
-    device fault. Exit status: 0 the program ended; 1 it has errors; 2 a usage problem
-    or an unreadable or invalid file (the world file included); faults as `rl1c run`:
-    10 argument out of range, 11 missing handler, 12 budget exhausted, 13 device error
+    Prints each call with the device time, its source line and the vehicle's pose after
+    it, how the run ended, the final variables, the device time and the instructions
+    run. A safety stop (off the floor, a collision, the time limit) is a device fault.
+    Exit status: 0 the program ended; 1 it has errors; 2 a usage problem or an
+    unreadable or invalid file (the world file included); faults as `rl1c run`: 10
+    argument out of range, 11 missing handler, 12 budget exhausted, 13 device error
     (safety stops included)."""
-    from rl1.vm.faults import RunResult
     from rl1.vm.sim.device import SimDevice
     from rl1.vm.sim.render import html, svg
     from rl1.vm.sim.world import WorldError, decode_world
-    from rl1.vm.verifier import VerifyError
 
-    from .run import run_ilc, run_source
+    from .run_report import call_text
+    from .running import run_file
     from .sim_report import render_json, render_text
 
+    if world is None:
+        raise click.UsageError("a simulation needs a world to run in: give --world FILE, a "
+                               f"world file (TOML, spec/simulator.md) such as {EXAMPLE_WORLD}")
+    for option, target in (("--svg", svg_file), ("--html", html_file)):
+        if target == "-":
+            raise click.UsageError(f"{option} writes a file, and standard output carries "
+                                   f"the report: give {option} FILE")
     try:
         the_world = decode_world(read_bounded(world, MAX_WORLD_BYTES, "a world file"), world)
     except SourceError as error:
@@ -72,27 +82,11 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
         raise invalid_file(WORLD_ROLE, world, str(error),
                            "correct it as spec/simulator.md describes") from None
     device = SimDevice(the_world, seed=seed)
-    source: Source | None = None
-    if file.lower().endswith(".ilc"):
-        if engine == "ast":
-            raise click.UsageError("--engine ast interprets RL/I source; an .ilc file runs "
-                                   "on the VM: leave out --engine, or run the .rob file")
-        try:
-            result = run_ilc(read_ilc(file), device, budget)
-        except VerifyError as error:
-            raise invalid_file(ILC_ROLE, file, f"byte {error.offset}: {error.message}",
-                               "compile the program again", EXIT_ERRORS) from None
-    else:
-        read = read_input(file)
-        if not isinstance(read, Source):
-            return emit([read], "human", "auto", "sim", err=True)
-        source = read
-        outcome = run_source(source.text, os.path.basename(source.name), device,
-                             "ast" if engine == "ast" else "vm", budget)
-        if not isinstance(outcome, RunResult):
-            return emit([FileDiagnostics(source.name, source.text, outcome)], "human",
-                        "auto", "sim", err=True)
-        result = outcome
+    ran = run_file(file, device, engine, budget, color, "sim")
+    if isinstance(ran, int):
+        return ran
+    result = ran.finished.result
+    ended_at = device.sim.time  # the device time when the program ended (before any run-on)
     run_on = None
     if result.fault is None:
         moving = device.sim.motion is not None
@@ -104,20 +98,19 @@ def sim(file: str, world: str, svg_file: str | None, html_file: str | None, sim_
     title = f"{os.path.basename(file)} on {os.path.basename(world)}"
     if svg_file is not None:
         write_file(svg_file, svg(the_world, device.sim.track, device.sim.events,
-                                 title).encode(), role="SVG file")
+                                 title).encode(), force=force, role="SVG file")
     if html_file is not None:
-        calls = [(entry.time, entry.call
-                  + (" " + ",".join(map(str, entry.args)) if entry.args else "")
-                  + (" -> " + " ".join(map(str, entry.result)) if entry.result else ""))
+        calls = [(entry.time, call_text(entry.call, entry.args, entry.result))
                  for entry in device.trace]
         write_file(html_file, html(the_world, device.sim.track, device.sim.events, calls,
-                                   title).encode(), role="HTML file")
+                                   title).encode(), force=force, role="HTML file")
     if sim_format == "json":
-        sys.stdout.write(render_json(result, device, run_on, trace_choice or "all"))
+        sys.stdout.write(render_json(result, device, ran.finished.instructions, ended_at,
+                                     run_on, trace_choice or "all"))
     else:
-        sys.stdout.write(render_text(result, device, file, source, run_on,
+        sys.stdout.write(render_text(ran, device, file, ended_at, run_on,
                                      trace_choice or "short",
-                                     color=use_color("auto", sys.stdout)))
+                                     color=use_color(color, sys.stdout)))
     return result.fault.kind.exit_status if result.fault is not None else 0
 
 

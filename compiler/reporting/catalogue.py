@@ -3,8 +3,9 @@
 Codes are stable: never reuse or renumber one. Ranges by area:
 E01xx source and syntax · E02xx/W02xx labels · E03xx/W03xx tracing handlers ·
 W04xx reserved variables · E05xx/W05xx calls and constants · W06xx control flow ·
-W07xx safety. The long explanation of CODE is explanations/CODE.md, printed by
-`rl1c explain CODE`.
+W07xx safety · E10xx run-time faults (not the checker's: the faults of a run, whose
+last two digits are the exit status of `rl1c run`; vm/faults.py names each kind's code).
+The long explanation of CODE is explanations/CODE.md, printed by `rl1c explain CODE`.
 """
 
 from __future__ import annotations
@@ -65,4 +66,8 @@ CODES: dict[str, CodeInfo] = _entries(
     ("W0603", W, "program without (END)"),
     ("W0604", W, "busy loop that never observes the world"),
     ("W0701", W, "program may end while the vehicle moves"),
+    ("E1010", E, "run-time fault: argument out of range"),
+    ("E1011", E, "run-time fault: missing lost-line handler"),
+    ("E1012", E, "run-time fault: budget exhausted"),
+    ("E1013", E, "run-time fault: device error"),
 )

@@ -1,18 +1,17 @@
-"""The CLI loads only what a command needs, and the option values it spells itself match
-the stages' own."""
+"""The CLI loads only what a command needs, and its option values are the stages' own."""
 
 import subprocess
 import sys
 from importlib.metadata import version
+from pathlib import Path
 
 import pytest
 from support import SAMPLE
+from support.cli import rl1c
 
-from rl1.compiler.backend import driver, firmware, optimize
+from rl1.compiler.backend import driver, firmware
 from rl1.compiler.cli import build as cli
-from rl1.compiler.cli import main, run_report
-from rl1.compiler.cli import run as runner
-from rl1.vm import faults, scripted
+from rl1.compiler.cli import main
 
 # What `rl1c check` must not load: heavy packages that only other commands need (lark
 # builds the parser's tables offline, numpy is for the simulator, hypothesis for the
@@ -23,11 +22,17 @@ COSTLY = {"lark", "numpy", "hypothesis", "pygls", "lsprotocol"}
 def test_option_values_are_the_stages_own() -> None:
     assert (*driver.EMITS, *firmware.FORMATS, "ils") == cli.EMIT_CHOICES
     assert set(cli.EMIT_SUFFIXES) == set(cli.EMIT_CHOICES)
-    assert cli.ENGINE_CHOICES == runner.ENGINES
-    assert cli.DEFAULT_BUDGET == faults.DEFAULT_BUDGET
-    assert cli.DEFAULT_LEVEL == optimize.DEFAULT_LEVEL
-    assert cli.TRACE_CHOICES == run_report.TRACE_CHOICES
-    assert int(cli.DEFAULT_TIME_LIMIT) * 1000 == scripted.DEFAULT_TIME_LIMIT_MS
+
+
+def test_rl1c_compile_and_compile_text_compile_at_one_default_level(tmp_path: Path) -> None:
+    compiled = tmp_path / "sample.ilc"
+    assert rl1c(SAMPLE, "--strip", "-o", compiled).exit_code == 0
+    default = driver.compile_text(SAMPLE.read_text(encoding="utf-8"), "sample.rob",
+                                  strip_debug=True)
+    assert compiled.read_bytes() == default.output
+    assert default.output != driver.compile_text(SAMPLE.read_text(encoding="utf-8"),
+                                                 "sample.rob", strip_debug=True,
+                                                 level=0).output  # a level that shows
 
 
 def modules_loaded_by(argv: list[str]) -> tuple[int, set[str]]:

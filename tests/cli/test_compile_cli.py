@@ -15,13 +15,14 @@ from rl1.compiler.backend import driver
 from rl1.compiler.backend.firmware import c_source
 from rl1.compiler.backend.ir import format_program
 from rl1.compiler.backend.lower import lower
-from rl1.compiler.backend.optimize import DEFAULT_LEVEL, optimize
+from rl1.compiler.backend.optimize import optimize
 from rl1.compiler.files import write_atomically
 from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.compiler.frontend.parser import parse_program
 from rl1.compiler.ils.asm import assemble
 from rl1.vm import ilc
+from rl1.vm.defaults import DEFAULT_LEVEL
 from rl1.vm.verifier import verify
 
 BROKEN = "A=1\nB=(MOV 1\nC=2\n"

@@ -14,8 +14,10 @@ from hypothesis import strategies as st
 from support import EXAMPLES, SAMPLE, SAMPLE_SENSORS
 from support.cli import rl1c
 
-from rl1.compiler.cli.run import load_script
 from rl1.compiler.cli.run_report import HEAD, TAIL, select_trace
+from rl1.compiler.reporting.catalogue import CODES
+from rl1.compiler.runner import load_script
+from rl1.vm.faults import FaultKind
 from rl1.vm.language import VARIABLES
 from rl1.vm.scripted import TraceEntry, decode_script
 
@@ -44,14 +46,23 @@ def test_the_sample_runs_its_main_path_and_prints_trace_lines_and_variables() ->
     lines = result.stdout.splitlines()
     assert lines[0].split() == ["time", "ms", "line", "call"]
     assert lines[1].split() == ["0", "2", "CAM", "Z"]  # (CAM Z) is on line 2
-    assert "IMG -> 185 128 90 0" in result.stdout
-    assert [line.split() for line in lines[-6:-2]] == [
+    # A reading of several values names each.
+    assert "     500     4  IMG -> area 185, x 128, y 90, angle 0\n" in result.stdout
+    assert [line.split() for line in lines[-7:-3]] == [
         ["3200", "40", "MVI", "1,1,50"], ["13200", "40", "MOV", "3,3"],
         ["13200", "41", "MOV", "0,0"], ["13200", "43", "FRE"]]  # the MVI takes 10 s
+    assert lines[-3] == "the program ended normally"
+    assert lines[-2].startswith("variables: A=5 C=589 D=450 L=100 U=160 ")
     executed = report(SAMPLE, "--sensors", SENSORS)[1]["instructions"]
-    assert lines[-2] == ("the program ended normally at 13200 ms of device time, after "
-                         f"{executed} instructions")
-    assert lines[-1].startswith("variables: A=5 C=589 D=450 L=100 U=160 ")
+    assert lines[-1] == f"13200 ms of device time, {executed:,} instructions"
+    interpreted = rl1c("run", SAMPLE, "--sensors", SENSORS, "--engine", "ast").stdout
+    assert interpreted.splitlines()[-1] == ("13200 ms of device time, the interpreter "
+                                            "counts no instructions")
+
+
+def test_one_instruction_is_one_instruction(tmp_path: Path) -> None:
+    result = rl1c("run", *program(tmp_path, "(END)\n"))
+    assert result.stdout.splitlines()[-1] == "0 ms of device time, 1 instruction"
 
 
 def test_a_rob_file_s_warnings_come_first_on_standard_error() -> None:
@@ -127,7 +138,7 @@ def test_each_fault_kind_has_its_status_and_is_shown_as_a_diagnostic(
     text = rl1c("run", *options)
     assert text.exit_code == status
     column = source.splitlines()[line - 1].index(call) + 1
-    shown = text.stdout.split(f"error[{code}]: ")[1]
+    shown = text.stdout.split(f"error[E10{status}]: ")[1]  # the code of `rl1c explain`
     assert f"\n --> {tmp_path / 'p.rob'}:{line}:{column}\n" in shown
     assert f"\n{line} | {source.splitlines()[line - 1]}\n" in shown
     assert f"\n  | {' ' * (column - 1)}{'^' * len(call)}\n" in shown  # the call underlined
@@ -149,7 +160,7 @@ def test_a_run_without_a_script_stops_at_the_first_sensing_call(tmp_path: Path) 
     result = rl1c("run", SAMPLE)
     assert result.exit_code == 13
     assert len(result.stdout.splitlines()) < 30
-    assert "error[device-error]: (IMG) at 300 ms has no reading: no sensor script was " \
+    assert "error[E1013]: (IMG) at 300 ms has no reading: no sensor script was " \
            "given\n --> " in result.stdout
     assert "= help: give the readings the program needs in a sensor script: --sensors FILE" \
            in result.stdout
@@ -202,15 +213,15 @@ def test_a_long_trace_shows_its_head_and_tail_and_how_much_was_left_out(
         tmp_path: Path) -> None:
     args = program(tmp_path, "A=100\n:10 (TIM 1); A--; ?A>#10\n")
     lines = rl1c("run", *args).stdout.splitlines()
-    entries = lines[1:-2]
+    entries = lines[1:-3]  # the heading; the ending, the variables, the time and count
     assert len(entries) == HEAD + 1 + TAIL
     assert entries[HEAD].split() == ["...", "(40", "entries", "left", "out:", "--trace",
                                      "all", "shows", "every", "one)"]
     assert entries[0].split() == ["0", "2", "TIM", "1"]
     assert entries[-1].split() == ["9900", "2", "TIM", "1"]
     every = rl1c("run", *args, "--trace", "all").stdout.splitlines()
-    assert len(every) == 1 + 100 + 2
-    assert rl1c("run", *args, "--trace", "none").stdout.splitlines() == lines[-2:]
+    assert len(every) == 1 + 100 + 3
+    assert rl1c("run", *args, "--trace", "none").stdout.splitlines() == lines[-3:]
     _, document = report(*args, "--trace", "short")
     assert len(document["trace"]) == HEAD + TAIL
     assert document["trace_left_out"] == {"after": HEAD, "count": 40}
@@ -313,7 +324,7 @@ def test_a_scripted_loss_that_never_happens_is_said(tmp_path: Path) -> None:
         {"time": 200}, {"time": 50000}, {"during": "MOV", "nth": 1, "after": 100},
         {"during": "MVI", "nth": 1}]})
     lines = rl1c("run", *args).stdout.splitlines()
-    assert lines[-4:-1] == [
+    assert lines[-5:-2] == [
         'note: the sensor script\'s line_lost[1], {"time": 50000}, never happened: the run '
         'ended before it',
         'note: the sensor script\'s line_lost[2], {"during": "MOV", "nth": 1, "after": 100}, '
@@ -334,3 +345,15 @@ def test_the_spec_s_json_and_toml_examples_are_the_same_valid_script() -> None:
     from_json = decode_script(json_example.encode(), "example.json")
     assert from_json == decode_script(toml_example.encode(), "example.toml")
     assert from_json.losses and from_json.images and from_json.ports
+
+
+@pytest.mark.parametrize("kind", list(FaultKind))
+def test_each_fault_kind_has_a_code_that_rl1c_explain_explains(kind: FaultKind) -> None:
+    info = CODES[kind.diagnostic_code]
+    assert (info.code, info.severity.value) == (f"E10{kind.exit_status}", "error")
+    explained = rl1c("explain", kind.diagnostic_code.lower())
+    assert explained.exit_code == 0
+    assert explained.stdout.startswith(f"# {info.code}: {info.title}\n")
+    assert f"`{kind.code}`" in explained.stdout  # the name JSON gives it
+    assert f"exit status {kind.exit_status}" in explained.stdout
+    assert explained.stdout.count("```") >= 4  # a failing and a fixed example

@@ -9,8 +9,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from support import SAMPLE_SENSORS
 
-from rl1.compiler.cli.run import load_script
 from rl1.compiler.files import SourceError
+from rl1.compiler.runner import load_script
 from rl1.vm.device import (
     BINDINGS,
     DeviceError,
@@ -20,8 +20,10 @@ from rl1.vm.device import (
     Odometry,
     perform,
 )
+from rl1.vm.hardware import Blocking
 from rl1.vm.language import BUILTINS
 from rl1.vm.scripted import (
+    LOST,
     LossAt,
     LossDuring,
     Script,
@@ -69,34 +71,31 @@ def test_the_sample_sensor_script_is_valid() -> None:
 
 @pytest.mark.parametrize(("document", "message"), [
     ([1, 2], "s.json: the script must be an object"),
-    ({"IMAGE": []}, 's.json:1: IMAGE: unknown key; expected one of "IMG"'),
-    ({"IMG": {}}, "s.json:1: IMG: expected a list of at least one reading (leave the key out for "
-     "none), found an object"),
-    ({"IMG": []}, "s.json:1: IMG: expected a list of at least one reading (leave the key out for "
-     "none), found an empty array"),
-    ({"IMG": [{"area": 1, "x": 2, "y": 3}]}, 's.json:1: IMG[0]: missing "z"'),
-    ({"IMG": [{"area": 1, "x": 2, "y": 3, "z": 4, "w": 5}]}, 's.json:1: IMG[0].w: unknown key; expected one of "area", "x", "y", "z"'),
+    ({"IMAGE": []}, 's.json:IMAGE: unknown key; expected one of "IMG"'),
+    ({"IMG": {}}, "s.json:IMG: expected a list of readings, found an object"),
+    ({"IMG": []}, "s.json:IMG: the list is empty"),
+    ({"IMG": [{"area": 1, "x": 2, "y": 3}]}, 's.json:IMG[0]: missing "z"'),
+    ({"IMG": [{"area": 1, "x": 2, "y": 3, "z": 4, "w": 5}]}, "s.json:IMG[0].w: unknown field"),
     ({"IMG": [{"area": "1", "x": 2, "y": 3, "z": 4}]},
-     's.json:1: IMG[0].area: expected an integer in -32768..32767, found the string "1"'),
+     's.json:IMG[0].area: expected an integer in -32768..32767, found the string "1"'),
     ({"KYO": [{"centre": 40000, "right": 0, "left": 0}]},
-     "s.json:1: KYO[0].centre: 40000 is outside -32768..32767"),
-    ({"ULT A": [True]}, "s.json:1: ULT A[0]: expected an integer in -32768..32767, found true"),
-    ({"CAM R": [785]}, "s.json:1: CAM R[0]: 785 is outside 0..784"),
-    ({"INP": {"x": [1]}}, 's.json:1: INP.x: expected a port number 0..125 in quotes, such as "3"'),
-    ({"INP": {"126": [1]}}, "s.json:1: INP.126: 126 is outside 0..125"),
-    ({"INP": {"3": [256]}}, "s.json:1: INP.3[0]: 256 is outside 0..255"),
-    ({"INP": [1]}, "s.json:1: INP: expected an object from port number"),
-    ({"line_lost": [{"time": 0}]}, "s.json:1: line_lost[0].time: 0 is outside 1.."),
+     "s.json:KYO[0].centre: 40000 is outside -32768..32767"),
+    ({"ULT A": [True]}, "s.json:ULT A[0]: expected an integer in -32768..32767, found true"),
+    ({"CAM R": [785]}, "s.json:CAM R[0]: 785 is outside 0..784"),
+    ({"INP": {"x": [1]}}, "s.json:INP.x: a port is a decimal number 0..125"),
+    ({"INP": {"126": [1]}}, "s.json:INP.126: 126 is outside 0..125"),
+    ({"INP": {"3": [256]}}, "s.json:INP.3[0]: 256 is outside 0..255"),
+    ({"INP": [1]}, "s.json:INP: expected an object from port number"),
+    ({"line_lost": [{"time": 0}]}, "s.json:line_lost[0].time: 0 is outside 1.."),
     ({"line_lost": [{"during": "TIM", "nth": 1}]},
-     's.json:1: line_lost[0].during: expected "MOV" or "MVI"'),
-    ({"line_lost": [{"at": 5}]}, 's.json:1: line_lost[0].at: unknown key; expected one of "time"'),
-    ({"line_lost": [{"time": 5, "nth": 1}]},
-     's.json:1: line_lost[0]: expected {"time": MS}, {"instruction": N} or'),
-    ({"comment": 5}, "s.json:1: comment: expected a string"),
-    ({"fail": ["TIM"]}, "s.json:1: fail: expected an object from a call"),
-    ({"fail": {"CAM X": 1}}, "s.json:1: fail.CAM X: not a built-in form"),
-    ({"fail": {"TIM": 0}}, "s.json:1: fail.TIM: 0 is outside 1.."),
-    ({"stop_fails": 1}, "s.json:1: stop_fails: expected true or false"),
+     's.json:line_lost[0].during: expected "MOV" or "MVI"'),
+    ({"line_lost": [{"at": 5}]},
+     's.json:line_lost[0]: expected {"time": MS}, {"instruction": N} or'),
+    ({"comment": 5}, "s.json:comment: expected a string"),
+    ({"fail": ["TIM"]}, "s.json:fail: expected an object from a call"),
+    ({"fail": {"CAM X": 1}}, "s.json:fail.CAM X: not a built-in form"),
+    ({"fail": {"TIM": 0}}, "s.json:fail.TIM: 0 is outside 1.."),
+    ({"stop_fails": 1}, "s.json:stop_fails: expected true or false"),
 ])
 def test_bad_scripts_are_refused_with_file_key_and_reason(
     tmp_path: Path, document: object, message: str,
@@ -115,7 +114,7 @@ def test_malformed_files_are_script_errors_and_unreadable_ones_source_errors(
     (tmp_path / "bin.json").write_bytes(b"\xff\xfe")
     (tmp_path / "deep.json").write_text("[" * 100_000)
     malformed = {
-        "bad.json": "bad.json:2: invalid JSON", "bad.toml": "bad.toml: invalid TOML",
+        "bad.json": "bad.json:2:1: invalid JSON", "bad.toml": "bad.toml: invalid TOML",
         "bin.json": "bin.json: not UTF-8 text",
         "deep.json": "deep.json(:1:100001)?: invalid JSON",
     }
@@ -431,14 +430,18 @@ def test_the_log_holds_every_loss_with_its_effect_and_the_trace_only_those_that_
     assert device.log[-1].handler is None and device.log[-2].handler == 96
 
 
-def test_entries_carry_the_line_the_locate_callback_gives() -> None:
-    device = ScriptedDevice()
-    lines = iter([7, 9])
-    device.locate = lambda: next(lines)
-    device.move(1, 1)
-    device.wait(1)
-    assert [(entry.call, entry.line) for entry in device.trace] == [("MOV", 7), ("TIM", 9)]
-    assert device.trace[0] == TraceEntry(0, "MOV", (1, 1))  # the line is no part of equality
+def test_entries_carry_the_line_the_adapter_gives() -> None:
+    device = ScriptedDevice(Script(losses=(LossAt(50),)))
+    perform(device, ("TRC", None), (3,), line=4)
+    perform(device, ("MOV", None), (1, 1), line=7)
+    perform(device, ("TIM", None), (1,), line=9)  # the line is lost during it
+    device.lose_line_after(12, 11)
+    hardware = Blocking(device, lambda: 13)
+    hardware.call(("OUT", None), (1, 2))
+    hardware.stop()
+    assert [(entry.call, entry.line) for entry in device.log] == [
+        ("TRC", 4), ("MOV", 7), ("TIM", 9), (LOST, 9), (LOST, 11), ("OUT", 13), ("STOP", 13)]
+    assert device.trace[1] == TraceEntry(0, "MOV", (1, 1))  # the line is no part of equality
 
 
 @settings(max_examples=40, deadline=None)

@@ -82,9 +82,10 @@ def test_every_feature_in_the_table_is_a_feature() -> None:
 # Diagnostic codes ---------------------------------------------------------------------
 
 
-def test_every_diagnostic_code_has_a_row_in_section_5() -> None:
-    section = SPEC.split("## 5. Static rules", 1)[1].split("## 6.", 1)[0]
-    rows = set(re.findall(r"^\| ([EW]\d{4}) \|", section, re.MULTILINE))
+def test_every_diagnostic_code_has_a_row_in_section_5_or_10() -> None:
+    static = SPEC.split("## 5. Static rules", 1)[1].split("## 6.", 1)[0]
+    faults = SPEC.split("## 10. Faults", 1)[1].split("## 11.", 1)[0]
+    rows = set(re.findall(r"^\| ([EW]\d{4}) \|", static + faults, re.MULTILINE))
     assert set(CODES) <= rows
 
 

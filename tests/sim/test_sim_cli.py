@@ -83,7 +83,7 @@ def test_a_safety_stop_is_a_device_fault_with_its_line(tmp_path: Path) -> None:
     assert status["safety"] == "off-floor" and status["line"] == 2
     assert (status["code"], status["exit_status"]) == ("device-error", 13)  # run's shape
     text = rl1c("sim", program, "--world", WORLD).stdout
-    assert "error[device-error]: " in text  # shown as `rl1c run` shows a fault
+    assert "error[E1013]: " in text  # shown as `rl1c run` shows a fault
     assert f"\n --> {program}:2:5\n" in text and "\n2 | :10 (IMG)\n" in text
 
 
@@ -134,7 +134,7 @@ def test_any_program_ends_with_a_known_status_and_no_traceback(tmp_path: Path,
 def test_the_trace_is_bounded_as_rl1c_run_bounds_it() -> None:
     every = rl1c("sim", SAMPLE, "--world", WORLD, "--trace", "all").stdout.splitlines()
     short = rl1c("sim", SAMPLE, "--world", WORLD).stdout.splitlines()
-    calls = [line for line in every if line.startswith("  ") and "[" not in line]
+    calls = [line for line in every[1:] if line.startswith("  ") and "[" not in line]
     assert short[1:41] == calls[:40]
     assert short[41].split()[:2] == ["...", f"({len(calls) - 60:,}"]
     assert short[42:62] == calls[-20:]
@@ -145,3 +145,71 @@ def test_the_trace_is_bounded_as_rl1c_run_bounds_it() -> None:
     assert document["trace_left_out"] == {"after": 40, "count": len(calls) - 60}
     none = rl1c("sim", SAMPLE, "--world", WORLD, "--trace", "none").stdout
     assert not none.startswith("trace") and "the program ended normally" in none
+
+
+def test_run_and_sim_report_alike(tmp_path: Path) -> None:
+    """The same columns (device time in ms when each call was made, source line), the
+    readings named, and the same last lines: variables, device time, instructions."""
+    program = tmp_path / "p.rob"
+    program.write_text("(TIM 5)\nA=(KYO); (MOV 0,0)\n(END)\n")
+    ran = rl1c("run", program, "--sensors", _script(tmp_path)).stdout.splitlines()
+    simulated = rl1c("sim", program, "--world", WORLD).stdout.splitlines()
+    assert ran[0] == simulated[0][:len(ran[0])] == "  time ms  line  call"
+    assert [line.split()[:3] for line in simulated[1:4]] == [
+        ["0", "1", "TIM"], ["500", "2", "KYO"], ["500", "2", "MOV"]]
+    assert [line.split()[:3] for line in ran[1:4]] == [line.split()[:3]
+                                                        for line in simulated[1:4]]
+    assert simulated[2].split("(")[0].rstrip().endswith("KYO -> centre 0, right 0, left 0")
+    assert ran[-3:] == simulated[-3:] == [
+        "the program ended normally", "variables: all 0",
+        "500 ms of device time, 6 instructions"]
+    document = json.loads(rl1c("sim", program, "--world", WORLD, "--format", "json").stdout)
+    assert (document["device_time"], document["instructions"]) == (500, 6)
+    assert [entry["line"] for entry in document["trace"]] == [1, 2, 2]
+
+
+def _script(tmp_path: Path) -> Path:
+    script = tmp_path / "s.json"
+    script.write_text(json.dumps({"KYO": [{"centre": 0, "right": 0, "left": 0}]}))
+    return script
+
+
+def test_without_a_world_it_says_what_to_give() -> None:
+    result = rl1c("sim", SAMPLE)
+    assert result.exit_code == 2
+    assert result.stderr.splitlines()[-1] == (
+        "rl1c sim: error: a simulation needs a world to run in: give --world FILE, a world "
+        "file (TOML, spec/simulator.md) such as examples/sample.world.toml")
+
+
+@pytest.mark.parametrize("option", ["--svg", "--html"])
+def test_a_picture_is_not_written_to_standard_output(tmp_path: Path, option: str) -> None:
+    result = rl1c("sim", SAMPLE, "--world", WORLD, option, "-")
+    assert result.exit_code == 2 and result.stdout == ""
+    assert (f"{option} writes a file, and standard output carries the report: give "
+            f"{option} FILE") in result.stderr
+    assert not Path("-").exists()
+
+
+def test_a_read_only_picture_is_replaced_only_with_force(tmp_path: Path) -> None:
+    picture = tmp_path / "run.svg"
+    picture.write_text("old")
+    picture.chmod(0o444)
+    refused = rl1c("sim", SAMPLE, "--world", WORLD, "--svg", picture)
+    assert refused.exit_code == 2 and "--force" in refused.stderr
+    assert picture.read_text() == "old"
+    forced = rl1c("sim", SAMPLE, "--world", WORLD, "--svg", picture, "--force")
+    assert forced.exit_code == 0, forced.output
+    assert picture.read_text().startswith("<svg")
+
+
+@pytest.mark.parametrize("command", ["run", "sim"])
+def test_color_is_asked_for_as_in_the_other_commands(tmp_path: Path, command: str) -> None:
+    program = tmp_path / "p.rob"
+    program.write_text("(MVI 3,-3,10)\n(END)\n")
+    world = ["--world", str(WORLD)] if command == "sim" else []
+    colored = rl1c(command, program, *world, "--color", "always")
+    plain = rl1c(command, program, *world, "--color", "never")
+    assert colored.exit_code == plain.exit_code == 13
+    assert "\x1b[" in colored.stdout and "\x1b[" not in plain.stdout
+    assert "error[E1013]" in plain.stdout

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from rl1.compiler.cli.run import Engine, run_source
+from rl1.compiler.runner import Finished, run
+from rl1.vm.defaults import Engine
 from rl1.vm.faults import RunResult
 from rl1.vm.sim.camera import focal, pulse_angle
 from rl1.vm.sim.device import SimDevice, SimEntry
@@ -27,9 +28,9 @@ def _world(name: str) -> World:
 
 def _run(world: World, engine: Engine = "vm") -> tuple[RunResult, SimDevice]:
     device = SimDevice(world)
-    result = run_source(SAMPLE, "sample.rob", device, engine)
-    assert isinstance(result, RunResult)
-    return result, device
+    finished = run(SAMPLE, device, engine=engine)
+    assert isinstance(finished, Finished)
+    return finished.result, device
 
 
 def _index(trace: list[SimEntry], call: str, args: tuple[int, ...] = (), start: int = 0) -> int:
@@ -119,8 +120,8 @@ def test_halving_the_step_leaves_listing_1_where_it_was() -> None:
     ends = []
     for step in (0.05, 0.025):
         device = SimDevice(world, step=step)
-        result = run_source(SAMPLE, "sample.rob", device)
-        assert isinstance(result, RunResult) and result.fault is None
+        finished = run(SAMPLE, device)
+        assert isinstance(finished, Finished) and finished.result.fault is None
         ends.append(device.sim.pose)
     assert math.hypot(ends[0].x - ends[1].x, ends[0].y - ends[1].y) < 1.0
     assert ends[0].heading == pytest.approx(ends[1].heading, abs=1e-6)

@@ -8,7 +8,7 @@ from dataclasses import replace
 import pytest
 from support.worlds import open_floor, stand_world
 
-from rl1.compiler.cli.run import run_source
+from rl1.compiler.runner import Finished, run
 from rl1.vm.faults import FaultKind, RunResult
 from rl1.vm.sim.device import SimDevice
 from rl1.vm.sim.world import Block, World
@@ -16,9 +16,9 @@ from rl1.vm.sim.world import Block, World
 
 def _run(world: World, text: str) -> tuple[RunResult, SimDevice]:
     device = SimDevice(world)
-    result = run_source(text, "t.rob", device)
-    assert isinstance(result, RunResult)
-    return result, device
+    finished = run(text, device)
+    assert isinstance(finished, Finished)
+    return finished.result, device
 
 
 def test_leaving_the_floor_stops_the_run_at_its_line() -> None:

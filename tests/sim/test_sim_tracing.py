@@ -92,25 +92,23 @@ def test_a_lost_line_during_mvi_interrupts_it_in_mode_2() -> None:
 
 
 def test_a_program_hears_of_a_lost_line_at_its_handler() -> None:
-    from rl1.compiler.cli.run import run_source
-    from rl1.vm.faults import RunResult
+    from rl1.compiler.runner import Finished, run
 
     world = line_world()
     world = replace(world, lines=(replace(world.lines[0], points=((0.0, 500.0),
                                                                    (400.0, 500.0))),))
     device = SimDevice(world)
     text = "(CAM D); (TRC 3); (MOV 6,6)\n:10 (TIM 1); #10\n:96 (MOV 0,0); H=1; (END)\n"
-    result = run_source(text, "t.rob", device)
-    assert isinstance(result, RunResult) and result.fault is None
-    assert result.named()["H"] == 1
+    finished = run(text, device)
+    assert isinstance(finished, Finished) and finished.result.fault is None
+    assert finished.result.named()["H"] == 1
     kinds = [event.kind for event in device.sim.events]
     assert kinds == ["lost", "handler"]
     assert "jump to :96" in device.sim.events[1].text
 
 
 def test_halving_the_step_leaves_a_patrol_where_it_was() -> None:
-    from rl1.compiler.cli.run import run_source
-    from rl1.vm.faults import RunResult
+    from rl1.compiler.runner import Finished, run
 
     patrol = ("(CAM A 90); (CAM D); (SCN 0); (TRC 1); (KYC)\nN=60\n"
               ":10 (MOV 4,4); (TIM 10); A=(ULT A); B=(KYO); C=(IMG); N--\n?N>#10\n"
@@ -118,8 +116,8 @@ def test_halving_the_step_leaves_a_patrol_where_it_was() -> None:
     ends = []
     for step in (0.05, 0.025):
         device = SimDevice(round_track(), step=step)
-        result = run_source(patrol, "patrol.rob", device)
-        assert isinstance(result, RunResult) and result.fault is None
+        finished = run(patrol, device)
+        assert isinstance(finished, Finished) and finished.result.fault is None
         ends.append(device.sim.pose)
     # A minute at 20 cm/s, tracing all the way: nearly a lap of the 12.6 m track.
     assert device.sim.time > 60

@@ -30,20 +30,22 @@ def _int16(value: float) -> int:
 
 @dataclass(frozen=True, slots=True)
 class SimEntry:
-    """One command the device received, at simulated time `time` (s), with the pose the
-    vehicle had when it was done."""
+    """One command the device received at simulated time `time` (s), from source line
+    `line` (None: unknown), with the pose the vehicle had when it was done."""
 
     time: float
     call: str
     args: tuple[int, ...]
     result: tuple[int, ...] | None
     pose: Pose
+    line: int | None = None
 
     def to_json(self) -> dict[str, Any]:
         entry: dict[str, Any] = {
             "time": round(self.time, 4), "call": self.call, "args": list(self.args),
             "pose": [round(self.pose.x, 2), round(self.pose.y, 2),
-                     round(math.degrees(self.pose.heading), 2)]}
+                     round(math.degrees(self.pose.heading), 2)],
+            "line": self.line}
         if self.result is not None:
             entry["result"] = list(self.result)
         return entry
@@ -68,11 +70,16 @@ class SimDevice:
         self.trace: list[SimEntry] = []
         self.pending: LineLost | None = None
         self.fault: SafetyFault | None = None
+        self.line: int | None = None  # the engine's source line (Device.line)
 
     # Bookkeeping
 
-    def _record(self, call: str, *args: int, result: tuple[int, ...] | None = None) -> None:
-        self.trace.append(SimEntry(self.sim.time, call, args, result, self.sim.pose))
+    def _record(self, call: str, *args: int, result: tuple[int, ...] | None = None,
+                start: float | None = None) -> None:
+        """Record a call done now that started at `start` (None: now, a call that took
+        no time): a trace gives the time each call was made, as the scripted device's."""
+        self.trace.append(SimEntry(self.sim.time if start is None else start, call, args,
+                                   result, self.sim.pose, self.line))
 
     def _pass(self, seconds: float, interruptible: bool = False) -> None:
         if self.fault is not None:
@@ -86,8 +93,9 @@ class SimDevice:
             self.pending = LineLost(lost, self.sim.mode)
 
     def _after(self, call: str, seconds: float, *args: int) -> None:
+        start = self.sim.time
         self._pass(seconds)
-        self._record(call, *args)
+        self._record(call, *args, start=start)
 
     # Motion and steering
 
@@ -107,12 +115,13 @@ class SimDevice:
             raise DeviceError(f"(MVI {left},{right},{cm}) would never end: with wheel speeds "
                               f"{left} and {right} the vehicle's centre does not move")
         # The sign of cm is taken from the wheels: a distance is covered, either way.
+        start = self.sim.time
         self.sim.drive("MVI", left, right, cm)
         if cm != 0:
             self._pass(math.inf, interruptible=True)
         else:
             self.sim.halt()
-        self._record("MVI", left, right, cm)
+        self._record("MVI", left, right, cm, start=start)
 
     def move(self, left: int, right: int) -> None:
         self._pass(0.0)
@@ -131,20 +140,22 @@ class SimDevice:
         self._after("STX", self.sim.turn_steering(math.radians(tenths / 10)), tenths)
 
     def rotate(self, degrees: int) -> None:
+        start = self.sim.time
         try:
             self.sim.rotate(degrees)
         except SafetyFault as fault:
             self.fault = fault
             raise DeviceError(f"safety stop [{fault.kind}]: {fault}") from None
-        self._record("ROT", degrees)
+        self._record("ROT", degrees, start=start)
 
     def set_tracing(self, mode: int) -> None:
         self.sim.mode = mode
         self._record("TRC", mode)
 
     def wait(self, tenths: int) -> None:
+        start = self.sim.time
         self._pass(tenths / 10, interruptible=True)
-        self._record("TIM", tenths)
+        self._record("TIM", tenths, start=start)
 
     # Sensing, camera, I/O, fuzzy board
 
@@ -164,11 +175,13 @@ class SimDevice:
         self._record("SCN", scene)
 
     def measure_image(self) -> ImageReading:
+        start = self.sim.time
         self._pass(self.sim.world.vehicle.image_time)
         found = self.sim.image()
         reading = ImageReading(found.area if found.area <= 32767 else 32767,
                                _int16(found.x), _int16(found.y), _int16(found.angle))
-        self._record("IMG", result=(reading.area, reading.x, reading.y, reading.z))
+        self._record("IMG", result=(reading.area, reading.x, reading.y, reading.z),
+                     start=start)
         return reading
 
     def camera_origin(self) -> None:
@@ -196,9 +209,10 @@ class SimDevice:
         return self.sim.pan
 
     def ultrasonic(self, sensor: str) -> int:
+        start = self.sim.time
         self._pass(self.sim.world.vehicle.ultrasonic_time)
         distance = _int16(self.sim.range_to(sensor))
-        self._record(f"ULT {sensor}", result=(distance,))
+        self._record(f"ULT {sensor}", result=(distance,), start=start)
         return distance
 
     def lamp(self, on: int) -> None:
