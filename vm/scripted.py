@@ -1,22 +1,7 @@
 """A deterministic Device driven by a sensor script, recording every command it gets.
 
-The script (JSON, or TOML when the file name ends in .toml) says what each sensing call
-returns, in order, and when the guidance line is lost:
-
-    {
-      "IMG": [{"area": 120, "x": 130, "y": 100, "z": 0}, ...],
-      "KYO": [{"centre": 50, "right": 52, "left": 48}, ...],
-      "CAM R": [392, ...],
-      "ULT A": [150, ...],          (also "ULT B", "ULT C", "ULT D")
-      "INP": {"3": [1, 0], ...},    (per input port, the port number in decimal)
-      "FZI": [{"s": 1, "t": -2}, ...],
-      "line_lost": [{"time": 2500}, {"during": "MVI", "nth": 1, "after": 300},
-                    {"instruction": 40}],
-      "fail": {"ULT A": 2, ...},     (the 2nd ULT A call of the run fails)
-      "stop_fails": true,
-      "after_last": "stop",          (or "repeat")
-      "comment": "free text, ignored"
-    }
+The script says what each sensing call returns, in order, and when the guidance line is
+lost; vm/sensor_script.py is its schema and loads it into a Script.
 
 Each call takes the next reading of its list. A call whose reading the script does not
 give (its list is used up, or there is none) ends the run at once with a device error
@@ -64,12 +49,9 @@ gives with a loss after an instruction count.
 from __future__ import annotations
 
 import bisect
-import json
 import math
-import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, Literal, TypeVar
 
 from .device import (
@@ -79,79 +61,22 @@ from .device import (
     LineLost,
     MotionCommand,
     Odometry,
-    form_name,
 )
 from .faults import RunResult
-from .language import BUILTINS, TOO_LONG, decimal_value, lost_line_handler
+from .language import BUILTINS, lost_line_handler
+from .sensor_script import LossAfter, LossAt, LossDuring
+
+# The script's schema and loader, imported from here too by the run stage and the tools.
+from .sensor_script import Script as Script
+from .sensor_script import ScriptError as ScriptError
+from .sensor_script import decode_script as decode_script
+from .sensor_script import parse_script as parse_script
 
 T = TypeVar("T")
 
 WHEEL_UNIT_CM_PER_S = 5
 STEP_MS = 100  # a waiting built-in with no duration of its own
 ROT_MS_PER_DEGREE = 10
-
-
-AfterLast = Literal["stop", "repeat"]
-AFTER_LAST: tuple[AfterLast, ...] = ("stop", "repeat")
-
-
-
-class ScriptError(Exception):
-    """A sensor script that cannot be used; the message starts `file:key:`."""
-
-
-@dataclass(frozen=True, slots=True)
-class LossAt:
-    """The line is lost at device time `time` ms."""
-
-    time: int
-
-    def to_json(self) -> dict[str, Any]:
-        """The loss as the script writes it."""
-        return {"time": self.time}
-
-
-@dataclass(frozen=True, slots=True)
-class LossDuring:
-    """The line is lost `after` ms into the `nth` call of `command`."""
-
-    command: MotionCommand
-    nth: int
-    after: int
-
-    def to_json(self) -> dict[str, Any]:
-        return {"during": self.command, "nth": self.nth, "after": self.after}
-
-
-@dataclass(frozen=True, slots=True)
-class LossAfter:
-    """The line is lost right after the VM's `instruction`-th instruction."""
-
-    instruction: int
-
-    def to_json(self) -> dict[str, Any]:
-        return {"instruction": self.instruction}
-
-
-@dataclass(frozen=True, slots=True)
-class Script:
-    images: tuple[ImageReading, ...] = ()
-    odometry: tuple[Odometry, ...] = ()
-    camera: tuple[int, ...] = ()
-    ultrasonic: dict[str, tuple[int, ...]] = field(default_factory=dict)
-    ports: dict[int, tuple[int, ...]] = field(default_factory=dict)
-    fuzzy: tuple[FuzzyReading, ...] = ()
-    losses: tuple[LossAt | LossDuring | LossAfter, ...] = ()
-    failures: dict[str, int] = field(default_factory=dict)  # a form -> the call that fails
-    stop_fails: bool = False
-    after_last: AfterLast = "stop"
-    name: str = field(default="", compare=False)  # its file; "" when no script was given
-
-    @property
-    def instruction_losses(self) -> tuple[int, ...]:
-        """The instruction counts after which the line is lost, in order."""
-        return tuple(sorted(loss.instruction for loss in self.losses
-                            if isinstance(loss, LossAfter)))
 
 
 LOST = "LINE LOST"
@@ -219,179 +144,6 @@ def run_document(result: RunResult, trace: Sequence[TraceEntry]) -> dict[str, An
     `exec:` engine of `rl1c fuzz` prints too (spec/optimization.md, section 5)."""
     return {"status": result.status(), "variables": result.named(),
             "trace": [entry.to_json() for entry in trace]}
-
-
-# Loading and validating scripts --------------------------------------------------------
-
-_INT16 = (-32768, 32767)
-_LIST_KEYS = ("IMG", "KYO", "CAM R", "ULT A", "ULT B", "ULT C", "ULT D", "FZI")
-_KEYS = (*_LIST_KEYS, "INP", "line_lost", "fail", "stop_fails", "after_last", "comment")
-
-
-def decode_script(data: bytes, name: str) -> Script:
-    """Decode and validate the bytes of a sensor script, TOML when `name` ends in .toml
-    and JSON otherwise; ScriptError says what is wrong and where."""
-    path = Path(name)
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as error:
-        raise ScriptError(f"{path}: not UTF-8 text (byte {error.start})") from None
-    if path.suffix.lower() == ".toml":
-        try:
-            document: object = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as error:
-            raise ScriptError(f"{path}: invalid TOML: {error}") from None
-        except RecursionError:
-            raise ScriptError(f"{path}: invalid TOML: nested too deeply") from None
-        except ValueError:  # tomllib converts every integer, however long
-            raise ScriptError(f"{path}: a number is far too long to be a reading; "
-                              "readings are 16-bit") from None
-    else:
-        try:
-            document = json.loads(text, parse_int=decimal_value)
-        except json.JSONDecodeError as error:
-            raise ScriptError(f"{path}:{error.lineno}:{error.colno}: invalid JSON: "
-                              f"{error.msg}") from None
-        except RecursionError:
-            raise ScriptError(f"{path}: invalid JSON: nested too deeply") from None
-    return parse_script(document, str(path))
-
-
-def parse_script(document: object, name: str = "<script>") -> Script:
-    """A Script from decoded JSON/TOML data; ScriptError names the offending key."""
-    if not isinstance(document, dict):
-        raise ScriptError(f"{name}: the script must be an object of sensor lists, "
-                          f"found {_kind(document)}")
-    for key in document:
-        if key not in _KEYS:
-            raise ScriptError(f"{name}:{key}: unknown key; expected one of "
-                              + ", ".join(f'"{k}"' for k in _KEYS))
-    if not isinstance(document.get("comment", ""), str):
-        raise ScriptError(f"{name}:comment: expected a string")
-    if not isinstance(document.get("stop_fails", False), bool):
-        raise ScriptError(f"{name}:stop_fails: expected true or false")
-    after_last = document.get("after_last", "stop")
-    if after_last not in AFTER_LAST:
-        raise ScriptError(f'{name}:after_last: expected "stop" or "repeat", '
-                          f"found {_kind(after_last)}")
-
-    def readings(key: str) -> list[object]:
-        return _list(document[key], f"{name}:{key}") if key in document else []
-
-    return Script(
-        images=tuple(ImageReading(*_fields(item, f"{name}:IMG[{i}]", ("area", "x", "y", "z")))
-                     for i, item in enumerate(readings("IMG"))),
-        odometry=tuple(Odometry(*_fields(item, f"{name}:KYO[{i}]", ("centre", "right", "left")))
-                       for i, item in enumerate(readings("KYO"))),
-        camera=tuple(_int(item, f"{name}:CAM R[{i}]", 0, 784)
-                     for i, item in enumerate(readings("CAM R"))),
-        ultrasonic={
-            letter: tuple(_int(item, f"{name}:ULT {letter}[{i}]", *_INT16)
-                          for i, item in enumerate(readings(f"ULT {letter}")))
-            for letter in "ABCD" if f"ULT {letter}" in document
-        },
-        ports=_ports(document.get("INP", {}), f"{name}:INP"),
-        fuzzy=tuple(FuzzyReading(*_fields(item, f"{name}:FZI[{i}]", ("s", "t")))
-                    for i, item in enumerate(readings("FZI"))),
-        losses=tuple(_loss(item, f"{name}:line_lost[{i}]")
-                     for i, item in enumerate(readings("line_lost"))),
-        failures=_failures(document.get("fail", {}), f"{name}:fail"),
-        stop_fails=document.get("stop_fails", False),
-        after_last=after_last,
-        name=name,
-    )
-
-
-def _kind(value: object) -> str:
-    if isinstance(value, bool):
-        return "true/false"
-    if isinstance(value, dict):
-        return "an object"
-    if isinstance(value, list):
-        return "a list"
-    if isinstance(value, str):
-        return f'the string "{value}"'
-    return "null" if value is None else repr(value)
-
-
-def _list(value: object, where: str) -> list[object]:
-    if not isinstance(value, list):
-        raise ScriptError(f"{where}: expected a list of readings, found {_kind(value)}")
-    if not value:
-        raise ScriptError(f"{where}: the list is empty; give at least one reading, "
-                          "or leave the key out")
-    return value
-
-
-def _int(value: object, where: str, low: int, high: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ScriptError(f"{where}: expected an integer in {low}..{high}, found {_kind(value)}")
-    if abs(value) >= TOO_LONG:
-        raise ScriptError(f"{where}: a number of more than {len(str(TOO_LONG)) - 1} digits "
-                          f"is far outside {low}..{high}")
-    if not low <= value <= high:
-        raise ScriptError(f"{where}: {value} is outside {low}..{high}")
-    return value
-
-
-def _fields(value: object, where: str, names: tuple[str, ...]) -> list[int]:
-    if not isinstance(value, dict):
-        raise ScriptError(f"{where}: expected an object with "
-                          + ", ".join(f'"{n}"' for n in names) + f", found {_kind(value)}")
-    for key in value:
-        if key not in names:
-            raise ScriptError(f"{where}.{key}: unknown field; expected "
-                              + ", ".join(f'"{n}"' for n in names))
-    missing = [n for n in names if n not in value]
-    if missing:
-        raise ScriptError(f"{where}: missing " + ", ".join(f'"{n}"' for n in missing))
-    return [_int(value[n], f"{where}.{n}", *_INT16) for n in names]
-
-
-def _ports(value: object, where: str) -> dict[int, tuple[int, ...]]:
-    if not isinstance(value, dict):
-        raise ScriptError(f"{where}: expected an object from port number to a list of "
-                          f'readings, e.g. {{"3": [1, 0]}}, found {_kind(value)}')
-    ports: dict[int, tuple[int, ...]] = {}
-    port_range = BUILTINS["INP"].forms[0].params[0]
-    for key, readings in value.items():
-        if not (key.isascii() and key.isdigit()):
-            raise ScriptError(f"{where}.{key}: a port is a decimal number "
-                              f"{port_range.low}..{port_range.high}")
-        port = _int(decimal_value(key), f"{where}.{key}", port_range.low, port_range.high)
-        ports[port] = tuple(_int(item, f"{where}.{key}[{i}]", 0, 255)
-                            for i, item in enumerate(_list(readings, f"{where}.{key}")))
-    return ports
-
-
-FORMS = frozenset(form_name((mnemonic, form.selector)) for mnemonic, builtin in BUILTINS.items()
-                  if mnemonic != "END" for form in builtin.forms)
-
-
-def _failures(value: object, where: str) -> dict[str, int]:
-    if not isinstance(value, dict):
-        raise ScriptError(f'{where}: expected an object from a call to the one that fails, '
-                          f'e.g. {{"TIM": 2}}, found {_kind(value)}')
-    for call in value:
-        if call not in FORMS:
-            raise ScriptError(f"{where}.{call}: not a built-in form; expected one of "
-                              + ", ".join(sorted(FORMS)))
-    return {call: _int(nth, f"{where}.{call}", 1, 2**31 - 1) for call, nth in value.items()}
-
-
-def _loss(value: object, where: str) -> LossAt | LossDuring | LossAfter:
-    if isinstance(value, dict) and set(value) == {"time"}:
-        return LossAt(_int(value["time"], f"{where}.time", 1, 2**31 - 1))
-    if isinstance(value, dict) and set(value) == {"instruction"}:
-        return LossAfter(_int(value["instruction"], f"{where}.instruction", 0, 2**31 - 1))
-    if isinstance(value, dict) and set(value) in ({"during", "nth"}, {"during", "nth", "after"}):
-        command = value["during"]
-        if command not in ("MOV", "MVI"):
-            raise ScriptError(f'{where}.during: expected "MOV" or "MVI", found {_kind(command)}')
-        return LossDuring(command, _int(value["nth"], f"{where}.nth", 1, 2**31 - 1),
-                          _int(value.get("after", 1), f"{where}.after", 1, 2**31 - 1))
-    raise ScriptError(f'{where}: expected {{"time": MS}}, {{"instruction": N}} or '
-                      f'{{"during": "MOV"|"MVI", "nth": N, "after": MS}}, found {_kind(value)}')
 
 
 # The device ----------------------------------------------------------------------------
