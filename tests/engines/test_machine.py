@@ -14,8 +14,10 @@ from support.ilc import images
 from support.scripts import MOVING_STARTS, scripts
 from support.semantics import int16, operate
 
-from rl1.compiler.runner import Finished, load_script
-from rl1.compiler.runner import run as run_program
+from rl1.compiler.analysis import analyze
+from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.cli.run import load_script
+from rl1.compiler.interpreter import Interpreter
 from rl1.compiler.strategies import checked_programs
 from rl1.vm import ilc, isa
 from rl1.vm.device import DeviceError, FuzzyReading, ImageReading, LineLost, Odometry
@@ -212,28 +214,21 @@ def test_modes_0_and_1_do_not_jump(mode: int) -> None:
 
 
 def test_an_event_after_a_jump_is_taken_there() -> None:
-    """A device that reports a loss between calls: the VM takes it at the jump."""
+    """A device that loses the line between calls: the VM takes it at the next jump."""
 
     class Asynchronous(ScriptedDevice):
-        looks = 0  # at `pending`: the line is lost between the first look and the second
-
-        @property
-        def pending(self) -> LineLost | None:
-            self.looks += 1
-            return self.poll_event()
-
-        @pending.setter
-        def pending(self, event: LineLost | None) -> None:
-            pass
+        takes = 0  # the line is lost after the second look at the mailbox (the MOV's)
 
         def poll_event(self) -> LineLost | None:
-            return LineLost("MOV", 3) if self.looks == 2 else None
+            self.takes += 1
+            return LineLost("MOV", 3) if self.takes == 3 else None
 
     program = assemble(call("MOV", 1, 1), op("INC", v("C")), op("JMP", To(1)),
                        op("LDI", 96), op("STV", v("H")), handlers={96: 3})
     device = Asynchronous()
     result = Machine(program, Blocking(device)).run()
-    assert (result.named()["C"], result.named()["H"]) == (2, 96)
+    assert (result.named()["C"], result.named()["H"]) == (1, 96)
+    assert device.takes == 3  # at the start, after the MOV, at the jump; not at END
 
 
 # Faults ---------------------------------------------------------------------------------
@@ -311,11 +306,18 @@ def test_any_verified_image_runs_to_an_end_or_a_fault(
 
 def both(text: str, script: Script) -> tuple[tuple[RunResult, ScriptedDevice],
                                              tuple[RunResult, ScriptedDevice]]:
+    analysis = analyze(text)
+    assert not analysis.has_errors, analysis.diagnostics
+    compiled = compile_text(text, "generated.rob")
+    assert compiled.output is not None
     interpreted_device, vm_device = ScriptedDevice(script), ScriptedDevice(script)
-    interpreted = run_program(text, interpreted_device, engine="ast")
-    ran = run_program(text, vm_device)
-    assert isinstance(interpreted, Finished) and isinstance(ran, Finished), ran
-    return (interpreted.result, interpreted_device), (ran.result, vm_device)
+    interpreter = Interpreter(analysis.program, interpreted_device)
+    interpreted_device.locate = lambda: interpreter.line
+    interpreted = interpreter.run()
+    machine = Machine(verify(compiled.output), Blocking(vm_device))
+    vm_device.locate = machine.current_line
+    ran = machine.run()
+    return (interpreted, interpreted_device), (ran, vm_device)
 
 
 def logged(device: ScriptedDevice) -> list[tuple[TraceEntry, int | None]]:

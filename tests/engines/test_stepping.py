@@ -54,12 +54,13 @@ def test_stepping_with_any_limits_gives_the_run_to_the_end(
 
 
 def test_a_step_stops_inside_a_statement_and_resumes_there() -> None:
-    """A=1+2+3 is one EXPRESSION step of the dispatch loop; a limit inside it still
-    stops after exactly that many instructions."""
-    machine = Machine(_compiled("A=1+2+3\nB=A\n"), Blocking(ScriptedDevice()))
+    """A=1+2+3 is four instructions; a limit inside them stops after exactly that many,
+    with the accumulator kept for the next step."""
+    machine = Machine(assemble(op("LDI", 1), op("ADDI", 2), op("ADDI", 3), op("STV", v("A")),
+                               op("LDV", v("A")), op("STV", v("B"))), Blocking(ScriptedDevice()))
     assert machine.step(2) is State.RUNNING and machine.executed == 2
-    assert machine.cells[v("A")] == 0  # the store has not run yet
-    assert machine.step(2) is State.RUNNING and machine.cells[v("A")] == 6
+    assert machine.variables[v("A")] == 0 and machine.acc == 3  # the store has not run yet
+    assert machine.step(2) is State.RUNNING and machine.variables[v("A")] == 6
     assert machine.step(100) is State.ENDED
     assert machine.result is not None and machine.result.named()["B"] == 6
 
@@ -219,11 +220,11 @@ def test_an_event_is_taken_after_a_call_that_takes_no_time_and_at_a_taken_jump()
     device = ScriptedDevice()
     machine = Machine(assemble(op("INC", v("A")), op("JMP", To(0)), op("INC", v("H")),
                                handlers={96: 2}), Blocking(device))
-    assert machine.step(2) is State.RUNNING and machine.cells[v("A")] == 1
+    assert machine.step(2) is State.RUNNING and machine.variables[v("A")] == 1
     device.pending = LineLost("MOV", 3)  # posted between two instructions
     assert machine.step(1) is State.RUNNING and machine.pc == 1  # INC A takes no event
     assert machine.step(1) is State.RUNNING and machine.pc == 2  # the JMP took it
-    assert commands(device) == [] and machine.cells[v("A")] == 2
+    assert commands(device) == [] and machine.variables[v("A")] == 2
 
 
 def test_a_failing_end_is_a_device_fault_at_the_end_and_end_is_not_called_twice() -> None:
