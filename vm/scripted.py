@@ -64,9 +64,11 @@ from .device import (
 )
 from .faults import RunResult
 from .language import BUILTINS, lost_line_handler
-from .sensor_script import LossAfter, LossAt, LossDuring
-
-# The script's schema and loader, imported from here too by the run stage and the tools.
+# The script's schema and loader, imported from here too by the run stage, its report
+# and the tools.
+from .sensor_script import LossAfter as LossAfter
+from .sensor_script import LossAt as LossAt
+from .sensor_script import LossDuring as LossDuring
 from .sensor_script import Script as Script
 from .sensor_script import ScriptError as ScriptError
 from .sensor_script import decode_script as decode_script
