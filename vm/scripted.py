@@ -64,6 +64,7 @@ from .device import (
 )
 from .faults import RunResult
 from .language import BUILTINS, lost_line_handler
+
 # The script's schema and loader, imported from here too by the run stage, its report
 # and the tools.
 from .sensor_script import LossAfter as LossAfter
