@@ -14,10 +14,8 @@ from support.ilc import images
 from support.scripts import MOVING_STARTS, scripts
 from support.semantics import int16, operate
 
-from rl1.compiler.analysis import analyze
-from rl1.compiler.backend.driver import compile_text
-from rl1.compiler.cli.run import load_script
-from rl1.compiler.interpreter import Interpreter
+from rl1.compiler.runner import Finished, load_script
+from rl1.compiler.runner import run as run_program
 from rl1.compiler.strategies import checked_programs
 from rl1.vm import ilc, isa
 from rl1.vm.device import DeviceError, FuzzyReading, ImageReading, LineLost, Odometry
@@ -306,18 +304,11 @@ def test_any_verified_image_runs_to_an_end_or_a_fault(
 
 def both(text: str, script: Script) -> tuple[tuple[RunResult, ScriptedDevice],
                                              tuple[RunResult, ScriptedDevice]]:
-    analysis = analyze(text)
-    assert not analysis.has_errors, analysis.diagnostics
-    compiled = compile_text(text, "generated.rob")
-    assert compiled.output is not None
     interpreted_device, vm_device = ScriptedDevice(script), ScriptedDevice(script)
-    interpreter = Interpreter(analysis.program, interpreted_device)
-    interpreted_device.locate = lambda: interpreter.line
-    interpreted = interpreter.run()
-    machine = Machine(verify(compiled.output), Blocking(vm_device))
-    vm_device.locate = machine.current_line
-    ran = machine.run()
-    return (interpreted, interpreted_device), (ran, vm_device)
+    interpreted = run_program(text, interpreted_device, engine="ast")
+    ran = run_program(text, vm_device)
+    assert isinstance(interpreted, Finished) and isinstance(ran, Finished), ran
+    return (interpreted.result, interpreted_device), (ran.result, vm_device)
 
 
 def logged(device: ScriptedDevice) -> list[tuple[TraceEntry, int | None]]:
