@@ -20,7 +20,7 @@ from rl1.vm.config_lines import KeyPath, entries, first_long_number, line_of
 
 keys = st.text(alphabet="ab_-. \"'#[]=\\é", min_size=1, max_size=4)
 scalars = (st.integers(-10**30, 10**30) | st.booleans() | st.floats(allow_nan=False)
-           | st.text(alphabet=st.characters(max_codepoint=0xFFFF, exclude_categories=("Cs",),
+           | st.text(alphabet=st.characters(max_codepoint=0xFFFF, codec="utf-8",
                                                exclude_characters="\x7f"),
                      max_size=6))
 
