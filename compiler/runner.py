@@ -31,7 +31,8 @@ from rl1.vm.faults import RunResult
 from rl1.vm.hardware import Blocking
 from rl1.vm.machine import Machine
 from rl1.vm.native import NativeMachine, library, load
-from rl1.vm.scripted import Script, ScriptedDevice, ScriptError, decode_script
+from rl1.vm.scripted import ScriptedDevice
+from rl1.vm.sensor_script import Script, ScriptError, decode_script
 from rl1.vm.verifier import verify
 
 MAX_SCRIPT_BYTES = 16 * 2**20

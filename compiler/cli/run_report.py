@@ -21,7 +21,8 @@ from rl1.compiler.reporting.render import FileDiagnostics, diagnostic_blocks
 from rl1.vm.defaults import TraceChoice
 from rl1.vm.device import READING_NAMES
 from rl1.vm.faults import Fault, FaultKind, RunResult
-from rl1.vm.scripted import LOST, LossAfter, LossAt, LossDuring, TraceEntry
+from rl1.vm.scripted import LOST, TraceEntry
+from rl1.vm.sensor_script import LossAfter, LossAt, LossDuring
 
 HEAD = 40
 TAIL = 20
