@@ -4,7 +4,7 @@ its line, and the safe fixes at once as `source.fixAll`, which `rl1c check --fix
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from lsprotocol import types
 
@@ -22,6 +22,7 @@ from .project import ProjectFiles
 
 # The rl1.toml selections that decide which fixes "fix all" makes, as for the checks.
 _PROJECTS = ProjectFiles()
+FIX_ALL = "Apply every safe fix (as `rl1c check --fix`)"
 
 
 def _edit(document: Document, fix: Fix, columns: Columns) -> types.WorkspaceEdit:
@@ -38,8 +39,12 @@ def _on_lines(diagnostic: Diagnostic, first: int, last: int) -> bool:
 
 
 def code_actions(document: Document, diagnostics: list[Diagnostic], requested: types.Range,
-                 only: Sequence[str] | None, columns: Columns) -> list[types.CodeAction]:
-    """Quick fixes for the diagnostics in `requested`, then one fix-all action."""
+                 only: Sequence[str] | None, columns: Columns,
+                 resolves_edits: bool = False) -> list[types.CodeAction]:
+    """Quick fixes for the diagnostics in `requested`, then one fix-all action, whose
+    edit is left for `codeAction/resolve` when the client `resolves_edits` (it costs a
+    check of the program for each round of fixes, and editors ask for code actions
+    whenever the cursor moves)."""
     first = document.locate(requested.start, columns)[0]
     last = document.locate(requested.end, columns)[0]
     actions: list[types.CodeAction] = []
@@ -62,11 +67,28 @@ def code_actions(document: Document, diagnostics: list[Diagnostic], requested: t
                     title=allow.title, kind=types.CodeActionKind.QuickFix,
                     diagnostics=[to_lsp(diagnostic, document, columns)],
                     edit=_edit(document, allow, columns)))
-    if only is None or any(types.CodeActionKind.SourceFixAll.startswith(kind) for kind in only):
-        fix_all = _fix_all(document, diagnostics, columns)
-        if fix_all is not None:
+    wants_fix_all = only is None or any(types.CodeActionKind.SourceFixAll.startswith(kind)
+                                        for kind in only)
+    if wants_fix_all and any(one.safe for diagnostic in diagnostics for one in diagnostic.fixes):
+        fix_all = types.CodeAction(title=FIX_ALL, kind=types.CodeActionKind.SourceFixAll,
+                                   data={"uri": document.uri, "version": document.version})
+        if not resolves_edits:
+            fix_all.edit = _fix_all_edit(document, columns)
+        if fix_all.edit is not None or resolves_edits:
             actions.append(fix_all)
     return actions
+
+
+def resolve(action: types.CodeAction, open_document: Callable[[str], Document | None],
+            columns: Columns) -> types.CodeAction:
+    """The fix-all action with its edit, for the version of the document it was offered
+    for; any other action, or one for a version since changed, as it came (no edit)."""
+    data = action.data if isinstance(action.data, dict) else {}
+    document = open_document(data["uri"]) if isinstance(data.get("uri"), str) else None
+    if action.kind == types.CodeActionKind.SourceFixAll and document is not None \
+            and data.get("version") == document.version:
+        action.edit = _fix_all_edit(document, columns)
+    return action
 
 
 def _allow(document: Document, diagnostic: Diagnostic) -> Fix | None:
@@ -86,23 +108,26 @@ def _allow(document: Document, diagnostic: Diagnostic) -> Fix | None:
                      f"{lead}rl1: allow {diagnostic.code}"),))
 
 
-def _fix_all(document: Document, diagnostics: list[Diagnostic],
-             columns: Columns) -> types.CodeAction | None:
+def _fix_all_edit(document: Document, columns: Columns) -> types.WorkspaceEdit | None:
     """The safe fixes, made as `rl1c check --fix` makes them, as one edit of the lines
-    they change; None when the document has none (then no check is run again)."""
-    if not any(one.safe for diagnostic in diagnostics for one in diagnostic.fixes):
-        return None
+    they change; None when they change nothing."""
     selection = _PROJECTS.selection(document.uri)
-    keep = selection.reports if isinstance(selection, Selection) else Selection().reports
+    if not isinstance(selection, Selection):  # a broken rl1.toml: as the checks do
+        selection = Selection()
     before = document.text()
-    after = fix_text(before, keep).text
+    fixed = document.derived(_fixed_texts)
+    if selection not in fixed:  # once per version and selection
+        fixed[selection] = fix_text(before, selection.reports).text
+    after = fixed[selection]
     if after == before:
         return None
-    return types.CodeAction(
-        title="Apply every safe fix (as `rl1c check --fix`)",
-        kind=types.CodeActionKind.SourceFixAll,
-        edit=types.WorkspaceEdit(changes={document.uri: [
-            _changed_lines(document, before, after, columns)]}))
+    return types.WorkspaceEdit(changes={document.uri: [
+        _changed_lines(document, before, after, columns)]})
+
+
+def _fixed_texts(document: Document) -> dict[Selection, str]:
+    """The document's text with its safe fixes made, by selection (filled as asked)."""
+    return {}
 
 
 def _changed_lines(document: Document, before: str, after: str,

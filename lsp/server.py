@@ -164,6 +164,7 @@ class Rl1Server(LanguageServer):
         self.columns = Columns(UTF16)
         self.snippets = False  # what the client's completion accepts
         self.markdown = False
+        self.resolves_edits = False  # the client fills in a code action's edit on resolve
         self.checks = checking.DiagnosticsScheduler(
             self.text_document_publish_diagnostics, lambda: self.columns)
         self.token_history = tokens.TokenHistory()
@@ -238,6 +239,9 @@ def create_server() -> Rl1Server:
         server.snippets = bool(item and item.snippet_support)
         formats = (item.documentation_format if item else None) or []
         server.markdown = types.MarkupKind.Markdown in formats
+        action_caps = text_document.code_action if text_document else None
+        resolving = action_caps.resolve_support if action_caps else None
+        server.resolves_edits = bool(resolving and "edit" in resolving.properties)
 
     # Synchronisation ----------------------------------------------------------------
 
@@ -344,10 +348,15 @@ def create_server() -> Rl1Server:
         return formatting.format_range(document, params.range, server.columns)
 
     @reads(types.TEXT_DOCUMENT_CODE_ACTION, [], types.CodeActionOptions(
-        code_action_kinds=[types.CodeActionKind.QuickFix, types.CodeActionKind.SourceFixAll]))
+        code_action_kinds=[types.CodeActionKind.QuickFix, types.CodeActionKind.SourceFixAll],
+        resolve_provider=True))
     def _(document: Document, params: types.CodeActionParams) -> list[types.CodeAction]:
         return actions.code_actions(document, server.checks.current(document), params.range,
-                                    params.context.only, server.columns)
+                                    params.context.only, server.columns, server.resolves_edits)
+
+    @server.feature(types.CODE_ACTION_RESOLVE)
+    def resolve_code_action(action: types.CodeAction) -> types.CodeAction:
+        return actions.resolve(action, server.document, server.columns)
 
     return server
 

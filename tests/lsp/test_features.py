@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import pytest
-from conftest import Client, position_of
+from conftest import SERVER, Client, initialize_params, make_client, position_of
 from lsprotocol import types
 from pygls.exceptions import JsonRpcException
+from pytest_lsp import ClientServerConfig
 
 from rl1.compiler.analysis import analyze, fix
 from rl1.compiler.formatter import format_text
@@ -426,6 +427,36 @@ async def test_fix_all_makes_the_safe_fixes_check_fix_makes(client: Client, text
     assert applied(text, edit) == fixed == fix(text).text
     guesses = [a for a in actions if a.diagnostics and a.diagnostics[0].code == "E0501"]
     assert not any(a.is_preferred for a in guesses), "a guess is never made unasked"
+
+
+async def test_a_client_that_resolves_edits_gets_the_fix_all_edit_on_resolve() -> None:
+    """The edit costs a check a round, and editors ask for code actions at every move
+    of the cursor: it is made only when the client resolves the action."""
+    client = await ClientServerConfig(server_command=SERVER, client_factory=make_client).start()
+    assert isinstance(client, Client)
+    try:
+        params = initialize_params()
+        assert params.capabilities.text_document is not None
+        params.capabilities.text_document.code_action = types.CodeActionClientCapabilities(
+            resolve_support=types.ClientCodeActionResolveOptions(properties=["edit"]))
+        result = await client.initialize_session(params)
+        options = result.capabilities.code_action_provider
+        assert isinstance(options, types.CodeActionOptions) and options.resolve_provider
+        text = ":5 (TIM 10); (mov 3,3)\n(MOVE 3,3)\n"
+        uri = await open_program(client, text)
+        (offered,) = [a for a in await actions_at(client, uri, 0)
+                      if a.kind == types.CodeActionKind.SourceFixAll]
+        assert offered.edit is None
+        resolved = await client.code_action_resolve_async(offered)
+        assert resolved.edit is not None and resolved.edit.changes is not None
+        (edit,) = resolved.edit.changes[uri]
+        assert applied(text, edit) == fix(text).text == ":05 (TIM 10); (MOV 3,3)\n(MOVE 3,3)\n"
+        client.change(uri, 2, ((1, 0, 1, 0), "A=1\n"))
+        stale = await client.code_action_resolve_async(offered)
+        assert stale.edit is None, "an action offered for an older version is not made"
+        await client.shutdown_session()
+    finally:
+        await client.stop()
 
 
 async def test_no_fix_all_when_no_safe_fix_is_left(client: Client) -> None:
