@@ -32,6 +32,12 @@ class Row:
         return f"Row({self.number})"
 
 
+_COLUMNS: dict[int, int] = {}
+"""One int object for each column number past 256, which CPython does not share: the
+spans of a long line would otherwise hold two ints of their own each, a quarter of the
+line's tree."""
+
+
 class Span:
     """A source range. Lines and columns are 1-based; columns count code points and
     `end_column` is exclusive (one past the last character), as in SARIF.
@@ -55,8 +61,9 @@ class Span:
             assert isinstance(end_line, int)
             self.row = Row(line)
             self.height = end_line - line
-        self.column = column
-        self.end_column = end_column
+        self.column = column if column <= 256 else _COLUMNS.setdefault(column, column)
+        self.end_column = (end_column if end_column <= 256
+                           else _COLUMNS.setdefault(end_column, end_column))
 
     @property
     def line(self) -> int:

@@ -28,7 +28,7 @@ from .diagnostics import Diagnostic, Edit, Fix, Severity
 from .lalr_tables import ACTIONS as TABLE
 from .lalr_tables import RULES, START
 from .scanner import Kinds, Lexeme, scan
-from .source import split_lines
+from .source import iter_lines
 
 # What each terminal is called in "expected ..." messages.
 TERMINAL_NAMES = {
@@ -309,7 +309,7 @@ def parse_program(text: str) -> tuple[ast.Program, list[Diagnostic]]:
     lines: list[ast.Line] = []
     diagnostics: list[Diagnostic] = []
     with collector_paused():
-        for number, line_text in enumerate(split_lines(text), start=1):
+        for number, line_text in enumerate(iter_lines(text), start=1):
             line, problems = parse_line(line_text, number)
             lines.append(line)
             if problems:

@@ -7,9 +7,12 @@ with LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them.
 from __future__ import annotations
 
 import re
+from collections.abc import Iterator
 from typing import NamedTuple
 
 from rl1.compiler.files import SourceError, read_bounded
+
+from .scanner import WHITESPACE
 
 MAX_SOURCE_BYTES = 8 * 1024 * 1024  # checking takes about 100 bytes a source byte
 UTF8_BOM = b"\xef\xbb\xbf"
@@ -35,6 +38,38 @@ def split_lines(text: str) -> list[str]:
     if lines and lines[-1] == "":
         lines.pop()
     return lines
+
+
+def iter_lines(text: str) -> Iterator[str]:
+    """The lines of `text` as split_lines gives them, one at a time: a long source's
+    lines are never all held as strings beside the text."""
+    start = 0
+    for line_break in LINE_BREAK.finditer(text):
+        yield text[start:line_break.start()]
+        start = line_break.end()
+    if start < len(text):
+        yield text[start:]
+
+
+def first_code_line_after(text: str, last: int) -> int | None:
+    """The number of the first line after line `last` that holds code (anything but
+    blanks before a `'`), or None: found in the text without splitting it into lines or
+    parsing it, so that a source too long for a limit on lines is told so before it
+    costs memory (a line of code past 65535 and the debug section, E0191)."""
+    if "\r" in text:
+        text = LINE_BREAK.sub("\n", text)  # one line end, for the searches below
+    if text.count("\n") < last:
+        return None  # `last` lines or fewer (a final line end starts no line)
+    start = 0
+    for _ in range(last):
+        start = text.index("\n", start) + 1
+    code = _CODE_LINE.search(text, start)
+    return None if code is None else last + 1 + text.count("\n", start, code.start())
+
+
+_CODE_LINE = re.compile(f"^[{re.escape(WHITESPACE)}]*[^{re.escape(WHITESPACE)}'\n]",
+                        re.MULTILINE)
+"""A line that holds code: one whose first character but blanks starts no comment."""
 
 
 def decode(data: bytes, name: str = "<input>") -> Source:
