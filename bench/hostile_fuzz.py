@@ -1,6 +1,7 @@
 """A fuzzing campaign against every rl1c command: the attacks of the test suite's
-bounded run (tests/support/hostile.py), for as long as asked. Prints how many inputs
-ran, how many found a problem, and the first few problems.
+bounded run (tests/support/hostile.py), and hostile project files (rl1.toml) under
+`rl1c check`, for as long as asked. Prints how many inputs ran, how many found a
+problem, and the first few problems.
 
     .venv/bin/python bench/hostile_fuzz.py --minutes 10
 """
@@ -8,6 +9,7 @@ ran, how many found a problem, and the first few problems.
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 import tempfile
 import time
@@ -17,10 +19,15 @@ from pathlib import Path
 from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
 
+from rl1.compiler.reporting.project import ProjectFileError, load_project_file
+
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 
-from support.hostile import (  # noqa: E402  (tests/ is put on the path just above)
+from support.cli import rl1c  # noqa: E402  (tests/ is put on the path just above)
+from support.hostile import (  # noqa: E402
+    _mutated,
+    _problems,
     hostile_ilc_files,
     hostile_sources,
     hostile_worlds,
@@ -30,6 +37,64 @@ from support.hostile import (  # noqa: E402  (tests/ is put on the path just abo
 )
 
 Attack = Callable[[bytes, Path], list[str]]
+
+SEED_PROJECT_FILES = [
+    b'[check]\nselect = ["W"]\nignore = ["W0603"]\nwarnings-as-errors = true\n',
+    b'# the team\'s choice\n[check]\nignore = ["W06", "W0205"]  # noisy\n',
+    b"[check]\nwarnings-as-errors = false\n",
+]
+# Values that break naive readers: huge numbers and strings, codes that do not exist,
+# the wrong types, deep nesting, control characters.
+HOSTILE_PROJECT_VALUES = [
+    "9" * 5000, "-" + "9" * 5000, "1e999", "nan", "inf", "0x" + "f" * 5000, '"W"',
+    '["W9999"]', '["' + "W" * 100_000 + '"]', '["w06"]', '[""]', "[1, 2]", "{}", "[[]]",
+    "[" * 600 + "]" * 600, '"\\u0000"', "1979-05-27T07:32:00Z", "true", '["W", "W"]',
+]
+WARNED_PROGRAM = b"' a program with warnings and no errors\n:10 A=1\n(MOV 1,1)\n"
+
+
+@st.composite
+def hostile_project_files(draw: st.DrawFn) -> bytes:
+    """Arbitrary bytes, the seeds mutated byte by byte, the seeds with one value
+    replaced by a hostile one, and the seeds behind a UTF-8 byte order mark."""
+    kind = draw(st.sampled_from(["bytes", "mutated", "value", "bom"]))
+    if kind == "bytes":
+        return draw(st.binary(max_size=400))
+    seed_file = draw(st.sampled_from(SEED_PROJECT_FILES))
+    if kind == "mutated":
+        return _mutated(seed_file, draw)
+    if kind == "bom":
+        return b"\xef\xbb\xbf" + seed_file
+    assignments = list(re.finditer(rb"(?m)^([\w-]+\s*=\s*)(.*?)(\s*(#.*)?)$", seed_file))
+    chosen = draw(st.sampled_from(assignments))
+    value = draw(st.sampled_from(HOSTILE_PROJECT_VALUES)).encode()
+    return seed_file[:chosen.start(2)] + value + seed_file[chosen.end(2):]
+
+
+def project_attack(data: bytes, folder: Path) -> list[str]:
+    """`rl1c check` on a program under the rl1.toml `data`: a file the reader refuses
+    must end with status 2 and a message naming it; one it accepts must check."""
+    project, program = folder / "rl1.toml", folder / "warned.rob"
+    project.write_bytes(data)
+    program.write_bytes(WARNED_PROGRAM)
+    result = rl1c("check", program)
+    found = _problems("check", result, None)
+    try:
+        load_project_file(str(project))
+    except ProjectFileError:
+        if result.exit_code != 2 or str(project) not in result.stderr:
+            found.append(f"check: a bad rl1.toml gave status {result.exit_code}: "
+                         f"{result.output_bytes[-300:]!r}")
+    except Exception as error:  # the reader must raise nothing else
+        found.append(f"load_project_file: {type(error).__name__}: {str(error)[:200]}")
+    else:
+        if result.exit_code not in (0, 1):
+            found.append(f"check: a readable rl1.toml gave status {result.exit_code}: "
+                         f"{result.output_bytes[-300:]!r}")
+    if data.startswith(b"\xef\xbb\xbf") and result.exit_code == 2:
+        found.append(f"check: an rl1.toml behind a byte order mark is refused: "
+                     f"{result.stderr[-200:]!r}")
+    return found
 
 
 def campaign(name: str, inputs: st.SearchStrategy[bytes], attack: Attack,
@@ -56,7 +121,10 @@ def campaign(name: str, inputs: st.SearchStrategy[bytes], attack: Attack,
         run()
         batch += 1
     print(f"{name}: {ran} inputs in {seconds:.0f} s, {failed} with a problem")
-    for problem in problems[:5]:
+    kinds: dict[str, str] = {}  # the first problem of each kind
+    for problem in problems:
+        kinds.setdefault(problem[:60], problem)
+    for problem in list(kinds.values())[:5]:
         print(f"  {problem}")
 
 
@@ -64,10 +132,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=1.0)
     options = parser.parse_args()
-    third = options.minutes * 20
-    campaign("sources (check, fmt, compile, run)", hostile_sources(), source_attack, third)
-    campaign(".ilc files (run, dis, asm)", hostile_ilc_files(), ilc_attack, third)
-    campaign("world files (sim)", hostile_worlds(), world_attack, third)
+    quarter = options.minutes * 15
+    campaign("sources (check, fmt, compile, run)", hostile_sources(), source_attack, quarter)
+    campaign(".ilc files (run, dis, asm)", hostile_ilc_files(), ilc_attack, quarter)
+    campaign("world files (sim)", hostile_worlds(), world_attack, quarter)
+    campaign("project files (rl1.toml, check)", hostile_project_files(), project_attack,
+             quarter)
 
 
 if __name__ == "__main__":

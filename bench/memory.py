@@ -32,11 +32,12 @@ SOURCE_BYTES = 8 * MIB
 DRIVE_ON = "(MOV 1,1)\n:10 (TIM 100); #10\n"
 
 
-def world(trace_interval: float, time_limit: float) -> str:
+def world(trace_interval: float, time_limit: float, delay: float = 0.0) -> str:
     """A floor as large as a world allows, the vehicle in the middle heading along it."""
     return (f"[floor]\nsize = [1000000, 1000000]\n\n"
             f"[start]\nx = 1000\ny = 500000\nheading = 0\n\n"
             f"[vehicle]\ntrace_interval = {trace_interval!r}\n\n"
+            f"[noise]\ndelay = {delay!r}\n\n"
             f"[limits]\ntime = {time_limit!r}\n")
 
 
@@ -62,8 +63,12 @@ def sim_cases(folder: Path, seconds: float) -> None:
     program = folder / "drive.rob"
     program.write_text(DRIVE_ON)
     print("rl1c sim: peak resident MB (bound: 200)")
+    # The worst valid worlds: the longest time limit, and the most tracing ticks a run
+    # may take (world.MAX_TICKS) with the longest sensor delay; then two that were valid
+    # before the world's bounds (issue 23), which the loader now refuses.
     cases = [
         ("default interval 0.05 s, time limit 24 h", world(0.05, 86400.0)),
+        ("interval 1e-3 s, delay 10 s, limit 2,000 s", world(1e-3, 2000.0, 10.0)),
         ("interval 1e-4 s, time limit 24 h", world(1e-4, 86400.0)),
         ("interval 1e-9 s, time limit 24 h", world(1e-9, 86400.0)),
     ]
@@ -91,7 +96,7 @@ def sources() -> list[tuple[str, bytes]]:
     return [
         ("lines of 19,999 characters", filled(statements + b"\n")),
         ("`A=1` lines", filled(b"A=1\n")),
-        ("65,535 lines, then 1-statement lines", filled(b"A=1;B=2\n")),
+        ("`A=1;B=2` lines", filled(b"A=1;B=2\n")),
         ("lines with a syntax error", filled(b"A=1 B=2\n")),
         ("comment lines", filled(b"' a remark that takes up some room, and then more\n")),
     ]
