@@ -129,6 +129,13 @@ def test_any_program_ends_with_a_known_status_and_no_traceback(tmp_path: Path,
     result = rl1c("sim", program, "--world", WORLD, "--budget", "20000", "--format", "json")
     assert result.exit_code in (0, 1, 10, 11, 12, 13), result.output
     assert "Traceback" not in result.output
+    if result.exit_code != 1:  # it ran: the text ends with what the JSON says
+        document = json.loads(result.stdout)
+        count = document["instructions"]
+        text = rl1c("sim", program, "--world", WORLD, "--budget", "20000", "--trace", "none")
+        assert text.stdout.splitlines()[-1] == (
+            f"{document['device_time']} ms of device time, {count:,} "
+            f"instruction{'s' if count != 1 else ''}")
 
 
 def test_the_trace_is_bounded_as_rl1c_run_bounds_it() -> None:
@@ -213,3 +220,13 @@ def test_color_is_asked_for_as_in_the_other_commands(tmp_path: Path, command: st
     assert colored.exit_code == plain.exit_code == 13
     assert "\x1b[" in colored.stdout and "\x1b[" not in plain.stdout
     assert "error[E1013]" in plain.stdout
+
+
+@pytest.mark.needs_cc
+def test_the_c_vm_drives_the_simulator_as_the_reference_does(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))  # a build of its own
+    reference = rl1c("sim", SAMPLE, "--world", WORLD, "--format", "json")
+    native = rl1c("sim", SAMPLE, "--world", WORLD, "--format", "json", "--engine", "c")
+    assert (native.exit_code, native.stdout) == (reference.exit_code, reference.stdout)
+    assert json.loads(native.stdout)["trace"][0]["line"] == 2  # lines from the C VM too
