@@ -50,7 +50,7 @@ def generate(program: ir.Program, source_name: str, *, debug: bool = True) -> il
             if offset + op.info.length > ilc.MAX_CODE_SIZE:
                 raise CodegenError(_too_large(op.line))
             if debug and op.line > ilc.MAX_LINE:
-                raise CodegenError(_line_too_far(op.line))
+                raise CodegenError(line_too_far(op.line))
             offset += op.info.length
     code = bytearray()
     lines: list[tuple[int, int]] = []
@@ -82,7 +82,7 @@ def _too_large(line: int) -> Diagnostic:
     )
 
 
-def _line_too_far(line: int) -> Diagnostic:
+def line_too_far(line: int) -> Diagnostic:
     return Diagnostic(
         "E0191", Severity.ERROR,
         f"line {line} holds code, but the .ilc debug section records line numbers up to "

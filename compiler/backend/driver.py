@@ -13,10 +13,11 @@ from typing import Literal
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.frontend.diagnostics import Diagnostic, sort_key
+from rl1.compiler.frontend.source import first_code_line_after
 from rl1.vm import ilc
 from rl1.vm.defaults import DEFAULT_LEVEL
 
-from .codegen import CodegenError, generate
+from .codegen import CodegenError, generate, line_too_far
 from .ir import format_program
 from .lower import lower
 from .optimize import LEVELS, optimize
@@ -40,6 +41,11 @@ def compile_text(text: str, source_name: str, *, emit: Emit = "ilc",
     """Compile a program at optimization `level` (by default DEFAULT_LEVEL, as
     `rl1c compile`); `source_name` is recorded in the debug section. `check` validates
     the IR after every pass (optimize.optimize)."""
+    if emit != "ir" and not strip_debug:
+        # Known from the text alone: a long source is refused before it is parsed.
+        too_far = first_code_line_after(text, ilc.MAX_LINE)
+        if too_far is not None:
+            return Compilation([line_too_far(too_far)], None)
     analysis = analyze(text)
     if analysis.has_errors:
         return Compilation(analysis.diagnostics, None)
