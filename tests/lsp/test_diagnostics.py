@@ -109,6 +109,18 @@ async def test_the_nearest_rl1_toml_selects_as_for_rl1c_check(client: Client,
         ("W0603", types.DiagnosticSeverity.Warning), ("W0701", types.DiagnosticSeverity.Warning)]
 
 
+async def test_an_rl1_toml_with_a_huge_number_is_said_and_checking_goes_on(
+        client: Client, tmp_path: Path) -> None:
+    # A value of 5,000 digits was an internal error: the documents under it got no
+    # diagnostics, so a repository could switch checking off in the editor.
+    (tmp_path / "rl1.toml").write_text("[check]\nwarnings-as-errors = " + "9" * 5000 + "\n",
+                                       encoding="utf-8")
+    _, shown = await client.opened("(MOV 3,3)\n", (tmp_path / "prog.rob").as_uri())
+    assert "line 2: check.warnings-as-errors: a number of more than 4300 digits" in \
+        shown[0].message
+    assert [d.code for d in shown[1:]] == ["W0603", "W0701"]  # checked as without it
+
+
 async def test_closing_a_document_clears_its_diagnostics(client: Client) -> None:
     uri, diagnostics = await client.opened("A=(\n")
     assert "E0101" in [d.code for d in diagnostics]
