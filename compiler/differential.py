@@ -10,11 +10,15 @@ name and a `run`.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
+import selectors
 import shlex
+import signal
 import subprocess
 import tempfile
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
@@ -25,7 +29,7 @@ from rl1.compiler.interpreter import interpret
 from rl1.compiler.strategies import Run
 from rl1.vm.faults import FaultKind
 from rl1.vm.hardware import Blocking
-from rl1.vm.language import VARIABLES
+from rl1.vm.language import VARIABLES, decimal_value
 from rl1.vm.machine import Machine
 from rl1.vm.native import BuildError, NativeMachine, library, load
 from rl1.vm.scripted import IGNORED, ScriptedDevice, parse_script, run_document
@@ -34,6 +38,8 @@ from rl1.vm.verifier import verify
 SOURCE_NAME = "fuzz.rob"
 _ENTRY_KEYS = ("time", "call", "args", "result")
 EXEC_TIMEOUT = 10.0  # seconds an exec: engine may take for one run
+EXEC_OUTPUT_LIMIT = 16 * 2**20  # bytes it may print: a run's JSON, however long the trace
+STDERR_KEPT = 4096  # the end of its standard error, for the message of a run it did not print
 BUDGET_CODE = FaultKind.BUDGET.code
 CRASH_CODE = "crash"  # the status of an engine that raised (a bug in it, not a run)
 
@@ -76,6 +82,11 @@ class Observation:
         if self.ran_away and trace and trace[-1].get("call") == "STOP":
             trace.pop()
         return trace
+
+
+class EngineUnavailable(Exception):
+    """An engine cannot run on this machine at all (not a finding); the message says why
+    and what to do. native.BuildError is the C engine's."""
 
 
 class Engine(Protocol):
@@ -151,34 +162,132 @@ class ExecEngine:
 
     def run(self, case: Run, budget: int) -> Observation:
         with tempfile.TemporaryDirectory(prefix="rl1-fuzz-") as folder:
+            if shlex.quote(folder) != folder:
+                # A quoted word is literal bare, but not inside double quotes, where a
+                # `$(...)` or backquote of the path would run: the paths need no quotes.
+                raise EngineUnavailable(
+                    f"exec: engines get the paths of their files in a shell command, and "
+                    f"the temporary folder {folder} has characters a shell reads (such as "
+                    "spaces, quotes, $ or `); set TMPDIR to a folder whose path has only "
+                    "letters, digits and / . _ - + , : @ % =")
             ilc_path = os.path.join(folder, "fuzz.ilc")
             sensors_path = os.path.join(folder, "fuzz.sensors.json")
             with open(ilc_path, "wb") as stream:
                 stream.write(compiled(case.source, 0))
             with open(sensors_path, "w", encoding="utf-8") as stream:
                 json.dump(case.script, stream)
-            try:
-                done = subprocess.run(self.command_line(ilc_path, sensors_path, budget),
-                                      shell=True, capture_output=True, timeout=EXEC_TIMEOUT,
-                                      check=False)
-            except subprocess.TimeoutExpired:
-                return Observation({"status": {"code": "timeout", "line": None},
-                                    "variables": {}, "trace": []})
-        return Observation(_document(done.stdout, done.stderr))
+            ran = _run_shell(self.command_line(ilc_path, sensors_path, budget))
+        match ran:
+            case _Ran(ending="timeout"):
+                return _no_run("timeout", f"it ran longer than {EXEC_TIMEOUT:.0f} seconds")
+            case _Ran(ending="too-much-output"):
+                return _no_run("too-much-output", "it printed more than "
+                               f"{EXEC_OUTPUT_LIMIT // 2**20} MiB on standard output")
+        return Observation(printed_run(ran.stdout, ran.stderr))
 
 
-def _document(stdout: bytes, stderr: bytes) -> dict[str, Any]:
-    """The run an exec: engine printed, or a status saying it printed none."""
+@dataclass(frozen=True)
+class _Ran:
+    """How a shell command ended ("done", "timeout", "too-much-output"), and what it
+    printed: its standard output whole, the end of its standard error."""
+
+    ending: str
+    stdout: bytes
+    stderr: bytes
+
+
+def _run_shell(command: str) -> _Ran:
+    """Run `command` through the shell for at most EXEC_TIMEOUT seconds, reading at most
+    EXEC_OUTPUT_LIMIT bytes of its output; then every process it started is killed (the
+    command runs in a process group of its own)."""
+    process = subprocess.Popen(command, shell=True, stdin=subprocess.DEVNULL,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               start_new_session=True)
+    assert process.stdout is not None and process.stderr is not None
+    stdout, stderr = bytearray(), bytearray()
+    ending = "done"
+    deadline = time.monotonic() + EXEC_TIMEOUT
     try:
-        document = json.loads(stdout)
-    except (UnicodeDecodeError, json.JSONDecodeError):
-        document = None
-    if isinstance(document, dict) and {"status", "variables", "trace"} <= set(document):
+        with selectors.DefaultSelector() as selector:
+            selector.register(process.stdout, selectors.EVENT_READ, stdout)
+            selector.register(process.stderr, selectors.EVENT_READ, stderr)
+            while selector.get_map() and ending == "done":
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    ending = "timeout"
+                for key, _ in selector.select(max(left, 0)):
+                    chunk = os.read(key.fd, 1 << 16)
+                    if not chunk:
+                        selector.unregister(key.fileobj)
+                    key.data.extend(chunk)
+                del stderr[:-STDERR_KEPT]
+                if len(stdout) > EXEC_OUTPUT_LIMIT:
+                    ending = "too-much-output"
+        if ending == "done":
+            try:
+                process.wait(max(deadline - time.monotonic(), 0))
+            except subprocess.TimeoutExpired:
+                ending = "timeout"
+    finally:
+        with contextlib.suppress(ProcessLookupError):  # all of them ended already
+            os.killpg(process.pid, signal.SIGKILL)  # before wait(): the group id is kept
+        process.wait()
+        process.stdout.close()
+        process.stderr.close()
+    return _Ran(ending, bytes(stdout), bytes(stderr))
+
+
+def _no_run(code: str, message: str) -> Observation:
+    return Observation({"status": {"code": code, "line": None, "message": message},
+                        "variables": {}, "trace": []})
+
+
+def printed_run(stdout: bytes, stderr: bytes) -> dict[str, Any]:
+    """The run an exec: engine printed, or a status saying it printed none, and why."""
+    try:
+        document: object = json.loads(stdout, parse_int=decimal_value)
+    except (ValueError, RecursionError):  # not JSON, nor UTF-8, or nested too deeply
+        problem: str | None = "it printed no JSON"
+    else:
+        problem = _shape_problem(document)
+    if problem is None and isinstance(document, dict):
         return document
     said = stderr.decode("utf-8", "replace").strip().splitlines()
-    return {"status": {"code": "no-run", "line": None,
-                       "message": said[-1] if said else "no output"},
-            "variables": {}, "trace": []}
+    return _no_run("no-run", f"{problem}" + (f"; its standard error ends: {said[-1]}"
+                                             if said else "")).document
+
+
+def _shape_problem(document: object) -> str | None:
+    """What keeps `document` from being a run as `rl1c run --format json` prints it
+    (section 5 of spec/optimization.md); None when it is one."""
+    if not isinstance(document, dict):
+        return "it printed JSON but no object"
+    missing = [key for key in ("status", "variables", "trace") if key not in document]
+    if missing:
+        return f"its object has no {' nor '.join(missing)}"
+    status, variables, trace = document["status"], document["variables"], document["trace"]
+    if status != "ok" and not (isinstance(status, dict) and isinstance(status.get("code"), str)
+                               and (status.get("line") is None or _whole(status["line"]))):
+        return 'its status is neither "ok" nor an object with a code and a line'
+    if not isinstance(variables, dict) or not all(map(_whole, variables.values())):
+        return "its variables are not an object of whole numbers"
+    if not isinstance(trace, list):
+        return "its trace is not a list"
+    for index, entry in enumerate(trace, 1):
+        if not (isinstance(entry, dict) and _whole(entry.get("time"))
+                and isinstance(entry.get("call"), str) and _numbers(entry.get("args"))
+                and (entry.get("result") is None or _numbers(entry["result"]))):
+            return (f"its trace entry {index} is not an object with a time, a call, its "
+                    "arguments and what it read")
+    return None
+
+
+def _whole(value: object) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _numbers(value: object) -> bool:
+    return isinstance(value, list) and all(map(_whole, value))
 
 
 def compiled(source: str, level: int) -> bytes:
@@ -274,7 +383,7 @@ def _observed(engine: Engine, case: Run, budget: int) -> Observation:
     is a finding that `rl1c fuzz` shrinks and writes down like a disagreement."""
     try:
         return engine.run(case, budget)
-    except BuildError:  # this machine cannot build the C VM: not the program's doing
+    except (BuildError, EngineUnavailable):  # this machine's doing, not the program's
         raise
     except Exception as error:  # whatever it raised is what was found
         return Observation({"status": {"code": CRASH_CODE, "line": None,

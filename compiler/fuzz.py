@@ -36,6 +36,7 @@ from rl1.compiler.differential import (
     compiled,
     judge,
 )
+from rl1.compiler.files import write_atomically
 from rl1.compiler.frontend.source import split_lines
 from rl1.compiler.strategies import Run, runs
 
@@ -175,17 +176,28 @@ def _reduce(items: list[T], keeps: Callable[[list[T]], bool]) -> list[T]:
     return items
 
 
-def write_reproducer(folder: str, finding: Finding, engines: Sequence[Engine],
-                     budget: int) -> str:
+FINDING_FOLDER = "finding-"  # each finding's folder under --out: finding-1, finding-2...
+
+
+@dataclass(frozen=True)
+class Reproducer:
+    folder: str  # the finding's own folder
+    replay: str  # the command that replays it
+
+
+def write_reproducer(out: str, finding: Finding, engines: Sequence[Engine],
+                     budget: int) -> Reproducer:
     """Write the run, its compiled files, each engine's run and `replay.sh` (every
-    engine's run again, one command each) into `folder`; the command that replays it."""
-    os.makedirs(folder, exist_ok=True)
+    engine's run again, one command each) into a new folder under `out` (made for it,
+    so that nothing there is replaced, followed or written into: the first free
+    `finding-N`); OSError when that cannot be done."""
+    os.makedirs(out, exist_ok=True)
+    folder = _new_folder(out)
     case = finding.case
 
     def write(name: str, data: bytes | str) -> str:
-        path = os.path.join(folder, name)
-        with open(path, "wb") as stream:
-            stream.write(data.encode("utf-8") if isinstance(data, str) else data)
+        write_atomically(os.path.join(folder, name),
+                         data.encode("utf-8") if isinstance(data, str) else data)
         return name
 
     write(SOURCE, case.source)
@@ -198,7 +210,20 @@ def write_reproducer(folder: str, finding: Finding, engines: Sequence[Engine],
               json.dumps(finding.verdict.observations[engine.name].document, indent=2) + "\n")
         commands.append(_replay(engine, case, budget, write))
     write("replay.sh", "\n".join(commands) + "\n")
-    return f"sh {shlex.quote(os.path.join(folder, 'replay.sh'))}"
+    return Reproducer(folder, f"sh {shlex.quote(os.path.join(folder, 'replay.sh'))}")
+
+
+def _new_folder(out: str) -> str:
+    """The first `finding-N` under `out` that did not exist, made now (by this process
+    alone, even when campaigns write to `out` together)."""
+    number = 1
+    while True:
+        folder = os.path.join(out, f"{FINDING_FOLDER}{number}")
+        try:
+            os.mkdir(folder)
+            return folder
+        except FileExistsError:
+            number += 1
 
 
 def _replay(engine: Engine, case: Run, budget: int,

@@ -40,7 +40,12 @@ import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from hypothesis import strategies as st
+try:
+    from hypothesis import strategies as st
+except ModuleNotFoundError as missing:  # an optional part of rl1: pyproject.toml's `fuzz`
+    raise ModuleNotFoundError("rl1.compiler.strategies generates programs with Hypothesis, "
+                              "which is not installed here: pip install 'rl1[fuzz]'",
+                              name="hypothesis") from missing
 
 from rl1.vm.language import BUILTINS, HANDLER_LABELS, RESERVED_VARIABLES, VARIABLES, Form
 

@@ -7,6 +7,7 @@ when it runs: they load Hypothesis.
 
 from __future__ import annotations
 
+import os
 import random
 import sys
 
@@ -39,7 +40,8 @@ BAR_WIDTH = 30
 @click.option("--seed", type=str, default=None, metavar="N",
               help="the seed of the generator, to repeat a campaign (default: random)")
 @click.option("--out", "out_dir", default="fuzz-out", show_default=True, metavar="DIR",
-              type=PATH, help="where to write the reproducer of a disagreement")
+              type=PATH, help="the folder under which a disagreement's reproducer is written, in a "
+                   "new folder finding-N of its own")
 @click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget,
               metavar="N", show_default=True, help="the budget of every run")
 def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
@@ -52,13 +54,29 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     program is shrunk to a small one, written with each engine's run and a replay
     script to --out, and the difference printed. Exit status: 0 all agreed, 1 a
     disagreement, 2 a usage problem."""
-    from rl1.compiler.differential import DEFAULT_ENGINES, ENGINE_NAMES, Engine, engine_named
+    try:
+        from rl1.compiler.differential import (
+            DEFAULT_ENGINES,
+            ENGINE_NAMES,
+            Engine,
+            EngineUnavailable,
+            engine_named,
+        )
+        from rl1.compiler.fuzz import campaign, write_reproducer
+    except ModuleNotFoundError as error:
+        if error.name != "hypothesis":
+            raise
+        raise Failure("error: rl1c fuzz generates programs with Hypothesis, an optional "
+                      "part of rl1 that is not installed here; install it with "
+                      "`pip install 'rl1[fuzz]'` (or `pip install hypothesis`)") from None
     from rl1.compiler.frontend.source import split_lines
-    from rl1.compiler.fuzz import campaign, write_reproducer
     from rl1.vm.native import BuildError
 
     if count is not None and seconds is not None:
         raise click.UsageError("give --count or --time, not both")
+    problem = _unwritable(out_dir)
+    if problem is not None:  # found now, not after a campaign that found something
+        raise click.UsageError(f"argument --out: {out_dir}: {problem}")
     engines: list[Engine] = []
     for name in engine_names or DEFAULT_ENGINES:
         engine = engine_named(name)
@@ -79,7 +97,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     try:
         outcome = campaign(engines, budget, count=limit, seconds=seconds, seed=seed_value,
                            progress=bar.update)
-    except BuildError as error:  # a c-ON engine on a machine without a C compiler
+    except (BuildError, EngineUnavailable) as error:  # such as no C compiler for c-ON
         raise Failure(f"error: {error}") from None
     finally:
         bar.close()
@@ -91,15 +109,36 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         click.echo(f"{summary}: all agreed")
         return 0
     finding = outcome.finding
-    replay = write_reproducer(out_dir, finding, engines, budget)
+    try:
+        reproducer = write_reproducer(out_dir, finding, engines, budget)
+    except OSError as error:  # the finding is printed all the same
+        reproducer, failed = None, error
     numbered = "\n".join(f"{number:4} | {line}" for number, line
                          in enumerate(split_lines(finding.case.source), 1))
     click.echo(f"{summary}: the engines disagree (reference: {engines[0].name})\n\n"
                f"the smallest program found:\n{numbered}\n\n"
-               + "\n".join(finding.verdict.problems)
-               + f"\n\nreproducer: {out_dir} (program, sensor script, each engine's run); "
-                 f"replay: {replay}")
+               + "\n".join(finding.verdict.problems))
+    if reproducer is None:
+        raise Failure(f"error: cannot write the reproducer under {out_dir} "
+                      f"({failed.strerror or failed}); the program is above, and the "
+                      "campaign runs again with the same --seed", EXIT_ERRORS)
+    click.echo(f"\nreproducer: {reproducer.folder} (program, sensor script, each engine's "
+               f"run); replay: {reproducer.replay}")
     return EXIT_ERRORS
+
+
+def _unwritable(folder: str) -> str | None:
+    """Why the reproducer of a finding could not be written under `folder` (which need
+    not exist yet), or None."""
+    path = os.path.abspath(folder)
+    while not os.path.exists(path):
+        path = os.path.dirname(path)
+    if not os.path.isdir(path):
+        return "it is a file, not a folder" if path == os.path.abspath(folder) \
+            else f"{path} is a file, not a folder"
+    if not os.access(path, os.W_OK | os.X_OK):
+        return f"{path} cannot be written to; name a folder of yours"
+    return None
 
 
 class _Bar:

@@ -4,17 +4,27 @@ spec/optimization.md section 5, and a planted bug is found, shrunk and written d
 from __future__ import annotations
 
 import json
+import os
 import shlex
+import stat
+import subprocess
 import sys
 from pathlib import Path
 
 import pytest
-from hypothesis import find
+from hypothesis import find, given
+from hypothesis import strategies as st
 from support import ROOT
 from support.cli import rl1c
 
-from rl1.compiler import fuzz
-from rl1.compiler.differential import Observation, differences, engine_named, judge
+from rl1.compiler import differential, fuzz
+from rl1.compiler.differential import (
+    Observation,
+    differences,
+    engine_named,
+    judge,
+    printed_run,
+)
 from rl1.compiler.frontend.source import split_lines
 from rl1.compiler.strategies import Run
 
@@ -103,19 +113,20 @@ def test_a_planted_shift_bug_is_found_and_shrunk_to_a_few_lines(
                   "--seed", "1", "--out", str(out))
     assert result.exit_code == 1, result.output
     assert "the engines disagree (reference: vm-O0)" in result.stdout
-    program = (out / "program.rob").read_text(encoding="utf-8")
+    found = out / "finding-1"
+    program = (found / "program.rob").read_text(encoding="utf-8")
     # Which run disagrees first depends on Hypothesis' draws, which mix in the literals
     # of the modules the suite has loaded: a loop around the shift (5 lines) is as small
     # as some of those runs go.
     assert 1 <= len(split_lines(program)) <= 5, program
     assert "<" in program  # a left shift, by a negative count
-    runs = [json.loads(path.read_text(encoding="utf-8")) for path in sorted(out.glob("run-*"))]
+    runs = [json.loads(path.read_text(encoding="utf-8")) for path in sorted(found.glob("run-*"))]
     assert len(runs) == 2 and runs[0]["variables"] != runs[1]["variables"]
-    assert "variables: " in result.stdout and f"sh {out}/replay.sh" in result.stdout
-    replay = (out / "replay.sh").read_text(encoding="utf-8")
+    assert "variables: " in result.stdout and f"sh {found}/replay.sh" in result.stdout
+    replay = (found / "replay.sh").read_text(encoding="utf-8")
     assert "rl1c run program-O0.ilc --sensors program.sensors.json" in replay
     assert {"program.sensors.json", "program-O0.ilc", "replay.sh"} <= {
-        path.name for path in out.iterdir()}
+        path.name for path in found.iterdir()}
 
 
 def test_an_engine_that_prints_no_run_disagrees(tmp_path: Path) -> None:
@@ -154,3 +165,218 @@ def test_runs_are_compared_on_what_the_protocol_names_only() -> None:
     moved = Observation({**annotated.document, "trace": [
         {"time": 0, "call": "MOV", "args": [3, 2], "line": 2}]})
     assert differences(annotated, moved) != []
+
+
+# `exec:` engines: what they print, how long, and what they leave behind ------------------
+
+CASE = Run("A=1\n", {})
+
+
+def exec_run(command: str) -> Observation:
+    engine = engine_named(f"exec:{command}")
+    assert engine is not None
+    return engine.run(CASE, 20_000)
+
+
+def assert_disagrees(observation: Observation, code: str) -> None:
+    reference = engine_named("ast")
+    assert reference is not None
+    assert observation.ending()["code"] == code  # type: ignore[index]
+    assert differences(reference.run(CASE, 20_000), observation) != []
+
+
+def test_an_engine_that_prints_too_much_is_stopped_and_disagrees() -> None:
+    # Its whole output was read into memory: `exec:yes` reached 2.4 GB in its 10 s.
+    limit = differential.EXEC_OUTPUT_LIMIT
+    observation = exec_run(f"head -c {limit + 4 * 2**20} /dev/zero; sleep 30")
+    assert_disagrees(observation, "too-much-output")
+    assert f"more than {limit // 2**20} MiB" in observation.document["status"]["message"]
+
+
+@pytest.mark.parametrize("printed", [
+    '{"status":1,"variables":2,"trace":3}',
+    '{"status":"ok","variables":{},"trace":[1]}',
+    '{"status":"ok","variables":{},"trace":[{"time":0,"call":"MOV","args":3}]}',
+    '{"status":"ok","variables":{},"trace":[{"time":0,"call":"IMG","args":[],"result":5}]}',
+    '{"status":{"code":"ok","line":"x"},"variables":{},"trace":[]}',
+    '{"status":"ok","variables":{"A":[]},"trace":[]}',
+    "[" * 100_000,
+    '"ok"',
+    "\xff",
+])
+def test_output_that_is_no_run_disagrees(tmp_path: Path, printed: str) -> None:
+    # Right keys, wrong types were an internal error of `rl1c fuzz` (exit 3).
+    output = tmp_path / "output"
+    output.write_bytes(printed.encode("latin-1"))
+    observation = exec_run(f"cat {shlex.quote(str(output))}")
+    assert_disagrees(observation, "no-run")
+
+
+def test_a_number_too_long_for_python_is_read_as_any_wrong_value(tmp_path: Path) -> None:
+    # Python refuses to convert more than 4,300 digits: an internal error.
+    output = tmp_path / "output"
+    output.write_text('{"status":"ok","variables":{"A":' + "7" * 5000 + '},"trace":[]}',
+                      encoding="ascii")
+    observation = exec_run(f"cat {shlex.quote(str(output))}")
+    assert_disagrees(observation, "ok")
+
+
+_json = st.recursive(st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False)
+                     | st.text(),
+                     lambda inner: st.lists(inner, max_size=4)
+                     | st.dictionaries(st.text(max_size=8), inner, max_size=4), max_leaves=20)
+_runs = st.fixed_dictionaries({"status": st.just("ok") | _json, "variables": _json,
+                               "trace": st.lists(_json | st.fixed_dictionaries(
+                                   {"time": _json, "call": _json, "args": _json}), max_size=3)})
+
+
+@given(_json | _runs)
+def test_whatever_an_engine_prints_is_a_run_or_no_run_and_compares(printed: object) -> None:
+    document = printed_run(json.dumps(printed).encode(), b"")
+    observation = Observation(document)
+    reference = Observation({"status": "ok", "variables": {"A": 1}, "trace": []})
+    assert document == printed or observation.ending() == {"code": "no-run", "line": None}
+    differences(reference, observation)
+    differences(observation, reference)
+
+
+def test_a_timed_out_engine_leaves_no_process_behind(tmp_path: Path,
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    # Only its shell was killed: its children ran on, orphaned.
+    monkeypatch.setattr(differential, "EXEC_TIMEOUT", 1.0)
+    pid_file = tmp_path / "pid"
+    observation = exec_run(f"sleep 300 & echo $! > {pid_file}; sleep 300")
+    pid = int(pid_file.read_text(encoding="ascii"))
+    try:
+        assert_disagrees(observation, "timeout")
+        stat_file = Path(f"/proc/{pid}/stat")
+        assert not stat_file.exists() or stat_file.read_text().split()[2] == "Z"
+    finally:
+        if Path(f"/proc/{pid}").exists():
+            os.kill(pid, 9)
+
+
+def test_a_quoted_placeholder_never_runs_the_folder_name(tmp_path: Path) -> None:
+    # shlex-quoted paths are literal bare, but inside double quotes the quote is a
+    # character and a `$(...)` in the temporary folder's name ran.
+    hostile = tmp_path / "tmp $(touch ran)"
+    hostile.mkdir()
+    done = subprocess.run([str(Path(sys.executable).with_name("rl1c")), "fuzz", "--engine",
+                           "ast", "--engine", 'exec:cat "{ilc}" > /dev/null', "--count", "2",
+                           "--out", str(tmp_path / "out")], capture_output=True, text=True,
+                          env={**os.environ, "TMPDIR": str(hostile)}, cwd=tmp_path,
+                          check=False)
+    assert not (tmp_path / "ran").exists()
+    assert done.returncode == 2, done.stderr
+    assert "set TMPDIR to a folder" in done.stderr and "Traceback" not in done.stderr
+
+
+# --out: a folder of its own for each finding ----------------------------------------------
+
+NO_RUN = ("--engine", "ast", "--engine", "exec:echo not json", "--count", "3", "--seed", "4")
+
+
+@pytest.fixture
+def quick_shrinking(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 20)
+
+
+@pytest.mark.usefixtures("quick_shrinking")
+@pytest.mark.parametrize("there", ["a file", "a read-only file", "a link out", "a FIFO"])
+def test_what_is_in_out_is_never_replaced_followed_or_written_into(tmp_path: Path,
+                                                                   there: str) -> None:
+    out, outside = tmp_path / "out", tmp_path / "outside.rob"
+    out.mkdir()
+    outside.write_text("mine\n", encoding="utf-8")
+    existing = out / "program.rob"
+    reader = None
+    match there:
+        case "a file" | "a read-only file":
+            existing.write_text("mine\n", encoding="utf-8")
+            if there == "a read-only file":
+                existing.chmod(0o444)
+        case "a link out":
+            existing.symlink_to(outside)
+        case "a FIFO":  # held open for reading, so that a write would not block
+            os.mkfifo(existing)
+            reader = os.open(existing, os.O_RDONLY | os.O_NONBLOCK)
+    result = rl1c("fuzz", *NO_RUN, "--out", out)
+    assert result.exit_code == 1, result.output
+    assert outside.read_text(encoding="utf-8") == "mine\n"
+    if reader is not None:
+        assert stat.S_ISFIFO(existing.lstat().st_mode)
+        assert os.read(reader, 4096) == b""  # no writer has written into it
+        os.close(reader)
+    elif there != "a link out":
+        assert existing.read_text(encoding="utf-8") == "mine\n"
+    program = (out / "finding-1" / "program.rob").read_text(encoding="utf-8")
+    assert all(line in result.stdout for line in split_lines(program))
+    assert f"reproducer: {out / 'finding-1'} " in result.stdout
+
+
+@pytest.mark.usefixtures("quick_shrinking")
+def test_each_finding_gets_a_folder_of_its_own(tmp_path: Path) -> None:
+    out = tmp_path / "new" / "out"
+    for _ in range(2):
+        assert rl1c("fuzz", *NO_RUN, "--out", out).exit_code == 1
+    assert sorted(path.name for path in out.iterdir()) == ["finding-1", "finding-2"]
+    assert all((out / name / "replay.sh").is_file() for name in ("finding-1", "finding-2"))
+
+
+@pytest.mark.parametrize("under", ["", "sub"])
+def test_an_out_that_is_a_file_is_refused_before_the_campaign(tmp_path: Path,
+                                                             under: str) -> None:
+    # It ended in an internal error after the finding was shrunk, losing it.
+    file = tmp_path / "file"
+    file.write_text("", encoding="utf-8")
+    result = rl1c("fuzz", *NO_RUN, "--out", file / under if under else file)
+    assert result.exit_code == 2
+    assert "argument --out" in result.stderr and "is a file, not a folder" in result.stderr
+    assert result.stdout == ""
+
+
+@pytest.mark.usefixtures("quick_shrinking")
+def test_a_reproducer_that_cannot_be_written_leaves_the_finding_printed(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    def full_disk(*args: object, **kwargs: object) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(fuzz, "write_atomically", full_disk)
+    result = rl1c("fuzz", *NO_RUN, "--out", tmp_path / "out")
+    assert result.exit_code == 1
+    assert "the smallest program found:" in result.stdout
+    assert "cannot write the reproducer under" in result.stderr
+    assert "No space left on device" in result.stderr and "Traceback" not in result.output
+
+
+# Hypothesis, an optional part of rl1 -------------------------------------------------------
+
+WITHOUT_HYPOTHESIS = """
+import sys
+
+class Hidden:
+    def find_spec(self, name, path=None, target=None):
+        if name.partition(".")[0] == "hypothesis":
+            raise ModuleNotFoundError(f"No module named {name!r}", name=name)
+
+sys.meta_path.insert(0, Hidden())
+"""
+
+
+def without_hypothesis(code: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-c", WITHOUT_HYPOTHESIS + code],
+                          capture_output=True, text=True, check=False)
+
+
+def test_rl1c_fuzz_without_hypothesis_says_what_to_install() -> None:
+    done = without_hypothesis("from rl1.compiler.cli.main import rl1c\n"
+                              "sys.argv = ['rl1c', 'fuzz', '--count', '1']\nrl1c()")
+    assert done.returncode == 2
+    assert "pip install 'rl1[fuzz]'" in done.stderr and "Traceback" not in done.stderr
+
+
+def test_the_strategies_without_hypothesis_say_what_to_install() -> None:
+    done = without_hypothesis("import rl1.compiler.strategies")
+    assert done.returncode == 1
+    assert "rl1.compiler.strategies generates programs with Hypothesis" in done.stderr
+    assert "pip install 'rl1[fuzz]'" in done.stderr
