@@ -7,7 +7,7 @@ Schema (spec/schemas/). This module reads a file's bytes into data (`read_docume
 one bounded reader of numbers: UTF-8 with or without a byte order mark, integers of at
 most `MAX_DIGITS` digits) and converts the data to a schema (`convert`). Every failure is
 a ConfigError naming the file, the line, the key path and what to write:
-`w.toml:27: vehicle.tread: 5e-324 is outside 1..1000; write one within it`.
+`w.toml:27: vehicle.tread: 5e-324 is outside 10..1000; write one within it`.
 
 msgspec's errors give a key path but no line, and neither tomllib nor json gives
 positions: `config_lines.py` finds the line from the key path in one linear pass.
@@ -18,6 +18,7 @@ from __future__ import annotations
 import json
 import math
 import re
+import sys
 import tomllib
 import types
 from collections.abc import Mapping
@@ -34,11 +35,11 @@ from .language import BUILTINS
 T = TypeVar("T")
 Syntax = Literal["toml", "json"]
 
-MAX_DIGITS = 4300
-"""The most digits of an integer in any configuration file: Python's own limit on
-converting decimal text (sys.int_info.default_max_str_digits), which the TOML and JSON
-readers hit past it. No value of these files is near that long; the range checks refuse
-the long ones that remain, quoting only a few digits."""
+MAX_DIGITS = sys.int_info.default_max_str_digits
+"""The most digits of an integer in any configuration file (4,300): Python's own limit on
+converting decimal text, which tomllib meets past it, and the JSON reader's hook
+enforces. No value of these files is near that long; the range checks refuse the long
+ones that remain, quoting only a few digits."""
 
 _EXCERPT = 40  # characters of a key or string quoted in a message
 
@@ -100,7 +101,7 @@ def read_document(data: bytes, name: str, syntax: Syntax) -> tuple[Any, str]:
     try:
         if syntax == "toml":
             return tomllib.loads(text), text
-        return json.loads(text, parse_constant=_refuse_constant), text
+        return json.loads(text, parse_int=_bounded_int, parse_constant=_refuse_constant), text
     except tomllib.TOMLDecodeError as error:
         raise ConfigError(name, None, "", f"invalid TOML: {error}") from None
     except json.JSONDecodeError as error:
@@ -109,12 +110,20 @@ def read_document(data: bytes, name: str, syntax: Syntax) -> tuple[Any, str]:
     except RecursionError:
         raise ConfigError(name, None, "", f"invalid {what}: arrays or tables nested too "
                           "deeply to read") from None
-    except ValueError:  # an integer longer than Python converts
+    except ValueError as error:  # an integer longer than MAX_DIGITS digits
         found = first_long_number(text, syntax, MAX_DIGITS)
-        line, path = found if found is not None else (None, ())
+        if found is None:
+            raise ConfigError(name, None, "", f"invalid {what}: {error}") from None
+        line, path = found
         raise ConfigError(name, line, describe_path(path), "a number of more than "
                           f"{MAX_DIGITS} digits; no value here is near that "
                           "long") from None
+
+
+def _bounded_int(digits: str) -> int:
+    if len(digits.lstrip("-")) > MAX_DIGITS:
+        raise ValueError(digits[:20])
+    return int(digits)
 
 
 def _refuse_constant(constant: str) -> float:
@@ -181,10 +190,14 @@ def convert(document: object, schema: type[T], name: str, text: str,
     if what.startswith(_MISSING):
         detail = _missing(kind, path, value, syntax)
     elif what.startswith(_UNKNOWN):
-        detail = _unknown(kind, syntax)
-        path = (*path, what[len(_UNKNOWN):-1])
+        known = _keys(kind)
+        unknown = (next((key for key in value if key not in known), None)
+                   if isinstance(value, Mapping) else None)
+        path = (*path, what[len(_UNKNOWN):-1] if unknown is None else unknown)
+        detail = "unknown key; expected one of " + ", ".join(
+            json.dumps(key) if syntax == "json" else key for key in known)
     elif at is not None and at.group(1) == "key" and isinstance(value, Mapping):
-        path = (*path, next(k for k, v in value.items() if not _valid({k: v}, kind)))
+        path = (*path, _first_failing(value, kind))
         key_kind = get_args(_strip(kind))[0]
         detail = f"expected {expected(mi.type_info(key_kind), syntax)}"
     else:
@@ -204,7 +217,7 @@ def _path(text: str, document: object, schema: Any) -> tuple[KeyPath, Any]:
         if field is not None:
             part = field
         elif index == "..." and isinstance(value, Mapping):
-            part = next(k for k, v in value.items() if not _valid({k: v}, kind))
+            part = _first_failing(value, kind)
         else:
             part = int(index)
         path.append(part)
@@ -212,27 +225,26 @@ def _path(text: str, document: object, schema: Any) -> tuple[KeyPath, Any]:
     return tuple(path), kind
 
 
-def _valid(value: object, kind: Any) -> bool:
-    try:
-        msgspec.convert(value, kind)
-    except msgspec.ValidationError:
-        return False
-    return True
+def _first_failing(mapping: Mapping[str, object], kind: Any) -> str:
+    """The first key of `mapping` whose entry alone is not a valid `kind`."""
+    for key, value in mapping.items():
+        try:
+            msgspec.convert({key: value}, kind)
+        except msgspec.ValidationError:
+            return key
+    return "..."  # every entry is valid alone: msgspec's own placeholder
 
 
 def _strip(kind: Any) -> Any:
     """`kind` without Annotated and without None in a union."""
     while True:
-        origin = get_origin(kind)
-        if origin is Annotated:
+        if get_origin(kind) is Annotated:
             kind = get_args(kind)[0]
-        elif origin in (Union, types.UnionType):
-            rest = [arg for arg in get_args(kind) if arg is not type(None)]
-            if len(rest) != 1:
-                return kind
-            kind = rest[0]
-        else:
+            continue
+        bare = _without_none(kind)
+        if bare is kind:
             return kind
+        kind = bare
 
 
 def _without_none(kind: Any) -> Any:
@@ -291,11 +303,9 @@ def _missing(kind: Any, path: KeyPath, value: object, syntax: Syntax) -> str:
     return "missing " + ", ".join(f"`{key}`" for key in keys) + f"; write `{keys[0]} = ...`"
 
 
-def _unknown(kind: Any, syntax: Syntax) -> str:
-    kind = _strip(kind)
-    names = [field.encode_name for field in msgspec.structs.fields(kind)]
-    quote = '"{}"' if syntax == "json" else "{}"
-    return "unknown key; expected one of " + ", ".join(quote.format(n) for n in names)
+def _keys(kind: Any) -> list[str]:
+    """The keys of the table type `kind`, as the file writes them."""
+    return [field.encode_name for field in msgspec.structs.fields(_strip(kind))]
 
 
 def _mismatch(kind: Any, value: object, syntax: Syntax) -> str:
