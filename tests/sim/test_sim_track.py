@@ -1,8 +1,9 @@
 """The record of a run stays bounded whatever the world asks for (spec/simulator.md, "The
 record of a run"): the track is decimated to a fixed number of points per second of
 simulated time and thinned past its cap, the recent poses of the sensor delay answer as
-the whole record would, and a flood of events is counted past its cap. What the pictures
-and the JSON show exactly (the start, the end, the events) stays exact."""
+the whole record would, a flood of events is counted past its cap, and a replay page
+lists a bounded number of calls. What the pictures and the JSON show exactly (the start,
+the end, the events) stays exact."""
 
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ from support.worlds import open_floor
 
 from rl1.vm.sim.device import SimDevice
 from rl1.vm.sim.motion import Pose
+from rl1.vm.sim.render import REPLAY_CALLS, html
 from rl1.vm.sim.simulator import MAX_EVENTS, Simulator
 from rl1.vm.sim.track import MAX_TRACK_POINTS, POINTS_PER_SECOND, History, Track
 
@@ -133,3 +135,15 @@ def test_the_default_step_keeps_every_point_of_a_short_run() -> None:
     device.wait(20)  # 40 steps of 0.05 s, each a tick of the tracing timer
     times = [time for time, _ in device.sim.track]
     assert len(times) == 41 and times[-1] == device.sim.time
+
+
+def test_a_replay_page_lists_the_first_and_last_calls_of_a_long_run() -> None:
+    world = open_floor()
+    calls = [(number / 1000, f"LMP {number}") for number in range(25_000)]
+    page = html(world, [(0.0, _pose(0))], [], calls)
+    listed = json.loads(page.split("const run = ", 1)[1].split(";\n", 1)[0])["calls"]
+    half = REPLAY_CALLS // 2
+    assert len(listed) == REPLAY_CALLS + 1
+    assert [text for _, text in listed[:half]] == [text for _, text in calls[:half]]
+    assert [text for _, text in listed[half + 1:]] == [text for _, text in calls[-half:]]
+    assert listed[half] == [calls[half][0], f"... {25_000 - REPLAY_CALLS:,} calls left out ..."]

@@ -15,6 +15,9 @@ from .simulator import Event
 from .world import World
 
 OUTLINE_EVERY = 40.0  # cm of travel (or, turning, its equivalent) between two outlines
+REPLAY_CALLS = 10_000
+"""The calls a replay page lists, at most: the first and the last half of them, and how
+many were left out between (a loop of calls can make millions, 16 bytes each)."""
 _COLOURS = {"lost": "#e67e00", "handler": "#8e24aa", "found": "#2a9d2a", "fault": "#d11",
             "end": "#1565c0"}
 
@@ -97,6 +100,11 @@ def html(world: World, track: Sequence[tuple[float, Pose]], events: Sequence[Eve
          calls: Sequence[tuple[float, str]], title: str = "") -> str:
     """A page that replays the run: the top view, the vehicle moving along its track,
     the calls as they are made. Everything is inline: it opens offline."""
+    if len(calls) > REPLAY_CALLS:
+        half = REPLAY_CALLS // 2
+        left_out = len(calls) - 2 * half
+        calls = [*calls[:half], (calls[half][0], f"... {left_out:,} calls left out ..."),
+                 *calls[len(calls) - half:]]
     data = json.dumps({
         "track": [[round(t, 3), round(p.x, 2), round(p.y, 2), round(p.heading, 4)]
                   for t, p in track],
