@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import json
 import tempfile
 from pathlib import Path
 
@@ -19,6 +20,7 @@ from rl1.vm.sim.world import (
     Vehicle,
     WorldError,
     decode_world,
+    parse_world,
 )
 
 SAMPLE_WORLD = Path(__file__).resolve().parents[2] / "examples" / "sample.world.toml"
@@ -243,3 +245,26 @@ def test_any_world_that_loads_simulates_without_an_internal_error(data: bytes) -
     decode_world(data, "w.toml")  # it loads
     with tempfile.TemporaryDirectory() as folder:
         assert world_attack(data, Path(folder)) == []
+
+
+_WORLD_KEYS = ["floor", "start", "vehicle", "lines", "marks", "stands", "walls", "scenes",
+               "ports", "fuzzy", "noise", "limits", "size", "x", "y", "facing", "points",
+               "name", "number", "sees", "window", "tread", "time", "3", "999", "s", "IMG"]
+_documents = st.recursive(
+    st.none() | st.booleans() | st.integers(-10**6, 10**25) | st.floats()
+    | st.text(max_size=4),
+    lambda children: st.lists(children, max_size=4)
+    | st.dictionaries(st.sampled_from(_WORLD_KEYS), children, max_size=5),
+    max_leaves=25,
+)
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.dictionaries(st.sampled_from(_WORLD_KEYS), _documents, max_size=6))
+def test_any_document_is_a_world_or_a_world_error_naming_the_file(
+        document: dict[str, object]) -> None:
+    text = json.dumps(document)
+    try:
+        parse_world(document, text, "w.toml")
+    except WorldError as error:
+        assert str(error).startswith("w.toml")
