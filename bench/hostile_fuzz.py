@@ -1,7 +1,7 @@
 """A fuzzing campaign against every rl1c command: the attacks of the test suite's
-bounded run (tests/support/hostile.py), and hostile project files (rl1.toml) under
-`rl1c check`, for as long as asked. Prints how many inputs ran, how many found a
-problem, and the first few problems.
+bounded run (tests/support/hostile.py, the C engine's build cache among them), and
+hostile project files (rl1.toml) under `rl1c check`, for as long as asked. Prints how
+many inputs ran, how many found a problem, and the first few problems.
 
     .venv/bin/python bench/hostile_fuzz.py --minutes 10
 """
@@ -28,7 +28,9 @@ from support.cli import rl1c  # noqa: E402  (tests/ is put on the path just abov
 from support.hostile import (  # noqa: E402
     _mutated,
     _problems,
+    cache_attack,
     hostile_ilc_files,
+    hostile_libraries,
     hostile_sources,
     hostile_worlds,
     ilc_attack,
@@ -98,15 +100,16 @@ def project_attack(data: bytes, folder: Path) -> list[str]:
 
 
 def campaign(name: str, inputs: st.SearchStrategy[bytes], attack: Attack,
-             seconds: float) -> None:
+             seconds: float, batch_size: int = 100) -> None:
     """Runs `attack` on inputs drawn from `inputs` until `seconds` have passed, in
-    batches of 100, each with a seed of its own so that every batch draws afresh."""
+    batches of `batch_size`, each with a seed of its own so that every batch draws
+    afresh."""
     ran, failed, problems = 0, 0, []
     deadline = time.monotonic() + seconds
     batch = 0
     while time.monotonic() < deadline:
         @seed(batch)
-        @settings(max_examples=100, deadline=None, database=None,
+        @settings(max_examples=batch_size, deadline=None, database=None,
                   suppress_health_check=list(HealthCheck))
         @given(data=inputs)
         def run(data: bytes) -> None:
@@ -132,12 +135,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--minutes", type=float, default=1.0)
     options = parser.parse_args()
-    quarter = options.minutes * 15
-    campaign("sources (check, fmt, compile, run)", hostile_sources(), source_attack, quarter)
-    campaign(".ilc files (run, dis, asm)", hostile_ilc_files(), ilc_attack, quarter)
-    campaign("world files (sim)", hostile_worlds(), world_attack, quarter)
+    fifth = options.minutes * 12
+    campaign("sources (check, fmt, compile, run)", hostile_sources(), source_attack, fifth)
+    campaign(".ilc files (run, dis, asm)", hostile_ilc_files(), ilc_attack, fifth)
+    campaign("world files (sim)", hostile_worlds(), world_attack, fifth)
     campaign("project files (rl1.toml, check)", hostile_project_files(), project_attack,
-             quarter)
+             fifth)
+    campaign("the C engine's build cache (run --engine c)", hostile_libraries(),
+             cache_attack, fifth, batch_size=5)  # a build, 2-3 s, each
 
 
 if __name__ == "__main__":

@@ -15,7 +15,9 @@ import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
 from support import SAMPLE, SAMPLE_SENSORS
+from support.hostile import cache_attack, hostile_libraries
 
 from rl1.vm import native
 
@@ -207,3 +209,10 @@ def test_a_library_for_another_machine_is_a_clear_error(tmp_path: Path) -> None:
     assert done.returncode == 2, done.stderr
     assert "-m32" in done.stderr or "set CC to a compiler for this one" in done.stderr
     assert "Traceback" not in done.stderr
+
+
+@settings(max_examples=6, deadline=None, suppress_health_check=list(HealthCheck))
+@given(data=hostile_libraries())
+def test_any_damage_to_the_cached_library_is_repaired(data: bytes, tmp_path: Path) -> None:
+    # bench/hostile_fuzz.py runs the same attack for as long as asked.
+    assert cache_attack(data, tmp_path) == []

@@ -5,22 +5,32 @@ bench/hostile_fuzz.py (a campaign as long as asked). `source_attack`, `ilc_attac
 `world_attack` run the commands in-process on one input and return the problems found:
 an internal error, an exit status the command does not document, output written by a
 command that failed, a traceback on any stream; and for world files, a bad world not
-refused with status 2 and a message naming the file.
+refused with status 2 and a message naming the file. `cache_attack` damages the C
+engine's build cache and runs `rl1c run --engine c` from it, in a process of its own.
 """
 
 from __future__ import annotations
 
+import atexit
+import functools
+import hashlib
 import json
+import os
 import re
+import shutil
+import subprocess
+import sys
+import tempfile
 from pathlib import Path
 
 from hypothesis import strategies as st
 
 from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.strategies import programs
+from rl1.vm import native
 from rl1.vm.sim.world import WorldError, decode_world
 
-from . import EXAMPLES, ROOT
+from . import EXAMPLES, ROOT, SAMPLE, SAMPLE_SENSORS
 from .cli import Result, rl1c
 from .ilc import with_crc
 
@@ -198,4 +208,62 @@ def world_attack(data: bytes, folder: Path) -> list[str]:
         if result.exit_code != 2 or not result.stderr.startswith(said):
             found.append(f"sim: a bad world gave status {result.exit_code}: "
                          f"{result.output_bytes[-300:]!r}")
+    return found
+
+
+# The C engine's build cache --------------------------------------------------------------
+
+
+@functools.cache
+def _built_cache() -> tuple[Path, bytes, str]:
+    """A cache folder with the C VM built in it, the library's bytes, and what
+    `rl1c run --engine c` prints from it (the first call builds: seconds)."""
+    cache = Path(tempfile.mkdtemp(prefix="rl1-hostile-cache-"))
+    atexit.register(shutil.rmtree, cache, ignore_errors=True)
+    library = native.library(cache / "rl1")
+    done = _run_engine_c(cache)
+    assert done.returncode == 0 and "rl1: warning" not in done.stderr, done.stderr
+    return cache, library.read_bytes(), done.stdout
+
+
+def _run_engine_c(cache: Path) -> subprocess.CompletedProcess[str]:
+    rl1c_path = Path(sys.executable).with_name("rl1c")
+    return subprocess.run([str(rl1c_path), "run", str(SAMPLE), "--sensors",
+                           str(SAMPLE_SENSORS), "--engine", "c", "--format", "json"],
+                          capture_output=True, text=True, check=False, timeout=600,
+                          env={**os.environ, "XDG_CACHE_HOME": str(cache)})
+
+
+@st.composite
+def hostile_libraries(draw: st.DrawFn) -> bytes:
+    """Bytes for the cached library in place of the one built: the built one mutated
+    (truncated, flipped, cut), arbitrary bytes, nothing."""
+    kind = draw(st.sampled_from(["mutated", "mutated", "bytes", "empty"]))
+    if kind == "bytes":
+        return draw(st.binary(max_size=4096))
+    return b"" if kind == "empty" else _mutated(_built_cache()[1], draw)
+
+
+def cache_attack(data: bytes, folder: Path) -> list[str]:
+    """`rl1c run --engine c` (in a process of its own: a bad library could kill it) from
+    a copy of a built cache whose library now holds `data`: it must print what it
+    printed from the intact cache, with a warning when the library was damaged, and
+    leave an intact library behind."""
+    cache, library_bytes, expected = _built_cache()
+    copy = Path(tempfile.mkdtemp(dir=folder)) / "cache"  # a folder may serve many inputs
+    shutil.copytree(cache, copy)
+    library = next((copy / "rl1").glob("librl1vm-*.so"))
+    library.write_bytes(data)
+    done = _run_engine_c(copy)
+    found = []
+    if done.returncode != 0 or done.stdout != expected:
+        found.append(f"run --engine c from a damaged cache: exit status {done.returncode}: "
+                     f"{done.stderr[-300:]!r}")
+    if "Traceback" in done.stderr or "internal error" in done.stderr:
+        found.append(f"run --engine c: {done.stderr[-300:]!r}")
+    if data != library_bytes and "is damaged or was not built there" not in done.stderr:
+        found.append("run --engine c: no warning of the damaged library")
+    recorded = library.with_name(library.name + native.DIGEST_SUFFIX)
+    if recorded.read_text("ascii").strip() != hashlib.sha256(library.read_bytes()).hexdigest():
+        found.append("run --engine c: the library left in the cache is not intact")
     return found
