@@ -6,12 +6,14 @@ library that crashes the loader would take pytest with it."""
 
 from __future__ import annotations
 
+import hashlib
 import os
 import shlex
 import shutil
 import stat
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -71,7 +73,7 @@ def built_cache(tmp_path: Path) -> tuple[Path, Path]:
 
 def assert_intact(library: Path) -> None:
     recorded = library.with_name(library.name + native.DIGEST_SUFFIX).read_text("ascii")
-    assert recorded.strip() == native.hashlib.sha256(library.read_bytes()).hexdigest()
+    assert recorded.strip() == hashlib.sha256(library.read_bytes()).hexdigest()
 
 
 def test_the_cache_folder_is_made_for_its_owner_alone(tmp_path: Path) -> None:
@@ -145,7 +147,7 @@ def test_no_folder_at_all_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> N
     def no_folder(prefix: str) -> str:
         raise PermissionError(13, "Permission denied")
 
-    monkeypatch.setattr(native.tempfile, "mkdtemp", no_folder)
+    monkeypatch.setattr(tempfile, "mkdtemp", no_folder)
     with pytest.raises(native.BuildError, match=r"no folder to build the C VM in.*TMPDIR"):
         native.library(Path("/dev/null/cache"), warn=lambda message: None)
 
@@ -165,7 +167,7 @@ def test_a_cache_folder_not_the_users_alone_is_not_used(
     if unsafe == "writable by others":
         cache.chmod(0o777)
     else:
-        monkeypatch.setattr(native.os, "getuid", lambda: os.stat(cache).st_uid + 1)
+        monkeypatch.setattr(os, "getuid", lambda: os.stat(cache).st_uid + 1)
     monkeypatch.setattr(native, "_ready", {})
     warnings: list[str] = []
     elsewhere = native.library(cache, warn=warnings.append)
