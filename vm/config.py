@@ -65,6 +65,13 @@ class ConfigError(Exception):
         self.detail = detail
 
 
+def error_at(name: str, text: str, path: KeyPath, detail: str,
+             syntax: Syntax = "toml") -> ConfigError:
+    """The ConfigError of a check that spans keys (a loader's own), at `path` in the
+    file `name` whose text is `text`."""
+    return ConfigError(name, line_of(text, path, syntax), describe_path(path), detail)
+
+
 def excerpt(text: str) -> str:
     """`text`, cut to a short excerpt for a message."""
     return text if len(text) <= _EXCERPT else text[:_EXCERPT] + "..."
@@ -202,7 +209,7 @@ def convert(document: object, schema: type[T], name: str, text: str,
         detail = f"expected {expected(mi.type_info(key_kind), syntax)}"
     else:
         detail = _mismatch(kind, value, syntax)
-    raise ConfigError(name, line_of(text, path, syntax), describe_path(path), detail)
+    raise error_at(name, text, path, detail, syntax)
 
 
 def _path(text: str, document: object, schema: Any) -> tuple[KeyPath, Any]:

@@ -45,11 +45,11 @@ from .config import (
     PortName,
     Syntax,
     convert,
-    describe_path,
+    error_at,
     found,
     read_document,
 )
-from .config_lines import KeyPath, line_of
+from .config_lines import KeyPath
 from .device import FuzzyReading, ImageReading, MotionCommand, Odometry, form_name
 from .language import BUILTINS
 
@@ -234,8 +234,7 @@ class _Script:
         self.syntax = syntax
 
     def fail(self, path: KeyPath, detail: str) -> ConfigError:
-        return ConfigError(self.name, line_of(self.text, path, self.syntax),
-                           describe_path(path), detail)
+        return error_at(self.name, self.text, path, detail, self.syntax)
 
     def build(self) -> Script:
         file = self.file

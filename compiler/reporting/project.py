@@ -53,8 +53,7 @@ def find_project_file(folder: str) -> str | None:
 def load_project_file(path: str) -> Selection:
     """The selection an rl1.toml sets (what it leaves out stays unset)."""
     # Only when a project has the file: the validation layer loads msgspec.
-    from rl1.vm.config import ConfigError, convert, describe_path, read_document
-    from rl1.vm.config_lines import line_of
+    from rl1.vm.config import ConfigError, convert, error_at, read_document
 
     from .project_schema import ProjectFile
 
@@ -71,9 +70,7 @@ def load_project_file(path: str) -> Selection:
             try:
                 codes[key] = parse_codes(value) if value is not None else None
             except SelectionError as error:
-                codes_at = (TABLE, key)
-                raise ConfigError(path, line_of(text, codes_at, "toml"),
-                                  describe_path(codes_at), str(error)) from None
+                raise error_at(path, text, (TABLE, key), str(error)) from None
     except ConfigError as error:
         at = f"line {error.line}: " if error.line is not None else ""
         where = f"{error.where}: " if error.where else ""

@@ -27,10 +27,10 @@ from ..config import (
     Int16,
     PortName,
     convert,
-    describe_path,
+    error_at,
     read_document,
 )
-from ..config_lines import KeyPath, line_of
+from ..config_lines import KeyPath
 from .geometry import Point, rectangle
 
 
@@ -295,8 +295,7 @@ class _World:
         self.points = 0
 
     def fail(self, path: KeyPath, detail: str) -> ConfigError:
-        return ConfigError(self.name, line_of(self.text, path, "toml"), describe_path(path),
-                           detail)
+        return error_at(self.name, self.text, path, detail)
 
     def count(self, points: int, path: KeyPath) -> None:
         """Count `points` against MAX_POINTS for the whole world."""
