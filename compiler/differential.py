@@ -229,8 +229,10 @@ def _run_shell(command: str) -> _Ran:
             except subprocess.TimeoutExpired:
                 ending = "timeout"
     finally:
-        with contextlib.suppress(ProcessLookupError):  # all of them ended already
-            os.killpg(process.pid, signal.SIGKILL)  # before wait(): the group id is kept
+        # Before wait(), so that the group's id is still the command's. Gone: they all
+        # ended already; not permitted: what is left runs as another user (setuid).
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(process.pid, signal.SIGKILL)
         process.wait()
         process.stdout.close()
         process.stderr.close()
