@@ -127,13 +127,11 @@ def too_large_notice(document: Document) -> types.Diagnostic:
                   "Check it with `rl1c check FILE`.")
 
 
-def over_limits_notice(held: tuple[int, int], limits: tuple[int, int]) -> types.Diagnostic:
-    """Why a document opened is not held: the documents and characters held, and the
-    most the server holds of each."""
-    return notice(f"rl1-lsp holds at most {limits[0]:,} open documents of {limits[1]:,} "
-                  f"characters in all, and {held[0]:,} of {held[1]:,} are open, so "
-                  "it does not analyse this one. Close some documents and reopen this "
-                  "one, or check it with `rl1c check FILE`.")
+def over_limits_notice(limit: str) -> types.Diagnostic:
+    """Why an open document is not held: `limit` says which of the server's."""
+    return notice(f"rl1-lsp holds at most {limit} for one client, and this document "
+                  "would go past that, so it is not analysed. Close some documents and "
+                  "reopen this one, or check it with `rl1c check FILE`.")
 
 
 def project_notice(problem: str) -> types.Diagnostic:

@@ -14,7 +14,7 @@ import logging
 import sys
 from collections.abc import Callable
 from importlib.metadata import version
-from typing import Any
+from typing import Any, NamedTuple
 
 import click
 from lsprotocol import types
@@ -47,9 +47,29 @@ NAME = "rl1-lsp"
 
 MAX_OPEN_DOCUMENTS = 500
 MAX_OPEN_CHARACTERS = 8 * MAX_ANALYSED_CHARACTERS
-"""What one session holds: a document past either limit is turned away with a notice.
-About 10 KB a small document, and some 100 bytes a character of an analysed one
-(bench/lsp_burst.py's figures), so that a session stays within a few hundred MB."""
+MAX_OPEN_LINES = 1_000_000
+MAX_ANALYSED_IN_ALL = MAX_ANALYSED_CHARACTERS
+"""What one session holds: a document opened, or edited, past one of these limits is
+dropped with a notice saying which. A document too large to analyse is kept in sync as
+its text and some 200 bytes a line; analysis costs about 150 bytes a character
+(bench/lsp_memory.py), so that a session holds at most about 300 MB of analysis and as
+much again of text."""
+
+
+class Weight(NamedTuple):
+    """What documents count against a session's limits."""
+
+    characters: int
+    lines: int
+    analysed: int  # the characters of those not too large to analyse
+
+    @staticmethod
+    def of(document: Document) -> Weight:
+        return Weight(document.size, document.line_count,
+                      0 if document.too_large else document.size)
+
+    def plus(self, other: Weight, sign: int = 1) -> Weight:
+        return Weight(*(mine + sign * theirs for mine, theirs in zip(self, other, strict=True)))
 
 
 class Rl1Protocol(LanguageServerProtocol):
@@ -160,7 +180,7 @@ class Rl1Server(LanguageServer):
         super().__init__(NAME, version("rl1"), protocol_cls=Rl1Protocol,
                          text_document_sync_kind=types.TextDocumentSyncKind.Incremental)
         self.documents: dict[str, Document] = {}
-        self.open_characters = 0  # in all the documents held
+        self.held = Weight(0, 0, 0)  # the documents' in all
         self.columns = Columns(UTF16)
         self.snippets = False  # what the client's completion accepts
         self.markdown = False
@@ -177,35 +197,42 @@ class Rl1Server(LanguageServer):
     def hold(self, document: Document) -> None:
         """Keep an opened document, or, beyond the limits, tell its client why not."""
         self.forget(document.uri)
-        if len(self.documents) >= MAX_OPEN_DOCUMENTS or (
-                self.open_characters + document.size > MAX_OPEN_CHARACTERS):
-            self._turn_away(document)
-            return
         self.documents[document.uri] = document
-        self.open_characters += document.size
-        self.checks.schedule(document)
+        self.held = self.held.plus(Weight.of(document))
+        if not self._turned_away(document):
+            self.checks.schedule(document)
 
-    def changed(self, document: Document, size_before: int) -> None:
-        """A held document was edited: check it, or drop it if it grew past the limit."""
-        self.open_characters += document.size - size_before
-        if self.open_characters > MAX_OPEN_CHARACTERS:
-            self.forget(document.uri)
-            self._turn_away(document)
-            return
-        self.checks.schedule(document)
+    def changed(self, document: Document, before: Weight) -> None:
+        """A held document was edited: check it, or drop it if it grew past the limits."""
+        self.held = self.held.plus(Weight.of(document)).plus(before, -1)
+        if not self._turned_away(document):
+            self.checks.schedule(document)
 
     def forget(self, uri: str) -> None:
         if (document := self.documents.pop(uri, None)) is not None:
-            self.open_characters -= document.size
+            self.held = self.held.plus(Weight.of(document), -1)
         self.token_history.forget(uri)
         self.checks.cancel(uri)
 
-    def _turn_away(self, document: Document) -> None:
-        log.warning("%s is not analysed: over the limits of open documents", document.uri)
+    def _turned_away(self, document: Document) -> bool:
+        """Whether holding `document` (already counted) goes past a limit: then it is
+        dropped, and its client told which limit."""
+        if len(self.documents) > MAX_OPEN_DOCUMENTS:
+            limit = f"{MAX_OPEN_DOCUMENTS:,} open documents"
+        elif self.held.characters > MAX_OPEN_CHARACTERS:
+            limit = f"{MAX_OPEN_CHARACTERS:,} characters in all the documents open"
+        elif self.held.lines > MAX_OPEN_LINES:
+            limit = f"{MAX_OPEN_LINES:,} lines in all the documents open"
+        elif self.held.analysed > MAX_ANALYSED_IN_ALL:
+            limit = f"{MAX_ANALYSED_IN_ALL:,} characters in all the documents it analyses"
+        else:
+            return False
+        log.warning("%s dropped: over the limit of %s", document.uri, limit)
+        self.forget(document.uri)
         self.text_document_publish_diagnostics(types.PublishDiagnosticsParams(
-            uri=document.uri, version=document.version, diagnostics=[checking.over_limits_notice(
-                (len(self.documents), self.open_characters),
-                (MAX_OPEN_DOCUMENTS, MAX_OPEN_CHARACTERS))]))
+            uri=document.uri, version=document.version,
+            diagnostics=[checking.over_limits_notice(limit)]))
+        return True
 
     # The session, as transports.py serves it ------------------------------------------
 
@@ -256,11 +283,11 @@ def create_server() -> Rl1Server:
         if document is None:
             log.warning("change to %s, which is not open: ignored", params.text_document.uri)
             return
-        size_before = document.size
+        before = Weight.of(document)
         for change in params.content_changes:
             document.apply(change, server.columns)
         document.version = params.text_document.version
-        server.changed(document, size_before)
+        server.changed(document, before)
 
     @server.feature(types.TEXT_DOCUMENT_DID_CLOSE)
     def did_close(params: types.DidCloseTextDocumentParams) -> None:

@@ -14,6 +14,7 @@ import pytest
 from raw import INITIALIZE, INITIALIZED, notification
 
 from rl1.lsp import server as server_module
+from rl1.lsp.document import MAX_ANALYSED_LINE
 from rl1.lsp.server import create_server
 
 Message = dict[str, Any]
@@ -70,15 +71,20 @@ async def settle() -> None:
     await asyncio.sleep(0.05)  # the checks scheduled run
 
 
-def turned_away(written: Collected, uri: str) -> bool:
-    return any("holds at most" in d["message"] and "Close some documents" in d["message"]
-               for params in written.published(uri) for d in params["diagnostics"])
+def turned_away(written: Collected, uri: str, limit: str = "") -> bool:
+    """Whether the last diagnostics of `uri` say it is over a limit (naming `limit`)."""
+    published = written.published(uri)
+    return bool(published) and any(
+        "holds at most" in d["message"] and limit in d["message"]
+        and "Close some documents and reopen this one" in d["message"]
+        for d in published[-1]["diagnostics"])
 
 
 @pytest.fixture
 def small_limits(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(server_module, "MAX_OPEN_DOCUMENTS", 3)
     monkeypatch.setattr(server_module, "MAX_OPEN_CHARACTERS", 1000)
+    monkeypatch.setattr(server_module, "MAX_ANALYSED_IN_ALL", 1000)
 
 
 @pytest.mark.usefixtures("small_limits")
@@ -87,8 +93,8 @@ def test_a_document_past_the_count_is_turned_away_until_another_closes() -> None
         for n in range(4):
             send(did_open(f"file:///d{n}.rob", "A=(\n"))
         await settle()
-        assert [turned_away(written, f"file:///d{n}.rob") for n in range(4)] == [
-            False, False, False, True]
+        assert [turned_away(written, f"file:///d{n}.rob", "3 open documents")
+                for n in range(4)] == [False, False, False, True]
         send(did_close("file:///d0.rob"))
         send(did_open("file:///d3.rob", "A=(\n"))
         await settle()
@@ -113,7 +119,36 @@ def test_characters_past_the_limit_turn_away_an_open_and_drop_a_change() -> None
         assert turned_away(written, "file:///big.rob")
         send(did_open("file:///more.rob", "A=1\n" * 60))  # now there is room
         await settle()
-        latest = written.published("file:///more.rob")[-1]["diagnostics"]
-        assert not any("holds at most" in d["message"] for d in latest)
+        assert not turned_away(written, "file:///more.rob")
+
+    run_session(scenario)
+
+
+def test_a_document_too_large_to_analyse_counts_only_its_characters(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(server_module, "MAX_ANALYSED_IN_ALL", 1000)
+    long_line = "A=1;" * (MAX_ANALYSED_LINE // 4 + 1) + "\n"  # kept in sync, not analysed
+
+    async def scenario(send: Callable[[Message], None], written: Collected) -> None:
+        send(did_open("file:///long.rob", long_line))
+        send(did_open("file:///small.rob", "A=1\n" * 200))
+        await settle()
+        assert not turned_away(written, "file:///long.rob")
+        assert not turned_away(written, "file:///small.rob")
+        send(did_open("file:///more.rob", "A=1\n" * 60))
+        await settle()
+        assert turned_away(written, "file:///more.rob",
+                           "1,000 characters in all the documents it analyses")
+
+    run_session(scenario)
+
+
+def test_lines_past_the_limit_turn_a_document_away(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(server_module, "MAX_OPEN_LINES", 100)
+
+    async def scenario(send: Callable[[Message], None], written: Collected) -> None:
+        send(did_open("file:///empty-lines.rob", "\n" * 100))  # 101 lines, as LSP counts
+        await settle()
+        assert turned_away(written, "file:///empty-lines.rob", "100 lines in all")
 
     run_session(scenario)
