@@ -110,7 +110,12 @@ def read_document(data: bytes, name: str, syntax: Syntax) -> tuple[Any, str]:
             return tomllib.loads(text), text
         return json.loads(text, parse_int=_bounded_int, parse_constant=_refuse_constant), text
     except tomllib.TOMLDecodeError as error:
-        raise ConfigError(name, None, "", f"invalid TOML: {error}") from None
+        # tomllib (before Python 3.14) gives the place only in its message.
+        place = _TOML_PLACE.search(str(error))
+        if place is None:
+            raise ConfigError(name, None, "", f"invalid TOML: {error}") from None
+        raise ConfigError(name, int(place["line"]), "", f"invalid TOML: "
+                          f"{str(error)[:place.start()]}(column {place['column']})") from None
     except json.JSONDecodeError as error:
         raise ConfigError(name, error.lineno, "", f"invalid JSON: {error.msg} (column "
                           f"{error.colno})") from None
@@ -125,6 +130,9 @@ def read_document(data: bytes, name: str, syntax: Syntax) -> tuple[Any, str]:
         raise ConfigError(name, line, describe_path(path), "a number of more than "
                           f"{MAX_DIGITS} digits; no value here is near that "
                           "long") from None
+
+
+_TOML_PLACE = re.compile(r"\(at line (?P<line>\d+), column (?P<column>\d+)\)$")
 
 
 def _bounded_int(digits: str) -> int:

@@ -327,7 +327,7 @@ def test_standard_input_takes_the_working_directorys_project_file(
 
 
 @pytest.mark.parametrize("content, says", [
-    ("[check\n", "invalid TOML: "),
+    ("[check\n", "line 1: invalid TOML: "),
     ('[check]\nselct = ["W06"]\n',
      "line 2: check.selct: unknown key; expected one of select, ignore, warnings-as-errors"),
     ('[lint]\nselect = ["W06"]\n', "line 1: lint: unknown key; expected one of check"),

@@ -85,7 +85,8 @@ def test_a_good_world_loads_with_defaults_filled_in() -> None:
     (GOOD + b"\n[[walls]]\npoints = [" + b", ".join(b"[%d, 1]" % i for i in range(10_001)) + b"]\n",
      "w.toml:27: walls[0].points: the world's lines, polygons and stands have more than 10000 "
      "points"),
-    (b"[floor\n", "w.toml: invalid TOML"),
+    (b"[floor\n", "w.toml:1: invalid TOML: Expected ']' at the end of a table declaration "
+     "(column 7)"),
     (b"\xff\xfe", "w.toml: not UTF-8 text"),
 ])
 def test_errors_say_where_and_what(text: bytes, expected: str) -> None:
