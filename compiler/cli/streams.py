@@ -215,22 +215,26 @@ def read_ilc(file: str) -> bytes:
 def refused_ilc(file: str, data: bytes, error: IlcFormatError, help: str) -> Failure:
     """The Failure (exit status 1) of the .ilc file `file` whose bytes `data` the
     verifier refused with `error`; `help` says what to do. A file that does not start
-    as an .ilc file does is said to be source text when it is one, else its first
-    bytes are shown in hex."""
-    from rl1.vm.ilc import MAGIC, Refusal
+    as an .ilc file does is said to be text (RL/I source, when named so) when it is,
+    with what to compile, else its first bytes are shown in hex."""
+    from rl1.vm.ilc import MAGIC
 
     name = STDIN_NAME if file == "-" else file
     detail = f"byte {error.offset}: {error.message}"
-    if error.refusal is Refusal.BAD_MAGIC:
+    if not data:
+        detail = "it is empty"
+    elif not data.startswith(MAGIC):  # refused for that, or as too short to be one
         try:
             decode(data, name)
         except SourceError:
             detail = (f"it does not start with `{MAGIC.decode()}` as an .ilc file does (its "
                       f"first bytes are {data[:len(MAGIC)].hex(' ').upper()})")
         else:
-            detail = "it is RL/I source text, not compiled code"
+            source = file.lower().endswith(SOURCE_SUFFIX)
+            detail = f"it is {'RL/I source ' if source else ''}text, not compiled code"
             output = with_suffix(file, ".ilc") if file != "-" else "FILE.ilc"
-            help = f"compile it first, `rl1c compile {file} -o {output}`, then give {output}"
+            help = (f"{'' if source else 'if it is an RL/I program, '}compile it first, "
+                    f"`rl1c compile {file} -o {output}`, then give {output}")
     return invalid_file(ILC_ROLE, name, detail, help, EXIT_ERRORS)
 
 

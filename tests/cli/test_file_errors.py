@@ -33,7 +33,7 @@ def cases(tmp: Path) -> list[tuple[list[str | Path], int, str]]:
         (["dis", gone / "p.ilc"], 2,
          f"cannot read the intermediate code file `{gone / 'p.ilc'}`"),
         (["dis", bad / "p.ilc"], 1, f"the intermediate code file `{bad / 'p.ilc'}` is not "
-         "valid: byte 0:"),
+         "valid: it is text, not compiled code"),
         (["dis", compiled, "--source", gone / "p.rob"], 2,
          f"cannot read the --source file `{gone / 'p.rob'}`"),
         (["asm", gone / "p.ils"], 2, f"cannot read the .ils file `{gone / 'p.ils'}`"),

@@ -218,6 +218,11 @@ def test_dis_says_a_source_is_source_text_and_what_to_run(tmp_path: Path) -> Non
                                     "not valid: it is RL/I source text, not compiled code\n")
     assert f"`rl1c compile {source} -o {tmp_path / 'p.ilc'}`" in result.stderr
     assert "b'" not in result.stderr and 'b"' not in result.stderr
+    notes = tmp_path / "notes.txt"
+    for data, detail in ((b"hi\n", "it is text, not compiled code"), (b"", "it is empty")):
+        notes.write_bytes(data)  # too short for a header: still named for what it is
+        other = rl1c("dis", notes)
+        assert other.exit_code == 1 and f"is not valid: {detail}\n" in other.stderr
 
 
 def _ilc_naming(tmp_path: Path, source_name: str, source: str | None = None) -> Path:
