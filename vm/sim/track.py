@@ -25,7 +25,8 @@ _ROUNDING = 1e-9  # s: steps of 0.05 s add up to times 0.04999... apart, which a
 
 MAX_HISTORY = 2**16
 """Poses the sensor delay looks back on: thinned by halves past this, which only a delay
-of more than 2**16 steps (3,277 s at the default step) ever needs."""
+of more than 2**16 steps ever needs (a valid world's delay of at most 10 s holds about
+10,000 at its shortest tracing interval)."""
 
 
 class Track:
