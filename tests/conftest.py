@@ -2,9 +2,10 @@
 `make quick` can leave out the tests marked `slow`, `needs_cc`, `needs_node` or
 `needs_browser` (pyproject.toml registers them) and run the rest in under a minute.
 
-A test is marked here by where it is (a folder, a module, or one test of a module), so
-that the test files stay about what they test; a module may also mark itself with
-`pytestmark`. tests/project/test_markers.py checks that every place named here exists.
+Every Hypothesis property is slow; any other test is marked here by where it is (a
+folder, a module, or one test of a module), so that the test files stay about what they
+test, or in its own module (`pytestmark`, or a mark on the test).
+tests/project/test_markers.py checks that every place named here exists.
 """
 
 from __future__ import annotations
@@ -19,6 +20,13 @@ MARKS: dict[str, tuple[str, ...]] = {
     "tests/c/": ("needs_cc", "slow"),
     "tests/backend/test_firmware.py::test_the_c_array_compiles_and_holds_the_ilc_bytes":
         ("needs_cc",),
+    # Slow, besides every Hypothesis property (below): fuzzing campaigns, hostile inputs
+    # in subprocesses, compilations under many hash seeds, searches through generated
+    # programs for each form of the syntax.
+    "tests/cli/test_fuzz_cli.py": ("slow",),
+    "tests/frontend/test_strategies.py": ("slow",),
+    "tests/cli/test_hostile_inputs.py": ("slow",),
+    "tests/backend/test_reproducible.py": ("slow",),
 }
 
 
@@ -31,7 +39,13 @@ def marks_of(nodeid: str) -> tuple[str, ...]:
                  for mark in marks)
 
 
+def is_property(item: pytest.Item) -> bool:
+    """Whether the test is a Hypothesis property, which runs its examples by the hundred
+    (about a tenth of the tests, and most of the time of the fast ones)."""
+    return getattr(getattr(item, "obj", None), "is_hypothesis_test", False) is True
+
+
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
-        for mark in marks_of(item.nodeid):
+        for mark in (*marks_of(item.nodeid), *(("slow",) if is_property(item) else ())):
             item.add_marker(mark)

@@ -1,15 +1,17 @@
-"""The markers `make quick` leaves out: registered in pyproject.toml, applied by path in
-tests/conftest.py to places that exist, and every one of them left out by the Makefile's
-quick target."""
+"""The markers `make quick` leaves out: registered in pyproject.toml, applied in
+tests/conftest.py to every Hypothesis property and by path to places that exist, and
+every one of them left out by the Makefile's quick target."""
 
 from __future__ import annotations
 
 import importlib.util
 import re
 import tomllib
-from types import ModuleType
+from types import ModuleType, SimpleNamespace
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from support import ROOT
 
 PYTEST = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))[
@@ -47,12 +49,27 @@ def test_every_mark_given_is_registered() -> None:
     ("tests/c/test_c_vm.py::test_vector[calls-3]", {"needs_cc", "slow"}),
     ("tests/backend/test_firmware.py::test_the_c_array_compiles_and_holds_the_ilc_bytes[x]",
      {"needs_cc"}),
-    ("tests/backend/test_firmware.py::test_the_c_array_spells_every_byte_in_order", set()),
+    ("tests/backend/test_firmware.py::test_names_c_cannot_take_are_refused", set()),
     ("tests/cli/test_cli_check.py::test_something", set()),
 ])
 def test_a_test_gets_the_marks_of_its_folder_module_and_name(nodeid: str,
                                                              marks: set[str]) -> None:
     assert set(CONFTEST.marks_of(nodeid)) == marks
+
+
+@given(st.integers())
+def _a_property(number: int) -> None:
+    assert number == number
+
+
+def _an_example() -> None:
+    assert 1 + 1 == 2
+
+
+def test_every_property_is_slow_and_an_example_is_not() -> None:
+    assert CONFTEST.is_property(SimpleNamespace(obj=_a_property))
+    assert not CONFTEST.is_property(SimpleNamespace(obj=_an_example))
+    assert not CONFTEST.is_property(SimpleNamespace())  # an item of no function
 
 
 def test_make_quick_leaves_out_every_marker_and_make_test_none() -> None:
