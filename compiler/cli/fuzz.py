@@ -109,19 +109,17 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         click.echo(f"{summary}: all agreed")
         return 0
     finding = outcome.finding
-    try:
-        reproducer = write_reproducer(out_dir, finding, engines, budget)
-    except OSError as error:  # the finding is printed all the same
-        reproducer, failed = None, error
     numbered = "\n".join(f"{number:4} | {line}" for number, line
                          in enumerate(split_lines(finding.case.source), 1))
     click.echo(f"{summary}: the engines disagree (reference: {engines[0].name})\n\n"
                f"the smallest program found:\n{numbered}\n\n"
                + "\n".join(finding.verdict.problems))
-    if reproducer is None:
+    try:
+        reproducer = write_reproducer(out_dir, finding, engines, budget)
+    except OSError as error:  # such as a full disk: the finding is printed above
         raise Failure(f"error: cannot write the reproducer under {out_dir} "
-                      f"({failed.strerror or failed}); the program is above, and the "
-                      "campaign runs again with the same --seed", EXIT_ERRORS)
+                      f"({error.strerror or error}); the program is above, and the "
+                      "campaign runs again with the same --seed", EXIT_ERRORS) from None
     click.echo(f"\nreproducer: {reproducer.folder} (program, sensor script, each engine's "
                f"run); replay: {reproducer.replay}")
     return EXIT_ERRORS
@@ -131,11 +129,11 @@ def _unwritable(folder: str) -> str | None:
     """Why the reproducer of a finding could not be written under `folder` (which need
     not exist yet), or None."""
     path = os.path.abspath(folder)
-    while not os.path.exists(path):
+    while not os.path.lexists(path):
         path = os.path.dirname(path)
-    if not os.path.isdir(path):
-        return "it is a file, not a folder" if path == os.path.abspath(folder) \
-            else f"{path} is a file, not a folder"
+    if not os.path.isdir(path):  # a file, or a link to nothing
+        return "it is not a folder" if path == os.path.abspath(folder) \
+            else f"{path} is not a folder"
     if not os.access(path, os.W_OK | os.X_OK):
         return f"{path} cannot be written to; name a folder of yours"
     return None

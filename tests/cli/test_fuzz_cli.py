@@ -323,15 +323,18 @@ def test_each_finding_gets_a_folder_of_its_own(tmp_path: Path) -> None:
     assert all((out / name / "replay.sh").is_file() for name in ("finding-1", "finding-2"))
 
 
-@pytest.mark.parametrize("under", ["", "sub"])
-def test_an_out_that_is_a_file_is_refused_before_the_campaign(tmp_path: Path,
-                                                             under: str) -> None:
-    # It ended in an internal error after the finding was shrunk, losing it.
+@pytest.mark.parametrize("out", ["a file", "a folder under a file", "a link to nothing"])
+def test_an_out_that_is_no_folder_is_refused_before_the_campaign(tmp_path: Path,
+                                                                 out: str) -> None:
+    # A file ended in an internal error after the finding was shrunk, losing it.
     file = tmp_path / "file"
     file.write_text("", encoding="utf-8")
-    result = rl1c("fuzz", *NO_RUN, "--out", file / under if under else file)
+    (tmp_path / "link").symlink_to(tmp_path / "nothing")
+    named = {"a file": file, "a folder under a file": file / "sub",
+             "a link to nothing": tmp_path / "link"}[out]
+    result = rl1c("fuzz", *NO_RUN, "--out", named)
     assert result.exit_code == 2
-    assert "argument --out" in result.stderr and "is a file, not a folder" in result.stderr
+    assert "argument --out" in result.stderr and "is not a folder" in result.stderr
     assert result.stdout == ""
 
 
