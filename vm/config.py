@@ -263,9 +263,9 @@ def _strip(kind: Any) -> Any:
 
 
 def _without_none(kind: Any) -> Any:
-    """`kind` without None in a union, its constraints kept."""
+    """`kind` without None or UNSET (a key left out) in a union, its constraints kept."""
     if get_origin(kind) in (Union, types.UnionType):
-        rest = [arg for arg in get_args(kind) if arg is not type(None)]
+        rest = [arg for arg in get_args(kind) if arg not in (type(None), msgspec.UnsetType)]
         if len(rest) == 1:
             return rest[0]
     return kind

@@ -33,7 +33,7 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import msgspec
-from msgspec import Meta, Struct
+from msgspec import UNSET, Meta, Struct, UnsetType
 
 from .config import (
     INPUT_PORTS,
@@ -156,11 +156,11 @@ class LossFields(Struct, forbid_unknown_fields=True):
     """A loss of the guidance line: {"time": MS}, {"instruction": N}, or
     {"during": "MOV"|"MVI", "nth": N, "after": MS}."""
 
-    time: Count | None = None
-    instruction: Annotated[int, Meta(ge=0, le=2**31 - 1)] | None = None
-    during: Literal["MOV", "MVI"] | None = None
-    nth: Count | None = None
-    after: Count | None = None
+    time: Count | UnsetType = UNSET
+    instruction: Annotated[int, Meta(ge=0, le=2**31 - 1)] | UnsetType = UNSET
+    during: Literal["MOV", "MVI"] | UnsetType = UNSET
+    nth: Count | UnsetType = UNSET
+    after: Count | UnsetType = UNSET
 
 
 class ScriptFile(Struct, forbid_unknown_fields=True, kw_only=True):
@@ -172,14 +172,14 @@ class ScriptFile(Struct, forbid_unknown_fields=True, kw_only=True):
         name="KYO", default_factory=list)
     camera: Annotated[list[CameraPosition], _NON_EMPTY] = msgspec.field(
         name="CAM R", default_factory=list)
-    ultrasonic_a: Annotated[list[Int16], _NON_EMPTY] | None = msgspec.field(
-        name="ULT A", default=None)
-    ultrasonic_b: Annotated[list[Int16], _NON_EMPTY] | None = msgspec.field(
-        name="ULT B", default=None)
-    ultrasonic_c: Annotated[list[Int16], _NON_EMPTY] | None = msgspec.field(
-        name="ULT C", default=None)
-    ultrasonic_d: Annotated[list[Int16], _NON_EMPTY] | None = msgspec.field(
-        name="ULT D", default=None)
+    ultrasonic_a: Annotated[list[Int16], _NON_EMPTY] = msgspec.field(
+        name="ULT A", default_factory=list)
+    ultrasonic_b: Annotated[list[Int16], _NON_EMPTY] = msgspec.field(
+        name="ULT B", default_factory=list)
+    ultrasonic_c: Annotated[list[Int16], _NON_EMPTY] = msgspec.field(
+        name="ULT C", default_factory=list)
+    ultrasonic_d: Annotated[list[Int16], _NON_EMPTY] = msgspec.field(
+        name="ULT D", default_factory=list)
     ports: Annotated[dict[PortName, Annotated[list[Byte], _NON_EMPTY]], Meta(extra={
         "expected": 'an object from port number to a list of readings, e.g. {"3": [1, 0]}'})
     ] = msgspec.field(name="INP", default_factory=dict)
@@ -240,7 +240,7 @@ class _Script:
         file = self.file
         ultrasonic = {letter: tuple(readings) for letter, readings in (
             ("A", file.ultrasonic_a), ("B", file.ultrasonic_b), ("C", file.ultrasonic_c),
-            ("D", file.ultrasonic_d)) if readings is not None}
+            ("D", file.ultrasonic_d)) if readings}  # a list given is never empty
         return Script(
             images=tuple(ImageReading(i.area, i.x, i.y, i.z) for i in file.images),
             odometry=tuple(Odometry(o.centre, o.right, o.left) for o in file.odometry),
@@ -269,14 +269,15 @@ class _Script:
 
     def loss(self, loss: LossFields, index: int) -> LossAt | LossDuring | LossAfter:
         given = {key for key in ("time", "instruction", "during", "nth", "after")
-                 if getattr(loss, key) is not None}
-        if given == {"time"} and loss.time is not None:
+                 if getattr(loss, key) is not UNSET}
+        if given == {"time"} and not isinstance(loss.time, UnsetType):
             return LossAt(loss.time)
-        if given == {"instruction"} and loss.instruction is not None:
+        if given == {"instruction"} and not isinstance(loss.instruction, UnsetType):
             return LossAfter(loss.instruction)
-        if given in ({"during", "nth"}, {"during", "nth", "after"}) and (
-                loss.during is not None and loss.nth is not None):
-            return LossDuring(loss.during, loss.nth, loss.after or 1)
+        if given in ({"during", "nth"}, {"during", "nth", "after"}) and not isinstance(
+                loss.during, UnsetType) and not isinstance(loss.nth, UnsetType):
+            after = 1 if isinstance(loss.after, UnsetType) else loss.after
+            return LossDuring(loss.during, loss.nth, after)
         keys = ", ".join(f'"{key}"' for key in sorted(given)) or "no keys"
         raise self.fail(("line_lost", index), 'expected {"time": MS}, {"instruction": N} '
                         'or {"during": "MOV"|"MVI", "nth": N, "after": MS}, found ' + keys)

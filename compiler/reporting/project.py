@@ -53,6 +53,8 @@ def find_project_file(folder: str) -> str | None:
 def load_project_file(path: str) -> Selection:
     """The selection an rl1.toml sets (what it leaves out stays unset)."""
     # Only when a project has the file: the validation layer loads msgspec.
+    from msgspec import UnsetType
+
     from rl1.vm.config import ConfigError, convert, error_at, read_document
 
     from .project_schema import ProjectFile
@@ -65,17 +67,18 @@ def load_project_file(path: str) -> Selection:
     try:
         document, text = read_document(data, path, "toml")
         check = convert(document, ProjectFile, path, text).check
-        codes = {}
+        codes: dict[str, tuple[str, ...] | None] = {}
         for key, value in (("select", check.select), ("ignore", check.ignore)):
             try:
-                codes[key] = parse_codes(value) if value is not None else None
+                codes[key] = None if isinstance(value, UnsetType) else parse_codes(value)
             except SelectionError as error:
                 raise error_at(path, text, (TABLE, key), str(error)) from None
     except ConfigError as error:
         at = f"line {error.line}: " if error.line is not None else ""
         where = f"{error.where}: " if error.where else ""
         raise ProjectFileError(path, at + where + error.detail) from None
-    return Selection(codes["select"], codes["ignore"], check.warnings_as_errors)
+    strict = None if isinstance(check.warnings_as_errors, UnsetType) else check.warnings_as_errors
+    return Selection(codes["select"], codes["ignore"], strict)
 
 
 def project_selection() -> Callable[[str], Selection]:

@@ -8,7 +8,7 @@ from __future__ import annotations
 from typing import Annotated
 
 import msgspec
-from msgspec import Meta, Struct
+from msgspec import UNSET, Meta, Struct, UnsetType
 
 Codes = Annotated[list[str], Meta(extra={"expected": 'a list of codes, such as ["W0601", "W06"]'},
                                   description="codes or prefixes of codes (rl1c explain)")]
@@ -17,10 +17,10 @@ Codes = Annotated[list[str], Meta(extra={"expected": 'a list of codes, such as [
 class CheckTable(Struct, forbid_unknown_fields=True, rename="kebab"):
     """The options of `rl1c check` that a team shares."""
 
-    select: Codes | None = None
-    ignore: Codes | None = None
-    warnings_as_errors: Annotated[bool | None, Meta(
-        description="a warning fails the check (for CI)")] = None
+    select: Codes | UnsetType = UNSET
+    ignore: Codes | UnsetType = UNSET
+    warnings_as_errors: Annotated[bool, Meta(
+        description="a warning fails the check (for CI)")] | UnsetType = UNSET
 
 
 class ProjectFile(Struct, forbid_unknown_fields=True):
