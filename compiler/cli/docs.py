@@ -52,28 +52,27 @@ def title(path: Path) -> str:
 
 
 @click.command(cls=Command)
-@click.argument("topic", required=False, metavar="[TOPIC]")
-def docs(topic: str | None) -> int:
+@click.argument("name", required=False, metavar="[NAME]")
+def docs(name: str | None) -> int:
     """Print a document: the guides and the specifications that help texts name.
 
     `rl1c docs` lists the documents; `rl1c docs sensors` (or `rl1c docs spec/sensors.md`,
     as help texts name it) prints one. Pipe it to a pager: `rl1c docs sensors | less`.
     Exit status: 0, 2 no such document."""
-    if topic is None:
-        for name, path in documents().items():
-            folder = path.parent.name
-            print(f"{name:<16} {folder}/{path.name}: {title(path)}")
-        return 0
     known = documents()
-    path = known.get(topic_name(topic))
-    if path is None:
+    if name is None:
+        for topic, path in known.items():
+            print(f"{topic:<16} {path.parent.name}/{path.name}: {title(path)}")
+        return 0
+    wanted = known.get(topic_name(name))
+    if wanted is None:
         import difflib  # for this message only
 
-        close = difflib.get_close_matches(topic_name(topic), list(known), n=1)
+        close = difflib.get_close_matches(topic_name(name), list(known), n=1)
         hint = f"did you mean `rl1c docs {close[0]}`? " if close else ""
-        raise Failure(f"error: `{topic}` is no document of rl1c\n"
+        raise Failure(f"error: `{name}` is no document of rl1c\n"
                       f"  = help: {hint}`rl1c docs` lists every document")
-    sys.stdout.write(path.read_text(encoding="utf-8"))
+    sys.stdout.write(wanted.read_text(encoding="utf-8"))
     return 0
 
 
