@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from typing import Annotated, Any
 
 import msgspec
-from msgspec import Meta, Struct
+from msgspec import UNSET, Meta, Struct, UnsetType
 
 from ..config import (
     INPUT_PORTS,
@@ -198,7 +198,7 @@ class StartTable(Struct, forbid_unknown_fields=True):
 class LineTable(Struct, forbid_unknown_fields=True, kw_only=True):
     """A guidance line: a polyline."""
 
-    name: Name | None = None
+    name: Name | UnsetType = UNSET
     points: Annotated[list[PointValue], Meta(min_length=2)]
     width: Annotated[float, _in(0.1, 1000, "cm", "the line's width")] = 2.0
 
@@ -206,7 +206,7 @@ class LineTable(Struct, forbid_unknown_fields=True, kw_only=True):
 class PolygonTable(Struct, forbid_unknown_fields=True, kw_only=True):
     """A mark on the floor, a wall or an obstacle: a polygon."""
 
-    name: Name | None = None
+    name: Name | UnsetType = UNSET
     points: Annotated[list[PointValue], Meta(min_length=3)]
 
 
@@ -214,7 +214,7 @@ class StandTable(Struct, forbid_unknown_fields=True, kw_only=True):
     """A work stand: a rectangle with a marker in the middle of the face it looks out
     of."""
 
-    name: Name | None = None
+    name: Name | UnsetType = UNSET
     x: Coordinate
     y: Coordinate
     width: Annotated[float, _in(1, 1000, "cm", "across the face")] = 40.0
@@ -284,6 +284,11 @@ def parse_world(document: dict[str, Any], text: str = "", name: str = "<world>")
         raise WorldError(str(error)) from None
 
 
+def _named(name: str | UnsetType, default: str) -> str:
+    """A feature's name, or the one it gets by its place when the file gives none."""
+    return default if isinstance(name, UnsetType) else name
+
+
 class _World:
     """The checks that span fields (the start on the floor, the scenes' names, the
     world's size), and the World they give."""
@@ -321,21 +326,21 @@ class _World:
         lines = []
         for i, line in enumerate(file.lines):
             self.count(len(line.points), ("lines", i, "points"))
-            lines.append(Line(line.name or f"line{i}", tuple(line.points), line.width))
+            lines.append(Line(_named(line.name, f"line{i}"), tuple(line.points), line.width))
         marks = []
         for i, mark in enumerate(file.marks):
             self.count(len(mark.points), ("marks", i, "points"))
-            marks.append(Mark(mark.name or f"mark{i}", tuple(mark.points)))
+            marks.append(Mark(_named(mark.name, f"mark{i}"), tuple(mark.points)))
         stands = []
         for i, stand in enumerate(file.stands):
             self.count(4, ("stands", i))
-            stands.append(Stand(stand.name or f"stand{i}", stand.x, stand.y, stand.width,
+            stands.append(Stand(_named(stand.name, f"stand{i}"), stand.x, stand.y, stand.width,
                                 stand.depth, stand.facing))
         blocks = []
         for kind, polygons in (("walls", file.walls), ("obstacles", file.obstacles)):
             for i, block in enumerate(polygons):
                 self.count(len(block.points), (kind, i, "points"))
-                blocks.append(Block(block.name or f"{kind}{i}", tuple(block.points)))
+                blocks.append(Block(_named(block.name, f"{kind}{i}"), tuple(block.points)))
         return World(floor=floor, start=(start.x, start.y, start.heading),
                      vehicle=file.vehicle, lines=tuple(lines), marks=tuple(marks),
                      stands=tuple(stands), blocks=tuple(blocks), scenes=self.scenes(),
@@ -346,7 +351,7 @@ class _World:
         file = self.file
         named = [*(line.name for line in file.lines), *(mark.name for mark in file.marks),
                  *(stand.name for stand in file.stands)]
-        known = {"lines", "marks", "markers", *(name for name in named if name)}
+        known = {"lines", "marks", "markers", *(name for name in named if isinstance(name, str))}
         scenes: dict[int, Scene] = {}
         for i, scene in enumerate(file.scenes):
             if scene.number in scenes:
