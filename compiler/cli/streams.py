@@ -17,6 +17,7 @@ from rl1.compiler.frontend.source import (
     UTF8_BOM,
     Source,
     decode,
+    read_source,
     split_lines,
 )
 from rl1.compiler.reporting.render import (
@@ -44,32 +45,16 @@ MAX_ILC_BYTES = 16 * 1024 * 1024  # far more than any .ilc file holds
 def read_input(name: str, role: str = "source file") -> Source | FileDiagnostics:
     """The source file `name` (`-` is standard input), or the E0100 report of why it
     cannot be read; `role` names it there."""
-    shown = STDIN_NAME if name == "-" else name
-    data: bytes | None = None
     try:
         if name != "-":
-            data = read_bounded(name, MAX_SOURCE_BYTES, "an RL/I source file")
-        else:
-            data = sys.stdin.buffer.read(MAX_SOURCE_BYTES + 1)
-            if len(data) > MAX_SOURCE_BYTES:
-                raise SourceError(STDIN_NAME, f"it holds more than {MAX_SOURCE_BYTES} bytes",
-                                  "RL/I sources are limited to that size")
-        return decode(data, shown)
+            return read_source(name)
+        data = sys.stdin.buffer.read(MAX_SOURCE_BYTES + 1)
+        if len(data) > MAX_SOURCE_BYTES:
+            raise SourceError(STDIN_NAME, f"it holds more than {MAX_SOURCE_BYTES} bytes",
+                              "RL/I sources are limited to that size")
+        return decode(data, STDIN_NAME)
     except SourceError as error:
-        return unreadable(shown, _compiled_code(name, data) or error, role)
-
-
-def _compiled_code(name: str, data: bytes | None) -> SourceError | None:
-    """Why `data`, read where a source was expected, is not one when it is an .ilc
-    file (said instead of "a binary file"); None when it is not."""
-    from rl1.vm.ilc import MAGIC  # only for a file that is not source: 40 ms to load
-
-    if data is None or not data.startswith(MAGIC):
-        return None
-    run = f"`rl1c run {name}`" if name.lower().endswith(".ilc") else \
-        "`rl1c run`, under a name that ends in .ilc"
-    return SourceError(name, "it is compiled code (an .ilc file), not RL/I source",
-                       f"run it with {run}, or show it as text with `rl1c dis {name}`")
+        return unreadable(STDIN_NAME if name == "-" else name, error, role)
 
 
 def source_files(names: Sequence[str], command: str) -> list[str | FileDiagnostics]:

@@ -73,8 +73,15 @@ _CODE_LINE = re.compile(f"^[{re.escape(WHITESPACE)}]*[^{re.escape(WHITESPACE)}'\
 
 
 def decode(data: bytes, name: str = "<input>") -> Source:
-    """Decode source bytes: UTF-8 (a BOM is dropped), else CP932, else refuse."""
+    """Decode source bytes: UTF-8 (a BOM is dropped), else CP932, else refuse (compiled
+    code, which holds NUL bytes as any binary file does, is named as such)."""
     if b"\x00" in data:
+        from rl1.vm.ilc import MAGIC  # only for bytes that are no source: 40 ms to load
+
+        if data.startswith(MAGIC):
+            raise SourceError(name, "it is compiled code (an .ilc file), not RL/I source",
+                              "run it with `rl1c run`, under a name that ends in .ilc, "
+                              "or show it as text with `rl1c dis`")
         offset = data.index(b"\x00")
         raise SourceError(
             name, f"it looks like a binary file (a NUL byte at offset {offset})",

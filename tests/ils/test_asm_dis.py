@@ -353,6 +353,11 @@ def test_dis_source_option_names_the_source_whatever_the_file_records(tmp_path: 
     assert missing.exit_code == 2
     assert missing.stderr.startswith(f"error[E0100]: cannot read the --source file "
                                      f"`{tmp_path / 'none.rob'}`: no such file\n")
+    compiled = rl1c("dis", target, "--source", target)  # compiled code where a source goes
+    assert compiled.exit_code == 2
+    assert compiled.stderr.startswith(f"error[E0100]: cannot read the --source file "
+                                      f"`{target}`: it is compiled code (an .ilc file), not "
+                                      "RL/I source\n")
 
 
 def test_dis_and_asm_read_standard_input(tmp_path: Path) -> None:
