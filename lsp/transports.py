@@ -5,8 +5,12 @@ own `initialize` and `exit`), and every message reaches it through the same boun
 reading: framing.py's reader on a byte stream, the WebSocket library's own message
 limit (framing.MAX_MESSAGE too) on a WebSocket. pygls' `start_tcp` and `start_ws` give
 every connection one shared session, so that a second client takes over the first's
-documents and diagnostics, and end the process when the first client leaves; they are
-not used.
+documents and diagnostics, read without bounds, and end the process when the first
+client leaves; they are not used. What would let them be: a session per connection
+(openlawlibrary/pygls#219, open since 2021) and a bounded reader (no upstream issue as
+of pygls 2.1.1). This module needs only pygls' public `JsonRPCProtocol.set_writer`
+(with `include_headers=False`: the writers here frame each message themselves, in bytes
+where pygls counts characters, openlawlibrary/pygls#604).
 
 TCP and WebSocket serve up to MAX_SESSIONS clients at once, each a session of its own,
 rather than one client at a time: the studio opens a WebSocket per page, and an editor
