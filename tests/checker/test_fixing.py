@@ -89,6 +89,19 @@ def test_safe_fixes_never_remove_a_label_or_a_statement_written(text: str) -> No
         assert statements <= statements_now, "every statement written is kept"
 
 
+@settings(deadline=None, max_examples=300)
+@given(programs() | fixable_programs())
+def test_unsafe_fixes_are_judged_on_what_was_written(text: str) -> None:
+    """A label goes only where the text as given was told it is never jumped to (W0205),
+    never one that a fix wrote (`:5` fixed to `:05`, then removed)."""
+    unused = {d.span.line for d in analyze(text).diagnostics if d.code == "W0205"}
+    before = written(parse_program(text)[0])
+    after = written(parse_program(fix(text, unsafe=True).text)[0])
+    for number, ((label, _, _), (label_now, _, _)) in enumerate(zip(before, after,
+                                                                    strict=False), 1):
+        assert label_now or not label or number in unused
+
+
 def test_a_label_fixed_to_two_digits_is_kept_though_nothing_jumps_to_it() -> None:
     # Issue 22: the E0201 fix wrote `:05`, then W0205's removed it as never jumped to.
     text = ":5 (TIM 10)\n(END)\n"
