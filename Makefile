@@ -41,7 +41,7 @@ demo: $(STAMP)
 test: lint typecheck vscode-test c-test pytest
 
 # The fast tests alone, in under a minute, while working: no test marked slow or needing
-# a C compiler, Node.js or a browser (tests/conftest.py marks them). `make test` runs all.
+# a C compiler, Node.js or a browser (tests/support/markers.py marks them). `make test` runs all.
 QUICK := not slow and not needs_cc and not needs_node and not needs_browser
 
 quick: $(STAMP)

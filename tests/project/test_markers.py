@@ -1,47 +1,37 @@
 """The markers `make quick` leaves out: registered in pyproject.toml, applied in
-tests/conftest.py to every Hypothesis property and by path to places that exist, and
+tests/support/markers.py to every Hypothesis property and by path to places that exist, and
 every one of them left out by the Makefile's quick target."""
 
 from __future__ import annotations
 
-import importlib.util
 import re
 import tomllib
-from types import ModuleType, SimpleNamespace
+from types import SimpleNamespace
 
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from support import ROOT
+from support import ROOT, markers
 
 PYTEST = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))[
     "tool"]["pytest"]["ini_options"]
 REGISTERED = {line.split(":", 1)[0] for line in PYTEST["markers"]}
 
 
-def _conftest() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("tests_conftest", ROOT / "tests" / "conftest.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
-CONFTEST = _conftest()
-
-
-@pytest.mark.parametrize("where", list(CONFTEST.MARKS))
+@pytest.mark.parametrize("where", list(markers.MARKS))
 def test_every_place_marked_exists(where: str) -> None:
     path, _, test = where.partition("::")
-    assert (ROOT / path).exists(), f"tests/conftest.py marks {path}, which does not exist"
+    assert (ROOT / path).exists(), f"support/markers.py marks {path}, which does not exist"
     if test:
         source = (ROOT / path).read_text(encoding="utf-8")
         assert re.search(rf"^(?:async )?def {re.escape(test)}\(", source, re.MULTILINE), (
-            f"tests/conftest.py marks {where}, which {path} does not define")
+            f"support/markers.py marks {where}, which {path} does not define")
 
 
 def test_every_mark_given_is_registered() -> None:
-    given = {mark for marks in CONFTEST.MARKS.values() for mark in marks}
+    given = {mark for marks in markers.MARKS.values() for mark in marks}
     assert given <= REGISTERED
 
 
@@ -54,7 +44,7 @@ def test_every_mark_given_is_registered() -> None:
 ])
 def test_a_test_gets_the_marks_of_its_folder_module_and_name(nodeid: str,
                                                              marks: set[str]) -> None:
-    assert set(CONFTEST.marks_of(nodeid)) == marks
+    assert set(markers.marks_of(nodeid)) == marks
 
 
 @given(st.integers())
@@ -67,9 +57,9 @@ def _an_example() -> None:
 
 
 def test_every_property_is_slow_and_an_example_is_not() -> None:
-    assert CONFTEST.is_property(SimpleNamespace(obj=_a_property))
-    assert not CONFTEST.is_property(SimpleNamespace(obj=_an_example))
-    assert not CONFTEST.is_property(SimpleNamespace())  # an item of no function
+    assert markers.is_property(SimpleNamespace(obj=_a_property))
+    assert not markers.is_property(SimpleNamespace(obj=_an_example))
+    assert not markers.is_property(SimpleNamespace())  # an item of no function
 
 
 def test_make_quick_leaves_out_every_marker_and_make_test_none() -> None:

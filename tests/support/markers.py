@@ -1,11 +1,13 @@
-"""Marks tests by what they need beyond Python and by how long they take, so that
-`make quick` can leave out the tests marked `slow`, `needs_cc`, `needs_node` or
-`needs_browser` (pyproject.toml registers them) and run the rest in under a minute.
+"""A pytest plugin every run loads (pyproject.toml's addopts): marks tests by what they
+need beyond Python and by how long they take, so that `make quick` can leave out the
+tests marked `slow`, `needs_cc`, `needs_node` or `needs_browser` (pyproject.toml
+registers them) and run the rest in under a minute.
 
 Every Hypothesis property is slow; any other test is marked here by where it is (a
 folder, a module, or one test of a module), so that the test files stay about what they
 test, or in its own module (`pytestmark`, or a mark on the test).
-tests/project/test_markers.py checks that every place named here exists.
+tests/project/test_markers.py checks that every place named here exists. (A plugin
+rather than tests/conftest.py, which mypy would take for tests/lsp/conftest.py.)
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ def marks_of(nodeid: str) -> tuple[str, ...]:
                  for mark in marks)
 
 
-def is_property(item: pytest.Item) -> bool:
+def is_property(item: object) -> bool:
     """Whether the test is a Hypothesis property, which runs its examples by the hundred
     (about a tenth of the tests, and most of the time of the fast ones)."""
     return getattr(getattr(item, "obj", None), "is_hypothesis_test", False) is True
