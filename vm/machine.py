@@ -157,9 +157,9 @@ class Machine:
         return State.RUNNING
 
     def current_line(self) -> int | None:
-        """The source line of the instruction at hand (the call under way, the one that
-        faulted), or of the one run last between steps; None before the first
-        instruction, or without a line map."""
+        """The source line of the instruction before pc: while an instruction runs, the
+        one at hand (the call under way, the one that faulted); None at index 0, or
+        without a line map."""
         debug = self.program.image.debug
         instructions = self.program.instructions
         if debug is None or self.pc == 0:
