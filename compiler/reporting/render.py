@@ -112,9 +112,9 @@ def fixes_not_made(left: int, unsafe: bool) -> str:
     """Why `left` fixes were not made: unsafe (without `unsafe`), or, being unsafe or
     coming after an unsafe fix, they wait for another run (analysis.fix)."""
     if unsafe:
-        return (f"{_plural(left, 'fix', 'fixes')} not made: they follow from other "
-                "fixes; run again to make them")
-    return f"{_plural(left, 'unsafe fix', 'unsafe fixes')} not made: --unsafe-fixes makes them"
+        return f"{_plural(left, 'fix', 'fixes')} left for another run to make"
+    them = "it" if left == 1 else "them"
+    return f"{_plural(left, 'unsafe fix', 'unsafe fixes')} not made: --unsafe-fixes makes {them}"
 
 
 def exit_status(files: Sequence[FileDiagnostics]) -> int:

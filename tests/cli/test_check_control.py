@@ -264,7 +264,10 @@ def test_diff_shows_what_fix_would_change_and_changes_nothing(tmp_path: Path) ->
     assert result.stdout == (f"--- {program}\n+++ {program} (fixed)\n@@ -1 +1,2 @@\n"
                              " (MOV 3,3)\n+(END)\n")
     assert result.stderr == ("--fix would make 1 fix in 1 file; 1 unsafe fix not made: "
-                             "--unsafe-fixes makes them\n")
+                             "--unsafe-fixes makes it\n")
+    unsafe = check("--diff", "--unsafe-fixes", program)
+    assert unsafe.stderr == ("--fix --unsafe-fixes would make 1 fix in 1 file; 1 fix left for "
+                             "another run to make\n")
     assert program.read_text(encoding="utf-8") == MOVING
     nothing = check("--diff", clean)
     assert (nothing.exit_code, nothing.stdout) == (0, "")
