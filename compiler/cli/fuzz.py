@@ -64,7 +64,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         )
         from rl1.compiler.fuzz import campaign, write_reproducer
     except ModuleNotFoundError as error:
-        if error.name != "hypothesis":
+        if (error.name or "").partition(".")[0] != "hypothesis":
             raise
         raise Failure("error: rl1c fuzz generates programs with Hypothesis, an optional "
                       "part of rl1 that is not installed here; install it with "
