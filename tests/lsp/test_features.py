@@ -456,7 +456,7 @@ async def test_a_client_that_resolves_edits_gets_the_fix_all_edit_on_resolve() -
         assert stale.edit is None, "an action offered for an older version is not made"
         await client.shutdown_session()
     finally:
-        await client.stop()
+        await client.stop()  # type: ignore[no-untyped-call]
 
 
 async def test_no_fix_all_when_no_safe_fix_is_left(client: Client) -> None:
