@@ -1,0 +1,145 @@
+"""How robust Listing 1 is on the scene of Fig. 4 (spec/simulator.md, "The paper's
+reading"): on the sample world and its mirror, the share of seeded runs that succeed at
+the world's noise and at twice it, and the stand moved on a grid of up to 10 cm in each
+direction (noise off).
+
+A run succeeds when the program ends normally having reached the stand: it held the
+vehicle (`HLD`, Listing 1's `:29`) with the camera within REACH cm of the stand's marker.
+"back" counts those that also ended over the guidance line (the line named "guide"
+within half the vehicle's width of its centre), as the paper says the vehicle returns.
+
+    .venv/bin/python bench/robustness.py [--seeds N] [--program FILE.rob]
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+from collections.abc import Iterator
+from pathlib import Path
+
+import msgspec
+
+from rl1.compiler.runner import Finished, run
+from rl1.vm.sim import camera
+from rl1.vm.sim.device import SimDevice
+from rl1.vm.sim.world import Noise, World, decode_world
+
+ROOT = Path(__file__).parents[1]
+WORLDS = ("sample.world.toml", "sample.mirrored.world.toml")
+REACH = 80.0  # cm from the camera to the marker when the vehicle holds: "at the stand"
+GRID = (-10, -5, 0, 5, 10)  # cm the stand is moved along x and along y
+FALLBACK_NOISE = Noise(image_px=0.5)
+"""The noise of a world that sets none (today's sample worlds): half a pixel on the
+centroid, what the issue measured the knife-edge with."""
+
+
+def _distance_to_polyline(x: float, y: float, points: tuple[tuple[float, float], ...]) -> float:
+    best = math.inf
+    for (ax, ay), (bx, by) in zip(points, points[1:], strict=False):
+        dx, dy = bx - ax, by - ay
+        length2 = dx * dx + dy * dy
+        t = 0.0 if not length2 else max(0.0, min(1.0, ((x - ax) * dx + (y - ay) * dy) / length2))
+        best = min(best, math.hypot(x - ax - t * dx, y - ay - t * dy))
+    return best
+
+
+def outcome(program: str, world: World, seed: int) -> tuple[bool, bool]:
+    """Whether the run succeeded, and whether it also ended over the guidance line."""
+    device = SimDevice(world, seed=seed)
+    finished = run(program, device)
+    if not isinstance(finished, Finished) or finished.result.fault is not None:
+        return False, False
+    marker = world.stands[0].marker()
+    vehicle = world.vehicle
+    reached = False
+    for entry in device.trace:
+        if entry.call == "HLD":
+            pose = entry.pose
+            eye = (pose.x + vehicle.camera_ahead * math.cos(pose.heading),
+                   pose.y + vehicle.camera_ahead * math.sin(pose.heading))
+            reached = math.dist(eye, marker) <= REACH
+    if not reached:
+        return False, False
+    pose = device.sim.pose
+    guides = [line for line in world.lines if line.name == "guide"]
+    back = any(_distance_to_polyline(pose.x, pose.y, line.points) <= vehicle.width / 2
+               for line in guides)
+    return True, back
+
+
+def scaled(noise: Noise, factor: float) -> Noise:
+    """Every standard deviation of `noise` times `factor` (flags stay as they are)."""
+    changes = {name: value * factor for name in noise.__struct_fields__
+               if isinstance(value := getattr(noise, name), float)}
+    return msgspec.structs.replace(noise, **changes)
+
+
+def noise_of(world: World) -> Noise:
+    noise = world.noise
+    quiet = all(not value for name in noise.__struct_fields__
+                if isinstance(value := getattr(noise, name), float))
+    return FALLBACK_NOISE if quiet else noise
+
+
+def moved(world: World, dx: float, dy: float) -> World:
+    stand = world.stands[0]
+    return dataclasses.replace(world, stands=(dataclasses.replace(
+        stand, x=stand.x + dx, y=stand.y + dy), *world.stands[1:]))
+
+
+def rate(program: str, world: World, seeds: int) -> tuple[int, int]:
+    successes = backs = 0
+    for seed in range(seeds):
+        success, back = outcome(program, world, seed)
+        successes += success
+        backs += back
+    return successes, backs
+
+
+def _cells(program: str, world: World) -> Iterator[str]:
+    quiet = dataclasses.replace(world, noise=Noise())
+    for dy in reversed(GRID):
+        yield f"  y{dy:+3d} " + " ".join(
+            {(True, True): "  B", (True, False): "  S", (False, False): "  ."}[
+                outcome(program, moved(quiet, dx, dy), 0)] for dx in GRID)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--seeds", type=int, default=100)
+    parser.add_argument("--program", type=Path, default=ROOT / "examples" / "sample.rob")
+    options = parser.parse_args()
+    program = options.program.read_text()
+    print(f"Listing 1 ({options.program.name}), {options.seeds} seeds; success = ended "
+          f"normally, held within {REACH:g} cm of the marker; back = and over the guidance "
+          "line at the end")
+    for name in WORLDS:
+        world = decode_world((ROOT / "examples" / name).read_bytes(), name)
+        stand = world.stands[0]
+        noise = noise_of(world)
+        print(f"\n{name}: stand at ({stand.x:g}, {stand.y:g}) facing {stand.facing:g}; "
+              f"pan {camera.PULSES} pulses for 180 degrees")
+        quiet = outcome(program, dataclasses.replace(world, noise=Noise()), 0)
+        print(f"  no noise: {'success' if quiet[0] else 'failure'}"
+              f"{', back on the guidance line' if quiet[1] else ''}")
+        for factor, label in ((1, "default"), (2, "twice")):
+            level = scaled(noise, factor)
+            successes, backs = rate(program, dataclasses.replace(world, noise=level),
+                                    options.seeds)
+            shown = ", ".join(f"{field} {getattr(level, field):g}"
+                              for field in level.__struct_fields__
+                              if isinstance(getattr(level, field), float)
+                              and getattr(level, field))
+            print(f"  {label:7} noise ({shown}): {successes:3d}/{options.seeds} succeed, "
+                  f"{backs:3d} back")
+        print("  the stand moved by dx (columns) and dy (rows), cm, no noise: "
+              "B success and back, S success, . failure")
+        print("       " + " ".join(f"{dx:+3d}" for dx in GRID))
+        for row in _cells(program, world):
+            print(row)
+
+
+if __name__ == "__main__":
+    main()
