@@ -17,13 +17,14 @@ import argparse
 import dataclasses
 import math
 from collections.abc import Iterator
+from itertools import pairwise
 from pathlib import Path
 
 import msgspec
 
 from rl1.compiler.runner import Finished, run
-from rl1.vm.sim import camera
 from rl1.vm.sim.device import SimDevice
+from rl1.vm.sim.geometry import segment_nearest
 from rl1.vm.sim.world import Noise, World, decode_world
 
 ROOT = Path(__file__).parents[1]
@@ -33,16 +34,6 @@ GRID = (-10, -5, 0, 5, 10)  # cm the stand is moved along x and along y
 FALLBACK_NOISE = Noise(image_px=0.5)
 """The noise of a world that sets none (today's sample worlds): half a pixel on the
 centroid, what the issue measured the knife-edge with."""
-
-
-def _distance_to_polyline(x: float, y: float, points: tuple[tuple[float, float], ...]) -> float:
-    best = math.inf
-    for (ax, ay), (bx, by) in zip(points, points[1:], strict=False):
-        dx, dy = bx - ax, by - ay
-        length2 = dx * dx + dy * dy
-        t = 0.0 if not length2 else max(0.0, min(1.0, ((x - ax) * dx + (y - ay) * dy) / length2))
-        best = min(best, math.hypot(x - ax - t * dx, y - ay - t * dy))
-    return best
 
 
 def outcome(program: str, world: World, seed: int) -> tuple[bool, bool]:
@@ -64,8 +55,8 @@ def outcome(program: str, world: World, seed: int) -> tuple[bool, bool]:
         return False, False
     pose = device.sim.pose
     guides = [line for line in world.lines if line.name == "guide"]
-    back = any(_distance_to_polyline(pose.x, pose.y, line.points) <= vehicle.width / 2
-               for line in guides)
+    back = any(segment_nearest(pose.x, pose.y, a, b)[2] <= vehicle.width / 2
+               for line in guides for a, b in pairwise(line.points))
     return True, back
 
 
@@ -119,8 +110,7 @@ def main() -> None:
         world = decode_world((ROOT / "examples" / name).read_bytes(), name)
         stand = world.stands[0]
         noise = noise_of(world)
-        print(f"\n{name}: stand at ({stand.x:g}, {stand.y:g}) facing {stand.facing:g}; "
-              f"pan {camera.PULSES} pulses for 180 degrees")
+        print(f"\n{name}: stand at ({stand.x:g}, {stand.y:g}) facing {stand.facing:g}")
         quiet = outcome(program, dataclasses.replace(world, noise=Noise()), 0)
         print(f"  no noise: {'success' if quiet[0] else 'failure'}"
               f"{', back on the guidance line' if quiet[1] else ''}")
