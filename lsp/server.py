@@ -16,10 +16,13 @@ from collections.abc import Callable
 from importlib.metadata import version
 from typing import Any, NamedTuple
 
+import cattrs
 import click
+from cattrs.errors import ClassValidationError
 from lsprotocol import types
 from pygls.exceptions import (
     JsonRpcException,
+    JsonRpcInvalidParams,
     JsonRpcInvalidRequest,
     JsonRpcParseError,
     JsonRpcServerNotInitialized,
@@ -72,6 +75,17 @@ class Weight(NamedTuple):
         return Weight(*(mine + sign * theirs for mine, theirs in zip(self, other, strict=True)))
 
 
+class _ParamsAnsweredInOneLine(logging.Filter):
+    """pygls logs a traceback for each message whose params do not fit LSP; the
+    session says what does not fit in one line (Rl1Protocol.structure_message)."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return record.msg != "Unable to deserialize message\n%s"
+
+
+logging.getLogger("pygls.protocol.json_rpc").addFilter(_ParamsAnsweredInOneLine())
+
+
 class Rl1Protocol(LanguageServerProtocol):
     """One session's end of JSON-RPC, fed each message's body by a transport
     (transports.py). pygls runs the requests (dispatch, cancellation, responses); this
@@ -110,8 +124,7 @@ class Rl1Protocol(LanguageServerProtocol):
             return
         try:
             message = self.structure_message(data)
-        except JsonRpcException as error:  # answered by structure_message if a request
-            log.warning("a message that does not fit LSP: %s", error)
+        except JsonRpcException:  # answered, or said, by structure_message
             return
         try:
             if hasattr(message, "method") and not hasattr(message, "id"):
@@ -150,16 +163,23 @@ class Rl1Protocol(LanguageServerProtocol):
                     f"{method} before initialize: send initialize first"))
                 return
             self.initialize_received = True
-            self.shutdown_received = method == types.SHUTDOWN
+            if method == types.SHUTDOWN:
+                self.shutdown_received = True
         super().handle_message(message)
 
     def structure_message(self, data: dict[str, Any]) -> Any:
         try:
             return super().structure_message(data)
         except JsonRpcException as error:
-            if "id" in data and "method" in data:
-                self._refuse(data["id"], error)
-            raise
+            if isinstance(error.__cause__, ClassValidationError):
+                what = "; ".join(cattrs.transform_error(error.__cause__)[:3])
+                error = JsonRpcInvalidParams(
+                    f"{data.get('method')}: {what}: send what the LSP specification gives")
+            if "method" in data and isinstance(msg_id := data.get("id"), int | str):
+                self._refuse(msg_id, error)
+            else:
+                log.warning("dropped a message that does not fit LSP: %s", error.message)
+            raise error from None
 
     def _refuse(self, msg_id: object, error: JsonRpcException) -> None:
         """Answer a request (or, without an id, a message that could not be read) with

@@ -18,6 +18,7 @@ from rl1.lsp.server import create_server
 
 PARSE_ERROR = -32700
 INVALID_REQUEST = -32600
+INVALID_PARAMS = -32602
 SERVER_NOT_INITIALIZED = -32002
 
 HOVER_NOWHERE = {"textDocument": {"uri": "file:///never/opened.rob"},
@@ -102,6 +103,22 @@ def test_json_that_is_no_message_is_an_invalid_request(server: RawServer, body: 
     msg_id = 2 if b'"id"' in body else None
     assert server.error_code(msg_id) == INVALID_REQUEST
     answered(server, 3)
+
+
+def test_params_that_do_not_fit_are_answered_with_where_and_no_traceback(
+        server: RawServer) -> None:
+    server.start()
+    server.send(frame(request(2, "textDocument/hover", {
+        "textDocument": {"uri": "file:///a.rob"}, "position": {"line": "one", "character": 0}})))
+    error = server.reply(2)["error"]
+    assert error["code"] == INVALID_PARAMS
+    assert "textDocument/hover" in error["message"] and "$.params.position.line" in error["message"]
+    server.send(frame(notification("textDocument/didChange", {"textDocument": 1})))
+    answered(server, 3)
+    server.send(frame(request(4, "shutdown")) + frame(notification("exit")))
+    status, stderr = server.finish()
+    assert status == 0 and "Traceback" not in stderr
+    assert "dropped a message that does not fit LSP: textDocument/didChange" in stderr
 
 
 # The session: initialize first, shutdown, exit --------------------------------------------

@@ -146,7 +146,7 @@ def send_raw(client: Client, message: dict[str, object]) -> asyncio.Future[objec
 
 
 async def test_malformed_params_get_an_error_response(client: Client) -> None:
-    with pytest.raises(JsonRpcException, match="Invalid Params"):
+    with pytest.raises(JsonRpcException, match=r"expected int @ \$\.params\.position\.line"):
         await send_raw(client, {"id": "bad-1", "method": types.TEXT_DOCUMENT_HOVER,
                                 "params": {"textDocument": {"uri": 42}, "position": "here"}})
     send_raw(client, {"method": types.TEXT_DOCUMENT_DID_CHANGE, "params": {"textDocument": 1}})
