@@ -4,10 +4,13 @@ standard input, and the server outlives every client and every kind of broken in
 
 from __future__ import annotations
 
+import contextlib
 import json
 from collections.abc import Iterator
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from raw import INITIALIZE, INITIALIZED, frame, notification, request
 from sockets import Listening, TcpClient, listening
 
@@ -127,6 +130,27 @@ def test_connections_beyond_the_limit_are_refused_clearly(tcp: Listening) -> Non
         pytest.fail("a closed session's place was not given to a new client")
     for client in clients:
         served(client, 9)
+
+
+pieces = st.one_of(
+    st.binary(max_size=300),
+    st.sampled_from([frame(INITIALIZE), frame(INITIALIZED), hover(7), b"Content-Length: ",
+                     b"\r\n\r\n", b"Content-Length: 99999999999\r\n\r\n", b"[" * 3000,
+                     frame(request(8, "shutdown")), frame(notification("exit"))]))
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=list(HealthCheck))
+@given(st.lists(pieces, max_size=12))
+def test_whatever_a_client_sends_the_next_one_is_served(tcp: Listening,
+                                                          sent: list[bytes]) -> None:
+    hostile = TcpClient(tcp.port)
+    with contextlib.suppress(OSError):
+        for piece in sent:
+            hostile.send(piece)
+    hostile.close()
+    client = session(tcp)
+    served(client, 2)
+    client.close()
 
 
 def test_the_server_still_runs_and_wrote_no_traceback(tcp: Listening) -> None:

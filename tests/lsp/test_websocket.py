@@ -9,6 +9,8 @@ import json
 from collections.abc import Iterator
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from raw import INITIALIZE, INITIALIZED, notification, request
 from sockets import Listening, listening
 
@@ -112,6 +114,26 @@ def test_websocket_from_a_web_page_elsewhere_is_refused(ws: Listening) -> None:
                  open_timeout=30) as local:
         local.send(json.dumps(INITIALIZE))
         assert "result" in ws_reply(local, 1)
+
+
+messages = st.one_of(
+    st.binary(max_size=300), st.text(max_size=300),
+    st.sampled_from([json.dumps(INITIALIZE), json.dumps(INITIALIZED), "[" * 3000,
+                     hover(7, "file:///nowhere.rob"), json.dumps(request(8, "shutdown")),
+                     json.dumps(notification("exit"))]))
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=list(HealthCheck))
+@given(st.lists(messages, max_size=12))
+def test_whatever_a_client_sends_the_next_one_is_served(ws: Listening,
+                                                          sent: list[str | bytes]) -> None:
+    with connect(f"ws://127.0.0.1:{ws.port}", open_timeout=30) as hostile, \
+            contextlib.suppress(websockets.ConnectionClosed):
+        for message in sent:
+            hostile.send(message)
+    with ws_session(ws) as client:
+        client.send(hover(2, "file:///nowhere.rob"))
+        assert ws_reply(client, 2)["result"] is None
 
 
 def test_the_server_still_runs_and_wrote_no_traceback(ws: Listening) -> None:
