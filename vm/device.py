@@ -93,7 +93,7 @@ class Device(Protocol):
     def move(self, left: int, right: int) -> None: ...  # (MOV): returns at once
     def steer_right(self, degrees: int) -> None: ...  # (STR)
     def steer_left(self, degrees: int) -> None: ...  # (STL)
-    def steer_to(self, tenths: int) -> None: ...  # (STX)
+    def steer_by(self, tenths: int) -> None: ...  # (STX)
     def rotate(self, degrees: int) -> None: ...  # (ROT)
     def set_tracing(self, mode: int) -> None: ...  # (TRC)
     def wait(self, tenths: int) -> None: ...  # (TIM)
@@ -180,7 +180,7 @@ BINDINGS: dict[FormKey, Binding] = {
     ("MOV", None): lambda d, a: _effect(lambda: d.move(a[0], a[1])),
     ("STR", None): lambda d, a: _effect(lambda: d.steer_right(a[0])),
     ("STL", None): lambda d, a: _effect(lambda: d.steer_left(a[0])),
-    ("STX", None): lambda d, a: _effect(lambda: d.steer_to(a[0])),
+    ("STX", None): lambda d, a: _effect(lambda: d.steer_by(a[0])),
     ("ROT", None): lambda d, a: _effect(lambda: d.rotate(a[0])),
     ("TRC", None): lambda d, a: _effect(lambda: d.set_tracing(a[0])),
     ("TIM", None): lambda d, a: _effect(lambda: d.wait(a[0])),

@@ -109,7 +109,7 @@ BUILTINS: dict[str, Builtin] = {
         Builtin("STL", "Steer Left", "motion", Feature.STEERING, True,
                 _one("Turn the steering left.", Param("deg", 0, 180, "angle in degrees"))),
         Builtin("STX", "Steer X", "motion", Feature.STEERING, True,
-                _one("Steer to a signed angle in 0.1 degree units (+ left, - right).",
+                _one("Turn the steering by a signed angle in 0.1 degree units (+ left, - right).",
                      Param("tenths", -1800, 1800, "angle in 0.1 degrees"))),
         Builtin("ROT", "Rotate", "motion", Feature.MOTION, True,
                 _one("Turn on the spot by differential wheel drive (PWS).",

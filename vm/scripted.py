@@ -385,7 +385,7 @@ class ScriptedDevice:
     def steer_left(self, degrees: int) -> None:
         self._takes("STL", degrees)
 
-    def steer_to(self, tenths: int) -> None:
+    def steer_by(self, tenths: int) -> None:
         self._takes("STX", tenths)
 
     def rotate(self, degrees: int) -> None:

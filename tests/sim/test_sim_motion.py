@@ -54,7 +54,7 @@ def test_rot_turns_in_place(degrees: int) -> None:
 @pytest.mark.parametrize("tenths", [450, -450, 900, 300])
 def test_steered_drive_unit_travels_diagonally_without_turning(tenths: int) -> None:
     device = SimDevice(open_floor())
-    device.steer_to(tenths)
+    device.steer_by(tenths)
     device.move_distance(2, 2, 100)
     pose = device.sim.pose
     angle = math.radians(tenths / 10)
@@ -119,7 +119,7 @@ def _drive(step: float, commands: list[tuple[object, ...]]) -> SimDevice:
         elif name == "tim":
             device.wait(values[0])
         elif name == "stx":
-            device.steer_to(values[0])
+            device.steer_by(values[0])
         else:
             device.rotate(values[0])
     return device

@@ -136,8 +136,9 @@ class SimDevice:
         self._after("STL", self.sim.turn_steering(self.sim.steering + math.radians(degrees)),
                     degrees)
 
-    def steer_to(self, tenths: int) -> None:
-        self._after("STX", self.sim.turn_steering(math.radians(tenths / 10)), tenths)
+    def steer_by(self, tenths: int) -> None:
+        self._after("STX", self.sim.turn_steering(self.sim.steering + math.radians(tenths / 10)),
+                    tenths)
 
     def rotate(self, degrees: int) -> None:
         start = self.sim.time
