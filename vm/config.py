@@ -251,12 +251,17 @@ def _first_failing(mapping: Mapping[str, object], kind: Any) -> str:
 
 
 def _strip(kind: Any) -> Any:
-    """`kind` without Annotated and without None in a union."""
+    """`kind` without Annotated and without None in a union; of a union of one table
+    and values (a world's `noise = false` or [noise] table), the table, which a key
+    path goes into."""
     while True:
         if get_origin(kind) is Annotated:
             kind = get_args(kind)[0]
             continue
         bare = _without_none(kind)
+        if get_origin(bare) in (Union, types.UnionType):
+            tables = [arg for arg in get_args(bare) if _is_table(arg)]
+            bare = tables[0] if len(tables) == 1 else bare
         if bare is kind:
             return kind
         kind = bare

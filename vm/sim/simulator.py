@@ -8,14 +8,14 @@ This module knows nothing of the Device protocol: device.py adapts it.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
-
-import numpy as np
 
 from . import camera, tracing, ultrasonic
 from .geometry import Point, overlap, rectangle
 from .motion import Odometer, Pose, advance, count, time_to_cover
+from .noise import Imperfections
 from .track import History, Track
 from .world import Scene, World
 
@@ -27,6 +27,12 @@ MAX_EVENTS = 10_000
 are always recorded): more are counted in `events_left_out`."""
 
 
+def heading_degrees(radians: float, digits: int) -> float:
+    """A heading as the reports give it: degrees rounded to `digits`, in (-180, 180]."""
+    degrees = round(math.degrees(radians), digits) % 360
+    return round(degrees - 360, digits) if degrees > 180 else degrees
+
+
 class SafetyFault(Exception):
     """The run was stopped: the vehicle left the floor, hit something, or ran out of
     time. `kind`, `time` and `pose` say which, when and where."""
@@ -34,7 +40,7 @@ class SafetyFault(Exception):
     def __init__(self, kind: str, message: str, time: float, pose: Pose) -> None:
         super().__init__(f"{message} at {time:.2f} s, the vehicle at "
                          f"({pose.x:.1f}, {pose.y:.1f}) cm heading "
-                         f"{math.degrees(pose.heading):.1f} degrees")
+                         f"{heading_degrees(pose.heading, 1):.1f} degrees")
         self.kind = kind
         self.time = time
         self.pose = pose
@@ -78,7 +84,7 @@ class Simulator:
     events_left_out: int = 0
     _speeds: tuple[float, float] = (0.0, 0.0)  # the wheels' speeds now, units
     _tick: int = 1  # the tracing timer's next tick
-    _rng: np.random.Generator = field(init=False)
+    _noise: Imperfections = field(init=False)
     _obstacles: list[tuple[str, list[Point], Point, float]] = field(init=False)
     _lines: tracing.LineIndex = field(init=False)
     _echoes: ultrasonic.Echoes = field(init=False)
@@ -86,18 +92,21 @@ class Simulator:
     _reach: float = field(init=False)  # from the centre to the outline's corners
     _track: Track = field(init=False)
     _history: History | None = field(init=False)  # the recent poses, with a sensor delay
+    on_move: Callable[[float, float, Pose, Pose], None] | None = None
+    """Told each step exactly (its start and end times, the poses before and after),
+    for what the decimated track cannot tell: the goal's judgement (goal.py)."""
 
     def __post_init__(self) -> None:
         x, y, heading = self.world.start
-        self.pose = Pose(x, y, math.radians(heading))
+        self._noise = Imperfections(self.world.noise, self.seed)
+        self.pose = self._noise.start(Pose(x, y, math.radians(heading)))
         self._track = Track(self.pose)
         self.track = self._track.points
         self._history = History(self.pose) if self.world.noise.delay else None
-        self._rng = np.random.default_rng(self.seed)
         self._lines = tracing.LineIndex(self.world.lines)
         self._obstacles = []
-        for name, points in [(f"stand {s.name}", s.corners()) for s in self.world.stands] + [
-                (f"obstacle {b.name}", list(b.points)) for b in self.world.blocks]:
+        for name, points in [(f"the stand {s.name}", s.corners()) for s in self.world.stands] + [
+                (f"the {b.kind} {b.name}", list(b.points)) for b in self.world.blocks]:
             cx = sum(p[0] for p in points) / len(points)
             cy = sum(p[1] for p in points) / len(points)
             radius = max(math.hypot(p[0] - cx, p[1] - cy) for p in points)
@@ -160,12 +169,8 @@ class Simulator:
         if scenery is None:
             scene = self.world.scenes.get(self.scene, _EMPTY_SCENE)
             scenery = self._sceneries[self.scene] = camera.Scenery(self.world, scene)
-        found = camera.moments(*scenery.render(self.view()))
-        noise = self.world.noise.image_px
-        if noise and found.area:
-            dx, dy = self._rng.normal(0.0, noise, 2)
-            return camera.Moments(found.area, found.x + dx, found.y + dy, found.angle)
-        return found
+        return self._noise.image(camera.moments(*scenery.render(self.view())),
+                                 scenery.window)
 
     def line_view(self) -> tracing.LineView | None:
         view = self.view()
@@ -174,51 +179,47 @@ class Simulator:
             return None
         cx, cy, slant = centre
         half = slant * math.tan(math.radians(self.world.vehicle.camera_fov) / 2)
-        return tracing.measure(self._lines, cx, cy, view.yaw, half)
+        return self._noise.line(tracing.measure(self._lines, cx, cy, view.yaw, half))
 
     def range_to(self, sensor: str) -> float:
         vehicle = self.world.vehicle
         distance = ultrasonic.sense(sensor, self.sensed_pose(), vehicle.length, vehicle.width,
                                     vehicle.ultrasonic_cone, vehicle.ultrasonic_range,
                                     self._echoes)
-        noise = self.world.noise.ultrasonic_cm
-        return distance + float(self._rng.normal(0.0, noise)) if noise else distance
+        return self._noise.ultrasonic(distance, vehicle.ultrasonic_range)
 
     def distance(self) -> tuple[float, float, float]:
         """The counters: centre, right wheel, left wheel, in cm."""
-        noise = self.world.noise.odometry
         odometer = self.odometer
-        if not noise:
-            return odometer.centre, odometer.right, odometer.left
-        right, left = (value * (1 + float(self._rng.normal(0.0, noise)))
-                       for value in (odometer.right, odometer.left))
-        return (right + left) / 2, right, left
+        return odometer.centre, odometer.right, odometer.left
 
     # The clock ----------------------------------------------------------------------------
 
     def run_for(self, seconds: float, interruptible: bool) -> Command | None:
         """Let `seconds` pass (math.inf: until a foreground MVI ends). Returns the command
-        during which the line was lost, when the program must hear of it and the wait is
-        `interruptible`; the wait then ends at once. Raises SafetyFault."""
+        during which the line was lost, when the program must hear of it, whatever the
+        wait (spec/language.md 7.7: the loss is taken after the call); an `interruptible`
+        wait (TIM, MVI) then ends at once, any other runs to its end. Raises SafetyFault."""
         end = self.time + seconds
         foreground = self.motion is not None and self.motion.command == "MVI"
         unit = self.world.vehicle.wheel_unit
+        heard: Command | None = None  # the loss the program is to hear of
         while self.time < end:
             if foreground and self.motion is None:
-                return None
+                return heard
             moving = self._speeds != (0.0, 0.0)
             if not moving:
                 if math.isinf(end):
-                    return None
+                    return heard
                 self.time = end
                 self._check_time()
-                return None
+                return heard
             interval = self.world.vehicle.trace_interval
             if self._tick * interval < self.time:  # the timer ticked on while standing
                 self._tick = math.floor(self.time / interval) + 1
             tick_time = self._tick * interval
             until = min(end, self.time + self.step, tick_time)
-            left, right = self._speeds[0] * unit, self._speeds[1] * unit
+            left, right = self._noise.wheels(self._speeds[0] * unit, self._speeds[1] * unit)
             if self.motion is not None and self.motion.command == "MVI":
                 until = min(until, self.time + time_to_cover(self.motion.remaining, left, right))
             self._move(until - self.time, left, right)
@@ -233,17 +234,23 @@ class Simulator:
                 lost = self._trace()
                 if lost is not None and interruptible:
                     return lost
-        return None
+                heard = heard or lost
+        return heard
 
     def _move(self, seconds: float, left: float, right: float) -> None:
         vehicle = self.world.vehicle
-        self.pose = advance(self.pose, self.steering, left, right, vehicle.tread, seconds)
+        before = self.pose
+        on_floor = self._noise.ground(left, right, seconds)  # what the counters do not see
+        self.pose = advance(self.pose, self.steering + self._noise.steering, *on_floor,
+                            vehicle.tread, seconds)
         count(self.odometer, left, right, seconds)
         if self.motion is not None and self.motion.command == "MVI":
             self.motion.remaining -= abs(left + right) / 2 * seconds
         self._track.add(self.time + seconds, self.pose)
         if self._history is not None:
             self._history.add(self.time + seconds, self.pose)
+        if self.on_move is not None:
+            self.on_move(self.time, self.time + seconds, before, self.pose)
 
     def _trace(self) -> Command | None:
         """One tick of the tracing timer; the command the line was lost during, when the

@@ -12,6 +12,7 @@ whose message reads `file:line: where: what is wrong; what to write`
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Annotated, Any
 
@@ -32,6 +33,7 @@ from ..config import (
 )
 from ..config_lines import KeyPath
 from .geometry import Point, rectangle
+from .goal import Goal, Hold, Region
 
 
 class WorldError(Exception):
@@ -78,15 +80,35 @@ class Vehicle(Struct, frozen=True, forbid_unknown_fields=True):
     ultrasonic_time: Annotated[float, _in(0.001, 10, "s", "one (ULT)")] = 0.02
     ultrasonic_range: Annotated[float, _in(1, 1000, "cm", "the sensors' reach")] = 100.0
     ultrasonic_cone: Annotated[float, _in(1, 89, "deg", "half-angle of each cone")] = 15.0
+    instruction_time: Annotated[float, _in(1e-5, 0.01, "s", (
+        "the interpreter's time for one instruction of intermediate code"))] = 2e-4
 
 
 class Noise(Struct, frozen=True, forbid_unknown_fields=True):
-    """Standard deviations of the sensor noise; all 0 (off) unless the world sets them."""
+    """The vehicle's imperfections (spec/simulator.md, "Noise"), applied by noise.py:
+    standard deviations, a probability and a blind zone, each default reasoned from the
+    paper's vehicle. A world has them when it says `noise = true` or has a [noise]
+    table; without either, or with `noise = false`, it has NOISELESS."""
 
-    image_px: Annotated[float, _in(0, 100, "px", "on the centroid")] = 0.0
-    odometry: Annotated[float, _in(0, 1, "1", "relative, on each wheel's count")] = 0.0
-    ultrasonic_cm: Annotated[float, _in(0, 100, "cm", "on each distance")] = 0.0
+    image_px: Annotated[float, _in(0, 100, "px", "on the centroid x and y, each IMG")] = 0.3
+    image_area: Annotated[float, _in(0, 1, "1", "relative, on the area, each IMG")] = 0.03
+    image_deg: Annotated[float, _in(0, 90, "deg", "on the axis angle, each IMG")] = 1.0
+    line_cm: Annotated[float, _in(0, 100, "cm", "on the traced line's offset, each tick")] = 0.2
+    line_deg: Annotated[float, _in(0, 90, "deg", "on the traced line's angle, each tick")] = 1.0
+    ultrasonic_cm: Annotated[float, _in(0, 100, "cm", "on each distance echoed")] = 1.0
+    ultrasonic_dropout: Annotated[float, _in(0, 1, "1", "chance a reading hears no echo")] = 0.02
+    ultrasonic_blind: Annotated[float, _in(0, 100, "cm", "the nearest distance read")] = 5.0
+    odometry: Annotated[float, _in(0, 1, "1", "each wheel's scale error, once per run")] = 0.005
+    slip: Annotated[float, _in(0, 100, "cm", "a wheel's slip over each metre it turns")] = 0.5
+    wheel_speed: Annotated[float, _in(0, 1, "1", "each wheel's speed error, once per run")] = 0.01
+    steering_deg: Annotated[float, _in(0, 45, "deg", "the steering's offset, once per run")] = 0.5
+    start_cm: Annotated[float, _in(0, 100, "cm", "on the start's x and y")] = 1.0
+    start_deg: Annotated[float, _in(0, 45, "deg", "on the start's heading")] = 1.0
     delay: Annotated[float, _in(0, 10, "s", "how late the camera and ultrasonic report")] = 0.0
+
+
+NOISELESS = Noise(**dict.fromkeys(Noise.__struct_fields__, 0.0))
+"""A world with no noise: every run is exact, whatever its seed."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -106,11 +128,21 @@ class Mark:
     points: tuple[Point, ...]
 
 
+LED_SPACING = 6.0  # cm from the marker's upper LED down to its lower one (Fig. 3)
+LED_RADIUS = 1.0  # cm
+# How high what stands on the floor is, unless the world says (cm): what the camera sees
+# over and what it does not.
+STAND_HEIGHT = 80.0  # a workbench
+WALL_HEIGHT = 200.0  # a room's wall, above any camera on the vehicle
+OBSTACLE_HEIGHT = 100.0  # a crate, a person
+
+
 @dataclass(frozen=True, slots=True)
 class Stand:
     """A work stand: a rectangle centred on (x, y), `depth` along `facing` (degrees,
-    the way its marker looks), `width` across. Its marker sits in the middle of the
-    face: two LEDs 6 cm apart vertically, the upper one at the camera's height."""
+    the way its marker looks), `width` across, `height` high. Its marker sits in the
+    middle of the face: two LEDs LED_SPACING apart vertically, the upper one at
+    `marker_height` (None: the camera's height)."""
 
     name: str
     x: float
@@ -118,6 +150,13 @@ class Stand:
     width: float
     depth: float
     facing: float
+    height: float = STAND_HEIGHT
+    marker_height: float | None = None
+
+    def leds(self, camera_height: float) -> tuple[float, float]:
+        """The heights of the marker's upper and lower LEDs' centres (cm)."""
+        upper = camera_height if self.marker_height is None else self.marker_height
+        return upper, upper - LED_SPACING
 
     def corners(self) -> list[Point]:
         return rectangle(self.x, self.y, self.depth, self.width, math.radians(self.facing))
@@ -131,10 +170,13 @@ class Stand:
 
 @dataclass(frozen=True, slots=True)
 class Block:
-    """A wall or an obstacle: a polygon the vehicle must not touch."""
+    """A wall or an obstacle (`kind`): a polygon the vehicle must not touch, `height` cm
+    high. Its name is the world file's, or where it is ("at (795, 200)", `place`)."""
 
     name: str
     points: tuple[Point, ...]
+    height: float = WALL_HEIGHT
+    kind: str = "wall"  # or "obstacle": what the reports call it
 
 
 @dataclass(frozen=True, slots=True)
@@ -159,8 +201,9 @@ class World:
     scenes: dict[int, Scene] = field(default_factory=dict)
     ports: dict[int, int] = field(default_factory=dict)
     fuzzy: tuple[int, int] = (0, 0)
-    noise: Noise = field(default_factory=Noise)
+    noise: Noise = NOISELESS
     time_limit: float = 600.0  # s of simulated time before the run is stopped
+    goal: Goal | None = None  # what the run must achieve ([goal]; vm/sim/goal.py)
 
 
 
@@ -210,6 +253,21 @@ class PolygonTable(Struct, forbid_unknown_fields=True, kw_only=True):
     points: Annotated[list[PointValue], Meta(min_length=3)]
 
 
+Height = Annotated[float, _in(1, 1000, "cm", "its top above the floor")]
+
+
+class WallTable(PolygonTable, kw_only=True):
+    """A wall: a polygon the vehicle must not touch, which hides what is behind it."""
+
+    height: Height = WALL_HEIGHT
+
+
+class ObstacleTable(PolygonTable, kw_only=True):
+    """An obstacle: a polygon the vehicle must not touch, which hides what is behind it."""
+
+    height: Height = OBSTACLE_HEIGHT
+
+
 class StandTable(Struct, forbid_unknown_fields=True, kw_only=True):
     """A work stand: a rectangle with a marker in the middle of the face it looks out
     of."""
@@ -220,6 +278,10 @@ class StandTable(Struct, forbid_unknown_fields=True, kw_only=True):
     width: Annotated[float, _in(1, 1000, "cm", "across the face")] = 40.0
     depth: Annotated[float, _in(1, 1000, "cm", "along facing")] = 40.0
     facing: Angle
+    height: Height = STAND_HEIGHT
+    marker_height: Annotated[float, _in(
+        LED_SPACING + LED_RADIUS, 1000, "cm", "the upper LED's centre above the floor "
+        "(default: the vehicle's camera_height)")] | UnsetType = UNSET
 
 
 class SceneTable(Struct, forbid_unknown_fields=True, kw_only=True):
@@ -246,6 +308,33 @@ class LimitsTable(Struct, forbid_unknown_fields=True):
                                "stopped")] = 600.0
 
 
+class GoalRegionTable(PolygonTable, kw_only=True):
+    """A region of the goal: the vehicle's centre in the polygon, and, when `heading`
+    is given, its heading within `tolerance` of it."""
+
+    heading: Angle | UnsetType = UNSET
+    tolerance: Annotated[float, _in(0, 180, "degrees", "from heading, either way")] = 10.0
+
+
+class HoldTable(Struct, forbid_unknown_fields=True, kw_only=True):
+    """Standing still with the camera near a stand's marker."""
+
+    stand: Name
+    within: Annotated[float, _in(1, 1000, "cm", "from the camera to the marker")] = 60.0
+    seconds: Annotated[float, _in(0, 3600, "s", "standing still there, at least")] = 0.5
+
+
+class GoalTable(Struct, forbid_unknown_fields=True, kw_only=True):
+    """What the program must achieve (vm/sim/goal.py)."""
+
+    reach: list[GoalRegionTable] = []
+    hold: list[HoldTable] = []
+    end: GoalRegionTable | UnsetType = UNSET
+    avoid: list[PolygonTable] = []
+    deadline: Annotated[float, _in(0.1, 86400, "s", "when the reaches and holds are "
+                                   "met and the run has ended, at the latest")] | UnsetType = UNSET
+
+
 class WorldFile(Struct, forbid_unknown_fields=True, kw_only=True):
     """A world file of `rl1c sim --world` (spec/simulator.md)."""
 
@@ -255,13 +344,14 @@ class WorldFile(Struct, forbid_unknown_fields=True, kw_only=True):
     lines: list[LineTable] = []
     marks: list[PolygonTable] = []
     stands: list[StandTable] = []
-    walls: list[PolygonTable] = []
-    obstacles: list[PolygonTable] = []
+    walls: list[WallTable] = []
+    obstacles: list[ObstacleTable] = []
     scenes: list[SceneTable] = []
     ports: dict[PortName, Byte] = {}
     fuzzy: FuzzyTable = msgspec.field(default_factory=FuzzyTable)
-    noise: Noise = msgspec.field(default_factory=Noise)
+    noise: Noise | bool = False  # true: Noise's defaults; false: NOISELESS
     limits: LimitsTable = msgspec.field(default_factory=LimitsTable)
+    goal: GoalTable | UnsetType = UNSET
 
 
 def decode_world(data: bytes, name: str) -> World:
@@ -282,6 +372,12 @@ def parse_world(document: dict[str, Any], text: str = "", name: str = "<world>")
         return _World(convert(document, WorldFile, name, text), text, name).build()
     except ConfigError as error:
         raise WorldError(str(error)) from None
+
+
+def place(points: list[Point]) -> str:
+    """Where a polygon is, as a name: the middle of its bounding box, to the cm."""
+    xs, ys = [x for x, _ in points], [y for _, y in points]
+    return f"at ({(min(xs) + max(xs)) / 2:.0f}, {(min(ys) + max(ys)) / 2:.0f})"
 
 
 def _named(name: str | UnsetType, default: str) -> str:
@@ -335,17 +431,66 @@ class _World:
         for i, stand in enumerate(file.stands):
             self.count(4, ("stands", i))
             stands.append(Stand(_named(stand.name, f"stand{i}"), stand.x, stand.y, stand.width,
-                                stand.depth, stand.facing))
+                                stand.depth, stand.facing, stand.height,
+                                None if isinstance(stand.marker_height, UnsetType)
+                                else stand.marker_height))
         blocks = []
-        for kind, polygons in (("walls", file.walls), ("obstacles", file.obstacles)):
+        kinds: tuple[tuple[str, Sequence[WallTable | ObstacleTable]], ...] = (
+            ("walls", file.walls), ("obstacles", file.obstacles))
+        for kind, polygons in kinds:
             for i, block in enumerate(polygons):
                 self.count(len(block.points), (kind, i, "points"))
-                blocks.append(Block(_named(block.name, f"{kind}{i}"), tuple(block.points)))
+                blocks.append(Block(_named(block.name, place(block.points)),
+                                    tuple(block.points), block.height, kind[:-1]))
         return World(floor=floor, start=(start.x, start.y, start.heading),
                      vehicle=file.vehicle, lines=tuple(lines), marks=tuple(marks),
                      stands=tuple(stands), blocks=tuple(blocks), scenes=self.scenes(),
                      ports=self.ports(), fuzzy=(file.fuzzy.s, file.fuzzy.t),
-                     noise=file.noise, time_limit=file.limits.time)
+                     noise=self.noise(), time_limit=file.limits.time,
+                     goal=self.goal(stands))
+
+    def noise(self) -> Noise:
+        match self.file.noise:
+            case Noise() as noise:
+                return noise
+            case True:
+                return Noise()
+        return NOISELESS
+
+    def goal(self, stands: list[Stand]) -> Goal | None:
+        table = self.file.goal
+        if isinstance(table, UnsetType):
+            return None
+        if not (table.reach or table.hold or table.avoid or not isinstance(table.end, UnsetType)
+                or not isinstance(table.deadline, UnsetType)):
+            raise self.fail(("goal",), "the goal asks for nothing; give it [[goal.reach]], "
+                                       "[[goal.hold]], [goal.end], [[goal.avoid]] or a deadline")
+
+        def region(path: KeyPath, table: PolygonTable, default: str) -> Region:
+            self.count(len(table.points), (*path, "points"))
+            if not isinstance(table, GoalRegionTable) or isinstance(table.heading, UnsetType):
+                return Region(_named(table.name, default), tuple(table.points))
+            return Region(_named(table.name, default), tuple(table.points),
+                          math.radians(table.heading), math.radians(table.tolerance))
+
+        markers = {stand.name: stand.marker() for stand in stands}
+        holds = []
+        for i, hold in enumerate(table.hold):
+            if hold.stand not in markers:
+                names = ", ".join(f'"{name}"' for name in markers)
+                raise self.fail(("goal", "hold", i, "stand"), f'"{hold.stand}" is not the '
+                                "name of a stand; " + (f"name one of {names}" if names else
+                                                       "the world has no [[stands]]"))
+            holds.append(Hold(hold.stand, markers[hold.stand], hold.within, hold.seconds))
+        return Goal(
+            reach=tuple(region(("goal", "reach", i), reach, f"reach{i}")
+                        for i, reach in enumerate(table.reach)),
+            holds=tuple(holds),
+            end=None if isinstance(table.end, UnsetType) else region(("goal", "end"),
+                                                                      table.end, "end"),
+            avoid=tuple(region(("goal", "avoid", i), avoid, f"avoid{i}")
+                        for i, avoid in enumerate(table.avoid)),
+            deadline=None if isinstance(table.deadline, UnsetType) else table.deadline)
 
     def scenes(self) -> dict[int, Scene]:
         file = self.file
