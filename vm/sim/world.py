@@ -98,10 +98,12 @@ class Noise(Struct, frozen=True, forbid_unknown_fields=True):
     ultrasonic_cm: Annotated[float, _in(0, 100, "cm", "on each distance echoed")] = 1.0
     ultrasonic_dropout: Annotated[float, _in(0, 1, "1", "chance a reading hears no echo")] = 0.02
     ultrasonic_blind: Annotated[float, _in(0, 100, "cm", "the nearest distance read")] = 5.0
-    odometry: Annotated[float, _in(0, 1, "1", "each wheel's scale error, once per run")] = 0.005
-    slip: Annotated[float, _in(0, 100, "cm", "a wheel's slip over each metre it turns")] = 0.5
-    wheel_speed: Annotated[float, _in(0, 1, "1", "each wheel's speed error, once per run")] = 0.01
-    steering_deg: Annotated[float, _in(0, 45, "deg", "the steering's offset, once per run")] = 0.5
+    # A tenth at most for the relative errors: a wheel that ran backwards would need a
+    # draw of ten standard deviations.
+    odometry: Annotated[float, _in(0, 0.1, "1", "each wheel's scale error, once per run")] = 0.005
+    slip: Annotated[float, _in(0, 10, "cm", "a wheel's slip over each metre it turns")] = 0.5
+    wheel_speed: Annotated[float, _in(0, 0.1, "1", "each wheel's speed error, once per run")] = 0.01
+    steering_deg: Annotated[float, _in(0, 10, "deg", "the steering's offset, once per run")] = 0.5
     start_cm: Annotated[float, _in(0, 100, "cm", "on the start's x and y")] = 1.0
     start_deg: Annotated[float, _in(0, 45, "deg", "on the start's heading")] = 1.0
     delay: Annotated[float, _in(0, 10, "s", "how late the camera and ultrasonic report")] = 0.0
