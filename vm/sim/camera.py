@@ -11,22 +11,17 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from itertools import pairwise
 
 import numpy as np
-import numpy.typing as npt
 
-from .geometry import Point
-from .world import Scene, Vehicle, World
-
-Floats = npt.NDArray[np.float64]
-Mask = npt.NDArray[np.bool_]
+from . import occlusion
+from .geometry import Box, Floats, Mask, Point, bounding_box, boxes_overlap, inside_each
+from .world import LED_RADIUS, Scene, Vehicle, World
 
 PULSES = 784  # the pan motor's travel, 0..784 pulses for 0..180 degrees
-LED_SPACING = 6.0  # cm between the marker's two LEDs (Fig. 3)
-LED_RADIUS = 1.0  # cm
 
 
 def pulse_angle(pulse: float) -> float:
@@ -90,17 +85,16 @@ def _axes(view: View) -> Axes:
     return (cp * cy, cp * sy, sp), (-sy, cy, 0.0), (sp * cy, sp * sy, -cp)
 
 
-Box = tuple[float, float, float, float]  # x0, y0, x1, y1 on the floor, cm
+def _to_camera(view: View) -> Callable[[Point], Point]:
+    """A point of the floor plan in the camera's frame turned to the world: cm ahead
+    along its yaw and to the left."""
+    cy, sy = math.cos(view.yaw), math.sin(view.yaw)
 
+    def local(point: Point) -> Point:
+        x, y = point[0] - view.x, point[1] - view.y
+        return x * cy + y * sy, y * cy - x * sy
 
-def _overlaps(first: Box, second: Box) -> bool:
-    return (first[2] >= second[0] and first[0] <= second[2]
-            and first[3] >= second[1] and first[1] <= second[3])
-
-
-def _box(points: Sequence[Point], reach: float = 0.0) -> Box:
-    xs, ys = [p[0] for p in points], [p[1] for p in points]
-    return min(xs) - reach, min(ys) - reach, max(xs) + reach, max(ys) + reach
+    return local
 
 
 @dataclass(frozen=True, slots=True)
@@ -132,18 +126,16 @@ def _near_piece(ahead: Floats, left: Floats, a: Point, b: Point, half_width: flo
     return np.hypot(ahead - (ax + t * dx), left - (ay + t * dy)) <= half_width
 
 
-def _in_polygon(px: Floats, py: Floats, polygon: Sequence[Point]) -> Mask:
-    """Whether each point (px, py), broadcast together, lies inside `polygon` (the
-    even-odd rule)."""
-    inside = np.zeros(np.broadcast_shapes(px.shape, py.shape), dtype=bool)
-    for i in range(len(polygon)):
-        x1, y1 = polygon[i]
-        x2, y2 = polygon[(i + 1) % len(polygon)]
-        if y1 == y2:
-            continue
-        crosses = ((y1 > py) != (y2 > py)) & (px < x1 + (py - y1) * (x2 - x1) / (y2 - y1))
-        inside ^= crosses
-    return inside
+@dataclass(frozen=True, slots=True)
+class _Marker:
+    """A stand's marker: the middle of its face on the floor plan, the way the face
+    looks (a unit vector), its LEDs' heights, and the stand's index in the world."""
+
+    x: float
+    y: float
+    facing: Point
+    leds: tuple[float, float]
+    stand: int
 
 
 @dataclass(frozen=True, slots=True)
@@ -204,14 +196,16 @@ class Scenery:
         self.window = (x0, y0, min(x1, vehicle.image_width), min(y1, vehicle.image_height))
         self.columns, self.rows = _offsets(vehicle.image_width, vehicle.image_height,
                                            self.window)
-        self.pieces = [_Piece(a, b, line.width / 2, _box((a, b), line.width / 2))
+        self.pieces = [_Piece(a, b, line.width / 2, bounding_box((a, b), line.width / 2))
                        for line in world.lines if seen("lines", line.name)
                        for a, b in pairwise(line.points)]
-        self.marks = [(mark.points, _box(mark.points)) for mark in world.marks
+        self.marks = [(mark.points, bounding_box(mark.points)) for mark in world.marks
                       if seen("marks", mark.name)]
-        self.markers = [(*stand.marker(), math.cos(math.radians(stand.facing)),
-                         math.sin(math.radians(stand.facing)))
-                        for stand in world.stands if seen("markers", stand.name)]
+        self.markers = [_Marker(*stand.marker(), (math.cos(math.radians(stand.facing)),
+                                                  math.sin(math.radians(stand.facing))),
+                                stand.leds(vehicle.camera_height), i)
+                        for i, stand in enumerate(world.stands) if seen("markers", stand.name)]
+        self.occluders = occlusion.occluders(world)
         self.all_columns, self.all_rows = _offsets(vehicle.image_width, vehicle.image_height,
                                                    (0, 0, vehicle.image_width,
                                                     vehicle.image_height))
@@ -281,11 +275,7 @@ class Scenery:
         if ground is None:
             return None
         cy, sy = math.cos(view.yaw), math.sin(view.yaw)
-
-        def local(point: Point) -> Point:
-            x, y = point[0] - view.x, point[1] - view.y
-            return x * cy + y * sy, y * cy - x * sy
-
+        local = _to_camera(view)
         # The window's floor is the projective image of a rectangle: a convex
         # quadrilateral, so its corners bound it.
         world_x = [view.x + a * cy - b * sy for a, b in ground.corners]
@@ -293,8 +283,8 @@ class Scenery:
         margin = 1e-6 * (1 + max(map(abs, world_x + world_y)))
         seen = (min(world_x) - margin, min(world_y) - margin,
                 max(world_x) + margin, max(world_y) + margin)
-        pieces = [piece for piece in self.pieces if _overlaps(piece.box, seen)]
-        marks = [points for points, box in self.marks if _overlaps(box, seen)]
+        pieces = [piece for piece in self.pieces if boxes_overlap(piece.box, seen)]
+        marks = [points for points, box in self.marks if boxes_overlap(box, seen)]
         if not (pieces or marks):
             return None
         image: Mask | None = None
@@ -303,10 +293,26 @@ class Scenery:
                                piece.half_width, ground.corners)
             image = near if image is None else image | near
         for points in marks:
-            inside = _in_polygon(ground.ahead, ground.left, [local(p) for p in points])
+            inside = inside_each(ground.ahead, ground.left, [local(p) for p in points])
             image = inside if image is None else image | inside
         assert image is not None
+        prisms = self._prisms(view, seen)
+        if prisms:
+            rows, columns = np.nonzero(image)
+            hide = occlusion.hidden(ground.ahead[rows, 0], ground.left[rows, columns], 0.0,
+                                    view.z, prisms)
+            image[rows[hide], columns[hide]] = False
         return ground.first, image
+
+    def _prisms(self, view: View, seen: Box,
+                looked_at: int | None = None) -> list[occlusion.Prism]:
+        """What may stand between the camera and what it sees within `seen` (on the
+        floor plan), but the stand `looked_at`, in the camera's frame."""
+        near = occlusion.near(self.occluders, (view.x, view.y), seen, looked_at)
+        if not near:
+            return []
+        local = _to_camera(view)
+        return [([local(point) for point in each.points], each.height) for each in near]
 
     def _leds(self, view: View, axes: Axes) -> list[_Patch]:
         """The pixels whose rays pass within an LED's radius of its centre, as patches
@@ -316,10 +322,12 @@ class Scenery:
         vehicle, f = self.vehicle, self.focal
         x0, y0, x1, y1 = self.window
         patches = []
-        for mx, my, cos_facing, sin_facing in self.markers:
-            if (view.x - mx) * cos_facing + (view.y - my) * sin_facing <= 0:
+        for marker in self.markers:
+            mx, my = marker.x, marker.y
+            if (view.x - mx) * marker.facing[0] + (view.y - my) * marker.facing[1] <= 0:
                 continue  # the camera is behind the marker's face
-            for height in (vehicle.camera_height, vehicle.camera_height - LED_SPACING):
+            prisms = self._prisms(view, bounding_box(((mx, my),), LED_RADIUS), marker.stand)
+            for height in marker.leds:
                 cx, cy, cz = mx - view.x, my - view.y, height - view.z
                 ahead, left, down = (ax * cx + ay * cy + az * cz for ax, ay, az in axes)
                 if ahead <= LED_RADIUS:
@@ -338,8 +346,27 @@ class Scenery:
                 along = (self.all_rows[r0:r1, None] * down + f * ahead) + (
                     self.all_columns[c0:c1] * left)
                 least = math.sqrt(cx * cx + cy * cy + cz * cz - LED_RADIUS * LED_RADIUS)
-                patches.append((r0, c0, along >= least * self.ray_lengths[r0:r1, c0:c1]))
+                lengths = self.ray_lengths[r0:r1, c0:c1]
+                patch = along >= least * lengths
+                if prisms:
+                    self._hide_led(patch, r0, c0, along, lengths, view, prisms)
+                patches.append((r0, c0, patch))
         return patches
+
+    def _hide_led(self, patch: Mask, r0: int, c0: int, along: Floats, lengths: Floats,
+                  view: View, prisms: list[occlusion.Prism]) -> None:
+        """Clear the pixels of an LED's `patch` (its top left pixel at row r0, column
+        c0) that `prisms` hide: each ray is followed to where it passes nearest the
+        LED's centre, `along` over its length squared times the ray."""
+        rows, columns = np.nonzero(patch)
+        u = self.all_columns[c0 + columns]
+        v = self.all_rows[r0 + rows]
+        t = along[rows, columns] / lengths[rows, columns] ** 2
+        cp, sp = math.cos(view.pitch), math.sin(view.pitch)
+        # The ray f forward + u left + v down, in the camera's frame turned to the world.
+        hide = occlusion.hidden(t * (self.focal * cp + v * sp), t * u,
+                                view.z + t * (self.focal * sp - v * cp), view.z, prisms)
+        patch[rows[hide], columns[hide]] = False
 
 
 @dataclass(frozen=True, slots=True)

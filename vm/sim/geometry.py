@@ -1,12 +1,19 @@
-"""Plane geometry on plain floats: the simulator calls these at every step, where
-numpy's per-call overhead would cost more than it saves."""
+"""Plane geometry: on plain floats where the simulator calls it at every step (numpy's
+per-call overhead would cost more than it saves), on numpy arrays where the camera asks
+it of every pixel."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
 
+import numpy as np
+import numpy.typing as npt
+
 Point = tuple[float, float]
+Box = tuple[float, float, float, float]  # x0, y0, x1, y1: the least and the most x and y
+Floats = npt.NDArray[np.float64]
+Mask = npt.NDArray[np.bool_]
 
 
 def segment_nearest(px: float, py: float, a: Point, b: Point) -> tuple[float, float, float]:
@@ -29,6 +36,31 @@ def inside(px: float, py: float, polygon: Sequence[Point]) -> bool:
         if (y1 > py) != (y2 > py) and px < x1 + (py - y1) * (x2 - x1) / (y2 - y1):
             result = not result
     return result
+
+
+def inside_each(px: Floats, py: Floats, polygon: Sequence[Point]) -> Mask:
+    """Whether each point (px, py), broadcast together, lies inside `polygon` (the
+    even-odd rule)."""
+    result = np.zeros(np.broadcast_shapes(px.shape, py.shape), dtype=bool)
+    for i in range(len(polygon)):
+        x1, y1 = polygon[i]
+        x2, y2 = polygon[(i + 1) % len(polygon)]
+        if y1 == y2:
+            continue
+        crosses = ((y1 > py) != (y2 > py)) & (px < x1 + (py - y1) * (x2 - x1) / (y2 - y1))
+        result ^= crosses
+    return result
+
+
+def bounding_box(points: Sequence[Point], reach: float = 0.0) -> Box:
+    """The box around `points`, grown by `reach` on every side."""
+    xs, ys = [p[0] for p in points], [p[1] for p in points]
+    return min(xs) - reach, min(ys) - reach, max(xs) + reach, max(ys) + reach
+
+
+def boxes_overlap(first: Box, second: Box) -> bool:
+    return (first[2] >= second[0] and first[0] <= second[2]
+            and first[3] >= second[1] and first[1] <= second[3])
 
 
 def _crosses(a: Point, b: Point, c: Point, d: Point) -> bool:
