@@ -3,8 +3,9 @@ against what is, how its wheels and steering obey, and where it starts, drawn fr
 generators seeded by the run's seed, so that the same seed gives the same run.
 
 Each source of noise draws from a generator of its own, so that a program that reads
-one sensor more often does not change what another reports. A setting of 0 draws
-nothing and changes nothing: with NOISELESS every value passes through exactly.
+one sensor more often does not change what another reports; the errors drawn once a run
+are drawn whatever their settings, so that setting one leaves the others' draws alone.
+A setting of 0 changes nothing: with NOISELESS every value passes through exactly.
 """
 
 from __future__ import annotations
