@@ -128,6 +128,13 @@ def test_the_same_seed_gives_the_same_run(seed: int) -> None:
     assert _errand(SimDevice(world, seed=seed)) == _errand(SimDevice(world, seed=seed))
 
 
+def test_a_setting_turned_on_leaves_the_other_draws_alone() -> None:
+    alone = Imperfections(only(odometry=0.01), 13)
+    joined = Imperfections(only(odometry=0.01, wheel_speed=0.02, steering_deg=1.0), 13)
+    assert joined.scale == alone.scale
+    assert joined.speed != (1.0, 1.0) and joined.steering != 0.0
+
+
 def test_other_seeds_give_other_runs() -> None:
     world = noisy(line_world(offset=3.0, angle=4.0), Noise())
     poses = {_errand(SimDevice(world, seed=seed))[3] for seed in range(5)}
