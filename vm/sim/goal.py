@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from itertools import pairwise
 from typing import TYPE_CHECKING, Any, Literal, NamedTuple
 
-from .geometry import Point, inside, segment_nearest
+from .geometry import Box, Point, bounding_box, boxes_overlap, inside, segment_nearest
 from .motion import Pose
 
 if TYPE_CHECKING:
@@ -256,9 +256,15 @@ def _entry(step: Step, region: Region) -> tuple[float, Pose] | None:
 # The judgement ---------------------------------------------------------------------------
 
 
+def _box_distance(x: float, y: float, box: Box) -> float:
+    """How far (x, y) lies from `box`: never more than from what the box holds."""
+    return math.hypot(max(box[0] - x, 0.0, x - box[2]), max(box[1] - y, 0.0, y - box[3]))
+
+
 @dataclass(slots=True)
 class _Reaching:
     region: Region
+    box: Box
     reached: tuple[float, Pose] | None = None  # when the part was met
     entered: tuple[float, Pose] | None = None  # when the centre first entered, any heading
     nearest: tuple[float, float, Pose] | None = None  # distance, time, pose
@@ -286,8 +292,12 @@ class Judge:
         self.pose = start
         self.camera_ahead = world.vehicle.camera_ahead
         self.stood_since = 0.0  # when the last step ended: the vehicle stands since
-        self.reaching = [_Reaching(region) for region in self.goal.reach]
+        # The regions' boxes spare a step the polygons it cannot touch (a world may give
+        # them 10,000 points), and the nearest approach the distances that cannot win.
+        self.reaching = [_Reaching(region, bounding_box(region.points))
+                         for region in self.goal.reach]
         self.holding = [_Holding(hold) for hold in self.goal.holds]
+        self.avoid = [(region, bounding_box(region.points)) for region in self.goal.avoid]
         self.entered: list[tuple[float, Pose] | None] = [None] * len(self.goal.avoid)
         self._visit(Step(0.0, 0.0, self.pose, self.pose))  # where it starts counts
 
@@ -321,19 +331,24 @@ class Judge:
     # What each step and each stop does
 
     def _visit(self, step: Step) -> None:
+        before, after = step.before, step.after
+        swept = bounding_box(((before.x, before.y), (after.x, after.y)))
         for reaching in self.reaching:
             if reaching.reached is not None:
                 continue
             region = reaching.region
-            reaching.reached = _entry(step, region)
-            if reaching.entered is None:
-                reaching.entered = _entry(step, Region(region.name, region.points))
-            if reaching.entered is None:
-                distance = _distance((step.after.x, step.after.y), region.points)
+            if boxes_overlap(swept, reaching.box):
+                reaching.reached = _entry(step, region)
+                if reaching.entered is None:
+                    reaching.entered = _entry(step, Region(region.name, region.points))
+            if reaching.entered is None and (
+                    reaching.nearest is None
+                    or _box_distance(after.x, after.y, reaching.box) < reaching.nearest[0]):
+                distance = _distance((after.x, after.y), region.points)
                 if reaching.nearest is None or distance < reaching.nearest[0]:
-                    reaching.nearest = (distance, step.end, step.after)
-        for i, region in enumerate(self.goal.avoid):
-            if self.entered[i] is None:
+                    reaching.nearest = (distance, step.end, after)
+        for i, (region, box) in enumerate(self.avoid):
+            if self.entered[i] is None and boxes_overlap(swept, box):
                 self.entered[i] = _entry(step, region)
 
     def _stood(self, since: float, until: float) -> None:
