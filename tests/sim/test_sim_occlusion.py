@@ -11,13 +11,14 @@ from pathlib import Path
 import msgspec.inspect as mi
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from support.worlds import line_world, stand_world
 
 from rl1.vm.sim.camera import Moments, Scenery, View, focal, moments, view_of
 from rl1.vm.sim.device import SimDevice
-from rl1.vm.sim.geometry import Mask, Point
+from rl1.vm.sim.geometry import Mask, Point, inside, rectangle
+from rl1.vm.sim.occlusion import hidden
 from rl1.vm.sim.world import (
     LED_RADIUS,
     LED_SPACING,
@@ -240,6 +241,45 @@ def test_a_wall_across_the_sight_taller_than_the_camera_hides_the_marker(
     wall = box(CAMERA_X + part * distance - 1, 0.0, CAMERA_X + part * distance + 1, 1000.0)
     hidden = with_wall(stand_world(distance), wall, VEHICLE.camera_height + over)
     assert marker_image(hidden)[1].area == 0
+
+
+def _clipped(target: Point, corners: list[Point]) -> tuple[float, float] | None:
+    """The part s0..s1 of the segment from (0, 0) to `target` inside the convex polygon
+    `corners` (counterclockwise), by clipping against each side's half-plane in turn
+    (Cyrus-Beck); None when it misses."""
+    low, high = 0.0, 1.0
+    for i, (ax, ay) in enumerate(corners):
+        bx, by = corners[(i + 1) % len(corners)]
+        nx, ny = by - ay, ax - bx  # outward, the polygon on the left of each side
+        towards, bound = nx * target[0] + ny * target[1], nx * ax + ny * ay
+        if towards > 0:
+            high = min(high, bound / towards)
+        elif towards < 0:
+            low = max(low, bound / towards)
+        elif bound < 0:
+            return None
+    return (low, high) if low < high else None
+
+
+@settings(max_examples=400, deadline=None)
+@given(centre=st.tuples(st.floats(-300, 300), st.floats(-300, 300)),
+       size=st.tuples(st.floats(1, 200), st.floats(1, 200)), turn=st.floats(0, 2 * math.pi),
+       top=st.floats(1, 100), camera=st.floats(1, 100),
+       target=st.tuples(st.floats(-400, 400), st.floats(-400, 400), st.floats(0, 100)))
+def test_hidden_agrees_with_clipping_the_ray_by_the_prism(
+        centre: Point, size: Point, turn: float, top: float, camera: float,
+        target: tuple[float, float, float]) -> None:
+    corners = rectangle(*centre, *size, turn)
+    assume(not inside(0.0, 0.0, corners))  # the camera is never inside what it sees
+    ahead, left, height = target
+    part = _clipped((ahead, left), corners)
+    lowest = None if part is None else min(camera + s * (height - camera) for s in part)
+    # Away from the ties (a ray grazing a corner or the top), where rounding decides.
+    assume(part is None or part[1] - part[0] > 1e-6)
+    assume(lowest is None or abs(lowest - top) > 1e-6)
+    found = hidden(np.array([ahead]), np.array([left]), np.array([height]), camera,
+                   [(corners, top)])
+    assert bool(found[0]) == (lowest is not None and lowest < top)
 
 
 # The world file ---------------------------------------------------------------------------

@@ -55,7 +55,7 @@ def hidden(ahead: Floats, left: Floats, height: Floats | float, camera_height: f
     ends inside a footprint under the top (having come in over it)."""
     result = np.zeros(ahead.shape, dtype=bool)
     rise = height - camera_height
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         for points, top in prisms:
             result |= inside_each(ahead, left, points) & (height < top)
             for i, (ax, ay) in enumerate(points):
@@ -63,7 +63,7 @@ def hidden(ahead: Floats, left: Floats, height: Floats | float, camera_height: f
                 ex, ey = bx - ax, by - ay
                 # The ray's track on the floor, s p for 0 < s < 1 (p = (ahead, left)),
                 # meets the side a + u e, 0 <= u <= 1, at s = (a x e) / (p x e) and
-                # u = (a x p) / (p x e); parallel, the division gives inf or nan.
+                # u = (a x p) / (p x e); parallel, or nearly, it gives inf or nan.
                 across = ahead * ey - left * ex
                 s = (ax * ey - ay * ex) / across
                 u = (ax * left - ay * ahead) / across
