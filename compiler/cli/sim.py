@@ -97,13 +97,14 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
         device.sim.note("fault", result.fault.message)
     title = f"{os.path.basename(file)} on {os.path.basename(world)}"
     if svg_file is not None:
-        write_file(svg_file, svg(the_world, device.sim.track, device.sim.events,
-                                 title).encode(), force=force, role="SVG file")
+        write_file(svg_file, svg(the_world, device.sim.track, device.sim.events, title,
+                                 device.trace, device.sightings).encode(),
+                   force=force, role="SVG file")
     if html_file is not None:
-        calls = [(entry.time, call_text(entry.call, entry.args, entry.result))
-                 for entry in device.trace]
-        write_file(html_file, html(the_world, device.sim.track, device.sim.events, calls,
-                                   title).encode(), force=force, role="HTML file")
+        write_file(html_file, html(
+            the_world, device.sim.track, device.sim.events, device.trace, title,
+            device.sightings, lambda entry: call_text(entry.call, entry.args, entry.result)
+        ).encode(), force=force, role="HTML file")
     if sim_format == "json":
         sys.stdout.write(render_json(result, device, ran.finished.instructions, ended_at,
                                      run_on, trace_choice or "all"))

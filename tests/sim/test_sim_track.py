@@ -18,9 +18,9 @@ from hypothesis import strategies as st
 from support.cli import rl1c
 from support.worlds import open_floor
 
-from rl1.vm.sim.device import SimDevice
+from rl1.vm.sim.device import SimDevice, SimEntry
 from rl1.vm.sim.motion import Pose
-from rl1.vm.sim.render import REPLAY_CALLS, html
+from rl1.vm.sim.render import REPLAY_CALLS, describe_call, html
 from rl1.vm.sim.simulator import MAX_EVENTS, Simulator
 from rl1.vm.sim.track import MAX_TRACK_POINTS, POINTS_PER_SECOND, History, Track
 
@@ -139,11 +139,14 @@ def test_the_default_step_keeps_every_point_of_a_short_run() -> None:
 
 def test_a_replay_page_lists_the_first_and_last_calls_of_a_long_run() -> None:
     world = open_floor()
-    calls = [(number / 1000, f"LMP {number}") for number in range(25_000)]
+    calls = [SimEntry(number / 1000, "LMP", (number,), None, _pose(0), 1)
+             for number in range(25_000)]
     page = html(world, [(0.0, _pose(0))], [], calls)
-    listed = json.loads(page.split("const run = ", 1)[1].split(";\n", 1)[0])["calls"]
+    listed = json.loads(page.split("const run = ", 1)[1].split(";\n", 1)[0])["log"]
     half = REPLAY_CALLS // 2
     assert len(listed) == REPLAY_CALLS + 1
-    assert [text for _, text in listed[:half]] == [text for _, text in calls[:half]]
-    assert [text for _, text in listed[half + 1:]] == [text for _, text in calls[-half:]]
-    assert listed[half] == [calls[half][0], f"... {25_000 - REPLAY_CALLS:,} calls left out ..."]
+    assert [text for *_, text in listed[:half]] == [describe_call(c) for c in calls[:half]]
+    assert [text for *_, text in listed[half + 1:]] == [describe_call(c)
+                                                       for c in calls[-half:]]
+    assert listed[half] == [calls[half].time, "call", None,
+                            f"... {25_000 - REPLAY_CALLS:,} calls left out ..."]

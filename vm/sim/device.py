@@ -18,6 +18,7 @@ from rl1.vm.language import LOST_LINE_RULES
 
 from .camera import PULSES
 from .motion import Pose
+from .sightings import Sighting, Sightings
 from .simulator import SafetyFault, Simulator
 from .world import World
 
@@ -68,6 +69,7 @@ class SimDevice:
         self.sim = Simulator(world, seed=seed) if step is None else Simulator(
             world, step=step, seed=seed)
         self.trace: list[SimEntry] = []
+        self.sightings = Sightings()  # what each (IMG) saw, for the pictures
         self.pending: LineLost | None = None
         self.fault: SafetyFault | None = None
         self.line: int | None = None  # the engine's source line (Device.line)
@@ -183,6 +185,8 @@ class SimDevice:
                                _int16(found.x), _int16(found.y), _int16(found.angle))
         self._record("IMG", result=(reading.area, reading.x, reading.y, reading.z),
                      start=start)
+        self.sightings.add(Sighting(start, self.sim.scene, self.sim.view(),
+                                    (reading.area, reading.x, reading.y)))
         return reading
 
     def camera_origin(self) -> None:
