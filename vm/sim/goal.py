@@ -195,8 +195,7 @@ def _heading_spans(start: float, turn: float, region: Region) -> list[Span]:
     if region.heading is None:
         return [(0.0, 1.0)]
     if turn == 0:
-        off = abs(math.remainder(start - region.heading, math.tau))
-        return [(0.0, 1.0)] if off <= region.tolerance else []
+        return [(0.0, 1.0)] if _heading_off(start, region) <= region.tolerance else []
     low, high = sorted((start, start + turn))
     spans = []
     first = math.floor((low - region.heading - region.tolerance) / math.tau)
