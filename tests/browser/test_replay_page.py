@@ -10,6 +10,7 @@ import os
 import re
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 from support.pictures import HANDLER_LINE, draw
@@ -47,12 +48,19 @@ class Page:
         self.page = self.context.new_page()
         self.problems: list[str] = []
         self.requests: list[str] = []
-        self.page.on("console", lambda message: message.type in ("error", "warning")
-                     and self.problems.append(f"{message.type}: {message.text}"))
+        self.page.on("console", self._console)
         self.page.on("pageerror", lambda error: self.problems.append(f"error: {error}"))
-        self.page.on("request", lambda request: request.url != path.as_uri()
-                     and self.requests.append(request.url))
-        self.page.goto(path.as_uri())
+        self.page.on("request", self._request)
+        self.address = path.as_uri()
+        self.page.goto(self.address)
+
+    def _console(self, message: Any) -> None:
+        if message.type in ("error", "warning"):
+            self.problems.append(f"{message.type}: {message.text}")
+
+    def _request(self, request: Any) -> None:
+        if request.url.split("#")[0] != self.address:
+            self.requests.append(request.url)
 
     def clock(self) -> float:
         text = self.page.text_content("#clock") or ""

@@ -9,8 +9,10 @@ from __future__ import annotations
 import base64
 import json
 import math
+import re
 import xml.etree.ElementTree as ElementTree
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -22,7 +24,15 @@ from support.worlds import open_floor
 from rl1.vm.sim.camera import View, view_centre, view_of
 from rl1.vm.sim.device import SimDevice
 from rl1.vm.sim.motion import Pose
-from rl1.vm.sim.render import FAR, MAX_FRAMES, footprint, html, turns_in_place, wheel_speeds
+from rl1.vm.sim.render import (
+    FAR,
+    MAX_FRAMES,
+    MAX_PLOTTED,
+    footprint,
+    html,
+    turns_in_place,
+    wheel_speeds,
+)
 from rl1.vm.sim.sightings import MAX_SIGHTINGS, Sighting, Sightings
 
 SVG = "{http://www.w3.org/2000/svg}"
@@ -48,8 +58,8 @@ def _points(element: ElementTree.Element) -> list[tuple[float, float]]:
             (pair.split(",") for pair in element.get("points", "").split())]
 
 
-def replay_data(page: str) -> dict[str, list[list[object]]]:
-    data: dict[str, list[list[object]]] = json.loads(
+def replay_data(page: str) -> dict[str, Any]:
+    data: dict[str, Any] = json.loads(
         page.split("const run = ", 1)[1].split(";\n", 1)[0])
     return data
 
@@ -58,8 +68,8 @@ def test_the_legend_names_every_kind_of_mark(
         pictures: tuple[ElementTree.Element, str]) -> None:
     root, _ = pictures
     legend = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "legend")
-    assert {"path", "start", "end pose", "run ended", "turn in place", "camera at each IMG", "ultrasonic echo",
-            "line lost", "line found", "handler taken", "fault", "wall",
+    assert {"path", "start", "end pose", "run ended", "turn in place", "camera at each IMG",
+            "ultrasonic echo", "line lost", "line found", "handler taken", "fault", "wall",
             "stand, marker"} <= set(_texts(legend))
 
 
@@ -129,7 +139,7 @@ def test_the_replay_log_has_the_lost_line_the_handler_and_source_lines(
     log = replay_data(page)["log"]
     kinds = [kind for _, kind, _, _ in log]
     assert "lost" in kinds and "handler" in kinds
-    assert [time for time, *_ in log] == sorted(time for time, *_ in log)  # type: ignore[type-var]
+    assert [time for time, *_ in log] == sorted(time for time, *_ in log)
     after = [entry for entry in log[kinds.index("handler"):] if entry[1] == "call"]
     assert after[0][2] == HANDLER_LINE and after[0][3] == "MOV 0,0"
     assert all(isinstance(line, int) for _, kind, line, _ in log if kind == "call")
@@ -144,7 +154,7 @@ def test_the_replay_frames_are_the_images_the_camera_saw(
     assert isinstance(bits, str) and isinstance(columns, int) and isinstance(rows, int)
     image = np.unpackbits(np.frombuffer(base64.b64decode(bits), dtype=np.uint8))
     # The line across the window: the set pixels are the area IMG returned.
-    assert int(image[:columns * rows].sum()) == reading[0] == 156  # type: ignore[index]
+    assert int(image[:columns * rows].sum()) == reading[0] == 156
     assert window == [98, 117, 158, 123] and frames[1][7][0] == 0  # the line lost at last
 
 
@@ -252,3 +262,17 @@ def test_a_run_on_the_sample_world_draws_valid_xml(tmp_path: Path) -> None:
     assert picture.exists(), result.output
     root = ElementTree.fromstring(picture.read_text())
     assert 'a <b> & "c"' in [text.text for text in _by_class(root, "text", "label")]
+
+
+def test_a_polling_loop_plots_a_bounded_number_of_points(tmp_path: Path) -> None:
+    from support.cli import rl1c
+    program, world, page = tmp_path / "poll.rob", tmp_path / "w.toml", tmp_path / "poll.html"
+    program.write_text("(MOV 1,1)\n:10 (KYO); (ULT A); #10\n")
+    world.write_text("[floor]\nsize = [2000, 500]\n[start]\nx = 100\ny = 250\n"
+                     "[limits]\ntime = 100\n")
+    result = rl1c("sim", program, "--world", world, "--html", page)
+    assert result.exit_code == 13, result.output  # the time limit, 5,000 readings on
+    plotted = re.findall(r'class="series" points="([^"]*)"', page.read_text())
+    # ULT A; KYO's centre, right and left; both wheels: each a staircase or a line.
+    assert len(plotted) == 6
+    assert all(0 < len(points.split()) <= 2 * MAX_PLOTTED + 1 for points in plotted)

@@ -39,6 +39,8 @@ MAX_DRAWN = 200
 more draws every n-th, and the legend says so."""
 MAX_FRAMES = 120
 """Camera images a replay page holds, at most (up to 8 KB each), spread over the run."""
+MAX_PLOTTED = 2_000
+"""Points of each series a plot draws, at most (a polling loop can read millions)."""
 MAX_SIGHTS = 2_000
 """Camera footprints a replay page holds, at most (60 bytes each), spread over the run."""
 VIEW_MOVED = 25.0  # cm
@@ -457,7 +459,9 @@ _SERIES_COLOURS = ("#1565c0", "#d11", "#2a9d2a", "#8e24aa")
 def _plot(name: str, unit: str, end: float, series: dict[str, list[tuple[float, float]]],
           steps: bool) -> str:
     """One plot over time, 0 to `end` s, a polyline per series (a staircase when the
-    value holds between readings)."""
+    value holds between readings) of at most MAX_PLOTTED points."""
+    series = {label: points[::_every(points, MAX_PLOTTED)] for label, points in series.items()
+              if points}
     width, height, left, right, top, bottom = 640, 110, 44, 10, 16, 18
     values = [v for points in series.values() for _, v in points]
     low, high = (min(values), max(values)) if values else (0.0, 1.0)
@@ -493,7 +497,7 @@ def _plot(name: str, unit: str, end: float, series: dict[str, list[tuple[float, 
             drawn.append(at(end, points[-1][1]))
         parts.append(f'<polyline class="series" points="{" ".join(drawn)}" fill="none" '
                      f'stroke="{colour}" stroke-width="1.2"><title>{escape(label)}</title>'
-                     f'</polyline><text x="{left + 150 + 90 * i}" y="11" font-size="11" '
+                     f'</polyline><text x="{left + 250 + 90 * i}" y="11" font-size="11" '
                      f'fill="{colour}" {_TEXT}>{escape(label)}</text>')
     parts.append(f'<line class="cursor" x1="{left}" y1="{top}" x2="{left}" '
                  f'y2="{height - bottom}" stroke="#000" stroke-opacity="0.5" '
