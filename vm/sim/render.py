@@ -608,8 +608,9 @@ font-weight:bold}} #log .fault{{color:#d11;font-weight:bold}} #log .end{{color:#
 <div id="panes">
 <div><div class="caption">calls, lost and found lines, handlers (newest last)</div>
 <div id="log"></div></div>
-<div><div class="caption">camera: the image of the last IMG, its window (box) and
-centroid (cross); image x counts columns left to right here</div>
+<div><div class="caption">camera: the scene's image at the last IMG (noise acts on what
+IMG returns, not on this), its window (box) and the centroid IMG returned (cross);
+image x counts columns left to right here</div>
 <canvas id="camera"></canvas><div id="frame" class="caption">no IMG yet</div></div>
 </div>
 <div id="plots">{plots}</div>
