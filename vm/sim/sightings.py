@@ -11,16 +11,15 @@ from __future__ import annotations
 
 from collections import deque
 from collections.abc import Iterator
-from dataclasses import dataclass
+from typing import NamedTuple
 
 from .camera import View
 
 MAX_SIGHTINGS = 10_000
-"""Sightings a run keeps, at most (about 150 bytes each)."""
+"""Sightings a run keeps, at most (about 420 bytes each: 4 MB in all)."""
 
 
-@dataclass(frozen=True, slots=True)
-class Sighting:
+class Sighting(NamedTuple):
     """One (IMG): when it started (s), the scene selected, where the camera was and
     looked, and what it returned (area, x, y)."""
 
