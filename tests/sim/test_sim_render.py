@@ -276,3 +276,18 @@ def test_a_polling_loop_plots_a_bounded_number_of_points(tmp_path: Path) -> None
     # ULT A; KYO's centre, right and left; both wheels: each a staircase or a line.
     assert len(plotted) == 6
     assert all(0 < len(points.split()) <= 2 * MAX_PLOTTED + 1 for points in plotted)
+
+
+def test_a_name_cannot_end_the_page_s_script(tmp_path: Path) -> None:
+    from support.cli import rl1c
+    program, world, page = tmp_path / "hit.rob", tmp_path / "w.toml", tmp_path / "hit.html"
+    program.write_text("(MOV 3,3); (TIM 100)\n")
+    world.write_text('[floor]\nsize = [800, 500]\n[start]\nx = 100\ny = 250\n[[walls]]\n'
+                     'name = "</script><b>"\npoints = [[300, 0], [320, 0], [320, 500]]\n')
+    result = rl1c("sim", program, "--world", world, "--html", page)
+    assert result.exit_code == 0, result.output  # ran on into the wall, named in an event
+    text = page.read_text()
+    assert text.count("</script>") == 1  # the page's own, at its end
+    assert "&lt;/script&gt;&lt;b&gt;" in text  # the wall's label
+    assert text.count("<b>") == text.count("<\\/script><b>") == 1  # in the script's data
+    assert "</script><b>" in json.dumps(replay_data(text)["log"])  # the JSON holds it whole
