@@ -1,10 +1,16 @@
 """The paper's reading that Listing 1 depends on (spec/simulator.md, "The paper's
-reading"): STX turns the steering relative to where it is, as STR and STL do; and the
-arithmetic of Listing 1's centring, left to right, which the spec's evidence cites."""
+reading"): STX turns the steering relative to where it is, as STR and STL do; the
+arithmetic of Listing 1's centring, left to right, which the spec's evidence cites; and
+the robust Fig. 4 scene the spec describes (the stand on the right, placed by round
+numbers, no return line), on which Listing 1 with its steering correction as `C`'s
+pattern reaches the stand and comes back to the guidance line."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
+from itertools import pairwise
+from pathlib import Path
 
 import pytest
 from hypothesis import given
@@ -14,9 +20,12 @@ from support.worlds import open_floor
 from rl1.compiler.runner import Finished, run
 from rl1.vm.sim import camera
 from rl1.vm.sim.device import SimDevice
-from rl1.vm.sim.world import Vehicle
+from rl1.vm.sim.geometry import segment_nearest
+from rl1.vm.sim.world import NOISELESS, Vehicle, World, decode_world
 
 STX_RANGE = range(-1800, 1801)
+EXAMPLES = Path(__file__).parents[2] / "examples"
+CORRECTED = (EXAMPLES / "sample.rob").read_text().replace("d=a<3+c>a<7", "d=a<3+c>7")
 
 
 def test_stx_turns_the_steering_from_where_it_is() -> None:
@@ -63,3 +72,34 @@ def test_listing_1s_pan_correction_is_the_pixels_angle() -> None:
     correction = _evaluate("a=64; b=a<4+a; C=a<3+b>6+C", "C")
     pixel = math.degrees(math.atan(1 / camera.focal(Vehicle())))
     assert correction / 64 * 180 / camera.PULSES == pytest.approx(pixel, rel=0.05)
+
+
+def _fig4_scene(dx: float, dy: float) -> World:
+    """sample.mirrored.world.toml with its stand at (390, 35) facing 135 degrees, moved
+    by (dx, dy), without its return line, without noise and goal."""
+    path = EXAMPLES / "sample.mirrored.world.toml"
+    world = decode_world(path.read_bytes(), path.name)
+    stand = dataclasses.replace(world.stands[0], x=390 + dx, y=35 + dy, facing=135)
+    return dataclasses.replace(world, stands=(stand,), noise=NOISELESS, goal=None,
+                               lines=tuple(line for line in world.lines
+                                           if line.name != "return"))
+
+
+@pytest.mark.parametrize(("dx", "dy"), [(0, 0), (-10, -10), (-10, 10), (10, -10), (10, 10)])
+def test_listing_1_corrected_reaches_a_stand_on_the_right_and_comes_back(
+        dx: float, dy: float) -> None:
+    world = _fig4_scene(dx, dy)
+    device = SimDevice(world)
+    assert CORRECTED.count("d=a<3+c>7") == 2
+    finished = run(CORRECTED, device)
+    assert isinstance(finished, Finished) and finished.result.fault is None, finished
+    held = [entry.pose for entry in device.trace if entry.call == "HLD"]
+    assert len(held) == 1
+    ahead = world.vehicle.camera_ahead
+    camera_at = (held[0].x + ahead * math.cos(held[0].heading),
+                 held[0].y + ahead * math.sin(held[0].heading))
+    assert math.dist(camera_at, world.stands[0].marker()) < 60
+    guide = next(line for line in world.lines if line.name == "guide")
+    end = device.sim.pose
+    assert min(segment_nearest(end.x, end.y, a, b)[2]
+               for a, b in pairwise(guide.points)) < 15
