@@ -105,7 +105,7 @@ def _scene(world: World, plane: _Plane) -> list[str]:
         labels.append(plane.label(mx + 8, my, mark.name, "start"))
     for block in world.blocks:
         parts.append(f'<polygon points="{plane.points(block.points)}" fill="#9aa" '
-                     f'stroke="#566"><title>wall {escape(block.name)}</title></polygon>')
+                     f'stroke="#566"><title>{escape(block.name)}</title></polygon>')
         labels.append(plane.label(*_centroid(block.points), block.name))
     for stand in world.stands:
         mx, my = plane.at(*stand.marker())
@@ -266,7 +266,7 @@ def _legend(x: float, y: float, notes: dict[str, str]) -> tuple[str, float]:
                        '<rect x="14" y="-4" width="8" height="8" fill="#444"/>'),
         ("stand, marker", '<rect x="0" y="-6" width="16" height="12" fill="#c9b38a" '
                           'stroke="#7a6236"/><circle cx="8" cy="0" r="3" fill="#f33"/>'),
-        ("wall", '<rect x="0" y="-6" width="22" height="12" fill="#9aa" stroke="#566"/>'),
+        ("wall, obstacle", '<rect x="0" y="-6" width="22" height="12" fill="#9aa" stroke="#566"/>'),
         *[(f"line {kind}" if kind in ("lost", "found") else
            {"handler": "handler taken", "fault": "fault", "end": "run ended"}[kind],
            f'<circle cx="8" cy="0" r="6" fill="{COLOURS[kind]}" fill-opacity="0.8"/>')
