@@ -8,8 +8,9 @@ device it is given, through the adapter that tells the device the source line of
 call (vm/device.py's `perform` for the interpreter, hardware.Blocking for the VMs).
 
 The VMs run in steps (vm/drive.py), which is also how a sensor script's losses after
-instruction N are made; the interpreter counts no instructions, so it refuses such a
-script.
+instruction N are made, and how the simulator's time passes between calls; the
+interpreter counts no instructions, so it refuses such a script, and on the simulator
+each statement it runs takes one instruction's time.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from rl1.compiler.frontend.diagnostics import Diagnostic
 from rl1.compiler.interpreter import Interpreter
 from rl1.vm.defaults import DEFAULT_BUDGET, Engine
 from rl1.vm.device import Device
-from rl1.vm.drive import drive
+from rl1.vm.drive import Clocked, drive, drive_clocked
 from rl1.vm.faults import RunResult
 from rl1.vm.hardware import Blocking
 from rl1.vm.machine import Machine
@@ -85,8 +86,10 @@ def _interpret(text: str, device: Device, budget: int) -> Finished | list[Diagno
     analysis = analyze(text)
     if analysis.has_errors:
         return analysis.diagnostics
-    return Finished(Interpreter(analysis.program, device, budget).run(), None,
-                    analysis.diagnostics)
+    interpreter = Interpreter(analysis.program, device, budget)
+    if isinstance(device, Clocked):  # the interpreter's statements take its time
+        device.count_instructions(lambda: interpreter.steps)
+    return Finished(interpreter.run(), None, analysis.diagnostics)
 
 
 def _on_vm(data: bytes, device: Device, engine: Engine, budget: int) -> Finished:
@@ -102,6 +105,8 @@ def _on_vm(data: bytes, device: Device, engine: Engine, budget: int) -> Finished
         machine = Machine(program, hardware, budget)
     if isinstance(device, ScriptedDevice):
         return Finished(drive(machine, device), machine.executed)
+    if isinstance(device, Clocked):
+        return Finished(drive_clocked(machine, device), machine.executed)
     return Finished(machine.run(), machine.executed)
 
 

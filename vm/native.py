@@ -376,6 +376,10 @@ class NativeMachine:
     def state(self) -> State:
         return State(self._vm.state)
 
+    @property
+    def variables(self) -> tuple[int, ...]:
+        return tuple(self._vm.V)
+
     def current_line(self) -> int | None:
         """The source line of the call under way, or of the instruction run last between
         steps (as Machine.current_line): the line entry at or before the byte before pc;

@@ -184,10 +184,11 @@ def fault_help(fault: Fault) -> str:
 
 
 def fault_text(fault: Fault, name: str, source_name: str, text: str | None, *,
-               color: bool = False) -> str:
+               color: bool = False, help: str | None = None) -> str:
     """The fault of a run of the program `name` as the checker shows a diagnostic:
     `error[E1010]: message`, `--> file:line:col`, the source line (of `text`, the
-    file `source_name`, when known) with the call underlined, and what to do."""
+    file `source_name`, when known) with the call underlined, and what to do (`help`,
+    or what `fault_help` says)."""
     lines = text.splitlines() if text is not None else []
     message = fault.message
     if fault.line is not None and 1 <= fault.line <= len(lines):
@@ -200,7 +201,7 @@ def fault_text(fault: Fault, name: str, source_name: str, text: str | None, *,
             message += f" (at line {fault.line})"
         shown = FileDiagnostics(name, None, [])
     diagnostic = Diagnostic(fault.kind.diagnostic_code, Severity.ERROR, message, span,
-                            help=fault_help(fault))
+                            help=help or fault_help(fault))
     return diagnostic_blocks(FileDiagnostics(shown.name, shown.text, [diagnostic]),
                              color=color)
 

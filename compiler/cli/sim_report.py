@@ -6,13 +6,14 @@ pose track and the events, for tools."""
 from __future__ import annotations
 
 import json
-import math
 from typing import Any
 
 from rl1.vm.defaults import TraceChoice
-from rl1.vm.faults import RunResult
+from rl1.vm.faults import FaultKind, RunResult
 from rl1.vm.sim.device import RunOn, SimDevice, SimEntry
+from rl1.vm.sim.goal import GOAL_MISSED, Verdict
 from rl1.vm.sim.motion import Pose
+from rl1.vm.sim.simulator import heading_degrees
 
 from .run_report import (
     TRACE_HEADING,
@@ -26,12 +27,35 @@ from .running import Ran
 
 
 def _pose(pose: Pose) -> list[float]:
-    return [round(pose.x, 2), round(pose.y, 2), round(math.degrees(pose.heading), 2)]
+    return [round(pose.x, 2), round(pose.y, 2), heading_degrees(pose.heading, 2)]
 
 
 def _ms(seconds: float) -> int:
     """Simulated time as the reports give device time: whole milliseconds."""
     return round(seconds * 1000)
+
+
+_SAFETY_HELP = {
+    "collision": "see where with --svg FILE (a top view of the path, the walls and the stop); "
+                 "stop or turn before it: read the distance ahead (`A=(ULT A)`), count the "
+                 "distance driven (`(KYO)`, `(MVI l,r,cm)`), or trace a line in mode 2",
+    "off-floor": "see where with --svg FILE (a top view of the path and the floor); stop or "
+                 "turn before the edge: count the distance driven (`(KYO)`, `(MVI l,r,cm)`) "
+                 "or trace a line in mode 2; or make the world's floor larger ([floor] size)",
+    "time-limit": "if the program should run longer, raise the world's [limits] time; if "
+                  "not, it waits for something that does not come: --svg FILE shows where "
+                  "the vehicle was",
+}
+_SIMULATED_DEVICE_HELP = ("the simulated vehicle cannot do what the call asks; "
+                          "spec/simulator.md says what each call does (\"Motion\")")
+
+
+def _help(device: SimDevice, kind: FaultKind) -> str | None:
+    """What to do about a fault of the kind `kind` in the simulator: a safety stop's
+    own words, or None for the words of `rl1c run` (a fault of the program)."""
+    if device.fault is not None:
+        return _SAFETY_HELP[device.fault.kind]
+    return _SIMULATED_DEVICE_HELP if kind is FaultKind.DEVICE else None
 
 
 def _ending(ran: Ran, device: SimDevice, run_on: RunOn | None, program: str,
@@ -48,21 +72,39 @@ def _ending(ran: Ran, device: SimDevice, run_on: RunOn | None, program: str,
                 f"until it stopped at ({pose.x:.1f}, {pose.y:.1f})")
         return (f"the program ended normally with the vehicle moving: it ran on for "
                 f"{run_on.seconds:.2f} s, {stop}")
-    return fault_text(fault, program, ran.source_name, ran.source, color=color).rstrip("\n")
+    return fault_text(fault, program, ran.source_name, ran.source, color=color,
+                      help=_help(device, fault.kind)).rstrip("\n")
+
+
+def run_status(result: RunResult, verdict: Verdict | None) -> dict[str, Any]:
+    """How the run ended, as `rl1c run`'s status (its exit status the command's), but
+    a program that ended without meeting the world's goal is `goal-missed` (a fault
+    comes first: the goal is judged all the same, and reported beside it)."""
+    if result.fault is not None or verdict is None or verdict.met:
+        return result.status()
+    return {"code": "goal-missed", "exit_status": GOAL_MISSED,
+            "message": f"the program ended, but {verdict.headline()}", "line": None}
+
+
+def _goal_lines(verdict: Verdict) -> list[str]:
+    """The verdict's headline, then each part: met or missed, and what happened."""
+    return [verdict.headline(), *(f"- {outcome.title()}: {'met' if outcome.met else 'MISSED'}"
+                                  f", {outcome.text}" for outcome in verdict.outcomes)]
 
 
 def _entry_line(entry: SimEntry) -> str:
     pose = entry.pose
     return (entry_start(_ms(entry.time), entry.line)
             + f"{call_text(entry.call, entry.args, entry.result):<40} "
-            f"({pose.x:7.1f}, {pose.y:7.1f}) {math.degrees(pose.heading):6.1f}")
+            f"({pose.x:7.1f}, {pose.y:7.1f}) {heading_degrees(pose.heading, 1):6.1f}")
 
 
 def render_text(ran: Ran, device: SimDevice, program: str, ended_at: float,
                 run_on: RunOn | None = None, trace: TraceChoice = "short", *,
-                color: bool = False) -> str:
+                color: bool = False, verdict: Verdict | None = None) -> str:
     """The report for people of the run `ran` of `program`, which ended at simulated
-    time `ended_at` (s), with the calls `trace` chooses (as `rl1c run --trace`)."""
+    time `ended_at` (s), with the calls `trace` chooses (as `rl1c run --trace`), and
+    the goal's `verdict` when the world has a goal."""
     lines = []
     shown = select_trace(device.trace, trace)
     if shown.head:
@@ -72,14 +114,16 @@ def render_text(ran: Ran, device: SimDevice, program: str, ended_at: float,
         if event.kind in ("lost", "handler", "found"):
             lines.append(f"{entry_start(_ms(event.time), None)}[{event.text}]")
     lines.append(_ending(ran, device, run_on, program, color))
+    if verdict is not None:
+        lines += _goal_lines(verdict)
     lines += closing_lines(ran.finished.result, _ms(ended_at), ran.finished.instructions)
     return "\n".join(lines) + "\n"
 
 
 def render_json(result: RunResult, device: SimDevice, instructions: int | None,
                 ended_at: float, run_on: RunOn | None = None,
-                trace: TraceChoice = "all") -> str:
-    status = result.status()  # the shape of `rl1c run`'s, and a safety stop's facts
+                trace: TraceChoice = "all", verdict: Verdict | None = None) -> str:
+    status = run_status(result, verdict)  # the shape of `rl1c run`'s, and a safety stop's
     if device.fault is not None:
         status |= {"safety": device.fault.kind, "time": round(device.fault.time, 4),
                    "pose": _pose(device.fault.pose)}
@@ -89,6 +133,7 @@ def render_json(result: RunResult, device: SimDevice, instructions: int | None,
         "instructions": instructions,  # as `rl1c run`'s: None when the interpreter ran it
         "device_time": _ms(ended_at),  # ms, as `rl1c run`'s
         "variables": result.named(),
+        "goal": None if verdict is None else verdict.to_json(),  # null: the world has none
         # After an (END) with the vehicle moving: how long it ran on, and what stopped it.
         "run_on": None if run_on is None else {
             "seconds": round(run_on.seconds, 4), "pose": _pose(device.sim.pose),
@@ -99,7 +144,7 @@ def render_json(result: RunResult, device: SimDevice, instructions: int | None,
         "events": [{"time": round(e.time, 4), "kind": e.kind, "text": e.text,
                     "pose": [round(e.pose.x, 2), round(e.pose.y, 2)]}
                    for e in device.sim.events],
-        "track": [[round(t, 4), round(p.x, 2), round(p.y, 2), round(math.degrees(p.heading), 2)]
+        "track": [[round(t, 4), round(p.x, 2), round(p.y, 2), heading_degrees(p.heading, 2)]
                   for t, p in device.sim.track],
     }
     return json.dumps(document, indent=1) + "\n"
