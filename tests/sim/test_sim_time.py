@@ -24,10 +24,11 @@ CORPUS = Path(__file__).parents[2] / "bench" / "corpus"
 ENGINES = ["vm", pytest.param("c", marks=pytest.mark.needs_cc)]
 
 
-def _world(instruction_time: float = Vehicle().instruction_time, **kwargs: object) -> World:
+def _world(instruction_time: float = Vehicle().instruction_time,
+           blocks: tuple[Block, ...] = ()) -> World:
     world = open_floor(100.0, 500.0)
     vehicle = msgspec.structs.replace(world.vehicle, instruction_time=instruction_time)
-    return replace(world, vehicle=vehicle, **kwargs)
+    return replace(world, vehicle=vehicle, blocks=blocks)
 
 
 def _run(world: World, text: str, engine: Engine = "vm") -> tuple[Finished, SimDevice]:
