@@ -58,14 +58,15 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
     Exit status: 0 the program ended; 1 it has errors; 2 a usage problem or an
     unreadable or invalid file (the world file included); faults as `rl1c run`: 10
     argument out of range, 11 missing handler, 12 budget exhausted, 13 device error
-    (safety stops included)."""
+    (safety stops included); 20 the program ended but missed the world's [goal]."""
     from rl1.vm.sim.device import SimDevice
+    from rl1.vm.sim.goal import Judge
     from rl1.vm.sim.render import html, svg
     from rl1.vm.sim.world import WorldError, decode_world
 
     from .run_report import call_text
     from .running import run_file
-    from .sim_report import render_json, render_text
+    from .sim_report import render_json, render_text, run_status
 
     if world is None:
         raise click.UsageError("a simulation needs a world to run in: give --world FILE, a "
@@ -82,6 +83,9 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
         raise invalid_file(WORLD_ROLE, world, str(error),
                            "correct it as spec/simulator.md describes") from None
     device = SimDevice(the_world, seed=seed)
+    judging = None if the_world.goal is None else Judge(the_world, device.sim.pose)
+    if judging is not None:
+        device.sim.on_move = judging.step  # each exact step: the track is decimated
     ran = run_file(file, device, engine, budget, color, "sim")
     if isinstance(ran, int):
         return ran
@@ -95,24 +99,26 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
         run_on = device.run_on()  # (END) leaves motion in effect: where does it go?
     elif device.fault is None:  # a safety stop has noted itself
         device.sim.note("fault", result.fault.message)
-    title = f"{os.path.basename(file)} on {os.path.basename(world)}"
+    verdict = None if judging is None else judging.verdict(device.sim.time)
+    title = f"{os.path.basename(file)} on {os.path.basename(world)}" + (
+        "" if verdict is None else f": {verdict.headline()}")
     if svg_file is not None:
         write_file(svg_file, svg(the_world, device.sim.track, device.sim.events, title,
-                                 device.trace, device.sightings).encode(),
+                                 device.trace, device.sightings, verdict).encode(),
                    force=force, role="SVG file")
     if html_file is not None:
         write_file(html_file, html(
             the_world, device.sim.track, device.sim.events, device.trace, title,
-            device.sightings, lambda entry: call_text(entry.call, entry.args, entry.result)
-        ).encode(), force=force, role="HTML file")
+            device.sightings, lambda entry: call_text(entry.call, entry.args, entry.result),
+            verdict).encode(), force=force, role="HTML file")
     if sim_format == "json":
         sys.stdout.write(render_json(result, device, ran.finished.instructions, ended_at,
-                                     run_on, trace_choice or "all"))
+                                     run_on, trace_choice or "all", verdict))
     else:
         sys.stdout.write(render_text(ran, device, file, ended_at, run_on,
                                      trace_choice or "short",
-                                     color=use_color(color, sys.stdout)))
-    return result.fault.kind.exit_status if result.fault is not None else 0
+                                     color=use_color(color, sys.stdout), verdict=verdict))
+    return int(run_status(result, verdict)["exit_status"])
 
 
 COMMANDS = (sim,)
