@@ -120,11 +120,14 @@ class SimDevice:
     def _begin(self) -> None:
         """The start of every call: the instructions before it take their time."""
         self.catch_up()
-        self._pass(0.0)
+        self._refuse_after_fault()
 
-    def _pass(self, seconds: float, interruptible: bool = False) -> None:
+    def _refuse_after_fault(self) -> None:
         if self.fault is not None:
             raise DeviceError(f"the simulation was stopped: {self.fault}")
+
+    def _pass(self, seconds: float, interruptible: bool = False) -> None:
+        self._refuse_after_fault()
         try:
             lost = self.sim.run_for(seconds, interruptible)
         except SafetyFault as fault:
