@@ -13,11 +13,17 @@ struct (rl1_vm) is read from the size of test/probe.c's symbol. Stack: from gcc'
 out return addresses and the hardware callbacks, which are the firmware's; the emulated
 targets (make -C vm/c targets) measure the high-water mark of a real run.
 
+What the VM needs from outside: the symbols a bare link of its two objects leaves
+undefined (`ld -r`, then `nm -u`). It calls no C library function; gcc's switch tables
+call libgcc's helpers on Cortex-M0 at -Os and on AVR, which every gcc link includes
+(after -nostdlib, add -lgcc). NEEDS is that set for each target, as vm/c/README.md
+states it (tests/c/test_c_bare_link.py holds the two equal).
+
     python3 bench/c_size.py [BUILD-FOLDER]      (default vm/c/build)
 
 Sizes do not depend on the machine's load, so `make -C vm/c test` runs this as a check:
-exit status 1 when a goal is missed (static RAM anywhere, or on Cortex-M3 more flash,
-struct or stack than the goals allow).
+exit status 1 when a goal is missed (static RAM anywhere, an undefined symbol other than
+NEEDS, or on Cortex-M3 more flash, struct or stack than the goals allow).
 """
 
 from __future__ import annotations
@@ -40,6 +46,13 @@ STEP_CHAIN: Chain = {"rl1vm": ("rl1_step", "take_event", "fault", "finish", "shi
                                "call", "resume", "run", "ended"),
                      "rl1vm_load": ("rl1_op_length", "rl1_arg_in_range")}
 GOALS = {"flash": 4096, "struct": 128, "stack": 256}
+# What a bare link of the VM and verifier leaves undefined, by target: libgcc's helpers
+# for switch tables (Thumb-1 has no table branch instruction; AVR jumps through flash).
+NEEDS: dict[str, frozenset[str]] = {
+    "Cortex-M0": frozenset({"__gnu_thumb1_case_uqi", "__gnu_thumb1_case_uhi"}),
+    "Cortex-M3": frozenset(),
+    "ATmega328P": frozenset({"__tablejump2__"}),
+}
 
 
 def sizes(tool: str, path: Path, rodata_in_ram: bool) -> tuple[int, int]:
@@ -87,6 +100,15 @@ def struct_size(tool: str, path: Path) -> int:
     raise ValueError(f"no rl1_vm_size_probe in {path}")
 
 
+def undefined_symbols(prefix: str, paths: list[Path], linked: Path) -> frozenset[str]:
+    """What the objects at `paths`, linked together alone (`ld -r`: no start-up code,
+    no library), still need from outside."""
+    subprocess.run([prefix + "ld", "-r", "-o", str(linked), *map(str, paths)], check=True)
+    output = subprocess.run([prefix + "nm", "-u", str(linked)], check=True,
+                            capture_output=True, text=True).stdout
+    return frozenset(line.split()[-1] for line in output.splitlines() if line.strip())
+
+
 def main() -> int:
     build = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).parent.parent / \
         "vm" / "c" / "build"
@@ -104,12 +126,20 @@ def main() -> int:
         struct = struct_size(prefix + "nm", build / f"probe-{suffix}.o")
         load_stack = stack_bound(build, suffix, LOAD_CHAIN)
         step_stack = stack_bound(build, suffix, STEP_CHAIN)
+        needs = undefined_symbols(prefix, paths, build / f"bare-{suffix}.o")
         total = vm_flash + load_flash
         print(f"{name:<12} {vm_flash:>6} + {load_flash:>6} = {total:>5} bytes"
               f"   {vm_ram + load_ram:>6} bytes   {struct:>3} bytes   "
               f"{load_stack:>4}, {step_stack:>4} bytes")
+        print(f"{'':<12} needs from outside (nm -u of a bare link): "
+              f"{' '.join(sorted(needs)) or 'nothing'}")
         if vm_ram + load_ram:
             print(f"  {name}: the VM must have no static data")
+            status = 1
+        if needs != NEEDS[name]:
+            print(f"  {name}: a bare link needs {' '.join(sorted(needs)) or 'nothing'}, "
+                  f"where vm/c/README.md says {' '.join(sorted(NEEDS[name])) or 'nothing'}:"
+                  f" remove the new call, or say it in the README and in NEEDS here")
             status = 1
         if name == "Cortex-M3":
             for goal, value in (("flash", total), ("struct", struct),

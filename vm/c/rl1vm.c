@@ -72,6 +72,18 @@ static uint16_t shifted(uint16_t x, int16_t count, bool left)
 #define SET_R (CALL_BIT(OP_KYO) | CALL_BIT(OP_IMG) | CALL_BIT(OP_INP)                      \
                | (CALL_BIT(OP_ULTD + 1u) - CALL_BIT(OP_CAMR)))
 
+/* A reading with every field zero, stored field by field: an initializer of the whole
+ * struct becomes a call to memset on Cortex-M0 (gcc at any level) and with clang at -O0,
+ * and the VM calls no library function (vm/c/README.md). */
+static void clear_reading(rl1_reading *out)
+{
+    out->result = 0;
+    out->writes[0] = 0;
+    out->writes[1] = 0;
+    out->writes[2] = 0;
+    out->writes[3] = 0;
+}
+
 /* Takes a finished call's answer: false for a device error (an ERROR, or a value out of
  * its documented range, 12.5: then nothing is written); else writes the reserved
  * variables, then R (spec/ilc.md section 9, steps 4-6). */
@@ -108,9 +120,10 @@ static rl1_fault call(rl1_vm *vm, const rl1_hardware *hw, uint8_t op, uint8_t ar
                       const uint8_t *operands)
 {
     int16_t args[3];
-    rl1_reading out = {0, {0, 0, 0, 0}};
+    rl1_reading out;
     rl1_status status;
     uint8_t mask, k;
+    clear_reading(&out);
     if (arity) {
         mask = RL1_BYTE(operands);
         for (k = 0; k < arity; k++) { /* left to right; the first out of range faults */
@@ -191,10 +204,12 @@ static rl1_state ended(rl1_vm *vm, const rl1_hardware *hw, uint16_t at)
 /* Resumes a call in progress (12.2): polls it once. */
 static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw)
 {
-    rl1_reading out = {0, {0, 0, 0, 0}};
+    rl1_reading out;
     uint8_t op = vm->waiting;
     uint16_t at = (uint16_t)(vm->pc - rl1_call_length(rl1_call_arity(op)));
-    rl1_status status = hw->poll(hw->ctx, &out);
+    rl1_status status;
+    clear_reading(&out);
+    status = hw->poll(hw->ctx, &out);
     if (status == RL1_BUSY) {
         return RL1_WAITING;
     }
