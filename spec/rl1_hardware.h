@@ -9,6 +9,10 @@
 
 #include <stdint.h>
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* ---- What every callback answers --------------------------------------------------- */
 
 typedef enum {
@@ -136,5 +140,9 @@ typedef struct {
  * hardware. Once RL1_ENDED or RL1_FAULTED, a step does nothing and says so again. */
 rl1_state rl1_step(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
                    uint32_t n);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* RL1_HARDWARE_H */

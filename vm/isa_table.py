@@ -1,12 +1,18 @@
-"""The instruction table of spec/ilc.md, rendered from isa.OPCODES.
+"""The instruction table of spec/ilc.md, and the C VM's opcode and feature constants,
+rendered from isa.OPCODES and language.Feature.
 
-`python -m rl1.vm.isa_table` prints it; tests/test_ilc_spec.py checks that the spec
-holds exactly this table, so the document cannot drift from the code.
+`python -m rl1.vm.isa_table` prints the table; tests/project/test_ilc_spec.py checks that
+the spec holds exactly it, so the document cannot drift from the code. `python -m
+rl1.vm.isa_table --c` prints the constants' block of vm/c/rl1vm.h, which
+tests/c/test_c_constants.py holds equal to the header's.
 """
 
 from __future__ import annotations
 
+import sys
+
 from . import isa
+from .language import Feature
 
 HEADER = ("| opcode | mnemonic | operands | bytes | meaning | writes | serves |\n"
           "|---|---|---|---|---|---|---|")
@@ -84,5 +90,43 @@ def render() -> str:
     return "\n".join([HEADER, *rows])
 
 
+# The lines that open and close the generated block in vm/c/rl1vm.h.
+C_BEGIN = "/* ---- Generated from vm/isa.py by `python -m rl1.vm.isa_table --c`: do not edit */"
+C_END = "/* ---- End of the generated constants ---- */"
+
+
+def render_c() -> str:
+    """The opcodes as a C enum (RL1_OP_ and the mnemonic: RL1_OP_MOV, RL1_OP_CAMZ), and
+    the device features as the bits of a program's `features` (RL1_FEATURE_MOTION...),
+    between C_BEGIN and C_END."""
+    opcodes = [f"    RL1_OP_{info.name} = 0x{info.opcode:02X},"
+               for info in sorted(isa.OPCODES.values(), key=lambda i: i.opcode)]
+    last_call = max(info.opcode for info in isa.OPCODES.values()
+                    if info.builtin is not None)
+    features = [f"    RL1_FEATURE_{feature.name} = 0x{1 << feature.value:02X},"
+                for feature in Feature]
+    known = sum(1 << feature.value for feature in Feature)
+    return "\n".join([
+        C_BEGIN,
+        "",
+        "/* The opcodes of spec/ilc.md 8.3. The built-in calls, which the callbacks are",
+        f"   given, run from RL1_OP_{isa.OPCODES[isa.CALL_BASE].name} to "
+        f"RL1_OP_{isa.OPCODES[last_call].name}: one for each form. */",
+        "typedef enum rl1_opcode {",
+        *opcodes,
+        f"    RL1_OP_FIRST_CALL = 0x{isa.CALL_BASE:02X},",
+        f"    RL1_OP_LAST_CALL = 0x{last_call:02X}",
+        "} rl1_opcode;",
+        "",
+        "/* The device features (spec/ilc.md 4.3): bits of rl1_program's `features`. */",
+        "typedef enum rl1_feature {",
+        *features,
+        f"    RL1_FEATURES_KNOWN = 0x{known:02X}  /* every feature this format defines */",
+        "} rl1_feature;",
+        "",
+        C_END,
+    ])
+
+
 if __name__ == "__main__":
-    print(render())
+    print(render_c() if sys.argv[1:] == ["--c"] else render())

@@ -46,28 +46,41 @@ def c_name_for(stem: str) -> str:
     return ("rl1_" if stem[0].isdigit() else "") + stem + "_ilc"
 
 
-def c_source(data: bytes, name: str, source_name: str) -> str:
+def c_source(data: bytes, name: str, source_name: str, progmem: bool = False) -> str:
     """A C99 translation unit defining `const uint8_t NAME[]` (the bytes of `data`) and
-    `const size_t NAME_len`, its length; `source_name` is said in the opening comment.
-    The extern declarations come first so that another file may copy them as its
-    header (and compilers that warn about definitions without one stay quiet)."""
+    `const uint32_t NAME_size`, its size (rl1_load's type: 32 bits on every target);
+    `source_name` is said in the opening comment. The extern declarations come first so
+    that another file may copy them as its header (and compilers that warn about
+    definitions without one stay quiet).
+
+    With `progmem` the array is `PROGMEM`: in AVR's flash, which is not in the data
+    address space, so the loader reads it with pgm_read_byte (vm/c/README.md, AVR) and
+    no RAM holds it; on any other target PROGMEM means nothing, so the file builds
+    everywhere. The size stays an ordinary constant, read with a plain load."""
     assert c_name_problem(name) is None, name
     rows = [", ".join(f"0x{byte:02x}" for byte in data[start:start + _BYTES_PER_C_LINE])
             for start in range(0, len(data), _BYTES_PER_C_LINE)]
     comment = source_name.replace("*/", "* /")  # a file name cannot end the comment early
+    command = "rl1c --emit c --progmem" if progmem else "rl1c --emit c"
+    placement = ("#ifdef __AVR__\n"
+                 "#include <avr/pgmspace.h> /* PROGMEM: in flash, read with pgm_read_byte */\n"
+                 "#endif\n"
+                 "#ifndef PROGMEM\n"
+                 "#define PROGMEM /* flash and data share one address space */\n"
+                 "#endif\n") if progmem else ""
     return (
         f"/* The RL/I program {comment} as .ilc intermediate code ({len(data)} bytes),\n"
-        f"   written by rl1c --emit c. Regenerate it rather than edit it. */\n"
-        "#include <stddef.h>\n"
+        f"   written by {command}. Regenerate it rather than edit it. */\n"
         "#include <stdint.h>\n"
-        "\n"
+        + placement
+        + "\n"
         f"extern const uint8_t {name}[{len(data)}];\n"
-        f"extern const size_t {name}_len;\n"
+        f"extern const uint32_t {name}_size;\n"
         "\n"
-        f"const uint8_t {name}[{len(data)}] = {{\n"
+        f"const uint8_t {name}[{len(data)}]{' PROGMEM' if progmem else ''} = {{\n"
         + "".join(f"    {row},\n" for row in rows)
         + "};\n"
-        f"const size_t {name}_len = {len(data)};\n"
+        f"const uint32_t {name}_size = {len(data)}u;\n"
     )
 
 

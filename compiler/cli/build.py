@@ -93,8 +93,12 @@ def _address(ctx: click.Context, param: click.Parameter, value: str | None) -> i
                     "array (FILE.c); ihex: the .ilc bytes as Intel HEX (FILE.hex); ils: "
                     "the .ilc file as .ils text, as `rl1c dis` prints it (FILE.ils)")
 @click.option("--c-name", metavar="NAME",
-              help="with --emit c: the array's name (its length is NAME_len). "
+              help="with --emit c: the array's name (its size is NAME_size). "
                    "Default: the file's name and _ilc, such as sample_ilc")
+@click.option("--progmem", is_flag=True,
+              help="with --emit c: put the array in AVR flash (PROGMEM), for a VM built "
+                   "to read it there (vm/c/README.md, AVR); on other targets it changes "
+                   "nothing")
 @click.option("--base-address", metavar="ADDRESS", callback=_address,
               help="with --emit ihex: the address of the first byte, decimal or 0x hex "
                    "(default 0)")
@@ -106,8 +110,9 @@ def _address(ctx: click.Context, param: click.Parameter, value: str | None) -> i
 @format_option
 @color_option
 def compile_program(file: str, output: str | None, strip: bool, emit_kind: str,
-                    c_name: str | None, base_address: int | None, optimize: str,
-                    force: bool, output_format: Format, color: ColorChoice) -> int:
+                    c_name: str | None, progmem: bool, base_address: int | None,
+                    optimize: str, force: bool, output_format: Format,
+                    color: ColorChoice) -> int:
     """Compile an RL/I program: `rl1c FILE.rob -o FILE.ilc`.
 
     FILE is the RL/I program; `-` reads standard input. With --emit, the same code in
@@ -124,7 +129,7 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: str,
     if strip and emit_kind == "ir":
         raise click.UsageError("--strip drops the debug section of an .ilc file; "
                                "it has no meaning with --emit ir")
-    _check_form_options(emit_kind, c_name, base_address)
+    _check_form_options(emit_kind, c_name, progmem, base_address)
     target = output or _default_output(file, emit_kind)
     source = read_input(file)
     if not isinstance(source, Source):
@@ -142,7 +147,7 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: str,
     data = compilation.output
     if emit_kind not in ("ilc", "ir"):
         name = c_name or _c_name_for(file if file != "-" else target)
-        data = _ilc_form(emit_kind, data, source, name, base_address or 0)
+        data = _ilc_form(emit_kind, data, source, name, progmem, base_address or 0)
     if target != "-":
         write_file(target, data, force=force)
     elif emit_kind == "ilc" and sys.stdout.isatty():
@@ -153,12 +158,16 @@ def compile_program(file: str, output: str | None, strip: bool, emit_kind: str,
     return status
 
 
-def _check_form_options(emit_kind: str, c_name: str | None, base_address: int | None) -> None:
+def _check_form_options(emit_kind: str, c_name: str | None, progmem: bool,
+                        base_address: int | None) -> None:
     from rl1.compiler.backend.firmware import c_name_problem
 
     if c_name is not None and emit_kind != "c":
         raise click.UsageError("--c-name names the array of --emit c: give --emit c, or "
                                "leave out --c-name")
+    if progmem and emit_kind != "c":
+        raise click.UsageError("--progmem places the array of --emit c: give --emit c, "
+                               "or leave out --progmem")
     if base_address is not None and emit_kind != "ihex":
         raise click.UsageError("--base-address places the bytes of --emit ihex: give "
                                "--emit ihex, or leave out --base-address")
@@ -173,13 +182,15 @@ def _c_name_for(path: str) -> str:
     return c_name_for(os.path.splitext(os.path.basename(path))[0] if path != "-" else "")
 
 
-def _ilc_form(emit_kind: str, data: bytes, source: Source, c_name: str, base: int) -> bytes:
+def _ilc_form(emit_kind: str, data: bytes, source: Source, c_name: str, progmem: bool,
+              base: int) -> bytes:
     """The .ilc bytes `data` of `source` in the form --emit asks for."""
     from rl1.compiler.backend import firmware
     from rl1.compiler.ils.disasm import disassemble
 
     if emit_kind == "c":
-        return firmware.c_source(data, c_name, os.path.basename(source.name)).encode("ascii")
+        return firmware.c_source(data, c_name, os.path.basename(source.name),
+                                 progmem).encode("ascii")
     if emit_kind == "ihex":
         try:
             return firmware.intel_hex(data, base).encode("ascii")

@@ -1,6 +1,7 @@
 """The .ilc bytes as a C99 array and as Intel HEX (`rl1c --emit c`, `--emit ihex`): the C
-compiles without a warning and holds the same bytes, and an independent Intel HEX
-reader (the intelhex package) reads back the same bytes at the same addresses."""
+compiles without a warning and holds the same bytes (in AVR flash with --progmem), and an
+independent Intel HEX reader (the intelhex package) reads back the same bytes at the same
+addresses."""
 
 from __future__ import annotations
 
@@ -34,17 +35,17 @@ PRINT_ARRAY = """\
 #include <stdio.h>
 
 extern const uint8_t {name}[];
-extern const size_t {name}_len;
+extern const uint32_t {name}_size;
 
 int main(void) {{
-    return fwrite({name}, 1, {name}_len, stdout) == {name}_len ? 0 : 1;
+    return fwrite({name}, 1, {name}_size, stdout) == {name}_size ? 0 : 1;
 }}
 """
 
 
 def bytes_through_cc(c_text: str, name: str, directory: Path) -> bytes:
     """Compiles `c_text` as C99 with every warning an error, links it with a program
-    that writes the array NAME[NAME_len] to standard output, and runs that."""
+    that writes the array NAME[NAME_size] to standard output, and runs that."""
     assert CC is not None
     (directory / "program.c").write_text(c_text, encoding="ascii")
     (directory / "main.c").write_text(PRINT_ARRAY.format(name=name), encoding="ascii")
@@ -67,20 +68,45 @@ def ilc_of(source: str) -> bytes:
 @needs_cc
 @settings(max_examples=8, deadline=None,
           suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
-@given(checked_programs())
-def test_the_c_array_compiles_and_holds_the_ilc_bytes(tmp_path: Path, source: str) -> None:
+@given(checked_programs(), st.booleans())
+def test_the_c_array_compiles_and_holds_the_ilc_bytes(tmp_path: Path, source: str,
+                                                     progmem: bool) -> None:
     data = ilc_of(source)
-    assert bytes_through_cc(c_source(data, "prog_ilc", "prog.rob"), "prog_ilc",
+    assert bytes_through_cc(c_source(data, "prog_ilc", "prog.rob", progmem), "prog_ilc",
                             tmp_path) == data
 
 
-@given(st.binary(max_size=300), st.sampled_from(["a", "sample_ilc", "x9"]))
-def test_the_c_array_spells_every_byte_in_order(data: bytes, name: str) -> None:
-    text = c_source(data, name, "p.rob")
-    body = re.search(r"const uint8_t " + name + r"\[(\d+)\] = \{\n(.*?)\};\n", text, re.S)
+@given(st.binary(max_size=300), st.sampled_from(["a", "sample_ilc", "x9"]), st.booleans())
+def test_the_c_array_spells_every_byte_in_order(data: bytes, name: str, progmem: bool) -> None:
+    text = c_source(data, name, "p.rob", progmem)
+    placed = " PROGMEM" if progmem else ""
+    body = re.search(r"const uint8_t " + name + r"\[(\d+)\]" + placed + r" = \{\n(.*?)\};\n",
+                     text, re.S)
     assert body is not None and int(body.group(1)) == len(data)
     assert bytes(int(byte, 16) for byte in re.findall(r"0x([0-9a-f]{2})", body.group(2))) == data
-    assert f"const size_t {name}_len = {len(data)};\n" in text
+    assert f"const uint32_t {name}_size = {len(data)}u;\n" in text
+
+
+AVR_GCC = shutil.which("avr-gcc")
+
+
+@pytest.mark.skipif(AVR_GCC is None, reason="no avr-gcc (vm/c/install-tools installs it)")
+@pytest.mark.parametrize("progmem, section", [(True, ".progmem.data"), (False, ".rodata")])
+def test_progmem_puts_the_array_in_avr_flash(tmp_path: Path, progmem: bool,
+                                             section: str) -> None:
+    """avr-gcc's start-up copies .rodata to RAM; .progmem.data stays in flash. The size
+    is an ordinary constant either way (read with a plain load)."""
+    assert AVR_GCC is not None
+    (tmp_path / "program.c").write_text(c_source(bytes(range(40)), "prog_ilc", "p.rob",
+                                                 progmem), encoding="ascii")
+    subprocess.run([AVR_GCC, "-mmcu=atmega328p", "-Os", "-std=c99", "-Wall", "-Wextra",
+                    "-Werror", "-pedantic", "-c", "program.c", "-o", "program.o"],
+                   cwd=tmp_path, check=True, capture_output=True)
+    symbols = subprocess.run(["avr-objdump", "-t", "program.o"], cwd=tmp_path, check=True,
+                             capture_output=True, text=True).stdout
+    array = next(line for line in symbols.splitlines() if line.endswith(" prog_ilc"))
+    size = next(line for line in symbols.splitlines() if line.endswith(" prog_ilc_size"))
+    assert section in array.split() and ".rodata" in size.split()
 
 
 @pytest.mark.parametrize("stem, name", [

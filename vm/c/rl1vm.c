@@ -20,15 +20,6 @@
 #define VAR_U 46u
 #define VAR_W 48u
 
-/* The opcodes the VM treats apart from the generic call. */
-#define OP_KYO 0x4Cu
-#define OP_IMG 0x4Eu
-#define OP_CAMR 0x54u
-#define OP_ULTA 0x55u
-#define OP_ULTD 0x58u
-#define OP_INP 0x5Au
-#define OP_FZI 0x5Du
-
 void rl1_vm_init(rl1_vm *vm, uint32_t budget)
 {
     unsigned char *byte = (unsigned char *)vm;
@@ -61,16 +52,18 @@ static uint16_t shifted(uint16_t x, int16_t count, bool left)
     return (uint16_t)(x >> places);
 }
 
-/* Sets of calls (0x40..0x5D), as bit op - 0x40 of a word: a test is one AND. */
-#define CALL_BIT(op) ((uint32_t)1 << ((op) - 0x40u))
+/* Sets of calls (RL1_OP_FRE..RL1_OP_FZI), as bit op - RL1_OP_FRE of a word: a test is
+ * one AND. */
+#define CALL_BIT(op) ((uint32_t)1 << ((unsigned)(op) - (unsigned)RL1_OP_FIRST_CALL))
 /* The calls that take device time, so are started and polled (12.2): ORG MVI STR STL
  * STX ROT TIM, and IMG through ULT D (every CAM and ULT form). */
-#define TAKE_TIME (CALL_BIT(0x42) | CALL_BIT(0x43) | CALL_BIT(0x45) | CALL_BIT(0x46)       \
-                   | CALL_BIT(0x47) | CALL_BIT(0x48) | CALL_BIT(0x4A)                      \
-                   | (CALL_BIT(OP_ULTD + 1u) - CALL_BIT(OP_IMG)))
+#define TAKE_TIME (CALL_BIT(RL1_OP_ORG) | CALL_BIT(RL1_OP_MVI) | CALL_BIT(RL1_OP_STR)      \
+                   | CALL_BIT(RL1_OP_STL) | CALL_BIT(RL1_OP_STX) | CALL_BIT(RL1_OP_ROT)    \
+                   | CALL_BIT(RL1_OP_TIM)                                                  \
+                   | (CALL_BIT(RL1_OP_ULTD + 1u) - CALL_BIT(RL1_OP_IMG)))
 /* The calls whose result goes into R: KYO, IMG, CAM R, every ULT form, INP. */
-#define SET_R (CALL_BIT(OP_KYO) | CALL_BIT(OP_IMG) | CALL_BIT(OP_INP)                      \
-               | (CALL_BIT(OP_ULTD + 1u) - CALL_BIT(OP_CAMR)))
+#define SET_R (CALL_BIT(RL1_OP_KYO) | CALL_BIT(RL1_OP_IMG) | CALL_BIT(RL1_OP_INP)          \
+               | (CALL_BIT(RL1_OP_ULTD + 1u) - CALL_BIT(RL1_OP_CAMR)))
 
 /* A reading with every field zero, stored field by field: an initializer of the whole
  * struct becomes a call to memset on Cortex-M0 (gcc at any level) and with clang at -O0,
@@ -90,17 +83,17 @@ static void clear_reading(rl1_reading *out)
 static bool finish(rl1_vm *vm, uint8_t op, rl1_status status, const rl1_reading *out)
 {
     uint8_t first = 0, count = 0, k;
-    if (status != RL1_OK || (op == OP_CAMR && (out->result < 0 || out->result > 784))
-        || (op == OP_INP && (out->result < 0 || out->result > 255))) {
+    if (status != RL1_OK || (op == RL1_OP_CAMR && (out->result < 0 || out->result > 784))
+        || (op == RL1_OP_INP && (out->result < 0 || out->result > 255))) {
         return false;
     }
-    if (op == OP_KYO) {
+    if (op == RL1_OP_KYO) {
         first = VAR_U; /* u, v */
         count = 2;
-    } else if (op == OP_IMG) {
+    } else if (op == RL1_OP_IMG) {
         first = VAR_W; /* w, x, y, z */
         count = 4;
-    } else if (op == OP_FZI) {
+    } else if (op == RL1_OP_FZI) {
         first = VAR_S; /* s, t */
         count = 2;
     }
@@ -344,30 +337,31 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
      * the table's address opaque, so that it stays in a register rather than being
      * remade in each case's jump, which would then be too long to keep in the case. */
     __extension__ static const void *const table[128] = {
-        [0x00] = &&op_0x00, [0x01] = &&op_0x01, [0x02] = &&op_0x02, [0x03] = &&op_0x03,
-        [0x04] = &&op_0x04, [0x05] = &&op_0x05, [0x06] = &&op_0x06, [0x07] = &&op_0x07,
-        [0x08] = &&op_0x08, [0x09] = &&op_0x09, [0x0A] = &&op_0x0A,
-#define TARGETS7(o0, o1, o2, o3, o4, o5, o6)                                                  \
-        [o0] = &&op_##o0, [o1] = &&op_##o1, [o2] = &&op_##o2, [o3] = &&op_##o3,             \
-        [o4] = &&op_##o4, [o5] = &&op_##o5, [o6] = &&op_##o6
-        TARGETS7(0x10, 0x11, 0x12, 0x13, 0x14, 0x15, 0x16),
-        TARGETS7(0x18, 0x19, 0x1A, 0x1B, 0x1C, 0x1D, 0x1E),
-        TARGETS7(0x20, 0x21, 0x22, 0x23, 0x24, 0x25, 0x26),
-        [0x30] = &&op_0x30, [0x31] = &&op_0x31, [0x32] = &&op_0x32, [0x33] = &&op_0x33,
-        [0x34] = &&op_0x34, [0x35] = &&op_0x35, [0x36] = &&op_0x36, [0x37] = &&op_0x37,
-        [0x40] = &&op_call, [0x41] = &&op_call, [0x42] = &&op_call, [0x43] = &&op_call,
-        [0x44] = &&op_call, [0x45] = &&op_call, [0x46] = &&op_call, [0x47] = &&op_call,
-        [0x48] = &&op_call, [0x49] = &&op_call, [0x4A] = &&op_call, [0x4B] = &&op_call,
-        [0x4C] = &&op_call, [0x4D] = &&op_call, [0x4E] = &&op_call, [0x4F] = &&op_call,
-        [0x50] = &&op_call, [0x51] = &&op_call, [0x52] = &&op_call, [0x53] = &&op_call,
-        [0x54] = &&op_call, [0x55] = &&op_call, [0x56] = &&op_call, [0x57] = &&op_call,
-        [0x58] = &&op_call, [0x59] = &&op_call, [0x5A] = &&op_call, [0x5B] = &&op_call,
-        [0x5C] = &&op_call, [0x5D] = &&op_call,
-        TARGETS7(0x60, 0x61, 0x62, 0x63, 0x64, 0x65, 0x66),
-        TARGETS7(0x68, 0x69, 0x6A, 0x6B, 0x6C, 0x6D, 0x6E),
-        TARGETS7(0x70, 0x71, 0x72, 0x73, 0x74, 0x75, 0x76),
-        TARGETS7(0x78, 0x79, 0x7A, 0x7B, 0x7C, 0x7D, 0x7E)
+#define TARGET(o) [o] = &&op_##o
+#define TARGETS7(o0, o1, o2, o3, o4, o5, o6)                                              \
+        TARGET(o0), TARGET(o1), TARGET(o2), TARGET(o3), TARGET(o4), TARGET(o5), TARGET(o6)
+        TARGET(RL1_OP_END), TARGET(RL1_OP_LDV), TARGET(RL1_OP_LDI), TARGET(RL1_OP_LDR),
+        TARGET(RL1_OP_STV), TARGET(RL1_OP_INC), TARGET(RL1_OP_DEC), TARGET(RL1_OP_MOVV),
+        TARGET(RL1_OP_MOVI), TARGET(RL1_OP_MOVR), TARGET(RL1_OP_MOVB),
+        TARGETS7(RL1_OP_ADDV, RL1_OP_SUBV, RL1_OP_ANDV, RL1_OP_ORV, RL1_OP_XORV,
+                 RL1_OP_SHLV, RL1_OP_SHRV),
+        TARGETS7(RL1_OP_ADDI, RL1_OP_SUBI, RL1_OP_ANDI, RL1_OP_ORI, RL1_OP_XORI,
+                 RL1_OP_SHLI, RL1_OP_SHRI),
+        TARGETS7(RL1_OP_ADDR, RL1_OP_SUBR, RL1_OP_ANDR, RL1_OP_ORR, RL1_OP_XORR,
+                 RL1_OP_SHLR, RL1_OP_SHRR),
+        TARGET(RL1_OP_JMP), TARGET(RL1_OP_JZ), TARGET(RL1_OP_JGT), TARGET(RL1_OP_JLT),
+        TARGET(RL1_OP_DJGT), TARGET(RL1_OP_SJZ), TARGET(RL1_OP_SJGT), TARGET(RL1_OP_SJLT),
+        [RL1_OP_FIRST_CALL ... RL1_OP_LAST_CALL] = &&op_call,
+        TARGETS7(RL1_OP_ADDVV, RL1_OP_SUBVV, RL1_OP_ANDVV, RL1_OP_ORVV, RL1_OP_XORVV,
+                 RL1_OP_SHLVV, RL1_OP_SHRVV),
+        TARGETS7(RL1_OP_ADDVI, RL1_OP_SUBVI, RL1_OP_ANDVI, RL1_OP_ORVI, RL1_OP_XORVI,
+                 RL1_OP_SHLVI, RL1_OP_SHRVI),
+        TARGETS7(RL1_OP_ADDRV, RL1_OP_SUBRV, RL1_OP_ANDRV, RL1_OP_ORRV, RL1_OP_XORRV,
+                 RL1_OP_SHLRV, RL1_OP_SHRRV),
+        TARGETS7(RL1_OP_ADDRI, RL1_OP_SUBRI, RL1_OP_ANDRI, RL1_OP_ORRI, RL1_OP_XORRI,
+                 RL1_OP_SHLRI, RL1_OP_SHRRI)
 #undef TARGETS7
+#undef TARGET
     };
     const void *const *targets = table;
     __asm__("" : "+r"(targets));
@@ -405,61 +399,63 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
         left--;
 #endif
         switch (op) {
-        CASE(0x00) /* END */
+        CASE(RL1_OP_END)
             state = RL1_ENDED;
             break;
-        CASE(0x01) acc = (uint16_t)VAR_AT(1); ip += 2; NEXT();            /* LDV v */
-        CASE(0x02) acc = U16_AT(1); ip += 3; NEXT();                      /* LDI i */
-        CASE(0x03) acc = (uint16_t)vm->R; ip += 1; NEXT();                /* LDR */
-        CASE(0x04) VAR_AT(1) = (int16_t)acc; ip += 2; NEXT();             /* STV v */
-        CASE(0x05)                                                          /* INC v */
+        CASE(RL1_OP_LDV) acc = (uint16_t)VAR_AT(1); ip += 2; NEXT();       /* v */
+        CASE(RL1_OP_LDI) acc = U16_AT(1); ip += 3; NEXT();                 /* i */
+        CASE(RL1_OP_LDR) acc = (uint16_t)vm->R; ip += 1; NEXT();
+        CASE(RL1_OP_STV) VAR_AT(1) = (int16_t)acc; ip += 2; NEXT();        /* v */
+        CASE(RL1_OP_INC)                                                     /* v */
             variable = &VAR_AT(1);
             *variable = (int16_t)(uint16_t)((uint16_t)*variable + 1u);
             ip += 2;
             NEXT();
-        CASE(0x06)                                                          /* DEC v */
+        CASE(RL1_OP_DEC)                                                     /* v */
             variable = &VAR_AT(1);
             *variable = (int16_t)(uint16_t)((uint16_t)*variable - 1u);
             ip += 2;
             NEXT();
         /* The superinstructions of format 1.2 (the verifier refuses them in older files). */
-        CASE(0x07) VAR_AT(1) = VAR_AT(2); ip += 3; NEXT();                /* MOVV v, w */
-        CASE(0x08) VAR_AT(1) = (int16_t)U16_AT(2); ip += 4; NEXT();       /* MOVI v, i */
-        CASE(0x09) VAR_AT(1) = vm->R; ip += 2; NEXT();                    /* MOVR v */
-        CASE(0x0A) VAR_AT(1) = S8_AT(2); ip += 3; NEXT();                 /* MOVB v, b */
-        ALU_CASES(0x10, 0x11, 0x12, 0x13, 0x14, 0x15, 0x16,
-                  (uint16_t)VAR_AT(1), 2);                                   /* ADDV ... */
-        ALU_CASES(0x18, 0x19, 0x1A, 0x1B, 0x1C, 0x1D, 0x1E, U16_AT(1), 3);  /* ADDI ... */
-        COMPUTE_CASES(0x20, 0x21, 0x22, 0x23, 0x24, 0x25, 0x26,
-                      acc, (uint16_t)vm->R, 1);                              /* ADDR ... */
-        CASE(0x30) target = U16_AT(1); goto jump;                         /* JMP a */
-        CASE(0x31) JUMP_IF(VAR_AT(1), ==);                                  /* JZ v, a */
-        CASE(0x32) JUMP_IF(VAR_AT(1), >);                                   /* JGT v, a */
-        CASE(0x33) JUMP_IF(VAR_AT(1), <);                                   /* JLT v, a */
-        CASE(0x34)                                                          /* DJGT v, a */
+        CASE(RL1_OP_MOVV) VAR_AT(1) = VAR_AT(2); ip += 3; NEXT();          /* v, w */
+        CASE(RL1_OP_MOVI) VAR_AT(1) = (int16_t)U16_AT(2); ip += 4; NEXT(); /* v, i */
+        CASE(RL1_OP_MOVR) VAR_AT(1) = vm->R; ip += 2; NEXT();              /* v */
+        CASE(RL1_OP_MOVB) VAR_AT(1) = S8_AT(2); ip += 3; NEXT();           /* v, b */
+        ALU_CASES(RL1_OP_ADDV, RL1_OP_SUBV, RL1_OP_ANDV, RL1_OP_ORV, RL1_OP_XORV,
+                  RL1_OP_SHLV, RL1_OP_SHRV, (uint16_t)VAR_AT(1), 2);
+        ALU_CASES(RL1_OP_ADDI, RL1_OP_SUBI, RL1_OP_ANDI, RL1_OP_ORI, RL1_OP_XORI,
+                  RL1_OP_SHLI, RL1_OP_SHRI, U16_AT(1), 3);
+        COMPUTE_CASES(RL1_OP_ADDR, RL1_OP_SUBR, RL1_OP_ANDR, RL1_OP_ORR, RL1_OP_XORR,
+                      RL1_OP_SHLR, RL1_OP_SHRR, acc, (uint16_t)vm->R, 1);
+        CASE(RL1_OP_JMP) target = U16_AT(1); goto jump;                    /* a */
+        CASE(RL1_OP_JZ) JUMP_IF(VAR_AT(1), ==);                              /* v, a */
+        CASE(RL1_OP_JGT) JUMP_IF(VAR_AT(1), >);                              /* v, a */
+        CASE(RL1_OP_JLT) JUMP_IF(VAR_AT(1), <);                              /* v, a */
+        CASE(RL1_OP_DJGT)                                                    /* v, a */
             variable = &VAR_AT(1);
             value = (int16_t)(uint16_t)((uint16_t)*variable - 1u);
             *variable = value;
             JUMP_IF(value, >);
-        CASE(0x35) value = (int16_t)acc; VAR_AT(1) = value; JUMP_IF(value, ==); /* SJZ */
-        CASE(0x36) value = (int16_t)acc; VAR_AT(1) = value; JUMP_IF(value, >); /* SJGT */
-        CASE(0x37) value = (int16_t)acc; VAR_AT(1) = value; JUMP_IF(value, <); /* SJLT */
-        COMPUTE_CASES(0x60, 0x61, 0x62, 0x63, 0x64, 0x65, 0x66,
-                      VAR_AT(1), (uint16_t)VAR_AT(2), 3);                    /* ADDVV ... */
-        COMPUTE_CASES(0x68, 0x69, 0x6A, 0x6B, 0x6C, 0x6D, 0x6E,
-                      VAR_AT(1), U16_AT(2), 4);                              /* ADDVI ... */
-        COMPUTE_CASES(0x70, 0x71, 0x72, 0x73, 0x74, 0x75, 0x76,
-                      vm->R, (uint16_t)VAR_AT(1), 2);                        /* ADDRV ... */
-        COMPUTE_CASES(0x78, 0x79, 0x7A, 0x7B, 0x7C, 0x7D, 0x7E,
-                      vm->R, U16_AT(1), 3);                                  /* ADDRI ... */
+        CASE(RL1_OP_SJZ) value = (int16_t)acc; VAR_AT(1) = value; JUMP_IF(value, ==);
+        CASE(RL1_OP_SJGT) value = (int16_t)acc; VAR_AT(1) = value; JUMP_IF(value, >);
+        CASE(RL1_OP_SJLT) value = (int16_t)acc; VAR_AT(1) = value; JUMP_IF(value, <);
+        COMPUTE_CASES(RL1_OP_ADDVV, RL1_OP_SUBVV, RL1_OP_ANDVV, RL1_OP_ORVV, RL1_OP_XORVV,
+                      RL1_OP_SHLVV, RL1_OP_SHRVV, VAR_AT(1), (uint16_t)VAR_AT(2), 3);
+        COMPUTE_CASES(RL1_OP_ADDVI, RL1_OP_SUBVI, RL1_OP_ANDVI, RL1_OP_ORVI, RL1_OP_XORVI,
+                      RL1_OP_SHLVI, RL1_OP_SHRVI, VAR_AT(1), U16_AT(2), 4);
+        COMPUTE_CASES(RL1_OP_ADDRV, RL1_OP_SUBRV, RL1_OP_ANDRV, RL1_OP_ORRV, RL1_OP_XORRV,
+                      RL1_OP_SHLRV, RL1_OP_SHRRV, vm->R, (uint16_t)VAR_AT(1), 2);
+        COMPUTE_CASES(RL1_OP_ADDRI, RL1_OP_SUBRI, RL1_OP_ANDRI, RL1_OP_ORRI, RL1_OP_XORRI,
+                      RL1_OP_SHLRI, RL1_OP_SHRRI, vm->R, U16_AT(1), 3);
         default:
             UNREACHABLE(); /* the verifier refuses every other opcode */
             break;
-        case 0x40: case 0x41: case 0x42: case 0x43: case 0x44: case 0x45: case 0x46:
-        case 0x47: case 0x48: case 0x49: case 0x4A: case 0x4B: case 0x4C: case 0x4D:
-        case 0x4E: case 0x4F: case 0x50: case 0x51: case 0x52: case 0x53: case 0x54:
-        case 0x55: case 0x56: case 0x57: case 0x58: case 0x59: case 0x5A: case 0x5B:
-        case 0x5C: case 0x5D: /* the calls */
+        case RL1_OP_FRE: case RL1_OP_HLD: case RL1_OP_ORG: case RL1_OP_MVI: case RL1_OP_MOV:
+        case RL1_OP_STR: case RL1_OP_STL: case RL1_OP_STX: case RL1_OP_ROT: case RL1_OP_TRC:
+        case RL1_OP_TIM: case RL1_OP_KYC: case RL1_OP_KYO: case RL1_OP_SCN: case RL1_OP_IMG:
+        case RL1_OP_CAMZ: case RL1_OP_CAMU: case RL1_OP_CAMD: case RL1_OP_CAMA: case RL1_OP_CAMP:
+        case RL1_OP_CAMR: case RL1_OP_ULTA: case RL1_OP_ULTB: case RL1_OP_ULTC: case RL1_OP_ULTD:
+        case RL1_OP_LMP: case RL1_OP_INP: case RL1_OP_OUT: case RL1_OP_FZO: case RL1_OP_FZI:
             COUNTED(op_call)
             if (left < over_below) {
                 kind = RL1_FAULT_BUDGET;

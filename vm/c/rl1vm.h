@@ -21,6 +21,131 @@
 
 #include "rl1_hardware.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- Generated from vm/isa.py by `python -m rl1.vm.isa_table --c`: do not edit */
+
+/* The opcodes of spec/ilc.md 8.3. The built-in calls, which the callbacks are
+   given, run from RL1_OP_FRE to RL1_OP_FZI: one for each form. */
+typedef enum rl1_opcode {
+    RL1_OP_END = 0x00,
+    RL1_OP_LDV = 0x01,
+    RL1_OP_LDI = 0x02,
+    RL1_OP_LDR = 0x03,
+    RL1_OP_STV = 0x04,
+    RL1_OP_INC = 0x05,
+    RL1_OP_DEC = 0x06,
+    RL1_OP_MOVV = 0x07,
+    RL1_OP_MOVI = 0x08,
+    RL1_OP_MOVR = 0x09,
+    RL1_OP_MOVB = 0x0A,
+    RL1_OP_ADDV = 0x10,
+    RL1_OP_SUBV = 0x11,
+    RL1_OP_ANDV = 0x12,
+    RL1_OP_ORV = 0x13,
+    RL1_OP_XORV = 0x14,
+    RL1_OP_SHLV = 0x15,
+    RL1_OP_SHRV = 0x16,
+    RL1_OP_ADDI = 0x18,
+    RL1_OP_SUBI = 0x19,
+    RL1_OP_ANDI = 0x1A,
+    RL1_OP_ORI = 0x1B,
+    RL1_OP_XORI = 0x1C,
+    RL1_OP_SHLI = 0x1D,
+    RL1_OP_SHRI = 0x1E,
+    RL1_OP_ADDR = 0x20,
+    RL1_OP_SUBR = 0x21,
+    RL1_OP_ANDR = 0x22,
+    RL1_OP_ORR = 0x23,
+    RL1_OP_XORR = 0x24,
+    RL1_OP_SHLR = 0x25,
+    RL1_OP_SHRR = 0x26,
+    RL1_OP_JMP = 0x30,
+    RL1_OP_JZ = 0x31,
+    RL1_OP_JGT = 0x32,
+    RL1_OP_JLT = 0x33,
+    RL1_OP_DJGT = 0x34,
+    RL1_OP_SJZ = 0x35,
+    RL1_OP_SJGT = 0x36,
+    RL1_OP_SJLT = 0x37,
+    RL1_OP_FRE = 0x40,
+    RL1_OP_HLD = 0x41,
+    RL1_OP_ORG = 0x42,
+    RL1_OP_MVI = 0x43,
+    RL1_OP_MOV = 0x44,
+    RL1_OP_STR = 0x45,
+    RL1_OP_STL = 0x46,
+    RL1_OP_STX = 0x47,
+    RL1_OP_ROT = 0x48,
+    RL1_OP_TRC = 0x49,
+    RL1_OP_TIM = 0x4A,
+    RL1_OP_KYC = 0x4B,
+    RL1_OP_KYO = 0x4C,
+    RL1_OP_SCN = 0x4D,
+    RL1_OP_IMG = 0x4E,
+    RL1_OP_CAMZ = 0x4F,
+    RL1_OP_CAMU = 0x50,
+    RL1_OP_CAMD = 0x51,
+    RL1_OP_CAMA = 0x52,
+    RL1_OP_CAMP = 0x53,
+    RL1_OP_CAMR = 0x54,
+    RL1_OP_ULTA = 0x55,
+    RL1_OP_ULTB = 0x56,
+    RL1_OP_ULTC = 0x57,
+    RL1_OP_ULTD = 0x58,
+    RL1_OP_LMP = 0x59,
+    RL1_OP_INP = 0x5A,
+    RL1_OP_OUT = 0x5B,
+    RL1_OP_FZO = 0x5C,
+    RL1_OP_FZI = 0x5D,
+    RL1_OP_ADDVV = 0x60,
+    RL1_OP_SUBVV = 0x61,
+    RL1_OP_ANDVV = 0x62,
+    RL1_OP_ORVV = 0x63,
+    RL1_OP_XORVV = 0x64,
+    RL1_OP_SHLVV = 0x65,
+    RL1_OP_SHRVV = 0x66,
+    RL1_OP_ADDVI = 0x68,
+    RL1_OP_SUBVI = 0x69,
+    RL1_OP_ANDVI = 0x6A,
+    RL1_OP_ORVI = 0x6B,
+    RL1_OP_XORVI = 0x6C,
+    RL1_OP_SHLVI = 0x6D,
+    RL1_OP_SHRVI = 0x6E,
+    RL1_OP_ADDRV = 0x70,
+    RL1_OP_SUBRV = 0x71,
+    RL1_OP_ANDRV = 0x72,
+    RL1_OP_ORRV = 0x73,
+    RL1_OP_XORRV = 0x74,
+    RL1_OP_SHLRV = 0x75,
+    RL1_OP_SHRRV = 0x76,
+    RL1_OP_ADDRI = 0x78,
+    RL1_OP_SUBRI = 0x79,
+    RL1_OP_ANDRI = 0x7A,
+    RL1_OP_ORRI = 0x7B,
+    RL1_OP_XORRI = 0x7C,
+    RL1_OP_SHLRI = 0x7D,
+    RL1_OP_SHRRI = 0x7E,
+    RL1_OP_FIRST_CALL = 0x40,
+    RL1_OP_LAST_CALL = 0x5D
+} rl1_opcode;
+
+/* The device features (spec/ilc.md 4.3): bits of rl1_program's `features`. */
+typedef enum rl1_feature {
+    RL1_FEATURE_MOTION = 0x01,
+    RL1_FEATURE_STEERING = 0x02,
+    RL1_FEATURE_CAMERA = 0x04,
+    RL1_FEATURE_VISION = 0x08,
+    RL1_FEATURE_ULTRASONIC = 0x10,
+    RL1_FEATURE_IO = 0x20,
+    RL1_FEATURE_FUZZY = 0x40,
+    RL1_FEATURES_KNOWN = 0x7F  /* every feature this format defines */
+} rl1_feature;
+
+/* ---- End of the generated constants ---- */
+
 /* Why a file is refused: one code per rule of spec/ilc.md section 10, in the order the
  * rules are checked. vm/ilc.py's Refusal has the same names and numbers (a test holds
  * them equal). The comment says where the error offset points. */
@@ -125,20 +250,20 @@ void rl1_vm_init(rl1_vm *vm, uint32_t budget);
  * operands' shape; 0 for an opcode unknown in that version. */
 uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape);
 
-/* How many arguments call `op` (0x40..0x5D) takes, 0 to 3: two bits a call, the calls
- * from 0x40 in one word and from 0x50 in the other (a table would be copied to RAM on
- * AVR). */
-#define RL1_ARITY(op, n) ((uint32_t)(n) << (2u * ((op) & 0x0Fu)))
+/* How many arguments call `op` (RL1_OP_FRE..RL1_OP_FZI) takes, 0 to 3: two bits a
+ * call, the calls from 0x40 in one word and from 0x50 in the other (a table would be
+ * copied to RAM on AVR). */
+#define RL1_ARITY(op, n) ((uint32_t)(n) << (2u * ((unsigned)(op) & 0x0Fu)))
 static inline uint8_t rl1_call_arity(uint8_t op)
 {
-    uint32_t arities = op < 0x50u
-        ? RL1_ARITY(0x43, 3) | RL1_ARITY(0x44, 2) /* MVI l, r, cm; MOV l, r */
-          | RL1_ARITY(0x45, 1) | RL1_ARITY(0x46, 1) | RL1_ARITY(0x47, 1) /* STR STL STX */
-          | RL1_ARITY(0x48, 1) | RL1_ARITY(0x49, 1) | RL1_ARITY(0x4A, 1) /* ROT TRC TIM */
-          | RL1_ARITY(0x4D, 1)                                          /* SCN */
-        : RL1_ARITY(0x52, 1) | RL1_ARITY(0x53, 1) /* CAM A, CAM P */
-          | RL1_ARITY(0x59, 1) | RL1_ARITY(0x5A, 1) /* LMP, INP */
-          | RL1_ARITY(0x5B, 2) | RL1_ARITY(0x5C, 2); /* OUT port, data; FZO a, b */
+    uint32_t arities = op < RL1_OP_CAMU
+        ? RL1_ARITY(RL1_OP_MVI, 3) | RL1_ARITY(RL1_OP_MOV, 2) /* MVI l, r, cm; MOV l, r */
+          | RL1_ARITY(RL1_OP_STR, 1) | RL1_ARITY(RL1_OP_STL, 1) | RL1_ARITY(RL1_OP_STX, 1)
+          | RL1_ARITY(RL1_OP_ROT, 1) | RL1_ARITY(RL1_OP_TRC, 1) | RL1_ARITY(RL1_OP_TIM, 1)
+          | RL1_ARITY(RL1_OP_SCN, 1)
+        : RL1_ARITY(RL1_OP_CAMA, 1) | RL1_ARITY(RL1_OP_CAMP, 1) | RL1_ARITY(RL1_OP_LMP, 1)
+          | RL1_ARITY(RL1_OP_INP, 1) | RL1_ARITY(RL1_OP_OUT, 2) /* OUT port, data */
+          | RL1_ARITY(RL1_OP_FZO, 2);                              /* FZO a, b */
     return (uint8_t)((arities >> (2u * (op & 0x0Fu))) & 3u);
 }
 
@@ -151,5 +276,9 @@ static inline uint8_t rl1_call_length(uint8_t arity)
 
 /* Whether `value` lies in the range of parameter `index` of call `op`. */
 bool rl1_arg_in_range(uint8_t op, uint8_t index, int32_t value);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -23,10 +23,8 @@
 #define FUSED_MINOR 2u       /* the superinstructions, MOVV ... SJLT and ADDVV ... SHRRI, came in 1.2 */
 #define KNOWN_MINOR 2u       /* the newest minor version this reader knows */
 #define REQUIRED_FLAGS 0x00FFu
-#define KNOWN_FEATURES 0x007Fu
 #define VARIABLES 53u
 #define MAX_U16 0xFFFFu
-#define NO_FEATURE 0xFFu
 
 /* The file being checked, and where the refusal points. */
 typedef struct loader {
@@ -110,38 +108,38 @@ uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape)
 {
     *shape = NONE;
     if (minor >= FUSED_MINOR) {
-        if (op == 0x07u) {
-            *shape = VAR_VAR; /* MOVV */
+        if (op == RL1_OP_MOVV) {
+            *shape = VAR_VAR;
             return 3;
         }
-        if (op == 0x08u) {
-            *shape = VAR_IMM; /* MOVI */
+        if (op == RL1_OP_MOVI) {
+            *shape = VAR_IMM;
             return 4;
         }
-        if (op == 0x09u) {
-            *shape = VAR; /* MOVR */
+        if (op == RL1_OP_MOVR) {
+            *shape = VAR;
             return 2;
         }
-        if (op == 0x0Au) {
-            *shape = VAR; /* MOVB: a variable, then a signed byte, which needs no check */
+        if (op == RL1_OP_MOVB) {
+            *shape = VAR; /* a variable, then a signed byte, which needs no check */
             return 3;
         }
-        if (op >= 0x34u && op <= 0x37u) {
+        if (op >= RL1_OP_DJGT && op <= RL1_OP_SJLT) {
             *shape = VAR_ADDR; /* DJGT, SJZ, SJGT, SJLT */
             return 4;
         }
         /* The load-and-operate blocks, operator in the low 3 bits (7 is unused).
          * No table: on AVR it would be copied to RAM. */
-        if (op >= 0x60u && op <= 0x7Eu && (op & 7u) != 7u) {
-            if (op < 0x68u) {
+        if (op >= RL1_OP_ADDVV && op <= RL1_OP_SHRRI && (op & 7u) != 7u) {
+            if (op < RL1_OP_ADDVI) {
                 *shape = VAR_VAR; /* ADDVV ... SHRVV */
                 return 3;
             }
-            if (op < 0x70u) {
+            if (op < RL1_OP_ADDRV) {
                 *shape = VAR_IMM; /* ADDVI ... SHRVI */
                 return 4;
             }
-            if (op < 0x78u) {
+            if (op < RL1_OP_ADDRI) {
                 *shape = VAR; /* ADDRV ... SHRRV */
                 return 2;
             }
@@ -149,26 +147,27 @@ uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape)
             return 3;
         }
     }
-    if (op == 0x00u || op == 0x03u || (op >= 0x20u && op <= 0x26u)) {
+    if (op == RL1_OP_END || op == RL1_OP_LDR || (op >= RL1_OP_ADDR && op <= RL1_OP_SHRR)) {
         return 1; /* END, LDR, the ...R arithmetic */
     }
-    if ((op >= 0x01u && op <= 0x06u && op != 0x02u) || (op >= 0x10u && op <= 0x16u)) {
+    if ((op >= RL1_OP_LDV && op <= RL1_OP_DEC && op != RL1_OP_LDI)
+        || (op >= RL1_OP_ADDV && op <= RL1_OP_SHRV)) {
         *shape = VAR; /* LDV, STV, INC, DEC, the ...V arithmetic */
         return 2;
     }
-    if (op == 0x02u || (op >= 0x18u && op <= 0x1Eu)) {
+    if (op == RL1_OP_LDI || (op >= RL1_OP_ADDI && op <= RL1_OP_SHRI)) {
         *shape = IMM; /* LDI, the ...I arithmetic */
         return 3;
     }
-    if (op == 0x30u) {
+    if (op == RL1_OP_JMP) {
         *shape = ADDR; /* JMP */
         return 3;
     }
-    if (op >= 0x31u && op <= 0x33u) {
+    if (op >= RL1_OP_JZ && op <= RL1_OP_JLT) {
         *shape = VAR_ADDR; /* JZ, JGT, JLT */
         return 4;
     }
-    if (op >= 0x40u && op <= 0x5Du) { /* the calls */
+    if (op >= RL1_OP_FIRST_CALL && op <= RL1_OP_LAST_CALL) {
         uint8_t arity = rl1_call_arity(op);
         *shape = arity ? ARGS : NONE;
         return rl1_call_length(arity);
@@ -176,28 +175,29 @@ uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape)
     return 0;
 }
 
-/* The device feature bit a call needs (spec/ilc.md 4.3); NO_FEATURE for END, TIM and
+/* The device feature a call needs (spec/ilc.md 4.3), as its bit; 0 for END, TIM and
  * the instructions that are not calls. */
 static uint8_t op_feature(uint8_t op)
 {
     switch (op) {
-    case 0x40: case 0x41: case 0x43: case 0x44: case 0x48: case 0x49: case 0x4B:
-    case 0x4C:
-        return 0; /* MOTION: FRE, HLD, MVI, MOV, ROT, TRC, KYC, KYO */
-    case 0x42: case 0x45: case 0x46: case 0x47:
-        return 1; /* STEERING: ORG, STR, STL, STX */
-    case 0x4F: case 0x50: case 0x51: case 0x52: case 0x53: case 0x54:
-        return 2; /* CAMERA: every CAM form */
-    case 0x4D: case 0x4E: case 0x59:
-        return 3; /* VISION: SCN, IMG, LMP */
-    case 0x55: case 0x56: case 0x57: case 0x58:
-        return 4; /* ULTRASONIC: every ULT form */
-    case 0x5A: case 0x5B:
-        return 5; /* IO: INP, OUT */
-    case 0x5C: case 0x5D:
-        return 6; /* FUZZY: FZO, FZI */
+    case RL1_OP_FRE: case RL1_OP_HLD: case RL1_OP_MVI: case RL1_OP_MOV: case RL1_OP_ROT:
+    case RL1_OP_TRC: case RL1_OP_KYC: case RL1_OP_KYO:
+        return RL1_FEATURE_MOTION;
+    case RL1_OP_ORG: case RL1_OP_STR: case RL1_OP_STL: case RL1_OP_STX:
+        return RL1_FEATURE_STEERING;
+    case RL1_OP_CAMZ: case RL1_OP_CAMU: case RL1_OP_CAMD: case RL1_OP_CAMA: case RL1_OP_CAMP:
+    case RL1_OP_CAMR:
+        return RL1_FEATURE_CAMERA;
+    case RL1_OP_SCN: case RL1_OP_IMG: case RL1_OP_LMP:
+        return RL1_FEATURE_VISION;
+    case RL1_OP_ULTA: case RL1_OP_ULTB: case RL1_OP_ULTC: case RL1_OP_ULTD:
+        return RL1_FEATURE_ULTRASONIC;
+    case RL1_OP_INP: case RL1_OP_OUT:
+        return RL1_FEATURE_IO;
+    case RL1_OP_FZO: case RL1_OP_FZI:
+        return RL1_FEATURE_FUZZY;
     default:
-        return NO_FEATURE;
+        return 0;
     }
 }
 
@@ -207,22 +207,22 @@ bool rl1_arg_in_range(uint8_t op, uint8_t index, int32_t value)
 {
     int32_t low = -32768, high = 32767; /* FZO a, b */
     switch (op) {
-    case 0x43: /* MVI l, r, cm */
+    case RL1_OP_MVI: /* l, r, cm */
         low = index == 2u ? -1900 : -12;
         high = index == 2u ? 1900 : 12;
         break;
-    case 0x44: low = -12; high = 12; break;      /* MOV l, r */
-    case 0x45: case 0x46: case 0x52:
-        low = 0; high = 180; break;                /* STR, STL, CAM A: degrees */
-    case 0x47: low = -1800; high = 1800; break;  /* STX tenths */
-    case 0x48: low = -360; high = 360; break;    /* ROT deg */
-    case 0x49: low = 0; high = 3; break;         /* TRC mode */
-    case 0x4A: low = 1; high = 100; break;       /* TIM tenths */
-    case 0x4D: low = 0; high = 7; break;         /* SCN scene */
-    case 0x53: low = 0; high = 784; break;       /* CAM P pulse */
-    case 0x59: low = 0; high = 1; break;         /* LMP on */
-    case 0x5A: low = 0; high = 0x7D; break;      /* INP port */
-    case 0x5B:                                    /* OUT port, data */
+    case RL1_OP_MOV: low = -12; high = 12; break;      /* l, r */
+    case RL1_OP_STR: case RL1_OP_STL: case RL1_OP_CAMA:
+        low = 0; high = 180; break;                      /* degrees */
+    case RL1_OP_STX: low = -1800; high = 1800; break;  /* tenths */
+    case RL1_OP_ROT: low = -360; high = 360; break;    /* deg */
+    case RL1_OP_TRC: low = 0; high = 3; break;         /* mode */
+    case RL1_OP_TIM: low = 1; high = 100; break;       /* tenths */
+    case RL1_OP_SCN: low = 0; high = 7; break;         /* scene */
+    case RL1_OP_CAMP: low = 0; high = 784; break;      /* pulse */
+    case RL1_OP_LMP: low = 0; high = 1; break;         /* on */
+    case RL1_OP_INP: low = 0; high = 0x7D; break;      /* port */
+    case RL1_OP_OUT:                                    /* port, data */
         low = 0;
         high = index == 0u ? 0x7D : 255;
         break;
@@ -408,7 +408,7 @@ static rl1_refusal check_container(loader *ld, rl1_program *program, uint32_t *c
         program->handlers[i] = entry;
     }
     program->features = u16_at(file + handler_start + HANDLER_SIZE);
-    if (program->features & ~KNOWN_FEATURES) {
+    if (program->features & ~(unsigned)RL1_FEATURES_KNOWN) {
         return fail(ld, RL1_UNKNOWN_FEATURE, handler_start + HANDLER_SIZE);
     }
     debug_start = handler_start + HANDLER_SIZE + FEATURE_SIZE;
@@ -500,7 +500,7 @@ static rl1_refusal check_instructions(loader *ld, const rl1_program *program, ui
             return status;
         }
         feature = op_feature(op);
-        if (feature != NO_FEATURE && !(((unsigned)program->features >> feature) & 1u)) {
+        if (feature & ~(unsigned)program->features) {
             return fail(ld, RL1_MISSING_FEATURE, at);
         }
         if (bitmap) {
