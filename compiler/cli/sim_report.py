@@ -12,8 +12,7 @@ from rl1.vm.defaults import TraceChoice
 from rl1.vm.faults import FaultKind, RunResult
 from rl1.vm.sim.device import RunOn, SimDevice, SimEntry
 from rl1.vm.sim.goal import GOAL_MISSED, Verdict
-from rl1.vm.sim.motion import Pose
-from rl1.vm.sim.simulator import heading_degrees
+from rl1.vm.sim.motion import Pose, heading_degrees
 
 from .run_report import (
     TRACE_HEADING,

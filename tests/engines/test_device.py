@@ -77,7 +77,8 @@ def test_the_sample_sensor_script_is_valid() -> None:
     ({"IMG": []}, "s.json:1: IMG: expected a list of at least one reading (leave the key out for "
      "none), found an empty array"),
     ({"IMG": [{"area": 1, "x": 2, "y": 3}]}, 's.json:1: IMG[0]: missing "z"'),
-    ({"IMG": [{"area": 1, "x": 2, "y": 3, "z": 4, "w": 5}]}, 's.json:1: IMG[0].w: unknown key; expected one of "area", "x", "y", "z"'),
+    ({"IMG": [{"area": 1, "x": 2, "y": 3, "z": 4, "w": 5}]},
+     's.json:1: IMG[0].w: unknown key; expected one of "area", "x", "y", "z"'),
     ({"IMG": [{"area": "1", "x": 2, "y": 3, "z": 4}]},
      's.json:1: IMG[0].area: expected an integer in -32768..32767, found the string "1"'),
     ({"KYO": [{"centre": 40000, "right": 0, "left": 0}]},

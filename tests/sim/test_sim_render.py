@@ -69,8 +69,8 @@ def test_the_legend_names_every_kind_of_mark(
     root, _ = pictures
     legend = next(g for g in root.iter(f"{SVG}g") if g.get("id") == "legend")
     assert {"path", "start", "end pose", "run ended", "turn in place", "camera at each IMG",
-            "ultrasonic echo", "line lost", "line found", "handler taken", "fault", "wall, obstacle",
-            "stand, marker"} <= set(_texts(legend))
+            "ultrasonic echo", "line lost", "line found", "handler taken", "fault",
+            "wall, obstacle", "stand, marker"} <= set(_texts(legend))
 
 
 def test_the_scale_bar_is_as_long_as_it_says(

@@ -22,9 +22,9 @@ from rl1.vm.device import DeviceError, FuzzyReading, ImageReading, LineLost, Odo
 from rl1.vm.language import LOST_LINE_RULES
 
 from .camera import PULSES
-from .motion import Pose
+from .motion import Pose, heading_degrees
 from .sightings import Sighting, Sightings
-from .simulator import SafetyFault, Simulator, heading_degrees
+from .simulator import SafetyFault, Simulator
 from .world import World
 
 _PULSES_PER_DEGREE = PULSES / 180  # pulses per degree of pan

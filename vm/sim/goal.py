@@ -24,7 +24,7 @@ from itertools import pairwise
 from typing import TYPE_CHECKING, Any, Literal, NamedTuple
 
 from .geometry import Box, Point, bounding_box, boxes_overlap, inside, segment_nearest
-from .motion import Pose
+from .motion import Pose, heading_degrees
 
 if TYPE_CHECKING:
     from .world import World
@@ -85,14 +85,9 @@ class Step(NamedTuple):
 # The verdict ------------------------------------------------------------------------------
 
 
-def degrees(heading: float) -> float:
-    """A heading in degrees within (-180, 180]."""
-    wrapped = math.degrees(heading) % 360.0
-    return wrapped - 360.0 if wrapped > 180.0 else wrapped
-
-
 def _at(time: float, pose: Pose) -> str:
-    return f"{time:.2f} s at ({pose.x:.1f}, {pose.y:.1f}) heading {degrees(pose.heading):.1f}"
+    heading = heading_degrees(pose.heading)
+    return f"{time:.2f} s at ({pose.x:.1f}, {pose.y:.1f}) heading {heading:.1f}"
 
 
 @dataclass(frozen=True, slots=True)
@@ -121,7 +116,7 @@ class Outcome:
                 "time": None if self.time is None else round(self.time, 4),
                 "pose": None if self.pose is None else [
                     round(self.pose.x, 2), round(self.pose.y, 2),
-                    round(degrees(self.pose.heading), 2)]}
+                    round(heading_degrees(self.pose.heading), 2)]}
 
 
 @dataclass(frozen=True, slots=True)
@@ -384,7 +379,7 @@ class Judge:
             return Outcome("reach", region.name, False, (
                 f"entered at {_at(time, pose)}, but never with the heading within "
                 f"{math.degrees(region.tolerance):g} degrees of "
-                f"{degrees(region.heading):g}"), time, pose)
+                f"{heading_degrees(region.heading):g}"), time, pose)
         assert reaching.nearest is not None  # the start is a visit, outside the region
         distance, time, pose = reaching.nearest
         return Outcome("reach", region.name, False, f"never reached: the nearest the "
@@ -419,7 +414,7 @@ class Judge:
             return Outcome("end", region.name, False, (
                 f"{where}: in the region, but the heading is more than "
                 f"{math.degrees(region.tolerance):g} degrees from "
-                f"{degrees(region.heading):g}"), ended, pose)
+                f"{heading_degrees(region.heading):g}"), ended, pose)
         return Outcome("end", region.name, True, where, ended, pose)
 
     def _avoided(self, region: Region, entered: tuple[float, Pose] | None) -> Outcome:

@@ -12,6 +12,16 @@ import math
 from dataclasses import dataclass
 
 
+def heading_degrees(radians: float, digits: int | None = None) -> float:
+    """A heading as the reports and the goal give it: degrees in (-180, 180], rounded to
+    `digits` when given (rounded first, so that 180.004 reads 180.0, not -180.0)."""
+    degrees = math.degrees(radians) if digits is None else round(math.degrees(radians), digits)
+    degrees %= 360.0
+    if degrees <= 180.0:
+        return degrees
+    return degrees - 360.0 if digits is None else round(degrees - 360.0, digits)
+
+
 @dataclass(frozen=True, slots=True)
 class Pose:
     x: float  # cm

@@ -14,7 +14,7 @@ from typing import Literal
 
 from . import camera, tracing, ultrasonic
 from .geometry import Point, overlap, rectangle
-from .motion import Odometer, Pose, advance, count, time_to_cover
+from .motion import Odometer, Pose, advance, count, heading_degrees, time_to_cover
 from .noise import Imperfections
 from .track import History, Track
 from .world import Scene, World
@@ -25,12 +25,6 @@ _EMPTY_SCENE = Scene((), (0, 0, 1, 1))
 MAX_EVENTS = 10_000
 """Lost lines, found lines and handlers taken that a run records (a fault and the end
 are always recorded): more are counted in `events_left_out`."""
-
-
-def heading_degrees(radians: float, digits: int) -> float:
-    """A heading as the reports give it: degrees rounded to `digits`, in (-180, 180]."""
-    degrees = round(math.degrees(radians), digits) % 360
-    return round(degrees - 360, digits) if degrees > 180 else degrees
 
 
 class SafetyFault(Exception):
