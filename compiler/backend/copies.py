@@ -9,7 +9,10 @@ Walking a block, it remembers the variables whose value the accumulator holds (a
 (`STV A; LDV A`, as `A=B+1; C=A` compiles) and a store into one of them (`A=A`, or
 `B=A` after `A=B`) do nothing, and go. A load followed by a commutative operation on
 one of them (`store d; load D; add d`, as `D=D+d` compiles after `d=...`) becomes that
-operation on what the load named (`add D`): one instruction instead of two.
+operation on what the load named (`add D`): one instruction instead of two. An
+operation on one of them is algebra with equal operands (spec/language.md 7.2: the
+16-bit patterns are the same): `A&A` and `A|A` are A, and go; `A-A` and `A^A` are 0,
+a load of 0 in the operation's place, which constant folding carries on.
 """
 
 from __future__ import annotations
@@ -17,6 +20,8 @@ from __future__ import annotations
 from . import ir
 
 COMMUTATIVE = "+&|^"
+IDEMPOTENT = "&|"  # x op x is x
+CANCELLING = "-^"  # x op x is 0
 
 
 def propagate_copies(program: ir.Program) -> ir.Program:
@@ -49,6 +54,14 @@ def _without_copies(instructions: list[ir.Instruction]) -> list[ir.Instruction]:
             if instruction.target.name in holds:
                 continue
             holds.add(instruction.target.name)
+        elif isinstance(instruction, ir.Operate) and isinstance(instruction.source, ir.Var) \
+                and instruction.source.name in holds and instruction.op in IDEMPOTENT:
+            continue
+        elif isinstance(instruction, ir.Operate) and isinstance(instruction.source, ir.Var) \
+                and instruction.source.name in holds and instruction.op in CANCELLING:
+            out.append(ir.Load(ir.Imm(0), instruction.line))
+            holds = set()
+            continue
         elif isinstance(instruction, ir.Operate | ir.Compute):
             holds = set()
         elif isinstance(instruction, ir.StepVar | ir.Move):

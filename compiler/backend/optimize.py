@@ -16,6 +16,7 @@ from .control import simplify_control
 from .copies import propagate_copies
 from .dead_stores import remove_dead_stores
 from .peephole import rewrite_steps
+from .signs import decide_branches
 from .superinstructions import fuse
 
 Pass = Callable[[ir.Program], ir.Program]
@@ -23,8 +24,9 @@ Pass = Callable[[ir.Program], ir.Program]
 # -O1: the passes whose output every format 1.0 reader runs. The control pass comes
 # first so that the others see merged blocks, and last so that it removes what they
 # made unreachable.
-O1_PASSES: tuple[Pass, ...] = (simplify_control, fold_constants, propagate_copies,
-                               rewrite_steps, remove_dead_stores, simplify_control)
+O1_PASSES: tuple[Pass, ...] = (simplify_control, fold_constants, decide_branches,
+                               propagate_copies, rewrite_steps, remove_dead_stores,
+                               simplify_control)
 LEVELS: dict[int, tuple[Pass, ...]] = {0: (), 1: O1_PASSES, 2: O1_PASSES}
 # What runs once after a level's passes stop changing the program: -O2's fusion, which
 # the other passes need not know.

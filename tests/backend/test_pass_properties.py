@@ -18,6 +18,7 @@ from rl1.compiler.backend.copies import propagate_copies
 from rl1.compiler.backend.dead_stores import remove_dead_stores
 from rl1.compiler.backend.lower import lower
 from rl1.compiler.backend.peephole import rewrite_steps
+from rl1.compiler.backend.signs import decide_branches
 from rl1.compiler.backend.superinstructions import fuse
 from rl1.compiler.differential import (
     Observation,
@@ -33,8 +34,8 @@ from rl1.vm.scripted import ScriptedDevice, parse_script, run_document
 from rl1.vm.verifier import verify
 
 BUDGET = 20_000
-PASSES = (fold_constants, propagate_copies, remove_dead_stores, rewrite_steps,
-          simplify_control, fuse)
+PASSES = (fold_constants, decide_branches, propagate_copies, remove_dead_stores,
+          rewrite_steps, simplify_control, fuse)
 # Not simplify_control: removing blocks can make jumps to thread that it saw as none.
 IDEMPOTENT = (propagate_copies, rewrite_steps, fuse)
 

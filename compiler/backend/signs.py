@@ -1,0 +1,194 @@
+"""Branches decided by signs: what earlier branches (and loads of constants, masks, and
+the calls' result ranges) proved about each variable's sign.
+
+Assumes: the IR is valid (the accumulator is dead where a block starts).
+Keeps: every instruction; every call; the value of every variable everywhere; the order
+of the blocks that remain; no path longer (spec/optimization.md, section 3).
+
+A forward data flow finds, where each block starts, the signs (`<`, `=`, `>`: negative,
+zero, positive) each variable may have: only `=` for all 53 where the program starts,
+any where a handler starts; a branch's taken edge keeps only its relation, its other
+edge all but it. Then:
+
+- A branch whose variable can only have signs its relation holds for becomes a jump to
+  its target, and one whose variable can have none of them a jump past it (after
+  `?H=#20` falls through, `?H=#30` is a jump on).
+- A branch to the block laid out next whose other way is a jump (`?N=#20; #10` with
+  `:20` next: a conditional, then a `JMP` on every way round), when every sign but the
+  branch's that the variable may have is one relation, becomes the branch on that
+  relation to where the jump went, falling through to the old target: as Lua's
+  `luaK_goiftrue` negates a test instead of jumping around a jump. The instruction set
+  has only `=`, `>` and `<` (no "not zero"), so this needs what the flow proved:
+  `?N=#20; #10` with N known not negative is `?N>#10`. The way that jumped runs one
+  instruction fewer, the other as many as before.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+
+from rl1.compiler.frontend.ast import Relation
+from rl1.vm.language import VARIABLES
+
+from . import flow, ir
+
+Signs = frozenset[str]
+"""The signs a value may have: a subset of `<`, `=`, `>` (the relations with zero)."""
+
+ANY: Signs = frozenset("<=>")
+NOT_NEGATIVE: Signs = frozenset("=>")
+State = dict[str, Signs]
+"""Each variable whose sign is known to be limited; a variable not in it may have any."""
+
+# What a step does to each sign: 0 + 1 is positive, 32767 + 1 wraps to -32768.
+_STEPPED: dict[str, dict[str, Signs]] = {
+    "++": {"<": frozenset("<="), "=": frozenset(">"), ">": frozenset("<>")},
+    "--": {">": frozenset("=>"), "=": frozenset("<"), "<": frozenset("<>")},
+}
+
+
+def decide_branches(program: ir.Program) -> ir.Program:
+    following = program.following()
+    for block_id, state in _solve(program).items():
+        block = program.blocks[block_id]
+        if isinstance(block.terminator, ir.Branch):
+            block.terminator = _rewritten(block.terminator, _exit_state(block, state),
+                                          following[block_id])
+    return program
+
+
+def _rewritten(branch: ir.Branch, state: State, following: ir.BlockId | None
+               ) -> ir.Terminator:
+    """The branch decided, or negated so that its jump falls through, or as it was."""
+    signs = state.get(branch.var.name, ANY)
+    decided = _decided(branch, signs)
+    if decided is not None:
+        return decided
+    others = signs - {branch.relation}
+    if branch.if_true == following and branch.if_false != following and len(others) == 1:
+        # `JLT N :20; JMP :10` with :20 next: one conditional jump to :10 does it.
+        relation: Relation = "=" if "=" in others else ">" if ">" in others else "<"
+        return ir.Branch(branch.var, relation, branch.if_false, branch.if_true, branch.line)
+    return branch
+
+
+def _decided(branch: ir.Branch, signs: Signs) -> ir.Jump | None:
+    if signs <= {branch.relation}:
+        return ir.Jump(branch.if_true, branch.line)
+    if branch.relation not in signs:
+        return ir.Jump(branch.if_false, branch.line)
+    return None
+
+
+def _solve(program: ir.Program) -> dict[ir.BlockId, State]:
+    """What is known where each block some path reaches starts: the union (the signs
+    any path allows) over its predecessors' edges and the program's or a handler's
+    start. A worklist in layout order; a decided branch's other edge is not followed."""
+    starts: dict[ir.BlockId, list[State]] = {block_id: [] for block_id in program.blocks}
+    starts[program.entry].append(dict.fromkeys(VARIABLES, frozenset("=")))
+    for block_id in program.handlers.values():
+        starts[block_id].append({})
+    incoming: dict[ir.BlockId, dict[ir.BlockId, State]] = {
+        block_id: {} for block_id in program.blocks}
+    entries: dict[ir.BlockId, State] = {}
+    work = deque(flow.roots(program))
+    queued = set(work)
+    while work:
+        block_id = work.popleft()
+        queued.discard(block_id)
+        state = _join([*starts[block_id], *incoming[block_id].values()])
+        if entries.get(block_id) == state:
+            continue
+        entries[block_id] = state
+        block = program.blocks[block_id]
+        for target in block.terminator.targets:
+            incoming[target].pop(block_id, None)
+        for target, leaving in _edges(block, _exit_state(block, state)):
+            incoming[target][block_id] = leaving
+            if target not in queued:
+                queued.add(target)
+                work.append(target)
+    return entries
+
+
+def _join(states: list[State]) -> State:
+    """The signs any of the states allows, in the first state's order (deterministic)."""
+    if len(states) <= 1:
+        return dict(states[0]) if states else {}
+    first, *rest = states
+    shared = set(first).intersection(*rest)
+    joined: State = {}
+    for name, signs in first.items():
+        if name in shared:
+            union = signs.union(*(state[name] for state in rest))
+            if union != ANY:
+                joined[name] = union
+    return joined
+
+
+def _edges(block: ir.Block, state: State) -> list[tuple[ir.BlockId, State]]:
+    terminator = block.terminator
+    if not isinstance(terminator, ir.Branch):
+        forgotten = {name: signs for name, signs in state.items()
+                     if not isinstance(terminator, ir.StoreBranch | ir.DecrementBranch)
+                     or name != terminator.var.name}
+        return [(target, forgotten) for target in terminator.targets]
+    name = terminator.var.name
+    signs = state.get(name, ANY)
+    decided = _decided(terminator, signs)
+    if decided is not None:
+        return [(decided.target, state)]
+    return [(terminator.if_true, {**state, name: frozenset(terminator.relation)}),
+            (terminator.if_false, {**state, name: signs - {terminator.relation}})]
+
+
+def _exit_state(block: ir.Block, entry: State) -> State:
+    state = dict(entry)
+    acc: Signs = ANY
+    result: Signs = ANY  # R's signs, from the last call's result range
+    for instruction in block.instructions:
+        match instruction:
+            case ir.Load(source=source):
+                acc = _operand(source, state, result)
+            case ir.Operate(op="&", source=source):
+                if acc <= NOT_NEGATIVE or _operand(source, state, result) <= NOT_NEGATIVE:
+                    acc = NOT_NEGATIVE  # a mask with the sign bit clear
+                else:
+                    acc = ANY
+            case ir.Operate():
+                acc = ANY
+            case ir.Store(target=target):
+                _set(state, target.name, acc)
+            case ir.StepVar(target=target, step=step):
+                before = state.get(target.name, ANY)
+                _set(state, target.name, frozenset().union(
+                    *(_STEPPED[step][sign] for sign in before)))
+            case ir.Move(target=target, source=source):
+                _set(state, target.name, _operand(source, state, result))
+            case ir.Compute():
+                acc = ANY
+            case ir.Call():
+                for name in instruction.form.writes:
+                    state.pop(name, None)
+                low, high = instruction.form.result_range
+                result = frozenset(sign for sign, present in
+                                   (("<", low < 0), ("=", low <= 0 <= high), (">", high > 0))
+                                   if present)
+    return state
+
+
+def _operand(operand: ir.Operand, state: State, result: Signs) -> Signs:
+    match operand:
+        case ir.Imm(value=value):
+            return frozenset("<" if value < 0 else "=" if value == 0 else ">")
+        case ir.Var(name=name):
+            return state.get(name, ANY)
+        case _:
+            return result
+
+
+def _set(state: State, name: str, signs: Signs) -> None:
+    if signs == ANY:
+        state.pop(name, None)
+    else:
+        state[name] = signs

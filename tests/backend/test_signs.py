@@ -1,0 +1,158 @@
+"""The passes of issue 25 that keep the instruction set, on small programs: branches
+decided or negated by the signs earlier branches proved (signs.py), and algebra with
+equal operands (copies.py). Each case also runs on every engine, which must agree."""
+
+from __future__ import annotations
+
+import pytest
+
+from rl1.compiler.analysis import analyze
+from rl1.compiler.backend import ir, optimize
+from rl1.compiler.backend.copies import propagate_copies
+from rl1.compiler.backend.lower import lower
+from rl1.compiler.backend.signs import decide_branches
+from rl1.compiler.differential import AstEngine, VmEngine, judge
+from rl1.compiler.strategies import Run
+
+ENGINES = (AstEngine(), VmEngine(0), VmEngine(1), VmEngine(2))
+BUDGET = 20_000
+
+
+def optimized(source: str, *passes: optimize.Pass) -> ir.Program:
+    program = lower(analyze(source).program)
+    for run in passes:
+        program = run(program)
+        assert ir.validate(program) == []
+    return program
+
+
+def terminators(program: ir.Program) -> dict[str, str]:
+    return {block.id: str(block.terminator) for block in program}
+
+
+def kept(branch: str, program: ir.Program) -> bool:
+    """Whether a branch is still there as `branch` begins (its fall-through aside)."""
+    return any(text.startswith(branch) for text in terminators(program).values())
+
+
+def instructions(program: ir.Program) -> list[str]:
+    return [str(instruction) for block in program for instruction in block.instructions]
+
+
+def agree(source: str, script: dict[str, object]) -> None:
+    assert judge(Run(source, script), ENGINES, BUDGET).problems == []
+
+
+# What a branch proved ------------------------------------------------------------------
+
+# After `?H=#20` falls through, H is not 0: with H from INP (0..255), it is positive.
+PORT_POLL = """H=(INP 3)
+?H=#20
+?H>#30
+(OUT 1,1); (END)
+:20 (OUT 2,2); (END)
+:30 (OUT 3,3); (END)
+"""
+
+
+def test_a_branch_that_an_earlier_branch_decided_becomes_a_jump() -> None:
+    program = optimized(PORT_POLL, decide_branches)
+    assert not kept("if H>0 then L30", program)
+    assert "jump L30" in terminators(program).values()
+
+
+@pytest.mark.parametrize("port", [0, 7, 255])
+def test_the_decided_program_runs_as_before(port: int) -> None:
+    agree(PORT_POLL, {"INP": {"3": [port]}})
+
+
+def test_a_branch_on_a_sign_the_path_excludes_goes_the_other_way() -> None:
+    # On `?A<#20`'s taken edge A is negative: `?A>#30` there can never be taken.
+    source = "A=(IMG)\n?A<#20\n(END)\n:20 ?A>#30\n(OUT 1,1); (END)\n:30 (OUT 2,2); (END)\n"
+    assert "jump B2" in terminators(optimized(source, decide_branches)).values()
+    agree(source, {"IMG": [{"area": -5, "x": 0, "y": 0, "z": 0}]})
+
+
+def test_a_branch_on_a_variable_of_any_sign_is_kept() -> None:
+    source = "A=(IMG)\n?A=#20\n?A>#30\n(END)\n:20 (END)\n:30 (OUT 2,2); (END)\n"
+    assert kept("if A>0 then L30", optimized(source, decide_branches))
+
+
+def test_paths_join_to_the_signs_either_allows() -> None:
+    # H is 0 or 5 at :10, so `?H<#30` never jumps; after `?H=#20` it is 5.
+    source = (":01 H=(INP 1); ?H=#10\nH=5\n:10 ?H<#30\n?H=#20\n?H>#40\n:20 (END)\n"
+              ":30 (OUT 3,3); (END)\n:40 (OUT 4,4); (END)\n")
+    branches = terminators(optimized(source, decide_branches))
+    assert branches["L10"] == "jump B1"  # past `?H<#30`
+    assert "jump L40" in branches.values()
+    for port in (0, 9):
+        agree(source, {"INP": {"1": [port]}})
+
+
+def test_a_step_that_can_wrap_forgets_the_sign() -> None:
+    # 32767 + 1 is -32768: a positive variable stepped up may be negative.
+    source = "A=(INP 1)\n?A=#20\nA++\n?A<#30\n(END)\n:20 (END)\n:30 (OUT 1,1); (END)\n"
+    assert kept("if A<0 then L30", optimized(source, decide_branches))
+
+
+def test_nothing_is_known_where_a_handler_starts() -> None:
+    source = ("(TRC 3); (MOV 1,1); H=(INP 1)\n:10 ?H<#20\n(TIM 1); #10\n:20 (END)\n"
+              ":96 ?H<#20\n(MOV 0,0); (END)\n")
+    assert kept("if H<0 then L20", optimized(source, decide_branches))
+
+
+# A negated branch ----------------------------------------------------------------------
+
+# `?N>#20; #10` with N from INP (0..255): not positive is zero, so `?N=#10` falls to :20.
+POLL_LOOP = ":10 N=(INP 2)\n?N>#20\n#10\n:20 (OUT 1,N); (END)\n"
+
+
+def test_a_branch_around_a_jump_is_negated_when_the_signs_allow_it() -> None:
+    program = optimize.optimize(lower(analyze(POLL_LOOP).program), 1, check=True)
+    assert terminators(program)["L10"] == "if N=0 then L10 else L20"
+
+
+def test_a_branch_around_a_jump_is_kept_when_the_variable_may_have_any_sign() -> None:
+    source = ":10 N=(IMG)\n?N>#20\n#10\n:20 (OUT 1,1); (END)\n"
+    program = optimize.optimize(lower(analyze(source).program), 1, check=True)
+    assert terminators(program)["L10"] == "if N>0 then L20 else L10"
+
+
+@pytest.mark.parametrize("readings", [[0, 0, 3], [5], [0, 255]])
+def test_the_negated_loop_runs_as_before_in_fewer_instructions(readings: list[int]) -> None:
+    script: dict[str, object] = {"INP": {"2": readings}}
+    verdict = judge(Run(POLL_LOOP, script), ENGINES, BUDGET)
+    assert verdict.problems == []
+    executed = {name: verdict.observations[name].executed for name in ("vm-O0", "vm-O1")}
+    # -O0 runs `JGT; JMP` on each round that goes on, -O1 one `JZ`.
+    assert executed["vm-O1"] is not None and executed["vm-O0"] is not None
+    assert executed["vm-O0"] - executed["vm-O1"] >= len(readings) - 1
+
+
+# Algebra with equal operands -----------------------------------------------------------
+
+@pytest.mark.parametrize(("expression", "value"), [("A-A", 0), ("A^A", 0), ("A&A", None),
+                                                   ("A|A", None)])
+def test_an_operation_on_the_accumulators_own_value_is_folded(expression: str,
+                                                                value: int | None) -> None:
+    source = f"A=(INP 1)\nB={expression}\n(OUT 1,B); (END)\n"
+    code = instructions(optimized(source, propagate_copies))
+    operator = {"-": "sub", "^": "xor", "&": "and", "|": "or"}[expression[1]]
+    assert f"{operator} A" not in code
+    if value is not None:
+        assert f"load {value}" in code
+    for port in (0, 77, 255):
+        agree(source, {"INP": {"1": [port]}})
+
+
+def test_an_operation_on_another_variable_is_kept() -> None:
+    code = instructions(optimized("A=(INP 1); C=(INP 2)\nB=A-C\n(END)\n", propagate_copies))
+    assert "sub C" in code
+
+
+def test_a_difference_of_equal_operands_folds_on_at_o1() -> None:
+    # `B=A-A+7` is 7 whatever A holds: constant folding carries the 0 on.
+    source = "A=(INP 1)\nB=A-A+7\n(OUT 1,B); (END)\n"
+    program = optimize.optimize(lower(analyze(source).program), 1, check=True)
+    assert "call OUT 1, 7" in instructions(program)
+    agree(source, {"INP": {"1": [200]}})
