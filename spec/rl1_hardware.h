@@ -31,7 +31,8 @@ typedef struct {
 } rl1_reading;
 
 /* The vehicle. One dispatch per kind of callback; the built-in is named by its opcode
- * (0x40..0x5D, spec/ilc.md 8.3: one opcode per form, CAM and ULT selectors included),
+ * (0x40..0x5D, spec/ilc.md 8.3: one opcode per form, CAM and ULT selectors included;
+ * vm/c/rl1vm.h names them RL1_OP_FRE .. RL1_OP_FZI),
  * `args` holds its arguments in parameter order, already range-checked (as many as the
  * form's arity; NULL when it has none). */
 typedef struct {

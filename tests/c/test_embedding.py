@@ -50,7 +50,7 @@ def readme_main_c() -> str:
 
 def readme_avr_recipe() -> list[str]:
     """The commands of the README's AVR recipe, each continued line joined."""
-    blocks = re.findall(r"```sh\n(.*?)```", embedding_section(), re.S)
+    blocks: list[str] = re.findall(r"```sh\n(.*?)```", embedding_section(), re.S)
     assert len(blocks) == 1, "the README's embedding section has one shell block"
     return blocks[0].replace("\\\n", " ").splitlines()
 

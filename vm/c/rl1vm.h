@@ -228,8 +228,9 @@ void rl1_vm_init(rl1_vm *vm, uint32_t budget);
 /* --- Internal: the instruction set, shared by the loader and the VM ----------------- */
 
 /* How a byte of the file is read: a plain load, unless the build says otherwise. AVR's
- * flash is not in its data address space, so a file kept there is read with
- * -DRL1_READ_BYTE(p)=pgm_read_byte(p) -include avr/pgmspace.h (vm/c/README.md). */
+ * flash is not in its data address space, so a file kept there (rl1c --emit c
+ * --progmem) is read with -DRL1_READ_BYTE(p)=pgm_read_byte(p) -include avr/pgmspace.h
+ * (vm/c/README.md). */
 #ifndef RL1_READ_BYTE
 #define RL1_READ_BYTE(p) (*(p))
 #endif
