@@ -146,6 +146,7 @@ def test_standard_input_and_output(tmp_path: Path) -> None:
     (["--emit", "ir", "-s"], "no meaning with --emit ir"),
     (["--emit", "asm"], "argument --emit: invalid choice: 'asm'"),
     (["--c-name", "x"], "--c-name names the array of --emit c"),
+    (["--emit", "ihex", "--progmem"], "--progmem places the array of --emit c"),
     (["--emit", "c", "--c-name", "2x"], "argument --c-name: `2x` is not a C identifier"),
     (["--emit", "c", "--c-name", "int"], "`int` is a C keyword"),
     (["--base-address", "0x100"], "--base-address places the bytes of --emit ihex"),
