@@ -4,7 +4,7 @@ its example sketch, compiled offline for an Arduino Uno by Debian's arduino-buil
 arduino-core-avr (`make -C vm/c arduino`) and run under simavr, prints on the serial
 port the calls, the readings, the instruction count and the variables of Listing 1 as
 the reference VM's run gives them (`rl1c run examples/sample.rob --sensors
-examples/sample.sensors.json`).
+examples/sample.sensors.json`), and builds without a warning at -Wall -Wextra.
 
 Skipped, saying why, where arduino-builder, arduino-core-avr or simavr is missing
 (vm/c/install-tools installs them)."""
@@ -114,6 +114,10 @@ def test_the_example_sketch_runs_listing_1_as_the_reference_vm(build: Path) -> N
                     "vm/c/install-tools installs it")
     printed = make(build, "arduino")
     assert "Sketch uses" in printed and "Global variables use" in printed
+    # Built with -Wall -Wextra, the library and the sketch are clean (the core is not).
+    log = (build / "arduino" / "sketch.log").read_text(encoding="utf-8")
+    assert not [line for line in log.splitlines()
+                if "warning:" in line and "/cores/arduino/" not in line]
     elf = build / "arduino" / "sketch" / "Listing1.ino.elf"
     # The sketch sleeps with interrupts off when the run is over, which ends simavr.
     done = subprocess.run(["simavr", "-m", "atmega328p", "-f", "16000000", str(elf)],
