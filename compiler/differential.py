@@ -3,8 +3,8 @@
 spec/optimization.md is the contract: section 2 says what is observable (the device
 trace, how the run ends, the 53 variables), section 3 the budget invariant between
 optimization levels, section 5 the engines (`ast`, `vm-O0`..`vm-O2`, `c-O0`..`c-O2`,
-`exec:COMMAND`). `rl1c fuzz` and the property tests both compare runs through this
-module. The C VM of the firmware (vm/c/, through vm/native.py) is one more `Engine`: a
+`exec:COMMAND`, `exec-ON:COMMAND`). `rl1c fuzz` and the property tests both compare runs
+through this module. The C VM of the firmware (vm/c/, through vm/native.py) is one more `Engine`: a
 name and a `run`.
 """
 
@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import selectors
 import shlex
 import signal
@@ -21,12 +22,13 @@ import tempfile
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, Literal, Protocol
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
 from rl1.compiler.interpreter import interpret
 from rl1.compiler.strategies import Run
+from rl1.vm.drive import drive
 from rl1.vm.faults import FaultKind
 from rl1.vm.hardware import Blocking
 from rl1.vm.language import VARIABLES, decimal_value
@@ -93,6 +95,11 @@ class Engine(Protocol):
     @property
     def name(self) -> str: ...
 
+    @property
+    def level(self) -> int | None:
+        """The optimization level of the code it runs; None for the interpreter, which
+        runs the source and counts statements."""
+
     def run(self, case: Run, budget: int) -> Observation: ...
 
 
@@ -101,6 +108,7 @@ class AstEngine:
     """The AST interpreter: the reference for what a program means."""
 
     name: str = "ast"
+    level: None = None
 
     def run(self, case: Run, budget: int) -> Observation:
         device = ScriptedDevice(parse_script(case.script))
@@ -120,8 +128,11 @@ class VmEngine:
 
     def run(self, case: Run, budget: int) -> Observation:
         device = ScriptedDevice(parse_script(case.script))
-        machine = Machine(verify(compiled(case.source, self.level)), Blocking(device), budget)
-        result = machine.run()
+        # As `rl1c run` does (compiler/runner.py): the device told each call's line, the
+        # run stepped by `drive`, which makes the script's losses after instruction counts.
+        machine = Machine(verify(compiled(case.source, self.level)),
+                          Blocking(device, lambda: machine.current_line()), budget)
+        result = drive(machine, device)
         return Observation(run_document(result, device.trace), machine.executed,
                            tuple(machine.call_counts))
 
@@ -139,21 +150,26 @@ class CEngine:
 
     def run(self, case: Run, budget: int) -> Observation:
         device = ScriptedDevice(parse_script(case.script))
-        machine = NativeMachine(compiled(case.source, self.level), Blocking(device), budget,
+        machine = NativeMachine(compiled(case.source, self.level),
+                                Blocking(device, lambda: machine.current_line()), budget,
                                 load(library()))
-        result = machine.run()
+        result = drive(machine, device)
         return Observation(run_document(result, device.trace), machine.executed)
+
 
 
 @dataclass(frozen=True)
 class ExecEngine:
-    """A command run once per program (spec/optimization.md, section 5)."""
+    """A command run once per program on the file compiled at `level`
+    (spec/optimization.md, section 5): `exec:COMMAND` at -O0, `exec-ON:COMMAND` at -ON."""
 
     command: str
+    level: int = 0
     name: str = field(init=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "name", f"exec:{self.command}")
+        object.__setattr__(self, "name", f"exec{f'-O{self.level}' if self.level else ''}:"
+                                         f"{self.command}")
 
     def command_line(self, ilc_path: str, sensors_path: str, budget: int) -> str:
         return (self.command.replace("{ilc}", shlex.quote(ilc_path))
@@ -173,7 +189,7 @@ class ExecEngine:
             ilc_path = os.path.join(folder, "fuzz.ilc")
             sensors_path = os.path.join(folder, "fuzz.sensors.json")
             with open(ilc_path, "wb") as stream:
-                stream.write(compiled(case.source, 0))
+                stream.write(compiled(case.source, self.level))
             with open(sensors_path, "w", encoding="utf-8") as stream:
                 json.dump(case.script, stream)
             ran = _run_shell(self.command_line(ilc_path, sensors_path, budget))
@@ -304,6 +320,10 @@ DEFAULT_ENGINES = ("ast", *(f"vm-O{level}" for level in OPTIMIZATION_LEVELS))
 ENGINE_NAMES = (*DEFAULT_ENGINES, *(f"c-O{level}" for level in OPTIMIZATION_LEVELS))
 
 
+EXEC_ENGINE = re.compile(r"exec(?:-O([0-9]+))?:(.*\S.*)", re.DOTALL)
+"""`exec:COMMAND` (given the -O0 file) or `exec-ON:COMMAND` (the file at -ON)."""
+
+
 def engine_named(name: str) -> Engine | None:
     """The engine a name on the command line means; None when it means none."""
     if name == "ast":
@@ -312,23 +332,46 @@ def engine_named(name: str) -> Engine | None:
         return VmEngine(int(name[4:]))
     if name.startswith("c-O") and name[3:] in {str(level) for level in OPTIMIZATION_LEVELS}:
         return CEngine(int(name[3:]))
-    if name.startswith("exec:") and name[5:].strip():
-        return ExecEngine(name[5:])
+    if (written := EXEC_ENGINE.fullmatch(name)) is not None:
+        level = int(written.group(1) or 0)
+        return ExecEngine(written.group(2), level) if level in OPTIMIZATION_LEVELS else None
     return None
 
 
 # Comparing runs --------------------------------------------------------------------------
 
+Rule = Literal["same-code", "invariant", "shared-prefix"]
+SAME_CODE: Rule = "same-code"  # both ran the same code: everything compares, the watchdog too
+INVARIANT: Rule = "invariant"  # the reference is the -O0 VM's run: section 3 says what compares
+SHARED_PREFIX: Rule = "shared-prefix"  # two runs past an -O0 run that met the watchdog
 
-def differences(reference: Observation, other: Observation) -> list[str]:
-    """How `other` differs from `reference`, one line each; empty when they agree. When
-    either met the watchdog, only the traces up to it are compared (engines count steps
-    differently, and optimized code runs fewer)."""
+
+def differences(reference: Observation, other: Observation, rule: Rule = INVARIANT
+                ) -> list[str]:
+    """How `other` differs from `reference`, one line each; empty when they agree.
+
+    What compares when a run meets the watchdog depends on how the two count steps
+    (spec/optimization.md, sections 3 and 5), the `rule`:
+    - SAME_CODE: they ran the same code (the same file), so they count the same
+      instructions: everything compares, a watchdog's fault like any other ending.
+    - INVARIANT: `reference` is the -O0 VM's run, `other` the same program run at a
+      level or by an engine that never counts more to a call (the interpreter counts
+      statements). An -O0 run that ended is matched in everything, so `other` meeting
+      the watchdog is a difference; one that met the watchdog must have its trace up to
+      the fault as a prefix of `other`'s, whose ending and variables are its own.
+    - SHARED_PREFIX: neither is the -O0 run, which met the watchdog: only their traces up
+      to the shorter compare."""
     found: list[str] = []
     ours, theirs = reference.commands(), other.commands()
-    if reference.ran_away or other.ran_away:
-        shorter = min(len(ours), len(theirs))
-        ours, theirs = ours[:shorter], theirs[:shorter]
+    match rule:  # how much of the traces compares, when not all of the runs
+        case "invariant" if reference.ran_away:
+            compared: int | None = len(ours)
+        case "shared-prefix" if reference.ran_away or other.ran_away:
+            compared = min(len(ours), len(theirs))
+        case _:
+            compared = None
+    if compared is not None:
+        ours, theirs = ours[:compared], theirs[:compared]
     for index, (mine, yours) in enumerate(zip(ours, theirs, strict=False)):
         if mine != yours:
             found.append(f"trace entry {index + 1}: {_entry(mine)} / {_entry(yours)}")
@@ -338,7 +381,7 @@ def differences(reference: Observation, other: Observation) -> list[str]:
             longer = ours if len(ours) > len(theirs) else theirs
             found.append(f"trace: {len(ours)} / {len(theirs)} entries, the first extra "
                          f"one {_entry(longer[min(len(ours), len(theirs))])}")
-    if reference.ran_away or other.ran_away:
+    if compared is not None:
         return found
     if reference.ending() != other.ending():
         found.append(f"ending: {_ending(reference)} / {_ending(other)}")
@@ -393,22 +436,69 @@ def _observed(engine: Engine, case: Run, budget: int) -> Observation:
                             "variables": {}, "trace": []})
 
 
+WITNESS = VmEngine(0)  # whose run decides what compares when the watchdog is met
+
+
 def judge(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
-    """Run `case` on every engine; compare each with the first, and the optimized VM
-    runs with the -O0 one."""
+    """Run `case` on every engine; compare each with the first, and with the -O0 VM's
+    run as the budget invariant says (spec/optimization.md, sections 3 and 5)."""
+    if parse_script(case.script).instruction_losses:
+        return _judge_by_level(case, engines, budget)
     observations = {engine.name: _observed(engine, case, budget) for engine in engines}
-    names = list(observations)
-    reference = observations[names[0]]
-    problems = [f"{name}: crashed: {observation.document['status']['message']}"
-                for name, observation in observations.items() if observation.crashed]
-    problems += [f"{name}: {line}" for name in names[1:]
-                 for line in differences(reference, observations[name])]
-    unoptimized = observations.get("vm-O0")
+    problems = _crashes(observations)
+    reference, *others = engines
+    witness = observations.get(WITNESS.name)
+    if witness is None and any(observation.ran_away for observation in observations.values()):
+        witness = _observed(WITNESS, case, budget)  # run only when it decides something
+    if witness is not None and witness.ran_away:
+        # Each engine has its trace up to -O0's fault, or all of it on the same code;
+        # between two others, only what both ran compares.
+        problems += [f"{engine.name}: {line}" for engine in engines
+                     if engine.name != WITNESS.name
+                     for line in differences(witness, observations[engine.name],
+                                             SAME_CODE if engine.level == 0 else INVARIANT)]
+        pairs_rule = SHARED_PREFIX
+    else:  # -O0 ended within the budget, so every engine ends as it does
+        pairs_rule = SAME_CODE
+        if witness is not None and not witness.crashed:
+            problems += [f"{name}: met the watchdog, where vm-O0 ended after "
+                         f"{witness.executed} instructions of the budget of {budget}"
+                         for name, observation in observations.items() if observation.ran_away]
+    if reference.name != WITNESS.name or pairs_rule == SAME_CODE:
+        problems += [f"{engine.name}: {line}" for engine in others
+                     for line in differences(
+                         observations[reference.name], observations[engine.name],
+                         SAME_CODE if engine.level == reference.level is not None
+                         else pairs_rule)]
+    unoptimized = observations.get(WITNESS.name)
     if unoptimized is not None:
-        problems += [f"{name}: {line}" for name in names
-                     if name.startswith("vm-O") and name != "vm-O0"
+        problems += [f"{name}: {line}" for name in observations
+                     if name.startswith("vm-O") and name != WITNESS.name
                      for line in budget_violations(unoptimized, observations[name], budget)]
-    return Verdict(observations, problems)
+    return Verdict(observations, list(dict.fromkeys(problems)))
+
+
+def _judge_by_level(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
+    """A script that loses the line after instruction counts names points in one
+    compiled program: only engines given the same file compare, each with the first of
+    its level, in everything; the interpreter, which counts statements, does not run."""
+    observations: dict[str, Observation] = {}
+    problems: list[str] = []
+    first_of_level: dict[int, str] = {}
+    for engine in engines:
+        if engine.level is None:
+            continue
+        observations[engine.name] = observed = _observed(engine, case, budget)
+        reference = first_of_level.setdefault(engine.level, engine.name)
+        if reference != engine.name:
+            problems += [f"{engine.name}: {line}" for line in
+                         differences(observations[reference], observed, SAME_CODE)]
+    return Verdict(observations, _crashes(observations) + problems)
+
+
+def _crashes(observations: dict[str, Observation]) -> list[str]:
+    return [f"{name}: crashed: {observation.document['status']['message']}"
+            for name, observation in observations.items() if observation.crashed]
 
 
 def _entry(entry: Any) -> str:
@@ -421,9 +511,11 @@ def _entry(entry: Any) -> str:
 
 
 def _ending(observation: Observation) -> str:
-    ending = observation.ending()
-    if isinstance(ending, dict):
-        line = ending.get("line")
-        return f"fault {ending.get('code')}" + (f" at line {line}" if line else "")
-    return "ended normally" if ending == "ok" else repr(ending)
+    match observation.ending():
+        case {"code": "ok"}:
+            return "ended normally"
+        case {"code": code, "line": line}:
+            return f"fault {code}" + (f" at line {line}" if line else "")
+        case other:
+            return repr(other)
 

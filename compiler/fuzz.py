@@ -100,6 +100,9 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
         smallest = case
         return True
 
+    # Losses after an instruction count compare only between engines given one file.
+    levels = [engine.level for engine in engines if engine.level is not None]
+    comparable = len(set(levels)) < len(levels)
     seeds = Random(seed)
     with contextlib.suppress(_TimeUp):
         while smallest is None and (count is None or programs < count):
@@ -109,7 +112,8 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
                               suppress_health_check=list(HealthCheck),
                               phases=(Phase.generate, Phase.shrink))
             with contextlib.suppress(NoSuchExample):
-                smallest = find(runs(), disagrees, settings=limits,
+                smallest = find(runs(instruction_losses=comparable), disagrees,
+                                settings=limits,
                                 random=Random(seeds.getrandbits(64)))
             if programs == before:  # Hypothesis generated nothing more: stop, not spin
                 break
@@ -235,6 +239,6 @@ def _replay(engine: Engine, case: Run, budget: int,
         ilc = write(f"program-O{engine.level}.ilc", compiled(case.source, engine.level))
         return f"rl1c run {ilc} {run}" + (" --engine c" if isinstance(engine, CEngine) else "")
     if isinstance(engine, ExecEngine):
-        ilc = write("program-O0.ilc", compiled(case.source, 0))
+        ilc = write(f"program-O{engine.level}.ilc", compiled(case.source, engine.level))
         return engine.command_line(ilc, SCRIPT, budget)
     return f"# {engine.name}: no command replays it"

@@ -29,7 +29,8 @@ simulator, an editor plug-in):
   loops that a sensor reading ends (the script's last readings end every such loop),
   lose the guidance line in tracing modes 2 and 3 (the script's `line_lost` entries) and
   enter handlers that end, or jump back into the program and so are entered again, or
-  are missing; and some pass a variable argument out of its range or ask the device for
+  are missing (and, when asked, lose the line between calls, after an instruction
+  count); and some pass a variable argument out of its range or ask the device for
   a move it refuses, so that runs fault. Most runs end within a small budget; a few
   meet the watchdog.
 """
@@ -502,9 +503,12 @@ def _readings(draw: st.DrawFn, make: st.SearchStrategy[object], ending: object) 
 
 
 @st.composite
-def sensor_scripts(draw: st.DrawFn) -> JsonScript:
+def sensor_scripts(draw: st.DrawFn, instruction_losses: bool = False) -> JsonScript:
     """A sensor script (JSON data, spec of vm/scripted.py) whose last readings end the
-    sensor loops of `runs()`, with up to four losses of the guidance line."""
+    sensor loops of `runs()`, with up to four losses of the guidance line: at a device
+    time, during a motion and, with `instruction_losses`, after an instruction count
+    (which only engines running the same compiled file can compare, and the interpreter
+    does not run)."""
     small = st.integers(-300, 1200)
     image = st.builds(lambda area, x, y, z: {"area": area, "x": x, "y": y, "z": z},
                       small, small, small, st.integers(-180, 180))
@@ -519,11 +523,15 @@ def sensor_scripts(draw: st.DrawFn) -> JsonScript:
         "FZI": draw(st.lists(st.builds(lambda a, b: {"s": a, "t": b}, small, small),
                              min_size=1, max_size=2)),
     }
-    losses = draw(st.lists(st.one_of(
+    kinds = [
         st.builds(lambda time: {"time": time}, st.integers(1, 2000)),
         st.builds(lambda command, nth, after: {"during": command, "nth": nth, "after": after},
                   st.sampled_from(("MOV", "MVI")), st.integers(1, 2), st.integers(1, 300)),
-    ), max_size=4))
+    ]
+    if instruction_losses and draw(st.booleans()):
+        # Between calls, where a loss is taken at a jump (or at the next call).
+        kinds.append(st.builds(lambda count: {"instruction": count}, st.integers(1, 400)))
+    losses = draw(st.lists(st.one_of(kinds), max_size=4))
     if losses:
         script["line_lost"] = losses
     script["after_last"] = "repeat"  # the last readings end the loops: they must repeat
@@ -531,6 +539,7 @@ def sensor_scripts(draw: st.DrawFn) -> JsonScript:
 
 
 @st.composite
-def runs(draw: st.DrawFn, max_blocks: int = 6) -> Run:
-    """A program the checker accepts, with a sensor script (see the module's notes)."""
-    return Run(_build(draw, max_blocks, _Wild()), draw(sensor_scripts()))
+def runs(draw: st.DrawFn, max_blocks: int = 6, instruction_losses: bool = False) -> Run:
+    """A program the checker accepts, with a sensor script (see the module's notes and
+    `sensor_scripts`)."""
+    return Run(_build(draw, max_blocks, _Wild()), draw(sensor_scripts(instruction_losses)))

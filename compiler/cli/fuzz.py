@@ -29,8 +29,9 @@ BAR_WIDTH = 30
               help="an engine to compare, repeatable: ast, vm-O0, vm-O1, vm-O2, the C VM "
                    "of the firmware c-O0, c-O1, c-O2 (built on first use), or "
                    "exec:COMMAND ({ilc}, {sensors} and {budget} replaced; it prints the run "
-                   "as `rl1c run --format json` does). Default: ast, vm-O0, vm-O1, vm-O2; "
-                   "the first is the reference")
+                   "as `rl1c run --format json` does), given the file compiled with -O0, "
+                   "or exec-O1:COMMAND, exec-O2:COMMAND at that level. Default: ast, "
+                   "vm-O0, vm-O1, vm-O2; the first is the reference")
 @click.option("--count", type=str, default=None, callback=lambda c, p, v: None if v is None
               else at_least_one(c, p, v), metavar="N",
               help=f"programs to run (default {DEFAULT_COUNT})")
@@ -82,7 +83,8 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         engine = engine_named(name)
         if engine is None:
             raise click.UsageError(f"argument --engine: unknown engine {name!r} (choose from "
-                                   f"{', '.join(ENGINE_NAMES)}, or exec:COMMAND)")
+                                   f"{', '.join(ENGINE_NAMES)}, or exec:COMMAND, "
+                                   "exec-O1:COMMAND, exec-O2:COMMAND)")
         engines.append(engine)
     if len({engine.name for engine in engines}) < 2 or len(set(engine_names)) < len(
             engine_names):

@@ -74,6 +74,7 @@ class _CrashesOnLess:
     the campaign."""
 
     name = "crashes"
+    level = None
 
     def run(self, case: Run, budget: int) -> Observation:
         if "<" in case.source:
@@ -129,6 +130,18 @@ def test_a_planted_shift_bug_is_found_and_shrunk_to_a_few_lines(
         path.name for path in found.iterdir()}
 
 
+@pytest.mark.usefixtures("quick_shrinking")
+def test_an_engine_that_only_ever_says_watchdog_disagrees(tmp_path: Path) -> None:
+    # When either run met the watchdog only the traces' shared prefix compared: an
+    # engine printing {"status": {"code": "budget"}} agreed with 200 programs.
+    lazy = shlex.quote(str(ROOT / "tests/support/engines/lazy.sh"))
+    result = rl1c("fuzz", "--engine", "vm-O0", "--engine", f"exec:sh {lazy}", "--count",
+                  "200", "--seed", "1", "--out", str(tmp_path))
+    assert result.exit_code == 1, result.output
+    assert "ending: ended normally / fault budget" in result.stdout
+    assert "met the watchdog, where vm-O0 ended after" in result.stdout
+
+
 def test_an_engine_that_prints_no_run_disagrees(tmp_path: Path) -> None:
     result = rl1c("fuzz", "--engine", "ast", "--engine", "exec:echo not json", "--count", "3",
                   "--seed", "4", "--out", str(tmp_path))
@@ -139,6 +152,7 @@ def test_an_engine_that_prints_no_run_disagrees(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize(("args", "message"), [
     (["--engine", "vm-O7", "--engine", "ast"], "unknown engine 'vm-O7'"),
+    (["--engine", "exec-O7:true", "--engine", "ast"], "unknown engine 'exec-O7:true'"),
     (["--engine", "ast"], "give at least two different engines"),
     (["--engine", "ast", "--engine", "ast"], "give at least two different engines"),
     (["--count", "5", "--time", "5"], "give --count or --time, not both"),

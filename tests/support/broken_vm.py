@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from rl1.vm import machine
+from rl1.vm.drive import drive
 from rl1.vm.hardware import Blocking
 from rl1.vm.scripted import ScriptedDevice, decode_script, run_document
 from rl1.vm.verifier import verify
@@ -26,7 +27,9 @@ def main() -> None:
     ilc, sensors, budget = sys.argv[1:]
     machine._shift_left = broken_left
     device = ScriptedDevice(decode_script(Path(sensors).read_bytes(), sensors))
-    result = machine.Machine(verify(Path(ilc).read_bytes()), Blocking(device), int(budget)).run()
+    vm = machine.Machine(verify(Path(ilc).read_bytes()),
+                         Blocking(device, lambda: vm.current_line()), int(budget))
+    result = drive(vm, device)  # as `rl1c run`: the script's losses after instruction counts
     json.dump(run_document(result, device.trace), sys.stdout)
 
 
