@@ -94,7 +94,8 @@ def assert_lines_agree(c_loader: Loader, data: bytes) -> None:
 
 def test_the_status_codes_are_the_python_refusals() -> None:
     header = (C_DIR / "rl1vm.h").read_text(encoding="utf-8")
-    codes = {name: int(value) for name, value in re.findall(r"RL1_(\w+) = (\d+)", header)}
+    refusals = header[header.index("typedef enum rl1_refusal {"):header.index("} rl1_refusal;")]
+    codes = {name: int(value) for name, value in re.findall(r"RL1_(\w+) = (\d+)", refusals)}
     assert codes == {"ACCEPTED": 0} | {refusal.name: refusal.value for refusal in ilc.Refusal}
 
 
