@@ -97,7 +97,7 @@ def _address(ctx: click.Context, param: click.Parameter, value: str | None) -> i
                    "Default: the file's name and _ilc, such as sample_ilc")
 @click.option("--progmem", is_flag=True,
               help="with --emit c: put the array in AVR flash (PROGMEM), for a VM built "
-                   "to read it there (vm/c/README.md, AVR); on other targets it changes "
+                   "to read it there (docs/firmware.md); on other targets it changes "
                    "nothing")
 @click.option("--base-address", metavar="ADDRESS", callback=_address,
               help="with --emit ihex: the address of the first byte, decimal or 0x hex "
