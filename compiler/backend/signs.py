@@ -21,10 +21,14 @@ edge all but it. Then:
   has only `=`, `>` and `<` (no "not zero"), so this needs what the flow proved:
   `?N=#20; #10` with N known not negative is `?N>#10`. The way that jumped runs one
   instruction fewer, the other as many as before.
+- A way into a block that holds only a branch, when what that way proved decides the
+  branch (`?V>#12` after `V=6`), goes straight to where the branch would go: the branch
+  it skips costs as much as the jump it may need instead.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections import deque
 
 from rl1.compiler.frontend.ast import Relation
@@ -49,12 +53,42 @@ _STEPPED: dict[str, dict[str, Signs]] = {
 
 def decide_branches(program: ir.Program) -> ir.Program:
     following = program.following()
-    for block_id, state in _solve(program).items():
+    branches = {block.id: block.terminator for block in program
+                if not block.instructions and isinstance(block.terminator, ir.Branch)}
+    exits = {block_id: _exit_state(program.blocks[block_id], state)
+             for block_id, state in _solve(program).items()}
+    for block_id, state in exits.items():
         block = program.blocks[block_id]
         if isinstance(block.terminator, ir.Branch):
-            block.terminator = _rewritten(block.terminator, _exit_state(block, state),
-                                          following[block_id])
+            block.terminator = _rewritten(block.terminator, state, following[block_id])
+    for block_id, state in exits.items():
+        block = program.blocks[block_id]
+        block.terminator = _threaded(block.terminator, state, branches)
     return program
+
+
+def _threaded(terminator: ir.Terminator, state: State,
+              branches: dict[ir.BlockId, ir.Terminator]) -> ir.Terminator:
+    """The terminator with each way into a block that only branches, where what the
+    way proves decides that branch, going straight on to where it goes: the branch
+    it skips costs as much as the jump it may need instead."""
+    def past(target: ir.BlockId, leaving: State) -> ir.BlockId:
+        branch = branches.get(target)
+        if not isinstance(branch, ir.Branch):
+            return target
+        decided = _decided(branch, leaving.get(branch.var.name, ANY))
+        return target if decided is None else decided.target
+
+    match terminator:
+        case ir.Jump(target=target):
+            return dataclasses.replace(terminator, target=past(target, state))
+        case ir.Branch(var=var, relation=relation, if_true=if_true, if_false=if_false):
+            signs = state.get(var.name, ANY)
+            return dataclasses.replace(
+                terminator, if_true=past(if_true, {**state, var.name: frozenset(relation)}),
+                if_false=past(if_false, {**state, var.name: signs - {relation}}))
+        case _:
+            return terminator
 
 
 def _rewritten(branch: ir.Branch, state: State, following: ir.BlockId | None

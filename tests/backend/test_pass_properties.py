@@ -34,8 +34,16 @@ from rl1.vm.scripted import ScriptedDevice, parse_script, run_document
 from rl1.vm.verifier import verify
 
 BUDGET = 20_000
-PASSES = (fold_constants, decide_branches, propagate_copies, remove_dead_stores,
-          rewrite_steps, simplify_control, fuse)
+
+
+def decide_branches_after_control(program: ir.Program) -> ir.Program:
+    """decide_branches where -O1 runs it: on IR whose jumps control.py has threaded, the
+    only IR on which its negation finds a branch next to its jump."""
+    return decide_branches(simplify_control(program))
+
+
+PASSES = (fold_constants, decide_branches, decide_branches_after_control, propagate_copies,
+          remove_dead_stores, rewrite_steps, simplify_control, fuse)
 # Not simplify_control: removing blocks can make jumps to thread that it saw as none.
 IDEMPOTENT = (propagate_copies, rewrite_steps, fuse)
 

@@ -156,3 +156,29 @@ def test_a_difference_of_equal_operands_folds_on_at_o1() -> None:
     program = optimize.optimize(lower(analyze(source).program), 1, check=True)
     assert "call OUT 1, 7" in instructions(program)
     agree(source, {"INP": {"1": [200]}})
+
+
+# A way into a branch that the way decides ----------------------------------------------
+
+# `V=6` proves V positive, so the way from it into `:11 ?V>#12` goes straight to :12; the
+# way from `?E<#11`, where V may have any sign, still meets the branch.
+CLAMP = """V=(IMG); E=V-6; ?E<#11
+V=6
+:11 ?V>#12
+V=1
+:12 (MOV V,V); (MOV 0,0); (END)
+"""
+
+
+def test_a_way_that_decides_the_branch_it_enters_goes_past_it() -> None:
+    program = optimized(CLAMP, decide_branches)
+    assert terminators(program)["B1"] == "jump L12"
+    assert kept("if E<0 then L11", program)
+    assert terminators(program)["L11"] == "if V>0 then L12 else B2"
+
+
+@pytest.mark.parametrize("area", [-3, 0, 4, 9])
+def test_the_threaded_program_runs_as_before_and_no_longer(area: int) -> None:
+    script: dict[str, object] = {"IMG": [{"area": area, "x": 0, "y": 0, "z": 0}]}
+    verdict = judge(Run(CLAMP, script), ENGINES, BUDGET)
+    assert verdict.problems == []
