@@ -95,11 +95,13 @@ def _meet(states: list[Known]) -> Known:
     """What every state knows alike, in the first state's order (a set of items would
     order it by hash, and the variable _holding picks with it: PYTHONHASHSEED would
     change the bytes)."""
-    if not states:
-        return {}
+    if len(states) <= 1:
+        return dict(states[0]) if states else {}  # a block with one way in: most of them
     first, *rest = states
-    return {name: value for name, value in first.items()
-            if all(state.get(name) == value for state in rest)}
+    shared = first.items() & rest[0].items()  # the set only tests: the order is first's
+    for state in rest[1:]:
+        shared &= state.items()
+    return {name: value for name, value in first.items() if (name, value) in shared}
 
 
 def _value(operand: ir.Operand, known: Known) -> int | None:

@@ -22,8 +22,8 @@ edge all but it. Then:
   `?N=#20; #10` with N known not negative is `?N>#10`. The way that jumped runs one
   instruction fewer, the other as many as before.
 - A way into a block that holds only a branch, when what that way proved decides the
-  branch (`?V>#12` after `V=6`), goes straight to where the branch would go: the branch
-  it skips costs as much as the jump it may need instead.
+  branch (`?V>#12` after `V=6; #11`), goes straight to where the branch would go,
+  unless that way falls through (the jump it would need costs as much as the branch).
 """
 
 from __future__ import annotations
@@ -55,26 +55,29 @@ def decide_branches(program: ir.Program) -> ir.Program:
     following = program.following()
     branches = {block.id: block.terminator for block in program
                 if not block.instructions and isinstance(block.terminator, ir.Branch)}
-    exits = {block_id: _exit_state(program.blocks[block_id], state)
-             for block_id, state in _solve(program).items()}
+    tracked = _tracked(program)
+    exits = {block_id: _exit_state(program.blocks[block_id], state, tracked)
+             for block_id, state in _solve(program, tracked).items()}
     for block_id, state in exits.items():
         block = program.blocks[block_id]
         if isinstance(block.terminator, ir.Branch):
             block.terminator = _rewritten(block.terminator, state, following[block_id])
     for block_id, state in exits.items():
         block = program.blocks[block_id]
-        block.terminator = _threaded(block.terminator, state, branches)
+        block.terminator = _threaded(block.terminator, state, branches, following[block_id])
     return program
 
 
 def _threaded(terminator: ir.Terminator, state: State,
-              branches: dict[ir.BlockId, ir.Terminator]) -> ir.Terminator:
+              branches: dict[ir.BlockId, ir.Terminator], following: ir.BlockId | None
+              ) -> ir.Terminator:
     """The terminator with each way into a block that only branches, where what the
-    way proves decides that branch, going straight on to where it goes: the branch
-    it skips costs as much as the jump it may need instead."""
+    way proves decides that branch, going straight on to where it goes, unless the way
+    falls through (a jump in place of the branch it skips would cost as many
+    instructions and three bytes more)."""
     def past(target: ir.BlockId, leaving: State) -> ir.BlockId:
         branch = branches.get(target)
-        if not isinstance(branch, ir.Branch):
+        if not isinstance(branch, ir.Branch) or target == following:
             return target
         decided = _decided(branch, leaving.get(branch.var.name, ANY))
         return target if decided is None else decided.target
@@ -114,12 +117,28 @@ def _decided(branch: ir.Branch, signs: Signs) -> ir.Jump | None:
     return None
 
 
-def _solve(program: ir.Program) -> dict[ir.BlockId, State]:
+def _tracked(program: ir.Program) -> frozenset[str]:
+    """The variables whose signs can matter: those branched on, and those loaded or
+    moved (whose signs a store can pass on). Following only them keeps the flow's
+    states small (most programs branch on a few of the 53)."""
+    names: set[str] = set()
+    for block in program:
+        if isinstance(block.terminator, ir.Branch):
+            names.add(block.terminator.var.name)
+        for instruction in block.instructions:
+            if isinstance(instruction, ir.Load | ir.Move) \
+                    and isinstance(instruction.source, ir.Var):
+                names.add(instruction.source.name)
+    return frozenset(names)
+
+
+def _solve(program: ir.Program, tracked: frozenset[str]) -> dict[ir.BlockId, State]:
     """What is known where each block some path reaches starts: the union (the signs
     any path allows) over its predecessors' edges and the program's or a handler's
     start. A worklist in layout order; a decided branch's other edge is not followed."""
     starts: dict[ir.BlockId, list[State]] = {block_id: [] for block_id in program.blocks}
-    starts[program.entry].append(dict.fromkeys(VARIABLES, frozenset("=")))
+    starts[program.entry].append(dict.fromkeys(
+        [name for name in VARIABLES if name in tracked], frozenset("=")))
     for block_id in program.handlers.values():
         starts[block_id].append({})
     incoming: dict[ir.BlockId, dict[ir.BlockId, State]] = {
@@ -137,7 +156,7 @@ def _solve(program: ir.Program) -> dict[ir.BlockId, State]:
         block = program.blocks[block_id]
         for target in block.terminator.targets:
             incoming[target].pop(block_id, None)
-        for target, leaving in _edges(block, _exit_state(block, state)):
+        for target, leaving in _edges(block, _exit_state(block, state, tracked)):
             incoming[target][block_id] = leaving
             if target not in queued:
                 queued.add(target)
@@ -176,7 +195,7 @@ def _edges(block: ir.Block, state: State) -> list[tuple[ir.BlockId, State]]:
             (terminator.if_false, {**state, name: signs - {terminator.relation}})]
 
 
-def _exit_state(block: ir.Block, entry: State) -> State:
+def _exit_state(block: ir.Block, entry: State, tracked: frozenset[str]) -> State:
     state = dict(entry)
     acc: Signs = ANY
     result: Signs = ANY  # R's signs, from the last call's result range
@@ -192,13 +211,13 @@ def _exit_state(block: ir.Block, entry: State) -> State:
             case ir.Operate():
                 acc = ANY
             case ir.Store(target=target):
-                _set(state, target.name, acc)
+                _set(state, target.name, acc, tracked)
             case ir.StepVar(target=target, step=step):
                 before = state.get(target.name, ANY)
                 _set(state, target.name, frozenset().union(
-                    *(_STEPPED[step][sign] for sign in before)))
+                    *(_STEPPED[step][sign] for sign in before)), tracked)
             case ir.Move(target=target, source=source):
-                _set(state, target.name, _operand(source, state, result))
+                _set(state, target.name, _operand(source, state, result), tracked)
             case ir.Compute():
                 acc = ANY
             case ir.Call():
@@ -221,8 +240,8 @@ def _operand(operand: ir.Operand, state: State, result: Signs) -> Signs:
             return result
 
 
-def _set(state: State, name: str, signs: Signs) -> None:
-    if signs == ANY:
+def _set(state: State, name: str, signs: Signs, tracked: frozenset[str]) -> None:
+    if signs == ANY or name not in tracked:
         state.pop(name, None)
     else:
         state[name] = signs
