@@ -71,7 +71,7 @@ def apply(op: ast.BinaryOperator, left: int, right: int) -> int:
     return shift_right(left, right)
 
 
-def _holds(relation: ast.Relation, value: int) -> bool:
+def holds(relation: ast.Relation, value: int) -> bool:
     if relation == "=":
         return value == 0
     return value > 0 if relation == ">" else value < 0
@@ -213,7 +213,7 @@ class Interpreter:
             return self._jump(statement.target)
         elif isinstance(statement, ast.CondJump):
             value = self.variables[VARIABLE_INDEX[statement.var.name]]
-            if _holds(statement.relation, value):
+            if holds(statement.relation, value):
                 return self._jump(statement.target)
         else:
             self._call(statement.call)
