@@ -5,6 +5,8 @@ equal operands (copies.py). Each case also runs on every engine, which must agre
 from __future__ import annotations
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend import ir, optimize
@@ -187,3 +189,37 @@ def test_the_threaded_program_runs_as_before_and_no_longer(area: int) -> None:
     script: dict[str, object] = {"IMG": [{"area": area, "x": 0, "y": 0, "z": 0}]}
     verdict = judge(Run(CLAMP, script), ENGINES, BUDGET)
     assert verdict.problems == []
+
+
+# Programs made of polls and branch chains, where the flow has signs to work with --------
+
+SOURCES = ("(INP 1)", "(CAM R)", "(IMG)", "N&7", "N-1", "5", "0", "-3")
+LABELS = ("10", "20", "30", "40")
+
+
+@st.composite
+def polling_programs(draw: st.DrawFn) -> str:
+    """Four labelled polls, each a reading and two or three branches on what was read,
+    the last way a jump: `:20 M=(INP 1); ?M=#40; ?M>#10; #30`."""
+    lines = ["(TRC 0)"]
+    for label, name in zip(LABELS, "NMPQ", strict=True):
+        source = draw(st.sampled_from(SOURCES))
+        tests = draw(st.lists(st.tuples(st.sampled_from("NMPQ"), st.sampled_from("=<>"),
+                                        st.sampled_from(LABELS)), min_size=1, max_size=3))
+        branches = "; ".join(f"?{var}{relation}#{target}" for var, relation, target in tests)
+        last = draw(st.sampled_from([*(f"#{target}" for target in LABELS), "(END)"]))
+        lines.append(f":{label} {name}={source}; {branches}; {last}")
+    return "\n".join(lines) + "\n"
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck))
+@given(source=polling_programs(),
+       ports=st.lists(st.integers(0, 255), min_size=1, max_size=6),
+       pulses=st.lists(st.integers(0, 784), min_size=1, max_size=6),
+       areas=st.lists(st.integers(-3, 3), min_size=1, max_size=6))
+def test_polls_and_branch_chains_run_alike_at_every_level(
+        source: str, ports: list[int], pulses: list[int], areas: list[int]) -> None:
+    script: dict[str, object] = {
+        "INP": {"1": ports}, "CAM R": pulses,
+        "IMG": [{"area": area, "x": 0, "y": 0, "z": 0} for area in areas]}
+    assert judge(Run(source, script), ENGINES, BUDGET).problems == []
