@@ -12,13 +12,27 @@ from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.reporting.render import ColorChoice, use_color
 from rl1.vm.defaults import DEFAULT_BUDGET, ENGINES, TRACE_CHOICES, Engine, TraceChoice
 
-from .command import PATH, Command, a_budget, choice_option, color_option, force_option
+from .command import (
+    PATH,
+    Command,
+    a_budget,
+    at_least_one,
+    choice_option,
+    color_option,
+    force_option,
+)
 from .streams import invalid_file, read_failure, write_file
 
 SECTION = "Simulation"
 MAX_WORLD_BYTES = 4 * 2**20
 WORLD_ROLE = "world file"
 EXAMPLE_WORLD = "examples/sample.world.toml"
+
+
+def at_least_one_or_none(ctx: click.Context, param: click.Parameter,
+                         value: str | None) -> int | None:
+    """An option's callback: left out, or a whole number of at least 1."""
+    return None if value is None else at_least_one(ctx, param, value)
 
 
 @click.command(cls=Command)
@@ -45,11 +59,23 @@ EXAMPLE_WORLD = "examples/sample.world.toml"
                help="which calls to show, as `rl1c run --trace`: short: the first 40 and "
                     "the last 20 of a longer trace, with how many were left out; all; calls; "
                     "none. Default: short with --format text, all with json")
+@click.option("--runs", type=str, default=None, callback=at_least_one_or_none, metavar="N",
+              help="a campaign: run N times, with the seeds --seed, --seed + 1, ...; print "
+                   "the success rate (95% Wilson interval) and the failures grouped by "
+                   "kind and source line, each with the command that replays one")
+@click.option("--jobs", type=str, default=None, callback=at_least_one_or_none, metavar="J",
+              help="with --runs: the processes that make the runs (default: every core); "
+                   "the results are the same for any J")
+@click.option("--out", "out_file", metavar="FILE", type=PATH,
+              help="with --runs: write each run as a JSON line to FILE (- for standard "
+                   "output, the summary then on standard error), in seed order, as the "
+                   "runs finish")
 @force_option
 @color_option
 def sim(file: str, world: str | None, svg_file: str | None, html_file: str | None,
         sim_format: str, seed: int, engine: Engine, budget: int,
-        trace_choice: TraceChoice | None, force: bool, color: ColorChoice) -> int:
+        trace_choice: TraceChoice | None, runs: int | None, jobs: int | None,
+        out_file: str | None, force: bool, color: ColorChoice) -> int:
     """Run a program (.rob source, or an .ilc file) on the simulated vehicle and world.
 
     Prints each call with the device time, its source line and the vehicle's pose after
@@ -58,15 +84,19 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
     Exit status: 0 the program ended; 1 it has errors; 2 a usage problem or an
     unreadable or invalid file (the world file included); faults as `rl1c run`: 10
     argument out of range, 11 missing handler, 12 budget exhausted, 13 device error
-    (safety stops included); 20 the program ended but missed the world's [goal]."""
-    from rl1.vm.sim.device import SimDevice
-    from rl1.vm.sim.goal import Judge
+    (safety stops included); 20 the program ended but missed the world's [goal].
+
+    With --runs N, a campaign (a mode of `rl1c sim` rather than a command of its own:
+    the same program, world, engine and budget, and each run is the `rl1c sim --seed`
+    run it names): exit status 0 when it ran to its end, whatever the success rate;
+    130 when stopped by Ctrl-C (143 by SIGTERM), after the summary of the runs made."""
+    from rl1.compiler.simulation import Simulation, run_status
     from rl1.vm.sim.render import html, svg
     from rl1.vm.sim.world import WorldError, decode_world
 
     from .run_report import call_text
     from .running import run_file
-    from .sim_report import render_json, render_text, run_status
+    from .sim_report import render_json, render_text
 
     if world is None:
         raise click.UsageError("a simulation needs a world to run in: give --world FILE, a "
@@ -75,31 +105,41 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
         if target == "-":
             raise click.UsageError(f"{option} writes a file, and standard output carries "
                                    f"the report: give {option} FILE")
+    if runs is None:
+        for option, given in (("--jobs", jobs), ("--out", out_file)):
+            if given is not None:
+                raise click.UsageError(f"{option} is for a campaign of runs: give --runs N")
+    else:
+        for option, given in (("--svg", svg_file), ("--html", html_file),
+                              ("--trace", trace_choice)):
+            if given is not None:
+                raise click.UsageError(f"{option} shows one run, and --runs makes many: "
+                                       "replay one run (the summary gives its command) "
+                                       f"with {option}")
+        if sim_format != "text":
+            raise click.UsageError("--format json shows one run: a campaign writes each "
+                                   "run as a JSON line with --out FILE")
     try:
-        the_world = decode_world(read_bounded(world, MAX_WORLD_BYTES, "a world file"), world)
+        world_bytes = read_bounded(world, MAX_WORLD_BYTES, "a world file")
+        the_world = decode_world(world_bytes, world)
     except SourceError as error:
         raise read_failure(error, WORLD_ROLE) from None
     except WorldError as error:
         raise invalid_file(WORLD_ROLE, world, str(error),
                            "correct it as spec/simulator.md describes") from None
-    device = SimDevice(the_world, seed=seed)
-    judging = None if the_world.goal is None else Judge(the_world, device.sim.pose)
-    if judging is not None:
-        device.sim.on_move = judging.step  # each exact step: the track is decimated
+    if runs is not None:
+        from .sim_campaign import Setting, run_campaign
+
+        setting = Setting(file, world, seed, runs, jobs or os.cpu_count() or 1, engine, budget)
+        return run_campaign(file, world_bytes, world, setting, out_file, color)
+    simulation = Simulation(the_world, seed)
+    device = simulation.device
     ran = run_file(file, device, engine, budget, color, "sim")
     if isinstance(ran, int):
         return ran
     result = ran.finished.result
-    ended_at = device.sim.time  # the device time when the program ended (before any run-on)
-    run_on = None
-    if result.fault is None:
-        moving = device.sim.motion is not None
-        device.sim.note("end", "the program ended" + (
-            " with the vehicle moving: it runs on" if moving else ""))
-        run_on = device.run_on()  # (END) leaves motion in effect: where does it go?
-    elif device.fault is None:  # a safety stop has noted itself
-        device.sim.note("fault", result.fault.message)
-    verdict = None if judging is None else judging.verdict(device.sim.time)
+    ending = simulation.end(result)
+    ended_at, run_on, verdict = ending.ended_at, ending.run_on, ending.verdict
     title = f"{os.path.basename(file)} on {os.path.basename(world)}" + (
         "" if verdict is None else f": {verdict.headline()}")
     if svg_file is not None:

@@ -8,10 +8,11 @@ from __future__ import annotations
 import json
 from typing import Any
 
+from rl1.compiler.simulation import run_status
 from rl1.vm.defaults import TraceChoice
 from rl1.vm.faults import FaultKind, RunResult
 from rl1.vm.sim.device import RunOn, SimDevice, SimEntry
-from rl1.vm.sim.goal import GOAL_MISSED, Verdict
+from rl1.vm.sim.goal import Verdict
 from rl1.vm.sim.motion import Pose, heading_degrees
 
 from .run_report import (
@@ -73,16 +74,6 @@ def _ending(ran: Ran, device: SimDevice, run_on: RunOn | None, program: str,
                 f"{run_on.seconds:.2f} s, {stop}")
     return fault_text(fault, program, ran.source_name, ran.source, color=color,
                       help=_help(device, fault.kind)).rstrip("\n")
-
-
-def run_status(result: RunResult, verdict: Verdict | None) -> dict[str, Any]:
-    """How the run ended, as `rl1c run`'s status (its exit status the command's), but
-    a program that ended without meeting the world's goal is `goal-missed` (a fault
-    comes first: the goal is judged all the same, and reported beside it)."""
-    if result.fault is not None or verdict is None or verdict.met:
-        return result.status()
-    return {"code": "goal-missed", "exit_status": GOAL_MISSED,
-            "message": f"the program ended, but {verdict.headline()}", "line": None}
 
 
 def _goal_lines(verdict: Verdict) -> list[str]:

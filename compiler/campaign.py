@@ -1,0 +1,229 @@
+"""A campaign: one program run on one world over many seeds, to answer "how often does it
+succeed, and how does it fail" (spec/simulator.md, "Campaigns").
+
+Each run is a plain function of the task (the program as source text or .ilc bytes, the
+world file's bytes, the engine and budget) and its seed, `run_one`, and is the run
+`rl1c sim FILE --world W --seed SEED` makes (both go through compiler/simulation.py).
+The runs go to any `concurrent.futures.Executor` (local processes here; Dask's client
+offers the same interface), each task carrying the program and the world, so a worker
+needs no files. `Campaign` yields the records in seed order whatever the executor, with
+at most `window` runs in flight, so the output is the same for any number of workers and
+memory stays flat; `Tally` keeps only counts and the first few seeds of each failure
+group, never the records.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Iterable, Iterator
+from concurrent.futures import Executor, Future
+from dataclasses import dataclass, field
+from functools import lru_cache
+from itertools import islice
+from typing import Any
+
+from rl1.compiler.runner import Finished, run
+from rl1.compiler.simulation import Simulation, run_status
+from rl1.vm.defaults import Engine
+from rl1.vm.sim.motion import heading_degrees
+from rl1.vm.sim.world import NOISELESS, World, decode_world
+
+MAX_SEED = 2**32 - 1  # `rl1c sim --seed`'s range
+Z_95 = 1.959963984540054  # the normal quantile of 0.975: a two-sided 95 % interval
+SEEDS_KEPT = 3  # of each failure group, the first seeds
+
+
+def campaign_seeds(start: int, runs: int) -> range:
+    """The seeds of a campaign of `runs` runs from seed `start`: start, start + 1, ...
+    (each names the `rl1c sim --seed` run it is). ValueError past the seeds' range."""
+    if runs < 1 or start < 0 or start + runs - 1 > MAX_SEED:
+        raise ValueError(f"the seeds {start}..{start + runs - 1} leave 0..{MAX_SEED}")
+    return range(start, start + runs)
+
+
+@dataclass(frozen=True, slots=True)
+class Task:
+    """What every run of a campaign shares, sent whole to each worker: the program (RL/I
+    source, named `source_name` in the compiled code, or the bytes of an .ilc file) and
+    the world file's bytes (named `world_name` in its errors)."""
+
+    program: str | bytes
+    world: bytes
+    world_name: str
+    engine: Engine = "vm"
+    budget: int = 0
+    source_name: str = "program.rob"
+
+
+@dataclass(frozen=True, slots=True)
+class Record:
+    """One run of a campaign: its seed and how it ended. `outcome` is `rl1c sim`'s
+    status code (ok, goal-missed, or the fault's kind) and `exit_status` its exit status;
+    a success is status 0. `missed` names the goal's parts missed (each `part "name"`,
+    as the report titles it), `safety` the kind of a safety stop; `device_time` is when
+    the program ended (ms), `pose` where the vehicle was at the end (after any run-on)."""
+
+    seed: int
+    outcome: str
+    exit_status: int
+    line: int | None
+    message: str
+    safety: str | None
+    goal_met: bool | None
+    missed: tuple[str, ...]
+    device_time: int
+    pose: tuple[float, float, float]
+    instructions: int | None
+
+    @property
+    def success(self) -> bool:
+        return self.exit_status == 0
+
+    def to_json(self) -> dict[str, Any]:
+        return {"seed": self.seed, "success": self.success, "outcome": self.outcome,
+                "exit_status": self.exit_status, "line": self.line,
+                "message": self.message, "safety": self.safety,
+                "goal": None if self.goal_met is None else {
+                    "met": self.goal_met, "missed": list(self.missed)},
+                "device_time": self.device_time, "pose": list(self.pose),
+                "instructions": self.instructions}
+
+
+@lru_cache(maxsize=4)
+def _decoded(data: bytes, name: str) -> World:
+    return decode_world(data, name)
+
+
+def world_of(task: Task) -> World:
+    """The world of `task`, decoded once per process (every task carries the same bytes)."""
+    return _decoded(task.world, task.world_name)
+
+
+def run_one(task: Task, seed: int) -> Record:
+    """The run of `task` with `seed`, as `rl1c sim --seed SEED` makes it. The program
+    must compile (a campaign checks it once before its runs)."""
+    simulation = Simulation(world_of(task), seed)
+    device = simulation.device
+    finished = run(task.program, device, engine=task.engine, budget=task.budget,
+                   source_name=task.source_name)
+    if not isinstance(finished, Finished):
+        raise ValueError("the program has errors: a campaign runs only a program that compiles")
+    result = finished.result
+    ending = simulation.end(result)
+    status = run_status(result, ending.verdict)
+    verdict = ending.verdict
+    pose = device.sim.pose
+    return Record(
+        seed=seed, outcome=status["code"], exit_status=status["exit_status"],
+        line=status["line"], message=status["message"],
+        safety=None if device.fault is None else device.fault.kind,
+        goal_met=None if verdict is None else verdict.met,
+        missed=() if verdict is None else tuple(part.title() for part in verdict.missed()),
+        device_time=round(ending.ended_at * 1000),
+        pose=(round(pose.x, 2), round(pose.y, 2), heading_degrees(pose.heading, 2)),
+        instructions=finished.instructions)
+
+
+def noiseless(task: Task) -> bool:
+    """Whether every run of `task` is the same run: its world has no noise, the only
+    thing a seed changes."""
+    return world_of(task).noise == NOISELESS
+
+
+class Campaign:
+    """The runs of `task` over `seeds` on `executor` (in this process when None), as an
+    iterator of their records in seed order, with at most `window` runs submitted and not
+    yet yielded. `salvage` ends it early, keeping the runs already finished."""
+
+    def __init__(self, task: Task, seeds: Iterable[int], executor: Executor | None,
+                 window: int) -> None:
+        self._task = task
+        self._seeds = iter(seeds)
+        self._executor = executor
+        self._window = window
+        self._pending: deque[Future[Record]] = deque()
+
+    def __iter__(self) -> Iterator[Record]:
+        if self._executor is None:
+            for seed in self._seeds:
+                yield run_one(self._task, seed)
+            return
+        for seed in islice(self._seeds, self._window):
+            self._submit(seed)
+        while self._pending:
+            record = self._pending[0].result()
+            self._pending.popleft()
+            for seed in islice(self._seeds, 1):
+                self._submit(seed)
+            yield record
+
+    def _submit(self, seed: int) -> None:
+        assert self._executor is not None
+        self._pending.append(self._executor.submit(run_one, self._task, seed))
+
+    def salvage(self) -> list[Record]:
+        """Stop: cancel the runs not finished, and return those finished but not yet
+        yielded, in seed order."""
+        finished = []
+        for future in self._pending:
+            if future.done() and not future.cancelled() and future.exception() is None:
+                finished.append(future.result())
+            else:
+                future.cancel()
+        self._pending.clear()
+        return finished
+
+
+def wilson(successes: int, runs: int, z: float = Z_95) -> tuple[float, float]:
+    """The Wilson score interval of a success rate of `successes` in `runs` (runs > 0),
+    at the normal quantile `z` (default: 95 %)."""
+    rate = successes / runs
+    z2 = z * z
+    centre = (rate + z2 / (2 * runs)) / (1 + z2 / runs)
+    half = z / (1 + z2 / runs) * math.sqrt(rate * (1 - rate) / runs + z2 / (4 * runs * runs))
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+@dataclass(slots=True)
+class Group:
+    """The failures of one kind at one place: how many, and the first seeds."""
+
+    count: int = 0
+    seeds: list[int] = field(default_factory=list)
+
+
+GroupKey = tuple[str, int | None, str]  # outcome, source line, what: a safety stop, parts missed
+
+
+def group_key(record: Record) -> GroupKey:
+    """A failure's group: its outcome and line, and the kind of a safety stop or, when
+    the program ended, the goal's parts it missed."""
+    detail = "; ".join(record.missed) if record.outcome == "goal-missed" else record.safety
+    return record.outcome, record.line, detail or ""
+
+
+@dataclass(slots=True)
+class Tally:
+    """What a campaign keeps of its records: counts, and the first SEEDS_KEPT seeds of
+    each failure group (the groups are bounded by the outcomes, lines and goal parts)."""
+
+    runs: int = 0
+    successes: int = 0
+    groups: dict[GroupKey, Group] = field(default_factory=dict)
+
+    def add(self, record: Record) -> None:
+        self.runs += 1
+        if record.success:
+            self.successes += 1
+            return
+        group = self.groups.setdefault(group_key(record), Group())
+        group.count += 1
+        if len(group.seeds) < SEEDS_KEPT:
+            group.seeds.append(record.seed)
+
+    def failures(self) -> list[tuple[GroupKey, Group]]:
+        """The failure groups, the most frequent first (then by outcome and line)."""
+        return sorted(self.groups.items(),
+                      key=lambda item: (-item[1].count, item[0][0], item[0][1] or 0,
+                                        item[0][2]))

@@ -1,0 +1,236 @@
+"""`rl1c sim FILE --world W --runs N`: a campaign (compiler/campaign.py), the program run
+over N seeds on local processes, each run a JSON line (`--out FILE`) as it finishes in
+seed order, progress on standard error, and a summary: the success rate with its 95 %
+Wilson interval and the failures grouped by kind and source line, each with the seeds
+of its first runs and the `rl1c sim` command that replays one. Ctrl-C or SIGTERM stops
+it with the runs finished kept, written and summed up."""
+
+from __future__ import annotations
+
+import json
+import os
+import shlex
+import signal
+import sys
+import time
+from collections.abc import Iterator
+from concurrent.futures import Executor, ProcessPoolExecutor
+from contextlib import contextmanager
+from dataclasses import dataclass
+from types import FrameType
+from typing import IO
+
+import click
+
+from rl1.compiler.campaign import (
+    Campaign,
+    Record,
+    Tally,
+    Task,
+    campaign_seeds,
+    noiseless,
+    wilson,
+    world_of,
+)
+from rl1.compiler.reporting.render import ColorChoice
+from rl1.vm.defaults import DEFAULT_BUDGET, Engine
+
+from .command import EXIT_INTERRUPTED
+from .running import run_file
+from .streams import cannot_write, file_failure, read_ilc
+
+PROGRESS_EVERY = 5.0  # s between progress lines when standard error is no terminal
+REDRAW_EVERY = 0.2  # s between redraws of the progress line on a terminal
+WINDOW_PER_JOB = 8  # runs in flight per worker: enough to keep each busy, few to hold
+
+
+@dataclass(frozen=True, slots=True)
+class Setting:
+    """A campaign as the command line gives it, for the summary and the replay command."""
+
+    file: str
+    world: str
+    seed: int
+    runs: int
+    jobs: int
+    engine: Engine
+    budget: int
+
+    def replay(self, seed: int) -> str:
+        """The `rl1c sim` command that makes the run of `seed` alone."""
+        words = ["rl1c", "sim", self.file, "--world", self.world, "--seed", str(seed)]
+        if self.engine != "vm":
+            words += ["--engine", self.engine]
+        if self.budget != DEFAULT_BUDGET:
+            words += ["--budget", str(self.budget)]
+        return shlex.join(words)
+
+
+class Stopped(Exception):
+    """SIGTERM, handled as Ctrl-C is: the campaign stops and keeps what it ran."""
+
+    def __init__(self, status: int) -> None:
+        super().__init__(status)
+        self.status = status
+
+
+def _stop_on_sigterm(signum: int, frame: FrameType | None) -> None:
+    raise Stopped(128 + signum)
+
+
+def _worker_start() -> None:
+    # Ctrl-C reaches the whole process group: the campaign stops its workers itself.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@contextmanager
+def _executor(jobs: int) -> Iterator[Executor | None]:
+    if jobs == 1:  # no pool: the runs are made in this process
+        yield None
+        return
+    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_start)
+    try:
+        yield pool
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def task_of(file: str, world: bytes, world_name: str, setting: Setting,
+            color: ColorChoice) -> Task | int:
+    """The campaign's task: the program checked by running the campaign's first seed in
+    this process, as `rl1c sim` runs it (its errors and warnings shown once, on standard
+    error); the exit status instead when it cannot run."""
+    from rl1.compiler.simulation import Simulation
+    from rl1.vm.sim.world import decode_world
+
+    simulation = Simulation(decode_world(world, world_name), setting.seed)
+    ran = run_file(file, simulation.device, setting.engine, setting.budget, color, "sim")
+    if isinstance(ran, int):
+        return ran
+    is_ilc = file.lower().endswith(".ilc")
+    program: str | bytes = read_ilc(file) if is_ilc else (ran.source or "")
+    return Task(program, world, world_name, setting.engine, setting.budget,
+                source_name=os.path.basename(ran.source_name))
+
+
+class Progress:
+    """The runs done, the success rate and the runs per second, on standard error: one
+    line redrawn on a terminal, else a line every PROGRESS_EVERY seconds."""
+
+    def __init__(self, total: int, stream: IO[str]) -> None:
+        self.total = total
+        self.stream = stream
+        self.terminal = stream.isatty()
+        self.started = self.shown = time.monotonic()
+
+    def update(self, tally: Tally) -> None:
+        now = time.monotonic()
+        if now - self.shown < (REDRAW_EVERY if self.terminal else PROGRESS_EVERY):
+            return
+        self.shown = now
+        rate = tally.runs / max(now - self.started, 1e-9)
+        line = (f"{tally.runs}/{self.total} runs, {tally.successes} succeeded "
+                f"({tally.successes / tally.runs:.1%}), {rate:.1f} runs/s")
+        if self.terminal:
+            width = 30
+            filled = round(width * tally.runs / self.total)
+            self.stream.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {line}")
+        else:
+            self.stream.write(line + "\n")
+        self.stream.flush()
+
+    def finish(self) -> None:
+        if self.terminal:
+            self.stream.write("\r\033[K")
+            self.stream.flush()
+
+
+def summary(setting: Setting, tally: Tally, task: Task, stopped: bool) -> str:
+    """The campaign's summary for people."""
+    lines = [f"{tally.runs} run{'s' if tally.runs != 1 else ''} of {setting.file} on "
+             f"{setting.world}, seeds {setting.seed}.."
+             f"{setting.seed + setting.runs - 1}"
+             + (f" (stopped after {tally.runs} of {setting.runs})" if stopped else "")]
+    if noiseless(task):
+        lines.append("the world has no noise: every seed makes the same run, so this is "
+                     "one outcome counted N times; give the world `noise = true` or a "
+                     "[noise] table (spec/simulator.md, \"Noise\") to vary the runs")
+    if tally.runs == 0:
+        return "\n".join(lines) + "\n"
+    low, high = wilson(tally.successes, tally.runs)
+    lines.append(f"success: {tally.successes} of {tally.runs}, "
+                 f"{tally.successes / tally.runs:.1%} (95% Wilson interval "
+                 f"{low:.1%}..{high:.1%}); a success ends normally"
+                 + (" and meets the world's goal" if world_of(task).goal is not None else ""))
+    failures = tally.failures()
+    if failures:
+        lines.append("failures by kind and source line:")
+    for (outcome, line, detail), group in failures:
+        where = "" if line is None else f" at line {line}"
+        what = f" ({detail})" if detail else ""
+        seeds = ", ".join(map(str, group.seeds)) + (", ..." if group.count > len(group.seeds)
+                                                    else "")
+        lines.append(f"  {group.count:>6}  {outcome}{where}{what}: seeds {seeds}")
+        lines.append(f"          replay: {setting.replay(group.seeds[0])}")
+    return "\n".join(lines) + "\n"
+
+
+def _open_out(out: str | None) -> IO[str] | None:
+    if out is None:
+        return None
+    if out == "-":
+        return sys.stdout
+    try:
+        return open(out, "w", encoding="utf-8")  # closed by run_campaign
+    except OSError as error:
+        raise file_failure(cannot_write(out, "campaign file", error)) from None
+
+
+def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out: str | None,
+                 color: ColorChoice) -> int:
+    """The campaign `setting` of the program `file` on the world file `world` (its bytes,
+    named `world_name`); its exit status: 0 when it ran to its end, whatever the rate."""
+    try:
+        seeds = campaign_seeds(setting.seed, setting.runs)
+    except ValueError as error:
+        raise click.UsageError(f"--seed and --runs: {error}; give a smaller --seed or "
+                               "fewer --runs") from None
+    task = task_of(file, world, world_name, setting, color)
+    if isinstance(task, int):
+        return task
+    lines = _open_out(out)
+    report = sys.stderr if out == "-" else sys.stdout
+    tally = Tally()
+    progress = Progress(setting.runs, sys.stderr)
+    status = 0
+    previous = signal.signal(signal.SIGTERM, _stop_on_sigterm)
+    try:
+        with _executor(setting.jobs) as executor:
+            runs = Campaign(task, seeds, executor, WINDOW_PER_JOB * setting.jobs)
+            try:
+                for record in runs:
+                    _keep(record, tally, lines)
+                    progress.update(tally)
+            except (KeyboardInterrupt, Stopped) as stop:
+                status = stop.status if isinstance(stop, Stopped) else EXIT_INTERRUPTED
+                for record in runs.salvage():
+                    _keep(record, tally, lines)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        progress.finish()
+        if lines is not None and lines is not sys.stdout:
+            lines.close()
+    report.write(summary(setting, tally, task, stopped=status != 0))
+    report.flush()
+    if status:
+        print("rl1c: interrupted: the runs finished are kept"
+              + ("" if out is None else f" in {out}"), file=sys.stderr)
+    return status
+
+
+def _keep(record: Record, tally: Tally, lines: IO[str] | None) -> None:
+    tally.add(record)
+    if lines is not None:
+        lines.write(json.dumps(record.to_json(), separators=(",", ":")) + "\n")
+        lines.flush()  # a line is whole on disk when the campaign is stopped
+
