@@ -69,7 +69,7 @@ def decide_branches(program: ir.Program) -> ir.Program:
 
 
 def _threaded(terminator: ir.Terminator, state: State,
-              branches: dict[ir.BlockId, ir.Terminator], following: ir.BlockId | None
+              branches: dict[ir.BlockId, ir.Branch], following: ir.BlockId | None
               ) -> ir.Terminator:
     """The terminator with each way into a block that only branches, where what the
     way proves decides that branch, going straight on to where it goes, unless the way
@@ -77,7 +77,7 @@ def _threaded(terminator: ir.Terminator, state: State,
     instructions and three bytes more)."""
     def past(target: ir.BlockId, leaving: State) -> ir.BlockId:
         branch = branches.get(target)
-        if not isinstance(branch, ir.Branch) or target == following:
+        if branch is None or target == following:
             return target
         decided = _decided(branch, leaving.get(branch.var.name, ANY))
         return target if decided is None else decided.target
