@@ -182,7 +182,8 @@ def wilson(successes: int, runs: int, z: float = Z_95) -> tuple[float, float]:
     z2 = z * z
     centre = (rate + z2 / (2 * runs)) / (1 + z2 / runs)
     half = z / (1 + z2 / runs) * math.sqrt(rate * (1 - rate) / runs + z2 / (4 * runs * runs))
-    return max(0.0, centre - half), min(1.0, centre + half)
+    # It always holds the rate; rounding alone would put 0 of n a hair above 0.
+    return max(0.0, min(centre - half, rate)), min(1.0, max(centre + half, rate))
 
 
 @dataclass(slots=True)

@@ -1,0 +1,254 @@
+"""Campaigns (`rl1c sim --runs N`, compiler/campaign.py): the Wilson interval against
+published values, a success rate with a known closed form (an ultrasonic dropout of
+chance 0.3 decides each run), runs equal to the `rl1c sim --seed` runs they name, the
+same output for any --jobs, bounded memory, and a campaign stopped by a signal keeping
+its runs and its summary."""
+
+from __future__ import annotations
+
+import json
+import os
+import shlex
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from support.cli import rl1c
+
+from rl1.compiler.campaign import (
+    SEEDS_KEPT,
+    Campaign,
+    Record,
+    Tally,
+    Task,
+    campaign_seeds,
+    wilson,
+)
+
+RL1C = str(Path(sys.executable).with_name("rl1c"))
+DROPOUT = 0.3
+
+# A vehicle 30 cm from a wall reads it with sensor A, except when the echo drops out
+# (chance DROPOUT) and the reading is the sensor's range, 100: then the program steers
+# by 2048 tenths, out of (STX)'s range, a fault at line 4. Nothing else is drawn.
+WALL_PROGRAM = """\
+A=(ULT A)-99; ?A>#90
+(END)
+:90 B=A<11
+(STX B)
+"""
+WALL_WORLD = f"""\
+[floor]
+size = [1000, 1000]
+[start]
+x = 500.0
+y = 500.0
+[[walls]]
+name = "ahead"
+points = [[570, 0], [580, 0], [580, 1000], [570, 1000]]
+[noise]
+start_cm = 0
+start_deg = 0
+ultrasonic_cm = 0
+ultrasonic_dropout = {DROPOUT}
+"""
+
+
+@pytest.fixture
+def wall(tmp_path: Path) -> tuple[Path, Path]:
+    program, world = tmp_path / "wall.rob", tmp_path / "wall.world.toml"
+    program.write_text(WALL_PROGRAM)
+    world.write_text(WALL_WORLD)
+    return program, world
+
+
+def wall_task(world: str = WALL_WORLD) -> Task:
+    return Task(WALL_PROGRAM, world.encode(), "wall.world.toml", budget=10_000)
+
+
+# The Wilson interval ----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("successes", "runs", "low", "high"), [
+    (0, 10, 0.0, 0.2775),  # Brown, Cai and DasGupta (2001); Newcombe (1998), table I
+    (5, 10, 0.2366, 0.7634),
+    (10, 10, 0.7225, 1.0),
+    (81, 263, 0.2553, 0.3662),  # Newcombe (1998): 81/263
+    (15, 148, 0.0624, 0.1605),  # Newcombe (1998): 15/148
+])
+def test_the_wilson_interval_has_its_published_values(successes: int, runs: int,
+                                                      low: float, high: float) -> None:
+    found = wilson(successes, runs)
+    assert found == pytest.approx((low, high), abs=5e-5)
+
+
+@given(runs=st.integers(1, 10**6), data=st.data())
+def test_the_wilson_interval_holds_the_rate_and_mirrors_failures(runs: int,
+                                                                 data: st.DataObject) -> None:
+    successes = data.draw(st.integers(0, runs))
+    low, high = wilson(successes, runs)
+    assert 0.0 <= low <= successes / runs <= high <= 1.0
+    mirrored = wilson(runs - successes, runs)
+    assert (1 - mirrored[1], 1 - mirrored[0]) == pytest.approx((low, high), abs=1e-12)
+
+
+# Seeds and the closed form ----------------------------------------------------------------
+
+
+def test_the_seeds_follow_the_first_and_stay_in_sims_range() -> None:
+    assert list(campaign_seeds(7, 3)) == [7, 8, 9]
+    assert list(campaign_seeds(2**32 - 2, 2)) == [2**32 - 2, 2**32 - 1]
+    with pytest.raises(ValueError, match=r"leave 0\.\.4294967295"):
+        campaign_seeds(2**32 - 2, 3)
+
+
+def test_a_rate_with_a_closed_form_lies_in_its_wilson_interval() -> None:
+    tally = Tally()
+    for record in Campaign(wall_task(), campaign_seeds(0, 600), None, 1):
+        tally.add(record)
+    low, high = wilson(tally.successes, tally.runs)
+    assert low <= 1 - DROPOUT <= high
+    # Every failure is the dropout's: one group, the fault at line 4.
+    assert [(key, group.count) for key, group in tally.failures()] == [
+        (("argument-range", 4, ""), tally.runs - tally.successes)]
+
+
+def test_without_noise_every_seed_makes_the_same_run(wall: tuple[Path, Path]) -> None:
+    program, world = wall
+    world.write_text(WALL_WORLD.split("[noise]")[0])
+    result = rl1c("sim", program, "--world", world, "--runs", "5", "--jobs", "1")
+    assert result.exit_code == 0, result.output
+    assert "the world has no noise: every seed makes the same run" in result.stdout
+    assert "success: 5 of 5, 100.0%" in result.stdout
+
+
+# The runs are `rl1c sim --seed`'s, whatever --jobs -----------------------------------------
+
+
+def test_a_campaigns_run_is_the_rl1c_sim_run_of_its_seed(wall: tuple[Path, Path]) -> None:
+    program, world = wall
+    records = {record.seed: record for record in
+               Campaign(wall_task(), range(40), None, 1)}
+    failed = next(seed for seed, record in records.items() if not record.success)
+    for seed in (failed, next(seed for seed, r in records.items() if r.success)):
+        single = rl1c("sim", program, "--world", world, "--seed", str(seed),
+                      "--budget", "10000", "--format", "json")
+        report = json.loads(single.stdout)
+        record = records[seed]
+        assert single.exit_code == record.exit_status
+        assert report["status"]["code"] == record.outcome
+        assert report["status"]["line"] == record.line
+        assert report["instructions"] == record.instructions
+        assert report["device_time"] == record.device_time
+        assert report["track"][-1][1:] == list(record.pose)
+
+
+def test_the_replay_command_of_a_failure_makes_that_failure(wall: tuple[Path, Path]) -> None:
+    program, world = wall
+    result = rl1c("sim", program, "--world", world, "--runs", "30", "--jobs", "1")
+    replay = next(line.split("replay: ")[1] for line in result.stdout.splitlines()
+                  if "replay: " in line)
+    words = shlex.split(replay)
+    assert words[:2] == ["rl1c", "sim"]
+    again = rl1c(*words[1:])
+    assert again.exit_code == 10  # the argument-range fault the group names
+    assert "--> " + str(program) + ":4:1" in again.stdout
+
+
+def test_the_output_is_the_same_for_one_job_and_two(wall: tuple[Path, Path],
+                                                   tmp_path: Path) -> None:
+    program, world = wall
+    outputs = []
+    for jobs in ("1", "2"):
+        out = tmp_path / f"runs{jobs}.jsonl"
+        result = rl1c("sim", program, "--world", world, "--runs", "60", "--jobs", jobs,
+                      "--out", out)
+        assert result.exit_code == 0, result.output
+        outputs.append((result.stdout, out.read_bytes()))
+    assert outputs[0] == outputs[1]
+    lines = [json.loads(line) for line in outputs[0][1].splitlines()]
+    assert [line["seed"] for line in lines] == list(range(60))
+    assert {line["outcome"] for line in lines} == {"ok", "argument-range"}
+
+
+# Memory and stopping ----------------------------------------------------------------------
+
+
+def _failure(seed: int) -> Record:
+    return Record(seed, "device-error", 13, 7, "stopped", "collision", None, (), 10,
+                  (0.0, 0.0, 0.0), 5)
+
+
+def test_a_tally_keeps_counts_and_a_few_seeds_never_the_runs() -> None:
+    tally = Tally()
+    for seed in range(10_000):
+        tally.add(_failure(seed))
+    [(key, group)] = tally.failures()
+    assert key == ("device-error", 7, "collision")
+    assert group.count == 10_000
+    assert group.seeds == list(range(SEEDS_KEPT))
+
+
+def test_a_campaign_holds_at_most_its_window_of_runs_in_flight() -> None:
+    submitted: list[int] = []
+
+    class Counting:  # the Executor interface, making each run at once
+        def submit(self, fn, *args):  # type: ignore[no-untyped-def]
+            from concurrent.futures import Future
+            submitted.append(args[1])
+            future: Future[Record] = Future()
+            future.set_result(fn(*args))
+            return future
+
+    runs = iter(Campaign(wall_task(), range(100), Counting(), 4))  # type: ignore[arg-type]
+    for taken in range(1, 20):
+        next(runs)
+        assert len(submitted) <= taken + 4
+
+
+@pytest.mark.parametrize(("signum", "status"), [(signal.SIGTERM, 143),
+                                                 (signal.SIGINT, 130)])
+def test_a_stopped_campaign_keeps_its_runs_and_prints_its_summary(
+        wall: tuple[Path, Path], tmp_path: Path, signum: int, status: int) -> None:
+    program, world = wall
+    out = tmp_path / "runs.jsonl"
+    with subprocess.Popen([RL1C, "sim", str(program), "--world", str(world), "--runs",
+                           "1000000", "--jobs", "2", "--out", str(out)],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
+        deadline = time.monotonic() + 60
+        while (not out.exists() or out.read_text().count("\n") < 20) \
+                and time.monotonic() < deadline:
+            time.sleep(0.1)
+        os.kill(process.pid, signum)
+        stdout, stderr = process.communicate(timeout=60)
+    assert process.returncode == status, stderr
+    assert "Traceback" not in stderr
+    assert "interrupted: the runs finished are kept" in stderr
+    kept = [json.loads(line) for line in out.read_text().splitlines()]  # every line whole
+    seeds = [line["seed"] for line in kept]
+    assert seeds == sorted(seeds) and len(kept) >= 20
+    assert f"{len(kept)} runs of" in stdout and "(stopped after" in stdout
+    assert f"success: {sum(line['success'] for line in kept)} of {len(kept)}" in stdout
+
+
+# Usage ------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("extra", "message"), [
+    (["--jobs", "2"], "--jobs is for a campaign of runs: give --runs N"),
+    (["--runs", "3", "--svg", "x.svg"], "--svg shows one run"),
+    (["--runs", "3", "--format", "json"], "--format json shows one run"),
+    (["--runs", "0"], "expected a whole number of at least 1"),
+    (["--runs", "3", "--seed", "4294967294"], "the seeds 4294967294..4294967296 leave"),
+])
+def test_campaign_options_out_of_place_are_usage_errors(
+        wall: tuple[Path, Path], extra: list[str], message: str) -> None:
+    program, world = wall
+    result = rl1c("sim", program, "--world", world, *extra)
+    assert result.exit_code == 2
+    assert message in result.stderr
