@@ -37,11 +37,12 @@ from rl1.vm.defaults import DEFAULT_BUDGET, Engine
 
 from .command import EXIT_INTERRUPTED
 from .running import run_file
-from .streams import cannot_write, file_failure, read_ilc
+from .streams import cannot_write, file_failure, read_ilc, same_file
 
 PROGRESS_EVERY = 5.0  # s between progress lines when standard error is no terminal
 REDRAW_EVERY = 0.2  # s between redraws of the progress line on a terminal
 WINDOW_PER_JOB = 8  # runs in flight per worker: enough to keep each busy, few to hold
+MAX_JOBS = 1024  # processes: beyond, --scheduler (a cluster) is the way
 
 
 @dataclass(frozen=True, slots=True)
@@ -175,11 +176,16 @@ def summary(setting: Setting, tally: Tally, task: Task, stopped: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _open_out(out: str | None) -> IO[str] | None:
+def _open_out(out: str | None, inputs: tuple[str, str]) -> IO[str] | None:
+    """The file of the JSON lines, replaced as `rl1c`'s outputs are, never an input."""
     if out is None:
         return None
     if out == "-":
         return sys.stdout
+    for role, name in zip(("program", "world file"), inputs, strict=True):
+        if os.path.exists(name) and same_file(name, out):
+            raise click.UsageError(f"--out `{out}` is the {role} itself: give another "
+                                   "path for the runs' JSON lines")
     try:
         return open(out, "w", encoding="utf-8")  # closed by run_campaign
     except OSError as error:
@@ -195,17 +201,20 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     except ValueError as error:
         raise click.UsageError(f"--seed and --runs: {error}; give a smaller --seed or "
                                "fewer --runs") from None
+    if setting.jobs > MAX_JOBS:
+        raise click.UsageError(f"--jobs {setting.jobs}: at most {MAX_JOBS} processes on "
+                               "one machine")
     task = task_of(file, world, world_name, setting, color)
     if isinstance(task, int):
         return task
-    lines = _open_out(out)
+    lines = _open_out(out, (file, setting.world))
     report = sys.stderr if out == "-" else sys.stdout
     tally = Tally()
     progress = Progress(setting.runs, sys.stderr)
     status = 0
     previous = signal.signal(signal.SIGTERM, _stop_on_sigterm)
     try:
-        with _executor(setting.jobs) as executor:
+        with _executor(min(setting.jobs, setting.runs)) as executor:
             runs = Campaign(task, seeds, executor, WINDOW_PER_JOB * setting.jobs)
             try:
                 for record in runs:

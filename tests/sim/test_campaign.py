@@ -87,6 +87,12 @@ def test_the_wilson_interval_has_its_published_values(successes: int, runs: int,
     assert found == pytest.approx((low, high), abs=5e-5)
 
 
+def test_the_wilson_interval_of_none_or_all_reaches_0_or_1_exactly() -> None:
+    # Rounding once put the lower end of 0 of 234 at 1.7e-18, above the rate itself.
+    assert wilson(0, 234)[0] == 0.0
+    assert wilson(234, 234)[1] == 1.0
+
+
 @given(runs=st.integers(1, 10**6), data=st.data())
 def test_the_wilson_interval_holds_the_rate_and_mirrors_failures(runs: int,
                                                                  data: st.DataObject) -> None:
@@ -236,6 +242,20 @@ def test_a_stopped_campaign_keeps_its_runs_and_prints_its_summary(
     assert f"success: {sum(line['success'] for line in kept)} of {len(kept)}" in stdout
 
 
+def test_out_never_replaces_an_input_and_an_unwritable_out_is_said(
+        wall: tuple[Path, Path], tmp_path: Path) -> None:
+    program, world = wall
+    for target, role in ((program, "program"), (world, "world file")):
+        result = rl1c("sim", program, "--world", world, "--runs", "2", "--out", target)
+        assert result.exit_code == 2
+        assert f"is the {role} itself" in result.stderr
+    assert program.read_text() == WALL_PROGRAM and world.read_text() == WALL_WORLD
+    result = rl1c("sim", program, "--world", world, "--runs", "2", "--out",
+                  tmp_path / "no such folder" / "runs.jsonl")
+    assert result.exit_code == 2
+    assert "cannot write" in result.stderr and "Traceback" not in result.output
+
+
 # Usage ------------------------------------------------------------------------------------
 
 
@@ -245,6 +265,7 @@ def test_a_stopped_campaign_keeps_its_runs_and_prints_its_summary(
     (["--runs", "3", "--format", "json"], "--format json shows one run"),
     (["--runs", "0"], "expected a whole number of at least 1"),
     (["--runs", "3", "--seed", "4294967294"], "the seeds 4294967294..4294967296 leave"),
+    (["--runs", "3", "--jobs", "5000"], "--jobs 5000: at most 1024 processes"),
 ])
 def test_campaign_options_out_of_place_are_usage_errors(
         wall: tuple[Path, Path], extra: list[str], message: str) -> None:
