@@ -461,8 +461,9 @@ def judge(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
     else:  # -O0 ended within the budget, so every engine ends as it does
         pairs_rule = SAME_CODE
         if witness is not None and not witness.crashed:
-            problems += [f"{name}: met the watchdog, where vm-O0 ended after "
-                         f"{witness.executed} instructions of the budget of {budget}"
+            executed = witness.executed
+            problems += [f"{name}: met the watchdog, where vm-O0 ended after {executed} "
+                         f"instruction{'s' if executed != 1 else ''} of the budget of {budget}"
                          for name, observation in observations.items() if observation.ran_away]
     if reference.name != WITNESS.name or pairs_rule == SAME_CODE:
         problems += [f"{engine.name}: {line}" for engine in others

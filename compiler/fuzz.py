@@ -4,8 +4,9 @@ disagrees, then that run shrunk to a small one and written down as a reproducer.
 Runs come from `strategies.runs()`; Hypothesis' `find` generates them and, on the first
 disagreement, shrinks the run to the smallest it can find that still disagrees (the
 disagreement may change on the way: it is the smallest run that shows one), for at most
-SHRINK_SECONDS or SHRINK_ATTEMPTS runs: a slow `exec:` engine can make shrinking take
-long. `judge` in differential.py decides what disagrees (spec/optimization.md).
+SHRINK_ATTEMPTS runs, a bound in runs rather than seconds, so that a seed gives the same
+reproducer on a loaded machine as on an idle one. `judge` in differential.py decides
+what disagrees (spec/optimization.md).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from random import Random
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from hypothesis import HealthCheck, Phase, find, settings
 from hypothesis.errors import NoSuchExample
@@ -34,14 +35,20 @@ from rl1.compiler.differential import (
     Verdict,
     VmEngine,
     compiled,
+    engine_named,
     judge,
 )
-from rl1.compiler.files import write_atomically
-from rl1.compiler.frontend.source import split_lines
+from rl1.compiler.files import read_bounded, write_atomically
+from rl1.compiler.frontend.source import read_source, split_lines
+from rl1.compiler.runner import MAX_SCRIPT_BYTES
 from rl1.compiler.strategies import Run, runs
+from rl1.vm.faults import MAX_BUDGET
+from rl1.vm.sensor_script import ScriptError, parse_script
 
-SHRINK_SECONDS = 20.0  # Hypothesis' shrinking stops here, with the smallest run so far
-SHRINK_ATTEMPTS = 10_000  # or after trying so many runs, whichever comes first
+# Hypothesis' shrinking stops after trying so many runs, with the smallest so far (on a
+# planted shift bug it went on for 1,100 to 1,700 runs to save a character or two, which
+# deleting lines and statements then does in far fewer).
+SHRINK_ATTEMPTS = 500
 # Programs per Hypothesis search. Its runner keeps what it learnt of every run it
 # generated (about 130 KB each) until the search ends, so a long campaign is many short
 # searches, each seeded from --seed, with their garbage collected in between.
@@ -49,6 +56,8 @@ BATCH = 500
 LABEL = re.compile(r"[ \t\f\v]*:[0-9]*")  # a label where a line starts (language 3.1)
 SOURCE = "program.rob"
 SCRIPT = "program.sensors.json"
+ENGINES = "engines.json"  # the engines a reproducer names, and the budget
+MAX_ENGINES_BYTES = 2**20
 
 
 @dataclass(frozen=True)
@@ -66,8 +75,8 @@ class Outcome:
     finding: Finding | None
 
 
-class _TimeUp(Exception):
-    pass
+class _Enough(Exception):
+    """The campaign's time is up, or shrinking has tried its runs."""
 
 
 def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
@@ -86,11 +95,11 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
         elapsed = time.monotonic() - start
         if found_after is None:
             if seconds is not None and elapsed >= seconds:
-                raise _TimeUp
+                raise _Enough
             programs += 1
             progress(programs, elapsed)
-        elif elapsed - found_after > SHRINK_SECONDS or attempts >= SHRINK_ATTEMPTS:
-            raise _TimeUp  # small enough: keep the smallest so far
+        elif attempts >= SHRINK_ATTEMPTS:
+            raise _Enough  # small enough: keep the smallest so far
         else:
             attempts += 1
         if not judge(case, engines, budget).problems:
@@ -104,7 +113,7 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
     levels = [engine.level for engine in engines if engine.level is not None]
     comparable = len(set(levels)) < len(levels)
     seeds = Random(seed)
-    with contextlib.suppress(_TimeUp):
+    with contextlib.suppress(_Enough):
         while smallest is None and (count is None or programs < count):
             before = programs
             batch = BATCH if count is None else min(BATCH, count - programs)
@@ -191,10 +200,11 @@ class Reproducer:
 
 def write_reproducer(out: str, finding: Finding, engines: Sequence[Engine],
                      budget: int) -> Reproducer:
-    """Write the run, its compiled files, each engine's run and `replay.sh` (every
-    engine's run again, one command each) into a new folder under `out` (made for it,
-    so that nothing there is replaced, followed or written into: the first free
-    `finding-N`); OSError when that cannot be done."""
+    """Write the run, its compiled files, each engine's run, the engines and budget
+    (`engines.json`) and `replay.sh` (which judges the run again, and names each engine's
+    command) into a new folder under `out` (made for it, so that nothing there is
+    replaced, followed or written into: the first free `finding-N`); OSError when that
+    cannot be done."""
     os.makedirs(out, exist_ok=True)
     folder = _new_folder(out)
     case = finding.case
@@ -206,15 +216,78 @@ def write_reproducer(out: str, finding: Finding, engines: Sequence[Engine],
 
     write(SOURCE, case.source)
     write(SCRIPT, json.dumps(case.script, indent=2) + "\n")
-    commands = ["#!/bin/sh", "# Each engine's run of the program, as `rl1c fuzz` compared "
-                "them.", 'cd "$(dirname "$0")"']
+    write(ENGINES, json.dumps({"engines": [engine.name for engine in engines],
+                               "budget": budget}, indent=2) + "\n")
+    commands = ["#!/bin/sh",
+                "# Runs every engine on the program again and prints what still differs: exit",
+                "# status 1 while the engines disagree, 0 once they agree. Run it from the",
+                "# folder the campaign ran in when an exec: engine names relative paths.",
+                "#", "# Each engine alone (the files named are in this folder):"]
     for index, engine in enumerate(engines, 1):
         slug = re.sub(r"[^A-Za-z0-9]+", "-", engine.name).strip("-")[:40]
         write(f"run-{index}-{slug}.json",
               json.dumps(finding.verdict.observations[engine.name].document, indent=2) + "\n")
-        commands.append(_replay(engine, case, budget, write))
+        commands.append("#   " + _replay(engine, case, budget, write))
+    commands.append('exec rl1c fuzz --replay "$(dirname "$0")"')
     write("replay.sh", "\n".join(commands) + "\n")
     return Reproducer(folder, f"sh {shlex.quote(os.path.join(folder, 'replay.sh'))}")
+
+
+class ReproducerError(Exception):
+    """A reproducer's file that is not as `write_reproducer` writes it: its `path`, and
+    what is wrong with it (`detail`)."""
+
+    def __init__(self, path: str, detail: str) -> None:
+        super().__init__(f"{path}: {detail}")
+        self.path = path
+        self.detail = detail
+
+
+@dataclass(frozen=True)
+class Replay:
+    """A reproducer read back: the run, and the engines and budget that judged it."""
+
+    case: Run
+    engines: list[Engine]
+    budget: int
+
+
+def read_reproducer(folder: str) -> Replay:
+    """The reproducer `write_reproducer` wrote into `folder`, as it now is (the program
+    and script may have been edited); files.SourceError when a file cannot be read,
+    ReproducerError when one is not what it should be."""
+    path = os.path.join(folder, SOURCE)
+    source = read_source(path).text
+    if analyze(source).has_errors:
+        raise ReproducerError(path, "the checker finds errors in it (rl1c check says "
+                              "which); the engines compare only programs it accepts")
+    path = os.path.join(folder, SCRIPT)
+    script = _json(path, read_bounded(path, MAX_SCRIPT_BYTES, "a sensor script"))
+    try:
+        parse_script(script, path)
+    except ScriptError as error:
+        raise ReproducerError(path, str(error)) from None
+    path = os.path.join(folder, ENGINES)
+    match _json(path, read_bounded(path, MAX_ENGINES_BYTES, "a list of engines")):
+        case {"engines": [*names], "budget": int(budget)} if 1 <= budget <= MAX_BUDGET:
+            pass
+        case _:
+            raise ReproducerError(path, 'expected {"engines": [NAME, ...], "budget": N} '
+                                  f"with N from 1 to {MAX_BUDGET}")
+    engines = [engine_named(name) if isinstance(name, str) else None for name in names]
+    unknown = [repr(name) for name, engine in zip(names, engines, strict=True)
+               if engine is None]
+    if unknown or len(engines) < 2:
+        raise ReproducerError(path, f"unknown engine {unknown[0]}" if unknown
+                              else "it names fewer than two engines")
+    return Replay(Run(source, script), [engine for engine in engines if engine], budget)
+
+
+def _json(path: str, data: bytes) -> Any:
+    try:
+        return json.loads(data)
+    except (ValueError, RecursionError) as error:  # not UTF-8, not JSON, nested too deeply
+        raise ReproducerError(path, f"it is not JSON ({error})") from None
 
 
 def _new_folder(out: str) -> str:

@@ -45,16 +45,19 @@ BAR_WIDTH = 30
                    "new folder finding-N of its own")
 @click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget,
               metavar="N", show_default=True, help="the budget of every run")
+@click.option("--replay", "replay_dir", default=None, metavar="DIR", type=PATH,
+              help="judge a reproducer again (a finding-N folder, as its replay.sh does) "
+                   "with its engines and budget: exit status 1 while they disagree")
 def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
-         seed: str | None, out_dir: str, budget: int) -> int:
+         seed: str | None, out_dir: str, budget: int, replay_dir: str | None) -> int:
     """Run generated programs on several engines and compare what they do.
 
     Every program (with a sensor script to match) runs on each engine; the runs must
     agree on the device trace, how they end and the final variables, and optimized code
     must keep the budget invariant (spec/optimization.md). On the first disagreement the
     program is shrunk to a small one, written with each engine's run and a replay
-    script to --out, and the difference printed. Exit status: 0 all agreed, 1 a
-    disagreement, 2 a usage problem."""
+    script to --out, and the difference printed; --replay judges it again. Exit status:
+    0 all agreed, 1 a disagreement, 2 a usage problem."""
     try:
         from rl1.compiler.differential import (
             DEFAULT_ENGINES,
@@ -70,9 +73,14 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         raise Failure("error: rl1c fuzz generates programs with Hypothesis, an optional "
                       "part of rl1 that is not installed here; install it with "
                       "`pip install 'rl1[fuzz]'` (or `pip install hypothesis`)") from None
-    from rl1.compiler.frontend.source import split_lines
     from rl1.vm.native import BuildError
 
+    if replay_dir is not None:
+        if engine_names or count is not None or seconds is not None or seed is not None:
+            raise click.UsageError("--replay takes the engines and budget of the "
+                                   "reproducer: give it without --engine, --count, --time "
+                                   "and --seed")
+        return _replay(replay_dir)
     if count is not None and seconds is not None:
         raise click.UsageError("give --count or --time, not both")
     problem = _unwritable(out_dir)
@@ -111,10 +119,8 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         click.echo(f"{summary}: all agreed")
         return 0
     finding = outcome.finding
-    numbered = "\n".join(f"{number:4} | {line}" for number, line
-                         in enumerate(split_lines(finding.case.source), 1))
     click.echo(f"{summary}: the engines disagree (reference: {engines[0].name})\n\n"
-               f"the smallest program found:\n{numbered}\n\n"
+               f"the smallest program found:\n{_numbered(finding.case.source)}\n\n"
                + "\n".join(finding.verdict.problems))
     try:
         reproducer = write_reproducer(out_dir, finding, engines, budget)
@@ -124,6 +130,45 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
                       "campaign runs again with the same --seed", EXIT_ERRORS) from None
     click.echo(f"\nreproducer: {reproducer.folder} (program, sensor script, each engine's "
                f"run); replay: {reproducer.replay}")
+    return EXIT_ERRORS
+
+
+def _numbered(source: str) -> str:
+    from rl1.compiler.frontend.source import split_lines
+
+    return "\n".join(f"{number:4} | {line}" for number, line
+                     in enumerate(split_lines(source), 1))
+
+
+def _replay(folder: str) -> int:
+    """Judge the reproducer in `folder` again: 1 while its engines disagree."""
+    from rl1.compiler.differential import EngineUnavailable, judge
+    from rl1.compiler.files import SourceError
+    from rl1.compiler.fuzz import ReproducerError, read_reproducer
+    from rl1.vm.native import BuildError
+
+    from .streams import invalid_file, read_failure
+
+    try:
+        replay = read_reproducer(folder)
+    except SourceError as error:
+        raise read_failure(error, "reproducer's file") from None
+    except ReproducerError as error:
+        raise invalid_file("reproducer's file", error.path, error.detail,
+                           "write it as `rl1c fuzz` did, or replay another finding"
+                           ) from None
+    try:
+        verdict = judge(replay.case, replay.engines, replay.budget)
+    except (BuildError, EngineUnavailable) as error:
+        raise Failure(f"error: {error}") from None
+    names = ", ".join(engine.name for engine in replay.engines)
+    program = _numbered(replay.case.source)
+    if not verdict.problems:
+        click.echo(f"replay: the engines agree now (engines {names}; budget "
+                   f"{replay.budget}) on:\n{program}")
+        return 0
+    click.echo(f"replay: the engines still disagree (reference: {replay.engines[0].name}; "
+               f"budget {replay.budget}) on:\n{program}\n\n" + "\n".join(verdict.problems))
     return EXIT_ERRORS
 
 

@@ -9,6 +9,7 @@ import shlex
 import stat
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -20,6 +21,7 @@ from support.cli import rl1c
 from rl1.compiler import differential, fuzz
 from rl1.compiler.differential import (
     Observation,
+    VmEngine,
     differences,
     engine_named,
     judge,
@@ -27,6 +29,7 @@ from rl1.compiler.differential import (
 )
 from rl1.compiler.frontend.source import split_lines
 from rl1.compiler.strategies import Run
+from rl1.vm import machine
 
 PYTHON = shlex.quote(sys.executable)
 RL1C = shlex.quote(str(Path(sys.executable).with_name("rl1c")))
@@ -95,6 +98,52 @@ def test_an_engine_that_crashes_is_a_finding_shrunk_like_a_disagreement(
     assert len(split_lines(outcome.finding.case.source)) <= 5
 
 
+class _BrokenShift:
+    """The reference VM at -O0 with `1<-1` giving 1 (a negative count shifts left by
+    nothing), in this process: a planted bug found in a few programs."""
+
+    name = "broken-shift"
+    level = 0
+
+    def run(self, case: Run, budget: int) -> Observation:
+        right = machine._shift_left
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(machine, "_shift_left", lambda value, count: value if count < 0
+                          else right(value, count))
+            return VmEngine(0).run(case, budget)
+
+
+class _Clock:
+    """time.monotonic for fuzz.py on a machine so loaded that a minute passes between
+    two runs."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def monotonic(self) -> float:
+        self.now += 60.0
+        return self.now
+
+
+def test_a_seed_gives_the_same_reproducer_however_long_the_runs_take(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # Shrinking was bounded by 20 seconds: a loaded machine wrote a larger reproducer.
+    monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 60)
+    engines = [VmEngine(0), _BrokenShift()]
+    folders = []
+    for clock in (time, _Clock()):
+        monkeypatch.setattr(fuzz, "time", clock)
+        outcome = fuzz.campaign(engines, 20_000, count=300, seconds=None, seed=1,
+                                progress=lambda programs, elapsed: None)
+        assert outcome.finding is not None
+        out = tmp_path / type(clock).__name__
+        folders.append(Path(fuzz.write_reproducer(str(out), outcome.finding, engines,
+                                                  20_000).folder))
+    made, loaded = ({path.name: path.read_bytes() for path in folder.iterdir()}
+                    for folder in folders)
+    assert made == loaded and "program.rob" in made
+
+
 def test_rl1c_run_itself_is_an_exec_engine_as_the_spec_shows(tmp_path: Path) -> None:
     command = f"exec:{RL1C} run {{ilc}} --sensors {{sensors}} --budget {{budget}} --format json"
     result = rl1c("fuzz", "--engine", "vm-O0", "--engine", command, "--count", "4",
@@ -105,9 +154,7 @@ def test_rl1c_run_itself_is_an_exec_engine_as_the_spec_shows(tmp_path: Path) -> 
 
 def test_a_planted_shift_bug_is_found_and_shrunk_to_a_few_lines(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    # A bound in runs, not seconds, so that a loaded machine shrinks as far as an idle
-    # one; then deleting lines does the rest.
-    monkeypatch.setattr(fuzz, "SHRINK_SECONDS", 600.0)
+    # Few runs of Hypothesis' shrinking; deleting lines does the rest.
     monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 40)
     out = tmp_path / "found"
     result = rl1c("fuzz", "--engine", "vm-O0", "--engine", BROKEN_VM, "--count", "300",
@@ -335,6 +382,79 @@ def test_each_finding_gets_a_folder_of_its_own(tmp_path: Path) -> None:
         assert rl1c("fuzz", *NO_RUN, "--out", out).exit_code == 1
     assert sorted(path.name for path in out.iterdir()) == ["finding-1", "finding-2"]
     assert all((out / name / "replay.sh").is_file() for name in ("finding-1", "finding-2"))
+
+
+@pytest.mark.usefixtures("quick_shrinking")
+def test_replay_sh_judges_again_and_fails_while_the_engines_disagree(tmp_path: Path) -> None:
+    # It printed each engine's run as JSON, compared nothing and exited 0.
+    engine = tmp_path / "engine.sh"
+    engine.write_text('echo \'{"status": {"code": "budget", "line": null}, "variables": {}, '
+                      '"trace": []}\'\n', encoding="utf-8")
+    result = rl1c("fuzz", "--engine", "vm-O0", "--engine",
+                  f"exec:sh {shlex.quote(str(engine))} {{ilc}} {{sensors}} {{budget}}",
+                  "--count", "5", "--seed", "1", "--out", str(tmp_path / "out"))
+    assert result.exit_code == 1, result.output
+    replay = tmp_path / "out" / "finding-1" / "replay.sh"
+    path = f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"
+
+    def replayed() -> subprocess.CompletedProcess[str]:
+        return subprocess.run(["sh", str(replay)], capture_output=True, text=True,
+                              env={**os.environ, "PATH": path}, check=False)
+
+    still = replayed()
+    assert still.returncode == 1, still.stderr
+    assert "replay: the engines still disagree (reference: vm-O0; budget 20000)" in still.stdout
+    assert "ending: ended normally / fault budget" in still.stdout
+    engine.write_text(f'exec {RL1C} run "$1" --sensors "$2" --budget "$3" --format json\n',
+                      encoding="utf-8")  # the engine fixed
+    fixed = replayed()
+    assert fixed.returncode == 0, fixed.stdout + fixed.stderr
+    assert fixed.stdout.startswith("replay: the engines agree now (engines vm-O0, exec:sh ")
+
+
+def _reproducer(folder: Path) -> None:
+    folder.mkdir()
+    (folder / "program.rob").write_text("A=1\n", encoding="utf-8")
+    (folder / "program.sensors.json").write_text("{}", encoding="utf-8")
+    (folder / "engines.json").write_text('{"engines": ["ast", "vm-O0"], "budget": 9}',
+                                         encoding="utf-8")
+
+
+def test_a_sound_reproducer_replays_to_agreement(tmp_path: Path) -> None:
+    _reproducer(tmp_path / "found")
+    result = rl1c("fuzz", "--replay", tmp_path / "found")
+    assert result.exit_code == 0, result.output
+    assert "the engines agree now (engines ast, vm-O0; budget 9)" in result.stdout
+
+
+@pytest.mark.parametrize(("file", "text", "message"), [
+    (None, None, "cannot read the reproducer's file"),
+    ("program.rob", "A=\n", "program.rob` is not valid: the checker finds errors in it"),
+    ("program.sensors.json", "[", "program.sensors.json` is not valid: it is not JSON"),
+    ("program.sensors.json", '{"IMG": 3}', "program.sensors.json` is not valid: "),
+    ("engines.json", "{}", 'expected {"engines": [NAME, ...], "budget": N}'),
+    ("engines.json", '{"engines": ["ast", "vm-O0"], "budget": 0}', "with N from 1 to"),
+    ("engines.json", '{"engines": ["ast", "vm-O9"], "budget": 5}', "unknown engine 'vm-O9'"),
+    ("engines.json", '{"engines": ["ast", 3], "budget": 5}', "unknown engine 3"),
+    ("engines.json", '{"engines": ["ast"], "budget": 5}', "fewer than two engines"),
+])
+def test_a_reproducer_that_cannot_be_replayed_says_which_file_and_why(
+        tmp_path: Path, file: str | None, text: str | None, message: str) -> None:
+    folder = tmp_path / "found"
+    _reproducer(folder)
+    if file is None:
+        (folder / "engines.json").unlink()
+    else:
+        (folder / file).write_text(text or "", encoding="utf-8")
+    result = rl1c("fuzz", "--replay", folder)
+    assert result.exit_code == 2, result.output
+    assert message in result.stderr and "Traceback" not in result.output
+
+
+def test_replay_takes_its_engines_from_the_reproducer(tmp_path: Path) -> None:
+    result = rl1c("fuzz", "--replay", tmp_path, "--engine", "ast")
+    assert result.exit_code == 2
+    assert "--replay takes the engines and budget of the reproducer" in result.stderr
 
 
 @pytest.mark.parametrize("out", ["a file", "a folder under a file", "a link to nothing"])
