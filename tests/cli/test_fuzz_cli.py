@@ -20,6 +20,7 @@ from support.cli import rl1c
 
 from rl1.compiler import differential, fuzz
 from rl1.compiler.differential import (
+    Engine,
     Observation,
     VmEngine,
     differences,
@@ -129,7 +130,7 @@ def test_a_seed_gives_the_same_reproducer_however_long_the_runs_take(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     # Shrinking was bounded by 20 seconds: a loaded machine wrote a larger reproducer.
     monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 60)
-    engines = [VmEngine(0), _BrokenShift()]
+    engines: list[Engine] = [VmEngine(0), _BrokenShift()]
     folders = []
     for clock in (time, _Clock()):
         monkeypatch.setattr(fuzz, "time", clock)
