@@ -14,6 +14,7 @@ group, never the records.
 
 from __future__ import annotations
 
+import gc
 import math
 from collections import deque
 from collections.abc import Iterable, Iterator
@@ -90,6 +91,10 @@ class Record:
                 "instructions": self.instructions}
 
 
+COLLECT_EVERY = 64  # runs between full collections of a worker's garbage
+_runs_since_collection = 0
+
+
 @lru_cache(maxsize=4)
 def _decoded(data: bytes, name: str) -> World:
     return decode_world(data, name)
@@ -103,6 +108,15 @@ def world_of(task: Task) -> World:
 def run_one(task: Task, seed: int) -> Record:
     """The run of `task` with `seed`, as `rl1c sim --seed SEED` makes it. The program
     must compile (a campaign checks it once before its runs)."""
+    global _runs_since_collection
+    _runs_since_collection += 1
+    if _runs_since_collection == COLLECT_EVERY:
+        # The front end pauses the collector while it parses (frontend/collector.py) and
+        # then moves every object, this process's earlier runs' garbage cycles included,
+        # to the oldest generation, which only a full collection frees: source compiled
+        # or interpreted each run would grow a worker without end.
+        _runs_since_collection = 0
+        gc.collect()
     simulation = Simulation(world_of(task), seed)
     device = simulation.device
     finished = run(task.program, device, engine=task.engine, budget=task.budget,

@@ -108,10 +108,17 @@ def task_of(file: str, world: bytes, world_name: str, setting: Setting,
     ran = run_file(file, simulation.device, setting.engine, setting.budget, color, "sim")
     if isinstance(ran, int):
         return ran
-    is_ilc = file.lower().endswith(".ilc")
-    program: str | bytes = read_ilc(file) if is_ilc else (ran.source or "")
-    return Task(program, world, world_name, setting.engine, setting.budget,
-                source_name=os.path.basename(ran.source_name))
+    source_name = os.path.basename(ran.source_name)
+    program: str | bytes
+    if file.lower().endswith(".ilc"):
+        program = read_ilc(file)
+    elif setting.engine == "ast":
+        program = ran.source or ""
+    else:  # compiled once, as `rl1c sim` compiles it for each run
+        from rl1.compiler.backend.driver import compile_text
+
+        program = compile_text(ran.source or "", source_name).output or b""
+    return Task(program, world, world_name, setting.engine, setting.budget, source_name)
 
 
 class Progress:
