@@ -19,7 +19,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from rl1.compiler.campaign import Campaign, Task, campaign_seeds
+from rl1.compiler.campaign import Campaign, Task, campaign_seeds, task_for
 from rl1.vm.defaults import DEFAULT_BUDGET
 
 ROOT = Path(__file__).parents[1]
@@ -49,8 +49,8 @@ def main() -> None:
     parser.add_argument("--rate-runs", type=int, default=100)
     options = parser.parse_args()
     cores = os.cpu_count() or 1
-    task = Task(PROGRAM.read_text(), noisy_world(), "sample.noisy.world.toml",
-                budget=DEFAULT_BUDGET, source_name=PROGRAM.name)
+    task = task_for(PROGRAM.read_text(), noisy_world(), "sample.noisy.world.toml", "vm",
+                    DEFAULT_BUDGET, PROGRAM.name)
     one = runs_per_second(task, options.rate_runs, 1)
     every = runs_per_second(task, options.rate_runs, cores)
     load = os.getloadavg()[0]  # other work on the machine takes cores from the pool

@@ -24,6 +24,7 @@ from functools import lru_cache
 from itertools import islice
 from typing import Any
 
+from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.runner import Finished, run
 from rl1.compiler.simulation import Simulation, run_status
 from rl1.vm.defaults import Engine
@@ -55,6 +56,20 @@ class Task:
     engine: Engine = "vm"
     budget: int = 0
     source_name: str = "program.rob"
+
+
+def task_for(program: str | bytes, world: bytes, world_name: str, engine: Engine,
+             budget: int, source_name: str) -> Task:
+    """The task of a campaign of `program`: RL/I source is compiled here once, as `rl1c
+    sim` compiles it for its run, for the VMs (the interpreter runs the source). The
+    source must compile."""
+    if isinstance(program, str) and engine != "ast":
+        compiled = compile_text(program, source_name).output
+        if compiled is None:
+            raise ValueError("the program has errors: a campaign runs only a program "
+                             "that compiles")
+        program = compiled
+    return Task(program, world, world_name, engine, budget, source_name)
 
 
 @dataclass(frozen=True, slots=True)

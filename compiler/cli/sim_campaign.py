@@ -29,6 +29,7 @@ from rl1.compiler.campaign import (
     Task,
     campaign_seeds,
     noiseless,
+    task_for,
     wilson,
     world_of,
 )
@@ -108,17 +109,9 @@ def task_of(file: str, world: bytes, world_name: str, setting: Setting,
     ran = run_file(file, simulation.device, setting.engine, setting.budget, color, "sim")
     if isinstance(ran, int):
         return ran
-    source_name = os.path.basename(ran.source_name)
-    program: str | bytes
-    if file.lower().endswith(".ilc"):
-        program = read_ilc(file)
-    elif setting.engine == "ast":
-        program = ran.source or ""
-    else:  # compiled once, as `rl1c sim` compiles it for each run
-        from rl1.compiler.backend.driver import compile_text
-
-        program = compile_text(ran.source or "", source_name).output or b""
-    return Task(program, world, world_name, setting.engine, setting.budget, source_name)
+    program = read_ilc(file) if file.lower().endswith(".ilc") else ran.source or ""
+    return task_for(program, world, world_name, setting.engine, setting.budget,
+                    os.path.basename(ran.source_name))
 
 
 class Progress:

@@ -30,6 +30,7 @@ from rl1.compiler.campaign import (
     Task,
     campaign_seeds,
     run_one,
+    task_for,
     wilson,
 )
 
@@ -155,6 +156,15 @@ def test_a_campaigns_run_is_the_rl1c_sim_run_of_its_seed(wall: tuple[Path, Path]
         assert report["instructions"] == record.instructions
         assert report["device_time"] == record.device_time
         assert report["track"][-1][1:] == list(record.pose)
+
+
+def test_a_program_compiled_once_runs_as_its_source_compiled_each_run() -> None:
+    source = wall_task()
+    compiled = task_for(WALL_PROGRAM, source.world, source.world_name, "vm", source.budget,
+                        source.source_name)
+    assert isinstance(compiled.program, bytes)
+    assert list(Campaign(compiled, range(30), None, 1)) == list(
+        Campaign(source, range(30), None, 1))
 
 
 def test_the_replay_command_of_a_failure_makes_that_failure(wall: tuple[Path, Path]) -> None:
