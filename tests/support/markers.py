@@ -22,6 +22,8 @@ MARKS: dict[str, tuple[str, ...]] = {
     "tests/c/": ("needs_cc", "slow"),
     "tests/backend/test_firmware.py::test_the_c_array_compiles_and_holds_the_ilc_bytes":
         ("needs_cc",),
+    # The replay page in Debian's chromium, through Playwright.
+    "tests/browser/": ("needs_browser", "slow"),
     # Slow, besides every Hypothesis property (below): fuzzing campaigns, hostile inputs
     # in subprocesses, compilations under many hash seeds, searches through generated
     # programs for each form of the syntax.
