@@ -120,6 +120,11 @@ class Simulator:
         self.motion = None
         self._speeds = (0.0, 0.0)
 
+    @property
+    def wheel_speeds(self) -> tuple[float, float]:
+        """The wheels' speeds now (units, left and right), as tracing corrects them."""
+        return self._speeds
+
     def turn_steering(self, radians: float) -> float:
         """Set the steering; the seconds the steering motor takes."""
         delta = abs(radians - self.steering)
