@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -33,14 +34,24 @@ def noisy_world() -> bytes:
     return b"noise = true\n" + WORLD.read_bytes()
 
 
-def runs_per_second(task: Task, runs: int, jobs: int) -> float:
-    started = time.perf_counter()
+def cpu_seconds() -> float:
+    """CPU time of this process and of its workers that have ended."""
+    own, workers = (resource.getrusage(who) for who in
+                    (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
+    return own.ru_utime + own.ru_stime + workers.ru_utime + workers.ru_stime
+
+
+def measure(task: Task, runs: int, jobs: int) -> tuple[float, float]:
+    """Runs per second of wall-clock time, and CPU ms a run (this process and the
+    workers together: what the machine's load does not change)."""
+    started, cpu = time.perf_counter(), cpu_seconds()
     if jobs == 1:
         done = sum(1 for _ in Campaign(task, campaign_seeds(0, runs), None, 1))
     else:
         with ProcessPoolExecutor(max_workers=jobs) as pool:
             done = sum(1 for _ in Campaign(task, campaign_seeds(0, runs), pool, 8 * jobs))
-    return done / (time.perf_counter() - started)
+    return (done / (time.perf_counter() - started),
+            (cpu_seconds() - cpu) * 1000 / done)
 
 
 def main() -> None:
@@ -51,13 +62,14 @@ def main() -> None:
     cores = os.cpu_count() or 1
     task = task_for(PROGRAM.read_text(), noisy_world(), "sample.noisy.world.toml", "vm",
                     DEFAULT_BUDGET, PROGRAM.name)
-    one = runs_per_second(task, options.rate_runs, 1)
-    every = runs_per_second(task, options.rate_runs, cores)
+    one, one_cpu = measure(task, options.rate_runs, 1)
+    every, every_cpu = measure(task, options.rate_runs, cores)
     load = os.getloadavg()[0]  # other work on the machine takes cores from the pool
     print(f"Listing 1 on the sample world with noise on, {options.rate_runs} runs "
           f"({cores} cores, load average {load:.1f} before):")
-    print(f"  1 process:   {one:6.1f} runs/s ({1000 / one:.0f} ms a run)")
-    print(f"  {cores} processes: {every:6.1f} runs/s ({every / one:.2f}x one process)")
+    print(f"  1 process:   {one:6.1f} runs/s, {one_cpu:.0f} ms of CPU a run")
+    print(f"  {cores} processes: {every:6.1f} runs/s ({every / one:.2f}x one process), "
+          f"{every_cpu:.0f} ms of CPU a run (the pool's start-up included)")
     with tempfile.TemporaryDirectory() as folder:
         shutil.copy(PROGRAM, folder)
         Path(folder, "sample.noisy.world.toml").write_bytes(noisy_world())
