@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import gc
+import io
 import json
 import os
 import shlex
@@ -33,6 +34,7 @@ from rl1.compiler.campaign import (
     task_for,
     wilson,
 )
+from rl1.compiler.cli import sim_campaign
 
 RL1C = str(Path(sys.executable).with_name("rl1c"))
 DROPOUT = 0.3
@@ -192,6 +194,9 @@ def test_the_output_is_the_same_for_one_job_and_two(wall: tuple[Path, Path],
     assert outputs[0] == outputs[1]
     lines = [json.loads(line) for line in outputs[0][1].splitlines()]
     assert [line["seed"] for line in lines] == list(range(60))
+    assert all(list(line) == ["seed", "success", "outcome", "exit_status", "line", "message",
+                              "safety", "goal", "device_time", "pose", "instructions"]
+               for line in lines)  # as spec/simulator.md, "Campaigns", lists them
     assert {line["outcome"] for line in lines} == {"ok", "argument-range"}
 
 
@@ -279,6 +284,21 @@ def test_out_never_replaces_an_input_and_an_unwritable_out_is_said(
                   tmp_path / "no such folder" / "runs.jsonl")
     assert result.exit_code == 2
     assert "cannot write" in result.stderr and "Traceback" not in result.output
+
+
+def test_progress_is_a_line_every_few_seconds_when_standard_error_is_no_terminal(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    clock = iter([0.0, 1.0, 5.5, 7.0, 11.0])
+    monkeypatch.setattr(sim_campaign.time, "monotonic", lambda: next(clock))
+    stream = io.StringIO()
+    progress = sim_campaign.Progress(100, stream)  # started at 0.0
+    tally = Tally()
+    for seconds in (1.0, 5.5, 7.0, 11.0):
+        tally.add(_failure(int(seconds)))
+        progress.update(tally)
+    assert stream.getvalue().splitlines() == [
+        "2/100 runs, 0 succeeded (0.0%), 0.4 runs/s",  # at 5.5 s, then none at 7 s
+        "4/100 runs, 0 succeeded (0.0%), 0.4 runs/s"]  # at 11 s
 
 
 # Usage ------------------------------------------------------------------------------------
