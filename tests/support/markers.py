@@ -29,6 +29,10 @@ MARKS: dict[str, tuple[str, ...]] = {
     # programs for each form of the syntax.
     "tests/cli/test_fuzz_cli.py": ("slow",),
     "tests/frontend/test_strategies.py": ("slow",),
+    # A language server process of its own for each test (its command line, its raw
+    # protocol over standard input and output).
+    "tests/lsp/test_command.py": ("slow",),
+    "tests/lsp/test_protocol.py": ("slow",),
     "tests/cli/test_hostile_inputs.py": ("slow",),
     "tests/backend/test_reproducible.py": ("slow",),
 }
