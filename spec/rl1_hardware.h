@@ -30,7 +30,8 @@ typedef struct {
                            KYO u v; IMG w x y z; FZI s t */
 } rl1_reading;
 
-/* The vehicle. One dispatch per kind of callback; the built-in is named by its opcode
+/* The vehicle. One dispatch per kind of callback; a callback runs inside rl1_step, so
+ * what it may do with the VM is said at rl1_step below; the built-in is named by its opcode
  * (0x40..0x5D, spec/ilc.md 8.3: one opcode per form, CAM and ULT selectors included;
  * vm/c/rl1vm.h names them RL1_OP_FRE .. RL1_OP_FZI),
  * `args` holds its arguments in parameter order, already range-checked (as many as the
@@ -84,6 +85,25 @@ static inline int rl1_post_line_lost(rl1_mailbox *box, uint8_t mode, uint8_t com
     return 1;
 }
 
+/* An emergency stop, from the main loop or an interrupt handler (never blocks, calls
+ * nothing): the run's next step, or the event point under way in one (after a call or
+ * a jump taken), stops the vehicle through `stop` and `end` and ends the run with the
+ * fault RL1_FAULT_ABORTED, at the call in progress or the instruction at hand. It is
+ * posted into the mailbox as an event of its own, over a pending lost line (which it
+ * makes moot) and never dropped; a second abort before the first is taken adds nothing.
+ * The device is the only other writer of the mailbox, and may interrupt this: the loop
+ * writes the event again until a loss posted in between is overwritten. An abort after
+ * the run is over (ENDED: END leaves the motion in effect, 12.3) is never taken: stop the
+ * vehicle yourself then. */
+#define RL1_ABORT_EVENT 0xFFu  /* no RL1_EVENT: mode 127 */
+static inline void rl1_abort(rl1_mailbox *box) {
+    if (box->posted != box->taken && box->event == RL1_ABORT_EVENT) return;
+    do {
+        box->event = RL1_ABORT_EVENT;
+        box->posted = (uint8_t)(box->posted + 1);
+    } while (box->event != RL1_ABORT_EVENT);
+}
+
 /* The VM takes the pending event, if any: 1 and *event set, or 0. */
 static inline int rl1_take_line_lost(rl1_mailbox *box, uint8_t *event) {
     uint8_t posted = box->posted;
@@ -99,7 +119,8 @@ typedef enum {
     RL1_RUNNING = 0,  /* the step ran its n instructions: step again */
     RL1_WAITING = 1,  /* a built-in is taking device time: step again to poll it */
     RL1_ENDED = 2,    /* (END), or past the last instruction */
-    RL1_FAULTED = 3   /* `fault` and `pc` say what and where */
+    RL1_FAULTED = 3,  /* `fault` and `pc` say what and where */
+    RL1_IN_STEP = 4   /* never returned: vm->state while a step runs (what callbacks see) */
 } rl1_state;
 
 typedef enum {  /* the values are rl1c run's exit statuses */
@@ -107,8 +128,11 @@ typedef enum {  /* the values are rl1c run's exit statuses */
     RL1_FAULT_ARGUMENT_RANGE = 10,
     RL1_FAULT_MISSING_HANDLER = 11,
     RL1_FAULT_BUDGET = 12,
-    RL1_FAULT_DEVICE = 13
+    RL1_FAULT_DEVICE = 13,  /* also: a callback broke the rules of rl1_step below */
+    RL1_FAULT_ABORTED = 14  /* rl1_abort: the emergency stop */
 } rl1_fault;
+
+
 
 /* The verified program (spec/ilc.md 10), as the implementation's loader makes it
  * (vm/c/rl1vm.h defines ours): the VM reads its code and its handler table. Read only,
@@ -125,7 +149,10 @@ typedef struct {
     int16_t R;
     uint16_t pc;                /* code offset of the next instruction; after a fault, of
                                    the faulting one (0xFFFF: before the first) */
-    uint32_t executed;          /* instructions run, the one that faulted included */
+    uint32_t executed;          /* instructions run, the one that faulted included. A
+                                   run that never ends (a patrol) is given more by
+                                   setting it back between steps: the budget then
+                                   bounds what runs after (vm/c/README.md) */
     uint32_t budget;            /* 1 .. 2^31 - 1 (12.6) */
     rl1_mailbox mailbox;        /* the device posts here */
     /* the run */
@@ -138,7 +165,20 @@ typedef struct {
 
 /* Run at most n instructions of `program` on `hw` (n = 0: only poll a call in progress)
  * and say where the run stands. Every step of a run must be given the same program and
- * hardware. Once RL1_ENDED or RL1_FAULTED, a step does nothing and says so again. */
+ * hardware. Once RL1_ENDED or RL1_FAULTED, a step does nothing and says so again.
+ *
+ * Inside a callback (which runs inside a step), vm->state reads RL1_IN_STEP and the
+ * locals of the step hold what is not yet written back: vm->acc, vm->executed and vm->pc
+ * are stale, and a call writes its reserved variables and R only after its callback
+ * returns. A callback may read vm->V, post into vm->mailbox and call rl1_abort; it must
+ * not call rl1_step or rl1_vm_init on the VM that called it: the nested rl1_step does
+ * nothing and returns RL1_FAULTED, and when the callback returns the step faults
+ * (RL1_FAULT_DEVICE at the call, or at END for `end`; `begin`: before the first
+ * instruction; a fault's own stop and end: its fault stays). rl1_vm_init would also have
+ * zeroed the variables. A step never waits: when it returns RL1_WAITING, nothing will
+ * change until the device finishes the call in progress, so a main loop may sleep until
+ * the device says so (the interrupt that ends the motion, the timer of a TIM) and then
+ * step; stepping sooner only polls. */
 rl1_state rl1_step(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
                    uint32_t n);
 

@@ -28,6 +28,7 @@ class FaultKind(Enum):
     MISSING_HANDLER = ("missing-handler", 11, "E1011")  # a lost line jumps to an undefined :96-:99
     BUDGET = ("budget", 12, "E1012")  # the watchdog: the step budget is used up
     DEVICE = ("device-error", 13, "E1013")  # the device failed (DeviceError)
+    ABORTED = ("aborted", 14, "E1014")  # the firmware's emergency stop (Machine.abort)
 
     def __init__(self, code: str, exit_status: int, diagnostic_code: str) -> None:
         self.code = code
@@ -83,6 +84,10 @@ def argument_range_message(param: str, form: str, value: int, variable: int, low
     got `value` from the variable of index `variable`."""
     return (f"argument {param} of ({form}) is {value} (the value of {VARIABLES[variable]}), "
             f"outside {low}..{high}")
+
+
+ABORTED_MESSAGE = "the run was aborted from outside the program (an emergency stop)"
+"""What an ABORTED fault says, whichever VM meets it."""
 
 
 STOP_FAILED = "; stopping the vehicle failed too: "

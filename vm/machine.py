@@ -24,6 +24,7 @@ from enum import Enum
 from . import isa
 from .device import Device, DeviceError, checked, form_name
 from .faults import (
+    ABORTED_MESSAGE,
     DEFAULT_BUDGET,
     STOP_FAILED,
     Fault,
@@ -123,6 +124,7 @@ class Machine:
         self.executed = 0  # instructions run so far, the one at hand included
         self.waiting: isa.Instruction | None = None  # a call started and not yet done
         self.begun = False
+        self.aborting = False  # abort() was called: the next step or event point faults
         self.state = State.RUNNING
         self.result: RunResult | None = None  # once ENDED or FAULTED
         # For each call, the instructions executed up to it, itself included: what the
@@ -136,6 +138,13 @@ class Machine:
         assert self.result is not None
         return self.result
 
+    def abort(self) -> None:
+        """The emergency stop (rl1_abort in C; spec/ilc.md 12.7), from anywhere, a
+        device's callback included: the next step, or the event point under way in one,
+        stops the vehicle and ends the run with the fault ABORTED. After the run is over
+        it changes nothing."""
+        self.aborting = True
+
     def step(self, limit: int) -> State:
         """Run at most `limit` instructions (0 or more) and say where the run stands.
         The first step begins the run; a call in progress is polled first, once."""
@@ -144,6 +153,8 @@ class Machine:
         try:
             if not self.begun:
                 self._begin()
+            if self.aborting:
+                return self._fault(FaultKind.ABORTED, ABORTED_MESSAGE, self._line_at_hand())
             if self.waiting is not None and not self._poll(self.waiting):
                 return State.WAITING
             for _ in range(limit):
@@ -155,6 +166,16 @@ class Machine:
         except DeviceError as error:
             return self._fault(FaultKind.DEVICE, str(error))
         return State.RUNNING
+
+    def _line_at_hand(self) -> int | None:
+        """Between steps: the source line of the call in progress, or else of the next
+        instruction (None past the last one, or without a line map)."""
+        debug = self.program.image.debug
+        if self.waiting is not None:
+            return self.current_line()
+        if debug is None or self.pc == len(self.program.instructions):
+            return None
+        return debug.line_at(self.program.instructions[self.pc].offset)
 
     def current_line(self) -> int | None:
         """The source line of the instruction before pc: while an instruction runs, the
@@ -272,6 +293,8 @@ class Machine:
     def _event_point(self, resume: int) -> int:
         """Where the program goes on from a point where a lost line is taken: the
         handler Table 4 names for a pending event, or else `resume`."""
+        if self.aborting:
+            raise _Faulted(FaultKind.ABORTED, ABORTED_MESSAGE)
         event = self.hardware.take_event()
         if event is None:
             return resume
@@ -362,9 +385,10 @@ class Machine:
             raise DeviceError(refusal(answer))
         self.result = RunResult(tuple(self.variables))
 
-    def _fault(self, kind: FaultKind, message: str) -> State:
+    def _fault(self, kind: FaultKind, message: str, line: int | None = None) -> State:
         """Stop the vehicle, tell the device the program is over (unless the fault came
-        from telling it), and describe the fault at the instruction at hand."""
+        from telling it), and describe the fault at the instruction at hand (`line`
+        when given, else the instruction run last)."""
         stopped = self.hardware.stop()
         if stopped.status is not Status.OK:
             message += STOP_FAILED + refusal(stopped)
@@ -372,7 +396,7 @@ class Machine:
             self.hardware.end()  # the fault is reported whatever the end answers
         self.state = State.FAULTED
         self.result = RunResult(tuple(self.variables),
-                                Fault(kind, message, self.current_line()))
+                                Fault(kind, message, line or self.current_line()))
         return State.FAULTED
 
 

@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, TypeVar
 from . import isa
 from .device import DeviceError, FormKey, Outcome, checked, form_name
 from .faults import (
+    ABORTED_MESSAGE,
     STOP_FAILED,
     Fault,
     FaultKind,
@@ -320,6 +321,8 @@ def load(path: Path) -> ctypes.CDLL:
                                   ctypes.c_char_p, ctypes.c_uint32, ctypes.c_uint32,
                                   ctypes.POINTER(ctypes.c_uint32)]
     lib.rl1_ffi_post.argtypes = [ctypes.POINTER(_Vm), ctypes.c_uint8, ctypes.c_uint8]
+    lib.rl1_ffi_abort.argtypes = [ctypes.POINTER(_Vm)]
+    lib.rl1_ffi_abort.restype = None
     lib.rl1_step.argtypes = [ctypes.POINTER(_Vm), ctypes.POINTER(_Program),
                              ctypes.POINTER(_Hardware), ctypes.c_uint32]
     lib.rl1_line_at.argtypes = [ctypes.POINTER(_Program), ctypes.c_uint16]
@@ -403,6 +406,11 @@ class NativeMachine:
             self.result = RunResult(tuple(self._vm.V), self._fault())
         return state
 
+    def abort(self) -> None:
+        """The emergency stop, as Machine.abort: rl1_abort on the VM's mailbox (from a
+        callback too, as an interrupt handler would)."""
+        self.lib.rl1_ffi_abort(ctypes.byref(self._vm))
+
     def run(self) -> RunResult:
         while self.step(SLICE) in (State.RUNNING, State.WAITING):
             pass
@@ -477,7 +485,7 @@ class NativeMachine:
 
     def _end(self, _ctx: object) -> int:
         answer = self.hardware.end()
-        if self._vm.state != State.ENDED.value:  # after a fault: its message stays
+        if self._vm.fault:  # after a fault (set before its stop and end): its message stays
             return _STATUS[answer.status]
         return self._answer(answer, None, None)
 
@@ -494,6 +502,8 @@ class NativeMachine:
         message = self._message
         if kind is FaultKind.BUDGET:
             message = budget_message(self.budget)
+        elif kind is FaultKind.ABORTED:
+            message = ABORTED_MESSAGE
         elif kind is FaultKind.ARGUMENT_RANGE:
             message = self._range_message(at)
         elif kind is FaultKind.MISSING_HANDLER:

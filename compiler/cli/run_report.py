@@ -161,6 +161,8 @@ _HELP = {
                       "closes a loop that nothing ends",
     FaultKind.DEVICE: "the vehicle refused or failed the call; on the scripted device, the "
                       "sensor script decides readings and failures (spec/sensors.md)",
+    FaultKind.ABORTED: "the firmware's emergency stop ended the run; the program did "
+                       "nothing wrong",
 }
 _TIME_LIMIT_HELP = ("if the program should run longer, raise --time-limit; if not, it waits "
                     "in a loop for something that does not come")

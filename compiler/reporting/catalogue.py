@@ -70,4 +70,5 @@ CODES: dict[str, CodeInfo] = _entries(
     ("E1011", E, "run-time fault: missing lost-line handler"),
     ("E1012", E, "run-time fault: budget exhausted"),
     ("E1013", E, "run-time fault: device error"),
+    ("E1014", E, "run-time fault: aborted"),
 )

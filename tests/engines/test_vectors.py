@@ -176,7 +176,9 @@ def test_every_builtin_form_has_constant_and_variable_arguments() -> None:
 
 def test_every_fault_kind_is_reached() -> None:
     statuses = {vector["status"] for vector in VECTORS}
-    assert statuses == {"ok"} | {kind.code for kind in FaultKind}
+    # but an abort, which the firmware makes, not the program or its sensor script
+    # (tests/c/test_run_control.py holds the two VMs to each other on it)
+    assert statuses == {"ok"} | {kind.code for kind in FaultKind if kind is not FaultKind.ABORTED}
 
 
 def test_every_range_checked_parameter_faults_below_and_above() -> None:

@@ -14,6 +14,9 @@
 #include "rl1vm.h"
 
 #define NO_PC 0xFFFFu  /* pc of a fault before the first instruction */
+/* vm->state once a callback called rl1_step on the VM that called it (RL1_IN_STEP before):
+ * the step under way faults when the callback returns. */
+#define REENTERED 5u
 
 /* The reserved variables the sensing calls write (spec/ilc.md 8.3), by index. */
 #define VAR_S 44u
@@ -77,13 +80,21 @@ static void clear_reading(rl1_reading *out)
     out->writes[3] = 0;
 }
 
-/* Takes a finished call's answer: false for a device error (an ERROR, or a value out of
- * its documented range, 12.5: then nothing is written); else writes the reserved
+/* Whether a callback broke in on the step under way: called rl1_step on this VM (the
+ * state is REENTERED) or rl1_vm_init (it is 0). Checked after each callback the run
+ * goes on from; the run then faults device-error (rl1vm.h, "What a callback may do"). */
+static bool broken_in(const rl1_vm *vm)
+{
+    return vm->state != (uint8_t)RL1_IN_STEP;
+}
+
+/* Takes a finished call's answer: false for a device error (an ERROR, a value out of
+ * its documented range, 12.5, or a callback that broke in: then nothing is written); else writes the reserved
  * variables, then R (spec/ilc.md section 9, steps 4-6). */
 static bool finish(rl1_vm *vm, uint8_t op, rl1_status status, const rl1_reading *out)
 {
     uint8_t first = 0, count = 0, k;
-    if (status != RL1_OK || (op == RL1_OP_CAMR && (out->result < 0 || out->result > 784))
+    if (status != RL1_OK || broken_in(vm) || (op == RL1_OP_CAMR && (out->result < 0 || out->result > 784))
         || (op == RL1_OP_INP && (out->result < 0 || out->result > 255))) {
         return false;
     }
@@ -136,7 +147,7 @@ static rl1_fault call(rl1_vm *vm, const rl1_hardware *hw, uint8_t op, uint8_t ar
             return RL1_FAULT_DEVICE;
         }
         status = hw->poll(hw->ctx, &out);
-        if (status == RL1_BUSY) {
+        if (status == RL1_BUSY && !broken_in(vm)) {
             vm->waiting = op;
             return RL1_FAULT_NONE;
         }
@@ -148,71 +159,76 @@ static rl1_fault call(rl1_vm *vm, const rl1_hardware *hw, uint8_t op, uint8_t ar
 
 /* The event point (section 9): takes a pending lost line and moves *pc to the handler
  * Table 4 names for it (mode 2: MOV :98, MVI :99; mode 3: MOV :96, MVI :97; no other
- * mode jumps). False when that handler is absent: the fault missing-handler. */
-static bool take_event(rl1_vm *vm, const rl1_program *program, uint16_t *pc)
+ * mode jumps). The fault missing-handler when that handler is absent; the fault aborted
+ * when the event is rl1_abort's. */
+static rl1_fault take_event(rl1_vm *vm, const rl1_program *program, uint16_t *pc)
 {
     uint8_t event, mode, entry;
     if (!rl1_take_line_lost(&vm->mailbox, &event)) {
-        return true;
+        return RL1_FAULT_NONE;
     }
     mode = RL1_EVENT_MODE(event);
-    if (mode != 2u && mode != 3u) {
-        return true;
+    if (mode != 2u && mode != 3u) { /* rl1_abort's event has mode 127 */
+        return event == RL1_ABORT_EVENT ? RL1_FAULT_ABORTED : RL1_FAULT_NONE;
     }
     entry = (uint8_t)((mode == 2u ? 2u : 0u) + RL1_EVENT_COMMAND(event));
     if (program->handlers[entry] == RL1_ABSENT) {
-        return false;
+        return RL1_FAULT_MISSING_HANDLER;
     }
     *pc = program->handlers[entry];
-    return true;
+    return RL1_FAULT_NONE;
+}
+
+/* rl1_abort asked for the run to end: its event is pending. */
+static bool abort_pending(const rl1_vm *vm)
+{
+    return vm->mailbox.posted != vm->mailbox.taken && vm->mailbox.event == RL1_ABORT_EVENT;
 }
 
 /* Stops the vehicle and ends the run with fault `kind` at code offset `at` (12.3); `end`
- * is not called again when it is its answer that faulted. */
+ * is not called again when it is its answer that faulted. The fault is set before the
+ * callbacks run, so that they can tell a fault's stop and end from others. */
 static rl1_state fault(rl1_vm *vm, const rl1_hardware *hw, rl1_fault kind, uint16_t at,
                        bool ended)
 {
+    vm->fault = (uint8_t)kind;
+    vm->pc = at;
     if (hw->stop(hw->ctx) != RL1_OK) {
         vm->stop_failed = 1;
     }
     if (!ended) {
         (void)hw->end(hw->ctx); /* the fault is reported whatever it answers */
     }
-    vm->fault = (uint8_t)kind;
-    vm->pc = at;
-    vm->state = RL1_FAULTED;
     return RL1_FAULTED;
 }
 
 /* The run has reached END at `at` (or the code's end: `at` is then code_size). */
 static rl1_state ended(rl1_vm *vm, const rl1_hardware *hw, uint16_t at)
 {
-    vm->state = RL1_ENDED;
-    if (hw->end(hw->ctx) != RL1_OK) {
-        return fault(vm, hw, RL1_FAULT_DEVICE, at, true);
-    }
-    return RL1_ENDED;
+    return hw->end(hw->ctx) != RL1_OK || broken_in(vm)
+        ? fault(vm, hw, RL1_FAULT_DEVICE, at, true) : RL1_ENDED;
 }
 
-/* Resumes a call in progress (12.2): polls it once. */
-static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw)
+/* Resumes the call in progress at code offset `at` (12.2): polls it once. */
+static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
+                        uint16_t at)
 {
     rl1_reading out;
     uint8_t op = vm->waiting;
-    uint16_t at = (uint16_t)(vm->pc - rl1_call_length(rl1_call_arity(op)));
     rl1_status status;
+    rl1_fault kind;
     clear_reading(&out);
     status = hw->poll(hw->ctx, &out);
-    if (status == RL1_BUSY) {
+    if (status == RL1_BUSY && !broken_in(vm)) {
         return RL1_WAITING;
     }
     vm->waiting = 0;
-    vm->state = RL1_RUNNING;
     if (!finish(vm, op, status, &out)) {
         return fault(vm, hw, RL1_FAULT_DEVICE, at, false);
     }
-    if (!take_event(vm, program, &vm->pc)) {
-        return fault(vm, hw, RL1_FAULT_MISSING_HANDLER, at, false);
+    kind = take_event(vm, program, &vm->pc);
+    if (kind != RL1_FAULT_NONE) {
+        return fault(vm, hw, kind, at, false);
     }
     return RL1_RUNNING;
 }
@@ -471,12 +487,11 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
             }
             if (vm->waiting) {
                 vm->acc = (int16_t)acc;
-                vm->state = RL1_WAITING;
                 return RL1_WAITING;
             }
             target = vm->pc;
-            if (!take_event(vm, program, &target)) {
-                kind = RL1_FAULT_MISSING_HANDLER;
+            kind = take_event(vm, program, &target);
+            if (kind != RL1_FAULT_NONE) {
                 break;
             }
             ip = code + target;
@@ -504,9 +519,11 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
             kind = RL1_FAULT_BUDGET;
             break;
         }
-        if (vm->mailbox.posted != vm->mailbox.taken && !take_event(vm, program, &target)) {
-            kind = RL1_FAULT_MISSING_HANDLER;
-            break;
+        if (vm->mailbox.posted != vm->mailbox.taken) {
+            kind = take_event(vm, program, &target);
+            if (kind != RL1_FAULT_NONE) {
+                break;
+            }
         }
         ip = code + target;
         stop = STOP;
@@ -521,24 +538,49 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
     return state == RL1_ENDED ? ended(vm, hw, vm->pc) : state;
 }
 
-rl1_state rl1_step(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
-                   uint32_t n)
+/* A step of a run that is neither over nor in a step already (vm->state RL1_IN_STEP). */
+static rl1_state step(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
+                      uint32_t n)
 {
-    if (vm->state == RL1_ENDED || vm->state == RL1_FAULTED) {
-        return (rl1_state)vm->state;
-    }
+    uint16_t at;
     if (!vm->begun) {
+        uint8_t posted = vm->mailbox.posted;
         vm->begun = 1;
-        if (hw->begin(hw->ctx) != RL1_OK) {
+        if (hw->begin(hw->ctx) != RL1_OK || broken_in(vm)) {
             return fault(vm, hw, RL1_FAULT_DEVICE, NO_PC, false);
         }
-        vm->mailbox.taken = vm->mailbox.posted; /* a loss before the program is not its own */
+        if (vm->mailbox.event != RL1_ABORT_EVENT) {
+            vm->mailbox.taken = posted; /* a loss before the program is not its own */
+        }
+    }
+    /* the instruction at hand: the call in progress (pc is past it), or the next */
+    at = vm->waiting ? (uint16_t)(vm->pc - rl1_call_length(rl1_call_arity(vm->waiting)))
+                     : vm->pc;
+    if (abort_pending(vm)) {
+        return fault(vm, hw, RL1_FAULT_ABORTED, at, false);
     }
     if (vm->waiting) {
-        rl1_state state = resume(vm, program, hw);
+        rl1_state state = resume(vm, program, hw, at);
         if (state != RL1_RUNNING) {
             return state;
         }
     }
     return run(vm, program, hw, n);
+}
+
+rl1_state rl1_step(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
+                   uint32_t n)
+{
+    rl1_state state = (rl1_state)vm->state;
+    if (state >= RL1_IN_STEP) { /* from a callback of the step under way: it faults */
+        vm->state = REENTERED;
+        return RL1_FAULTED;
+    }
+    if (state >= RL1_ENDED) { /* ENDED or FAULTED */
+        return state;
+    }
+    vm->state = RL1_IN_STEP;
+    state = step(vm, program, hw, n);
+    vm->state = (uint8_t)state;
+    return state;
 }

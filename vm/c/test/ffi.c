@@ -12,6 +12,7 @@ void rl1_ffi_layout(uint32_t *out);
 int rl1_ffi_start(rl1_vm *vm, rl1_program *program, const uint8_t *file, uint32_t size,
                   uint32_t budget, uint32_t *error_offset);
 int rl1_ffi_post(rl1_vm *vm, uint8_t mode, uint8_t command);
+void rl1_ffi_abort(rl1_vm *vm);
 
 static uint8_t bitmap[RL1_BITMAP_SIZE(0xFFFFu)];
 
@@ -68,4 +69,10 @@ int rl1_ffi_start(rl1_vm *vm, rl1_program *program, const uint8_t *file, uint32_
 int rl1_ffi_post(rl1_vm *vm, uint8_t mode, uint8_t command)
 {
     return rl1_post_line_lost(&vm->mailbox, mode, command);
+}
+
+/* rl1_abort, for a Python caller. */
+void rl1_ffi_abort(rl1_vm *vm)
+{
+    rl1_abort(&vm->mailbox);
 }

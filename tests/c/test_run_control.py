@@ -1,0 +1,144 @@
+"""The emergency stop (rl1_abort in C, Machine.abort in the reference VM): on generated
+programs, an abort between steps or from inside a callback (where an interrupt handler
+would call it) gives both VMs the same fault ABORTED, at the same line, after the same
+instructions and device trace. vm/c/test/run_control.c tests the C side alone (a signal
+handler, callbacks that step the VM again, a patrol's budget): `make -C vm/c
+run-control`."""
+
+from __future__ import annotations
+
+import ctypes
+import shutil
+from dataclasses import dataclass, field
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from support.scripts import MOVING_STARTS, scripts
+
+from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
+from rl1.compiler.strategies import checked_programs
+from rl1.vm import native
+from rl1.vm.device import FormKey, LineLost
+from rl1.vm.faults import ABORTED_MESSAGE, Fault, FaultKind, RunResult
+from rl1.vm.hardware import Answer, Blocking
+from rl1.vm.machine import Machine, State
+from rl1.vm.scripted import Script, ScriptedDevice
+from rl1.vm.verifier import verify
+
+GOING = (State.RUNNING, State.WAITING)
+
+
+@pytest.fixture(scope="session")
+def c_vm(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
+    if not any(shutil.which(cc) for cc in ("gcc", "cc", "clang")):
+        pytest.skip("no C compiler (gcc, cc or clang) on this machine: vm/c/install-tools "
+                    "installs one on Debian")
+    return native.load(native.library(tmp_path_factory.mktemp("c-vm"), sanitize=True))
+
+
+def _compiled(text: str, level: int = 0) -> bytes:
+    compiled = compile_text(text, "generated.rob", level=level)
+    assert compiled.output is not None, compiled.diagnostics
+    return compiled.output
+
+
+@dataclass
+class Aborting:
+    """Blocking hardware that calls `abort` from inside its callback number `at` (1 the
+    first), as an interrupt handler would while the VM runs; never when `at` is 0."""
+
+    inner: Blocking
+    at: int
+    abort: list[Machine | native.NativeMachine] = field(default_factory=list)
+    calls: int = 0
+
+    def _count(self, answer: Answer) -> Answer:
+        self.calls += 1
+        if self.calls == self.at:
+            self.abort[0].abort()
+        return answer
+
+    def begin(self) -> Answer:
+        return self._count(self.inner.begin())
+
+    def call(self, form: FormKey, args: tuple[int, ...]) -> Answer:
+        return self._count(self.inner.call(form, args))
+
+    def start(self, form: FormKey, args: tuple[int, ...]) -> Answer:
+        return self._count(self.inner.start(form, args))
+
+    def poll(self) -> Answer:
+        return self._count(self.inner.poll())
+
+    def stop(self) -> Answer:
+        return self.inner.stop()
+
+    def end(self) -> Answer:
+        return self.inner.end()
+
+    @property
+    def pending(self) -> LineLost | None:
+        return self.inner.pending
+
+    def take_event(self) -> LineLost | None:
+        return self.inner.take_event()
+
+
+def _run(machine: Machine | native.NativeMachine, device: ScriptedDevice,
+         slices: list[int], abort_before: int) -> tuple[RunResult, list[object], int, bool]:
+    """Steps `machine` by `slices`, aborting before step number `abort_before` (none
+    when it is past the last), then to its end; the last field says whether that abort
+    came while the run was going."""
+    aborted = False
+    for index, limit in enumerate(slices):
+        if index == abort_before:
+            aborted = machine.state in GOING
+            machine.abort()
+        if machine.step(limit) not in GOING:
+            break
+    return machine.run(), list(device.trace), machine.executed, aborted
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.sampled_from(MOVING_STARTS), checked_programs(max_blocks=3), scripts(),
+       st.lists(st.integers(0, 9), min_size=1, max_size=12), st.integers(0, 14),
+       st.integers(0, 12), st.sampled_from(OPTIMIZATION_LEVELS))
+def test_an_abort_ends_both_vms_alike(c_vm: ctypes.CDLL, start: str, text: str,
+                                      script: Script, slices: list[int], abort_before: int,
+                                      in_callback: int, level: int) -> None:
+    data = _compiled(start + text, level)
+    runs = []
+    for make in (lambda hw: Machine(verify(data), hw, 5000),
+                 lambda hw: native.NativeMachine(data, hw, 5000, c_vm)):
+        device = ScriptedDevice(script)
+        hardware = Aborting(Blocking(device), in_callback)
+        machine = make(hardware)
+        hardware.abort.append(machine)
+        runs.append(_run(machine, device, slices, abort_before))
+    expected, got = runs
+    assert got == expected
+    if expected[3]:  # the next step takes an abort made between steps, whatever it is
+        assert expected[0].fault is not None
+        assert (expected[0].fault.kind, expected[0].fault.message) == (FaultKind.ABORTED,
+                                                                        ABORTED_MESSAGE)
+
+
+def test_an_abort_between_steps_stops_the_vehicle_at_the_next_step(c_vm: ctypes.CDLL) -> None:
+    data = _compiled("(TRC 2); (MOV 3,3)\n:10 (TIM 5); C=C+1; #10\n:98 (END)\n")
+    results = []
+    for make in (lambda hw: Machine(verify(data), hw, 5000),
+                 lambda hw: native.NativeMachine(data, hw, 5000, c_vm)):
+        device = ScriptedDevice(Script())
+        machine = make(Blocking(device))
+        assert machine.step(7) is State.RUNNING
+        machine.abort()
+        assert machine.step(7) is State.FAULTED
+        assert machine.executed == 7
+        assert machine.result is not None
+        assert machine.result.fault == Fault(FaultKind.ABORTED, ABORTED_MESSAGE, 2)
+        assert [entry.call for entry in device.trace][-1] == "STOP"
+        machine.abort()  # once over, an abort changes nothing
+        assert machine.step(7) is State.FAULTED
+        results.append((machine.result, device.trace))
+    assert results[0] == results[1]
