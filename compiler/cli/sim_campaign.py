@@ -13,7 +13,7 @@ import shlex
 import signal
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -118,14 +118,16 @@ class Progress:
     """The runs done, the success rate and the runs per second, on standard error: one
     line redrawn on a terminal, else a line every PROGRESS_EVERY seconds."""
 
-    def __init__(self, total: int, stream: IO[str]) -> None:
+    def __init__(self, total: int, stream: IO[str],
+                 clock: Callable[[], float] = time.monotonic) -> None:
         self.total = total
         self.stream = stream
         self.terminal = stream.isatty()
-        self.started = self.shown = time.monotonic()
+        self.clock = clock
+        self.started = self.shown = clock()
 
     def update(self, tally: Tally) -> None:
-        now = time.monotonic()
+        now = self.clock()
         if now - self.shown < (REDRAW_EVERY if self.terminal else PROGRESS_EVERY):
             return
         self.shown = now

@@ -34,7 +34,7 @@ from rl1.compiler.campaign import (
     task_for,
     wilson,
 )
-from rl1.compiler.cli import sim_campaign
+from rl1.compiler.cli.sim_campaign import Progress
 
 RL1C = str(Path(sys.executable).with_name("rl1c"))
 DROPOUT = 0.3
@@ -286,12 +286,10 @@ def test_out_never_replaces_an_input_and_an_unwritable_out_is_said(
     assert "cannot write" in result.stderr and "Traceback" not in result.output
 
 
-def test_progress_is_a_line_every_few_seconds_when_standard_error_is_no_terminal(
-        monkeypatch: pytest.MonkeyPatch) -> None:
+def test_progress_is_a_line_every_few_seconds_when_standard_error_is_no_terminal() -> None:
     clock = iter([0.0, 1.0, 5.5, 7.0, 11.0])
-    monkeypatch.setattr(sim_campaign.time, "monotonic", lambda: next(clock))
     stream = io.StringIO()
-    progress = sim_campaign.Progress(100, stream)  # started at 0.0
+    progress = Progress(100, stream, lambda: next(clock))  # started at 0.0
     tally = Tally()
     for seconds in (1.0, 5.5, 7.0, 11.0):
         tally.add(_failure(int(seconds)))
