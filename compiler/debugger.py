@@ -58,6 +58,8 @@ def compile_program(text: str, source_name: str, level: int | None = None
 # Conditions ----------------------------------------------------------------------------
 
 _CONDITION = re.compile(r"^(?P<value>.*?)\s*(?P<relation>[=<>])\s*0\s*$", re.DOTALL)
+_AGAINST_NUMBER = re.compile(r"^(.+?)\s*([=<>])\s*(-?[0-9]+)\s*$", re.DOTALL)
+_RELATIONS: dict[str, ast.Relation] = {"=": "=", ">": ">", "<": "<"}
 _CONDITION_HELP = ("write a value of the language compared with 0, as a conditional jump "
                    "tests it: `A<0`, `U-L>0`, `d=0`")
 
@@ -92,6 +94,13 @@ def parse_condition(text: str) -> Condition:
     """A breakpoint's condition, parsed by the front end as the right side of an
     assignment; DebugError saying what is wrong."""
     match = _CONDITION.match(text.strip())
+    other = _AGAINST_NUMBER.match(text.strip())
+    if match is None and other is not None:
+        shown, compared, number = other.groups()
+        sign = "+" if number.startswith("-") else "-"
+        raise DebugError(f"the condition `{text.strip()}` compares with {number}, and a "
+                         f"condition compares with 0 (`<` after a value is a shift): "
+                         f"write `{shown}{sign}{number.lstrip('-')}{compared}0`")
     if match is None or not match["value"]:
         raise DebugError(f"the condition `{text.strip()}` compares nothing with 0: "
                          f"{_CONDITION_HELP}")
@@ -113,8 +122,7 @@ def parse_condition(text: str) -> Condition:
             case ast.Const(hex=False, value=number) if not -32768 <= number <= 32767:
                 raise DebugError(f"the constant {number} of the condition is outside "
                                  "-32768..32767, the values a variable holds")
-    relation: ast.Relation = match["relation"]  # type: ignore[assignment]
-    return Condition(text.strip(), assign, relation)
+    return Condition(text.strip(), assign, _RELATIONS[match["relation"]])
 
 
 def parse_call(name: str) -> FormKey:
