@@ -163,7 +163,8 @@ def noiseless(task: Task) -> bool:
 class Campaign:
     """The runs of `task` over `seeds` on `executor` (in this process when None), as an
     iterator of their records in seed order, with at most `window` runs submitted and not
-    yet yielded. `salvage` ends it early, keeping the runs already finished."""
+    yet yielded. `salvage` ends it early, keeping the runs already finished that follow
+    the last yielded without a gap."""
 
     def __init__(self, task: Task, seeds: Iterable[int], executor: Executor | None,
                  window: int) -> None:
@@ -192,14 +193,18 @@ class Campaign:
         self._pending.append(self._executor.submit(run_one, self._task, seed))
 
     def salvage(self) -> list[Record]:
-        """Stop: cancel the runs not finished, and return those finished but not yet
-        yielded, in seed order."""
-        finished = []
+        """Stop: cancel the runs not yet made, and return the finished runs that follow
+        the last yielded in seed order without a gap (so that the records of a stopped
+        campaign are its first seeds, and the next campaign can start where it ended)."""
+        finished: list[Record] = []
+        gap = False
         for future in self._pending:
-            if future.done() and not future.cancelled() and future.exception() is None:
-                finished.append(future.result())
+            gap = gap or not future.done() or future.cancelled() \
+                or future.exception() is not None
+            if gap:
+                future.cancel()  # a run already started ends on its own, unread
             else:
-                future.cancel()
+                finished.append(future.result())
         self._pending.clear()
         return finished
 

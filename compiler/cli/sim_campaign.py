@@ -36,7 +36,6 @@ from rl1.compiler.campaign import (
 from rl1.compiler.reporting.render import ColorChoice
 from rl1.vm.defaults import DEFAULT_BUDGET, Engine
 
-from .command import EXIT_INTERRUPTED
 from .running import run_file
 from .streams import cannot_write, file_failure, read_ilc, same_file
 
@@ -58,26 +57,70 @@ class Setting:
     engine: Engine
     budget: int
 
-    def replay(self, seed: int) -> str:
-        """The `rl1c sim` command that makes the run of `seed` alone."""
-        words = ["rl1c", "sim", self.file, "--world", self.world, "--seed", str(seed)]
+    def rest(self, seed: int, runs: int) -> str:
+        """The `rl1c sim --runs` command of the campaign's last `runs` runs, from `seed`."""
+        words = ["rl1c", "sim", self.file, "--world", self.world, "--runs", str(runs),
+                 "--seed", str(seed), "--jobs", str(self.jobs)]
+        return shlex.join(words + self._engine_words())
+
+    def _engine_words(self) -> list[str]:
+        words = []
         if self.engine != "vm":
             words += ["--engine", self.engine]
         if self.budget != DEFAULT_BUDGET:
             words += ["--budget", str(self.budget)]
-        return shlex.join(words)
+        return words
+
+    def replay(self, seed: int) -> str:
+        """The `rl1c sim` command that makes the run of `seed` alone."""
+        words = ["rl1c", "sim", self.file, "--world", self.world, "--seed", str(seed)]
+        return shlex.join(words + self._engine_words())
 
 
 class Stopped(Exception):
-    """SIGTERM, handled as Ctrl-C is: the campaign stops and keeps what it ran."""
+    """Ctrl-C (SIGINT) or SIGTERM: the campaign stops and keeps what it ran; the exit
+    status is 128 + the signal's number, as shells report a program a signal stopped."""
 
     def __init__(self, status: int) -> None:
         super().__init__(status)
         self.status = status
 
 
-def _stop_on_sigterm(signum: int, frame: FrameType | None) -> None:
-    raise Stopped(128 + signum)
+class Stopping:
+    """While in effect, SIGINT and SIGTERM stop the campaign by raising Stopped, but
+    never while a run is being kept (`keeping`): then after it, so that the JSON lines
+    and the summary always count the same runs."""
+
+    SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+    def __init__(self) -> None:
+        self._keeping = False
+        self._pending: int | None = None
+
+    def _handle(self, signum: int, frame: FrameType | None) -> None:
+        if self._keeping:
+            self._pending = signum
+        else:
+            raise Stopped(128 + signum)
+
+    @contextmanager
+    def in_effect(self) -> Iterator[None]:
+        previous = {signum: signal.signal(signum, self._handle) for signum in self.SIGNALS}
+        try:
+            yield
+        finally:
+            for signum, handler in previous.items():
+                signal.signal(signum, handler)
+
+    @contextmanager
+    def keeping(self) -> Iterator[None]:
+        self._keeping = True
+        try:
+            yield
+        finally:
+            self._keeping = False
+        if self._pending is not None:
+            raise Stopped(128 + self._pending)
 
 
 def _worker_start() -> None:
@@ -214,28 +257,33 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     tally = Tally()
     progress = Progress(setting.runs, sys.stderr)
     status = 0
-    previous = signal.signal(signal.SIGTERM, _stop_on_sigterm)
+    stopping = Stopping()
     try:
-        with _executor(min(setting.jobs, setting.runs)) as executor:
+        with stopping.in_effect(), _executor(min(setting.jobs, setting.runs)) as executor:
             runs = Campaign(task, seeds, executor, WINDOW_PER_JOB * setting.jobs)
             try:
                 for record in runs:
-                    _keep(record, tally, lines)
+                    with stopping.keeping():
+                        _keep(record, tally, lines)
                     progress.update(tally)
-            except (KeyboardInterrupt, Stopped) as stop:
-                status = stop.status if isinstance(stop, Stopped) else EXIT_INTERRUPTED
-                for record in runs.salvage():
-                    _keep(record, tally, lines)
+            except Stopped as stop:
+                status = stop.status
+                with stopping.keeping():
+                    for record in runs.salvage():
+                        _keep(record, tally, lines)
+    except Stopped as stop:  # again, while the workers end their runs
+        status = stop.status
     finally:
-        signal.signal(signal.SIGTERM, previous)
         progress.finish()
         if lines is not None and lines is not sys.stdout:
             lines.close()
     report.write(summary(setting, tally, task, stopped=status != 0))
     report.flush()
     if status:
+        next_seed = setting.seed + tally.runs
         print("rl1c: interrupted: the runs finished are kept"
-              + ("" if out is None else f" in {out}"), file=sys.stderr)
+              + ("" if out is None else f" in {out}") + "; to go on, run the seeds left: "
+              + setting.rest(next_seed, setting.runs - tally.runs), file=sys.stderr)
     return status
 
 

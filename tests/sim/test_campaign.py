@@ -247,14 +247,16 @@ def test_a_campaign_holds_at_most_its_window_of_runs_in_flight() -> None:
         assert len(submitted) <= taken + 4
 
 
+@pytest.mark.parametrize("jobs", ["1", "2"])
 @pytest.mark.parametrize(("signum", "status"), [(signal.SIGTERM, 143),
                                                  (signal.SIGINT, 130)])
 def test_a_stopped_campaign_keeps_its_runs_and_prints_its_summary(
-        wall: tuple[Path, Path], tmp_path: Path, signum: int, status: int) -> None:
+        wall: tuple[Path, Path], tmp_path: Path, signum: int, status: int,
+        jobs: str) -> None:
     program, world = wall
     out = tmp_path / "runs.jsonl"
     with subprocess.Popen([RL1C, "sim", str(program), "--world", str(world), "--runs",
-                           "1000000", "--jobs", "2", "--out", str(out)],
+                           "1000000", "--jobs", jobs, "--out", str(out)],
                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
         deadline = time.monotonic() + 60
         while (not out.exists() or out.read_text().count("\n") < 20) \
@@ -266,8 +268,9 @@ def test_a_stopped_campaign_keeps_its_runs_and_prints_its_summary(
     assert "Traceback" not in stderr
     assert "interrupted: the runs finished are kept" in stderr
     kept = [json.loads(line) for line in out.read_text().splitlines()]  # every line whole
-    seeds = [line["seed"] for line in kept]
-    assert seeds == sorted(seeds) and len(kept) >= 20
+    assert [line["seed"] for line in kept] == list(range(len(kept)))  # the first seeds
+    assert len(kept) >= 20
+    assert f"--runs {1_000_000 - len(kept)} --seed {len(kept)} --jobs {jobs}" in stderr
     assert f"{len(kept)} runs of" in stdout and "(stopped after" in stdout
     assert f"success: {sum(line['success'] for line in kept)} of {len(kept)}" in stdout
 
