@@ -34,7 +34,7 @@ from . import EXAMPLES, ROOT, SAMPLE, SAMPLE_SENSORS
 from .cli import Result, rl1c
 from .ilc import with_crc
 
-# The exit statuses each command documents (README, the commands table).
+# The exit statuses each command documents (docs/commands.md).
 STATUSES = {
     "check": {0, 1, 2},
     "fmt": {0, 1, 2},
