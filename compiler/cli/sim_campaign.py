@@ -14,7 +14,7 @@ import signal
 import sys
 import time
 from collections.abc import Callable, Iterator
-from concurrent.futures import Executor, ProcessPoolExecutor
+from concurrent.futures import BrokenExecutor, Executor, ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
 from types import FrameType
@@ -36,6 +36,7 @@ from rl1.compiler.campaign import (
 from rl1.compiler.reporting.render import ColorChoice
 from rl1.vm.defaults import DEFAULT_BUDGET, Engine
 
+from .command import EXIT_INTERNAL
 from .running import run_file
 from .streams import cannot_write, file_failure, read_ilc, same_file
 
@@ -124,8 +125,11 @@ class Stopping:
 
 
 def _worker_start() -> None:
-    # Ctrl-C reaches the whole process group: the campaign stops its workers itself.
+    # Ctrl-C reaches the whole process group: the campaign stops its workers itself; and
+    # a worker forked while Stopping is in effect must not take its handler: the pool
+    # ends its workers with SIGTERM when one of them dies.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 @contextmanager
@@ -258,19 +262,24 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     progress = Progress(setting.runs, sys.stderr)
     status = 0
     stopping = Stopping()
+    broken_at = None  # the first seed left when the workers last broke
     try:
-        with stopping.in_effect(), _executor(min(setting.jobs, setting.runs)) as executor:
-            runs = Campaign(task, seeds, executor, WINDOW_PER_JOB * setting.jobs)
-            try:
-                for record in runs:
-                    with stopping.keeping():
-                        _keep(record, tally, lines)
-                    progress.update(tally)
-            except Stopped as stop:
-                status = stop.status
-                with stopping.keeping():
-                    for record in runs.salvage():
-                        _keep(record, tally, lines)
+        with stopping.in_effect():
+            while status == 0 and tally.runs < setting.runs:
+                left = range(setting.seed + tally.runs, seeds.stop)
+                try:
+                    status = _make_runs(task, left, setting.jobs, tally, lines, progress,
+                                        stopping)
+                except BrokenExecutor:
+                    first_left = setting.seed + tally.runs
+                    if first_left == broken_at:
+                        status = EXIT_INTERNAL  # the same run broke them twice
+                        break
+                    broken_at = first_left
+                    progress.finish()
+                    print(f"rl1c: warning: a worker process ended abruptly (killed, or out "
+                          f"of memory); the workers start again from seed {broken_at}",
+                          file=sys.stderr)
     except Stopped as stop:  # again, while the workers end their runs
         status = stop.status
     finally:
@@ -279,12 +288,41 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
             lines.close()
     report.write(summary(setting, tally, task, stopped=status != 0))
     report.flush()
-    if status:
-        next_seed = setting.seed + tally.runs
+    next_seed = setting.seed + tally.runs
+    rest = setting.rest(next_seed, setting.runs - tally.runs)
+    if status == EXIT_INTERNAL:
+        print(f"rl1c: error: the run of seed {next_seed} ended its worker process twice: "
+              f"replay it alone ({setting.replay(next_seed)}), and if rl1c crashed, report "
+              f"it; the runs before it are kept; to go on after it: "
+              f"{setting.rest(next_seed + 1, setting.runs - tally.runs - 1)}",
+              file=sys.stderr)
+    elif status:
         print("rl1c: interrupted: the runs finished are kept"
               + ("" if out is None else f" in {out}") + "; to go on, run the seeds left: "
-              + setting.rest(next_seed, setting.runs - tally.runs), file=sys.stderr)
+              + rest, file=sys.stderr)
     return status
+
+
+def _make_runs(task: Task, seeds: range, jobs: int, tally: Tally, lines: IO[str] | None,
+               progress: Progress, stopping: Stopping) -> int:
+    """Make the runs of `seeds` on `jobs` processes, keeping each; 0, or the status of a
+    signal that stopped them. BrokenExecutor when a worker process ended abruptly,
+    after keeping the runs finished before the first it lost."""
+    with _executor(min(jobs, len(seeds))) as executor:
+        runs = Campaign(task, seeds, executor, WINDOW_PER_JOB * jobs)
+        try:
+            for record in runs:
+                with stopping.keeping():
+                    _keep(record, tally, lines)
+                progress.update(tally)
+        except (Stopped, BrokenExecutor) as stop:
+            with stopping.keeping():
+                for record in runs.salvage():
+                    _keep(record, tally, lines)
+            if isinstance(stop, BrokenExecutor):
+                raise
+            return stop.status
+    return 0
 
 
 def _keep(record: Record, tally: Tally, lines: IO[str] | None) -> None:

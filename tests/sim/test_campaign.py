@@ -35,6 +35,7 @@ from rl1.compiler.campaign import (
     wilson,
 )
 from rl1.compiler.cli.sim_campaign import Progress
+from rl1.vm.defaults import DEFAULT_BUDGET
 
 RL1C = str(Path(sys.executable).with_name("rl1c"))
 DROPOUT = 0.3
@@ -75,6 +76,12 @@ def wall(tmp_path: Path) -> tuple[Path, Path]:
 
 def wall_task(world: str = WALL_WORLD) -> Task:
     return Task(WALL_PROGRAM, world.encode(), "wall.world.toml", budget=10_000)
+
+
+def compiled_wall_task() -> Task:
+    """The task `rl1c sim wall.rob --runs N` makes: the program compiled once."""
+    return task_for(WALL_PROGRAM, WALL_WORLD.encode(), "wall.world.toml", "vm",
+                    DEFAULT_BUDGET, "wall.rob")
 
 
 # The Wilson interval ----------------------------------------------------------------------
@@ -121,7 +128,7 @@ def test_the_seeds_follow_the_first_and_stay_in_sims_range() -> None:
 
 def test_a_rate_with_a_closed_form_lies_in_its_wilson_interval() -> None:
     tally = Tally()
-    for record in Campaign(wall_task(), campaign_seeds(0, 600), None, 1):
+    for record in Campaign(compiled_wall_task(), campaign_seeds(0, 2000), None, 1):
         tally.add(record)
     low, high = wilson(tally.successes, tally.runs)
     assert low <= 1 - DROPOUT <= high
@@ -300,6 +307,43 @@ def test_progress_is_a_line_every_few_seconds_when_standard_error_is_no_terminal
     assert stream.getvalue().splitlines() == [
         "2/100 runs, 0 succeeded (0.0%), 0.4 runs/s",  # at 5.5 s, then none at 7 s
         "4/100 runs, 0 succeeded (0.0%), 0.4 runs/s"]  # at 11 s
+
+
+def test_a_worker_killed_in_a_campaign_loses_no_run(wall: tuple[Path, Path],
+                                                    tmp_path: Path) -> None:
+    program, world = wall
+    out = tmp_path / "runs.jsonl"
+    runs = 1500
+    with subprocess.Popen([RL1C, "sim", str(program), "--world", str(world), "--runs",
+                           str(runs), "--jobs", "2", "--out", str(out)],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
+        workers: list[int] = []
+        deadline = time.monotonic() + 60
+        while not workers and time.monotonic() < deadline:
+            workers = _children(process.pid)
+            time.sleep(0.05)
+        os.kill(workers[0], signal.SIGKILL)
+        stdout, stderr = process.communicate(timeout=120)
+    assert process.returncode == 0, stderr
+    assert "a worker process ended abruptly" in stderr and "Traceback" not in stderr
+    kept = [json.loads(line) for line in out.read_text().splitlines()]
+    assert [line["seed"] for line in kept] == list(range(runs))
+    assert f"success: {sum(line['success'] for line in kept)} of {runs}" in stdout
+    for seed in range(0, runs, 37):  # and each the run of its seed
+        assert kept[seed] == run_one(compiled_wall_task(), seed).to_json()
+
+
+def _children(pid: int) -> list[int]:
+    """The processes whose parent is `pid`."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue  # ended meanwhile
+        if int(fields[1]) == pid:
+            found.append(int(stat.parent.name))
+    return found
 
 
 # Usage ------------------------------------------------------------------------------------
