@@ -128,7 +128,7 @@ def test_the_seeds_follow_the_first_and_stay_in_sims_range() -> None:
 
 def test_a_rate_with_a_closed_form_lies_in_its_wilson_interval() -> None:
     tally = Tally()
-    for record in Campaign(compiled_wall_task(), campaign_seeds(0, 2000), None, 1):
+    for record in Campaign(compiled_wall_task(), campaign_seeds(0, 1000), None, 1):
         tally.add(record)
     low, high = wilson(tally.successes, tally.runs)
     assert low <= 1 - DROPOUT <= high
