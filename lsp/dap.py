@@ -1,0 +1,425 @@
+"""`rl1-dap`: a Debug Adapter Protocol server over standard input and output, on the
+debugging core (compiler/debugger.py).
+
+A client launches a `.rob` file (compiled in memory at the level asked, the default
+`rl1c run`'s) or an `.ilc` file, on a sensor script (`sensors`) or in a world (`world`,
+the simulator, with `seed`); sets line breakpoints (with conditions written as the
+language writes a value: `A<0`), function breakpoints on calls (`IMG`, `CAM P`), and
+the exception breakpoints `lost-line`; and steps (`next` a line, `stepIn` a line or,
+with granularity `instruction`, an instruction), continues, pauses and restarts. A fault
+always stops the run as an exception on its line, and ends it. One thread, the program;
+one frame, its line; three scopes: the user variables (A-Z, a-r, @), the reserved
+variables (s-z) and the device. Each call the device receives is an `output` event.
+
+Messages are framed as LSP's are, read by lsp/framing.py's bounded reader. The program
+runs in a worker thread while the reader answers, so that `pause` reaches it.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import threading
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, BinaryIO
+
+from rl1.compiler.debugger import DebugError, Session, Stop, compile_program, parse_call
+from rl1.compiler.files import SourceError, read_bounded
+from rl1.compiler.frontend.source import read_source
+from rl1.compiler.runner import load_script
+from rl1.vm.defaults import DEFAULT_BUDGET
+from rl1.vm.device import Device
+from rl1.vm.language import VARIABLES
+from rl1.vm.scripted import ScriptedDevice, TraceEntry
+from rl1.vm.sensor_script import ScriptError
+from rl1.vm.sim.device import SimEntry
+from rl1.vm.verifier import VerifyError
+
+from .framing import CHUNK, Framer, frame
+
+THREAD = 1
+FRAME = 1
+USER, RESERVED, DEVICE = 1, 2, 3  # the scopes' variablesReference
+RESERVED_NAMES = "stuvwxyz"
+MAX_ILC_BYTES = 16 * 2**20
+MAX_WORLD_BYTES = 16 * 2**20
+
+CAPABILITIES: dict[str, Any] = {
+    "supportsConfigurationDoneRequest": True,
+    "supportsConditionalBreakpoints": True,
+    "supportsFunctionBreakpoints": True,
+    "supportsRestartRequest": True,
+    "supportsSteppingGranularity": True,
+    "supportsExceptionInfoRequest": True,
+    "exceptionBreakpointFilters": [
+        {"filter": "lost-line", "label": "Lost lines",
+         "description": "Stop where the program jumps to a lost-line handler (:96-:99)",
+         "default": False},
+    ],
+}
+
+_STOP_REASONS = {"entry": "entry", "step": "step", "breakpoint": "breakpoint",
+                 "call": "function breakpoint", "lost-line": "exception",
+                 "pause": "pause", "fault": "exception"}
+
+
+class Refused(Exception):
+    """A request the adapter cannot carry out; the message says why and what to do."""
+
+
+class Adapter:
+    """One client's debugging session: the requests, answered through `send`."""
+
+    def __init__(self, send: Callable[[dict[str, Any]], None]) -> None:
+        self._send = send
+        self._seq = 0
+        self._lock = threading.Lock()  # one message written at a time
+        self.session: Session | None = None
+        self.program_path = ""
+        self.stop_on_entry = False
+        self.done = False  # after disconnect
+        self._worker: threading.Thread | None = None
+        self._told = 0  # the trace entries already sent as output
+        self._last_stop: Stop | None = None
+
+    # Writing
+
+    def _write(self, message: dict[str, Any]) -> None:
+        with self._lock:
+            self._seq += 1
+            self._send({"seq": self._seq, **message})
+
+    def event(self, name: str, body: dict[str, Any] | None = None) -> None:
+        self._write({"type": "event", "event": name,
+                     **({} if body is None else {"body": body})})
+
+    def _respond(self, request: dict[str, Any], body: dict[str, Any] | None = None) -> None:
+        self._write({"type": "response", "request_seq": request["seq"], "success": True,
+                     "command": request["command"], **({} if body is None else {"body": body})})
+
+    def _refuse(self, request: dict[str, Any], message: str) -> None:
+        self._write({"type": "response", "request_seq": request.get("seq", 0),
+                     "success": False, "command": request.get("command", ""),
+                     "message": message,
+                     "body": {"error": {"id": 1, "format": message, "showUser": True}}})
+
+    # Reading
+
+    def receive(self, body: bytes) -> None:
+        """Handle one message's body."""
+        try:
+            message = json.loads(body)
+        except (ValueError, RecursionError) as error:
+            print(f"rl1-dap: a message that is no JSON was skipped: {error}", file=sys.stderr)
+            return
+        if not isinstance(message, dict) or message.get("type") != "request" or not (
+                isinstance(message.get("seq"), int) and isinstance(message.get("command"), str)):
+            print("rl1-dap: a message that is no DAP request (type, seq and command) was "
+                  "skipped", file=sys.stderr)
+            return
+        handler = getattr(self, "_on_" + message["command"], None)
+        if handler is None:
+            self._refuse(message, f"rl1-dap does not support the request "
+                                  f"'{message['command']}'")
+            return
+        arguments = message.get("arguments", {})
+        try:
+            if not isinstance(arguments, dict):
+                raise Refused("the request's arguments are not an object")
+            handler(message, arguments)
+        except Refused as refused:
+            self._refuse(message, str(refused))
+
+    # Requests
+
+    def _on_initialize(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        self._respond(request, CAPABILITIES)
+
+    def _on_launch(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        program = _text(arguments, "program")
+        if program is None:
+            raise Refused("launch needs `program`: the .rob or .ilc file to debug")
+        image = self._image(program, arguments)
+        make_device = _device_maker(arguments)
+        budget = arguments.get("budget", DEFAULT_BUDGET)
+        if not isinstance(budget, int) or budget < 1:
+            raise Refused(f"`budget` is {budget!r}: give a whole number of instructions, 1 "
+                          "or more")
+        try:
+            self.session = Session(image, make_device, budget)
+        except VerifyError as error:
+            raise Refused(f"{program}: byte {error.offset}: {error.message}; compile the "
+                          "program again") from None
+        self.program_path = str(Path(program).resolve())
+        self.stop_on_entry = arguments.get("stopOnEntry") is True
+        self._respond(request)
+        self.event("initialized")
+
+    def _image(self, program: str, arguments: dict[str, Any]) -> bytes:
+        level = arguments.get("level")
+        if level is not None and level not in (0, 1, 2):
+            raise Refused(f"`level` is {level!r}: give 0, 1 or 2, as rl1c -O0..-O2")
+        try:
+            if program.lower().endswith(".ilc"):
+                return read_bounded(program, MAX_ILC_BYTES, "an .ilc file")
+            text = read_source(program).text
+        except SourceError as error:
+            raise Refused(f"{error}" + (f"; {error.help}" if error.help else "")) from None
+        compiled = compile_program(text, os.path.basename(program), level)
+        if isinstance(compiled, list):
+            errors = [d for d in compiled if d.is_error]
+            shown = "; ".join(f"{program}:{d.span.line}: {d.message}" for d in errors[:3])
+            raise Refused(f"the program has errors, so it cannot run: {shown} (rl1c check "
+                          f"{program} shows them all)")
+        return compiled
+
+    def _session(self) -> Session:
+        if self.session is None:
+            raise Refused("no program is launched: send launch first")
+        return self.session
+
+    def _on_setBreakpoints(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        session = self._session()
+        wanted = arguments.get("breakpoints", [])
+        if not isinstance(wanted, list) or not all(
+                isinstance(b, dict) and isinstance(b.get("line"), int) for b in wanted):
+            raise Refused("`breakpoints` is a list of objects, each with a `line`")
+        bindings = session.set_line_breakpoints(
+            (b["line"], b.get("condition") if isinstance(b.get("condition"), str) else None)
+            for b in wanted)
+        self._respond(request, {"breakpoints": [
+            {"verified": True, "line": binding.line} if binding.verified else
+            {"verified": False, "line": binding.requested, "message": binding.message}
+            for binding in bindings]})
+
+    def _on_setFunctionBreakpoints(self, request: dict[str, Any], arguments: dict[str, Any]
+                                   ) -> None:
+        session = self._session()
+        answers, names = [], []
+        for wanted in arguments.get("breakpoints", []):
+            name = wanted.get("name") if isinstance(wanted, dict) else None
+            try:
+                parse_call(str(name))
+            except DebugError as error:
+                answers.append({"verified": False, "message": str(error)})
+                continue
+            names.append(str(name))
+            answers.append({"verified": True})
+        session.set_call_breakpoints(names)
+        self._respond(request, {"breakpoints": answers})
+
+    def _on_setExceptionBreakpoints(self, request: dict[str, Any], arguments: dict[str, Any]
+                                    ) -> None:
+        filters = arguments.get("filters", [])
+        self._session().stop_on_lost_line = isinstance(filters, list) and "lost-line" in filters
+        self._respond(request)
+
+    def _on_configurationDone(self, request: dict[str, Any], arguments: dict[str, Any]
+                              ) -> None:
+        self._respond(request)
+        self._start(self._session())
+
+    def _start(self, session: Session) -> None:
+        """The run from its start: stopped on entry, or continued to its first stop."""
+        if self.stop_on_entry:
+            self._stopped(Stop("entry", session.line))
+        else:
+            self._go(session.continue_)
+
+    def _on_continue(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        session = self._idle()
+        self._respond(request, {"allThreadsContinued": True})
+        self._go(session.continue_)
+
+    def _on_next(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        session = self._idle()
+        self._respond(request)
+        self._go(session.step_instruction if arguments.get("granularity") == "instruction"
+                 else session.step_line)
+
+    _on_stepIn = _on_next  # no subroutines: stepping in is stepping on
+
+    def _on_pause(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        self._session().pause()
+        self._respond(request)
+
+    def _on_restart(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        session = self._idle()
+        session.restart()
+        self._told = 0
+        self._last_stop = None
+        self._respond(request)
+        self._start(session)
+
+    def _on_threads(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        self._respond(request, {"threads": [{"id": THREAD, "name": "program"}]})
+
+    def _on_stackTrace(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        session = self._session()
+        stop = self._last_stop
+        line = stop.line if stop is not None and stop.reason == "fault" else session.line
+        frame_: dict[str, Any] = {"id": FRAME, "name": "program", "line": line or 0,
+                                  "column": 1 if line else 0}
+        if line:
+            frame_["source"] = {"name": os.path.basename(self.program_path),
+                                "path": self.program_path}
+        self._respond(request, {"stackFrames": [frame_], "totalFrames": 1})
+
+    def _on_scopes(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        self._respond(request, {"scopes": [
+            {"name": "Variables", "variablesReference": USER, "expensive": False},
+            {"name": "Reserved variables", "variablesReference": RESERVED, "expensive": False},
+            {"name": "Device", "variablesReference": DEVICE, "expensive": False},
+        ]})
+
+    def _on_variables(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        session = self._session()
+        reference = arguments.get("variablesReference")
+        variables = session.variables
+        if reference in (USER, RESERVED):
+            names = [name for name in VARIABLES
+                     if (name in RESERVED_NAMES) == (reference == RESERVED)]
+            shown = [{"name": name, "value": str(variables[name]), "variablesReference": 0}
+                     for name in names]
+        elif reference == DEVICE:
+            shown = [{"name": name, "value": _shown(value), "variablesReference": 0}
+                     for name, value in session.device_state().items()]
+        else:
+            raise Refused(f"no variables have the reference {reference!r}")
+        self._respond(request, {"variables": shown})
+
+    def _on_exceptionInfo(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        stop = self._last_stop
+        if stop is None or stop.reason not in ("fault", "lost-line"):
+            raise Refused("the program did not stop on an exception")
+        code, _, text = stop.text.partition(": ") if stop.reason == "fault" else (
+            "lost-line", "", stop.text)
+        self._respond(request, {"exceptionId": code, "description": text or stop.text,
+                                "breakMode": "always"})
+
+    def _on_disconnect(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        if self.session is not None:
+            self.session.pause()
+        self._respond(request)
+        self.done = True
+
+    _on_terminate = _on_disconnect
+
+    # Running
+
+    def _idle(self) -> Session:
+        session = self._session()
+        if self._worker is not None and self._worker.is_alive():
+            raise Refused("the program is running: pause it first")
+        return session
+
+    def _go(self, command: Callable[[], Stop]) -> None:
+        self.event("continued", {"threadId": THREAD, "allThreadsContinued": True})
+        self._worker = threading.Thread(target=lambda: self._stopped(command()), daemon=True)
+        self._worker.start()
+
+    def _stopped(self, stop: Stop) -> None:
+        session = self._session()
+        previous, self._last_stop = self._last_stop, stop
+        self._tell_trace(session)
+        # A fault is shown as an exception where it happened; the command after it ends.
+        if stop.reason == "end" or (stop.reason == "fault" and previous == stop):
+            self.event("exited", {"exitCode": 0 if stop.reason == "end" else
+                                  _exit_status(session)})
+            self.event("terminated")
+            return
+        self.event("stopped", {"reason": _STOP_REASONS[stop.reason], "threadId": THREAD,
+                               "allThreadsStopped": True,
+                               **({"description": stop.text, "text": stop.text}
+                                  if stop.text else {})})
+
+    def _tell_trace(self, session: Session) -> None:
+        trace = session.trace
+        for entry in trace[self._told:]:
+            self.event("output", {"category": "console", "output": _described(entry) + "\n"})
+        self._told = len(trace)
+
+
+def _exit_status(session: Session) -> int:
+    result = session.result
+    return 0 if result is None or result.fault is None else result.fault.kind.exit_status
+
+
+def _text(arguments: dict[str, Any], key: str) -> str | None:
+    value = arguments.get(key)
+    if value is not None and not isinstance(value, str):
+        raise Refused(f"`{key}` is {value!r}: give a file's path as a string")
+    return value
+
+
+def _device_maker(arguments: dict[str, Any]) -> Callable[[], Device]:
+    sensors, world = _text(arguments, "sensors"), _text(arguments, "world")
+    if sensors is not None and world is not None:
+        raise Refused("give `sensors` (a sensor script) or `world` (the simulator's world), "
+                      "not both")
+    if world is not None:
+        from rl1.vm.sim.device import SimDevice
+        from rl1.vm.sim.world import WorldError, decode_world
+
+        seed = arguments.get("seed", 0)
+        if not isinstance(seed, int):
+            raise Refused(f"`seed` is {seed!r}: give a whole number")
+        try:
+            the_world = decode_world(read_bounded(world, MAX_WORLD_BYTES, "a world file"),
+                                     world)
+        except (SourceError, WorldError) as error:
+            raise Refused(str(error)) from None
+        return lambda: SimDevice(the_world, seed=seed)
+    try:
+        script = load_script(sensors) if sensors is not None else None
+    except (SourceError, ScriptError) as error:
+        raise Refused(str(error)) from None
+    return lambda: ScriptedDevice(script)
+
+
+def _shown(value: object) -> str:
+    return value if isinstance(value, str) else json.dumps(value)
+
+
+def _described(entry: TraceEntry | SimEntry) -> str:
+    match entry:
+        case TraceEntry():
+            return f"{entry.time} ms, line {entry.line}: {entry.describe()}"
+        case SimEntry():
+            args = ",".join(map(str, entry.args))
+            result = "" if entry.result is None else " -> " + " ".join(map(str, entry.result))
+            return f"{entry.time:.3f} s, line {entry.line}: {entry.call} {args}{result}"
+
+
+def serve(input_: BinaryIO, output: BinaryIO) -> None:
+    """Answer the requests read from `input_` on `output` until disconnect or the input's
+    end."""
+    def send(message: dict[str, Any]) -> None:
+        output.write(frame(json.dumps(message, separators=(",", ":")).encode("utf-8")))
+        output.flush()
+
+    adapter = Adapter(send)
+    framer = Framer()
+    while not adapter.done:
+        chunk = os.read(input_.fileno(), CHUNK)
+        if not chunk:
+            break
+        for body in framer.feed(chunk):
+            adapter.receive(body)
+            if adapter.done:
+                break
+        for problem in framer.problems:
+            print(f"rl1-dap: skipped {problem}; reading on from the next Content-Length "
+                  "header", file=sys.stderr)
+        framer.problems.clear()
+
+
+def main() -> None:
+    """The `rl1-dap` command: DAP on standard input and output."""
+    serve(sys.stdin.buffer, sys.stdout.buffer)
+
+
+if __name__ == "__main__":
+    main()

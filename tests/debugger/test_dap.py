@@ -1,0 +1,273 @@
+"""`rl1-dap` driven by a DAP client over its real protocol: the server in a subprocess,
+each message framed with Content-Length on its standard input and output, the answers
+compared as exact JSON where the protocol fixes them."""
+
+from __future__ import annotations
+
+import json
+import queue
+import subprocess
+import sys
+import threading
+from pathlib import Path
+from typing import IO, Any
+
+import pytest
+from support import SAMPLE, SAMPLE_SENSORS
+
+from rl1.lsp.dap import CAPABILITIES
+
+WORLD = SAMPLE.parent / "sample.world.toml"
+TIMEOUT = 60
+
+
+def _read_messages(stream: IO[bytes], into: queue.Queue[dict[str, Any] | None]) -> None:
+    while True:
+        length = None
+        while (line := stream.readline()) not in (b"\r\n", b""):
+            name, _, value = line.decode("ascii").partition(":")
+            if name.lower() == "content-length":
+                length = int(value)
+        if not line or length is None:
+            into.put(None)
+            return
+        into.put(json.loads(stream.read(length)))
+
+
+class Client:
+    """A DAP client: requests numbered from 1, every message the server sends kept."""
+
+    def __init__(self) -> None:
+        self.server = subprocess.Popen([sys.executable, "-m", "rl1.lsp.dap"],
+                                       stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                       stderr=subprocess.PIPE)
+        assert self.server.stdin is not None and self.server.stdout is not None
+        self.messages: queue.Queue[dict[str, Any] | None] = queue.Queue()
+        self.events: list[dict[str, Any]] = []
+        threading.Thread(target=_read_messages, args=(self.server.stdout, self.messages),
+                         daemon=True).start()
+        self.seq = 0
+
+    def send_raw(self, data: bytes) -> None:
+        assert self.server.stdin is not None
+        self.server.stdin.write(data)
+        self.server.stdin.flush()
+
+    def send(self, command: str, arguments: dict[str, Any] | None = None) -> int:
+        self.seq += 1
+        message: dict[str, Any] = {"seq": self.seq, "type": "request", "command": command}
+        if arguments is not None:
+            message["arguments"] = arguments
+        body = json.dumps(message).encode()
+        self.send_raw(b"Content-Length: %d\r\n\r\n%s" % (len(body), body))
+        return self.seq
+
+    def _next(self) -> dict[str, Any]:
+        message = self.messages.get(timeout=TIMEOUT)
+        assert message is not None, "the server closed its output"
+        return message
+
+    def request(self, command: str, arguments: dict[str, Any] | None = None
+                ) -> dict[str, Any]:
+        """The response to the request, keeping the events sent before it."""
+        seq = self.send(command, arguments)
+        while (message := self._next())["type"] != "response":
+            self.events.append(message)
+        assert message["request_seq"] == seq and message["command"] == command
+        return message
+
+    def event(self, name: str) -> dict[str, Any]:
+        """The first event called `name` (of those kept, else of those to come), taken
+        from those kept."""
+        while True:
+            for index, message in enumerate(self.events):
+                if message["event"] == name:
+                    return self.events.pop(index)
+            message = self._next()
+            assert message["type"] == "event", message
+            self.events.append(message)
+
+    def variables(self, reference: int) -> dict[str, str]:
+        response = self.request("variables", {"variablesReference": reference})
+        return {v["name"]: v["value"] for v in response["body"]["variables"]}
+
+    def line(self) -> int:
+        response = self.request("stackTrace", {"threadId": 1})
+        (frame,) = response["body"]["stackFrames"]
+        return int(frame["line"])
+
+    def close(self) -> tuple[int, str]:
+        self.request("disconnect", {})
+        status = self.server.wait(timeout=TIMEOUT)
+        assert self.server.stderr is not None
+        return status, self.server.stderr.read().decode()
+
+
+@pytest.fixture
+def client() -> Any:
+    started = Client()
+    yield started
+    if started.server.poll() is None:
+        started.server.kill()
+        started.server.wait()
+
+
+def _launched(client: Client, **arguments: Any) -> None:
+    client.request("initialize", {"adapterID": "rl1", "linesStartAt1": True})
+    response = client.request("launch", arguments)
+    assert response["success"], response
+    client.event("initialized")
+
+
+def test_initialize_answers_the_capabilities_as_exact_json(client: Client) -> None:
+    response = client.request("initialize", {"adapterID": "rl1"})
+    assert response == {"seq": 1, "type": "response", "request_seq": 1, "success": True,
+                        "command": "initialize", "body": CAPABILITIES}
+    assert json.loads(json.dumps(CAPABILITIES)) == {
+        "supportsConfigurationDoneRequest": True, "supportsConditionalBreakpoints": True,
+        "supportsFunctionBreakpoints": True, "supportsRestartRequest": True,
+        "supportsSteppingGranularity": True, "supportsExceptionInfoRequest": True,
+        "exceptionBreakpointFilters": [{
+            "filter": "lost-line", "label": "Lost lines",
+            "description": "Stop where the program jumps to a lost-line handler (:96-:99)",
+            "default": False}]}
+    assert client.close() == (0, "")
+
+
+def test_listing_1_stops_at_line_20_steps_and_runs_to_its_end(client: Client) -> None:
+    _launched(client, program=str(SAMPLE), sensors=str(SAMPLE_SENSORS))
+    response = client.request("setBreakpoints", {
+        "source": {"path": str(SAMPLE)},
+        "breakpoints": [{"line": 20}, {"line": 22, "condition": "A<5"}]})
+    assert response["body"] == {"breakpoints": [
+        {"verified": True, "line": 20},
+        {"verified": False, "line": 22, "message": (
+            "the condition `A<5` compares with 5, and a condition compares with 0 (`<` "
+            "after a value is a shift): write `A-5<0`")}]}
+    assert client.request("configurationDone")["success"]
+    stopped = client.event("stopped")
+    assert {k: v for k, v in stopped.items() if k != "seq"} == {
+        "type": "event", "event": "stopped",
+        "body": {"reason": "breakpoint", "threadId": 1, "allThreadsStopped": True}}
+    assert client.request("threads")["body"] == {"threads": [{"id": 1, "name": "program"}]}
+    frames = client.request("stackTrace", {"threadId": 1})["body"]
+    assert frames == {"totalFrames": 1, "stackFrames": [{
+        "id": 1, "name": "program", "line": 20, "column": 1,
+        "source": {"name": "sample.rob", "path": str(SAMPLE.resolve())}}]}
+    scopes = client.request("scopes", {"frameId": 1})["body"]["scopes"]
+    assert [(s["name"], s["variablesReference"]) for s in scopes] == [
+        ("Variables", 1), ("Reserved variables", 2), ("Device", 3)]
+    user = client.variables(1)
+    assert list(user) == list("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqr@")
+    assert {name: value for name, value in user.items() if value != "0"} == {
+        "A": "60", "C": "589", "D": "450", "L": "100", "U": "160"}
+    assert client.variables(2) == {"s": "0", "t": "0", "u": "0", "v": "0", "w": "40",
+                                   "x": "128", "y": "100", "z": "0"}
+    assert client.variables(3) == {"time (ms)": "2000", "tracing mode": "0",
+                                   "motion": "null",
+                                   "last readings": '{"IMG": [40, 128, 100, 0]}'}
+    calls = [e["body"]["output"] for e in client.events if e["event"] == "output"]
+    assert calls[0] == "0 ms, line 2: CAM Z\n" and calls[-1].endswith(
+        "line 18: CAM P 589\n")
+
+    client.request("next", {"threadId": 1})
+    assert client.event("stopped")["body"]["reason"] == "step"
+    assert client.line() == 21
+    client.request("stepIn", {"threadId": 1, "granularity": "instruction"})
+    assert client.event("stopped")["body"]["reason"] == "step"
+    assert client.line() == 22
+    assert client.request("continue", {"threadId": 1})["body"] == {"allThreadsContinued": True}
+    assert client.event("exited")["body"] == {"exitCode": 0}
+    client.event("terminated")
+    assert client.close() == (0, "")
+
+
+def test_a_fault_is_an_exception_on_its_line_then_the_end(client: Client,
+                                                         tmp_path: Path) -> None:
+    program = tmp_path / "fault.rob"
+    program.write_text("A=5\nA=A-10\n(TIM A)\n(END)\n")
+    _launched(client, program=str(program))
+    client.request("configurationDone")
+    message = "argument tenths of (TIM) is -5 (the value of A), outside 1..100"
+    assert client.event("stopped")["body"] == {
+        "reason": "exception", "threadId": 1, "allThreadsStopped": True,
+        "description": f"E1010: {message}", "text": f"E1010: {message}"}
+    assert client.request("exceptionInfo", {"threadId": 1})["body"] == {
+        "exceptionId": "E1010", "description": message, "breakMode": "always"}
+    assert client.line() == 3
+    client.request("continue", {"threadId": 1})
+    assert client.event("exited")["body"] == {"exitCode": 10}
+    client.event("terminated")
+    assert client.close() == (0, "")
+
+
+def test_a_call_breakpoint_on_the_simulator_shows_the_vehicle(client: Client) -> None:
+    _launched(client, program=str(SAMPLE), world=str(WORLD))
+    response = client.request("setFunctionBreakpoints", {
+        "breakpoints": [{"name": "IMG"}, {"name": "IMAGE"}]})
+    assert response["body"]["breakpoints"][0] == {"verified": True}
+    assert response["body"]["breakpoints"][1]["verified"] is False
+    assert "`IMAGE` is no built-in to stop at" in response["body"]["breakpoints"][1]["message"]
+    client.request("configurationDone")
+    assert client.event("stopped")["body"] == {
+        "reason": "function breakpoint", "threadId": 1, "allThreadsStopped": True,
+        "description": "(IMG)", "text": "(IMG)"}
+    assert client.line() == 4
+    device = client.variables(3)
+    assert device["tracing mode"] == "3" and device["motion"] == "MOV"
+    assert device["camera pan (pulses)"] == "392" and device["camera tilt"] == "down"
+    assert {"x (cm)", "y (cm)", "heading (degrees)", "wheel speeds (units)",
+            "steering (degrees)"} <= set(device)
+    client.close()
+
+
+def test_pause_stops_a_running_program_and_restart_begins_again(client: Client,
+                                                               tmp_path: Path) -> None:
+    program = tmp_path / "loop.rob"
+    program.write_text(":10 A++\n#10\n")
+    # At -O0: -O1 drops the A++ that no one sees in a loop that never ends.
+    _launched(client, program=str(program), budget=10**9, stopOnEntry=True, level=0)
+    client.request("configurationDone")
+    assert client.event("stopped")["body"]["reason"] == "entry"
+    client.request("continue", {"threadId": 1})
+    refused = client.request("next", {"threadId": 1})
+    assert (refused["success"], refused["message"]) == (
+        False, "the program is running: pause it first")
+    client.request("pause", {"threadId": 1})
+    assert client.event("stopped")["body"]["reason"] == "pause"
+    assert int(client.variables(1)["A"]) != 0
+    client.request("restart", {})
+    assert client.event("stopped")["body"]["reason"] == "entry"
+    assert client.variables(1)["A"] == "0"
+    client.close()
+
+
+def test_what_cannot_be_launched_is_refused_with_why(client: Client, tmp_path: Path) -> None:
+    client.request("initialize", {})
+    missing = client.request("launch", {"program": str(tmp_path / "none.rob")})
+    assert missing["success"] is False and "none.rob" in missing["message"]
+    broken = tmp_path / "broken.rob"
+    broken.write_text("A=(MOV 1,1)\n")
+    refused = client.request("launch", {"program": str(broken)})
+    assert refused["success"] is False
+    assert refused["message"].startswith(f"the program has errors, so it cannot run: {broken}:1:")
+    both = client.request("launch", {"program": str(SAMPLE), "sensors": "a", "world": "b"})
+    assert both["message"] == ("give `sensors` (a sensor script) or `world` (the simulator's "
+                               "world), not both")
+    assert client.request("scopes", {"frameId": 1})["success"] is True
+    unknown = client.request("readMemory", {})
+    assert unknown["message"] == "rl1-dap does not support the request 'readMemory'"
+    early = client.request("setBreakpoints", {"breakpoints": []})
+    assert early["message"] == "no program is launched: send launch first"
+
+
+def test_broken_input_is_skipped_and_said_on_standard_error(client: Client) -> None:
+    client.send_raw(b"Content-Length: 5\r\n\r\nnot j")
+    client.send_raw(b"Content-Length: 2\r\n\r\n[]")
+    client.send_raw(b"garbage\r\n\r\n")
+    assert client.request("threads")["success"] is True
+    status, errors = client.close()
+    assert status == 0
+    assert "a message that is no JSON was skipped" in errors
+    assert "a message that is no DAP request (type, seq and command) was skipped" in errors
+    assert "skipped a line that is no header" in errors
