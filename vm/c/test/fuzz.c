@@ -48,12 +48,15 @@ static uint32_t next(device *d)
     return d->state;
 }
 
-/* Now and then a lost line, in any mode (modes 0 and 1 must not jump). */
+/* Now and then a lost line, in any mode (modes 0 and 1 must not jump); more rarely an
+ * emergency stop, from inside a callback as an interrupt handler would. */
 static void maybe_lose(device *d)
 {
     uint32_t r = next(d);
     if ((r & 7u) == 0u) {
         (void)rl1_post_line_lost(d->mailbox, (uint8_t)((r >> 3) & 3u), (uint8_t)((r >> 5) & 1u));
+    } else if ((r & 511u) == 1u) {
+        rl1_abort(d->mailbox);
     }
 }
 
