@@ -34,7 +34,10 @@ MARKS: dict[str, tuple[str, ...]] = {
     "tests/lsp/test_command.py": ("slow",),
     "tests/lsp/test_protocol.py": ("slow",),
     "tests/cli/test_hostile_inputs.py": ("slow",),
+    "tests/lsp/test_hostile_transports.py": ("slow",),
     "tests/backend/test_reproducible.py": ("slow",),
+    # Campaigns of simulated runs on pools of processes.
+    "tests/sim/test_campaign.py": ("slow",),
     # Forty seeded simulations of the robust Fig. 4 example.
     "tests/sim/test_sim_fig4.py::test_with_noise_it_succeeds_in_at_least_nine_runs_of_ten":
         ("slow",),
