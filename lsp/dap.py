@@ -131,6 +131,11 @@ class Adapter:
             handler(message, arguments)
         except Refused as refused:
             self._refuse(message, str(refused))
+        except Exception as error:  # a bug of ours: the session goes on, and says so
+            print(f"rl1-dap: internal error in '{message['command']}': {error!r}; please "
+                  "report it", file=sys.stderr)
+            self._refuse(message, f"rl1-dap failed on this request ({error!r}): please "
+                                  "report it")
 
     # Requests
 
@@ -144,7 +149,7 @@ class Adapter:
         image = self._image(program, arguments)
         make_device = _device_maker(arguments)
         budget = arguments.get("budget", DEFAULT_BUDGET)
-        if not isinstance(budget, int) or budget < 1:
+        if not _whole(budget) or budget < 1:
             raise Refused(f"`budget` is {budget!r}: give a whole number of instructions, 1 "
                           "or more")
         try:
@@ -159,7 +164,7 @@ class Adapter:
 
     def _image(self, program: str, arguments: dict[str, Any]) -> bytes:
         level = arguments.get("level")
-        if level is not None and level not in (0, 1, 2):
+        if level is not None and not (_whole(level) and level in (0, 1, 2)):
             raise Refused(f"`level` is {level!r}: give 0, 1 or 2, as rl1c -O0..-O2")
         try:
             if program.lower().endswith(".ilc"):
@@ -182,9 +187,8 @@ class Adapter:
 
     def _on_setBreakpoints(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
         session = self._session()
-        wanted = arguments.get("breakpoints", [])
-        if not isinstance(wanted, list) or not all(
-                isinstance(b, dict) and isinstance(b.get("line"), int) for b in wanted):
+        wanted = _listed(arguments, "breakpoints")
+        if not all(isinstance(b, dict) and _whole(b.get("line")) for b in wanted):
             raise Refused("`breakpoints` is a list of objects, each with a `line`")
         bindings = session.set_line_breakpoints(
             (b["line"], b.get("condition") if isinstance(b.get("condition"), str) else None)
@@ -198,7 +202,7 @@ class Adapter:
                                    ) -> None:
         session = self._session()
         answers, names = [], []
-        for wanted in arguments.get("breakpoints", []):
+        for wanted in _listed(arguments, "breakpoints"):
             name = wanted.get("name") if isinstance(wanted, dict) else None
             try:
                 parse_call(str(name))
@@ -212,8 +216,7 @@ class Adapter:
 
     def _on_setExceptionBreakpoints(self, request: dict[str, Any], arguments: dict[str, Any]
                                     ) -> None:
-        filters = arguments.get("filters", [])
-        self._session().stop_on_lost_line = isinstance(filters, list) and "lost-line" in filters
+        self._session().stop_on_lost_line = "lost-line" in _listed(arguments, "filters")
         self._respond(request)
 
     def _on_configurationDone(self, request: dict[str, Any], arguments: dict[str, Any]
@@ -347,6 +350,18 @@ def _exit_status(session: Session) -> int:
     return 0 if result is None or result.fault is None else result.fault.kind.exit_status
 
 
+def _whole(value: object) -> bool:
+    """Whether `value` is a JSON integer (true and false are no numbers here)."""
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _listed(arguments: dict[str, Any], key: str) -> list[Any]:
+    value = arguments.get(key, [])
+    if not isinstance(value, list):
+        raise Refused(f"`{key}` is {value!r}: give a list")
+    return value
+
+
 def _text(arguments: dict[str, Any], key: str) -> str | None:
     value = arguments.get(key)
     if value is not None and not isinstance(value, str):
@@ -364,7 +379,7 @@ def _device_maker(arguments: dict[str, Any]) -> Callable[[], Device]:
         from rl1.vm.sim.world import WorldError, decode_world
 
         seed = arguments.get("seed", 0)
-        if not isinstance(seed, int):
+        if not _whole(seed):
             raise Refused(f"`seed` is {seed!r}: give a whole number")
         try:
             the_world = decode_world(read_bounded(world, MAX_WORLD_BYTES, "a world file"),
@@ -397,8 +412,11 @@ def serve(input_: BinaryIO, output: BinaryIO) -> None:
     """Answer the requests read from `input_` on `output` until disconnect or the input's
     end."""
     def send(message: dict[str, Any]) -> None:
-        output.write(frame(json.dumps(message, separators=(",", ":")).encode("utf-8")))
-        output.flush()
+        try:
+            output.write(frame(json.dumps(message, separators=(",", ":")).encode("utf-8")))
+            output.flush()
+        except OSError:  # the client has gone: its input ends too
+            adapter.done = True
 
     adapter = Adapter(send)
     framer = Framer()

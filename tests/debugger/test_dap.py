@@ -13,9 +13,11 @@ from pathlib import Path
 from typing import IO, Any
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from support import SAMPLE, SAMPLE_SENSORS
 
-from rl1.lsp.dap import CAPABILITIES
+from rl1.lsp.dap import CAPABILITIES, Adapter
 
 WORLD = SAMPLE.parent / "sample.world.toml"
 TIMEOUT = 60
@@ -271,3 +273,39 @@ def test_broken_input_is_skipped_and_said_on_standard_error(client: Client) -> N
     assert "a message that is no JSON was skipped" in errors
     assert "a message that is no DAP request (type, seq and command) was skipped" in errors
     assert "skipped a line that is no header" in errors
+
+
+json_values = st.recursive(
+    st.none() | st.booleans() | st.integers(-2**40, 2**40) | st.text(max_size=8),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=8), inner,
+                                                                max_size=3),
+    max_leaves=8)
+KEYS = ("program", "sensors", "world", "level", "budget", "seed", "stopOnEntry",
+        "breakpoints", "filters", "line", "condition", "name", "variablesReference",
+        "granularity", "threadId", "frameId")
+COMMANDS = ("initialize", "launch", "setBreakpoints", "setFunctionBreakpoints",
+            "setExceptionBreakpoints", "configurationDone", "continue", "next", "stepIn",
+            "pause", "restart", "threads", "stackTrace", "scopes", "variables",
+            "exceptionInfo", "evaluate")
+
+
+@settings(max_examples=300)
+@given(st.lists(st.tuples(st.sampled_from(COMMANDS),
+                          json_values | st.dictionaries(st.sampled_from(KEYS), json_values)),
+                max_size=12))
+def test_any_arguments_get_one_answer_and_never_break_the_adapter(
+        requests: list[tuple[str, Any]]) -> None:
+    sent: list[dict[str, Any]] = []
+    adapter = Adapter(sent.append)
+    launch = {"seq": 1, "type": "request", "command": "launch",
+              "arguments": {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS),
+                            "stopOnEntry": True}}
+    adapter.receive(json.dumps(launch).encode())
+    for seq, (command, arguments) in enumerate(requests, start=2):
+        if adapter._worker is not None:
+            adapter._worker.join(TIMEOUT)  # a run started by the request before
+        adapter.receive(json.dumps({"seq": seq, "type": "request", "command": command,
+                                    "arguments": arguments}).encode())
+    responses = [m for m in sent if m["type"] == "response"]
+    assert [m["request_seq"] for m in responses] == list(range(1, len(requests) + 2))
+    assert not [m for m in responses if "please report it" in m.get("message", "")]
