@@ -354,6 +354,7 @@ class NativeMachine:
         self._message = ""  # why the device failed, for the fault's message
         self._stop_message: str | None = None
         self._form: FormKey | None = None  # the started built-in
+        self._stepping = False  # inside rl1_step: a step now comes from a callback
         self._callbacks = _Hardware(None, _BEGIN(self._guard(self._begin)),
                                     _CALL(self._guard(self._call)),
                                     _START(self._guard(self._start)),
@@ -394,10 +395,22 @@ class NativeMachine:
         return line or None
 
     def step(self, limit: int) -> State:
-        """Run at most `limit` instructions and say where the run stands."""
+        """Run at most `limit` instructions and say where the run stands. From one of
+        its own callbacks, the C VM refuses the step, and the step under way faults."""
+        if self._stepping:
+            self._message = ("a callback stepped the VM that called it, which the C VM "
+                             "refuses (spec/rl1_hardware.h, rl1_step)")
+            return State(self.lib.rl1_step(ctypes.byref(self._vm),
+                                           ctypes.byref(self._program),
+                                           ctypes.byref(self._callbacks), limit))
         self._sync()
-        state = State(self.lib.rl1_step(ctypes.byref(self._vm), ctypes.byref(self._program),
-                                        ctypes.byref(self._callbacks), limit))
+        self._stepping = True
+        try:
+            state = State(self.lib.rl1_step(ctypes.byref(self._vm),
+                                            ctypes.byref(self._program),
+                                            ctypes.byref(self._callbacks), limit))
+        finally:
+            self._stepping = False
         if self._error is not None:
             error, self._error = self._error, None
             raise error

@@ -142,3 +142,55 @@ def test_an_abort_between_steps_stops_the_vehicle_at_the_next_step(c_vm: ctypes.
         assert machine.step(7) is State.FAULTED
         results.append((machine.result, device.trace))
     assert results[0] == results[1]
+
+
+@dataclass
+class SteppingAgain:
+    """Blocking hardware whose first call steps the machine that called it."""
+
+    inner: Blocking
+    machine: list[native.NativeMachine] = field(default_factory=list)
+    nested: list[State] = field(default_factory=list)
+
+    def begin(self) -> Answer:
+        return self.inner.begin()
+
+    def call(self, form: FormKey, args: tuple[int, ...]) -> Answer:
+        if not self.nested:
+            self.nested.append(self.machine[0].step(100))
+        return self.inner.call(form, args)
+
+    def start(self, form: FormKey, args: tuple[int, ...]) -> Answer:
+        return self.inner.start(form, args)
+
+    def poll(self) -> Answer:
+        return self.inner.poll()
+
+    def stop(self) -> Answer:
+        return self.inner.stop()
+
+    def end(self) -> Answer:
+        return self.inner.end()
+
+    @property
+    def pending(self) -> LineLost | None:
+        return self.inner.pending
+
+    def take_event(self) -> LineLost | None:
+        return self.inner.take_event()
+
+
+def test_a_callback_that_steps_the_c_vm_again_faults_the_step(c_vm: ctypes.CDLL) -> None:
+    """It counted to 1 instead of 14 and ended; now the call faults, the count untouched."""
+    data = _compiled("C=0\n:10 (KYC); C=C+1; D=C-14; ?D<#10\n(END)\n")
+    device = ScriptedDevice(Script())
+    hardware = SteppingAgain(Blocking(device))
+    machine = native.NativeMachine(data, hardware, 5000, c_vm)
+    hardware.machine.append(machine)
+    result = machine.run()
+    assert hardware.nested == [State.FAULTED]
+    assert result.fault is not None
+    assert (result.fault.kind, result.fault.line) == (FaultKind.DEVICE, 2)
+    assert result.fault.message.startswith("a callback stepped the VM that called it")
+    assert result.variables[2] == 0  # C
+    assert [entry.call for entry in device.trace] == ["KYC", "STOP"]
