@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -55,44 +55,80 @@ def compile_program(text: str, source_name: str, level: int | None = None
     return compilation.diagnostics if compilation.output is None else compilation.output
 
 
-# Conditions ----------------------------------------------------------------------------
+# Values and conditions ----------------------------------------------------------------------------
 
 _CONDITION = re.compile(r"^(?P<value>.*?)\s*(?P<relation>[=<>])\s*0\s*$", re.DOTALL)
 _AGAINST_NUMBER = re.compile(r"^(.+?)\s*([=<>])\s*(-?[0-9]+)\s*$", re.DOTALL)
 _RELATIONS: dict[str, ast.Relation] = {"=": "=", ">": ">", "<": "<"}
 _CONDITION_HELP = ("write a value of the language compared with 0, as a conditional jump "
                    "tests it: `A<0`, `U-L>0`, `d=0`")
+_VALUE_HELP = "write variables and constants joined by operators, as `U-L` or `a<3+c`"
 
 
 @dataclass(frozen=True, slots=True)
-class Condition:
-    """A value (the right side of an assignment, without calls) and the relation of
-    `?V=`, `?V>`, `?V<` that it must bear to 0."""
+class Value:
+    """A value as the language writes one: the right side of an assignment, without
+    calls (`U-L`, `a<3+c`), read left to right."""
 
     text: str
     assign: ast.Assign
-    relation: ast.Relation
 
-    def met(self, variables: list[int]) -> bool:
+    def of(self, variables: Sequence[int]) -> int:
         value = self._operand(self.assign.first, variables)
         for step in self.assign.rest:
             value = apply(step.op, value, self._operand(step.operand, variables))
-        return holds(self.relation, value)
+        return value
 
     @staticmethod
-    def _operand(operand: ast.Operand, variables: list[int]) -> int:
+    def _operand(operand: ast.Operand, variables: Sequence[int]) -> int:
         match operand:
             case ast.Var(name=name):
                 return variables[VARIABLE_INDEX[name]]
             case ast.Const():
                 return constant(operand)
-            case _:  # parse_condition refused calls
+            case _:  # parse_value refused calls
                 raise AssertionError(operand)
 
 
+@dataclass(frozen=True, slots=True)
+class Condition:
+    """A value and the relation of `?V=`, `?V>`, `?V<` that it must bear to 0."""
+
+    text: str
+    value: Value
+    relation: ast.Relation
+
+    def met(self, variables: Sequence[int]) -> bool:
+        return holds(self.relation, self.value.of(variables))
+
+
+def parse_value(text: str, help: str = _VALUE_HELP) -> Value:
+    """A value, parsed by the front end as the right side of an assignment; DebugError
+    saying what is wrong, and `help`."""
+    if not text.strip():
+        raise DebugError(f"no value is given: {help}")
+    line, diagnostics = parse_line(f"A={text}", 1)
+    statements = line.statements
+    if diagnostics or line.label is not None or len(statements) != 1 or not isinstance(
+            statements[0], ast.Assign):
+        reason = diagnostics[0].message if diagnostics else "it is not one value"
+        raise DebugError(f"the value `{text.strip()}` cannot be read: {reason}; {help}")
+    assign = statements[0]
+    for operand in (assign.first, *(step.operand for step in assign.rest)):
+        match operand:
+            case ast.Call():
+                raise DebugError(f"`{text.strip()}` calls a built-in, which would drive the "
+                                 "vehicle: use the variables it writes (x, y, w after "
+                                 "(IMG)) instead")
+            case ast.Const(hex=False, value=number) if not -32768 <= number <= 32767:
+                raise DebugError(f"the constant {number} in `{text.strip()}` is outside "
+                                 "-32768..32767, the values a variable holds")
+    return Value(text.strip(), assign)
+
+
 def parse_condition(text: str) -> Condition:
-    """A breakpoint's condition, parsed by the front end as the right side of an
-    assignment; DebugError saying what is wrong."""
+    """A breakpoint's condition: a value compared with 0; DebugError saying what is
+    wrong."""
     match = _CONDITION.match(text.strip())
     other = _AGAINST_NUMBER.match(text.strip())
     if match is None and other is not None:
@@ -104,25 +140,8 @@ def parse_condition(text: str) -> Condition:
     if match is None or not match["value"]:
         raise DebugError(f"the condition `{text.strip()}` compares nothing with 0: "
                          f"{_CONDITION_HELP}")
-    value = match["value"]
-    line, diagnostics = parse_line(f"A={value}", 1)
-    statements = line.statements
-    if diagnostics or line.label is not None or len(statements) != 1 or not isinstance(
-            statements[0], ast.Assign):
-        reason = diagnostics[0].message if diagnostics else "it is not one value"
-        raise DebugError(f"the condition's value `{value}` cannot be read: {reason}; "
-                         f"{_CONDITION_HELP}")
-    assign = statements[0]
-    for operand in (assign.first, *(step.operand for step in assign.rest)):
-        match operand:
-            case ast.Call():
-                raise DebugError(f"the condition `{text.strip()}` calls a built-in, which "
-                                 "would drive the vehicle: use the variables it writes "
-                                 "(x, y, w after (IMG)) instead")
-            case ast.Const(hex=False, value=number) if not -32768 <= number <= 32767:
-                raise DebugError(f"the constant {number} of the condition is outside "
-                                 "-32768..32767, the values a variable holds")
-    return Condition(text.strip(), assign, _RELATIONS[match["relation"]])
+    value = parse_value(match["value"], _CONDITION_HELP)
+    return Condition(text.strip(), value, _RELATIONS[match["relation"]])
 
 
 def parse_call(name: str) -> FormKey:

@@ -9,7 +9,8 @@ the exception breakpoints `lost-line`; and steps (`next` a line, `stepIn` a line
 with granularity `instruction`, an instruction), continues, pauses and restarts. A fault
 always stops the run as an exception on its line, and ends it. One thread, the program;
 one frame, its line; three scopes: the user variables (A-Z, a-r, @), the reserved
-variables (s-z) and the device. Each call the device receives is an `output` event.
+variables (s-z) and the device; `evaluate` computes a value (`U-L`) for a watch or a
+hover. Each call the device receives is an `output` event.
 
 Messages are framed as LSP's are, read by lsp/framing.py's bounded reader. The program
 runs in a worker thread while the reader answers, so that `pause` reaches it.
@@ -25,7 +26,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, BinaryIO
 
-from rl1.compiler.debugger import DebugError, Session, Stop, compile_program, parse_call
+from rl1.compiler.debugger import (
+    DebugError,
+    Session,
+    Stop,
+    compile_program,
+    parse_call,
+    parse_value,
+)
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.frontend.source import read_source
 from rl1.compiler.runner import load_script
@@ -53,6 +61,7 @@ CAPABILITIES: dict[str, Any] = {
     "supportsRestartRequest": True,
     "supportsSteppingGranularity": True,
     "supportsExceptionInfoRequest": True,
+    "supportsEvaluateForHovers": True,
     "exceptionBreakpointFilters": [
         {"filter": "lost-line", "label": "Lost lines",
          "description": "Stop where the program jumps to a lost-line handler (:96-:99)",
@@ -292,6 +301,18 @@ class Adapter:
         else:
             raise Refused(f"no variables have the reference {reference!r}")
         self._respond(request, {"variables": shown})
+
+    def _on_evaluate(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        """A watch or hover: a value of the language over the variables now (`U-L`)."""
+        expression = arguments.get("expression")
+        if not isinstance(expression, str):
+            raise Refused("evaluate needs `expression`: a value, as `U-L`")
+        session = self._session()
+        try:
+            value = parse_value(expression).of(session.machine.variables)
+        except DebugError as error:
+            raise Refused(str(error)) from None
+        self._respond(request, {"result": str(value), "variablesReference": 0})
 
     def _on_exceptionInfo(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
         stop = self._last_stop

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rl1.compiler.debugger import DebugError, parse_call, parse_condition
+from rl1.compiler.debugger import DebugError, parse_call, parse_condition, parse_value
 from rl1.vm.language import VARIABLE_INDEX, VARIABLES
 
 values = st.integers(-32768, 32767)
@@ -55,16 +55,16 @@ def test_a_value_is_read_left_to_right_with_shifts_and_constants(a: int, c: int)
             "shift): write `A-5<0`"),
     ("U-L>-20", "write `U-L+20>0`"),
     ("<0", "compares nothing with 0"),
-    ("A+<0", "cannot be read"),
-    ("A; B<0", "cannot be read"),
+    ("A+<0", "the value `A+` cannot be read"),
+    ("A; B<0", "the value `A; B` cannot be read"),
     ("(IMG)-180<0", "calls a built-in"),
-    ("A-40000<0", "outside -32768..32767"),
+    ("A-40000<0", "the constant 40000 in `A-40000` is outside -32768..32767"),
 ])
 def test_what_is_no_condition_is_said_with_what_to_write(text: str, says: str) -> None:
     with pytest.raises(DebugError) as raised:
         parse_condition(text)
     assert says in str(raised.value)
-    if "compares nothing" in says or "cannot be read" in says:
+    if "compares nothing" in says or "cannot be read" in says:  # and how to write one
         assert "`A<0`, `U-L>0`, `d=0`" in str(raised.value)
 
 
@@ -82,3 +82,21 @@ def test_a_call_breakpoint_names_a_built_in_or_one_of_its_forms(
 def test_an_unknown_call_is_refused_with_what_exists(name: str, says: str) -> None:
     with pytest.raises(DebugError, match=says):
         parse_call(name)
+
+
+@given(values, values)
+def test_a_value_is_what_the_condition_compares(a: int, c: int) -> None:
+    value = parse_value(" a<3+c-$10 ")
+    assert value.text == "a<3+c-$10"
+    assert value.of(_variables(a=a, c=c)) == _wrapped(_wrapped(_wrapped(a * 8) + c) - 16)
+
+
+@pytest.mark.parametrize(("text", "says"), [
+    (" ", "no value is given: write variables and constants joined by operators, as "
+          "`U-L` or `a<3+c`"),
+    ("x+(IMG)", "`x+(IMG)` calls a built-in, which would drive the vehicle"),
+    ("#10", "the value `#10` cannot be read")])
+def test_what_is_no_value_is_said(text: str, says: str) -> None:
+    with pytest.raises(DebugError) as raised:
+        parse_value(text)
+    assert str(raised.value).startswith(says)

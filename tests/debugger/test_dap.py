@@ -129,6 +129,7 @@ def test_initialize_answers_the_capabilities_as_exact_json(client: Client) -> No
         "supportsConfigurationDoneRequest": True, "supportsConditionalBreakpoints": True,
         "supportsFunctionBreakpoints": True, "supportsRestartRequest": True,
         "supportsSteppingGranularity": True, "supportsExceptionInfoRequest": True,
+        "supportsEvaluateForHovers": True,
         "exceptionBreakpointFilters": [{
             "filter": "lost-line", "label": "Lost lines",
             "description": "Stop where the program jumps to a lost-line handler (:96-:99)",
@@ -168,6 +169,12 @@ def test_listing_1_stops_at_line_20_steps_and_runs_to_its_end(client: Client) ->
     assert client.variables(3) == {"time (ms)": "2000", "tracing mode": "0",
                                    "motion": "null",
                                    "last readings": '{"IMG": [40, 128, 100, 0]}'}
+    assert client.request("evaluate", {"expression": "U-L", "context": "watch"})[
+        "body"] == {"result": "60", "variablesReference": 0}
+    refused = client.request("evaluate", {"expression": "(IMG)", "context": "hover"})
+    assert (refused["success"], refused["message"]) == (False, (
+        "`(IMG)` calls a built-in, which would drive the vehicle: use the variables it "
+        "writes (x, y, w after (IMG)) instead"))
     calls = [e["body"]["output"] for e in client.events if e["event"] == "output"]
     assert calls[0] == "0 ms, line 2: CAM Z\n" and calls[-1].endswith(
         "line 18: CAM P 589\n")
@@ -289,7 +296,7 @@ KEYS = {
     "continue": ("threadId",), "next": ("granularity",), "stepIn": ("granularity",),
     "pause": (), "restart": (), "threads": (), "stackTrace": ("threadId",),
     "scopes": ("frameId",), "variables": ("variablesReference",),
-    "exceptionInfo": ("threadId",), "evaluate": ("expression",)}
+    "exceptionInfo": ("threadId",), "evaluate": ("expression", "context")}
 breakpoint_lists = st.lists(st.dictionaries(st.sampled_from(("line", "condition", "name")),
                                             json_values), max_size=3)
 
