@@ -26,6 +26,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, BinaryIO
 
+import click
+
 from rl1.compiler.debugger import (
     DebugError,
     Session,
@@ -455,9 +457,20 @@ def serve(input_: BinaryIO, output: BinaryIO) -> None:
         framer.problems.clear()
 
 
-def main() -> None:
-    """The `rl1-dap` command: DAP on standard input and output."""
+@click.command("rl1-dap", context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="rl1", prog_name="rl1-dap")
+def command() -> None:
+    """The RL/I debug adapter: the Debug Adapter Protocol over standard input and output,
+    for VS Code, nvim-dap and any DAP client. Launch a .rob (compiled in memory, `level`
+    0 to 2) or an .ilc file with `sensors` (a sensor script) or `world` (a world file);
+    breakpoints on lines (with conditions such as A<0), on calls (IMG) and on lost lines
+    and faults; stepping by line or instruction; the variables and the device."""
     serve(sys.stdin.buffer, sys.stdout.buffer)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """The `rl1-dap` command line (default: the process's arguments)."""
+    command.main(argv, prog_name="rl1-dap")
 
 
 if __name__ == "__main__":

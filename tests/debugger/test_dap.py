@@ -326,3 +326,10 @@ def test_any_arguments_get_one_answer_and_never_break_the_adapter(
     responses = [m for m in sent if m["type"] == "response"]
     assert [m["request_seq"] for m in responses] == list(range(1, len(requests) + 2))
     assert not [m for m in responses if "please report it" in m.get("message", "")]
+
+
+def test_the_command_line_answers_help_and_version_without_serving() -> None:
+    for flag, said in (("--help", "Debug Adapter Protocol"), ("--version", "rl1-dap, version")):
+        done = subprocess.run([sys.executable, "-m", "rl1.lsp.dap", flag], input=b"",
+                              capture_output=True, timeout=60, check=False)
+        assert done.returncode == 0 and said in done.stdout.decode(), done
