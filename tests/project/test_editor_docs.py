@@ -21,7 +21,7 @@ def test_the_editors_guide_installs_every_command_with_pipx() -> None:
     scripts = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))[
         "project"]["scripts"]
     section = _section((ROOT / "docs" / "editors.md").read_text(encoding="utf-8"),
-                       "Installing `rl1c` and `rl1-lsp` on the PATH")
+                       "Installing `rl1c`, `rl1-lsp` and `rl1-dap` on the PATH")
     assert "pipx install /path/to/rl1" in section and "pipx install -e" in section
     missing = [name for name in scripts if f"`{name}`" not in section]
     assert not missing, f"the pipx section of docs/editors.md does not name {missing}"
