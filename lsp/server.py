@@ -260,6 +260,10 @@ class Rl1Server(LanguageServer):
     def exit_status(self) -> int | None:
         return self.protocol.exit_status
 
+    @property
+    def initialized(self) -> bool:
+        return self.protocol.initialize_received
+
     def attach(self, writer: transports.Writer) -> None:
         self.protocol.set_writer(writer, include_headers=False)  # the writer frames
 

@@ -18,7 +18,9 @@ that reconnects must not find its old connection holding the server. A client be
 the limit is told so (an error answering its first request on TCP, close code 1013 on a
 WebSocket). What the server holds is bounded per session (its open documents,
 server.MAX_OPEN_CHARACTERS; one message being read; MAX_UNREAD bytes written that the
-client has not read), so by MAX_SESSIONS times that in all.
+client has not read), so by MAX_SESSIONS times that in all. A connection that has not
+sent `initialize` within INITIALIZE_SECONDS is closed, so that a local process cannot
+hold every place by connecting and saying nothing.
 """
 
 from __future__ import annotations
@@ -44,6 +46,9 @@ MAX_UNREAD = 2 * MAX_MESSAGE
 """Bytes written to a client that it has not read yet: past this, it is disconnected."""
 REFUSAL_SECONDS = 10.0
 """How long a client beyond MAX_SESSIONS has to send the request that is refused."""
+INITIALIZE_SECONDS = 10.0
+"""How long a connection has to send `initialize`: past this, it is closed, so that
+connections that send nothing cannot hold every place."""
 REQUEST_FAILED = -32803  # LSP's code for a valid request that failed
 
 LOCAL_ORIGIN = re.compile(r"https?://(localhost|127\.0\.0\.1|\[::1\])(:\d+)?")
@@ -70,6 +75,10 @@ class Session(Protocol):
     def exit_status(self) -> int | None:
         """None until the client sends `exit`; then the status LSP gives it."""
 
+    @property
+    def initialized(self) -> bool:
+        """Whether the client has sent `initialize`."""
+
     def attach(self, writer: Writer) -> None:
         """Write every message to `writer`."""
 
@@ -92,6 +101,25 @@ async def _serve_stream(session: Session, chunks: AsyncIterator[bytes]) -> None:
             log.warning("skipped %s; reading on from the next Content-Length header. "
                         "The client is breaking LSP's framing: please report it", problem)
         framer.problems.clear()
+
+
+async def _close_unless_initialized(session: Session, close: Callable[[], object]) -> None:
+    """Call `close` if `session` has not received `initialize` in INITIALIZE_SECONDS."""
+    await asyncio.sleep(INITIALIZE_SECONDS)
+    if not session.initialized:
+        log.warning("a client sent no initialize in %.0f s: disconnected", INITIALIZE_SECONDS)
+        close()
+
+
+@contextlib.asynccontextmanager
+async def _initialize_deadline(session: Session, close: Callable[[], object]
+                               ) -> AsyncIterator[None]:
+    """While inside, `close` is called if `session` is not initialized in time."""
+    watch = asyncio.create_task(_close_unless_initialized(session, close))
+    try:
+        yield
+    finally:
+        watch.cancel()
 
 
 # Standard input and output ----------------------------------------------------------------
@@ -226,7 +254,8 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
             sessions.add(session)
             session.attach(_TcpWriter(writer))
             try:
-                await _serve_stream(session, _read_tcp(reader, writer))
+                async with _initialize_deadline(session, writer.transport.abort):
+                    await _serve_stream(session, _read_tcp(reader, writer))
             finally:
                 sessions.discard(session)
                 session.end()
@@ -299,10 +328,11 @@ async def serve_websocket(new_session: Callable[[], Session], host: str, port: i
         writer = _WebSocketWriter(connection)
         session.attach(writer)
         try:
-            async for message in connection:
-                session.receive(message.encode() if isinstance(message, str) else message)
-                if session.exit_status is not None:
-                    break
+            async with _initialize_deadline(session, connection.transport.abort):
+                async for message in connection:
+                    session.receive(message.encode() if isinstance(message, str) else message)
+                    if session.exit_status is not None:
+                        break
         except ConnectionClosed as closed:  # such as a message over MAX_MESSAGE
             log.info("a WebSocket connection ended: %s", closed)
         finally:

@@ -12,21 +12,30 @@ engine's build cache and runs `rl1c run --engine c` from it, in a process of its
 from __future__ import annotations
 
 import atexit
+import base64
+import collections
+import contextlib
 import functools
 import hashlib
 import json
 import os
 import re
 import shutil
+import socket
 import subprocess
 import sys
 import tempfile
+import threading
+import time
+from dataclasses import dataclass
 from pathlib import Path
+from typing import IO, Any
 
 from hypothesis import strategies as st
 
 from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.strategies import programs
+from rl1.lsp.transports import BUSY, MAX_SESSIONS
 from rl1.vm import native
 from rl1.vm.sim.world import WorldError, decode_world
 
@@ -266,4 +275,382 @@ def cache_attack(data: bytes, folder: Path) -> list[str]:
     recorded = library.with_name(library.name + native.DIGEST_SUFFIX)
     if recorded.read_text("ascii").strip() != hashlib.sha256(library.read_bytes()).hexdigest():
         found.append("run --engine c: the library left in the cache is not intact")
+    return found
+
+
+# The language server over TCP and WebSocket ----------------------------------------------
+
+LSP_SERVER = [sys.executable, "-m", "rl1.lsp"]
+PROBE_SECONDS = 15.0
+"""How long the well-behaved client after each input waits for each answer (a few seconds
+on an idle machine; more on a loaded one, before a hung server is called hung)."""
+GROWTH_BOUND_MIB = 256
+"""How far the server's resident memory may grow past what it held once started: one
+message being read (framing.MAX_MESSAGE) at most, and what the allocator keeps."""
+SECRET = "file:///hostile/secret.rob"
+"""The document every hostile connection opens: no other session may hear of it."""
+WS_GUID = b"258EAFA5-E914-47DA-95CA-C5AB0DC85B11"
+
+
+def _frame(message: object) -> bytes:
+    body = message if isinstance(message, bytes) else json.dumps(message).encode()
+    return b"Content-Length: %d\r\n\r\n" % len(body) + body
+
+
+def _lsp(msg_id: int | None, method: str, params: object) -> dict[str, object]:
+    message: dict[str, object] = {"jsonrpc": "2.0", "method": method, "params": params}
+    return message if msg_id is None else {**message, "id": msg_id}
+
+
+INITIALIZE = _lsp(1, "initialize", {"processId": None, "rootUri": None, "capabilities": {}})
+OPEN_SECRET = _lsp(None, "textDocument/didOpen", {"textDocument": {
+    "uri": SECRET, "languageId": "rl1", "version": 1, "text": "A=(  ' secret\n"}})
+
+
+class ServedLsp:
+    """`rl1-lsp --tcp` or `--ws` on a free port of 127.0.0.1, in a process of its own."""
+
+    def __init__(self, transport: str) -> None:
+        self.transport = transport
+        self.start()
+
+    def start(self) -> None:
+        with socket.socket() as probe:
+            probe.bind(("127.0.0.1", 0))
+            self.port: int = probe.getsockname()[1]
+        self.process = subprocess.Popen(
+            [*LSP_SERVER, f"--{self.transport}", f"127.0.0.1:{self.port}"],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        self.said: collections.deque[str] = collections.deque(maxlen=40)
+        self.tracebacks: list[str] = []
+        # Read standard error as it comes, lest a full pipe stop the server's logging.
+        threading.Thread(target=self._read_stderr, args=(self.process.stderr,),
+                         daemon=True).start()
+        deadline = time.monotonic() + 60
+        while self.process.poll() is None and time.monotonic() < deadline:
+            with contextlib.suppress(OSError), socket.create_connection(
+                    ("127.0.0.1", self.port), timeout=1):
+                break
+            time.sleep(0.1)
+        self.started_mib = self.resident_mib()
+
+    def resident_mib(self) -> float:
+        """Resident memory, from /proc (0 once the process has ended)."""
+        with contextlib.suppress(OSError):
+            for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1]) / 1024
+        return 0.0
+
+    def _read_stderr(self, stream: IO[bytes]) -> None:
+        with stream:
+            for line in stream:
+                text = line.decode(errors="replace")
+                self.said.append(text)
+                if "Traceback" in text:
+                    self.tracebacks.append("".join(self.said))
+
+    def stop(self) -> str:
+        """Ends the server; returns the last lines it wrote on standard error."""
+        if self.process.poll() is None:
+            self.process.terminate()
+            try:
+                self.process.wait(30)
+            except subprocess.TimeoutExpired:
+                self.process.kill()
+                self.process.wait()
+        return "".join(self.said)
+
+
+@dataclass(frozen=True)
+class HostileConnection:
+    """What one hostile connection sends: `chunks` in order (on a WebSocket, after the
+    opening handshake, raw frames), then maybe half-closes its end (`half_close`);
+    `copies` such connections at once, each kept open while the next input's
+    well-behaved client is served when they leave it a place."""
+
+    chunks: tuple[bytes, ...]
+    half_close: bool = False
+    copies: int = 1
+    origin: str | None = None
+
+
+def _json_values() -> st.SearchStrategy[object]:
+    return st.recursive(
+        st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=20),
+        lambda inner: st.lists(inner, max_size=4) | st.dictionaries(
+            st.text(max_size=10), inner, max_size=4), max_leaves=12)
+
+
+LSP_METHODS = ["initialize", "textDocument/didOpen", "textDocument/didChange",
+               "textDocument/hover", "textDocument/completion", "textDocument/codeAction",
+               "textDocument/formatting", "textDocument/rename", "shutdown", "exit",
+               "$/cancelRequest", "workspace/didChangeConfiguration", "no/such/method"]
+
+
+@st.composite
+def _hostile_bodies(draw: st.DrawFn) -> bytes:
+    """Message bodies: nested or malformed JSON, JSON that is no message, valid LSP with
+    hostile parameters, documents of hostile source."""
+    kind = draw(st.sampled_from(["nested", "malformed", "json", "params", "document"]))
+    if kind == "nested":
+        depth = draw(st.integers(100, 5000))
+        return draw(st.sampled_from([b"[", b'{"a":', b'{"jsonrpc":"2.0","params":['])) * depth
+    if kind == "malformed":
+        return _mutated(json.dumps(INITIALIZE).encode(), draw)
+    if kind == "json":
+        return json.dumps(draw(_json_values())).encode()
+    if kind == "params":
+        msg_id = draw(st.none() | st.integers(-2**63, 2**63) | st.text(max_size=8))
+        return json.dumps(_lsp(msg_id, draw(st.sampled_from(LSP_METHODS)),  # type: ignore[arg-type]
+                               draw(_json_values()))).encode()
+    text = draw(hostile_sources()).decode("utf-8", errors="replace")
+    return json.dumps(_lsp(None, "textDocument/didOpen", {"textDocument": {
+        "uri": SECRET, "languageId": "rl1", "version": draw(st.integers()),
+        "text": text}})).encode()
+
+
+@st.composite
+def _hostile_stream(draw: st.DrawFn) -> tuple[bytes, ...]:
+    """What a hostile client writes on a byte stream (TCP): broken headers, lying or huge
+    Content-Lengths, hostile bodies, after an initialize and the secret document or not."""
+    start = (_frame(INITIALIZE) + _frame(OPEN_SECRET),) if draw(st.booleans()) else ()
+    body = draw(_hostile_bodies())
+    kind = draw(st.sampled_from(["framed", "lie", "header", "bomb", "bytes"]))
+    if kind == "framed":
+        return (*start, _frame(body))
+    if kind == "lie":
+        told = max(0, len(body) + draw(st.integers(-len(body), 4096)))
+        return (*start, b"Content-Length: %d\r\n\r\n" % told + body)
+    if kind == "header":
+        header = draw(st.sampled_from([
+            b"Content-Length: -1", b"Content-Length: 1e3", b"Content-Length: 0x10",
+            b"Content-Length: " + b"9" * 5000, b"Content-Length: 99999999999",
+            b"Content-Length: 5\r\nContent-Length: 7", b"X: " + b"y" * 200_000,
+            b"Content-Type: \xff\xfe", b"content-length:" + b" " * 9000 + b"3", b"",
+            b"\r\n" * 1000, b"Content-Length: 3\n"]))
+        return (*start, header + b"\r\n\r\n" + body)
+    if kind == "bomb":  # a huge length, then data streamed: read in bounded memory
+        mebibytes = draw(st.integers(1, 24))
+        return (*start, b"Content-Length: 99999999999\r\n\r\n",
+                *([b"[" * 2**20] * mebibytes))
+    return (*start, draw(st.binary(max_size=2000)))
+
+
+def ws_frame(opcode: int, payload: bytes, fin: bool = True, masked: bool = True,
+              told: int | None = None) -> bytes:
+    """One WebSocket frame as a client sends it (RFC 6455 5.2); `told` lies about the
+    payload's length."""
+    length = len(payload) if told is None else told
+    head = bytes([(0x80 if fin else 0) | opcode])
+    mask_bit = 0x80 if masked else 0
+    if length < 126:
+        head += bytes([mask_bit | length])
+    elif length < 2**16:
+        head += bytes([mask_bit | 126]) + length.to_bytes(2, "big")
+    else:
+        head += bytes([mask_bit | 127]) + length.to_bytes(8, "big")
+    if not masked:
+        return head + payload
+    mask = os.urandom(4)
+    return head + mask + bytes(byte ^ mask[i % 4] for i, byte in enumerate(payload))
+
+
+@st.composite
+def _hostile_frames(draw: st.DrawFn) -> tuple[bytes, ...]:
+    """What a hostile client writes after the opening handshake: frames of the wrong type,
+    oversize, fragmented, unmasked, lying about their length, of hostile bodies."""
+    start = ((ws_frame(1, json.dumps(INITIALIZE).encode()),
+              ws_frame(1, json.dumps(OPEN_SECRET).encode())) if draw(st.booleans()) else ())
+    body = draw(_hostile_bodies())
+    kind = draw(st.sampled_from(["text", "binary", "opcode", "fragments", "unmasked",
+                                 "oversize", "lie", "control", "bytes"]))
+    if kind == "text":
+        return (*start, ws_frame(1, body))
+    if kind == "binary":
+        return (*start, ws_frame(2, body))
+    if kind == "opcode":  # reserved opcodes, a continuation with nothing to continue
+        return (*start, ws_frame(draw(st.sampled_from([0, 3, 7, 11, 15])), body))
+    if kind == "fragments":
+        cuts = sorted(draw(st.lists(st.integers(0, len(body)), max_size=6)))
+        pieces = [body[a:b] for a, b in zip([0, *cuts], [*cuts, len(body)], strict=True)]
+        frames = [ws_frame(1 if i == 0 else 0, piece, fin=i == len(pieces) - 1)
+                  for i, piece in enumerate(pieces)]
+        if draw(st.booleans()):  # a ping between fragments is allowed; a text frame is not
+            frames.insert(draw(st.integers(0, len(frames))),
+                          ws_frame(draw(st.sampled_from([1, 9])), b"x"))
+        return (*start, *frames)
+    if kind == "unmasked":
+        return (*start, ws_frame(1, body, masked=False))
+    if kind == "oversize":  # over the message limit, declared or sent
+        if draw(st.booleans()):
+            return (*start, ws_frame(1, b"", told=2**63 - 1))
+        mebibytes = draw(st.integers(1, 80))
+        return (*start, ws_frame(1, b"[" * (mebibytes * 2**20)))
+    if kind == "lie":
+        return (*start, ws_frame(1, body, told=len(body) + draw(st.integers(1, 4096))))
+    if kind == "control":  # a control frame too long, fragmented, or a bad close
+        return (*start, draw(st.sampled_from([
+            ws_frame(9, b"p" * 200), ws_frame(9, b"p", fin=False),
+            ws_frame(8, b"\x00\x01"), ws_frame(8, b"\x03\xe8\xff"), ws_frame(8, b"x")])))
+    return (*start, draw(st.binary(max_size=2000)))
+
+
+@st.composite
+def hostile_connections(draw: st.DrawFn, transport: str) -> HostileConnection:
+    """Hostile clients of `rl1-lsp --tcp` (transport "tcp") or `--ws` ("ws")."""
+    chunks = draw(_hostile_stream() if transport == "tcp" else _hostile_frames())
+    origin = None
+    if transport == "ws":
+        origin = draw(st.sampled_from([None, None, "http://localhost:8000",
+                                       "https://evil.example", "null", "http://127.0.0.1.evil"]))
+    return HostileConnection(chunks=chunks, half_close=draw(st.booleans()),
+                             copies=draw(st.sampled_from([1, 1, 1, 2, 7, 12])), origin=origin)
+
+
+def ws_handshake(port: int, origin: str | None) -> bytes:
+    key = base64.b64encode(os.urandom(16))
+    lines = [b"GET / HTTP/1.1", b"Host: 127.0.0.1:%d" % port, b"Upgrade: websocket",
+             b"Connection: Upgrade", b"Sec-WebSocket-Key: " + key,
+             b"Sec-WebSocket-Version: 13"]
+    if origin is not None:
+        lines.append(b"Origin: " + origin.encode())
+    return b"\r\n".join(lines) + b"\r\n\r\n"
+
+
+def _send_hostile(server: ServedLsp, attack: HostileConnection) -> socket.socket | None:
+    """Open one hostile connection and send what it sends; None when the server closed
+    it or it timed out on the way (the server may refuse anything)."""
+    try:
+        connection = socket.create_connection(("127.0.0.1", server.port), timeout=5)
+    except OSError:
+        return None
+    try:
+        if server.transport == "ws":
+            connection.sendall(ws_handshake(server.port, attack.origin))
+        for chunk in attack.chunks:
+            connection.sendall(chunk)
+        if attack.half_close:
+            connection.shutdown(socket.SHUT_WR)
+        return connection
+    except OSError:
+        connection.close()
+        return None
+
+
+class _Probe:
+    """The well-behaved client: initialize, open a small document, get its diagnostics,
+    and hear nothing of any other session's documents."""
+
+    def __init__(self, server: ServedLsp) -> None:
+        self.server = server
+        self.heard: list[dict[str, Any]] = []
+
+    def run(self) -> str | None:
+        """None when served, else what went wrong. A refusal because the server serves
+        as many clients as it may is tried again (the hostile ones' places are freed
+        when the server reads their end)."""
+        deadline = time.monotonic() + PROBE_SECONDS
+        while (said := self._once()) == BUSY and time.monotonic() < deadline:
+            time.sleep(0.2)
+        return said
+
+    def _once(self) -> str | None:
+        uri = f"file:///probe/{os.urandom(4).hex()}.rob"
+        opened = _lsp(None, "textDocument/didOpen", {"textDocument": {
+            "uri": uri, "languageId": "rl1", "version": 1, "text": "A=(  ' unclosed\n"}})
+        try:
+            if self.server.transport == "tcp":
+                return self._over_tcp(uri, opened)
+            return self._over_websocket(uri, opened)
+        except (OSError, TimeoutError, ValueError) as error:
+            return f"the next client was not served: {type(error).__name__}: {error}"
+
+    def _check(self, message: dict[str, Any], uri: str) -> str | None:
+        """None while waiting for more; "" when served; else what went wrong."""
+        self.heard.append(message)
+        if SECRET in json.dumps(message):
+            return f"the next client heard another session's document: {message}"
+        if message.get("id") == 1 and message.get("error", {}).get("message") == BUSY:
+            return BUSY
+        if message.get("id") == 1 and "result" not in message:
+            return f"the next client's initialize was not answered: {message}"
+        if message.get("method") == "textDocument/publishDiagnostics":
+            params = message["params"]
+            if params["uri"] != uri:
+                return f"the next client got diagnostics of another document: {params}"
+            return "" if params["diagnostics"] else f"no diagnostics for {uri}"
+        return None
+
+    def _over_tcp(self, uri: str, opened: dict[str, object]) -> str | None:
+        with socket.create_connection(("127.0.0.1", self.server.port),
+                                      timeout=PROBE_SECONDS) as client:
+            client.sendall(_frame(INITIALIZE) + _frame(_lsp(None, "initialized", {}))
+                           + _frame(opened))
+            buffer = b""
+            deadline = time.monotonic() + PROBE_SECONDS
+            while time.monotonic() < deadline:
+                head, found, rest = buffer.partition(b"\r\n\r\n")
+                length = int(head.split(b":")[1]) if found else -1
+                if 0 <= length <= len(rest):
+                    buffer = rest[length:]
+                    if (said := self._check(json.loads(rest[:length]), uri)) is not None:
+                        return said or None
+                    continue
+                chunk = client.recv(65536)
+                if not chunk:
+                    return f"the server closed the next client's connection: {self.heard}"
+                buffer += chunk
+        return f"the next client got no diagnostics in {PROBE_SECONDS:.0f} s: {self.heard}"
+
+    def _over_websocket(self, uri: str, opened: dict[str, object]) -> str | None:
+        from websockets.exceptions import WebSocketException
+        from websockets.sync.client import connect
+
+        try:
+            with connect(f"ws://127.0.0.1:{self.server.port}",
+                         open_timeout=PROBE_SECONDS) as client:
+                for message in (INITIALIZE, _lsp(None, "initialized", {}), opened):
+                    client.send(json.dumps(message))
+                deadline = time.monotonic() + PROBE_SECONDS
+                while (left := deadline - time.monotonic()) > 0:
+                    if (said := self._check(json.loads(client.recv(left)), uri)) is not None:
+                        return said or None
+        except WebSocketException as error:
+            if getattr(getattr(error, "rcvd", None), "code", None) == 1013:  # try again later
+                return BUSY
+            return f"the next client was not served: {type(error).__name__}: {error}"
+        return f"the next client got no diagnostics in {PROBE_SECONDS:.0f} s: {self.heard}"
+
+
+def transport_attack(server: ServedLsp, attack: HostileConnection) -> list[str]:
+    """The hostile connections of `attack`, then a well-behaved client, which must be
+    served (initialize answered, diagnostics of its document within PROBE_SECONDS, nothing
+    of another session's documents) while the server's memory stays within
+    GROWTH_BOUND_MIB of what it started with. A server found dead is started again."""
+    hostile = [_send_hostile(server, attack) for _ in range(attack.copies)]
+    try:
+        if len(hostile) >= MAX_SESSIONS:  # they hold the places: the probe comes after
+            for connection in hostile:
+                if connection is not None:
+                    connection.close()
+        found = []
+        if (said := _Probe(server).run()) is not None:
+            found.append(f"{server.transport}: {said[:300]}")
+    finally:
+        for connection in hostile:
+            if connection is not None:
+                connection.close()
+    if (grown := server.resident_mib() - server.started_mib) > GROWTH_BOUND_MIB:
+        found.append(f"{server.transport}: the server grew by {grown:.0f} MiB")
+    if server.tracebacks:
+        found.append(f"{server.transport}: a traceback: {server.tracebacks[0][-300:]!r}")
+        server.tracebacks.clear()
+    if server.process.poll() is not None:
+        found.append(f"{server.transport}: the server ended with status "
+                     f"{server.process.returncode}: {server.stop()[-300:]!r}")
+        server.start()
+    elif found:  # start afresh, so that one problem is not counted again and again
+        server.stop()
+        server.start()
     return found

@@ -1,0 +1,106 @@
+"""`rl1-lsp --tcp` and `--ws` under the hostile harness (tests/support/hostile.py;
+bench/hostile_fuzz.py runs the same attacks for as long as asked): whatever a client
+sends (broken framing, Content-Length bombs and lies, nested or malformed JSON, hostile
+parameters and documents, WebSocket frames of the wrong type, oversize or fragmented, a
+wrong Origin, half-closed sockets, many connections at once), the next client is served,
+hears nothing of the other sessions, and the server stays alive in bounded memory. And
+connections that send nothing cannot hold every place."""
+
+from __future__ import annotations
+
+import contextlib
+import socket
+import time
+from collections.abc import Iterator
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from support.hostile import (
+    HostileConnection,
+    ServedLsp,
+    hostile_connections,
+    transport_attack,
+    ws_frame,
+    ws_handshake,
+)
+
+from rl1.lsp.transports import INITIALIZE_SECONDS, MAX_SESSIONS
+
+pytest.importorskip("websockets")
+TRANSPORTS = ["tcp", "ws"]
+
+
+@pytest.fixture(scope="module", params=TRANSPORTS)
+def server(request: pytest.FixtureRequest) -> Iterator[ServedLsp]:
+    served = ServedLsp(request.param)
+    try:
+        yield served
+    finally:
+        served.stop()
+
+
+@settings(max_examples=30, deadline=None, database=None,
+          suppress_health_check=list(HealthCheck))
+@given(data=st.data())
+def test_after_any_hostile_client_the_next_one_is_served(server: ServedLsp,
+                                                         data: st.DataObject) -> None:
+    attack = data.draw(hostile_connections(server.transport))
+    assert transport_attack(server, attack) == []
+
+
+@pytest.mark.parametrize("transport", TRANSPORTS)
+def test_the_harness_finds_a_server_that_died(transport: str) -> None:
+    """The property above can fail: a dead server is a problem (and is started again)."""
+    server = ServedLsp(transport)
+    try:
+        server.process.kill()
+        server.process.wait()
+        found = transport_attack(server, HostileConnection(chunks=(b"",)))
+        assert any("not served" in problem for problem in found), found
+        assert any("ended with status" in problem for problem in found), found
+        assert transport_attack(server, HostileConnection(chunks=(b"",))) == []
+    finally:
+        server.stop()
+
+
+KNOWN_HARD = {
+    "tcp": [b"X: " + b"y" * 200_000 + b"\r\n\r\n", b"Content-Length: 99999999999\r\n\r\n"
+            + b"[" * 2**23, b"Content-Length: 10\r\n\r\n" + b"[" * 5000],
+    "ws": [ws_frame(1, b"", told=2**63 - 1), ws_frame(2, b"[" * 5000),
+           ws_frame(3, b"{}"), ws_frame(1, b"{", fin=False) + ws_frame(1, b"}")],
+}
+
+
+@pytest.mark.parametrize(("transport", "sent"), [
+    (transport, sent) for transport, attacks in KNOWN_HARD.items() for sent in attacks])
+def test_known_hard_inputs(transport: str, sent: bytes) -> None:
+    server = ServedLsp(transport)
+    try:
+        assert transport_attack(server, HostileConnection(chunks=(sent,), copies=7)) == []
+    finally:
+        server.stop()
+
+
+def _silent(server: ServedLsp) -> socket.socket:
+    """A connection that opens (on a WebSocket, completes the handshake) and says nothing."""
+    connection = socket.create_connection(("127.0.0.1", server.port), timeout=30)
+    if server.transport == "ws":
+        connection.sendall(ws_handshake(server.port, None))
+        assert connection.recv(4096).startswith(b"HTTP/1.1 101")
+    return connection
+
+
+@pytest.mark.parametrize("transport", TRANSPORTS)
+def test_connections_that_send_no_initialize_do_not_hold_every_place(transport: str) -> None:
+    """Eight connections that said nothing once kept every other client out for as long
+    as they stayed open."""
+    server = ServedLsp(transport)
+    try:
+        with contextlib.ExitStack() as stack:
+            for _ in range(MAX_SESSIONS):
+                stack.enter_context(_silent(server))
+            time.sleep(INITIALIZE_SECONDS + 2)  # they are closed by now
+            assert transport_attack(server, HostileConnection(chunks=(b"",), copies=0)) == []
+    finally:
+        server.stop()
