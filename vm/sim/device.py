@@ -235,12 +235,13 @@ class SimDevice:
         self._begin()
         start = self.sim.time
         self._pass(self.sim.world.vehicle.image_time)
-        found = self.sim.image()
+        view = self.sim.view()
+        found = self.sim.image(view)
         reading = ImageReading(found.area if found.area <= 32767 else 32767,
                                _int16(found.x), _int16(found.y), _int16(found.angle))
         self._record("IMG", result=(reading.area, reading.x, reading.y, reading.z),
                      start=start)
-        self.sightings.add(Sighting(start, self.sim.scene, self.sim.view(),
+        self.sightings.add(Sighting(start, self.sim.scene, view,
                                     (reading.area, reading.x, reading.y)))
         return reading
 

@@ -162,13 +162,14 @@ class Simulator:
         pose = self.sensed_pose()
         return camera.view_of(pose.x, pose.y, pose.heading, self.pan, tilt, self.world.vehicle)
 
-    def image(self) -> camera.Moments:
-        """What the image processor measures now, in the selected scene."""
+    def image(self, view: camera.View | None = None) -> camera.Moments:
+        """What the image processor measures now, in the selected scene; `view` is
+        self.view(), when the caller has it already."""
         scenery = self._sceneries.get(self.scene)
         if scenery is None:
             scene = self.world.scenes.get(self.scene, _EMPTY_SCENE)
             scenery = self._sceneries[self.scene] = camera.Scenery(self.world, scene)
-        return self._noise.image(camera.moments(*scenery.render(self.view())),
+        return self._noise.image(camera.moments(*scenery.render(view or self.view())),
                                  scenery.window)
 
     def line_view(self) -> tracing.LineView | None:
@@ -201,34 +202,37 @@ class Simulator:
         wait (TIM, MVI) then ends at once, any other runs to its end. Raises SafetyFault."""
         end = self.time + seconds
         foreground = self.motion is not None and self.motion.command == "MVI"
-        unit = self.world.vehicle.wheel_unit
+        vehicle = self.world.vehicle
+        unit, interval, wheels = vehicle.wheel_unit, vehicle.trace_interval, self._noise.wheels
         heard: Command | None = None  # the loss the program is to hear of
         while self.time < end:
-            if foreground and self.motion is None:
+            motion = self.motion
+            if foreground and motion is None:
                 return heard
-            moving = self._speeds != (0.0, 0.0)
-            if not moving:
+            speeds = self._speeds
+            if speeds == (0.0, 0.0):  # standing
                 if math.isinf(end):
                     return heard
                 self.time = end
                 self._check_time()
                 return heard
-            interval = self.world.vehicle.trace_interval
-            if self._tick * interval < self.time:  # the timer ticked on while standing
-                self._tick = math.floor(self.time / interval) + 1
+            now = self.time
+            if self._tick * interval < now:  # the timer ticked on while standing
+                self._tick = math.floor(now / interval) + 1
             tick_time = self._tick * interval
-            until = min(end, self.time + self.step, tick_time)
-            left, right = self._noise.wheels(self._speeds[0] * unit, self._speeds[1] * unit)
-            if self.motion is not None and self.motion.command == "MVI":
-                until = min(until, self.time + time_to_cover(self.motion.remaining, left, right))
-            self._move(until - self.time, left, right)
+            until = min(end, now + self.step, tick_time)
+            left, right = wheels(speeds[0] * unit, speeds[1] * unit)
+            if motion is not None and motion.command == "MVI":
+                until = min(until, now + time_to_cover(motion.remaining, left, right))
+            self._move(until - now, left, right)
             self.time = until
             self._check_safety()
-            if (self.motion is not None and self.motion.command == "MVI"
-                    and self.motion.remaining <= 1e-6):  # 10 nm: well above rounding
+            motion = self.motion
+            if (motion is not None and motion.command == "MVI"
+                    and motion.remaining <= 1e-6):  # 10 nm: well above rounding
                 self.halt()
                 continue
-            if self.time >= tick_time:
+            if until >= tick_time:
                 self._tick += 1
                 lost = self._trace()
                 if lost is not None and interruptible:
@@ -237,19 +241,20 @@ class Simulator:
         return heard
 
     def _move(self, seconds: float, left: float, right: float) -> None:
-        vehicle = self.world.vehicle
-        before = self.pose
-        on_floor = self._noise.ground(left, right, seconds)  # what the counters do not see
-        self.pose = advance(self.pose, self.steering + self._noise.steering, *on_floor,
-                            vehicle.tread, seconds)
+        noise, before, start = self._noise, self.pose, self.time
+        end = start + seconds
+        on_floor = noise.ground(left, right, seconds)  # what the counters do not see
+        after = self.pose = advance(before, self.steering + noise.steering, *on_floor,
+                                    self.world.vehicle.tread, seconds)
         count(self.odometer, left, right, seconds)
-        if self.motion is not None and self.motion.command == "MVI":
-            self.motion.remaining -= abs(left + right) / 2 * seconds
-        self._track.add(self.time + seconds, self.pose)
+        motion = self.motion
+        if motion is not None and motion.command == "MVI":
+            motion.remaining -= abs(left + right) / 2 * seconds
+        self._track.add(end, after)
         if self._history is not None:
-            self._history.add(self.time + seconds, self.pose)
+            self._history.add(end, after)
         if self.on_move is not None:
-            self.on_move(self.time, self.time + seconds, before, self.pose)
+            self.on_move(start, end, before, after)
 
     def _trace(self) -> Command | None:
         """One tick of the tracing timer; the command the line was lost during, when the
