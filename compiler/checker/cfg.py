@@ -30,8 +30,8 @@ def build_cfg(program: ast.Program, memo: LineMemo | None = None) -> ControlFlow
     the lines it shares with the program."""
     if memo is None:
         cuts = cut(program.lines, runs_of).cuts
-        summaries = [summarize(block.statements) or BlockEffects.nothing()
-                     for block in cuts[:-1]]
+        nothing = BlockEffects.nothing()  # never changed: one for every block without effects
+        summaries = [summarize(block.statements) or nothing for block in cuts[:-1]]
     else:
         walk, summaries = memo.cut(program.lines)
         cuts = walk.cuts

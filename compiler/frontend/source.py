@@ -7,6 +7,7 @@ with LF, CRLF or a lone CR, exactly as the Language Server Protocol counts them.
 from __future__ import annotations
 
 import re
+from array import array
 from collections.abc import Iterator
 from typing import NamedTuple
 
@@ -49,6 +50,31 @@ def iter_lines(text: str) -> Iterator[str]:
         start = line_break.end()
     if start < len(text):
         yield text[start:]
+
+
+class LineIndex:
+    """The lines of a text as split_lines gives them, each found by its index without
+    holding them all as strings: 8 bytes a line (the reporter shows a few lines of a
+    source that may have millions)."""
+
+    __slots__ = ("_starts", "text")
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+        starts = array("q", [0])
+        starts.extend(line_break.end() for line_break in LINE_BREAK.finditer(text))
+        if starts[-1] == len(text):
+            starts.pop()  # a final line end starts no line; an empty text has none
+        self._starts = starts
+
+    def __len__(self) -> int:
+        return len(self._starts)
+
+    def __getitem__(self, index: int) -> str:
+        """Line `index` (0-based) without its line end."""
+        start = self._starts[index]
+        end = self._starts[index + 1] if index + 1 < len(self._starts) else len(self.text)
+        return self.text[start:end].rstrip("\r\n")  # a line holds neither
 
 
 def first_code_line_after(text: str, last: int) -> int | None:

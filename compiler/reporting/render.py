@@ -16,7 +16,7 @@ from typing import IO, Any, Literal, NamedTuple
 
 from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity, sort_key
-from rl1.compiler.frontend.source import split_lines
+from rl1.compiler.frontend.source import LineIndex, split_lines
 
 from .catalogue import CODES
 
@@ -226,7 +226,7 @@ class _HumanRenderer:
     def __init__(self, file: FileDiagnostics, color: bool) -> None:
         self.file = file
         self.color = color
-        self.lines = split_lines(file.text) if file.text is not None else []
+        self.lines = LineIndex(file.text if file.text is not None else "")
 
     def paint(self, text: str, role: str) -> str:
         return f"{_STYLES[role]}{text}{_RESET}" if self.color else text
