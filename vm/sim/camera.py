@@ -225,10 +225,10 @@ class Scenery:
             if not patches:
                 return np.zeros((0, 0), dtype=bool), (x0, y0)
             # Only the LEDs: the image is the box around their patches.
-            top = min(r0 for r0, _, _ in patches)
-            left = min(c0 for _, c0, _ in patches)
-            bottom = max(r0 + mask.shape[0] for r0, _, mask in patches)
-            right = max(c0 + mask.shape[1] for _, c0, mask in patches)
+            top, left, bottom, right = patches[0][0], patches[0][1], 0, 0
+            for r0, c0, mask in patches:
+                top, left = min(top, r0), min(left, c0)
+                bottom, right = max(bottom, r0 + mask.shape[0]), max(right, c0 + mask.shape[1])
             image = np.zeros((bottom - top, right - left), dtype=bool)
         else:
             first, image = floor
@@ -319,14 +319,16 @@ class Scenery:
         of the window: only a box around each LED's projection is tested. A ray at
         angle a to the LED's direction misses its centre by |c| sin a, so it hits when
         its component along c is at least sqrt(|c|^2 - r^2)."""
-        vehicle, f = self.vehicle, self.focal
+        f = self.focal
         x0, y0, x1, y1 = self.window
+        half_width, half_height = self.vehicle.image_width / 2, self.vehicle.image_height / 2
         patches = []
         for marker in self.markers:
             mx, my = marker.x, marker.y
             if (view.x - mx) * marker.facing[0] + (view.y - my) * marker.facing[1] <= 0:
                 continue  # the camera is behind the marker's face
-            prisms = self._prisms(view, bounding_box(((mx, my),), LED_RADIUS), marker.stand)
+            prisms = self._prisms(view, (mx - LED_RADIUS, my - LED_RADIUS,
+                                         mx + LED_RADIUS, my + LED_RADIUS), marker.stand)
             for height in marker.leds:
                 cx, cy, cz = mx - view.x, my - view.y, height - view.z
                 ahead, left, down = (ax * cx + ay * cy + az * cz for ax, ay, az in axes)
@@ -335,7 +337,6 @@ class Scenery:
                 (u0, u1), (v0, v1) = _led_extent(ahead, left, down, f)
                 # Pixel i's centre is i + 0.5 - width / 2 from the axis; a pixel more
                 # each side absorbs the rounding of the extent.
-                half_width, half_height = vehicle.image_width / 2, vehicle.image_height / 2
                 c0 = max(x0, math.floor(u0 + half_width - 0.5) - 1)
                 c1 = min(x1, math.ceil(u1 + half_width - 0.5) + 2)
                 r0 = max(y0, math.floor(v0 + half_height - 0.5) - 1)
@@ -389,6 +390,9 @@ def _powers(count: int) -> Floats:
     return powers
 
 
+_POWERS = _powers(1024)  # enough for any image of a valid world's camera
+
+
 def moments(image: Mask, origin: tuple[int, int]) -> Moments:
     """The zeroth, first and second moments of a binary image whose top left pixel is
     `origin` (column, row)."""
@@ -396,7 +400,8 @@ def moments(image: Mask, origin: tuple[int, int]) -> Moments:
     # [1 y y^2]^T @ that sums them over the rows. Pixel centres are halves, so the sums
     # are exact (far below 2^53) whatever the order of summation.
     rows, columns = image.shape
-    powers = _powers(max(1024, origin[0] + columns, origin[1] + rows))
+    reach = max(origin[0] + columns, origin[1] + rows)
+    powers = _POWERS if reach <= len(_POWERS) else _powers(reach)
     sums = (powers[origin[1]:origin[1] + rows].T
             @ (image @ powers[origin[0]:origin[0] + columns])).tolist()
     area = sums[0][0]
