@@ -1,6 +1,7 @@
 """A fuzzing campaign against every rl1c command: the attacks of the test suite's
-bounded run (tests/support/hostile.py, the C engine's build cache among them), and
-hostile project files (rl1.toml) under `rl1c check`, for as long as asked. Prints how
+bounded run (tests/support/hostile.py, the C engine's build cache among them), hostile
+project files (rl1.toml) under `rl1c check`, and hostile clients of `rl1-lsp --tcp` and
+`--ws` (one server each per campaign), for as long as asked. Prints how
 many inputs ran, how many found a problem, and the first few problems.
 
     .venv/bin/python bench/hostile_fuzz.py --minutes 10
@@ -9,12 +10,14 @@ many inputs ran, how many found a problem, and the first few problems.
 from __future__ import annotations
 
 import argparse
+import functools
 import re
 import sys
 import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import TypeVar
 
 from hypothesis import HealthCheck, given, seed, settings
 from hypothesis import strategies as st
@@ -26,19 +29,23 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 from support.cli import rl1c  # noqa: E402  (tests/ is put on the path just above)
 from support.hostile import (  # noqa: E402
+    HostileConnection,
+    ServedLsp,
     _mutated,
     _problems,
     cache_attack,
+    hostile_connections,
     hostile_ilc_files,
     hostile_libraries,
     hostile_sources,
     hostile_worlds,
     ilc_attack,
     source_attack,
+    transport_attack,
     world_attack,
 )
 
-Attack = Callable[[bytes, Path], list[str]]
+Input = TypeVar("Input")
 
 SEED_PROJECT_FILES = [
     b'[check]\nselect = ["W"]\nignore = ["W0603"]\nwarnings-as-errors = true\n',
@@ -99,8 +106,9 @@ def project_attack(data: bytes, folder: Path) -> list[str]:
     return found
 
 
-def campaign(name: str, inputs: st.SearchStrategy[bytes], attack: Attack,
-             seconds: float, batch_size: int = 100) -> None:
+def campaign(name: str, inputs: st.SearchStrategy[Input],
+             attack: Callable[[Input, Path], list[str]], seconds: float,
+             batch_size: int = 100) -> None:
     """Runs `attack` on inputs drawn from `inputs` until `seconds` have passed, in
     batches of `batch_size`, each with a seed of its own so that every batch draws
     afresh."""
@@ -112,7 +120,7 @@ def campaign(name: str, inputs: st.SearchStrategy[bytes], attack: Attack,
         @settings(max_examples=batch_size, deadline=None, database=None,
                   suppress_health_check=list(HealthCheck))
         @given(data=inputs)
-        def run(data: bytes) -> None:
+        def run(data: Input) -> None:
             nonlocal ran, failed
             ran += 1
             with tempfile.TemporaryDirectory() as folder:
@@ -133,16 +141,28 @@ def campaign(name: str, inputs: st.SearchStrategy[bytes], attack: Attack,
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--minutes", type=float, default=1.0)
+    parser.add_argument("--minutes", type=float, default=10.0)
     options = parser.parse_args()
-    fifth = options.minutes * 12
-    campaign("sources (check, fmt, compile, run)", hostile_sources(), source_attack, fifth)
-    campaign(".ilc files (run, dis, asm)", hostile_ilc_files(), ilc_attack, fifth)
-    campaign("world files (sim)", hostile_worlds(), world_attack, fifth)
+    share = options.minutes * 60 / 7
+    campaign("sources (check, fmt, compile, run)", hostile_sources(), source_attack, share)
+    campaign(".ilc files (run, dis, asm)", hostile_ilc_files(), ilc_attack, share)
+    campaign("world files (sim)", hostile_worlds(), world_attack, share)
     campaign("project files (rl1.toml, check)", hostile_project_files(), project_attack,
-             fifth)
+             share)
     campaign("the C engine's build cache (run --engine c)", hostile_libraries(),
-             cache_attack, fifth, batch_size=5)  # a build, 2-3 s, each
+             cache_attack, share, batch_size=5)  # a build, 2-3 s, each
+    for transport, name in [("tcp", "rl1-lsp --tcp"), ("ws", "rl1-lsp --ws")]:
+        server = ServedLsp(transport)
+        try:
+            campaign(f"{name} (hostile clients, then a well-behaved one)",
+                     hostile_connections(transport), functools.partial(_on, server), share,
+                     batch_size=10)  # up to seconds each
+        finally:
+            server.stop()
+
+
+def _on(server: ServedLsp, attack: HostileConnection, _folder: Path) -> list[str]:
+    return transport_attack(server, attack)
 
 
 if __name__ == "__main__":

@@ -310,6 +310,25 @@ class _WebSocketWriter:
         self._pump.cancel()
 
 
+class _OneLine(logging.Filter):
+    """Says an exception in one line, not as a traceback: the websockets library logs one
+    as an "unexpected internal error" when a client half-closes its socket while the
+    server answers its opening handshake (websockets 17.4, send_eof's assertion); the
+    server goes on serving."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if record.exc_info is not None and record.exc_info[1] is not None:
+            error = record.exc_info[1]
+            record.msg = f"{record.msg} ({type(error).__name__}: {error}); a client's " \
+                "connection ended, the server goes on"
+            record.exc_info = None
+        return True
+
+
+_WEBSOCKETS_LOG = logging.getLogger(f"{__name__}.websockets")
+_WEBSOCKETS_LOG.addFilter(_OneLine())
+
+
 async def serve_websocket(new_session: Callable[[], Session], host: str, port: int) -> None:
     """Serve each WebSocket connection to HOST:PORT as a session of its own, one LSP
     message a WebSocket message, until stopped. Needs the `websockets` package."""
@@ -341,7 +360,7 @@ async def serve_websocket(new_session: Callable[[], Session], host: str, port: i
             await writer.finish()
 
     async with serve(connected, host, port, max_size=MAX_MESSAGE, max_queue=1,
-                     origins=[None, LOCAL_ORIGIN]) as server:
+                     origins=[None, LOCAL_ORIGIN], logger=_WEBSOCKETS_LOG) as server:
         log.info("serving LSP over WebSocket on %s",
                  ", ".join(str(s.getsockname()) for s in server.sockets))
         await server.serve_forever()

@@ -9,6 +9,7 @@ connections that send nothing cannot hold every place."""
 from __future__ import annotations
 
 import contextlib
+import logging
 import socket
 import time
 from collections.abc import Iterator
@@ -104,3 +105,25 @@ def test_connections_that_send_no_initialize_do_not_hold_every_place(transport: 
             assert transport_attack(server, HostileConnection(chunks=(b"",), copies=0)) == []
     finally:
         server.stop()
+
+
+
+def test_an_error_the_websocket_library_logs_is_one_line(
+        capsys: pytest.CaptureFixture[str]) -> None:
+    """The campaign found the websockets library logging a traceback ("unexpected internal
+    error", an assertion in its send_eof) when a client half-closed its socket while the
+    server refused its opening handshake; the server went on, but wrote a traceback."""
+    handler = logging.StreamHandler()  # to standard error, as rl1-lsp logs
+    # the logger serve_websocket gives the library
+    websockets_log = logging.getLogger("rl1.lsp.transports.websockets")
+    websockets_log.addHandler(handler)
+    try:
+        try:
+            raise AssertionError("send_eof")
+        except AssertionError:
+            websockets_log.error("unexpected internal error", exc_info=True)
+    finally:
+        websockets_log.removeHandler(handler)
+    said = capsys.readouterr().err
+    assert "Traceback" not in said
+    assert "unexpected internal error (AssertionError: send_eof)" in said

@@ -35,6 +35,7 @@ from hypothesis import strategies as st
 
 from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.strategies import programs
+from rl1.lsp.framing import MAX_MESSAGE
 from rl1.lsp.transports import BUSY, MAX_SESSIONS
 from rl1.vm import native
 from rl1.vm.sim.world import WorldError, decode_world
@@ -284,9 +285,10 @@ LSP_SERVER = [sys.executable, "-m", "rl1.lsp"]
 PROBE_SECONDS = 15.0
 """How long the well-behaved client after each input waits for each answer (a few seconds
 on an idle machine; more on a loaded one, before a hung server is called hung)."""
-GROWTH_BOUND_MIB = 256
+GROWTH_BOUND_MIB = MAX_SESSIONS * MAX_MESSAGE // 2**20 + 64
 """How far the server's resident memory may grow past what it held once started: one
-message being read (framing.MAX_MESSAGE) at most, and what the allocator keeps."""
+message being read (framing.MAX_MESSAGE) by each session at most, as transports.py
+bounds it, and what the allocator keeps."""
 SECRET = "file:///hostile/secret.rob"
 """The document every hostile connection opens: no other session may hear of it."""
 WS_GUID = b"258EAFA5-E914-47DA-95CA-C5AB0DC85B11"
@@ -348,7 +350,9 @@ class ServedLsp:
                 text = line.decode(errors="replace")
                 self.said.append(text)
                 if "Traceback" in text:
-                    self.tracebacks.append("".join(self.said))
+                    self.tracebacks.append("")
+                if self.tracebacks and len(self.tracebacks[-1]) < 3000:
+                    self.tracebacks[-1] += text
 
     def stop(self) -> str:
         """Ends the server; returns the last lines it wrote on standard error."""
@@ -482,11 +486,12 @@ def _hostile_frames(draw: st.DrawFn) -> tuple[bytes, ...]:
         return (*start, *frames)
     if kind == "unmasked":
         return (*start, ws_frame(1, body, masked=False))
-    if kind == "oversize":  # over the message limit, declared or sent
+    if kind == "oversize":  # over the message limit, as a frame or in fragments
+        told = draw(st.sampled_from([MAX_MESSAGE + 1, 2**32, 2**63 - 1]))
         if draw(st.booleans()):
-            return (*start, ws_frame(1, b"", told=2**63 - 1))
-        mebibytes = draw(st.integers(1, 80))
-        return (*start, ws_frame(1, b"[" * (mebibytes * 2**20)))
+            return (*start, ws_frame(1, b"[" * 2**20, told=told))
+        piece = b"[" * (MAX_MESSAGE // 4 + 1)
+        return (*start, ws_frame(1, piece, fin=False), *[ws_frame(0, piece, fin=False)] * 4)
     if kind == "lie":
         return (*start, ws_frame(1, body, told=len(body) + draw(st.integers(1, 4096))))
     if kind == "control":  # a control frame too long, fragmented, or a bad close
@@ -644,7 +649,7 @@ def transport_attack(server: ServedLsp, attack: HostileConnection) -> list[str]:
     if (grown := server.resident_mib() - server.started_mib) > GROWTH_BOUND_MIB:
         found.append(f"{server.transport}: the server grew by {grown:.0f} MiB")
     if server.tracebacks:
-        found.append(f"{server.transport}: a traceback: {server.tracebacks[0][-300:]!r}")
+        found.append(f"{server.transport}: a traceback: {server.tracebacks[0][-600:]!r}")
         server.tracebacks.clear()
     if server.process.poll() is not None:
         found.append(f"{server.transport}: the server ended with status "
