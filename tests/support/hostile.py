@@ -7,6 +7,8 @@ an internal error, an exit status the command does not document, output written 
 command that failed, a traceback on any stream; and for world files, a bad world not
 refused with status 2 and a message naming the file. `cache_attack` damages the C
 engine's build cache and runs `rl1c run --engine c` from it, in a process of its own.
+`transport_attack` sends `rl1-lsp --tcp` or `--ws` (a `ServedLsp`, started once for many
+inputs) hostile connections, then checks that a well-behaved client is still served.
 """
 
 from __future__ import annotations
