@@ -63,7 +63,7 @@ def _with_edges(cuts: list[Cut], summaries: list[BlockEffects], last_cuts: list[
     if (previous is None or len(last_cuts) != len(cuts) or previous.labels != labels
             or previous.opaque != opaque):
         blocks = [Block(index, block_cut.statements, block_cut.labels, block_cut.opaque,
-                        [], [], nothing) for index, block_cut in enumerate(cuts)]
+                        (), (), nothing) for index, block_cut in enumerate(cuts)]
         changed: Iterable[int] = range(len(cuts) - 1)
     else:
         blocks = previous.blocks
@@ -72,7 +72,7 @@ def _with_edges(cuts: list[Cut], summaries: list[BlockEffects], last_cuts: list[
         for index in changed:
             block_cut = cuts[index]
             blocks[index] = Block(index, block_cut.statements, block_cut.labels,
-                                  block_cut.opaque, [], [], nothing)
+                                  block_cut.opaque, (), (), nothing)
         if changed and changed[-1] == exit_index:
             changed.pop()  # the exit block has no effects nor edges
     named = sorted(set(labels.values()))
@@ -83,16 +83,16 @@ def _with_edges(cuts: list[Cut], summaries: list[BlockEffects], last_cuts: list[
         following = block.index + 1
         last = block.statements[-1] if block.statements else None
         if block.opaque:
-            block.successors = list(dict.fromkeys([following, *named, exit_index]))
+            block.successors = tuple(dict.fromkeys([following, *named, exit_index]))
         elif isinstance(last, JUMPS):
             block.jump = last
             number = last.target.number
             target = labels.get(number) if number is not None else None
             found = opaque if target is None else [target]
             if isinstance(last, ast.Goto):
-                block.successors = list(found)
+                block.successors = tuple(found)
             else:
-                block.successors = [following, *(other for other in found if other != following)]
+                block.successors = (following, *(other for other in found if other != following))
         elif last is None or not ast.is_end(last):
-            block.successors = [following]
+            block.successors = (following,)
     return ControlFlowGraph(blocks, labels, labelled, opaque)

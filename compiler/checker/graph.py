@@ -55,8 +55,10 @@ class Block:
     statements: list[ast.Statement]
     labels: list[ast.LabelDef]  # the labels naming it
     opaque: bool  # stands for a line with a syntax error
-    successors: list[int] = field(default_factory=list)
-    handlers: list[HandlerEdge] = field(default_factory=list)
+    # tuples, not lists: a program of broken lines has a block a line, so the thousands
+    # of blocks without edges share the empty tuple
+    successors: tuple[int, ...] = ()
+    handlers: tuple[HandlerEdge, ...] = ()
     effects: BlockEffects = field(default_factory=BlockEffects.nothing)
     # the `#NN` or `?V..#NN` that ends the block, if one does: a field, not a property,
     # so that the rules gather the jumps of thousands of blocks in C (attrgetter)

@@ -14,8 +14,8 @@ def add_handler_edges(graph: ControlFlowGraph) -> None:
     graph.device_on_entry, triggers = trace(graph)
     for block, found in zip(graph.blocks, triggers, strict=True):
         # a block the incremental check took over may hold the last check's edges
-        block.handlers = [HandlerEdge(label, index, graph.labels.get(label))
-                          for label, (index, _) in sorted(found.items())] if found else []
+        block.handlers = tuple(HandlerEdge(label, index, graph.labels.get(label))
+                               for label, (index, _) in sorted(found.items()))
 
 
 def trace(graph: ControlFlowGraph) -> tuple[list[int], list[device.Triggers]]:

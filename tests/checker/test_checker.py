@@ -258,7 +258,7 @@ def test_blocks_start_at_labels_and_end_at_jumps_and_end() -> None:
     shapes = [[type(s).__name__ for s in block.statements] for block in graph.blocks]
     assert shapes == [["Assign", "Assign"], ["Assign", "CondJump"], ["Assign"],
                       ["CallStmt"], ["Assign"], []]
-    assert [block.successors for block in graph.blocks] == [[1], [2, 3], [3], [], [5], []]
+    assert [block.successors for block in graph.blocks] == [(1,), (2, 3), (3,), (), (5,), ()]
     assert graph.labels == {10: 1, 20: 3}
     assert [graph.reachable(index) for index in range(6)] == [True] * 4 + [False, False]
 
@@ -266,13 +266,13 @@ def test_blocks_start_at_labels_and_end_at_jumps_and_end() -> None:
 def test_a_label_after_the_last_statement_names_the_exit() -> None:
     graph = build_cfg(parse_program("?A>#50\n:50\n")[0])
     assert graph.labels == {50: graph.exit}
-    assert graph.blocks[0].successors == [graph.exit]
+    assert graph.blocks[0].successors == (graph.exit,)
 
 
 def test_a_broken_line_may_go_anywhere() -> None:
     graph = build_cfg(parse_program("#30\nA=(\n:20 B=1\n:30 C=2")[0])
     opaque = graph.blocks[1]
-    assert opaque.opaque and opaque.successors == [2, 3, graph.exit]
+    assert opaque.opaque and opaque.successors == (2, 3, graph.exit)
 
 
 def test_handler_edges_follow_the_tracing_mode_and_the_motion() -> None:
