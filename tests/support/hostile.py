@@ -54,7 +54,7 @@ STATUSES = {
     "run": {0, 1, 2, 10, 11, 12, 13},
     "dis": {0, 1, 2},
     "asm": {0, 1, 2},
-    "sim": {0, 1, 2, 10, 11, 12, 13},
+    "sim": {0, 1, 2, 10, 11, 12, 13, 20},  # 20: the program ended but missed its goal
 }
 BUDGET = "20000"  # instructions: a runaway input ends quickly
 
