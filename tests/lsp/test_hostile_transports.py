@@ -73,8 +73,11 @@ KNOWN_HARD = {
 }
 
 
+# Named by place, not by their bytes: a WebSocket frame's mask is random, and the workers
+# of pytest-xdist must collect the same names.
 @pytest.mark.parametrize(("transport", "sent"), [
-    (transport, sent) for transport, attacks in KNOWN_HARD.items() for sent in attacks])
+    pytest.param(transport, sent, id=f"{transport}-{index}")
+    for transport, attacks in KNOWN_HARD.items() for index, sent in enumerate(attacks)])
 def test_known_hard_inputs(transport: str, sent: bytes) -> None:
     server = ServedLsp(transport)
     try:
