@@ -42,9 +42,10 @@ def line_of(text: str, path: KeyPath, syntax: Literal["toml", "json"]) -> int | 
 
 def first_long_number(text: str, syntax: Literal["toml", "json"],
                       digits: int) -> tuple[int, KeyPath] | None:
-    """The line and path of the first integer of more than `digits` digits."""
+    """The line and path of the first integer of more than `digits` digits (of any base:
+    TOML's 0x, 0o and 0b integers too)."""
     for path, line, scalar in entries(text, syntax):
-        if sum(c.isdigit() for c in scalar) > digits and not scalar.startswith(('"', "'")):
+        if sum(c.isalnum() for c in scalar) > digits and not scalar.startswith(('"', "'")):
             return line, path
     return None
 

@@ -303,6 +303,15 @@ def test_a_project_file_may_start_with_a_byte_order_mark(tmp_path: Path) -> None
     assert check(write(tmp_path, "a.rob", MOVING)).exit_code == 0  # refused before
 
 
+def test_a_project_files_hexadecimal_integer_of_any_length_is_an_error_with_its_line(
+        tmp_path: Path) -> None:
+    # tomllib reads 0x integers without Python's 4300-digit bound: it was an internal error.
+    write(tmp_path, "rl1.toml", "[check]\nignore = 0x" + "f" * 5000 + "\n")
+    result = check(write(tmp_path, "a.rob", MOVING))
+    assert result.exit_code == 2
+    assert "line 2: check.ignore: a number of more than 4300 digits" in result.stderr
+
+
 def test_options_given_win_over_the_project_file(tmp_path: Path) -> None:
     write(tmp_path, "rl1.toml", '[check]\nselect = ["W06"]\nwarnings-as-errors = true\n')
     program = write(tmp_path, "a.rob", MOVING)

@@ -208,6 +208,11 @@ def test_a_sensor_script_given_as_a_world_is_named_as_one(data: bytes, says: str
      "more than 4300 digits"),
     (GOOD.replace(b'"3" = 7', b'"' + b"9" * 5000 + b'" = 7'), "w.toml:24: ports.9999"),
     (GOOD.replace(b'"3" = 7', b'"126" = 7'), "w.toml:24: ports.126: 126 is outside 0..125"),
+    # TOML's hexadecimal, octal and binary integers are read without Python's bound.
+    (GOOD.replace(b'"3" = 7', b'"3" = 0x' + b"f" * 5000), "w.toml:24: ports.3: a number of "
+     "more than 4300 digits"),
+    (GOOD.replace(b'"3" = 7', b'"3" = 0b' + b"1" * 20000), "w.toml:24: ports.3: a number of "
+     "more than 4300 digits"),
 ])
 def test_keys_and_numbers_of_any_length_are_read_within_bounds(data: bytes,
                                                                says: str | None) -> None:
