@@ -107,10 +107,10 @@ def read_document(data: bytes, name: str, syntax: Syntax) -> tuple[Any, str]:
     what = "TOML" if syntax == "toml" else "JSON"
     try:
         if syntax == "toml":
-            data = tomllib.loads(text)
-            if _holds_a_huge_int(data):  # 0x, 0o and 0b integers are read without a bound
+            document = tomllib.loads(text)
+            if _holds_a_huge_int(document):  # 0x, 0o and 0b integers are read unbounded
                 raise ValueError("an integer too long")
-            return data, text
+            return document, text
         return json.loads(text, parse_int=_bounded_int, parse_constant=_refuse_constant), text
     except tomllib.TOMLDecodeError as error:
         # tomllib (before Python 3.14) gives the place only in its message.
@@ -140,19 +140,19 @@ _TOML_PLACE = re.compile(r"\(at line (?P<line>\d+), column (?P<column>\d+)\)$")
 
 # The bits of the largest integer of MAX_DIGITS decimal digits: any longer one, however it
 # is written, could not even be shown in a message.
-MAX_BITS = (10**MAX_DIGITS - 1).bit_length()
+MAX_BITS: int = (10**MAX_DIGITS - 1).bit_length()
 
 
-def _holds_a_huge_int(data: object) -> bool:
-    match data:
+def _holds_a_huge_int(value: object) -> bool:
+    match value:
         case bool():
             return False
         case int():
-            return data.bit_length() > MAX_BITS
+            return value.bit_length() > MAX_BITS
         case dict():
-            return any(_holds_a_huge_int(value) for value in data.values())
+            return any(_holds_a_huge_int(item) for item in value.values())
         case list():
-            return any(_holds_a_huge_int(value) for value in data)
+            return any(_holds_a_huge_int(item) for item in value)
     return False
 
 
