@@ -27,7 +27,6 @@ import msgspec
 from rl1.compiler.runner import Finished, run
 from rl1.vm.sim.device import SimDevice
 from rl1.vm.sim.geometry import segment_nearest
-from rl1.vm.sim.goal import Judge
 from rl1.vm.sim.world import NOISELESS, Noise, World, decode_world
 
 ROOT = Path(__file__).parents[1]
@@ -39,7 +38,7 @@ GRID = (-10, -5, 0, 5, 10)  # cm the stand is moved along x and along y
 def outcome(program: str, world: World, seed: int) -> tuple[bool, bool]:
     """Whether the run succeeded, and whether it also ended over the guidance line."""
     device = SimDevice(world, seed=seed)
-    judging = None if world.goal is None else Judge(world, device.sim.pose)
+    judging = None if world.goal is None else world.judge(device.sim.pose)
     if judging is not None:
         device.sim.on_move = judging.step
     finished = run(program, device)

@@ -16,7 +16,7 @@ from typing import Any
 
 from rl1.vm.faults import RunResult
 from rl1.vm.sim.device import RunOn, SimDevice
-from rl1.vm.sim.goal import GOAL_MISSED, Judge, Verdict
+from rl1.vm.sim.goal import GOAL_MISSED, Verdict
 from rl1.vm.sim.world import World
 
 
@@ -37,7 +37,7 @@ class Simulation:
 
     def __init__(self, world: World, seed: int) -> None:
         self.device = SimDevice(world, seed=seed)
-        self._judge = None if world.goal is None else Judge(world, self.device.sim.pose)
+        self._judge = None if world.goal is None else world.judge(self.device.sim.pose)
         if self._judge is not None:
             self.device.sim.on_move = self._judge.step  # each exact step: the track is decimated
 

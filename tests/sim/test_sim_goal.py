@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 from support.cli import rl1c
 from support.worlds import open_floor
 
-from rl1.vm.sim.goal import GOAL_MISSED, Goal, Hold, Judge, Region, Step, Verdict, judge
+from rl1.vm.sim.goal import GOAL_MISSED, Goal, Hold, Region, Step, Verdict, judge
 from rl1.vm.sim.motion import Pose
 from rl1.vm.sim.simulator import Simulator
 from rl1.vm.sim.world import (
@@ -43,7 +43,7 @@ def with_goal(goal: Goal, x: float = 60.0, y: float = 150.0, heading: float = 0.
 def drive(world: World, seconds: float, left: int = 6, right: int = 6) -> Verdict:
     """Drive at constant wheel speeds for `seconds`, judged online as `rl1c sim` does."""
     sim = Simulator(world)
-    judging = Judge(world, sim.pose)
+    judging = world.judge(sim.pose)
     sim.on_move = judging.step
     sim.drive("MOV", left, right)
     sim.run_for(seconds, interruptible=False)
@@ -85,7 +85,7 @@ def test_a_forbidden_region_crossed_between_two_kept_track_points_is_caught() ->
     pit = Region("pit", box(61, 100, 62, 200))
     world = with_goal(Goal(avoid=(pit,)))
     sim = Simulator(world)
-    judging = Judge(world, sim.pose)
+    judging = world.judge(sim.pose)
     sim.on_move = judging.step
     sim.drive("MOV", 12, 12)
     sim.run_for(1.0, interruptible=False)
@@ -111,7 +111,7 @@ def test_a_region_with_a_heading_is_reached_when_the_heading_comes_within_tolera
     region = Region("facing up", box(50, 140, 70, 160), math.radians(90), math.radians(10))
     world = with_goal(Goal(reach=(region,)))
     sim = Simulator(world)
-    judging = Judge(world, sim.pose)
+    judging = world.judge(sim.pose)
     sim.on_move = judging.step
     sim.rotate(120)
     [outcome] = judging.verdict(sim.time).outcomes
@@ -144,11 +144,11 @@ def test_a_hold_is_met_once_the_vehicle_has_stood_long_enough_near_the_marker() 
     # To x = 130 in 2 s (the camera at 160, 40 cm from the marker), a stop of 1 s, away.
     steps = [Step(0.0, 2.0, Pose(0, 150, 0), Pose(130, 150, 0)),
              Step(3.0, 4.0, Pose(130, 150, 0), Pose(30, 150, 0))]
-    [outcome] = judge(_hold_world(0.5), steps, 4.0).outcomes
+    [outcome] = judge(_hold_world(0.5).judge(), steps, 4.0).outcomes
     assert outcome.met and outcome.time == 2.5
     assert outcome.text == ("stood still 0.5 s with the camera within 50 cm of its marker "
                             "by 2.50 s at (130.0, 150.0) heading 0.0")
-    [short] = judge(_hold_world(1.5), steps, 4.0).outcomes
+    [short] = judge(_hold_world(1.5).judge(), steps, 4.0).outcomes
     assert not short.met
     assert short.text == ("never stood still 1.5 s with the camera within 50 cm of its "
                           "marker: the nearest stop was 140.0 cm from it, from 4.00 s at "
@@ -157,7 +157,7 @@ def test_a_hold_is_met_once_the_vehicle_has_stood_long_enough_near_the_marker() 
 
 def test_the_rest_after_the_run_counts_as_standing() -> None:
     steps = [Step(0.0, 2.0, Pose(0, 150, 0), Pose(130, 150, 0))]
-    [outcome] = judge(_hold_world(5.0), steps, 2.0).outcomes
+    [outcome] = judge(_hold_world(5.0).judge(), steps, 2.0).outcomes
     assert outcome.met and outcome.time == 7.0
 
 
@@ -165,15 +165,15 @@ def test_the_end_region_judges_the_last_pose_and_its_heading() -> None:
     end = Region("home", box(250, 100, 350, 200), 0.0, math.radians(5))
     steps = [Step(0.0, 8.0, Pose(60, 150, 0), Pose(300, 150, math.radians(7)))]
     world = with_goal(Goal(end=end))
-    [turned] = judge(world, steps, 8.0).outcomes
+    [turned] = judge(world.judge(), steps, 8.0).outcomes
     assert not turned.met and "in the region, but the heading is more than 5 degrees" in (
         turned.text)
     steps[0] = steps[0]._replace(after=Pose(400, 150, 0))
-    [outside] = judge(world, steps, 8.0).outcomes
+    [outside] = judge(world.judge(), steps, 8.0).outcomes
     assert outside.text == "ended at 8.00 s at (400.0, 150.0) heading 0.0, 50.0 cm outside " \
                            "the region"
     steps[0] = steps[0]._replace(after=Pose(300, 150, math.radians(-364)))
-    assert judge(world, steps, 8.0).met  # -364 degrees is 4 degrees from 0
+    assert judge(world.judge(), steps, 8.0).met  # -364 degrees is 4 degrees from 0
 
 
 @given(st.floats(-300, 300), st.floats(-300, 300), st.integers(1, 40))
@@ -188,8 +188,8 @@ def test_the_judgement_does_not_depend_on_how_a_straight_run_is_cut_into_steps(
     def at(k: int) -> Pose:
         return Pose(dx * k / pieces, dy * k / pieces, 0.0)
 
-    whole = judge(world, [Step(0.0, 10.0, at(0), end)], 10.0)
-    cut = judge(world, [Step(10.0 * k / pieces, 10.0 * (k + 1) / pieces, at(k), at(k + 1))
+    whole = judge(world.judge(), [Step(0.0, 10.0, at(0), end)], 10.0)
+    cut = judge(world.judge(), [Step(10.0 * k / pieces, 10.0 * (k + 1) / pieces, at(k), at(k + 1))
                         for k in range(pieces)], 10.0)
     assert [o.met for o in whole.outcomes] == [o.met for o in cut.outcomes]
     for one, other in zip(whole.outcomes, cut.outcomes, strict=True):

@@ -5,9 +5,10 @@ track still counts.
 
 The record is a sequence of `Step`s (the pose before and after each step of the
 simulator, with their times) and the time the run ended; between two steps, and after
-the last, the vehicle stood still. `judge` is a plain function of it; `Judge` is the
-same judgement made online, one step at a time, through the simulator's `on_move` hook,
-so that a run of millions of steps keeps nothing of them.
+the last, the vehicle stood still. `Judge` makes the judgement online, one step at a
+time, through the simulator's `on_move` hook, so that a run of millions of steps keeps
+nothing of them; `judge` gives it a whole record. `World.judge` makes the judge of a
+world's goal (this module knows nothing of worlds, which hold goals).
 
 A region is judged by the vehicle's centre, the pose's point: within a step the centre
 is taken along the chord from one pose to the next, and the heading to turn evenly
@@ -21,13 +22,10 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from itertools import pairwise
-from typing import TYPE_CHECKING, Any, Literal, NamedTuple
+from typing import Any, Literal, NamedTuple
 
 from .geometry import Box, Point, bounding_box, boxes_overlap, inside, segment_nearest
 from .motion import Pose, heading_degrees
-
-if TYPE_CHECKING:
-    from .world import World
 
 GOAL_MISSED = 20
 """The exit status of `rl1c sim` when the program ended but the world's goal was missed
@@ -272,19 +270,15 @@ class _Holding:
 
 
 class Judge:
-    """The goal of `world` judged online from `start` (the simulator's first pose; by
-    default the world's start): `step` for each step of the simulator (its `on_move`
-    hook), then `verdict` with the time the run ended."""
+    """`goal` judged online from `start` (the simulator's first pose) for a vehicle whose
+    camera is `camera_ahead` cm ahead of its centre (World.judge makes one from a world):
+    `step` for each step of the simulator (its `on_move` hook), then `verdict` with the
+    time the run ended."""
 
-    def __init__(self, world: World, start: Pose | None = None) -> None:
-        if world.goal is None:
-            raise ValueError("the world has no [goal] to judge a run by")
-        self.goal = world.goal
-        if start is None:
-            x, y, heading = world.start
-            start = Pose(x, y, math.radians(heading))
+    def __init__(self, goal: Goal, start: Pose, camera_ahead: float) -> None:
+        self.goal = goal
         self.pose = start
-        self.camera_ahead = world.vehicle.camera_ahead
+        self.camera_ahead = camera_ahead
         self.stood_since = 0.0  # when the last step ended: the vehicle stands since
         # The regions' boxes spare a step the polygons it cannot touch (a world may give
         # them 10,000 points), and the nearest approach the distances that cannot win.
@@ -425,11 +419,9 @@ class Judge:
                        time, pose)
 
 
-def judge(world: World, steps: Iterable[Step], ended: float,
-          start: Pose | None = None) -> Verdict:
-    """The verdict of `world`'s goal on a run: the simulator's steps in order, the time
-    (s) the run ended, and where it started (by default the world's start)."""
-    judging = Judge(world, start)
+def judge(judging: Judge, steps: Iterable[Step], ended: float) -> Verdict:
+    """The verdict of `judging` on a run: the simulator's steps in order, and the time
+    (s) the run ended."""
     for step in steps:
         judging.step(*step)
     return judging.verdict(ended)

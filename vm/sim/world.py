@@ -33,7 +33,8 @@ from ..config import (
 )
 from ..config_lines import KeyPath
 from .geometry import Point, rectangle
-from .goal import Goal, Hold, Region
+from .goal import Goal, Hold, Judge, Region
+from .motion import Pose
 
 
 class WorldError(Exception):
@@ -206,6 +207,16 @@ class World:
     noise: Noise = NOISELESS
     time_limit: float = 600.0  # s of simulated time before the run is stopped
     goal: Goal | None = None  # what the run must achieve ([goal]; vm/sim/goal.py)
+
+    def judge(self, start: Pose | None = None) -> Judge:
+        """The judge of this world's goal for a run from `start` (by default the world's
+        start). ValueError when the world has no goal."""
+        if self.goal is None:
+            raise ValueError("the world has no [goal] to judge a run by")
+        if start is None:
+            x, y, heading = self.start
+            start = Pose(x, y, math.radians(heading))
+        return Judge(self.goal, start, self.vehicle.camera_ahead)
 
 
 
