@@ -19,12 +19,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from support import ROOT
 from support.cli import rl1c
+from support.hardware import Relay
 from support.scripts import MOVING_STARTS, scripts
 
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
 from rl1.compiler.strategies import checked_programs
 from rl1.vm import native
-from rl1.vm.device import FormKey, LineLost, Outcome
+from rl1.vm.device import FormKey, Outcome
 from rl1.vm.drive import Stepper, drive
 from rl1.vm.faults import RunResult
 from rl1.vm.hardware import BUSY, Answer, Blocking, Hardware, Status
@@ -104,12 +105,11 @@ PASS, ERROR, BUSY_TWICE, OUT_OF_RANGE, BUSY_OUT_OF_TURN = range(5)
 
 
 @dataclass
-class Flaky:
+class Flaky(Relay):
     """Blocking hardware whose k-th callback does what plan[k] says: pass, answer ERROR,
     answer BUSY twice before the answer (a poll), read values out of every range, or
     answer BUSY where only a poll may (any other callback)."""
 
-    inner: Blocking
     plan: list[int]
     calls: int = 0
     busy: int = 0  # BUSY answers still to give
@@ -163,13 +163,6 @@ class Flaky:
 
     def end(self) -> Answer:
         return self._answer(self.inner.end())
-
-    @property
-    def pending(self) -> LineLost | None:
-        return self.inner.pending
-
-    def take_event(self) -> LineLost | None:
-        return self.inner.take_event()
 
 
 def _flaky_run(machine: Stepper, device: ScriptedDevice) -> Run:

@@ -14,12 +14,13 @@ from dataclasses import dataclass, field
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support.hardware import Relay
 from support.scripts import MOVING_STARTS, scripts
 
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
 from rl1.compiler.strategies import checked_programs
 from rl1.vm import native
-from rl1.vm.device import FormKey, LineLost
+from rl1.vm.device import FormKey
 from rl1.vm.faults import ABORTED_MESSAGE, Fault, FaultKind, RunResult
 from rl1.vm.hardware import Answer, Blocking
 from rl1.vm.machine import Machine, State
@@ -44,11 +45,10 @@ def _compiled(text: str, level: int = 0) -> bytes:
 
 
 @dataclass
-class Aborting:
+class Aborting(Relay):
     """Blocking hardware that calls `abort` from inside its callback number `at` (1 the
     first), as an interrupt handler would while the VM runs; never when `at` is 0."""
 
-    inner: Blocking
     at: int
     abort: list[Machine | native.NativeMachine] = field(default_factory=list)
     calls: int = 0
@@ -70,19 +70,6 @@ class Aborting:
 
     def poll(self) -> Answer:
         return self._count(self.inner.poll())
-
-    def stop(self) -> Answer:
-        return self.inner.stop()
-
-    def end(self) -> Answer:
-        return self.inner.end()
-
-    @property
-    def pending(self) -> LineLost | None:
-        return self.inner.pending
-
-    def take_event(self) -> LineLost | None:
-        return self.inner.take_event()
 
 
 def _run(machine: Machine | native.NativeMachine, device: ScriptedDevice,
@@ -145,39 +132,16 @@ def test_an_abort_between_steps_stops_the_vehicle_at_the_next_step(c_vm: ctypes.
 
 
 @dataclass
-class SteppingAgain:
+class SteppingAgain(Relay):
     """Blocking hardware whose first call steps the machine that called it."""
 
-    inner: Blocking
     machine: list[native.NativeMachine] = field(default_factory=list)
     nested: list[State] = field(default_factory=list)
-
-    def begin(self) -> Answer:
-        return self.inner.begin()
 
     def call(self, form: FormKey, args: tuple[int, ...]) -> Answer:
         if not self.nested:
             self.nested.append(self.machine[0].step(100))
         return self.inner.call(form, args)
-
-    def start(self, form: FormKey, args: tuple[int, ...]) -> Answer:
-        return self.inner.start(form, args)
-
-    def poll(self) -> Answer:
-        return self.inner.poll()
-
-    def stop(self) -> Answer:
-        return self.inner.stop()
-
-    def end(self) -> Answer:
-        return self.inner.end()
-
-    @property
-    def pending(self) -> LineLost | None:
-        return self.inner.pending
-
-    def take_event(self) -> LineLost | None:
-        return self.inner.take_event()
 
 
 def test_a_callback_that_steps_the_c_vm_again_faults_the_step(c_vm: ctypes.CDLL) -> None:
