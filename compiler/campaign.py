@@ -183,9 +183,11 @@ class Campaign:
             self._submit(seed)
         while self._pending:
             record = self._pending[0].result()
-            self._pending.popleft()
+            # The next run is submitted before this one leaves the queue: a broken pool
+            # refuses it, and salvage must still find this record.
             for seed in islice(self._seeds, 1):
                 self._submit(seed)
+            self._pending.popleft()
             yield record
 
     def _submit(self, seed: int) -> None:

@@ -16,7 +16,10 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
+from concurrent.futures import BrokenExecutor, Executor, Future
 from pathlib import Path
+from typing import ParamSpec, TypeVar
 
 import pytest
 from hypothesis import given
@@ -363,3 +366,34 @@ def test_campaign_options_out_of_place_are_usage_errors(
     result = rl1c("sim", program, "--world", world, *extra)
     assert result.exit_code == 2
     assert message in result.stderr
+
+
+P = ParamSpec("P")
+T = TypeVar("T")
+
+
+class BrokenAfter(Executor):
+    """An executor that makes its first `runs` submissions at once, then refuses every
+    other as a pool whose worker died does."""
+
+    def __init__(self, runs: int) -> None:
+        self.left = runs
+
+    def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
+        if self.left == 0:
+            raise BrokenExecutor("a worker process ended abruptly")
+        self.left -= 1
+        future: Future[T] = Future()
+        future.set_result(fn(*args, **kwargs))
+        return future
+
+
+def test_a_run_finished_when_the_pool_breaks_is_kept() -> None:
+    # The pool refused the next submission after the first record left the queue: that
+    # record was neither yielded nor salvaged, and the campaign resumed after it.
+    campaign = Campaign(compiled_wall_task(), range(5), BrokenAfter(2), window=2)
+    made: list[Record] = []
+    with pytest.raises(BrokenExecutor):
+        made.extend(campaign)
+    made.extend(campaign.salvage())
+    assert [record.seed for record in made] == [0, 1]
