@@ -273,12 +273,15 @@ def test_hidden_agrees_with_clipping_the_ray_by_the_prism(
     # The camera is never inside what it sees, nor on its side (a tie: a ray straight
     # down along the side is hidden or not as rounding decides).
     assume(not inside(0.0, 0.0, corners))
-    assume(min(segment_nearest(0.0, 0.0, a, b)[2]
-               for a, b in zip(corners, (*corners[1:], corners[0]), strict=True)) > 1e-6)
+    sides = list(zip(corners, (*corners[1:], corners[0]), strict=True))
+    assume(min(segment_nearest(0.0, 0.0, a, b)[2] for a, b in sides) > 1e-6)
     ahead, left, height = target
     part = _clipped((ahead, left), corners)
     lowest = None if part is None else min(camera + s * (height - camera) for s in part)
-    # Away from the ties (a ray grazing a corner or the top), where rounding decides.
+    # Away from the ties (a ray grazing a corner or the top, a target on a side), where
+    # rounding decides.
+    assume(min(segment_nearest(x, y, (0.0, 0.0), (ahead, left))[2] for x, y in corners) > 1e-6)
+    assume(min(segment_nearest(ahead, left, a, b)[2] for a, b in sides) > 1e-6)
     assume(part is None or part[1] - part[0] > 1e-6)
     assume(lowest is None or abs(lowest - top) > 1e-6)
     found = hidden(np.array([ahead]), np.array([left]), np.array([height]), camera,
