@@ -1,0 +1,104 @@
+// The debugger's marks in the editor: breakpoints in a gutter of their own (a click on
+// a line's gutter sets or clears one, and they move with the text as it is edited), and
+// the line the run is stopped on, highlighted.
+
+import { RangeSet, StateEffect, StateField, EditorState } from "@codemirror/state";
+import { Decoration, DecorationSet, EditorView, GutterMarker, gutter } from "@codemirror/view";
+
+const toggleBreakpoint = StateEffect.define<number>();  // at a line's start
+const setCurrentLine = StateEffect.define<number | null>();  // a 1-based line, or none
+
+class BreakpointMarker extends GutterMarker {
+  override elementClass = "cm-breakpoint";
+  override toDOM() {
+    const dot = document.createElement("span");
+    dot.className = "cm-breakpoint-dot";
+    dot.textContent = "●";
+    return dot;
+  }
+}
+const BREAKPOINT = new BreakpointMarker();
+
+const breakpointField = StateField.define<RangeSet<GutterMarker>>({
+  create: () => RangeSet.empty,
+  update(set, transaction) {
+    set = set.map(transaction.changes);
+    for (const effect of transaction.effects) {
+      if (!effect.is(toggleBreakpoint)) continue;
+      let present = false;
+      set.between(effect.value, effect.value, () => { present = true; });
+      set = present
+        ? set.update({ filter: (from) => from !== effect.value })
+        : set.update({ add: [BREAKPOINT.range(effect.value)] });
+    }
+    return set;
+  },
+});
+
+/** The 1-based lines that have a breakpoint, in order. */
+export function breakpointLines(state: EditorState): number[] {
+  const lines = new Set<number>();
+  for (let cursor = state.field(breakpointField).iter(); cursor.value; cursor.next()) {
+    lines.add(state.doc.lineAt(cursor.from).number);
+  }
+  return [...lines].sort((a, b) => a - b);
+}
+
+/** Sets or clears the breakpoint on a 1-based line. */
+export function toggleBreakpointAt(view: EditorView, line: number): void {
+  view.dispatch({ effects: toggleBreakpoint.of(view.state.doc.line(line).from) });
+}
+
+/** Highlights the line the run is stopped on (1-based), or none. */
+export function showCurrentLine(view: EditorView, line: number | null): void {
+  const valid = line !== null && line >= 1 && line <= view.state.doc.lines ? line : null;
+  view.dispatch({ effects: setCurrentLine.of(valid) });
+  if (valid !== null) {
+    view.dispatch({ effects: EditorView.scrollIntoView(view.state.doc.line(valid).from, { y: "nearest" }) });
+  }
+}
+
+const currentLineMark = Decoration.line({ class: "cm-run-line" });
+
+const currentLineField = StateField.define<DecorationSet>({
+  create: () => Decoration.none,
+  update(marks, transaction) {
+    marks = marks.map(transaction.changes);
+    for (const effect of transaction.effects) {
+      if (effect.is(setCurrentLine)) {
+        marks = effect.value === null ? Decoration.none
+          : Decoration.set([currentLineMark.range(transaction.state.doc.line(effect.value).from)]);
+      }
+    }
+    return marks;
+  },
+  provide: (field) => EditorView.decorations.from(field),
+});
+
+/** The gutter and the highlight; `changed` hears every change of the breakpoints' lines. */
+export function debuggerMarks(changed: (lines: number[]) => void) {
+  let last = "";
+  return [
+    breakpointField,
+    currentLineField,
+    gutter({
+      class: "cm-breakpoint-gutter",
+      markers: (view) => view.state.field(breakpointField),
+      initialSpacer: () => BREAKPOINT,
+      domEventHandlers: {
+        mousedown(view, line) {
+          view.dispatch({ effects: toggleBreakpoint.of(line.from) });
+          return true;
+        },
+      },
+    }),
+    EditorView.updateListener.of((update) => {
+      const lines = breakpointLines(update.state);
+      const now = lines.join(",");
+      if (now !== last) {
+        last = now;
+        changed(lines);
+      }
+    }),
+  ];
+}

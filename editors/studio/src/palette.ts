@@ -1,0 +1,63 @@
+// The palette of built-ins (the paper's Tables 2 and 3, as the server sends them): a
+// button for each form of each call, which inserts the call at the cursor with a field
+// for each argument, named after its parameter (Tab goes to the next).
+
+import { snippet } from "@codemirror/autocomplete";
+import { EditorView } from "@codemirror/view";
+import type { Builtin, Form } from "./protocol";
+
+/** The call as the palette writes it: `(MOV ${l},${r})`, `(CAM P ${pulse})`, `(IMG)`. */
+export function callTemplate(builtin: Builtin, form: Form): string {
+  const head = form.selector === null ? builtin.mnemonic : `${builtin.mnemonic} ${form.selector}`;
+  const args = form.params.map((param) => "${" + param.name + "}").join(",");
+  return args ? `(${head} ${args})` : `(${head})`;
+}
+
+function label(builtin: Builtin, form: Form): string {
+  return callTemplate(builtin, form).replace(/\$\{([^}]*)\}/g, "$1");
+}
+
+function tooltip(builtin: Builtin, form: Form): string {
+  const params = form.params.map((param) => `${param.name}: ${param.meaning}, ${param.low}..${param.high}`);
+  return [`${builtin.name}: ${form.summary}`, ...params,
+          ...(form.result ? [`returns ${form.result}`] : [])].join("\n");
+}
+
+const TABLES: Record<string, string> = {
+  motion: "Table 2: motion",
+  sensing: "Table 3: sensing",
+};
+
+/** Fills `parent` with the buttons; each inserts its call into `editor`. */
+export function showPalette(parent: HTMLElement, builtins: readonly Builtin[],
+                            editor: EditorView): void {
+  parent.replaceChildren();
+  for (const [group, title] of Object.entries(TABLES)) {
+    const heading = document.createElement("div");
+    heading.className = "table";
+    heading.textContent = title;
+    parent.append(heading);
+    for (const builtin of builtins.filter((one) => one.group === group)) {
+      for (const form of builtin.forms) {
+        const button = document.createElement("button");
+        button.type = "button";
+        button.textContent = label(builtin, form);
+        button.title = tooltip(builtin, form);
+        button.dataset.call = label(builtin, form);
+        button.addEventListener("click", () => insertCall(editor, callTemplate(builtin, form)));
+        parent.append(button);
+      }
+    }
+  }
+}
+
+/** Inserts a call at the cursor as a statement: after a `; ` when the line has code
+ * before the cursor, with its first argument selected. */
+export function insertCall(editor: EditorView, template: string): void {
+  const { from, to } = editor.state.selection.main;
+  const line = editor.state.doc.lineAt(from);
+  const before = editor.state.sliceDoc(line.from, from).trimEnd();
+  const separator = before === "" || before.endsWith(";") ? "" : "; ";
+  snippet(separator + template)(editor, null, from, to);
+  editor.focus();
+}
