@@ -1,0 +1,156 @@
+"""`rl1c test`: run the tests of test files (spec/tests.md; compiler/test_file.py reads
+them, compiler/program_tests.py runs them, test_report.py reports them)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import time
+from collections.abc import Iterator, Sequence
+from concurrent.futures import Executor, ProcessPoolExecutor
+from contextlib import contextmanager
+from typing import TYPE_CHECKING
+
+import click
+
+from rl1.compiler.files import SourceError, read_bounded
+from rl1.compiler.reporting.render import EXIT_ERRORS, EXIT_USAGE, ColorChoice, use_color
+
+from .command import PATH, Command, Failure, color_option
+from .sim import at_least_one_or_none
+from .streams import cannot, file_problem, problem_text, unreadable, write_file
+
+if TYPE_CHECKING:  # the test file's schema loads when the command runs
+    from rl1.compiler.test_file import Test
+
+SECTION = "Testing"
+MAX_TEST_FILE_BYTES = 2**20
+TEST_FILE_ROLE = "test file"
+
+
+@click.command(cls=Command)
+@click.argument("paths", nargs=-1, metavar="[PATH]...", type=PATH)
+@click.option("--jobs", type=str, default=None, callback=at_least_one_or_none, metavar="J",
+              help="the processes that make a success rate's runs (default: every core); "
+                   "the results are the same for any J")
+@click.option("--junit", "junit_file", metavar="FILE", type=PATH,
+              help="also write the results as JUnit XML to FILE, for CI")
+@color_option
+def test(paths: tuple[str, ...], jobs: int | None, junit_file: str | None,
+         color: ColorChoice) -> int:
+    """Run the tests of test files: each a program on a world or a sensor script, and
+    what must hold (spec/tests.md).
+
+    PATH is a test file, or a folder searched for files named *.tests.toml (hidden
+    folders left out); the default is the current folder. Prints a character per test
+    (. passed, F failed, E an error: a file missing or invalid, a program with errors),
+    then each failure with the run's story and the command that replays it, and a
+    summary. Exit status: 0 every test passed; 1 a test failed or had an error; 2 a
+    usage problem, or a test file that cannot be read or is not valid."""
+    from rl1.compiler.program_tests import Case, run_test
+    from rl1.compiler.test_file import Success
+
+    from .test_report import MARKS, Result, junit_xml, story_text, summary_line
+
+    cases = [Case(file, test) for file, tests in _load(paths or (".",)) for test in tests]
+    workers = jobs or os.cpu_count() or 1
+    color_on = use_color(color, sys.stdout)
+    started = time.perf_counter()
+    results: list[Result] = []
+    campaigns = any(isinstance(case.test.expect.success, Success) for case in cases)
+    with _executor(workers if campaigns else 1) as executor:
+        file = None
+        for case in cases:
+            if case.file != file:
+                sys.stdout.write(("\n" if file is not None else "") + f"{case.file} ")
+                file = case.file
+            results.append(Result(case, run_test(case, executor, workers)))
+            sys.stdout.write(MARKS[results[-1].outcome.status])
+            sys.stdout.flush()
+    seconds = time.perf_counter() - started
+    sys.stdout.write("\n")
+    unpassed = [result for result in results if result.outcome.status != "passed"]
+    if unpassed:
+        sys.stdout.write(f"\n{' FAILURES ':=^60}\n")
+        for result in unpassed:
+            sys.stdout.write(story_text(result, workers, color=color_on))
+    sys.stdout.write(f"{' ' + summary_line(results, seconds) + ' ':=^60}\n")
+    if junit_file is not None:
+        write_file(junit_file, junit_xml(results, seconds, workers), role="JUnit file")
+    return EXIT_ERRORS if unpassed else 0
+
+
+def _load(paths: Sequence[str]) -> list[tuple[str, list[Test]]]:
+    """The tests of each test file `paths` name (each file, or the test files in each
+    folder); a Failure (exit status 2) naming every file that cannot be read or used."""
+    from rl1.compiler.test_file import load_test_file
+    from rl1.vm.config import ConfigError
+
+    loaded = []
+    problems = []
+    for file in _test_files(paths):
+        try:
+            loaded.append((file, load_test_file(read_bounded(
+                file, MAX_TEST_FILE_BYTES, "a test file"), file).test))
+        except SourceError as error:
+            problems.append(unreadable(file, error, TEST_FILE_ROLE))
+        except ConfigError as error:
+            problems.append(file_problem(file, f"the {TEST_FILE_ROLE} `{file}` is not "
+                                               f"valid: {error}",
+                                         "correct it as spec/tests.md describes"))
+    if problems:
+        raise Failure("\n".join(problem_text(problem) for problem in problems), EXIT_USAGE)
+    return loaded
+
+
+def _test_files(paths: Sequence[str]) -> list[str]:
+    """Each file of `paths` as given, and for each folder its test files, in sorted
+    order (hidden files and folders left out)."""
+    from rl1.compiler.test_file import TEST_FILE_SUFFIX, is_test_file
+
+    files: list[str] = []
+    for path in paths:
+        if not os.path.isdir(path):
+            files.append(path)
+            continue
+        found = []
+        unlisted: list[OSError] = []
+        for folder, folders, names in os.walk(path, onerror=unlisted.append):
+            folders[:] = sorted(name for name in folders if not name.startswith("."))
+            found += [os.path.normpath(os.path.join(folder, name)) for name in sorted(names)
+                      if is_test_file(name) and not name.startswith(".")
+                      and os.path.isfile(os.path.join(folder, name))]
+        if unlisted:
+            error = unlisted[0]
+            folder = str(error.filename or path)
+            raise Failure(problem_text(file_problem(folder, cannot(
+                "list", "folder", folder, str(error.strerror or error)),
+                "check its permissions")), EXIT_USAGE)
+        if not found:
+            raise Failure(f"rl1c test: error: no test file (*{TEST_FILE_SUFFIX}) in "
+                          f"`{path}` or below it; write one as spec/tests.md describes, "
+                          "or start a project with one: `rl1c new DIR`", EXIT_USAGE)
+        files += found
+    return files
+
+
+def _ignore_interrupts() -> None:
+    # Ctrl-C reaches the whole process group: the command ends its workers itself.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@contextmanager
+def _executor(jobs: int) -> Iterator[Executor | None]:
+    """Worker processes for the success rates' runs; None (this process) for one job."""
+    if jobs == 1:
+        yield None
+        return
+    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_interrupts)
+    try:
+        yield pool
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+COMMANDS = (test,)
