@@ -11,12 +11,15 @@ whose message reads `file:line: where: what is wrong; what to write`
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import cache
 from typing import Annotated, Any
 
 import msgspec
+import msgspec.inspect as mi
 from msgspec import UNSET, Meta, Struct, UnsetType
 
 from ..config import (
@@ -35,6 +38,18 @@ from ..config_lines import KeyPath
 from .geometry import Point, rectangle
 from .goal import Goal, Hold, Judge, Region
 from .motion import Pose
+from .vary import (
+    Parameter,
+    Varied,
+    VaryTable,
+    check_bounds,
+    distribution,
+    entries,
+    key_of,
+    split_key,
+    uniform_draw,
+    wrong_key,
+)
 
 
 class WorldError(Exception):
@@ -207,6 +222,7 @@ class World:
     noise: Noise = NOISELESS
     time_limit: float = 600.0  # s of simulated time before the run is stopped
     goal: Goal | None = None  # what the run must achieve ([goal]; vm/sim/goal.py)
+    varied: tuple[Varied, ...] = ()  # what each run draws ([vary]; vm/sim/vary.py)
 
     def judge(self, start: Pose | None = None) -> Judge:
         """The judge of this world's goal for a run from `start` (by default the world's
@@ -217,6 +233,94 @@ class World:
             x, y, heading = self.start
             start = Pose(x, y, math.radians(heading))
         return Judge(self.goal, start, self.vehicle.camera_ahead)
+
+    def parameter(self, key: str) -> Parameter:
+        """The value `key` names (`start.x`, `stands.NAME.facing`, `vehicle.k1`,
+        `noise.slip`) and its range; ValueError saying why when it names none."""
+        table, name, field = split_key(key)
+        if table == "start" and field in _START_FIELDS:
+            index = _START_FIELDS.index(field)
+            low, high = _float_range(StartTable, field)
+            if index < 2:  # on the floor
+                low, high = max(low, 0.0), min(high, self.floor[index])
+            return Parameter(self.start[index], low, high)
+        if table == "stands" and field in _STAND_FIELDS:
+            stand = next((stand for stand in self.stands if stand.name == name), None)
+            if stand is None:
+                names = ", ".join(f'"{stand.name}"' for stand in self.stands)
+                raise ValueError(f'no stand is named "{name}"; ' + (
+                    f"name one of {names}" if names else "the world has no [[stands]]"))
+            return Parameter(getattr(stand, field), *_float_range(StandTable, field))
+        settings: Vehicle | Noise = self.vehicle if table == "vehicle" else self.noise
+        if table in ("vehicle", "noise") and field in settings.__struct_fields__:
+            if not isinstance(getattr(settings, field), float):
+                raise ValueError("a whole number, which is never drawn nor swept; set "
+                                 "it in the world")
+            low, high = _float_range(type(settings), field)
+            if field == "trace_interval":  # a run's ticks are bounded
+                low = max(low, self.time_limit / MAX_TICKS)
+            return Parameter(getattr(settings, field), low, high)
+        fields = {"start": _START_FIELDS, "stands": _STAND_FIELDS}.get(
+            table, tuple(name for name in settings.__struct_fields__
+                         if isinstance(getattr(settings, name), float)))
+        raise ValueError(f"unknown key; expected one of {', '.join(fields)}")
+
+    def moved(self, offsets: Mapping[str, float]) -> World:
+        """This world with the parameters of `offsets` moved by them (cm, degrees, or the
+        setting's unit), a hold's marker with its stand; ValueError when one would leave
+        its range."""
+        start = list(self.start)
+        stands = {stand.name: stand for stand in self.stands}
+        settings: dict[str, dict[str, float]] = {"vehicle": {}, "noise": {}}
+        for key, offset in offsets.items():
+            parameter = self.parameter(key)
+            value = parameter.value + offset
+            slack = 1e-9 * max(1.0, abs(parameter.low), abs(parameter.high))  # rounding
+            if not parameter.low - slack <= value <= parameter.high + slack:
+                raise ValueError(f"{key}: {parameter.value:g} moved by {offset:+g} is "
+                                 f"{value:g}, outside {parameter.low:g}..{parameter.high:g}")
+            value = min(parameter.high, max(parameter.low, value))
+            table, name, field = split_key(key)
+            if table == "start":
+                start[_START_FIELDS.index(field)] = value
+            elif name is not None:
+                stands[name] = dataclasses.replace(stands[name], **{field: value})
+            else:
+                settings[table][field] = value
+        goal = self.goal
+        if goal is not None:
+            goal = dataclasses.replace(goal, holds=tuple(
+                dataclasses.replace(hold, marker=stands[hold.stand].marker())
+                for hold in goal.holds))
+        return dataclasses.replace(
+            self, start=(start[0], start[1], start[2]), stands=tuple(stands.values()),
+            vehicle=msgspec.structs.replace(self.vehicle, **settings["vehicle"]),
+            noise=msgspec.structs.replace(self.noise, **settings["noise"]), goal=goal)
+
+    def drawn(self, seed: int) -> tuple[World, dict[str, float]]:
+        """This world as the run of `seed` has it, each [vary] parameter drawn, and the
+        values drawn (each parameter's value in the run)."""
+        offsets = {}
+        for varied in self.varied:
+            parameter = self.parameter(varied.key)
+            offsets[varied.key] = varied.distribution.draw(
+                uniform_draw(seed, varied.key), parameter.low - parameter.value,
+                parameter.high - parameter.value)
+        world = self.moved(offsets)
+        return world, {key: world.parameter(key).value for key in offsets}
+
+
+_START_FIELDS = ("x", "y", "heading")
+_STAND_FIELDS = ("x", "y", "facing")
+
+
+@cache
+def _float_range(schema: type[Struct], field: str) -> tuple[float, float]:
+    """The range a number of the world file's `schema` may take."""
+    info = next(info for info in mi.type_info(schema).fields if info.encode_name == field)
+    kind = info.type.type if isinstance(info.type, mi.Metadata) else info.type
+    assert isinstance(kind, mi.FloatType) and kind.ge is not None and kind.le is not None
+    return kind.ge, kind.le
 
 
 
@@ -365,6 +469,7 @@ class WorldFile(Struct, forbid_unknown_fields=True, kw_only=True):
     noise: Noise | bool = False  # true: Noise's defaults; false: NOISELESS
     limits: LimitsTable = msgspec.field(default_factory=LimitsTable)
     goal: GoalTable | UnsetType = UNSET
+    vary: VaryTable = msgspec.field(default_factory=VaryTable)
 
 
 def decode_world(data: bytes, name: str) -> World:
@@ -455,12 +560,35 @@ class _World:
                 self.count(len(block.points), (kind, i, "points"))
                 blocks.append(Block(_named(block.name, place(block.points)),
                                     tuple(block.points), block.height, kind[:-1]))
-        return World(floor=floor, start=(start.x, start.y, start.heading),
-                     vehicle=file.vehicle, lines=tuple(lines), marks=tuple(marks),
-                     stands=tuple(stands), blocks=tuple(blocks), scenes=self.scenes(),
-                     ports=self.ports(), fuzzy=(file.fuzzy.s, file.fuzzy.t),
-                     noise=self.noise(), time_limit=file.limits.time,
-                     goal=self.goal(stands))
+        world = World(floor=floor, start=(start.x, start.y, start.heading),
+                      vehicle=file.vehicle, lines=tuple(lines), marks=tuple(marks),
+                      stands=tuple(stands), blocks=tuple(blocks), scenes=self.scenes(),
+                      ports=self.ports(), fuzzy=(file.fuzzy.s, file.fuzzy.t),
+                      noise=self.noise(), time_limit=file.limits.time,
+                      goal=self.goal(stands))
+        return dataclasses.replace(world, varied=self.varied(world))
+
+    def varied(self, world: World) -> tuple[Varied, ...]:
+        """The [vary] table's entries, each a parameter of `world` whose draws stay
+        within its range."""
+        found = []
+        for path, entry in entries(self.file.vary):
+            where: KeyPath = ("vary", *path)
+            try:
+                spread = distribution(entry)
+            except ValueError as error:
+                raise self.fail((*where, wrong_key(error)) if wrong_key(error) else where,
+                                str(error)) from None
+            try:
+                parameter = world.parameter(key_of(path))
+            except ValueError as error:
+                raise self.fail(where, str(error)) from None
+            problem = check_bounds(spread, parameter.low - parameter.value,
+                                   parameter.high - parameter.value)
+            if problem is not None:
+                raise self.fail(where, problem)
+            found.append(Varied(key_of(path), spread))
+        return tuple(found)
 
     def noise(self) -> Noise:
         match self.file.noise:
