@@ -49,13 +49,14 @@ export function toggleBreakpointAt(view: EditorView, line: number): void {
   view.dispatch({ effects: toggleBreakpoint.of(view.state.doc.line(line).from) });
 }
 
-/** Highlights the line the run is stopped on (1-based), or none. */
-export function showCurrentLine(view: EditorView, line: number | null): void {
+/** Highlights the line the run is on (1-based), or none; `scroll` brings it into view. */
+export function showCurrentLine(view: EditorView, line: number | null, scroll: boolean): void {
   const valid = line !== null && line >= 1 && line <= view.state.doc.lines ? line : null;
-  view.dispatch({ effects: setCurrentLine.of(valid) });
-  if (valid !== null) {
-    view.dispatch({ effects: EditorView.scrollIntoView(view.state.doc.line(valid).from, { y: "nearest" }) });
-  }
+  view.dispatch({
+    effects: [setCurrentLine.of(valid),
+              ...(scroll && valid !== null
+                ? [EditorView.scrollIntoView(view.state.doc.line(valid).from, { y: "nearest" })] : [])],
+  });
 }
 
 const currentLineMark = Decoration.line({ class: "cm-run-line" });

@@ -52,7 +52,7 @@ function token(stream: StringStream, state: State, facts: LanguageFacts): string
     if (state.previous === "lpar") {
       state.previous = "mnemonic";
       state.mnemonic = text.toUpperCase();
-      return facts.selectors.has(state.mnemonic) ? "builtinCall" : "function";
+      return facts.selectors.has(state.mnemonic) ? "builtinCall" : "variableName.function";
     }
     const selectors = state.previous === "mnemonic" ? facts.selectors.get(state.mnemonic) : null;
     state.previous = "operand";

@@ -1,32 +1,26 @@
 // The studio's page: the program's editor on the language server, the palette of
-// built-ins, the world with the vehicle moving, the world file, and the debugger. All
-// it knows comes from the server over two WebSockets (spec/studio.md): the language
-// server's session at /lsp, and the studio's protocol.
+// built-ins, the world with the vehicle moving and its file, and the debugger. All it
+// knows comes from the server over two WebSockets (spec/studio.md): the language
+// server's session at /lsp, and the studio's protocol at /studio.
 
 import "./studio.css";
 import { EditorState } from "@codemirror/state";
-import { EditorView, keymap, lineNumbers, highlightActiveLine, drawSelection } from "@codemirror/view";
+import { EditorView, drawSelection, highlightActiveLine, keymap, lineNumbers } from "@codemirror/view";
 import { defaultKeymap, history, historyKeymap, indentWithTab } from "@codemirror/commands";
-import { syntaxHighlighting, bracketMatching } from "@codemirror/language";
+import { bracketMatching, syntaxHighlighting } from "@codemirror/language";
 import { lintGutter, setDiagnostics } from "@codemirror/lint";
-import { closeBrackets, autocompletion } from "@codemirror/autocomplete";
+import { autocompletion, closeBrackets } from "@codemirror/autocomplete";
 import { rl1Highlight, rl1Language } from "./language";
 import { openSocket, studioClient, webSocketTransport } from "./lsp";
 import { debuggerMarks, showCurrentLine } from "./breakpoints";
 import { showPalette } from "./palette";
 import { WorldView } from "./world";
 import { DebugPane } from "./debugPane";
-import { StudioConnection } from "./protocol";
-import type { Builtin, Frame, Geometry, Stopped } from "./protocol";
-
-interface Opened {
-  file: string;
-  uri: string;
-  text: string;
-  builtins: Builtin[];
-  reserved: string[];
-  world: { file: string; text: string; geometry: Geometry | null; errors: string[] };
-}
+import { Sensors } from "./sensors";
+import {
+  Binding, Builtin, CheckDiagnostic, Ended, FileEntry, FileText, Frame, Hello, INVALID_CONFIGURATION,
+  Launched, PROGRAM_HAS_ERRORS, Progress, Stopped, StudioConnection, StudioError, WorldCheck,
+} from "./protocol";
 
 const byId = <T extends HTMLElement = HTMLElement>(id: string): T => {
   const found = document.getElementById(id);
@@ -40,6 +34,21 @@ function say(text: string, problem = false): void {
   status.classList.toggle("problem", problem);
 }
 
+/** A file: URI of a path relative to the served folder. */
+const fileUri = (rootUri: string, path: string): string =>
+  `${rootUri.replace(/\/$/, "")}/${path.split("/").map(encodeURIComponent).join("/")}`;
+
+/** The page's address names the files it shows after `#`: `#program=a.rob&world=a.world.toml`. */
+const chosen = new URLSearchParams(location.hash.slice(1));
+
+function fillSelect(select: HTMLSelectElement, paths: string[], current: string | null, none?: string): void {
+  const options = [...(none === undefined ? [] : [[none, ""]]), ...paths.map((path) => [path, path])];
+  if (current !== null && !paths.includes(current)) options.push([current, current]);
+  select.replaceChildren(...options.map(([label, value]) => new Option(label, value, false, value === (current ?? ""))));
+}
+
+type RunState = "none" | "running" | "stopped" | "ended";
+
 async function start(): Promise<void> {
   const token = new URLSearchParams(location.search).get("token") ?? "";
   const base = `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}`;
@@ -47,45 +56,64 @@ async function start(): Promise<void> {
   const [studioSocket, lspSocket] = await Promise.all([
     openSocket(`${base}/studio${query}`), openSocket(`${base}/lsp${query}`)]);
   const studio = new StudioConnection(studioSocket, (why) => say(`disconnected: ${why}`, true));
-  const opened = await studio.request<Opened>("open");
+  const hello = await studio.request<Hello>("initialize");
+  const [{ files }, { builtins }] = await Promise.all([
+    studio.request<{ files: FileEntry[] }>("files/list"), studio.request<{ builtins: Builtin[] }>("palette")]);
+  const paths = (kind: FileEntry["kind"]) => files.filter((file) => file.kind === kind).map((file) => file.path);
+  const programPath = chosen.get("program") ?? hello.program ?? paths("program")[0] ?? "program.rob";
+  let worldPath: string | null = chosen.has("world") ? chosen.get("world") || null : hello.world;
+  const program = files.some((file) => file.path === programPath)
+    ? await studio.request<FileText>("files/read", { path: programPath })
+    : { path: programPath, text: "", encoding: "utf-8" as const };
 
   const client = studioClient(
     (count) => { byId("editor").dataset.diagnostics = String(count); },
     (message) => say(message, true));
   client.connect(webSocketTransport(lspSocket));
-  lspSocket.addEventListener("close", () => say("the language server's connection closed", true));
+  lspSocket.addEventListener("close", () => say("the language server's connection closed: reload the page", true));
 
+  // Which names are built-ins, which take a selector, which variables calls set: the palette's.
   const facts = {
-    selectors: new Map(opened.builtins.map((builtin) => [
+    selectors: new Map(builtins.map((builtin) => [
       builtin.mnemonic, new Set(builtin.forms.flatMap((form) => form.selector ? [form.selector] : []))])),
-    reserved: new Set(opened.reserved),
+    reserved: new Set(builtins.flatMap((builtin) => builtin.forms.flatMap((form) => form.writes))),
   };
-  let breakpoints: number[] = [];
-  const fileName = byId("file");
-  fileName.textContent = opened.file;
-  let savedText = opened.text;
 
+  // The program.
+  const programSelect = byId<HTMLSelectElement>("program-file");
+  fillSelect(programSelect, paths("program"), programPath);
+  let savedText = program.text;
+  const markUnsaved = (text: string) => programSelect.classList.toggle("unsaved", text !== savedText);
   const save = async (): Promise<void> => {
     const text = editor.state.doc.toString();
     try {
-      await studio.request("save", { text });
+      await studio.request("files/save", { path: programPath, text, encoding: program.encoding });
       savedText = text;
-      fileName.classList.toggle("unsaved", false);
-      say(`saved ${opened.file}`);
+      markUnsaved(text);
+      say(`saved ${programPath}`);
     } catch (error) {
-      say(String((error as Error).message), true);
+      say((error as Error).message, true);
     }
   };
-
+  let breakpoints: number[] = [];
+  const sendBreakpoints = async (): Promise<void> => {
+    const answer = await studio.request<{ breakpoints: Binding[] | null }>(
+      "debug/setBreakpoints", { lines: breakpoints.map((line) => ({ line })) });
+    reportBindings(answer.breakpoints ?? []);
+  };
+  const reportBindings = (bindings: Binding[]): void => {
+    const refused = bindings.filter((binding) => !binding.verified);
+    if (refused.length) say(refused.map((binding) => `breakpoint on line ${binding.line}: ${binding.message}`).join("; "), true);
+  };
   const editor = new EditorView({
     parent: byId("editor"),
     state: EditorState.create({
-      doc: opened.text,
+      doc: program.text,
       extensions: [
         lineNumbers(),
         debuggerMarks((lines) => {
           breakpoints = lines;
-          void studio.request("breakpoints", { lines });
+          sendBreakpoints().catch((error: Error) => say(error.message, true));
         }),
         lintGutter(),
         history(),
@@ -98,84 +126,194 @@ async function start(): Promise<void> {
         syntaxHighlighting(rl1Highlight),
         keymap.of([{ key: "Mod-s", run: () => { void save(); return true; } },
                    ...defaultKeymap, ...historyKeymap, indentWithTab]),
-        client.plugin(opened.uri, "rl1"),
+        client.plugin(fileUri(hello.rootUri, programPath), "rl1"),
         EditorView.updateListener.of((update) => {
-          if (update.docChanged) fileName.classList.toggle("unsaved", update.state.doc.toString() !== savedText);
+          if (update.docChanged) markUnsaved(update.state.doc.toString());
         }),
       ],
     }),
   });
   byId("save").addEventListener("click", () => void save());
-  showPalette(byId("palette"), opened.builtins, editor);
+  programSelect.addEventListener("change", () => {
+    if (editor.state.doc.toString() !== savedText && !confirm(`${programPath} has unsaved changes: leave them?`)) {
+      programSelect.value = programPath;
+      return;
+    }
+    chosen.set("program", programSelect.value);
+    location.hash = chosen.toString();
+    location.reload();
+  });
+  showPalette(byId("palette"), builtins, editor);
 
-  // The world, and its file.
+  // The world, and its file: checked as it is edited, drawn while it is valid.
   const world = new WorldView(byId("world") as unknown as SVGSVGElement, byId("world-clock"));
-  if (opened.world.geometry) world.show(opened.world.geometry);
-  byId("world-name").textContent = opened.world.file;
+  const worldSelect = byId<HTMLSelectElement>("world-name");
+  fillSelect(worldSelect, paths("world"), worldPath, "no world (the scripted device)");
   const worldErrors = byId("world-errors");
-  const showWorldErrors = (errors: string[]): void => {
-    worldErrors.replaceChildren(...errors.map((text) => {
-      const item = document.createElement("li");
-      item.textContent = text;
-      return item;
-    }));
-    byId("world-file").toggleAttribute("open", errors.length > 0 || byId("world-file").hasAttribute("open"));
-  };
-  showWorldErrors(opened.world.errors);
   const worldEditor = new EditorView({
     parent: byId("world-editor"),
     state: EditorState.create({
-      doc: opened.world.text,
       extensions: [lineNumbers(), history(), drawSelection(), lintGutter(),
-                   keymap.of([...defaultKeymap, ...historyKeymap])],
+                   keymap.of([...defaultKeymap, ...historyKeymap]),
+                   EditorView.updateListener.of((update) => { if (update.docChanged) scheduleWorldCheck(); })],
     }),
   });
-  byId("world-apply").addEventListener("click", async () => {
-    const result = await studio.request<{ geometry: Geometry | null; errors: { line: number; message: string }[] }>(
-      "world", { text: worldEditor.state.doc.toString() });
-    showWorldErrors(result.errors.map((error) => error.message));
-    worldEditor.dispatch(setDiagnostics(worldEditor.state, result.errors.map((error) => {
-      const line = worldEditor.state.doc.line(Math.min(Math.max(error.line, 1), worldEditor.state.doc.lines));
+  const showWorldErrors = (check: WorldCheck): void => {
+    worldErrors.replaceChildren(...check.errors.map((error) => {
+      const item = document.createElement("li");
+      item.textContent = error.message;
+      return item;
+    }));
+    const doc = worldEditor.state.doc;
+    worldEditor.dispatch(setDiagnostics(worldEditor.state, check.errors.map((error) => {
+      const line = doc.line(Math.min(Math.max(error.line ?? 1, 1), doc.lines));
       return { from: line.from, to: line.to, severity: "error", message: error.message };
     })));
-    if (result.geometry) world.show(result.geometry);
+    if (check.errors.length) byId("world-file").setAttribute("open", "");
+  };
+  let worldCheck = 0;
+  const checkWorld = async (): Promise<void> => {
+    if (worldPath === null) return;
+    const asked = ++worldCheck;
+    const check = await studio.request<WorldCheck>("world/check", { text: worldEditor.state.doc.toString(), path: worldPath });
+    if (asked !== worldCheck) return;  // edited since
+    showWorldErrors(check);
+    if (check.geometry) world.show(check.geometry);
+  };
+  let worldTimer = -1;
+  const scheduleWorldCheck = (): void => {
+    clearTimeout(worldTimer);
+    worldTimer = window.setTimeout(() => checkWorld().catch((error: Error) => say(error.message, true)), 250);
+  };
+  const openWorld = async (path: string | null): Promise<void> => {
+    worldPath = path;
+    byId("world-pane").classList.toggle("no-world", path === null);
+    const text = path === null ? "" : (await studio.request<FileText>("files/read", { path })).text;
+    worldEditor.dispatch({ changes: { from: 0, to: worldEditor.state.doc.length, insert: text } });
+    clearTimeout(worldTimer);
+    await checkWorld();
+  };
+  await openWorld(worldPath);
+  worldSelect.addEventListener("change", () => {
+    chosen.set("world", worldSelect.value);
+    window.history.replaceState(null, "", `#${chosen.toString()}`);
+    openWorld(worldSelect.value || null).catch((error: Error) => say(error.message, true));
+  });
+  byId("world-save").addEventListener("click", async () => {
+    if (worldPath === null) return;
+    try {
+      await studio.request("files/save", { path: worldPath, text: worldEditor.state.doc.toString() });
+      say(`saved ${worldPath}`);
+    } catch (error) {
+      say((error as Error).message, true);
+    }
   });
 
   // The debugger.
   const pane = new DebugPane(byId("stop"), byId("variables"), byId("device"),
                              byId<HTMLOListElement>("trace"), facts.reserved);
-  studio.on("frame", (frame: Frame) => world.frame(frame));
-  studio.on("stopped", (stopped: Stopped) => {
-    pane.show(stopped);
-    showCurrentLine(editor, stopped.reason === "end" ? null : stopped.line);
-    setRunning(false);
-  });
-  const controls = ["run", "pause", "step-line", "step-instruction", "continue", "restart"];
-  const setRunning = (running: boolean): void => {
-    for (const name of controls) {
-      (byId(name) as HTMLButtonElement).disabled = name === "pause" ? !running : running;
+  const sensors = new Sensors(byId("plots"), byId<HTMLCanvasElement>("camera"), byId("camera-caption"));
+  let state: RunState = "none";
+  const controls: Record<string, RunState[]> = {
+    run: ["none", "stopped", "ended"], pause: ["running"], "step-line": ["none", "stopped", "ended"],
+    "step-instruction": ["none", "stopped", "ended"], continue: ["none", "stopped", "ended"],
+    restart: ["running", "stopped", "ended"],
+  };
+  const setState = (now: RunState): void => {
+    state = now;
+    for (const [name, enabled] of Object.entries(controls)) byId<HTMLButtonElement>(name).disabled = !enabled.includes(now);
+    document.body.dataset.run = now;
+  };
+  setState("none");
+  let shownLine: number | null = null;
+  const progress = (notice: Progress): void => {
+    if (notice.frame) world.frame(notice.frame);
+    world.events(notice.events);
+    sensors.add(notice.trace, notice.frame);
+  };
+  studio.on("run/frame", (frame: Progress) => {
+    progress(frame);
+    pane.progress(frame);
+    const line = (frame.frame as Frame | null)?.line ?? null;
+    if (line !== shownLine) {
+      shownLine = line;
+      showCurrentLine(editor, line, false);
     }
-    document.body.dataset.running = String(running);
+  });
+  studio.on("run/stopped", (stopped: Stopped) => {
+    progress(stopped);
+    pane.stopped(stopped);
+    shownLine = stopped.line;
+    showCurrentLine(editor, stopped.line, true);
+    setState("stopped");
+  });
+  studio.on("run/ended", (ended: Ended) => {
+    progress(ended);
+    pane.ended(ended);
+    shownLine = ended.status?.line ?? null;
+    showCurrentLine(editor, shownLine, true);
+    setState("ended");
+  });
+  const speedSelect = byId<HTMLSelectElement>("speed");
+  const speed = (): number | null => speedSelect.value === "" ? null : Number(speedSelect.value);
+  speedSelect.addEventListener("change", () => {
+    if (state !== "none") studio.request("debug/setSpeed", { speed: speed() }).catch((error: Error) => say(error.message, true));
+  });
+
+  const launch = async (stopOnEntry: boolean): Promise<void> => {
+    world.reset();
+    pane.clear();
+    sensors.clear();
+    showCurrentLine(editor, null, false);
+    const launched = await studio.request<Launched>("run/launch", {
+      program: { text: editor.state.doc.toString(), name: programPath },
+      ...(worldPath === null ? {} : { world: { text: worldEditor.state.doc.toString(), name: worldPath } }),
+      speed: speed(),
+      stopOnEntry,
+    });
+    reportBindings(launched.breakpoints);
   };
-  setRunning(false);
-  const speed = byId<HTMLSelectElement>("speed");
+  const commands: Record<string, () => Promise<unknown>> = {
+    run: () => launch(false),
+    pause: () => studio.request("debug/pause"),
+    "step-line": () => state === "stopped" ? studio.request("debug/stepLine") : launch(true),
+    "step-instruction": () => state === "stopped" ? studio.request("debug/stepInstruction") : launch(true),
+    continue: () => state === "stopped" ? studio.request("debug/continue", { speed: speed() }) : launch(false),
+    restart: () => studio.request("debug/restart"),
+  };
   const command = (name: string): void => {
-    if (name !== "pause") setRunning(true);
-    if (name === "run" || name === "restart") world.reset();
-    studio.request(name, { text: editor.state.doc.toString(), breakpoints, speed: Number(speed.value) })
-      .catch((error: Error) => { say(error.message, true); setRunning(false); });
+    if (!controls[name].includes(state)) return;
+    const before = state;
+    if (name !== "pause") setState("running");  // before the answer, which a stop may precede
+    say("");
+    commands[name]().catch((error: Error) => {
+      if (state === "running") setState(before);
+      explain(error);
+    });
   };
-  for (const name of controls) byId(name).addEventListener("click", () => command(name));
-  speed.addEventListener("change", () => void studio.request("speed", { speed: Number(speed.value) }));
+  const explain = (error: Error): void => {
+    if (error instanceof StudioError && error.code === PROGRAM_HAS_ERRORS) {
+      const { diagnostics } = error.data as { diagnostics: CheckDiagnostic[] };
+      const first = diagnostics.find((diagnostic) => diagnostic.severity === "error") ?? diagnostics[0];
+      say(first ? `the program cannot run: line ${first.line}: ${first.message} [${first.code}]` : error.message, true);
+    } else if (error instanceof StudioError && error.code === INVALID_CONFIGURATION) {
+      const { errors } = error.data as WorldCheck;
+      showWorldErrors({ errors, geometry: null });
+      say(`the world cannot be used: ${errors[0]?.message ?? error.message}`, true);
+    } else {
+      say(error.message, true);
+    }
+  };
+  for (const name of Object.keys(controls)) byId(name).addEventListener("click", () => command(name));
+  const keys: Record<string, string> = { F5: "run", F6: "pause", F10: "step-line", F11: "step-instruction" };
   document.addEventListener("keydown", (event) => {
-    const key = { F5: "run", F6: "pause", F10: "step-line", F11: "step-instruction" }[event.key];
-    if (key) {
+    if (keys[event.key]) {
       event.preventDefault();
-      command(key);
+      command(keys[event.key]);
     }
   });
   document.body.dataset.ready = "true";
-  say("ready");
+  say(`serving ${hello.folder}`);
 }
 
 start().catch((error: Error) => say(`the studio cannot start: ${error.message}`, true));

@@ -1,20 +1,14 @@
 // The palette of built-ins (the paper's Tables 2 and 3, as the server sends them): a
-// button for each form of each call, which inserts the call at the cursor with a field
-// for each argument, named after its parameter (Tab goes to the next).
+// button for each form of each call, which inserts the call's snippet at the cursor, a
+// field for each argument named after its parameter (Tab goes to the next).
 
 import { snippet } from "@codemirror/autocomplete";
 import { EditorView } from "@codemirror/view";
 import type { Builtin, Form } from "./protocol";
 
-/** The call as the palette writes it: `(MOV ${l},${r})`, `(CAM P ${pulse})`, `(IMG)`. */
-export function callTemplate(builtin: Builtin, form: Form): string {
-  const head = form.selector === null ? builtin.mnemonic : `${builtin.mnemonic} ${form.selector}`;
-  const args = form.params.map((param) => "${" + param.name + "}").join(",");
-  return args ? `(${head} ${args})` : `(${head})`;
-}
-
-function label(builtin: Builtin, form: Form): string {
-  return callTemplate(builtin, form).replace(/\$\{([^}]*)\}/g, "$1");
+/** The call as a button shows it: the snippet with its tab stops' names, `(MOV l,r)`. */
+export function callLabel(form: Form): string {
+  return form.snippet.replace(/\$\{\d+:([^}]*)\}/g, "$1").replace(/\$\{?\d+\}?/g, "");
 }
 
 function tooltip(builtin: Builtin, form: Form): string {
@@ -41,10 +35,9 @@ export function showPalette(parent: HTMLElement, builtins: readonly Builtin[],
       for (const form of builtin.forms) {
         const button = document.createElement("button");
         button.type = "button";
-        button.textContent = label(builtin, form);
+        button.textContent = callLabel(form);
         button.title = tooltip(builtin, form);
-        button.dataset.call = label(builtin, form);
-        button.addEventListener("click", () => insertCall(editor, callTemplate(builtin, form)));
+        button.addEventListener("click", () => insertCall(editor, form.snippet));
         parent.append(button);
       }
     }

@@ -1,35 +1,116 @@
-// The studio's protocol (spec/studio.md): the page's one connection to the server besides
-// the language server's, a WebSocket of JSON messages, and the shapes of its data.
+// The studio's protocol (spec/studio.md, "/studio"): JSON-RPC 2.0 over a WebSocket, one
+// message a text frame, and the shapes of its data as that page gives them.
 
 export type Point = [number, number];
+/** x, y (cm), heading (degrees, counterclockwise from +x). */
+export type Pose = [number, number, number];
 
-export interface Param { name: string; low: number; high: number; meaning: string }
-export interface Form { selector: string | null; params: Param[]; summary: string; result: string | null; writes: string[] }
-export interface Builtin { mnemonic: string; name: string; group: string; forms: Form[] }
-
-export interface Geometry {
-  floor: Point;
-  start: Frame;
-  lines: { name: string; width: number; points: Point[] }[];
-  marks: { name: string; points: Point[] }[];
-  blocks: { name: string; points: Point[] }[];
-  stands: { name: string; corners: Point[]; marker: Point }[];
-  vehicle: { outline: Point[] };
+export interface Hello {
+  version: string;
+  folder: string;
+  rootUri: string;
+  program: string | null;
+  world: string | null;
+  levels: number[];
+  defaultLevel: number;
+  maxFramesPerSecond: number;
 }
 
-export interface Frame { time: number; x: number; y: number; heading: number }
+export interface FileEntry { path: string; kind: "program" | "world" | "sensors"; size: number }
+export interface FileText { path: string; text: string; encoding: "utf-8" | "cp932" }
 
-export interface Stopped {
-  reason: string;
+export interface Param { name: string; low: number; high: number; meaning: string }
+export interface Form {
+  selector: string | null;
+  summary: string;
+  params: Param[];
+  result: string | null;
+  writes: string[];
+  snippet: string;
+}
+export interface Builtin { mnemonic: string; name: string; group: string; waits: boolean; forms: Form[] }
+
+interface Named { name: string; points: Point[] }
+export interface Geometry {
+  floor: Point;
+  start: Pose;
+  vehicle: { length: number; width: number; cameraAhead: number };
+  lines: (Named & { width: number })[];
+  marks: Named[];
+  stands: { name: string; corners: Point[]; marker: Point; facing: number }[];
+  walls: Named[];
+  obstacles: Named[];
+  goal: null | {
+    reach: Named[];
+    holds: { stand: string; marker: Point; within: number }[];
+    end: Named | null;
+    avoid: Named[];
+    deadline: number | null;
+  };
+}
+
+export interface ConfigProblem { line: number | null; message: string }
+export interface WorldCheck { errors: ConfigProblem[]; geometry: Geometry | null }
+
+export interface Frame {
+  time: number;
+  line: number | null;
+  pose: Pose;
+  wheels: [number, number];
+  steering: number;
+  pan: number;
+  tilt: "up" | "down";
+  mode: number;
+  scene: number;
+}
+
+export interface TraceEntry {
+  time: number;
+  call: string;
+  args: number[];
+  result?: number[];
+  line: number | null;
+  pose?: Pose;
+  text: string;
+}
+
+export interface RunEvent { time: number; kind: "lost" | "found" | "handler" | "fault" | "end"; text: string; pose: Point }
+
+/** What every notification of a run carries since the one before. */
+export interface Progress { frame: Frame | null; trace: TraceEntry[]; events: RunEvent[] }
+
+export interface Stopped extends Progress {
+  reason: "entry" | "step" | "breakpoint" | "call" | "lost-line" | "pause";
   line: number | null;
   text: string;
   variables: Record<string, number>;
   changed: string[];
   device: Record<string, unknown>;
-  trace: TraceLine[];
 }
 
-export interface TraceLine { text: string; kind: string; line: number | null }
+export interface Ended extends Progress {
+  status: { code: string; exit_status: number; message: string; line: number | null } | null;
+  variables: Record<string, number>;
+  instructions: number;
+  deviceTime: number;
+  goal: { met?: boolean; [key: string]: unknown } | null;
+}
+
+export interface Binding { line: number; boundTo: number | null; condition: string | null; verified: boolean; message?: string }
+export interface Launched { breakpoints: Binding[]; calls: unknown[]; lines: number[] }
+
+/** A diagnostic of `rl1c check --format json`, as -32003's data lists them. */
+export interface CheckDiagnostic { line: number; column: number; severity: string; code: string; message: string }
+
+/** An error answer, with its code and data. */
+export class StudioError extends Error {
+  constructor(message: string, readonly code: number, readonly data: unknown) {
+    super(message);
+  }
+}
+
+export const PROGRAM_HAS_ERRORS = -32003;
+export const INVALID_CONFIGURATION = -32004;
 
 type Handler = (params: any) => void;
 
@@ -39,12 +120,12 @@ export class StudioConnection {
   private readonly waiting = new Map<number, { resolve: (value: any) => void; reject: (error: Error) => void }>();
   private readonly handlers = new Map<string, Handler>();
 
-  constructor(private readonly socket: WebSocket, private readonly lost: (why: string) => void) {
+  constructor(private readonly socket: WebSocket, lost: (why: string) => void) {
     socket.addEventListener("message", (event) => this.receive(String(event.data)));
     socket.addEventListener("close", (event) => {
       for (const { reject } of this.waiting.values()) reject(new Error("the studio's server is gone"));
       this.waiting.clear();
-      this.lost(event.reason || "the studio's server closed the connection");
+      lost(event.reason || "the studio's server closed the connection: start `rl1c studio` again");
     });
   }
 
@@ -56,7 +137,7 @@ export class StudioConnection {
     const id = this.nextId++;
     return new Promise<T>((resolve, reject) => {
       this.waiting.set(id, { resolve, reject });
-      this.socket.send(JSON.stringify({ id, method, params }));
+      this.socket.send(JSON.stringify({ jsonrpc: "2.0", id, method, params }));
     });
   }
 
@@ -65,8 +146,11 @@ export class StudioConnection {
     if (typeof message.id === "number" && this.waiting.has(message.id)) {
       const { resolve, reject } = this.waiting.get(message.id)!;
       this.waiting.delete(message.id);
-      if (message.error) reject(new Error(message.error.message ?? String(message.error)));
-      else resolve(message.result);
+      if (message.error) {
+        reject(new StudioError(String(message.error.message), message.error.code, message.error.data));
+      } else {
+        resolve(message.result);
+      }
     } else if (typeof message.method === "string") {
       this.handlers.get(message.method)?.(message.params);
     }
