@@ -45,6 +45,7 @@ MODULES: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("build", ("compile", "run", "dis", "asm")),
     ("sim", ("sim",)),
     ("testing", ("test",)),
+    ("new", ("new",)),
     ("fuzz", ("fuzz",)),
     ("docs", ("docs",)),
 )
