@@ -1,6 +1,6 @@
 """Write the JSON Schemas of the configuration files, spec/schemas/*.schema.json, from
 their msgspec schemas (the same types that validate the files), for editors' completion
-and checking: a world file, a sensor script (JSON or TOML) and rl1.toml.
+and checking: a world file, a sensor script (JSON or TOML), rl1.toml and a test file.
 
     .venv/bin/python spec/schemas/generate.py           write the files
     .venv/bin/python spec/schemas/generate.py --check   write nothing; exit 1 if a file
@@ -21,6 +21,7 @@ import msgspec
 
 from rl1.compiler.files import write_atomically
 from rl1.compiler.reporting.project_schema import ProjectFile
+from rl1.compiler.test_file import TestFile
 from rl1.vm.sensor_script import ScriptFile
 from rl1.vm.sim.world import WorldFile
 
@@ -31,6 +32,7 @@ SCHEMAS: dict[str, tuple[type[Any], str]] = {
     "sensors.schema.json": (ScriptFile, "A sensor script of rl1c run --sensors "
                                         "(spec/sensors.md)"),
     "rl1.schema.json": (ProjectFile, "rl1.toml, the project file of rl1c check"),
+    "tests.schema.json": (TestFile, "A test file of rl1c test, *.tests.toml (spec/tests.md)"),
 }
 
 

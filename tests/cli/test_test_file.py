@@ -3,20 +3,24 @@ accepts, and every mistake refused as `file:line: key: what; what to write`."""
 
 from __future__ import annotations
 
+import json
 from typing import get_args
 
+import msgspec
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from support import EXAMPLES
+from support import EXAMPLES, ROOT
 
 from rl1.compiler.test_file import (
     Ends,
+    Expect,
     Success,
     is_test_file,
     load_test_file,
     parse_call,
 )
+from rl1.compiler.test_file import Test as Table  # pytest would collect a class Test*
 from rl1.vm.config import ConfigError
 from rl1.vm.faults import FaultKind
 from rl1.vm.sensor_script import FORMS
@@ -151,3 +155,11 @@ def test_a_call_as_the_trace_shows_it_is_read_back(form: str, args: list[int] | 
 def test_any_text_is_a_call_or_none_never_an_exception(text: str) -> None:
     found = parse_call(text)
     assert found is None or found[0] in FORMS
+
+
+def test_the_json_schema_names_every_key_the_loader_accepts() -> None:
+    document = json.loads((ROOT / "spec" / "schemas" / "tests.schema.json").read_text())
+    for struct in (Table, Expect, Success):
+        table = document["$defs"][struct.__name__]
+        assert set(table["properties"]) == {f.encode_name for f in msgspec.structs.fields(struct)}
+        assert table["additionalProperties"] is False
