@@ -30,6 +30,7 @@ from rl1.compiler.reporting.selection import Selection
 from .document import MAX_ANALYSED_CHARACTERS, MAX_ANALYSED_LINE, Document
 from .positions import Columns
 from .project import ProjectFiles
+from .test_files import is_test_file_uri, test_file_diagnostics
 
 log = logging.getLogger(__name__)
 
@@ -225,6 +226,9 @@ class DiagnosticsScheduler:
         version = document.version
         if document.too_large:
             self._send(document, version, [too_large_notice(document)])
+            return
+        if is_test_file_uri(document.uri):  # TOML, not RL/I: what rl1c test would refuse
+            self._send(document, version, test_file_diagnostics(document, self._columns()))
             return
         waiting = document.unprepared()
         for first in range(waiting.start, waiting.stop, PARSE_SLICE):

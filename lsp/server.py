@@ -38,6 +38,7 @@ from . import (
     hints,
     hover,
     navigation,
+    test_files,
     tokens,
     transports,
 )
@@ -210,9 +211,12 @@ class Rl1Server(LanguageServer):
         self.token_history = tokens.TokenHistory()
 
     def document(self, uri: str) -> Document | None:
-        """An open document the server analyses; None for unknown or huge ones."""
+        """An open document the server analyses; None for unknown or huge ones, and
+        for test files (TOML), which it only checks."""
         document = self.documents.get(uri)
-        return None if document is None or document.too_large else document
+        if document is None or document.too_large or test_files.is_test_file_uri(uri):
+            return None
+        return document
 
     def hold(self, document: Document) -> None:
         """Keep an opened document, or, beyond the limits, tell its client why not."""
