@@ -218,3 +218,24 @@ def test_the_examples_pass() -> None:
     result = rl1c("test", EXAMPLES, "--jobs", "2")
     assert result.exit_code == 0, result.output
     assert result.stdout.splitlines()[0] == f"{EXAMPLES / 'listing1.tests.toml'} ....."
+
+
+@pytest.mark.parametrize("data", [b"\xff\xfe\x00garbage", b"[[test]]\nname = \"x\"\nprogram = 3\n",
+                                  b"[[test]]\n" + b"[" * 5000, b"test = " + b"9" * 5000])
+def test_a_hostile_test_file_is_exit_status_2_without_a_traceback(
+        tmp_path: Path, data: bytes) -> None:
+    file = tmp_path / "h.tests.toml"
+    file.write_bytes(data)
+    result = rl1c("test", file)
+    assert result.exit_code == 2
+    assert f"the test file `{file}` is not valid" in result.stderr
+    assert "Traceback" not in result.output and "internal error" not in result.output
+
+
+def test_a_folder_named_as_the_program_is_an_error(tmp_path: Path) -> None:
+    file = project(tmp_path, table("folder", **ON_SENSORS))
+    file.write_text(file.read_text().replace('"main.rob"', '"sub"'))
+    (tmp_path / "sub").mkdir()
+    result = rl1c("test", file)
+    assert result.exit_code == 1
+    assert "it is a directory" in result.stdout

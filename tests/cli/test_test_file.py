@@ -163,3 +163,43 @@ def test_the_json_schema_names_every_key_the_loader_accepts() -> None:
         table = document["$defs"][struct.__name__]
         assert set(table["properties"]) == {f.encode_name for f in msgspec.structs.fields(struct)}
         assert table["additionalProperties"] is False
+
+
+@given(st.binary(max_size=200) | st.text(max_size=200).map(str.encode))
+def test_any_bytes_are_a_test_file_or_a_config_error(data: bytes) -> None:
+    try:
+        load_test_file(data, NAME)
+    except ConfigError as error:
+        assert error.file == NAME and error.detail
+
+
+def toml_value(value: object) -> str:
+    """`value` written as TOML: JSON's strings, integers, booleans and arrays are TOML's."""
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{json.dumps(key)} = {toml_value(item)}"
+                                for key, item in value.items()) + " }"
+    return json.dumps(value)
+
+
+VALUES = (st.booleans() | st.integers() | st.text(max_size=8)
+          | st.lists(st.integers() | st.text(max_size=4), max_size=3))
+
+
+@given(st.dictionaries(
+    st.sampled_from(["name", "program", "world", "sensors", "seed", "engine", "budget",
+                     "expect"]),
+    VALUES | st.dictionaries(st.sampled_from(["ends", "goal", "variables", "calls",
+                                              "success", "A"]),
+                             VALUES | st.dictionaries(st.sampled_from(
+                                 ["A", "runs", "at_least", "@", "AB"]), VALUES, max_size=3),
+                             max_size=4),
+    max_size=8))
+def test_any_table_of_the_keys_is_a_test_or_a_config_error_at_a_line(
+        table: dict[str, object]) -> None:
+    text = "[[test]]\n" + "".join(f"{key} = {toml_value(value)}\n"
+                                  for key, value in table.items())
+    try:
+        load(text)
+    except ConfigError as error:
+        assert error.detail
+        assert error.line is None or 1 <= error.line <= len(table) + 1
