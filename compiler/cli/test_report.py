@@ -174,8 +174,8 @@ def junit_xml(results: Sequence[Result], seconds: float, jobs: int) -> bytes:
                     "type": kind})
                 problem.text = _xml_text(story_text(result, jobs))
     ET.indent(root)
-    return b'<?xml version="1.0" encoding="utf-8"?>\n' + ET.tostring(root, "utf-8",
-                                                                      xml_declaration=False) + b"\n"
+    body: bytes = ET.tostring(root, "utf-8", xml_declaration=False)
+    return b'<?xml version="1.0" encoding="utf-8"?>\n' + body + b"\n"
 
 
 def _attributes(name: str, results: Sequence[Result], seconds: float) -> dict[str, str]:
