@@ -1,8 +1,8 @@
 """`rl1c`: compile RL/I (`rl1c FILE.rob -o FILE.ilc`) and the commands beside it.
 
 The commands live by what they work on: source.py (check, fmt, explain), build.py
-(compile, run, dis, asm), sim.py (sim) and fuzz.py (fuzz); command.py has what they
-share. A command's module is imported only when the command runs (or help lists them
+(compile, run, dis, asm), sim.py (sim), testing.py (test), new.py (new) and fuzz.py
+(fuzz); command.py has what they share. A command's module is imported only when the command runs (or help lists them
 all), as click's documentation shows for lazy groups: `rl1c check` pays for no other
 command.
 
