@@ -2,9 +2,9 @@
 
 The commands live by what they work on: source.py (check, fmt, explain), build.py
 (compile, run, dis, asm), sim.py (sim), testing.py (test), new.py (new) and fuzz.py
-(fuzz); command.py has what they share. A command's module is imported only when the command runs (or help lists them
-all), as click's documentation shows for lazy groups: `rl1c check` pays for no other
-command.
+(fuzz); command.py has what they share. A command's module is imported only when the
+command runs (or help lists them all), as click's documentation shows for lazy groups:
+`rl1c check` pays for no other command.
 
 This module makes them one click group with what the toolchain adds to click: a first
 word that names a file means `compile`, a mistyped command gets a suggestion, and usage
