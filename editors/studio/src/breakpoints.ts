@@ -1,9 +1,9 @@
 // The debugger's marks in the editor: breakpoints in a gutter of their own (a click on
-// a line's gutter sets or clears one, and they move with the text as it is edited), and
-// the line the run is stopped on, highlighted.
+// a line's gutter, or F9 on the line, sets or clears one, and they move with the text as
+// it is edited), and the line the run is on, highlighted.
 
 import { RangeSet, StateEffect, StateField, EditorState } from "@codemirror/state";
-import { Decoration, DecorationSet, EditorView, GutterMarker, gutter } from "@codemirror/view";
+import { Decoration, DecorationSet, EditorView, GutterMarker, gutter, keymap } from "@codemirror/view";
 
 const toggleBreakpoint = StateEffect.define<number>();  // at a line's start
 const setCurrentLine = StateEffect.define<number | null>();  // a 1-based line, or none
@@ -36,17 +36,12 @@ const breakpointField = StateField.define<RangeSet<GutterMarker>>({
 });
 
 /** The 1-based lines that have a breakpoint, in order. */
-export function breakpointLines(state: EditorState): number[] {
+function breakpointLines(state: EditorState): number[] {
   const lines = new Set<number>();
   for (let cursor = state.field(breakpointField).iter(); cursor.value; cursor.next()) {
     lines.add(state.doc.lineAt(cursor.from).number);
   }
   return [...lines].sort((a, b) => a - b);
-}
-
-/** Sets or clears the breakpoint on a 1-based line. */
-export function toggleBreakpointAt(view: EditorView, line: number): void {
-  view.dispatch({ effects: toggleBreakpoint.of(view.state.doc.line(line).from) });
 }
 
 /** Highlights the line the run is on (1-based), or none; `scroll` brings it into view. */
@@ -85,7 +80,6 @@ export function debuggerMarks(changed: (lines: number[]) => void) {
     gutter({
       class: "cm-breakpoint-gutter",
       markers: (view) => view.state.field(breakpointField),
-      initialSpacer: () => BREAKPOINT,
       domEventHandlers: {
         mousedown(view, line) {
           view.dispatch({ effects: toggleBreakpoint.of(line.from) });
@@ -93,6 +87,13 @@ export function debuggerMarks(changed: (lines: number[]) => void) {
         },
       },
     }),
+    keymap.of([{
+      key: "F9",
+      run: (view) => {
+        view.dispatch({ effects: toggleBreakpoint.of(view.state.doc.lineAt(view.state.selection.main.head).from) });
+        return true;
+      },
+    }]),
     EditorView.updateListener.of((update) => {
       const lines = breakpointLines(update.state);
       const now = lines.join(",");

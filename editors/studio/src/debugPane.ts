@@ -42,7 +42,8 @@ export class DebugPane {
     this.say(status === null ? "stopped"
       : `ended: ${status.message}${status.line === null ? "" : ` (line ${status.line})`}${goal}; `
         + `${ended.instructions} instructions, ${(ended.deviceTime / 1000).toFixed(2)} s`,
-             status === null || status.code === "ok" ? "end" : "fault");
+             status === null ? "stopped" : status.code === "ok" ? "end"
+               : status.code === "goal-missed" ? "goal-missed" : "fault");
     const changed = new Set(Object.keys(ended.variables).filter((name) => ended.variables[name] !== this.shown[name]));
     this.showVariables(ended.variables, changed);
   }

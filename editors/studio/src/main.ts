@@ -54,7 +54,7 @@ async function start(): Promise<void> {
   const base = `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}`;
   const query = `?token=${encodeURIComponent(token)}`;
   const [studioSocket, lspSocket] = await Promise.all([
-    openSocket(`${base}/studio${query}`), openSocket(`${base}/lsp${query}`)]);
+    openSocket(`${base}/studio${query}`), openSocket(`${base}/lsp${query}`).catch(() => null)]);
   const studio = new StudioConnection(studioSocket, (why) => say(`disconnected: ${why}`, true));
   const hello = await studio.request<Hello>("initialize");
   const [{ files }, { builtins }] = await Promise.all([
@@ -66,11 +66,16 @@ async function start(): Promise<void> {
     ? await studio.request<FileText>("files/read", { path: programPath })
     : { path: programPath, text: "", encoding: "utf-8" as const };
 
+  // Without the language server the page still edits, saves and runs the program.
   const client = studioClient(
     (count) => { byId("editor").dataset.diagnostics = String(count); },
     (message) => say(message, true));
-  client.connect(webSocketTransport(lspSocket));
-  lspSocket.addEventListener("close", () => say("the language server's connection closed: reload the page", true));
+  const lspLost = "the language server's connection closed: reload the page";
+  const withLsp = lspSocket?.readyState === WebSocket.OPEN;
+  if (withLsp) {
+    client.connect(webSocketTransport(lspSocket));
+    lspSocket.addEventListener("close", () => say(lspLost, true));
+  }
 
   // Which names are built-ins, which take a selector, which variables calls set: the palette's.
   const facts = {
@@ -126,7 +131,7 @@ async function start(): Promise<void> {
         syntaxHighlighting(rl1Highlight),
         keymap.of([{ key: "Mod-s", run: () => { void save(); return true; } },
                    ...defaultKeymap, ...historyKeymap, indentWithTab]),
-        client.plugin(fileUri(hello.rootUri, programPath), "rl1"),
+        withLsp ? client.plugin(fileUri(hello.rootUri, programPath), "rl1") : [],
         EditorView.updateListener.of((update) => {
           if (update.docChanged) markUnsaved(update.state.doc.toString());
         }),
@@ -313,7 +318,7 @@ async function start(): Promise<void> {
     }
   });
   document.body.dataset.ready = "true";
-  say(`serving ${hello.folder}`);
+  say(withLsp ? `serving ${hello.folder}` : lspLost, !withLsp);
 }
 
 start().catch((error: Error) => say(`the studio cannot start: ${error.message}`, true));

@@ -1,0 +1,186 @@
+"""The studio as a user feels it, in the browser tests' real Chromium (Debian's, through
+Playwright): `rl1c studio` on Listing 1 and the scene of Fig. 4 (a copy of examples/),
+against issue 28's goals.
+
+- keystroke to diagnostic: a key that makes line 3's `(MOV 3,3)` a mistyped call, to the
+  error's underline in the editor (and the key that mends it, to the underline gone);
+  median of N, goal 100 ms.
+- run to the first frame: the Run button, to the vehicle drawn away from its start;
+  median of N, goal 100 ms.
+- step line: the Step line button, to the next stop shown (the page and the server).
+- frames a second at 10x real time: the vehicle drawn while the run goes on, goal 30.
+
+Times are the page's own (performance.now, from the input event's time stamp to the
+change of the page seen by a MutationObserver), so Playwright's round trips do not
+count. Wall time on a shared machine: the median of N.
+
+    .venv/bin/python bench/studio_latency.py [N]
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+
+from playwright.sync_api import Page, sync_playwright
+
+ROOT = Path(__file__).parents[1]
+CHROMIUM = "/usr/bin/chromium"
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--no-first-run", "--disable-sync"]
+SERVING = re.compile(r"rl1c studio: serving .* at (http://127\.0\.0\.1:\d+/\?token=\S+) ")
+GOAL_MS = 100.0
+GOAL_FPS = 30.0
+WAIT = 30_000  # ms
+
+
+# Watches the page for the first change after an input event (a key or a click) after
+# which CHANGED, a JavaScript expression, holds: window.__ms is then the milliseconds
+# from the event's time stamp.
+WATCH = """() => {
+    window.__ms = null;
+    let started = null;
+    const input = (event) => { if (started === null) started = event.timeStamp; };
+    addEventListener("keydown", input, {capture: true, once: true});
+    addEventListener("mousedown", input, {capture: true, once: true});
+    const observer = new MutationObserver(() => {
+        if (started !== null && (CHANGED)) {
+            observer.disconnect();
+            window.__ms = performance.now() - started;
+        }
+    });
+    observer.observe(document.body, {subtree: true, childList: true, attributes: true,
+                                     characterData: true});
+}"""
+
+
+def watch(page: Page, changed: str, act: Callable[[], object]) -> float:
+    """The milliseconds from the input event of `act` to the change after which the
+    JavaScript expression `changed` holds."""
+    page.evaluate(WATCH.replace("CHANGED", changed))
+    act()
+    page.wait_for_function("window.__ms !== null", timeout=WAIT)
+    ms: float = page.evaluate("window.__ms")
+    return ms
+
+
+def start_studio(folder: Path) -> tuple[subprocess.Popen[str], str]:
+    rl1c = str(Path(sys.executable).with_name("rl1c"))
+    server = subprocess.Popen([rl1c, "studio", "sample.rob", "--world", "sample.world.toml",
+                               "--no-browser", "--port", "0"], cwd=folder, text=True,
+                              stdout=subprocess.PIPE)
+    assert server.stdout is not None
+    first = server.stdout.readline()
+    serving = SERVING.match(first)
+    if serving is None:
+        server.kill()
+        raise SystemExit(f"rl1c studio did not say where it serves: {first!r}")
+    return server, serving[1]
+
+
+def keystrokes(page: Page, runs: int) -> list[float]:
+    """Key to underline: `V` of `(MOV 3,3)` replaced by `B`, then back."""
+    line = page.locator("#editor .cm-line").nth(2)
+    line.click()
+    page.keyboard.press("End")
+    for _ in range(len(" 3,3)")):
+        page.keyboard.press("ArrowLeft")
+    errors = "document.querySelectorAll('#editor .cm-lintRange-error').length"
+    times = []
+    for _ in range(runs):
+        page.keyboard.press("Backspace")
+        times.append(watch(page, f"{errors} > 0", lambda: page.keyboard.type("B")))
+        page.keyboard.press("Backspace")
+        watch(page, f"{errors} === 0", lambda: page.keyboard.type("V"))
+    return times
+
+
+def first_frames(page: Page, runs: int, start: str) -> list[float]:
+    """Run to the vehicle drawn away from `start` (its outline at the world's start),
+    then pause."""
+    page.select_option("#speed", "1")
+    moved = f"document.getElementById('vehicle').getAttribute('points') !== {json.dumps(start)}"
+    times = []
+    for _ in range(runs):
+        page.wait_for_selector("#run:not([disabled])", state="attached", timeout=WAIT)
+        times.append(watch(page, moved, lambda: page.click("#run")))
+        page.click("#pause")
+        page.wait_for_selector("body:not([data-run=running])", state="attached", timeout=WAIT)
+    return times
+
+
+def line_steps(page: Page, runs: int) -> list[float]:
+    """Stop at the first line, then step line by line."""
+    page.wait_for_selector("#step-line:not([disabled])", state="attached", timeout=WAIT)
+    page.click("#step-line")  # after a pause: a step; else a launch, stopped on entry
+    page.wait_for_selector("body[data-run=stopped]", state="attached", timeout=WAIT)
+    times = []
+    for _ in range(runs):
+        times.append(watch(page, "document.body.dataset.run !== 'running'",
+                           lambda: page.click("#step-line")))
+        if page.get_attribute("body", "data-run") == "ended":
+            break
+    return times
+
+
+def frames_per_second(page: Page) -> float:
+    """Frames drawn a second while the run goes on at 10x real time, over 1.5 s."""
+    page.select_option("#speed", "10")
+    page.wait_for_selector("#run:not([disabled])", state="attached", timeout=WAIT)
+    page.click("#run")
+    page.wait_for_function("Number(document.getElementById('world').dataset.framesDrawn) > 0",
+                           timeout=WAIT)
+    drawn = "Number(document.getElementById('world').dataset.framesDrawn)"
+    first = page.evaluate(f"[{drawn}, performance.now()]")
+    page.wait_for_timeout(1500)
+    last = page.evaluate(f"[{drawn}, performance.now(), document.body.dataset.run]")
+    if last[2] != "running":
+        print("  (the run ended within the window: the figure is a lower bound)")
+    return float((last[0] - first[0]) / ((last[1] - first[1]) / 1000))
+
+
+def summary(name: str, times: list[float], goal: float) -> None:
+    median = statistics.median(times)
+    print(f"{name}: median {median:.1f} ms, slowest {max(times):.1f} ms over {len(times)} "
+          f"(goal {goal:.0f} ms: {'met' if median <= goal else 'missed'})")
+
+
+def main() -> None:
+    runs = int(sys.argv[1]) if len(sys.argv) > 1 else 20
+    with tempfile.TemporaryDirectory() as temporary:
+        folder = Path(temporary) / "examples"
+        shutil.copytree(ROOT / "examples", folder)
+        server, address = start_studio(folder)
+        try:
+            with sync_playwright() as playwright:
+                browser = playwright.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+                page = browser.new_page(viewport={"width": 1400, "height": 900})
+                page.goto(address)
+                page.wait_for_selector("body[data-ready=true]", state="attached", timeout=WAIT)
+                page.wait_for_selector("#editor[data-diagnostics]", state="attached",
+                                       timeout=WAIT)
+                print(f"studio latency in Chromium, Listing 1 on examples/sample.world.toml, "
+                      f"N={runs}")
+                summary("keystroke to diagnostic", keystrokes(page, runs), GOAL_MS)
+                start = page.get_attribute("#vehicle", "points") or ""
+                summary("run to the first frame of the vehicle moving",
+                        first_frames(page, runs, start), GOAL_MS)
+                summary("step line, click to the stop shown", line_steps(page, runs), 20.0)
+                fps = frames_per_second(page)
+                print(f"frames a second at 10x real time: {fps:.1f} "
+                      f"(goal {GOAL_FPS:.0f}: {'met' if fps >= GOAL_FPS - 1 else 'missed'})")
+                browser.close()
+        finally:
+            server.terminate()
+            server.wait(timeout=30)
+
+
+if __name__ == "__main__":
+    main()
