@@ -239,3 +239,26 @@ def test_a_folder_named_as_the_program_is_an_error(tmp_path: Path) -> None:
     result = rl1c("test", file)
     assert result.exit_code == 1
     assert "it is a directory" in result.stdout
+
+
+def test_an_ilc_program_runs_and_a_refused_one_is_an_error(tmp_path: Path) -> None:
+    file = project(tmp_path, table("compiled", program='"main.ilc"', **ON_SENSORS,
+                                   **{"expect.variables": "{ A = -2 }"})
+                   + table("refused", program='"bad.ilc"', **ON_SENSORS))
+    text = file.read_text().replace('program = "main.rob"\n', "", 2)
+    file.write_text(text)
+    assert rl1c("compile", tmp_path / "main.rob", "-o", tmp_path / "main.ilc").exit_code == 0
+    (tmp_path / "bad.ilc").write_bytes(b"RL1I\x00garbage")
+    result = rl1c("test", file)
+    assert result.exit_code == 1
+    assert result.stdout.splitlines()[0] == f"{file} .E"
+    assert f"{tmp_path / 'bad.ilc'} is not valid intermediate code: byte " in result.stdout
+
+
+def test_a_goal_expected_of_a_world_without_one_is_an_error(tmp_path: Path) -> None:
+    (tmp_path / "plain.world.toml").write_text(WORLD.split("[goal]")[0])
+    file = project(tmp_path, table("no goal", world='"plain.world.toml"',
+                                   **{"expect.goal": '"met"'}))
+    result = rl1c("test", file)
+    assert result.exit_code == 1
+    assert "has no [goal] to judge: add one" in result.stdout
