@@ -1,6 +1,7 @@
 """`rl1c new DIR`: start a project (the files of project_template.py), all at once: they
-are written into a temporary folder beside DIR, which is then renamed to DIR, so that a
-failure leaves nothing half written and DIR is never written into."""
+are written into a temporary folder beside DIR, which is then renamed to DIR (or, for an
+empty DIR that exists, whose entries are moved into it, each whole), so that a failure
+leaves nothing half written, and nothing in DIR is ever replaced."""
 
 from __future__ import annotations
 
@@ -45,8 +46,11 @@ def new(folder: str) -> int:
             os.makedirs(os.path.dirname(path), exist_ok=True)
             with open(path, "w", encoding="utf-8", newline="\n") as stream:
                 stream.write(text)
-        os.chmod(building, 0o777 & ~_umask())  # mkdtemp's folder is the owner's alone
-        os.rename(building, target)  # replaces an empty folder; refuses a filled one
+        if os.path.isdir(target):
+            _move_into(building, target)
+        else:
+            os.chmod(building, 0o777 & ~_umask())  # mkdtemp's folder is the owner's alone
+            os.rename(building, target)
     except OSError as error:
         with contextlib.suppress(OSError):
             shutil.rmtree(building)
@@ -58,6 +62,31 @@ def new(folder: str) -> int:
     print(f"next: {here}rl1c test (its tests pass as written); rl1c sim {PROGRAM} --world "
           "main.world.toml --svg run.svg; then make the program yours")
     return 0
+
+
+def _move_into(building: str, target: str) -> None:
+    """Move the built files into the empty folder `target`, each whole, keeping the
+    folder itself (it may be a shell's current folder, which a rename over it would
+    leave behind); on a failure, the files moved are taken out again."""
+    import shutil
+
+    moved: list[str] = []
+    try:
+        for entry in sorted(os.listdir(building)):
+            destination = os.path.join(target, entry)
+            if os.path.lexists(destination):  # written there in the meantime
+                raise FileExistsError(17, "a file appeared in it meanwhile", destination)
+            os.rename(os.path.join(building, entry), destination)
+            moved.append(destination)
+        os.rmdir(building)
+    except OSError:
+        for destination in moved:
+            with contextlib.suppress(OSError):
+                if os.path.isdir(destination) and not os.path.islink(destination):
+                    shutil.rmtree(destination)
+                else:
+                    os.unlink(destination)
+        raise
 
 
 def _refuse_unless_empty(folder: str, target: str) -> None:

@@ -89,12 +89,40 @@ def test_every_file_says_what_it_is(tmp_path: Path) -> None:
         assert text.startswith(comment), name
 
 
-def test_an_empty_folder_is_used(tmp_path: Path) -> None:
+def test_an_empty_folder_is_used_and_kept(tmp_path: Path,
+                                         monkeypatch: pytest.MonkeyPatch) -> None:
     folder = tmp_path / "empty"
     folder.mkdir()
-    result = rl1c("new", folder)
+    inode = folder.stat().st_ino
+    monkeypatch.chdir(folder)
+    result = rl1c("new", ".")
     assert result.exit_code == 0, result.output
-    assert (folder / "main.rob").is_file()
+    # The same folder, not one renamed over it: a shell in it sees the files.
+    assert folder.stat().st_ino == inode
+    assert sorted(os.listdir(".")) == sorted({name.split("/")[0] for name in FILES})
+    assert "next: rl1c test" in result.stdout
+    assert [path.name for path in tmp_path.iterdir()] == ["empty"]  # no temporary left
+
+
+def test_a_failure_moving_into_an_empty_folder_leaves_it_empty(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    folder = tmp_path / "empty"
+    folder.mkdir()
+    rename = os.rename
+    calls = []
+
+    def third_fails(source: str, target: str) -> None:
+        calls.append(target)
+        if len(calls) == 3:
+            raise OSError(28, "No space left on device")
+        rename(source, target)
+
+    monkeypatch.setattr(os, "rename", third_fails)
+    result = rl1c("new", folder)
+    assert result.exit_code == 2
+    assert "no space left on device" in result.stderr
+    assert list(folder.iterdir()) == []
+    assert [path.name for path in tmp_path.iterdir()] == ["empty"]
 
 
 def test_a_folder_that_holds_anything_is_refused_and_left_alone(tmp_path: Path) -> None:
