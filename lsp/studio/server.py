@@ -1,0 +1,283 @@
+"""The studio's server (spec/studio.md): one asyncio server of the `websockets` package
+on the loopback address, answering plain HTTP GETs for the page and its files and two
+WebSockets, `/lsp` (the language server, lsp/transports.py) and `/studio`
+(connection.py).
+
+Every request passes the same gate before anything else: its Host is this server's
+(against DNS rebinding), it presents the token in its query, and its Origin, if any,
+is the page's own. A page of another site cannot then reach the server (it has no
+token, and the browser sends its Origin), nor can another local user who cannot read
+the command's output.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import logging
+import mimetypes
+import secrets
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from http import HTTPStatus
+from pathlib import Path
+from typing import Any
+from urllib.parse import parse_qs, unquote, urlsplit
+
+from websockets.asyncio.server import ServerConnection, serve
+from websockets.datastructures import Headers
+from websockets.exceptions import ConnectionClosed
+from websockets.http11 import Request, Response
+
+from .. import server as language_server
+from .. import transports
+from ..framing import MAX_MESSAGE
+from .connection import Connection, Studio
+from .files import Folder, Refused, Unusable
+
+log = logging.getLogger(__name__)
+
+HOST = "127.0.0.1"
+STATIC = Path(__file__).with_name("static")
+TOKEN_PLACEHOLDER = "__RL1_STUDIO_TOKEN__"
+BUILD_HELP = "cd editors/studio && npm ci && npm run build"
+MAX_UNSENT = 2 * MAX_MESSAGE
+"""Bytes a page may leave unread before it is disconnected."""
+_TYPES = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=utf-8",
+          ".css": "text/css; charset=utf-8", ".json": "application/json",
+          ".map": "application/json", ".svg": "image/svg+xml", ".png": "image/png",
+          ".woff2": "font/woff2"}
+
+
+def new_token() -> str:
+    return secrets.token_urlsafe(32)
+
+
+@dataclass(slots=True)
+class Gate:
+    """Who may use the server: the token, and this server's own addresses."""
+
+    token: str
+    port: int = 0  # known once the server listens
+
+    def refusal(self, request: Request) -> str | None:
+        """Why `request` is refused, or None."""
+        hosts = {f"{HOST}:{self.port}", f"localhost:{self.port}"}
+        if request.headers.get("Host") not in hosts:
+            return ("the request names another host than this server: open the address "
+                    "rl1c studio printed")
+        tokens = parse_qs(urlsplit(request.path).query).get("token", [])
+        if len(tokens) != 1 or not secrets.compare_digest(tokens[0].encode(),
+                                                          self.token.encode()):
+            return ("a wrong or missing token: open the address rl1c studio printed, with "
+                    "its ?token=")
+        origin = request.headers.get("Origin")
+        if origin is not None and origin not in {f"http://{host}" for host in hosts}:
+            return (f"a page of {origin} may not use the studio: only the page rl1c studio "
+                    "serves may")
+        return None
+
+    def policy(self) -> str:
+        sockets = " ".join(f"ws://{host}:{self.port}" for host in (HOST, "localhost"))
+        return ("default-src 'none'; script-src 'self'; style-src 'self' 'unsafe-inline'; "
+                f"img-src 'self' data:; font-src 'self'; connect-src {sockets}; "
+                "base-uri 'none'; form-action 'none'; frame-ancestors 'none'")
+
+
+@dataclass(slots=True)
+class Server:
+    """The studio's state: the gate, the shared setting, and who is connected."""
+
+    gate: Gate
+    studio: Studio
+    static: Path = STATIC
+    lsp_sessions: set[transports.Session] = field(default_factory=set)
+    pages: int = 0
+    addresses: list[tuple[str, int]] = field(default_factory=list)  # listened on
+
+    # HTTP
+
+    def process_request(self, connection: ServerConnection, request: Request
+                        ) -> Response | None:
+        refused = self.gate.refusal(request)
+        if refused is not None:
+            return self._text(HTTPStatus.FORBIDDEN, f"rl1c studio: {refused}")
+        path = urlsplit(request.path).path
+        if path in ("/lsp", "/studio"):
+            return None  # the WebSocket handshake goes on
+        if request.method != "GET":
+            return self._text(HTTPStatus.METHOD_NOT_ALLOWED,
+                              f"rl1c studio: {request.method} is not served: only GET")
+        if path == "/":
+            return self._index()
+        if path.startswith("/static/"):
+            return self._static(unquote(path.removeprefix("/static/")))
+        return self._text(HTTPStatus.NOT_FOUND, f"rl1c studio: no page at {path}")
+
+    def _index(self) -> Response:
+        try:
+            page = Folder(self.static).read("index.html").decode()
+        except (OSError, Refused, Unusable, UnicodeDecodeError):
+            return self._response(HTTPStatus.SERVICE_UNAVAILABLE, _NOT_BUILT.encode(),
+                                  _TYPES[".html"])
+        return self._response(HTTPStatus.OK,
+                              page.replace(TOKEN_PLACEHOLDER, self.gate.token).encode(),
+                              _TYPES[".html"])
+
+    def _static(self, path: str) -> Response:
+        try:
+            data = Folder(self.static).read(path)
+        except (OSError, Refused, Unusable):
+            return self._text(HTTPStatus.NOT_FOUND, f"rl1c studio: no file {path} in the page")
+        suffix = Path(path).suffix
+        kind = _TYPES.get(suffix) or mimetypes.types_map.get(suffix, "application/octet-stream")
+        return self._response(HTTPStatus.OK, data, kind)
+
+    def _text(self, status: HTTPStatus, text: str) -> Response:
+        return self._response(status, f"{text}\n".encode(), "text/plain; charset=utf-8")
+
+    def _response(self, status: HTTPStatus, body: bytes, kind: str) -> Response:
+        headers = Headers([
+            ("Content-Type", kind), ("Content-Length", str(len(body))),
+            ("Cache-Control", "no-store"), ("X-Content-Type-Options", "nosniff"),
+            ("Referrer-Policy", "no-referrer"),
+            ("Content-Security-Policy", self.gate.policy()), ("Connection", "close")])
+        return Response(status.value, status.phrase, headers, body)
+
+    # WebSockets
+
+    async def handle(self, connection: ServerConnection) -> None:
+        path = urlsplit(connection.request.path).path if connection.request else ""
+        if path == "/lsp":
+            folder = self.studio.folder
+            await transports.serve_lsp_connection(
+                connection, lambda: Confined(language_server.create_server(), folder),
+                self.lsp_sessions)
+        elif path == "/studio":
+            await self._studio(connection)
+
+    async def _studio(self, connection: ServerConnection) -> None:
+        if self.pages >= transports.MAX_SESSIONS:
+            log.warning("a page beyond the %d served at once: refused", transports.MAX_SESSIONS)
+            await connection.close(1013, "rl1c studio serves 8 pages at once: close one")
+            return
+        self.pages += 1
+        outbox = _Outbox(connection)
+        page = Connection(self.studio, outbox.send, lambda: outbox.unsent)
+        try:
+            async for message in connection:
+                await page.receive(message)
+        except ConnectionClosed as closed:
+            log.info("a page's connection ended: %s", closed)
+        finally:
+            self.pages -= 1
+            page.close()
+            outbox.close()
+
+
+class _Outbox:
+    """Sends each message as a text frame, in order, from a task of its own; a page
+    that leaves MAX_UNSENT bytes unread is disconnected."""
+
+    def __init__(self, connection: ServerConnection) -> None:
+        self._connection = connection
+        self._queue: asyncio.Queue[str] = asyncio.Queue()
+        self.unsent = 0
+        self._pump = asyncio.get_running_loop().create_task(self._send_all())
+
+    def send(self, text: str) -> None:
+        self.unsent += len(text)
+        if self.unsent > MAX_UNSENT:
+            log.warning("a page has not read %d MiB: disconnected", MAX_UNSENT // 2**20)
+            self._connection.transport.abort()
+            return
+        self._queue.put_nowait(text)
+
+    async def _send_all(self) -> None:
+        with contextlib.suppress(ConnectionClosed):
+            while True:
+                text = await self._queue.get()
+                await self._connection.send(text)
+                self.unsent -= len(text)
+
+    def close(self) -> None:
+        self._pump.cancel()
+
+
+class Confined:
+    """A language server session that hears only of documents in the folder: a message
+    about a document elsewhere is answered with an error (a request) or dropped."""
+
+    def __init__(self, inner: language_server.Rl1Server, folder: Folder) -> None:
+        self._inner = inner
+        self._folder = folder
+        self._writer: transports.Writer | None = None
+
+    @property
+    def exit_status(self) -> int | None:
+        return self._inner.exit_status
+
+    @property
+    def initialized(self) -> bool:
+        return self._inner.initialized
+
+    def attach(self, writer: transports.Writer) -> None:
+        self._writer = writer
+        self._inner.attach(writer)
+
+    def receive(self, body: bytes) -> None:
+        try:
+            message = json.loads(body)
+        except (ValueError, RecursionError):
+            message = None  # the session answers what is no JSON
+        if isinstance(message, dict) and (uri := _document_uri(message)) is not None \
+                and not self._inside(uri):
+            if "id" in message and self._writer is not None:
+                self._writer.write(json.dumps({"jsonrpc": "2.0", "id": message["id"], "error": {
+                    "code": -32602, "message": f"{uri} is outside {self._folder.root}, the "
+                    "folder rl1c studio was started in: open documents inside it"}}).encode())
+            return
+        self._inner.receive(body)
+
+    def end(self) -> None:
+        self._inner.end()
+
+    def _inside(self, uri: str) -> bool:
+        parsed = urlsplit(uri)
+        if parsed.scheme != "file" or parsed.netloc not in ("", "localhost"):
+            return False
+        try:
+            self._folder.resolve(unquote(parsed.path))
+        except Refused:
+            return False
+        return True
+
+
+def _document_uri(message: dict[str, Any]) -> str | None:
+    params = message.get("params")
+    document = params.get("textDocument") if isinstance(params, dict) else None
+    uri = document.get("uri") if isinstance(document, dict) else None
+    return uri if isinstance(uri, str) else None
+
+
+async def serve_studio(server: Server, port: int, listening: Callable[[int], None]) -> None:
+    """Serve until cancelled; `listening` is told the port once the server listens."""
+    async with serve(server.handle, HOST, port, process_request=server.process_request,
+                     max_size=MAX_MESSAGE, max_queue=1, logger=log,
+                     server_header=None) as listener:
+        server.addresses = [socket.getsockname()[:2] for socket in listener.sockets]
+        server.gate.port = server.addresses[0][1]
+        listening(server.gate.port)
+        await listener.serve_forever()
+
+
+_NOT_BUILT = f"""<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><title>RL/I studio: the page is not built</title>
+</head><body><h1>The studio's page is not built</h1>
+<p>rl1c studio serves the page from <code>{STATIC}</code>, which has no
+<code>index.html</code>. Build it from its sources (Node.js needed once), then reload:</p>
+<pre>{BUILD_HELP}</pre>
+<p>An installed rl1 package ships the page built; this is a checkout without it.</p>
+</body></html>
+"""

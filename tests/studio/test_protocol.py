@@ -1,0 +1,309 @@
+"""The studio's protocol driven as the page drives it (spec/studio.md, "/studio"): Listing
+1 launched on its world, stopped at a breakpoint with its variables, stepped, and run on
+to the same ending as `rl1c sim`; frames while it runs; pause, restart, stop; the files;
+and every kind of bad message answered with its JSON-RPC error, the server going on."""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from served import Failed, Page, Served, page, sample_folder, serving
+from support.cli import rl1c
+
+from rl1.lsp.studio.run import FRAMES_PER_SECOND
+from rl1.vm.language import BUILTINS, VARIABLES
+
+LISTING_1 = {"program": {"path": "sample.rob"}, "world": {"path": "sample.world.toml"}}
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return sample_folder(tmp_path_factory.mktemp("robots"))
+
+
+@pytest.fixture(scope="module")
+def served(folder: Path) -> Iterator[Served]:
+    with serving(folder, "sample.rob") as server:
+        yield server
+
+
+@pytest.fixture
+def client(served: Served) -> Iterator[Page]:
+    with page(served) as connection:
+        yield connection
+
+
+def rl1c_sim(folder: Path) -> dict[str, Any]:
+    ran = rl1c("sim", folder / "sample.rob", "--world", folder / "sample.world.toml",
+               "--format", "json")
+    assert ran.exit_code == 0, ran.stderr
+    document: dict[str, Any] = json.loads(ran.stdout)
+    return document
+
+
+def told(client: Page, stop: dict[str, Any]) -> list[dict[str, Any]]:
+    """The trace told up to `stop`: in the frames before it (the client passed over
+    them), then in it."""
+    frames = [message["params"] for message in client.skipped
+              if message["method"] == "run/frame"]
+    client.skipped.clear()
+    return [entry for message in (*frames, stop) for entry in message["trace"]]
+
+
+def test_initialize_names_the_folder_and_the_command_lines_files(client: Page,
+                                                                  folder: Path) -> None:
+    hello = client.request("initialize")
+    assert hello["folder"] == str(folder.resolve())
+    assert hello["rootUri"] == folder.resolve().as_uri()
+    assert (hello["program"], hello["world"]) == ("sample.rob", "sample.world.toml")
+    assert hello["maxFramesPerSecond"] == FRAMES_PER_SECOND
+
+
+def test_listing_1_stops_at_line_20_steps_and_ends_as_rl1c_sim_does(client: Page,
+                                                                    folder: Path) -> None:
+    assert client.request("debug/setBreakpoints", {"lines": [{"line": 20}]}) == {
+        "breakpoints": None, "calls": None}
+    launched = client.request("run/launch", {**LISTING_1, "speed": None})
+    assert launched["breakpoints"] == [
+        {"line": 20, "boundTo": 20, "condition": None, "verified": True}]
+    assert 20 in launched["lines"] and 11 not in launched["lines"]  # `:13` has no code
+
+    stopped = client.until("run/stopped")
+    assert (stopped["reason"], stopped["line"]) == ("breakpoint", 20)
+    assert list(stopped["variables"]) == list(VARIABLES)
+    # Lines 13-19 centred the camera on the stand: C is the pan; @ counted down from 5
+    # to 0, where it started, so it is not changed.
+    assert stopped["variables"]["@"] == 0
+    assert {"C", "D", "L", "U"} <= set(stopped["changed"])
+    assert "@" not in stopped["changed"]
+    assert all(stopped["variables"][name] == 0 for name in VARIABLES
+               if name not in stopped["changed"])
+    assert stopped["frame"]["pan"] == stopped["variables"]["C"]
+    assert stopped["device"]["camera pan (pulses)"] == stopped["variables"]["C"]
+    before = told(client, stopped)
+    assert [entry["call"] for entry in before[:3]] == ["CAM Z", "CAM A", "CAM D"]
+    assert before[1]["text"] == "(CAM A 90)"
+
+    client.request("debug/stepLine")
+    stepped = client.until("run/stopped")
+    assert (stepped["reason"], stepped["line"]) == ("step", 21)
+    assert [entry["call"] for entry in stepped["trace"]] == ["STX", "MOV"]
+    assert all(entry["line"] == 20 for entry in stepped["trace"])
+
+    client.request("debug/setBreakpoints", {"lines": []})
+    client.request("debug/continue")
+    ended = client.until("run/ended")
+    expected = rl1c_sim(folder)
+    assert ended["status"] == expected["status"]
+    assert ended["variables"] == expected["variables"]
+    assert ended["instructions"] == expected["instructions"]
+    assert ended["deviceTime"] == expected["device_time"]
+    assert ended["goal"] == expected["goal"]
+    trace = [*before, *stepped["trace"], *told(client, ended)]
+    assert [{key: value for key, value in entry.items() if key != "text"}
+            for entry in trace] == expected["trace"]
+
+
+def test_stop_on_entry_then_step_an_instruction(client: Page) -> None:
+    client.request("run/launch", {**LISTING_1, "stopOnEntry": True})
+    entry = client.until("run/stopped")
+    assert (entry["reason"], entry["line"], entry["changed"]) == ("entry", 2, [])
+    assert entry["trace"] == []
+    client.request("debug/stepInstruction")
+    assert client.until("run/stopped")["reason"] == "step"
+    assert client.request("debug/evaluate", {"expression": "C-1"}) == {"value": -1}
+
+
+def test_a_conditional_breakpoint_and_a_call_breakpoint(client: Page) -> None:
+    bound = client.request("debug/setBreakpoints", {
+        "lines": [{"line": 15, "condition": "@-3<0"}, {"line": 16, "condition": "a<3"}],
+        "calls": ["img", "CAM Q"]})
+    assert bound["breakpoints"] is None
+    launched = client.request("run/launch", {**LISTING_1, "speed": None})
+    wrong, = (binding for binding in launched["breakpoints"] if not binding["verified"])
+    assert wrong["line"] == 16 and "write `a-3<0`" in wrong["message"]
+    assert launched["calls"][0] == {"name": "img", "verified": True}
+    assert launched["calls"][1]["verified"] is False
+    assert "its forms are" in launched["calls"][1]["message"]
+    first = client.until("run/stopped")
+    assert (first["reason"], first["text"]) == ("call", "(IMG)")
+    client.request("debug/setBreakpoints", {"calls": []})
+    client.request("debug/continue")
+    second = client.until("run/stopped", "run/ended")
+    # @ counts the centring steps down from 5 (line 13), one a pass (line 19).
+    assert (second["reason"], second["line"], second["text"]) == ("breakpoint", 15, "@-3<0")
+    assert second["variables"]["@"] == 2
+    assert client.request("debug/evaluate", {"expression": "@-3"}) == {"value": -1}
+
+
+def test_frames_come_while_it_runs_and_pause_stops_it(client: Page) -> None:
+    client.request("debug/setBreakpoints", {"lines": [], "calls": []})
+    started = time.monotonic()
+    client.request("run/launch", {**LISTING_1, "speed": 10})
+    frames = [client.until("run/frame") for _ in range(5)]
+    client.request("debug/pause")
+    paused = client.until("run/stopped")
+    elapsed = time.monotonic() - started
+    assert paused["reason"] == "pause"
+    times = [frame["frame"]["time"] for frame in frames]
+    assert times == sorted(times) and times[-1] > times[0]
+    # At most FRAMES_PER_SECOND frames a second of wall time, however fast it runs.
+    assert len(frames) <= FRAMES_PER_SECOND * elapsed + 1
+    # At ten times real time, the simulated time is at most ten times the wall time.
+    assert paused["frame"]["time"] <= 10 * elapsed + 0.1
+    with pytest.raises(Failed) as running:
+        client.request("debug/evaluate", {"expression": "A"})
+        client.request("debug/continue", {"speed": None})
+        client.request("debug/continue")
+    assert running.value.code == -32006
+
+
+def test_restart_starts_again_and_stop_ends_the_run(client: Page) -> None:
+    client.request("debug/setBreakpoints", {"lines": [{"line": 6}], "calls": []})
+    client.request("run/launch", {**LISTING_1, "speed": None})
+    assert client.until("run/stopped")["line"] == 6
+    client.request("debug/stepLine")
+    client.until("run/stopped")
+    client.request("debug/restart")
+    again = client.until("run/stopped")
+    assert (again["reason"], again["line"]) == ("breakpoint", 6)
+    assert told(client, again)[0]["text"] == "(CAM Z)"  # told again from the start
+    client.request("debug/stop")
+    assert client.until("run/ended")["status"] is None
+    with pytest.raises(Failed) as gone:
+        client.request("debug/continue")
+    assert gone.value.code == -32005
+
+
+def test_a_sensor_script_runs_as_rl1c_run_does(client: Page, folder: Path) -> None:
+    client.request("debug/setBreakpoints", {"lines": [], "calls": []})
+    client.request("run/launch", {"program": {"path": "sample.rob"},
+                                  "sensors": {"path": "sample.sensors.json"}})
+    ended = client.until("run/ended")
+    ran = rl1c("run", folder / "sample.rob", "--sensors", folder / "sample.sensors.json",
+               "--format", "json")
+    expected = json.loads(ran.stdout)
+    assert ended["status"] == expected["status"]
+    assert ended["variables"] == expected["variables"]
+    assert ended["frame"] is None
+
+
+def test_the_editors_text_runs_unsaved(client: Page) -> None:
+    client.request("run/launch", {"program": {"text": "A=3\nB=A+A\n(END)\n", "name": "x.rob"}})
+    assert client.until("run/ended")["variables"]["B"] == 6
+
+
+def test_a_program_with_errors_is_not_launched(client: Page) -> None:
+    with pytest.raises(Failed) as refused:
+        client.request("run/launch", {"program": {"text": "A=(FOO)\n(END)\n"}})
+    assert refused.value.code == -32003
+    assert "program.rob:1: `FOO` is not a built-in function" in str(refused.value)
+    diagnostic, = refused.value.data["diagnostics"]
+    assert (diagnostic["file"], diagnostic["line"], diagnostic["code"]) == (
+        "program.rob", 1, "E0501")
+
+
+def test_a_broken_world_is_not_launched_and_says_where(client: Page) -> None:
+    with pytest.raises(Failed) as refused:
+        client.request("run/launch", {"program": {"path": "sample.rob"}, "world": {
+            "text": "[floor]\nsize = [800, 500]\n[start]\nx = 'left'\ny = 1\n",
+            "name": "w.world.toml"}})
+    assert refused.value.code == -32004
+    problem, = refused.value.data["errors"]
+    assert problem["line"] == 4
+    assert problem["message"].startswith("w.world.toml:4: start.x: ")
+
+
+def test_world_check_gives_the_geometry_or_the_errors(client: Page, folder: Path) -> None:
+    text = (folder / "sample.world.toml").read_text()
+    checked = client.request("world/check", {"text": text, "path": "sample.world.toml"})
+    assert checked["errors"] == []
+    geometry = checked["geometry"]
+    assert geometry["floor"] == [800, 500] and geometry["start"] == [60, 150, 0]
+    assert [line["name"] for line in geometry["lines"]] == ["guide", "return"]
+    stand, = geometry["stands"]
+    assert stand["name"] == "stand" and len(stand["corners"]) == 4
+    assert geometry["goal"]["holds"][0]["within"] == 60
+    broken = client.request("world/check", {"text": text.replace("size = [800, 500]",
+                                                                 "size = [800]")})
+    assert broken["geometry"] is None
+    assert broken["errors"][0]["line"] == 7
+    assert broken["errors"][0]["message"].startswith("world.toml:7: floor.size")
+
+
+def test_the_palette_is_vm_languages_builtins(client: Page) -> None:
+    builtins = client.request("palette")["builtins"]
+    assert [builtin["mnemonic"] for builtin in builtins] == list(BUILTINS)
+    move = next(builtin for builtin in builtins if builtin["mnemonic"] == "MVI")
+    form, = move["forms"]
+    assert form["snippet"] == "(MVI ${1:l},${2:r},${3:cm})"
+    assert form["params"][2] == {"name": "cm", "low": -1900, "high": 1900,
+                                 "meaning": "distance in cm"}
+    camera = next(builtin for builtin in builtins if builtin["mnemonic"] == "CAM")
+    assert [form["snippet"] for form in camera["forms"]][:2] == ["(CAM Z)", "(CAM U)"]
+
+
+def test_files_are_listed_read_and_saved(client: Page, folder: Path) -> None:
+    listed = client.request("files/list")
+    assert [entry["path"] for entry in listed["files"]] == [
+        "sample.rob", "sample.sensors.json", "sample.world.toml"]
+    read = client.request("files/read", {"path": "sample.rob"})
+    assert read["text"] == (folder / "sample.rob").read_text()
+    assert read["encoding"] == "utf-8"
+    text = "'ロボット\n(END)\n"  # a legacy comment
+    saved = client.request("files/save", {"path": "new.rob", "text": text,
+                                          "encoding": "cp932"})
+    assert saved == {"path": "new.rob", "size": 16}
+    assert (folder / "new.rob").read_bytes() == text.encode("cp932")
+    assert client.request("files/read", {"path": "new.rob"})["encoding"] == "cp932"
+    for params, code in [({"path": "../x.rob", "text": ""}, -32001),
+                         ({"path": "x.txt", "text": ""}, -32001),
+                         ({"path": "x.rob", "text": "😀", "encoding": "cp932"}, -32002),
+                         ({"path": "x.rob"}, -32602)]:
+        with pytest.raises(Failed) as refused:
+            client.request("files/save", params)
+        assert refused.value.code == code
+    with pytest.raises(Failed) as missing:
+        client.request("files/read", {"path": "nothing.rob"})
+    assert missing.value.code == -32002
+
+
+@pytest.mark.parametrize(("message", "code"), [
+    ("{bad", -32700),
+    ("[1, 2]", -32600),
+    ('{"jsonrpc": "2.0", "method": "initialize"}', -32600),
+    ('{"jsonrpc": "1.0", "id": 7, "method": "initialize"}', -32600),
+    ('{"jsonrpc": "2.0", "id": 7, "method": 3}', -32600),
+    ('{"jsonrpc": "2.0", "id": 7, "method": "run/fly", "params": {}}', -32601),
+    ('{"jsonrpc": "2.0", "id": 7, "method": "palette", "params": [1]}', -32602),
+    ('{"jsonrpc": "2.0", "id": 7, "method": "run/launch", "params": {}}', -32602),
+    ('{"jsonrpc": "2.0", "id": 7, "method": "run/launch", "params": '
+     '{"program": {"path": "sample.rob"}, "level": 3}}', -32602),
+    ('{"jsonrpc": "2.0", "id": 7, "method": "run/launch", "params": '
+     '{"program": {"path": "sample.rob"}, "speed": 0}}', -32602),
+    ('{"jsonrpc": "2.0", "id": 7, "method": "files/read", "params": {"path": "/etc/passwd"}}',
+     -32001),
+    ('{"jsonrpc": "2.0", "id": 7, "method": "debug/setBreakpoints", "params": '
+     '{"lines": [{"line": "20"}]}}', -32602),
+    ("[" * 100_000, -32700),
+])
+def test_bad_messages_are_answered_and_the_server_goes_on(client: Page, message: str,
+                                                          code: int) -> None:
+    client.send(message)
+    answer = client.answer(7 if '"id": 7' in message else None)
+    assert answer["error"]["code"] == code
+    assert answer["error"]["message"]
+    assert client.request("initialize")["program"] == "sample.rob"
+
+
+def test_commands_without_a_run_say_to_launch(served: Served) -> None:
+    with page(served) as fresh:
+        for method in ("debug/continue", "debug/stepLine", "debug/pause", "debug/stop"):
+            with pytest.raises(Failed, match="run/launch") as refused:
+                fresh.request(method)
+            assert refused.value.code == -32005
