@@ -497,6 +497,45 @@ def _judge_by_level(case: Run, engines: Sequence[Engine], budget: int) -> Verdic
     return Verdict(observations, _crashes(observations) + problems)
 
 
+def signature(verdict: Verdict) -> str:
+    """What a disagreement is, the same for two programs that show one bug: for each
+    engine that disagrees, the kind of its first difference, with what varies from
+    program to program left out (the numbers of a trace entry, its time, the lines and
+    values): the calls of the first differing trace entry, the two endings' codes, an
+    exception's type and message with its numbers as N. `rl1c fuzz --keep-going`
+    groups its findings by it."""
+    names = sorted(verdict.observations, key=len, reverse=True)  # `exec:a b` before `exec:a`
+    first: dict[str, str] = {}
+    for problem in verdict.problems:
+        name = next((name for name in names if problem.startswith(f"{name}: ")), "")
+        first.setdefault(name, _kind(problem[len(name) + 2 if name else 0:]))
+    return " | ".join(f"{name}: {kind}" if name else kind for name, kind in first.items())
+
+
+_NUMBER = re.compile(r"(?<!\w)-?[0-9]+")  # not the 0 of vm-O0
+_CALL = re.compile(r"[^0-9-]*")  # a trace entry as `_entry` writes it, up to its arguments
+
+
+def _call(entry: str) -> str:
+    return _CALL.match(entry).group().strip()  # type: ignore[union-attr]
+
+
+def _kind(difference: str) -> str:
+    """One line of `differences` (or of the budget invariant, or a crash) without what
+    varies between two programs that show one bug."""
+    match difference.split(": ", 1):
+        case ["variables", _]:
+            return "variables"
+        case ["ending", endings]:
+            return "ending: " + re.sub(r" at line [0-9]+", "", endings)
+        case [entry, sides] if entry.startswith("trace entry "):
+            return "trace entry: " + " / ".join(map(_call, sides.split(" / ", 1)))
+        case ["trace", extra]:
+            return "trace: extra " + _call(extra.rsplit(" one ", 1)[-1])
+        case _:
+            return _NUMBER.sub("N", difference)
+
+
 def _crashes(observations: dict[str, Observation]) -> list[str]:
     return [f"{name}: crashed: {observation.document['status']['message']}"
             for name, observation in observations.items() if observation.crashed]

@@ -14,12 +14,16 @@ from __future__ import annotations
 import contextlib
 import gc
 import json
+import math
 import os
 import re
 import shlex
+import shutil
+import tempfile
 import time
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
+from dataclasses import dataclass, field
 from random import Random
 from typing import Any, TypeVar
 
@@ -37,6 +41,7 @@ from rl1.compiler.differential import (
     compiled,
     engine_named,
     judge,
+    signature,
 )
 from rl1.compiler.files import read_bounded, write_atomically
 from rl1.compiler.frontend.source import read_source, split_lines
@@ -49,10 +54,11 @@ from rl1.vm.sensor_script import ScriptError, parse_script
 # planted shift bug it went on for 1,100 to 1,700 runs to save a character or two, which
 # deleting lines and statements then does in far fewer).
 SHRINK_ATTEMPTS = 500
-# Programs per Hypothesis search. Its runner keeps what it learnt of every run it
-# generated (about 130 KB each) until the search ends, so a long campaign is many short
-# searches, each seeded from --seed, with their garbage collected in between.
-BATCH = 500
+# Programs per search. Hypothesis' runner keeps what it learnt of every run it generated
+# (about 130 KB each) until the search ends, so a long campaign is many short searches,
+# each seeded from --seed, with their garbage collected in between; and the searches are
+# what processes share, so that a campaign of 1,000 keeps ten of them busy.
+BATCH = 100
 LABEL = re.compile(r"[ \t\f\v]*:[0-9]*")  # a label where a line starts (language 3.1)
 SOURCE = "program.rob"
 SCRIPT = "program.sensors.json"
@@ -67,71 +73,310 @@ class Finding:
     case: Run
     verdict: Verdict
 
+    @property
+    def signature(self) -> str:
+        return signature(self.verdict)
+
+
+@dataclass(frozen=True)
+class Search:
+    """One search of a campaign, what a worker is sent: up to `size` programs generated
+    from `seed` (a Hypothesis search, then another from a seed drawn from it when one
+    ends early on a finding that `keep_going` goes past), judged on `engines`. Its
+    programs depend on nothing else, so a campaign's programs are the same whatever
+    runs its searches, and however many at once."""
+
+    index: int
+    seed: int
+    size: int
+    engines: tuple[Engine, ...]
+    budget: int
+    keep_going: bool = False
+    deadline: float | None = None  # time.time() after which it generates no program
+    channel: str | None = None  # the campaign's Channel folder, on this machine
+
+
+@dataclass
+class Searched:
+    """What a search found: its programs, how many of them showed each signature, and
+    the smallest run of each signature (of the first only, without `keep_going`)."""
+
+    index: int
+    programs: int = 0
+    counts: dict[str, int] = field(default_factory=dict)
+    findings: dict[str, Finding] = field(default_factory=dict)
+
 
 @dataclass(frozen=True)
 class Outcome:
-    programs: int  # programs run up to the first disagreement (or in all)
-    seconds: float  # the time they took (shrinking not counted)
-    finding: Finding | None
+    programs: int  # programs run (by every search)
+    seconds: float  # the time the campaign took
+    finding: Finding | None  # the first (of the search first in order), or None
+    counts: dict[str, int] = field(default_factory=dict)  # programs of each signature
+    findings: dict[str, Finding] = field(default_factory=dict)  # each signature's first
+    stopped: bool = False  # halted (a signal) before its end
 
 
-class _Enough(Exception):
-    """The campaign's time is up, or shrinking has tried its runs."""
+class _Enough(BaseException):
+    """The campaign's time is up, it was halted, or shrinking has tried its runs: a
+    BaseException, which Hypothesis lets through at once (an Exception would be a
+    failure to shrink, calling the predicate again and again)."""
 
 
-def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
-             seconds: float | None, seed: int,
-             progress: Callable[[int, float], None]) -> Outcome:
-    """Run generated programs on `engines` until `count` programs or `seconds` have
-    passed, or until they disagree; `progress(programs, elapsed)` after each program."""
-    start = time.monotonic()
-    programs = 0
-    found_after: float | None = None  # seconds until the first disagreement
-    smallest: Run | None = None  # the last run that disagreed: the smallest so far
-    attempts = 0  # runs tried since the first disagreement
+HALT = "halt"  # the Channel's file naming the first search that must stop
+TOLD_EVERY = 1.0  # seconds between a search's counts on the Channel
+
+
+class Channel:
+    """A campaign's folder on this machine, through which its searches hear when to stop
+    and tell how far they are: a search reads the file `halt` (the index of the first
+    search that must stop) before each program, and writes its count to `told-INDEX`
+    every TOLD_EVERY seconds. Files rather than shared memory, so that it works with any
+    executor whose workers share this machine; a worker elsewhere finds no file, and its
+    search runs to its end."""
+
+    def __init__(self, folder: str | None = None) -> None:
+        self.folder = folder if folder is not None else tempfile.mkdtemp(prefix="rl1-fuzz-")
+        self.everything = False  # halt() stopped every search: a signal, not a finding
+
+    def halt(self, first: int = 0) -> None:
+        """Stop the searches from index `first` on (every one by default: safe in a
+        signal handler, which may run in the middle of a halt after a finding)."""
+        self.everything = self.everything or first == 0
+        first = 0 if self.everything else min(first, self.halted_from())
+        self._put(HALT, first)
+
+    def halted_from(self) -> float:
+        if self.everything:
+            return 0
+        try:
+            with open(os.path.join(self.folder, HALT), "rb") as stream:
+                return int(stream.read())
+        except (OSError, ValueError):  # not halted, or a folder elsewhere
+            return math.inf
+
+    def tell(self, index: int, programs: int) -> None:
+        self._put(f"told-{index}", programs)
+
+    def _put(self, name: str, number: float) -> None:
+        """Replace the file `name` with `number`, whole (a reader sees the old number or
+        the new); a file system that refuses it leaves the old (a search halted later,
+        a progress line behind), not the campaign failed."""
+        path = os.path.join(self.folder, name)
+        with contextlib.suppress(OSError):
+            with open(f"{path}.{os.getpid()}", "w", encoding="ascii") as stream:
+                stream.write(str(number))
+            os.replace(f"{path}.{os.getpid()}", path)
+
+    def told(self, indexes: Iterable[int]) -> int:
+        """The programs the searches `indexes` last told."""
+        total = 0
+        for index in indexes:
+            with contextlib.suppress(OSError, ValueError), \
+                    open(os.path.join(self.folder, f"told-{index}"), "rb") as stream:
+                total += int(stream.read())
+        return total
+
+    def close(self) -> None:
+        shutil.rmtree(self.folder, ignore_errors=True)
+
+
+def search(task: Search, progress: Callable[[int], None] | None = None) -> Searched:
+    """Run the search `task`: Hypothesis searches of its programs, each shrinking the
+    first run that disagrees; without `keep_going` the search ends there, with it a run
+    of a signature found already counts and the search goes on (a new one is shrunk
+    keeping its signature). `progress(programs)` after each program. It ends early,
+    with what it found, when halted, past its deadline, or on KeyboardInterrupt (Ctrl-C
+    reaches a terminal's every process)."""
+    searched = Searched(task.index)
+    channel = Channel(task.channel) if task.channel is not None else None
+    told = time.monotonic()
+    target: str | None = None  # the signature being shrunk
+    shrinks = 0  # runs tried since the first disagreement
+
+    def stopped() -> bool:
+        return channel is not None and channel.halted_from() <= task.index
 
     def disagrees(case: Run) -> bool:
-        nonlocal programs, found_after, smallest, attempts
-        elapsed = time.monotonic() - start
-        if found_after is None:
-            if seconds is not None and elapsed >= seconds:
+        nonlocal told, target, shrinks
+        if stopped():
+            raise _Enough
+        if target is None:
+            if task.deadline is not None and time.time() >= task.deadline:
                 raise _Enough
-            programs += 1
-            progress(programs, elapsed)
-        elif attempts >= SHRINK_ATTEMPTS:
+            searched.programs += 1
+            if progress is not None:
+                progress(searched.programs)
+            if channel is not None and time.monotonic() - told >= TOLD_EVERY:
+                told = time.monotonic()
+                channel.tell(task.index, searched.programs)
+        elif shrinks >= SHRINK_ATTEMPTS:
             raise _Enough  # small enough: keep the smallest so far
         else:
-            attempts += 1
-        if not judge(case, engines, budget).problems:
+            shrinks += 1
+        verdict = judge(case, task.engines, task.budget)
+        if not verdict.problems:
             return False
-        if found_after is None:
-            found_after = elapsed
-        smallest = case
+        found = signature(verdict)
+        if target is None:
+            searched.counts[found] = searched.counts.get(found, 0) + 1
+            if task.keep_going and found in searched.findings:
+                return False
+            target = found
+        elif task.keep_going and found != target:
+            return False
+        searched.findings[target] = Finding(case, verdict)  # the smallest so far
         return True
 
     # Losses after an instruction count compare only between engines given one file.
-    levels = [engine.level for engine in engines if engine.level is not None]
+    levels = [engine.level for engine in task.engines if engine.level is not None]
     comparable = len(set(levels)) < len(levels)
-    seeds = Random(seed)
-    with contextlib.suppress(_Enough):
-        while smallest is None and (count is None or programs < count):
-            before = programs
-            batch = BATCH if count is None else min(BATCH, count - programs)
-            limits = settings(max_examples=batch, database=None, deadline=None,
-                              suppress_health_check=list(HealthCheck),
-                              phases=(Phase.generate, Phase.shrink))
-            with contextlib.suppress(NoSuchExample):
-                smallest = find(runs(instruction_losses=comparable), disagrees,
-                                settings=limits,
-                                random=Random(seeds.getrandbits(64)))
-            if programs == before:  # Hypothesis generated nothing more: stop, not spin
-                break
-            gc.collect()  # a finished search is cyclic garbage: collect it now
-    elapsed = time.monotonic() - start if found_after is None else found_after
-    if smallest is None:
-        return Outcome(programs, elapsed, None)
-    smallest = _deleted(smallest, lambda case: bool(judge(case, engines, budget).problems))
-    return Outcome(programs, elapsed, Finding(smallest, judge(smallest, engines, budget)))
+    seeds = Random(task.seed)
+    try:
+        with contextlib.suppress(_Enough):
+            while searched.programs < task.size and (task.keep_going or not searched.findings):
+                before = searched.programs
+                target, shrinks = None, 0
+                limits = settings(max_examples=task.size - searched.programs, database=None,
+                                  deadline=None, suppress_health_check=list(HealthCheck),
+                                  phases=(Phase.generate, Phase.shrink))
+                with contextlib.suppress(NoSuchExample), contextlib.suppress(_Enough):
+                    find(runs(instruction_losses=comparable), disagrees, settings=limits,
+                         random=Random(seeds.getrandbits(64)))
+                if target is not None and not stopped():
+                    _delete_lines(searched, target, task)
+                if searched.programs == before:  # Hypothesis generated nothing more
+                    break
+    except KeyboardInterrupt:  # in a worker: the campaign halts it too
+        pass
+    if channel is not None:
+        channel.tell(task.index, searched.programs)
+    gc.collect()  # a finished search is cyclic garbage: collect it now
+    return searched
+
+
+def _delete_lines(searched: Searched, target: str, task: Search) -> None:
+    """The finding of `target` with the lines and statements it does not need deleted."""
+    def keeps(case: Run) -> bool:
+        verdict = judge(case, task.engines, task.budget)
+        return bool(verdict.problems) and (not task.keep_going or signature(verdict) == target)
+
+    smallest = _deleted(searched.findings[target].case, keeps)
+    searched.findings[target] = Finding(smallest, judge(smallest, task.engines, task.budget))
+
+
+def searches(seed: int, count: int | None) -> Iterator[tuple[int, int]]:
+    """The seeds and sizes of a campaign's searches: BATCH programs each (the last what
+    is left of `count`), each seeded by the next 64 bits of a generator seeded by
+    `seed`. Endless without a count."""
+    draws = Random(seed)
+    planned = 0
+    while count is None or planned < count:
+        size = BATCH if count is None else min(BATCH, count - planned)
+        planned += size
+        yield draws.getrandbits(64), size
+
+
+def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
+             seconds: float | None, seed: int, progress: Callable[[int, float], None],
+             executor: Executor | None = None, jobs: int = 1, keep_going: bool = False,
+             found: Callable[[Finding], None] | None = None,
+             channel: Channel | None = None) -> Outcome:
+    """Run generated programs on `engines` until `count` programs or `seconds` have
+    passed, or until they disagree (with `keep_going`, until then whatever they find);
+    `progress(programs, elapsed)` as programs run, `found(finding)` on each new
+    signature's smallest run. The searches run in this process, or `jobs` at a time on
+    `executor`; a disagreement stops the searches after the one that found it, and is
+    the one of the first search in order that finds one: the finding of one process.
+    `channel.halt()` (from a signal handler) stops every search, keeping their counts
+    and findings."""
+    start = time.monotonic()
+    deadline = None if seconds is None else time.time() + seconds
+    own_channel = channel is None
+    channel = Channel() if channel is None else channel
+    results: dict[int, Searched] = {}
+    stop_at = math.inf  # the first search that found something, without keep_going
+    plan = searches(seed, count)
+    index = 0
+
+    def next_search() -> Search | None:
+        nonlocal index
+        if index >= stop_at or channel.halted_from() <= index or (
+                deadline is not None and time.time() >= deadline):
+            return None
+        drawn = next(plan, None)
+        if drawn is None:
+            return None
+        index += 1
+        return Search(index - 1, *drawn, tuple(engines), budget, keep_going, deadline,
+                      channel.folder)
+
+    def keep(searched: Searched) -> None:
+        nonlocal stop_at
+        results[searched.index] = searched
+        if found is not None:
+            known = {name for other in results.values() if other is not searched
+                     for name in other.findings}
+            for name, finding in searched.findings.items():
+                if name not in known:
+                    found(finding)
+        if searched.findings and not keep_going and searched.index < stop_at:
+            stop_at = searched.index
+            channel.halt(searched.index + 1)
+
+    def done() -> int:
+        return sum(searched.programs for searched in results.values())
+
+    try:
+        if executor is None:
+            before = 0  # the programs of the searches before this one
+
+            def told(programs: int) -> None:
+                progress(before + programs, time.monotonic() - start)
+
+            while (task := next_search()) is not None:
+                before = done()
+                keep(search(task, told))
+        else:
+            _on_executor(executor, jobs, next_search, keep, channel,
+                         lambda told: progress(done() + told, time.monotonic() - start))
+    finally:
+        if own_channel:
+            channel.close()
+    counts: dict[str, int] = {}
+    findings: dict[str, Finding] = {}
+    for searched in sorted(results.values(), key=lambda searched: searched.index):
+        for name, number in searched.counts.items():
+            counts[name] = counts.get(name, 0) + number
+        for name, finding in searched.findings.items():
+            findings.setdefault(name, finding)
+    first = next(iter(findings.values()), None)
+    return Outcome(done(), time.monotonic() - start, first, counts, findings,
+                   channel.everything)
+
+
+POLL = 0.5  # seconds between looks at the searches under way, for progress
+
+
+def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search | None],
+                 keep: Callable[[Searched], None], channel: Channel,
+                 progress: Callable[[int], None]) -> None:
+    """Run the searches `next_search` gives on `executor`, `jobs` at a time, keeping
+    each as it ends."""
+    pending: dict[Future[Searched], int] = {}
+
+    def submit() -> None:
+        while len(pending) < jobs and (task := next_search()) is not None:
+            pending[executor.submit(search, task)] = task.index
+
+    submit()
+    while pending:
+        finished, _ = wait(pending, timeout=POLL, return_when=FIRST_COMPLETED)
+        for future in finished:
+            del pending[future]
+            keep(future.result())
+        submit()
+        progress(channel.told(pending.values()))
 
 
 def _deleted(case: Run, disagrees: Callable[[Run], bool]) -> Run:

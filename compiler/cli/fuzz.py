@@ -9,16 +9,26 @@ from __future__ import annotations
 
 import os
 import random
+import signal
 import sys
+from collections.abc import Iterator
+from concurrent.futures import BrokenExecutor
+from contextlib import contextmanager
+from types import FrameType
+from typing import TYPE_CHECKING
 
 import click
 
 from rl1.compiler.reporting.render import EXIT_ERRORS
 
-from .command import PATH, Command, Failure, a_budget, at_least_one
+from .command import EXIT_INTERNAL, PATH, Command, Failure, a_budget, at_least_one
+
+if TYPE_CHECKING:
+    from rl1.compiler.fuzz import Channel
 
 SECTION = "Testing"
 
+SIGNALS = (signal.SIGINT, signal.SIGTERM)  # what stops a campaign, keeping its summary
 DEFAULT_COUNT = 1000
 DEFAULT_BUDGET = 20_000  # generated programs are short; a runaway is found quickly
 BAR_WIDTH = 30
@@ -45,19 +55,27 @@ BAR_WIDTH = 30
                    "new folder finding-N of its own")
 @click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget,
               metavar="N", show_default=True, help="the budget of every run")
+@click.option("--jobs", type=str, default=None, metavar="J",
+              callback=lambda c, p, v: None if v is None else at_least_one(c, p, v),
+              help="processes that run the searches (default: one per core); the "
+                   "programs are the same for any J")
 @click.option("--replay", "replay_dir", default=None, metavar="DIR", type=PATH,
               help="judge a reproducer again (a finding-N folder, as its replay.sh does) "
                    "with its engines and budget: exit status 1 while they disagree")
 def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
-         seed: str | None, out_dir: str, budget: int, replay_dir: str | None) -> int:
+         seed: str | None, out_dir: str, budget: int, jobs: int | None,
+         replay_dir: str | None) -> int:
     """Run generated programs on several engines and compare what they do.
 
     Every program (with a sensor script to match) runs on each engine; the runs must
     agree on the device trace, how they end and the final variables, and optimized code
-    must keep the budget invariant (spec/optimization.md). On the first disagreement the
-    program is shrunk to a small one, written with each engine's run and a replay
-    script to --out, and the difference printed; --replay judges it again. Exit status:
-    0 all agreed, 1 a disagreement, 2 a usage problem."""
+    must keep the budget invariant (spec/optimization.md). The programs come in searches
+    of 100, run --jobs at a time, each seeded from --seed (so a seed gives the same
+    programs on any number of processes). On the first disagreement the program is
+    shrunk to a small one, written with each engine's run and a replay script to --out,
+    and the difference printed; --replay judges it again. Ctrl-C or SIGTERM stops the
+    campaign with its summary and its seed. Exit status: 0 all agreed, 1 a
+    disagreement, 2 a usage problem, 130 or 143 stopped by Ctrl-C or SIGTERM."""
     try:
         from rl1.compiler.differential import (
             DEFAULT_ENGINES,
@@ -66,14 +84,17 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
             EngineUnavailable,
             engine_named,
         )
-        from rl1.compiler.fuzz import campaign, write_reproducer
+        from rl1.compiler.fuzz import Channel, campaign, write_reproducer
     except ModuleNotFoundError as error:
         if (error.name or "").partition(".")[0] != "hypothesis":
             raise
         raise Failure("error: rl1c fuzz generates programs with Hypothesis, an optional "
                       "part of rl1 that is not installed here; install it with "
                       "`pip install 'rl1[fuzz]'` (or `pip install hypothesis`)") from None
+    from rl1.compiler.executors import Unavailable, workers
     from rl1.vm.native import BuildError
+
+    from .sim_campaign import MAX_JOBS
 
     if replay_dir is not None:
         if engine_names or count is not None or seconds is not None or seed is not None:
@@ -102,22 +123,36 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     except ValueError:
         raise click.UsageError(f"argument --seed: expected a whole number, got {seed!r}"
                                ) from None
+    if jobs is not None and jobs > MAX_JOBS:
+        raise click.UsageError(f"argument --jobs: at most {MAX_JOBS} processes on one "
+                               "machine")
     limit = None if seconds is not None else count or DEFAULT_COUNT
     bar = _Bar(limit, seconds)
+    channel = Channel()
     try:
-        outcome = campaign(engines, budget, count=limit, seconds=seconds, seed=seed_value,
-                           progress=bar.update)
-    except (BuildError, EngineUnavailable) as error:  # such as no C compiler for c-ON
+        with _halted_by_signals(channel) as signalled, \
+                workers(jobs or os.cpu_count() or 1) as held:
+            outcome = campaign(engines, budget, count=limit, seconds=seconds,
+                               seed=seed_value, progress=bar.update, executor=held.executor,
+                               jobs=max(held.slots, 1), channel=channel)
+    except (BuildError, EngineUnavailable, Unavailable) as error:  # such as no C compiler
         raise Failure(f"error: {error}") from None
+    except BrokenExecutor:
+        raise Failure("error: a worker process ended abruptly (killed, or out of memory); "
+                      f"the campaign runs again with --seed {seed_value}", EXIT_INTERNAL
+                      ) from None
     finally:
         bar.close()
+        channel.close()
     names = ", ".join(engine.name for engine in engines)
     rate = outcome.programs / outcome.seconds if outcome.seconds else 0.0
     summary = (f"fuzz: {outcome.programs} programs in {outcome.seconds:.1f} s "
                f"({rate:.1f} per second); engines {names}; seed {seed_value}")
+    stopped = 128 + signalled[0] if signalled else 0
     if outcome.finding is None:
-        click.echo(f"{summary}: all agreed")
-        return 0
+        click.echo(f"{summary}: " + ("stopped by a signal before its end, all agreed so "
+                                     "far" if stopped else "all agreed"))
+        return stopped
     finding = outcome.finding
     click.echo(f"{summary}: the engines disagree (reference: {engines[0].name})\n\n"
                f"the smallest program found:\n{_numbered(finding.case.source)}\n\n"
@@ -130,7 +165,26 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
                       "campaign runs again with the same --seed", EXIT_ERRORS) from None
     click.echo(f"\nreproducer: {reproducer.folder} (program, sensor script, each engine's "
                f"run); replay: {reproducer.replay}")
-    return EXIT_ERRORS
+    return stopped or EXIT_ERRORS
+
+
+@contextmanager
+def _halted_by_signals(channel: Channel) -> Iterator[list[int]]:
+    """While in effect, SIGINT and SIGTERM halt the campaign's searches (which end
+    within a program, keeping what they found) instead of stopping rl1c; the signals
+    caught are in the list it gives."""
+    caught: list[int] = []
+
+    def halt(signum: int, frame: FrameType | None) -> None:
+        caught.append(signum)
+        channel.halt()
+
+    previous = {signum: signal.signal(signum, halt) for signum in SIGNALS}
+    try:
+        yield caught
+    finally:
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def _numbered(source: str) -> str:

@@ -1,0 +1,128 @@
+"""`rl1c fuzz` campaigns: searches spread over processes (--jobs), stopped by signals,
+going on past findings (--keep-going), seeded from a corpus, and their statistics."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import pytest
+from support.cli import rl1c
+
+from rl1.compiler import fuzz
+from rl1.compiler.differential import Observation, VmEngine
+from rl1.compiler.strategies import Run
+from rl1.vm import machine
+
+pytestmark = pytest.mark.slow  # campaigns, on pools of processes
+
+RL1C = [str(Path(sys.executable).with_name("rl1c"))]
+
+
+class _Recording:
+    """The -O0 VM, writing each program it runs to a file, from any process."""
+
+    name = "recording"
+    level = 0
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def run(self, case: Run, budget: int) -> Observation:
+        with open(self.path, "a", encoding="utf-8") as stream:
+            stream.write(json.dumps(case.source) + "\n")
+        return VmEngine(0).run(case, budget)
+
+
+class _BrokenShift:
+    """The -O0 VM with `1<-1` giving 1 (a negative count shifts left by nothing): a
+    planted bug found in a few programs, in whichever process runs it."""
+
+    name = "broken-shift"
+    level = 0
+
+    def run(self, case: Run, budget: int) -> Observation:
+        right = machine._shift_left
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(machine, "_shift_left", lambda value, count: value if count < 0
+                          else right(value, count))
+            return VmEngine(0).run(case, budget)
+
+
+def _campaign(engines: list[fuzz.Engine], jobs: int, count: int, **options: object
+              ) -> fuzz.Outcome:
+    def quiet(programs: int, elapsed: float) -> None:
+        pass
+
+    if jobs == 1:
+        return fuzz.campaign(engines, 20_000, count=count, seconds=None, seed=11,
+                             progress=quiet, **options)  # type: ignore[arg-type]
+    with ProcessPoolExecutor(jobs) as pool:
+        return fuzz.campaign(engines, 20_000, count=count, seconds=None, seed=11,
+                             progress=quiet, executor=pool, jobs=jobs,
+                             **options)  # type: ignore[arg-type]
+
+
+def test_a_seed_gives_the_same_programs_on_any_number_of_processes(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fuzz, "BATCH", 4)  # 12 programs in three searches
+    seen = []
+    for jobs in (1, 2, 3):
+        path = tmp_path / f"jobs-{jobs}"
+        outcome = _campaign([VmEngine(0), _Recording(path)], jobs, 12)
+        assert outcome.programs == 12 and outcome.finding is None
+        seen.append(sorted(path.read_text(encoding="utf-8").splitlines()))
+    assert seen[0] == seen[1] == seen[2] and len(seen[0]) == 12
+
+
+def test_the_finding_is_the_first_in_search_order_whatever_the_processes(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 30)
+    monkeypatch.setattr(fuzz, "BATCH", 20)
+    engines: list[fuzz.Engine] = [VmEngine(0), _BrokenShift()]
+    one, two = (_campaign(engines, jobs, 400) for jobs in (1, 2))
+    assert one.finding is not None and two.finding is not None
+    assert one.finding.case == two.finding.case
+    # Every search that ran counts, the ones after the finding's too.
+    assert two.programs >= one.programs
+
+
+def test_the_summary_counts_every_process_programs() -> None:
+    result = rl1c("fuzz", "--count", "30", "--seed", "5", "--jobs", "2")
+    assert result.exit_code == 0, result.output
+    assert result.stdout.startswith("fuzz: 30 programs in ")
+    assert "; seed 5: all agreed" in result.stdout
+
+
+def _stopped(tmp_path: Path, signum: int, *args: str) -> tuple[int, str]:
+    """`rl1c fuzz ARGS` given `signum` once it has run programs: its status and output."""
+    process = subprocess.Popen([*RL1C, "fuzz", "--time", "300", "--out", str(tmp_path),
+                                *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               text=True, cwd=tmp_path)
+    try:
+        time.sleep(8)  # started, and some programs run even on a loaded machine
+        process.send_signal(signum)
+        out, err = process.communicate(timeout=60)
+    finally:
+        process.kill()
+    return process.returncode, out + err
+
+
+@pytest.mark.parametrize(("signum", "jobs"), [(signal.SIGINT, "1"), (signal.SIGTERM, "2")])
+def test_a_signal_stops_the_campaign_with_its_summary_and_seed(
+        tmp_path: Path, signum: int, jobs: str) -> None:
+    status, output = _stopped(tmp_path, signum, "--jobs", jobs)
+    assert status == 128 + signum, output
+    summary = re.search(r"fuzz: ([0-9]+) programs in .*; seed ([0-9]+): stopped by a "
+                        r"signal before its end, all agreed so far", output)
+    assert summary is not None, output
+    assert int(summary.group(1)) > 0
+    assert "Traceback" not in output
+    assert not [name for name in os.listdir(tmp_path) if name.startswith("finding-")]
