@@ -9,6 +9,8 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from support import EXAMPLES
 from support.cli import rl1c
 
@@ -262,3 +264,41 @@ def test_a_goal_expected_of_a_world_without_one_is_an_error(tmp_path: Path) -> N
     result = rl1c("test", file)
     assert result.exit_code == 1
     assert "has no [goal] to judge: add one" in result.stdout
+
+
+@st.composite
+def mutated(draw: st.DrawFn, text: bytes) -> bytes:
+    """`text` with a few bytes flipped, inserted, deleted or cut off."""
+    data = bytearray(text)
+    for _ in range(draw(st.integers(1, 6))):
+        at = draw(st.integers(0, max(len(data) - 1, 0)))
+        match draw(st.sampled_from(["flip", "insert", "delete", "cut"])):
+            case "flip" if data:
+                data[at] ^= 1 << draw(st.integers(0, 7))
+            case "insert":
+                data[at:at] = draw(st.binary(min_size=1, max_size=8))
+            case "delete":
+                del data[at:at + draw(st.integers(1, 8))]
+            case _:
+                del data[at:]
+    return bytes(data)
+
+
+HOSTILE_BASE = (table("on the script", **ON_SENSORS, **{"expect.variables": "{ A = -2 }",
+                                                        "expect.calls": '["ULT A"]'})
+                + table("no script", **{"expect.ends": '"device-error"'})).encode()
+
+
+@settings(max_examples=60, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=mutated(HOSTILE_BASE), sensors=mutated(SENSORS.encode()))
+def test_mutated_test_files_and_scripts_never_crash(tmp_path: Path, data: bytes,
+                                                     sensors: bytes) -> None:
+    file = project(tmp_path, "")
+    file.write_bytes(data)
+    (tmp_path / "main.sensors.toml").write_bytes(sensors)
+    result = rl1c("test", file, "--junit", tmp_path / "junit.xml")
+    assert result.exit_code in (0, 1, 2), result.output
+    assert "Traceback" not in result.output and "internal error" not in result.output
+    if result.exit_code != 2:
+        ET.fromstring((tmp_path / "junit.xml").read_bytes())  # well-formed, whatever the names
