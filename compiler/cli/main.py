@@ -44,6 +44,7 @@ MODULES: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("source", ("check", "fmt", "explain")),
     ("build", ("compile", "run", "dis", "asm")),
     ("sim", ("sim",)),
+    ("studio", ("studio",)),
     ("testing", ("test",)),
     ("new", ("new",)),
     ("fuzz", ("fuzz",)),

@@ -51,6 +51,7 @@ FRAMES_PER_SECOND = 30
 """The most `run/frame`s a second of wall time."""
 DEFAULT_SPEED = 1.0
 MIN_SPEED, MAX_SPEED = 0.1, 1000.0
+_FRAME_INTERVAL = 1 / FRAMES_PER_SECOND
 _BEHIND = 0.25
 """Seconds of wall time the run may fall behind its pace (a slow machine, a long
 computation) before the pace starts again from where the run is, rather than hurrying
@@ -87,7 +88,7 @@ class Run:
         self._wake = threading.Event()  # a pacing sleep is to end
         self._pacing = False  # a continue is under way (steps are not slowed)
         self._anchor = (0.0, 0.0)  # the wall time and simulated time the pace is kept from
-        self._last_frame = -math.inf
+        self._next_frame = -math.inf  # when the next frame is due (time.monotonic)
         self._told_trace = self._told_events = 0
         self._seen: dict[str, int] = {}
         self.busy = False  # a command is under way (the loop's view)
@@ -186,25 +187,32 @@ class Run:
             self._pacing = False
 
     def _pace(self) -> None:
-        """Wait until the wall clock catches up with the simulated time at the speed, and
-        send a frame when one is due."""
+        """Wait until the wall clock catches up with the simulated time at the speed,
+        sending the frames that fall due meanwhile."""
         simulation, speed = self._simulation, self._speed
         if simulation is None:
             return
         now = time.monotonic()
-        if speed is not None and not self._pausing.is_set():
+        if speed is not None:
             wall, simulated = self._anchor
-            delay = wall + (simulation.device.sim.time - simulated) / speed - now
-            if delay > 0:
-                self._wake.wait(delay)
-                self._wake.clear()
-            elif delay < -_BEHIND:
+            due = wall + (simulation.device.sim.time - simulated) / speed
+            while now < due and not self._pausing.is_set() and not self._wake.is_set():
+                self._frame_if_due(now)
+                self._wake.wait(min(due, self._next_frame) - now)
+                now = time.monotonic()
+            self._wake.clear()
+            if now - due > _BEHIND:
                 self._anchor = (now, simulation.device.sim.time)
-        if time.monotonic() - self._last_frame >= 1 / FRAMES_PER_SECOND:
-            self._frame()
+        self._frame_if_due(now)
 
-    def _frame(self) -> None:
-        self._last_frame = time.monotonic()
+    def _frame_if_due(self, now: float) -> None:
+        """A frame, when the next is due: on a grid of 1/FRAMES_PER_SECOND, so that the
+        frames keep their rate however the chances to send one fall."""
+        if now < self._next_frame:
+            return
+        self._next_frame += _FRAME_INTERVAL
+        if self._next_frame <= now:  # late by a whole frame or more: no burst to catch up
+            self._next_frame = now + _FRAME_INTERVAL
         params = {"frame": self._frame_now(), **self._news()}
         self._loop.call_soon_threadsafe(self._deliver, self._generation, "run/frame", params)
 
@@ -241,7 +249,7 @@ class Run:
         """A start of the run (the launch, a restart): nothing told of it yet."""
         self._told_trace = self._told_events = 0
         self._seen = self.session.variables
-        self._last_frame = -math.inf
+        self._next_frame = -math.inf
 
     def _stopped(self, stop: Stop) -> dict[str, Any]:
         variables = self.session.variables

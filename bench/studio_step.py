@@ -1,0 +1,156 @@
+"""The studio's server as a page meets it (spec/studio.md; issue 28's goals): the wall
+time from a `debug/stepLine` request to its `run/stopped` over the WebSocket, stepping
+Listing 1 on the sample world line by line (median and slowest, goal 20 ms), against the
+same steps of the debugging core's Session alone in this process; and the frames a
+second of a live run at 10x real time (goal 30), with how far the simulated time kept
+to ten times the wall time.
+
+The server runs in a thread of this process, on a free port of 127.0.0.1; wall time
+(time.perf_counter), as the page sees it. The machine is shared: the figures vary.
+
+    .venv/bin/python bench/studio_step.py
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import statistics
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+from websockets.sync.client import ClientConnection, connect
+
+from rl1.compiler.debugger import Session, compile_program
+from rl1.lsp.studio.server import Gate, Server, new_token, serve_studio
+from rl1.lsp.studio.start import studio_for
+from rl1.vm.sim.device import SimDevice
+from rl1.vm.sim.world import decode_world
+
+ROOT = Path(__file__).parents[1]
+EXAMPLES = ROOT / "examples"
+STEP_GOAL_MS = 20.0
+FRAMES_GOAL = 30
+LIVE_SECONDS = 4.0
+SPEED = 10
+
+
+@contextlib.contextmanager
+def studio() -> Iterator[str]:
+    """The address of /studio on a server for the examples folder."""
+    server = Server(Gate(new_token()), studio_for(EXAMPLES, None, None))
+    ready = threading.Event()
+    running: dict[str, Any] = {}
+
+    async def main() -> None:
+        running["loop"], running["task"] = asyncio.get_running_loop(), asyncio.current_task()
+        await serve_studio(server, 0, lambda port: ready.set())
+
+    def serve() -> None:
+        with contextlib.suppress(asyncio.CancelledError):
+            asyncio.run(main())
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    ready.wait(30)
+    try:
+        yield f"ws://127.0.0.1:{server.gate.port}/studio?token={server.gate.token}"
+    finally:
+        running["loop"].call_soon_threadsafe(running["task"].cancel)
+        thread.join(30)
+
+
+class Page:
+    def __init__(self, connection: ClientConnection) -> None:
+        self.connection = connection
+        self.id = 0
+
+    def request(self, method: str, params: dict[str, Any] | None = None) -> None:
+        self.id += 1
+        self.connection.send(json.dumps({"jsonrpc": "2.0", "id": self.id, "method": method,
+                                         "params": params or {}}))
+
+    def until(self, *methods: str) -> tuple[str, dict[str, Any]]:
+        while True:
+            message = json.loads(self.connection.recv(timeout=60))
+            if message.get("method") in methods:
+                return message["method"], message["params"]
+            if "error" in message:
+                raise RuntimeError(message["error"]["message"])
+
+
+def launch(page: Page, **options: Any) -> None:
+    page.request("run/launch", {"program": {"path": "sample.rob"},
+                                "world": {"path": "sample.world.toml"}, **options})
+
+
+def server_steps(page: Page) -> list[float]:
+    """Each line step of the whole run, from the request to its answer's stop."""
+    launch(page, stopOnEntry=True)
+    page.until("run/stopped")
+    steps = []
+    while True:
+        started = time.perf_counter()
+        page.request("debug/stepLine")
+        method, _ = page.until("run/stopped", "run/ended")
+        steps.append(time.perf_counter() - started)
+        if method == "run/ended":
+            return steps
+
+
+def session_steps() -> list[float]:
+    """The same steps of a Session alone."""
+    image = compile_program((EXAMPLES / "sample.rob").read_text(), "sample.rob")
+    assert isinstance(image, bytes)
+    world = decode_world((EXAMPLES / "sample.world.toml").read_bytes(), "sample.world.toml")
+    session = Session(image, lambda: SimDevice(world))
+    steps = []
+    while not session.over:
+        started = time.perf_counter()
+        session.step_line()
+        steps.append(time.perf_counter() - started)
+    return steps
+
+
+def live(page: Page) -> tuple[int, float, float]:
+    """Frames received in LIVE_SECONDS of a run at SPEED, the wall time, and the
+    simulated time reached."""
+    launch(page, speed=SPEED)
+    page.until("run/frame")
+    started = time.perf_counter()  # from the first frame: the launch is not counted
+    frames, simulated = 0, 0.0
+    while (elapsed := time.perf_counter() - started) < LIVE_SECONDS:
+        method, params = page.until("run/frame", "run/ended")
+        if method == "run/ended":
+            break
+        frames += 1
+        simulated = params["frame"]["time"]
+    page.request("debug/stop")
+    page.until("run/ended")
+    return frames, elapsed, simulated
+
+
+def main() -> None:
+    alone = session_steps()
+    with studio() as address, connect(address, max_size=None) as connection:
+        page = Page(connection)
+        steps = server_steps(page)
+        frames, elapsed, simulated = live(page)
+    median, slowest = statistics.median(steps) * 1000, max(steps) * 1000
+    print(f"line steps of Listing 1 on the sample world: {len(steps)}, request to "
+          f"run/stopped median {median:.2f} ms, slowest {slowest:.2f} ms (goal "
+          f"{STEP_GOAL_MS:g} ms: {'met' if median <= STEP_GOAL_MS else 'missed'}); the "
+          f"Session alone: median {statistics.median(alone) * 1000:.3f} ms, slowest "
+          f"{max(alone) * 1000:.2f} ms")
+    rate = frames / elapsed
+    print(f"live at {SPEED}x real time: {frames} frames in {elapsed:.2f} s, {rate:.1f} a "
+          f"second (goal {FRAMES_GOAL}: {'met' if rate >= FRAMES_GOAL * 0.95 else 'missed'}); "
+          f"simulated {simulated:.2f} s, {simulated / elapsed:.2f}x the wall time")
+
+
+if __name__ == "__main__":
+    main()
