@@ -24,7 +24,7 @@ from rl1.vm.sensor_script import Script, ScriptError, decode_script
 from rl1.vm.sim.world import World, WorldError, decode_world
 
 from . import shapes
-from .files import Folder, Refused, Unusable
+from .files import MAX_FILE_BYTES, Folder, Refused, Unusable
 from .run import DEFAULT_SPEED, FRAMES_PER_SECOND, MAX_SPEED, MIN_SPEED, Launch, Run
 
 log = logging.getLogger(__name__)
@@ -41,6 +41,11 @@ NO_RUN = -32005
 RUNNING = -32006
 
 LEVELS = (0, 1, 2)
+MAX_BREAKPOINTS = 10_000
+"""Line breakpoints, and call breakpoints, a page may set: binding them costs a pass over
+the program's lines each, on the event loop."""
+MAX_EXPRESSION = 1000
+"""Characters of a condition or an evaluated value."""
 MAX_SEED = 2**32 - 1
 FRAME_BACKLOG = 2**20
 """Bytes the page has not read yet past which frames are dropped (the next one shows
@@ -218,6 +223,9 @@ class Connection:
     async def _check_world(self, params: dict[str, Any]) -> dict[str, Any]:
         text = _string(params, "text")
         name = _string(params, "path") if "path" in params else "world.toml"
+        if len(text) > MAX_FILE_BYTES:
+            raise RpcError(FILE_UNUSABLE, f"the world is larger than {MAX_FILE_BYTES // 2**20} "
+                           "MiB, the most the studio reads")
         try:
             world = await asyncio.to_thread(decode_world, text.encode(), name)
         except WorldError as error:
@@ -306,17 +314,21 @@ class Connection:
     async def _set_breakpoints(self, params: dict[str, Any]) -> dict[str, Any]:
         if "lines" in params:
             wanted = params["lines"]
-            if not isinstance(wanted, list) or not all(
+            if not isinstance(wanted, list) or len(wanted) > MAX_BREAKPOINTS or not all(
                     isinstance(item, dict) and _whole(item.get("line"))
-                    and isinstance(item.get("condition"), str | None) for item in wanted):
+                    and isinstance(item.get("condition"), str | None)
+                    and len(item.get("condition") or "") <= MAX_EXPRESSION for item in wanted):
                 raise RpcError(INVALID_PARAMS, "`lines` is a list of objects, each with a "
-                               "`line` (a whole number) and maybe a `condition` (a string)")
+                               "`line` (a whole number) and maybe a `condition` (a string of "
+                               f"{MAX_EXPRESSION:,} characters at most), {MAX_BREAKPOINTS:,} "
+                               "at most")
             self._lines = [(item["line"], item.get("condition") or None) for item in wanted]
         if "calls" in params:
             calls = params["calls"]
-            if not isinstance(calls, list) or not all(isinstance(c, str) for c in calls):
+            if not isinstance(calls, list) or len(calls) > MAX_BREAKPOINTS or not all(
+                    isinstance(call, str) and len(call) <= MAX_EXPRESSION for call in calls):
                 raise RpcError(INVALID_PARAMS, "`calls` is a list of strings, such as "
-                               "[\"IMG\", \"CAM P\"]")
+                               f"[\"IMG\", \"CAM P\"], {MAX_BREAKPOINTS:,} at most")
             self._calls = calls
         if "lostLines" in params:
             if not isinstance(params["lostLines"], bool):
@@ -410,6 +422,9 @@ class Connection:
 
     async def _evaluate(self, params: dict[str, Any]) -> dict[str, Any]:
         expression = _string(params, "expression")
+        if len(expression) > MAX_EXPRESSION:
+            raise RpcError(INVALID_PARAMS, f"`expression` is longer than {MAX_EXPRESSION:,} "
+                           "characters: give a value such as `U-L`")
         run = self._running_run()
         if run.busy:
             raise RpcError(RUNNING, "the program is running: pause it first")
@@ -458,6 +473,9 @@ def _source(params: dict[str, Any], key: str, default_name: str) -> Source | Non
         case {"path": str(path)}:
             return Source(path, path=path)
         case {"text": str(text), **rest} if isinstance(rest.get("name", default_name), str):
+            if len(text) > MAX_FILE_BYTES:
+                raise RpcError(FILE_UNUSABLE, f"`{key}` is larger than "
+                               f"{MAX_FILE_BYTES // 2**20} MiB, the most the studio runs")
             return Source(rest.get("name", default_name), text=text)
     raise RpcError(INVALID_PARAMS, f"`{key}` is {json.dumps(given)[:80]}: give {{\"path\": "
                    "\"a file in the folder\"} or {\"text\": \"...\", \"name\": \"...\"}")

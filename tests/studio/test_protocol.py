@@ -291,6 +291,12 @@ def test_files_are_listed_read_and_saved(client: Page, folder: Path) -> None:
     ('{"jsonrpc": "2.0", "id": 7, "method": "debug/setBreakpoints", "params": '
      '{"lines": [{"line": "20"}]}}', -32602),
     ("[" * 100_000, -32700),
+    (json.dumps({"jsonrpc": "2.0", "id": 7, "method": "debug/setBreakpoints",
+                 "params": {"lines": [{"line": 1}] * 10_001}}), -32602),
+    (json.dumps({"jsonrpc": "2.0", "id": 7, "method": "debug/setBreakpoints",
+                 "params": {"lines": [{"line": 1, "condition": "A" * 1001 + "<0"}]}}), -32602),
+    (json.dumps({"jsonrpc": "2.0", "id": 7, "method": "run/launch",
+                 "params": {"program": {"text": "'" * (8 * 2**20 + 1)}}}), -32002),
 ])
 def test_bad_messages_are_answered_and_the_server_goes_on(client: Page, message: str,
                                                           code: int) -> None:
