@@ -6,7 +6,8 @@ import { RangeSet, StateEffect, StateField, EditorState } from "@codemirror/stat
 import { Decoration, DecorationSet, EditorView, GutterMarker, gutter, keymap } from "@codemirror/view";
 
 const toggleBreakpoint = StateEffect.define<number>();  // at a line's start
-const setCurrentLine = StateEffect.define<number | null>();  // a 1-based line, or none
+// A 1-based line, or none, and whether the run faulted there.
+const setCurrentLine = StateEffect.define<{ line: number | null; fault: boolean }>();
 
 class BreakpointMarker extends GutterMarker {
   override elementClass = "cm-breakpoint";
@@ -44,17 +45,19 @@ function breakpointLines(state: EditorState): number[] {
   return [...lines].sort((a, b) => a - b);
 }
 
-/** Highlights the line the run is on (1-based), or none; `scroll` brings it into view. */
-export function showCurrentLine(view: EditorView, line: number | null, scroll: boolean): void {
+/** Highlights the line the run is on (1-based), or none, or the line it faulted on;
+ * `scroll` brings it into view. */
+export function showCurrentLine(view: EditorView, line: number | null, scroll: boolean, fault = false): void {
   const valid = line !== null && line >= 1 && line <= view.state.doc.lines ? line : null;
   view.dispatch({
-    effects: [setCurrentLine.of(valid),
+    effects: [setCurrentLine.of({ line: valid, fault }),
               ...(scroll && valid !== null
                 ? [EditorView.scrollIntoView(view.state.doc.line(valid).from, { y: "nearest" })] : [])],
   });
 }
 
 const currentLineMark = Decoration.line({ class: "cm-run-line" });
+const faultLineMark = Decoration.line({ class: "cm-fault-line" });
 
 const currentLineField = StateField.define<DecorationSet>({
   create: () => Decoration.none,
@@ -62,8 +65,9 @@ const currentLineField = StateField.define<DecorationSet>({
     marks = marks.map(transaction.changes);
     for (const effect of transaction.effects) {
       if (effect.is(setCurrentLine)) {
-        marks = effect.value === null ? Decoration.none
-          : Decoration.set([currentLineMark.range(transaction.state.doc.line(effect.value).from)]);
+        const { line, fault } = effect.value;
+        marks = line === null ? Decoration.none : Decoration.set([
+          (fault ? faultLineMark : currentLineMark).range(transaction.state.doc.line(line).from)]);
       }
     }
     return marks;

@@ -38,13 +38,15 @@ export class DebugPane {
   ended(ended: Ended): void {
     this.progress(ended);
     const status = ended.status;
-    const goal = ended.goal === null ? "" : ended.goal.met ? "; goal met" : "; goal missed";
+    const goal = ended.goal?.met ? "; goal met" : "";  // a missed goal is in the message
     this.say(status === null ? "stopped"
       : `ended: ${status.message}${status.line === null ? "" : ` (line ${status.line})`}${goal}; `
         + `${ended.instructions} instructions, ${(ended.deviceTime / 1000).toFixed(2)} s`,
              status === null ? "stopped" : status.code === "ok" ? "end"
                : status.code === "goal-missed" ? "goal-missed" : "fault");
-    const changed = new Set(Object.keys(ended.variables).filter((name) => ended.variables[name] !== this.shown[name]));
+    // Changed since the last stop shown, or since the start, where every variable is 0.
+    const changed = new Set(Object.keys(ended.variables).filter(
+      (name) => ended.variables[name] !== (this.shown[name] ?? 0)));
     this.showVariables(ended.variables, changed);
   }
 

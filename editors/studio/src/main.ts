@@ -255,8 +255,8 @@ async function start(): Promise<void> {
   studio.on("run/ended", (ended: Ended) => {
     progress(ended);
     pane.ended(ended);
-    shownLine = ended.status?.line ?? null;
-    showCurrentLine(editor, shownLine, true);
+    shownLine = ended.status?.line ?? null;  // a fault's
+    showCurrentLine(editor, shownLine, true, true);
     setState("ended");
   });
   const speedSelect = byId<HTMLSelectElement>("speed");
@@ -278,12 +278,13 @@ async function start(): Promise<void> {
     });
     reportBindings(launched.breakpoints);
   };
-  const commands: Record<string, () => Promise<unknown>> = {
+  // Each command, given the state the run was in when it was asked.
+  const commands: Record<string, (from: RunState) => Promise<unknown>> = {
     run: () => launch(false),
     pause: () => studio.request("debug/pause"),
-    "step-line": () => state === "stopped" ? studio.request("debug/stepLine") : launch(true),
-    "step-instruction": () => state === "stopped" ? studio.request("debug/stepInstruction") : launch(true),
-    continue: () => state === "stopped" ? studio.request("debug/continue", { speed: speed() }) : launch(false),
+    "step-line": (from) => from === "stopped" ? studio.request("debug/stepLine") : launch(true),
+    "step-instruction": (from) => from === "stopped" ? studio.request("debug/stepInstruction") : launch(true),
+    continue: (from) => from === "stopped" ? studio.request("debug/continue", { speed: speed() }) : launch(false),
     restart: () => studio.request("debug/restart"),
   };
   const command = (name: string): void => {
@@ -291,7 +292,7 @@ async function start(): Promise<void> {
     const before = state;
     if (name !== "pause") setState("running");  // before the answer, which a stop may precede
     say("");
-    commands[name]().catch((error: Error) => {
+    commands[name](before).catch((error: Error) => {
       if (state === "running") setState(before);
       explain(error);
     });

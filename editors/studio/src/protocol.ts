@@ -93,7 +93,7 @@ export interface Ended extends Progress {
   variables: Record<string, number>;
   instructions: number;
   deviceTime: number;
-  goal: { met?: boolean; [key: string]: unknown } | null;
+  goal: { met: boolean } | null;
 }
 
 export interface Binding { line: number; boundTo: number | null; condition: string | null; verified: boolean; message?: string }
