@@ -472,11 +472,12 @@ def _source(params: dict[str, Any], key: str, default_name: str) -> Source | Non
     match given:
         case {"path": str(path)}:
             return Source(path, path=path)
-        case {"text": str(text), **rest} if isinstance(rest.get("name", default_name), str):
+        case {"text": str(text), **rest} if isinstance(name := rest.get("name", default_name),
+                                                       str):
             if len(text) > MAX_FILE_BYTES:
                 raise RpcError(FILE_UNUSABLE, f"`{key}` is larger than "
                                f"{MAX_FILE_BYTES // 2**20} MiB, the most the studio runs")
-            return Source(rest.get("name", default_name), text=text)
+            return Source(name, text=text)
     raise RpcError(INVALID_PARAMS, f"`{key}` is {json.dumps(given)[:80]}: give {{\"path\": "
                    "\"a file in the folder\"} or {\"text\": \"...\", \"name\": \"...\"}")
 

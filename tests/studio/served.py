@@ -17,6 +17,7 @@ from typing import Any
 
 from support import EXAMPLES
 from websockets.sync.client import ClientConnection, connect
+from websockets.typing import Origin
 
 from rl1.lsp.studio.server import STATIC, Gate, Server, new_token, serve_studio
 from rl1.lsp.studio.start import studio_for
@@ -160,5 +161,5 @@ class Page:
 @contextlib.contextmanager
 def page(served: Served, origin: str | None = None) -> Iterator[Page]:
     with connect(served.url("/studio", scheme="ws"), max_size=None, open_timeout=TIMEOUT,
-                 origin=origin) as connection:  # type: ignore[arg-type]
+                 origin=None if origin is None else Origin(origin)) as connection:
         yield Page(connection)

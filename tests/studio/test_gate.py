@@ -13,6 +13,7 @@ import pytest
 from served import Served, get, page, sample_folder, serving
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
+from websockets.typing import Origin
 
 from rl1.lsp.studio.server import BUILD_HELP, TOKEN_PLACEHOLDER
 
@@ -66,7 +67,7 @@ def test_both_websockets_want_the_token(served: Served, route: str, token: str) 
 def test_a_websocket_from_another_origin_is_refused(served: Served, route: str,
                                                      origin: str) -> None:
     with pytest.raises(InvalidStatus) as refused:
-        connect(served.url(route, scheme="ws"), origin=origin, open_timeout=30)  # type: ignore[arg-type]
+        connect(served.url(route, scheme="ws"), origin=Origin(origin), open_timeout=30)
     assert refused.value.response.status_code == 403
     assert origin.encode() in refused.value.response.body
 
