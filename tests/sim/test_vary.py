@@ -246,3 +246,14 @@ start.x = { normal = [0, 5], within = [-10, 10] }
 stands.bench.x = { normal = [2, 4] }
 """
     assert world(tables).drawn(11) == world(dotted).drawn(11)
+
+
+def test_of_two_stands_of_one_name_the_last_is_drawn_and_both_are_kept() -> None:
+    # The goal holds at the last stand of a name (the world's markers by name): that is
+    # the one a key of that name moves.
+    text = WORLD.replace("[goal]", '[[stands]]\nname = "bench"\nx = 800.0\ny = 100.0\n'
+                                   "facing = 90.0\n[goal]")
+    varied = world(text + "[vary]\nstands.bench.x = { uniform = [5, 5] }\n").drawn(0)[0]
+    assert [(stand.x, stand.y) for stand in varied.stands] == [(400.0, 330.0), (805.0, 100.0)]
+    assert varied.goal is not None
+    assert varied.goal.holds[0].marker == varied.stands[1].marker()

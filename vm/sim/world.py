@@ -245,7 +245,9 @@ class World:
                 low, high = max(low, 0.0), min(high, self.floor[index])
             return Parameter(self.start[index], low, high)
         if table == "stands" and field in _STAND_FIELDS:
-            stand = next((stand for stand in self.stands if stand.name == name), None)
+            # Of stands of one name, the last: the one a [[goal.hold]] at it holds at.
+            stand = next((stand for stand in reversed(self.stands) if stand.name == name),
+                         None)
             if stand is None:
                 names = ", ".join(f'"{stand.name}"' for stand in self.stands)
                 raise ValueError(f'no stand is named "{name}"; ' + (
@@ -270,7 +272,8 @@ class World:
         setting's unit), a hold's marker with its stand; ValueError when one would leave
         its range."""
         start = list(self.start)
-        stands = {stand.name: stand for stand in self.stands}
+        stands = list(self.stands)
+        last = {stand.name: i for i, stand in enumerate(stands)}  # as parameter() finds it
         settings: dict[str, dict[str, float]] = {"vehicle": {}, "noise": {}}
         for key, offset in offsets.items():
             parameter = self.parameter(key)
@@ -284,16 +287,20 @@ class World:
             if table == "start":
                 start[_START_FIELDS.index(field)] = value
             elif name is not None:
-                stands[name] = dataclasses.replace(stands[name], **{field: value})
+                stand = stands[last[name]]
+                x, y, facing = {"x": (value, stand.y, stand.facing),
+                                "y": (stand.x, value, stand.facing),
+                                "facing": (stand.x, stand.y, value)}[field]
+                stands[last[name]] = dataclasses.replace(stand, x=x, y=y, facing=facing)
             else:
                 settings[table][field] = value
         goal = self.goal
         if goal is not None:
             goal = dataclasses.replace(goal, holds=tuple(
-                dataclasses.replace(hold, marker=stands[hold.stand].marker())
+                dataclasses.replace(hold, marker=stands[last[hold.stand]].marker())
                 for hold in goal.holds))
         return dataclasses.replace(
-            self, start=(start[0], start[1], start[2]), stands=tuple(stands.values()),
+            self, start=(start[0], start[1], start[2]), stands=tuple(stands),
             vehicle=msgspec.structs.replace(self.vehicle, **settings["vehicle"]),
             noise=msgspec.structs.replace(self.noise, **settings["noise"]), goal=goal)
 
@@ -317,7 +324,9 @@ _STAND_FIELDS = ("x", "y", "facing")
 @cache
 def _float_range(schema: type[Struct], field: str) -> tuple[float, float]:
     """The range a number of the world file's `schema` may take."""
-    info = next(info for info in mi.type_info(schema).fields if info.encode_name == field)
+    struct = mi.type_info(schema)
+    assert isinstance(struct, mi.StructType)
+    info = next(info for info in struct.fields if info.encode_name == field)
     kind = info.type.type if isinstance(info.type, mi.Metadata) else info.type
     assert isinstance(kind, mi.FloatType) and kind.ge is not None and kind.le is not None
     return kind.ge, kind.le
