@@ -5,8 +5,9 @@ against issue 28's goals.
 - keystroke to diagnostic: a key that makes line 3's `(MOV 3,3)` a mistyped call, to the
   error's underline in the editor (and the key that mends it, to the underline gone);
   median of N, goal 100 ms.
-- run to the first frame: the Run button, to the vehicle drawn away from its start;
-  median of N, goal 100 ms.
+- run to the first frame: the Run button, to the run's first frame drawn (goal 100 ms),
+  and to the vehicle drawn away from its start (which Listing 1's camera moves delay by
+  401 ms of device time, at real time); median of N.
 - step line: the Step line button, to the next stop shown (the page and the server).
 - frames a second at 10x real time: the vehicle drawn while the run goes on, goal 30.
 
@@ -39,21 +40,33 @@ SERVING = re.compile(r"rl1c studio: serving .* at (http://127\.0\.0\.1:\d+/\?tok
 GOAL_MS = 100.0
 GOAL_FPS = 30.0
 WAIT = 30_000  # ms
+FIRST_MOVE_MS = 401.0
+"""When Listing 1's (MOV 3,3) starts the vehicle on this world, in device time (its
+three (CAM) calls take that long before): at real time, the vehicle cannot be drawn away
+from its start sooner (`rl1c sim examples/sample.rob --world examples/sample.world.toml`
+shows it in the trace)."""
 
 
-# Watches the page for the first change after an input event (a key or a click) after
-# which CHANGED, a JavaScript expression, holds: window.__ms is then the milliseconds
-# from the event's time stamp.
+# Watches the page, after an input event (a key or a click), for the first change after
+# which each of CHANGED, JavaScript expressions, holds, and writes the milliseconds from
+# the event's time stamp to each in the body's data-measured, as JSON. (The page's
+# Content-Security-Policy allows no eval, which Playwright's wait_for_function needs: the
+# bench waits for that attribute instead.)
 WATCH = """() => {
-    window.__ms = null;
+    delete document.body.dataset.measured;
+    const changed = [CHANGED], times = changed.map(() => null);
     let started = null;
     const input = (event) => { if (started === null) started = event.timeStamp; };
     addEventListener("keydown", input, {capture: true, once: true});
     addEventListener("mousedown", input, {capture: true, once: true});
     const observer = new MutationObserver(() => {
-        if (started !== null && (CHANGED)) {
+        if (started === null) return;
+        changed.forEach((holds, i) => {
+            if (times[i] === null && holds()) times[i] = performance.now() - started;
+        });
+        if (times.every((time) => time !== null)) {
             observer.disconnect();
-            window.__ms = performance.now() - started;
+            document.body.dataset.measured = JSON.stringify(times);
         }
     });
     observer.observe(document.body, {subtree: true, childList: true, attributes: true,
@@ -61,14 +74,14 @@ WATCH = """() => {
 }"""
 
 
-def watch(page: Page, changed: str, act: Callable[[], object]) -> float:
-    """The milliseconds from the input event of `act` to the change after which the
-    JavaScript expression `changed` holds."""
-    page.evaluate(WATCH.replace("CHANGED", changed))
+def watch(page: Page, changed: list[str], act: Callable[[], object]) -> list[float]:
+    """The milliseconds from the input event of `act` to the first change after which
+    each JavaScript expression of `changed` holds."""
+    page.evaluate(WATCH.replace("CHANGED", ", ".join(f"() => ({one})" for one in changed)))
     act()
-    page.wait_for_function("window.__ms !== null", timeout=WAIT)
-    ms: float = page.evaluate("window.__ms")
-    return ms
+    page.wait_for_selector("body[data-measured]", state="attached", timeout=WAIT)
+    times: list[float] = json.loads(page.get_attribute("body", "data-measured") or "[]")
+    return times
 
 
 def start_studio(folder: Path) -> tuple[subprocess.Popen[str], str]:
@@ -96,24 +109,29 @@ def keystrokes(page: Page, runs: int) -> list[float]:
     times = []
     for _ in range(runs):
         page.keyboard.press("Backspace")
-        times.append(watch(page, f"{errors} > 0", lambda: page.keyboard.type("B")))
+        times += watch(page, [f"{errors} > 0"], lambda: page.keyboard.type("B"))
         page.keyboard.press("Backspace")
-        watch(page, f"{errors} === 0", lambda: page.keyboard.type("V"))
+        watch(page, [f"{errors} === 0"], lambda: page.keyboard.type("V"))
     return times
 
 
-def first_frames(page: Page, runs: int, start: str) -> list[float]:
-    """Run to the vehicle drawn away from `start` (its outline at the world's start),
-    then pause."""
+def first_frames(page: Page, runs: int, start: str) -> tuple[list[float], list[float]]:
+    """Run to the first frame of the run drawn, and to the vehicle drawn away from
+    `start` (its outline at the world's start), at real time; then pause."""
     page.select_option("#speed", "1")
+    drawn = "document.getElementById('world').dataset.framesDrawn"
     moved = f"document.getElementById('vehicle').getAttribute('points') !== {json.dumps(start)}"
-    times = []
+    first, away = [], []
     for _ in range(runs):
         page.wait_for_selector("#run:not([disabled])", state="attached", timeout=WAIT)
-        times.append(watch(page, moved, lambda: page.click("#run")))
+        before = json.dumps(page.get_attribute("#world", "data-frames-drawn"))
+        frame, vehicle = watch(page, [f"{drawn} !== ({before} ?? undefined)", moved],
+                               lambda: page.click("#run"))
+        first.append(frame)
+        away.append(vehicle)
         page.click("#pause")
         page.wait_for_selector("body:not([data-run=running])", state="attached", timeout=WAIT)
-    return times
+    return first, away
 
 
 def line_steps(page: Page, runs: int) -> list[float]:
@@ -123,8 +141,8 @@ def line_steps(page: Page, runs: int) -> list[float]:
     page.wait_for_selector("body[data-run=stopped]", state="attached", timeout=WAIT)
     times = []
     for _ in range(runs):
-        times.append(watch(page, "document.body.dataset.run !== 'running'",
-                           lambda: page.click("#step-line")))
+        times += watch(page, ["document.body.dataset.run !== 'running'"],
+                       lambda: page.click("#step-line"))
         if page.get_attribute("body", "data-run") == "ended":
             break
     return times
@@ -134,13 +152,14 @@ def frames_per_second(page: Page) -> float:
     """Frames drawn a second while the run goes on at 10x real time, over 1.5 s."""
     page.select_option("#speed", "10")
     page.wait_for_selector("#run:not([disabled])", state="attached", timeout=WAIT)
+    drawn = "() => [Number(document.getElementById('world').dataset.framesDrawn ?? 0), " \
+            "performance.now(), document.body.dataset.run]"
+    before = page.evaluate(drawn)[0]
     page.click("#run")
-    page.wait_for_function("Number(document.getElementById('world').dataset.framesDrawn) > 0",
-                           timeout=WAIT)
-    drawn = "Number(document.getElementById('world').dataset.framesDrawn)"
-    first = page.evaluate(f"[{drawn}, performance.now()]")
+    while (first := page.evaluate(drawn))[0] == before:
+        page.wait_for_timeout(10)
     page.wait_for_timeout(1500)
-    last = page.evaluate(f"[{drawn}, performance.now(), document.body.dataset.run]")
+    last = page.evaluate(drawn)
     if last[2] != "running":
         print("  (the run ended within the window: the figure is a lower bound)")
     return float((last[0] - first[0]) / ((last[1] - first[1]) / 1000))
@@ -170,8 +189,10 @@ def main() -> None:
                       f"N={runs}")
                 summary("keystroke to diagnostic", keystrokes(page, runs), GOAL_MS)
                 start = page.get_attribute("#vehicle", "points") or ""
-                summary("run to the first frame of the vehicle moving",
-                        first_frames(page, runs, start), GOAL_MS)
+                first, away = first_frames(page, runs, start)
+                summary("run to the first frame drawn, at real time", first, GOAL_MS)
+                summary(f"run to the vehicle drawn away from its start ({FIRST_MOVE_MS:.0f} ms "
+                        "of it Listing 1's camera moves)", away, GOAL_MS + FIRST_MOVE_MS)
                 summary("step line, click to the stop shown", line_steps(page, runs), 20.0)
                 fps = frames_per_second(page)
                 print(f"frames a second at 10x real time: {fps:.1f} "
