@@ -1,15 +1,21 @@
-"""Campaigns (`rl1c sim --runs`, compiler/campaign.py): runs per second of Listing 1 on
-the sample world with noise on (`noise = true`: spec/simulator.md, "Noise"), in one
-process and on every core (the pool's start-up included: a campaign pays it once), then
-a campaign of `--runs` runs (default 1,000) through the command line, its summary as
-printed.
+"""Campaigns (`rl1c sim --runs`, compiler/campaign.py), in one run:
 
-    .venv/bin/python bench/campaign.py [--runs N] [--rate-runs N]
+- runs per second of Listing 1 on the sample world with noise on (`noise = true`:
+  spec/simulator.md, "Noise"), in one process and on every core (the pool's start-up
+  included: a campaign pays it once);
+- the same on a local Dask cluster (compiler/executors.py) of 1 worker, then of 2;
+- the memory of a long campaign: the resident size of a campaign in this process,
+  sampled as the runs go, over `--memory-runs` runs (default 100,000) of a cheap program;
+- last, a campaign of `--runs` runs (default 1,000) of Listing 1 through the command
+  line, its summary as printed.
+
+    .venv/bin/python bench/campaign.py [--runs N] [--rate-runs N] [--memory-runs N]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import resource
 import shutil
@@ -17,16 +23,19 @@ import subprocess
 import sys
 import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-from rl1.compiler.campaign import Campaign, Task, campaign_seeds, task_for
+from rl1.compiler.campaign import Campaign, Tally, Task, campaign_seeds, task_for
+from rl1.compiler.cli.sim_campaign import WINDOW_PER_JOB
+from rl1.compiler.executors import workers
 from rl1.vm.defaults import DEFAULT_BUDGET
 
 ROOT = Path(__file__).parents[1]
 PROGRAM = ROOT / "examples" / "sample.rob"
 WORLD = ROOT / "examples" / "sample.world.toml"
 RL1C = str(Path(sys.executable).with_name("rl1c"))
+CHEAP_PROGRAM = "A=(ULT A)\n(END)\n"  # one noisy reading: a run of about a millisecond
+SAMPLES = 10  # of the memory, over the long campaign
 
 
 def noisy_world() -> bytes:
@@ -41,35 +50,89 @@ def cpu_seconds() -> float:
     return own.ru_utime + own.ru_stime + workers.ru_utime + workers.ru_stime
 
 
-def measure(task: Task, runs: int, jobs: int) -> tuple[float, float]:
-    """Runs per second of wall-clock time, and CPU ms a run (this process and the
-    workers together: what the machine's load does not change)."""
-    started, cpu = time.perf_counter(), cpu_seconds()
-    if jobs == 1:
-        done = sum(1 for _ in Campaign(task, campaign_seeds(0, runs), None, 1))
-    else:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            done = sum(1 for _ in Campaign(task, campaign_seeds(0, runs), pool, 8 * jobs))
-    return (done / (time.perf_counter() - started),
-            (cpu_seconds() - cpu) * 1000 / done)
+def measure(task: Task, runs: int, jobs: int, scheduler: str | None = None) -> float:
+    """Runs per second of wall-clock time, on `jobs` local processes or on the cluster of
+    `scheduler`, as `rl1c sim --runs` makes them."""
+    started = time.perf_counter()
+    with workers(jobs, scheduler) as held:
+        done = sum(1 for _ in Campaign(task, campaign_seeds(0, runs), held.executor,
+                                       WINDOW_PER_JOB * max(held.slots, 1), held.lost))
+    return done / (time.perf_counter() - started)
+
+
+def cluster_rates(task: Task, runs: int) -> list[float]:
+    """Runs per second on a local Dask cluster of 1 worker, then of 2 (a process each,
+    one thread), reached through its scheduler's address as `--scheduler` reaches it."""
+    from distributed import LocalCluster
+
+    rates = []
+    for count in (1, 2):
+        with LocalCluster(  # type: ignore[no-untyped-call]
+                n_workers=count, threads_per_worker=1, processes=True,
+                dashboard_address=":0") as cluster:  # the dashboard on any free port
+            measure(task, 2 * count, 1, cluster.scheduler_address)  # the workers' imports
+            rates.append(measure(task, runs, 1, cluster.scheduler_address))
+    return rates
+
+
+def resident_mb() -> float:
+    """This process's resident memory now (not its peak)."""
+    pages = int(Path("/proc/self/statm").read_text().split()[1])
+    return pages * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+
+def memory_samples(runs: int) -> list[tuple[int, float]]:
+    """The resident memory after every tenth of a campaign of `runs` runs of a cheap
+    program, each run kept as the command keeps it (counted, written as a JSON line)."""
+    task = task_for(CHEAP_PROGRAM, noisy_world(), "sample.noisy.world.toml", "vm",
+                    DEFAULT_BUDGET, "cheap.rob")
+    tally = Tally()
+    samples = [(0, resident_mb())]
+    with open(os.devnull, "w", encoding="utf-8") as lines:  # written, not held
+        for record in Campaign(task, campaign_seeds(0, runs), None, 1):
+            tally.add(record)
+            lines.write(json.dumps(record.to_json(), separators=(",", ":")) + "\n")
+            if tally.runs % (runs // SAMPLES) == 0:
+                samples.append((tally.runs, resident_mb()))
+    return samples
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=int, default=1000)
     parser.add_argument("--rate-runs", type=int, default=100)
+    parser.add_argument("--memory-runs", type=int, default=100_000)
     options = parser.parse_args()
     cores = os.cpu_count() or 1
     task = task_for(PROGRAM.read_text(), noisy_world(), "sample.noisy.world.toml", "vm",
                     DEFAULT_BUDGET, PROGRAM.name)
-    one, one_cpu = measure(task, options.rate_runs, 1)
-    every, every_cpu = measure(task, options.rate_runs, cores)
     load = os.getloadavg()[0]  # other work on the machine takes cores from the pool
+    started, cpu = time.perf_counter(), cpu_seconds()
+    one = measure(task, options.rate_runs, 1)
+    one_cpu = (cpu_seconds() - cpu) * 1000 / options.rate_runs
+    every = measure(task, options.rate_runs, cores)
     print(f"Listing 1 on the sample world with noise on, {options.rate_runs} runs "
           f"({cores} cores, load average {load:.1f} before):")
-    print(f"  1 process:   {one:6.1f} runs/s, {one_cpu:.0f} ms of CPU a run")
-    print(f"  {cores} processes: {every:6.1f} runs/s ({every / one:.2f}x one process), "
-          f"{every_cpu:.0f} ms of CPU a run (the pool's start-up included)")
+    print(f"  1 process:   {one:6.1f} runs/s ({one_cpu:.0f} ms of CPU a run)")
+    print(f"  {cores} processes: {every:6.1f} runs/s ({every / one:.2f}x one process; "
+          "the pool's start-up included)")
+    one_worker, two_workers = cluster_rates(task, options.rate_runs)
+    print(f"  Dask, 1 worker:  {one_worker:6.1f} runs/s ({one_worker / one:.2f}x one "
+          "process)")
+    print(f"  Dask, 2 workers: {two_workers:6.1f} runs/s ({two_workers / one_worker:.2f}x "
+          f"1 worker)")
+
+    print(f"\nmemory of a campaign of {options.memory_runs:,} runs of `{CHEAP_PROGRAM!r}` "
+          "(resident, this process):")
+    started = time.perf_counter()
+    samples = memory_samples(options.memory_runs)
+    seconds = time.perf_counter() - started
+    for runs, megabytes in samples:
+        print(f"  after {runs:>7,} runs: {megabytes:6.1f} MB")
+    first = samples[1][1]  # after the first tenth: the caches and the collector settled
+    print(f"  growth from the first tenth to the end: {samples[-1][1] - first:+.1f} MB "
+          f"({options.memory_runs / seconds:.0f} runs/s)")
+
     with tempfile.TemporaryDirectory() as folder:
         shutil.copy(PROGRAM, folder)
         Path(folder, "sample.noisy.world.toml").write_bytes(noisy_world())

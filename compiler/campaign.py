@@ -4,8 +4,8 @@ succeed, and how does it fail" (spec/simulator.md, "Campaigns").
 Each run is a plain function of the task (the program as source text or .ilc bytes, the
 world file's bytes, the engine and budget) and its seed, `run_one`, and is the run
 `rl1c sim FILE --world W --seed SEED` makes (both go through compiler/simulation.py).
-The runs go to any `concurrent.futures.Executor` (local processes here; Dask's client
-offers the same interface), each task carrying the program and the world, so a worker
+The runs go to any `concurrent.futures.Executor` (local processes or a Dask cluster:
+compiler/executors.py), each task carrying the program and the world, so a worker
 needs no files. `Campaign` yields the records in seed order whatever the executor, with
 at most `window` runs in flight, so the output is the same for any number of workers and
 memory stays flat; `Tally` keeps only counts and the first few seeds of each failure
@@ -160,19 +160,24 @@ def noiseless(task: Task) -> bool:
     return world_of(task).noise == NOISELESS
 
 
+RESUBMISSIONS = 2  # of a run lost with its worker: more, and the run may be what kills them
+
+
 class Campaign:
     """The runs of `task` over `seeds` on `executor` (in this process when None), as an
     iterator of their records in seed order, with at most `window` runs submitted and not
-    yet yielded. `salvage` ends it early, keeping the runs already finished that follow
-    the last yielded without a gap."""
+    yet yielded. A run that fails with an error of `lost` (a Dask cluster's KilledWorker:
+    its worker died) is submitted again, at most RESUBMISSIONS times. `salvage` ends it
+    early, keeping the runs already finished that follow the last yielded without a gap."""
 
     def __init__(self, task: Task, seeds: Iterable[int], executor: Executor | None,
-                 window: int) -> None:
+                 window: int, lost: tuple[type[BaseException], ...] = ()) -> None:
         self._task = task
         self._seeds = iter(seeds)
         self._executor = executor
         self._window = window
-        self._pending: deque[Future[Record]] = deque()
+        self._lost = lost
+        self._pending: deque[tuple[int, Future[Record]]] = deque()
 
     def __iter__(self) -> Iterator[Record]:
         if self._executor is None:
@@ -182,7 +187,7 @@ class Campaign:
         for seed in islice(self._seeds, self._window):
             self._submit(seed)
         while self._pending:
-            record = self._pending[0].result()
+            record = self._first_record()
             # The next run is submitted before this one leaves the queue: a broken pool
             # refuses it, and salvage must still find this record.
             for seed in islice(self._seeds, 1):
@@ -192,7 +197,19 @@ class Campaign:
 
     def _submit(self, seed: int) -> None:
         assert self._executor is not None
-        self._pending.append(self._executor.submit(run_one, self._task, seed))
+        self._pending.append((seed, self._executor.submit(run_one, self._task, seed)))
+
+    def _first_record(self) -> Record:
+        """The record of the first run in flight, submitted again in its place while it
+        is lost with its worker."""
+        assert self._executor is not None
+        for _ in range(RESUBMISSIONS):
+            seed, future = self._pending[0]
+            try:
+                return future.result()
+            except self._lost:
+                self._pending[0] = seed, self._executor.submit(run_one, self._task, seed)
+        return self._pending[0][1].result()
 
     def salvage(self) -> list[Record]:
         """Stop: cancel the runs not yet made, and return the finished runs that follow
@@ -200,7 +217,7 @@ class Campaign:
         campaign are its first seeds, and the next campaign can start where it ended)."""
         finished: list[Record] = []
         gap = False
-        for future in self._pending:
+        for _, future in self._pending:
             gap = gap or not future.done() or future.cancelled() \
                 or future.exception() is not None
             if gap:

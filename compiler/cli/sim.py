@@ -66,6 +66,10 @@ def at_least_one_or_none(ctx: click.Context, param: click.Parameter,
 @click.option("--jobs", type=str, default=None, callback=at_least_one_or_none, metavar="J",
               help="with --runs: the processes that make the runs (default: every core); "
                    "the results are the same for any J")
+@click.option("--scheduler", metavar="ADDRESS",
+              help="with --runs: make the runs on the Dask cluster of this scheduler "
+                   "(tcp://HOST:8786; the extra rl1[cluster]) instead of local processes; "
+                   "the same results")
 @click.option("--out", "out_file", metavar="FILE", type=PATH,
               help="with --runs: write each run as a JSON line to FILE (- for standard "
                    "output, the summary then on standard error), in seed order, as the "
@@ -75,7 +79,7 @@ def at_least_one_or_none(ctx: click.Context, param: click.Parameter,
 def sim(file: str, world: str | None, svg_file: str | None, html_file: str | None,
         sim_format: str, seed: int, engine: Engine, budget: int,
         trace_choice: TraceChoice | None, runs: int | None, jobs: int | None,
-        out_file: str | None, force: bool, color: ColorChoice) -> int:
+        scheduler: str | None, out_file: str | None, force: bool, color: ColorChoice) -> int:
     """Run a program (.rob source, or an .ilc file) on the simulated vehicle and world.
 
     Prints each call with the device time, its source line and the vehicle's pose after
@@ -106,9 +110,13 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
             raise click.UsageError(f"{option} writes a file, and standard output carries "
                                    f"the report: give {option} FILE")
     if runs is None:
-        for option, given in (("--jobs", jobs), ("--out", out_file)):
+        for option, given in (("--jobs", jobs), ("--scheduler", scheduler),
+                              ("--out", out_file)):
             if given is not None:
                 raise click.UsageError(f"{option} is for a campaign of runs: give --runs N")
+    elif jobs is not None and scheduler is not None:
+        raise click.UsageError("--jobs counts local processes, and --scheduler gives the "
+                               "runs to a cluster's workers: give one of them")
     else:
         for option, given in (("--svg", svg_file), ("--html", html_file),
                               ("--trace", trace_choice)):
@@ -130,7 +138,8 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
     if runs is not None:
         from .sim_campaign import Setting, run_campaign
 
-        setting = Setting(file, world, seed, runs, jobs or os.cpu_count() or 1, engine, budget)
+        setting = Setting(file, world, seed, runs, jobs or os.cpu_count() or 1, engine, budget,
+                          scheduler)
         return run_campaign(file, world_bytes, world, setting, out_file, color)
     simulation = Simulation(the_world, seed)
     device = simulation.device

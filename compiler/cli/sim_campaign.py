@@ -1,9 +1,10 @@
 """`rl1c sim FILE --world W --runs N`: a campaign (compiler/campaign.py), the program run
-over N seeds on local processes, each run a JSON line (`--out FILE`) as it finishes in
-seed order, progress on standard error, and a summary: the success rate with its 95 %
-Wilson interval and the failures grouped by kind and source line, each with the seeds
-of its first runs and the `rl1c sim` command that replays one. Ctrl-C or SIGTERM stops
-it with the runs finished kept, written and summed up."""
+over N seeds on local processes or a Dask cluster (compiler/executors.py), each run a
+JSON line (`--out FILE`) as it finishes in seed order, progress on standard error, and a
+summary: the success rate with its 95 % Wilson interval and the failures grouped by kind
+and source line, each with the seeds of its first runs and the `rl1c sim` command that
+replays one. Ctrl-C or SIGTERM stops it with the runs finished kept, written and summed
+up."""
 
 from __future__ import annotations
 
@@ -14,8 +15,8 @@ import signal
 import sys
 import time
 from collections.abc import Callable, Iterator
-from concurrent.futures import BrokenExecutor, Executor, ProcessPoolExecutor
-from contextlib import contextmanager
+from concurrent.futures import BrokenExecutor
+from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass
 from types import FrameType
 from typing import IO
@@ -33,16 +34,18 @@ from rl1.compiler.campaign import (
     wilson,
     world_of,
 )
+from rl1.compiler.executors import Unavailable, Workers, workers
 from rl1.compiler.reporting.render import ColorChoice
 from rl1.vm.defaults import DEFAULT_BUDGET, Engine
 
-from .command import EXIT_INTERNAL
+from .command import EXIT_INTERNAL, Failure
 from .running import run_file
 from .streams import cannot_write, file_failure, read_ilc, same_file
 
 PROGRESS_EVERY = 5.0  # s between progress lines when standard error is no terminal
 REDRAW_EVERY = 0.2  # s between redraws of the progress line on a terminal
-WINDOW_PER_JOB = 8  # runs in flight per worker: enough to keep each busy, few to hold
+WINDOW_PER_JOB = 8  # runs in flight per worker (a cluster: per thread): enough to keep
+# each busy, few to hold
 MAX_JOBS = 1024  # processes: beyond, --scheduler (a cluster) is the way
 
 
@@ -57,11 +60,14 @@ class Setting:
     jobs: int
     engine: Engine
     budget: int
+    scheduler: str | None = None  # a Dask cluster's, instead of `jobs` local processes
 
     def rest(self, seed: int, runs: int) -> str:
         """The `rl1c sim --runs` command of the campaign's last `runs` runs, from `seed`."""
         words = ["rl1c", "sim", self.file, "--world", self.world, "--runs", str(runs),
-                 "--seed", str(seed), "--jobs", str(self.jobs)]
+                 "--seed", str(seed)]
+        words += ["--jobs", str(self.jobs)] if self.scheduler is None else [
+            "--scheduler", self.scheduler]
         return shlex.join(words + self._engine_words())
 
     def _engine_words(self) -> list[str]:
@@ -124,24 +130,19 @@ class Stopping:
             raise Stopped(128 + self._pending)
 
 
-def _worker_start() -> None:
-    # Ctrl-C reaches the whole process group: the campaign stops its workers itself; and
-    # a worker forked while Stopping is in effect must not take its handler: the pool
-    # ends its workers with SIGTERM when one of them dies.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-
-
 @contextmanager
-def _executor(jobs: int) -> Iterator[Executor | None]:
-    if jobs == 1:  # no pool: the runs are made in this process
-        yield None
-        return
-    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_worker_start)
+def _workers(setting: Setting) -> Iterator[Workers]:
+    """The campaign's workers (no more local processes than runs), or the Failure that
+    says why there are none."""
     try:
-        yield pool
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+        with workers(min(setting.jobs, setting.runs), setting.scheduler) as held:
+            if setting.scheduler is not None and held.slots == 0:
+                print(f"rl1c: note: the scheduler at {setting.scheduler} has no workers yet; "
+                      f"the runs wait for one (`dask worker {setting.scheduler}`)",
+                      file=sys.stderr)
+            yield held
+    except Unavailable as error:
+        raise Failure(str(error)) from None
 
 
 def task_of(file: str, world: bytes, world_name: str, setting: Setting,
@@ -256,7 +257,13 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     task = task_of(file, world, world_name, setting, color)
     if isinstance(task, int):
         return task
-    lines = _open_out(out, (file, setting.world))
+    held = ExitStack()  # the workers: a cluster is reached before --out replaces a file
+    current = held.enter_context(_workers(setting))
+    try:
+        lines = _open_out(out, (file, setting.world))
+    except BaseException:
+        held.close()
+        raise
     report = sys.stderr if out == "-" else sys.stdout
     tally = Tally()
     progress = Progress(setting.runs, sys.stderr)
@@ -264,11 +271,11 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     stopping = Stopping()
     broken_at = None  # the first seed left when the workers last broke
     try:
-        with stopping.in_effect():
+        with stopping.in_effect(), held:  # the workers end while a signal only stops
             while status == 0 and tally.runs < setting.runs:
                 left = range(setting.seed + tally.runs, seeds.stop)
                 try:
-                    status = _make_runs(task, left, setting.jobs, tally, lines, progress,
+                    status = _make_runs(task, left, current, tally, lines, progress,
                                         stopping)
                 except BrokenExecutor:
                     first_left = setting.seed + tally.runs
@@ -280,6 +287,8 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
                     print(f"rl1c: warning: a worker process ended abruptly (killed, or out "
                           f"of memory); the workers start again from seed {broken_at}",
                           file=sys.stderr)
+                    held.close()
+                    current = held.enter_context(_workers(setting))
     except Stopped as stop:  # again, while the workers end their runs
         status = stop.status
     finally:
@@ -291,9 +300,9 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     next_seed = setting.seed + tally.runs
     rest = setting.rest(next_seed, setting.runs - tally.runs)
     if status == EXIT_INTERNAL:
-        print(f"rl1c: error: the run of seed {next_seed} ended its worker process twice: "
-              f"replay it alone ({setting.replay(next_seed)}), and if rl1c crashed, report "
-              f"it; the runs before it are kept; to go on after it: "
+        print(f"rl1c: error: the run of seed {next_seed} ended its worker each time it "
+              f"was made: replay it alone ({setting.replay(next_seed)}), and if rl1c "
+              f"crashed, report it; the runs before it are kept; to go on after it: "
               f"{setting.rest(next_seed + 1, setting.runs - tally.runs - 1)}",
               file=sys.stderr)
     elif status:
@@ -303,25 +312,30 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     return status
 
 
-def _make_runs(task: Task, seeds: range, jobs: int, tally: Tally, lines: IO[str] | None,
-               progress: Progress, stopping: Stopping) -> int:
-    """Make the runs of `seeds` on `jobs` processes, keeping each; 0, or the status of a
-    signal that stopped them. BrokenExecutor when a worker process ended abruptly,
-    after keeping the runs finished before the first it lost."""
-    with _executor(min(jobs, len(seeds))) as executor:
-        runs = Campaign(task, seeds, executor, WINDOW_PER_JOB * jobs)
-        try:
-            for record in runs:
-                with stopping.keeping():
-                    _keep(record, tally, lines)
-                progress.update(tally)
-        except (Stopped, BrokenExecutor) as stop:
+def _make_runs(task: Task, seeds: range, held: Workers, tally: Tally,
+               lines: IO[str] | None, progress: Progress, stopping: Stopping) -> int:
+    """Make the runs of `seeds` on `held`, keeping each; 0, the status of a signal that
+    stopped them, or EXIT_INTERNAL when a run was lost with its worker each time it was
+    made. BrokenExecutor when a local worker process ended abruptly, after keeping the
+    runs finished before the first it lost."""
+    runs = Campaign(task, seeds, held.executor, WINDOW_PER_JOB * max(held.slots, 1),
+                    held.lost)
+    ending: tuple[type[BaseException], ...] = (Stopped, BrokenExecutor, *held.lost)
+    try:
+        for record in runs:
             with stopping.keeping():
-                for record in runs.salvage():
-                    _keep(record, tally, lines)
-            if isinstance(stop, BrokenExecutor):
+                _keep(record, tally, lines)
+            progress.update(tally)
+    except ending as stop:
+        with stopping.keeping():
+            for record in runs.salvage():
+                _keep(record, tally, lines)
+        match stop:
+            case Stopped():
+                return stop.status
+            case BrokenExecutor():
                 raise
-            return stop.status
+        return EXIT_INTERNAL
     return 0
 
 

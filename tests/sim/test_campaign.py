@@ -24,9 +24,11 @@ from typing import ParamSpec, TypeVar
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from support.campaigns import DROPOUT, WALL_PROGRAM, WALL_WORLD
 from support.cli import rl1c
 
 from rl1.compiler.campaign import (
+    RESUBMISSIONS,
     SEEDS_KEPT,
     Campaign,
     Record,
@@ -41,32 +43,6 @@ from rl1.compiler.cli.sim_campaign import Progress
 from rl1.vm.defaults import DEFAULT_BUDGET
 
 RL1C = str(Path(sys.executable).with_name("rl1c"))
-DROPOUT = 0.3
-
-# A vehicle 30 cm from a wall reads it with sensor A, except when the echo drops out
-# (chance DROPOUT) and the reading is the sensor's range, 100: then the program steers
-# by 2048 tenths, out of (STX)'s range, a fault at line 4. Nothing else is drawn.
-WALL_PROGRAM = """\
-A=(ULT A)-99; ?A>#90
-(END)
-:90 B=A<11
-(STX B)
-"""
-WALL_WORLD = f"""\
-[floor]
-size = [1000, 1000]
-[start]
-x = 500.0
-y = 500.0
-[[walls]]
-name = "ahead"
-points = [[570, 0], [580, 0], [580, 1000], [570, 1000]]
-[noise]
-start_cm = 0
-start_deg = 0
-ultrasonic_cm = 0
-ultrasonic_dropout = {DROPOUT}
-"""
 
 
 @pytest.fixture
@@ -354,7 +330,7 @@ def _children(pid: int) -> list[int]:
 
 @pytest.mark.parametrize(("extra", "message"), [
     (["--jobs", "2"], "--jobs is for a campaign of runs: give --runs N"),
-    (["--runs", "3", "--svg", "x.svg"], "--svg shows one run"),
+    (["--runs", "3", "--trace", "all"], "--trace shows one run"),
     (["--runs", "3", "--format", "json"], "--format json shows one run"),
     (["--runs", "0"], "expected a whole number of at least 1"),
     (["--runs", "3", "--seed", "4294967294"], "the seeds 4294967294..4294967296 leave"),
@@ -397,3 +373,54 @@ def test_a_run_finished_when_the_pool_breaks_is_kept() -> None:
         made.extend(campaign)
     made.extend(campaign.salvage())
     assert [record.seed for record in made] == [0, 1]
+
+
+class Lost(Exception):
+    """A run lost with its worker, as a Dask cluster's KilledWorker says it."""
+
+
+class Losing(Executor):
+    """An executor that makes each run at once, except the first `losses` submissions of
+    the run of `seed`, which it loses."""
+
+    def __init__(self, seed: int, losses: int) -> None:
+        self.seed = seed
+        self.losses = losses
+        self.submitted: list[int] = []
+
+    def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
+        seed = args[1]
+        assert isinstance(seed, int)
+        self.submitted.append(seed)
+        future: Future[T] = Future()
+        if seed == self.seed and self.losses > 0:
+            self.losses -= 1
+            future.set_exception(Lost(f"the worker of seed {seed} died"))
+        else:
+            future.set_result(fn(*args, **kwargs))
+        return future
+
+
+def test_a_run_lost_with_its_worker_is_made_again_in_its_place() -> None:
+    task = compiled_wall_task()
+    losing = Losing(seed=3, losses=RESUBMISSIONS)
+    made = list(Campaign(task, range(8), losing, window=4, lost=(Lost,)))
+    assert made == list(Campaign(task, range(8), None, 1))
+    assert losing.submitted.count(3) == 1 + RESUBMISSIONS
+
+
+def test_a_run_lost_each_time_it_is_made_stops_the_campaign_after_the_runs_before_it() -> None:
+    campaign = Campaign(compiled_wall_task(), range(8), Losing(seed=3, losses=99), window=4,
+                        lost=(Lost,))
+    made: list[Record] = []
+    with pytest.raises(Lost):
+        made.extend(campaign)
+    assert [record.seed for record in made] == [0, 1, 2]
+    assert campaign.salvage() == []  # the runs after it are not the next seeds
+
+
+def test_an_error_that_is_no_lost_worker_is_not_made_again() -> None:
+    losing = Losing(seed=1, losses=1)
+    with pytest.raises(Lost):
+        list(Campaign(compiled_wall_task(), range(4), losing, window=2))
+    assert losing.submitted.count(1) == 1

@@ -35,9 +35,14 @@ MARKS: dict[str, tuple[str, ...]] = {
     "tests/lsp/test_protocol.py": ("slow",),
     "tests/cli/test_hostile_inputs.py": ("slow",),
     "tests/lsp/test_hostile_transports.py": ("slow",),
+    # rl1c studio in a process of its own, stopped by Ctrl-C.
+    "tests/studio/test_command.py::test_it_prints_its_address_serves_there_and_stops_on_ctrl_c":
+        ("slow",),
     "tests/backend/test_reproducible.py": ("slow",),
-    # Campaigns of simulated runs on pools of processes.
+    # Campaigns of simulated runs on pools of processes, and on a Dask cluster of a
+    # scheduler and two workers started for each test.
     "tests/sim/test_campaign.py": ("slow",),
+    "tests/sim/test_cluster.py": ("slow",),
     # Forty seeded simulations of the robust Fig. 4 example.
     "tests/sim/test_sim_fig4.py::test_with_noise_it_succeeds_in_at_least_nine_runs_of_ten":
         ("slow",),

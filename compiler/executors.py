@@ -1,0 +1,123 @@
+"""Where the work of a campaign is done: in this process, on a pool of local processes,
+or on a Dask cluster (`--scheduler tcp://HOST:8786`), each a `concurrent.futures.Executor`
+(Dask's client offers one), so that `rl1c sim --runs` and `rl1c fuzz` have one code path
+for all three.
+
+Dask's `distributed` is an optional extra (`pip install 'rl1[cluster]'`), imported only
+when a scheduler is given. Its workers need rl1 installed and nothing else: what they
+run carries its inputs (compiler/campaign.py's Task holds the program and the world).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import signal
+from collections.abc import Iterator
+from concurrent.futures import Executor, ProcessPoolExecutor
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from distributed import Client
+
+CONNECT_TIMEOUT = 5  # s: an unreachable scheduler is said in a few seconds
+EXTRA = "cluster"  # pyproject.toml's extra that installs `distributed`
+
+
+class Unavailable(Exception):
+    """The executor asked for cannot be had: its message says why and what to do."""
+
+
+@dataclass(frozen=True, slots=True)
+class Workers:
+    """An executor (None: the work is done in this process), how many tasks it makes at
+    once (a cluster: its workers' threads when it was reached, 0 while none has joined),
+    and the errors of a task lost with its worker, which can be submitted again
+    (a pool whose worker died is broken instead: concurrent.futures.BrokenExecutor)."""
+
+    executor: Executor | None
+    slots: int
+    lost: tuple[type[BaseException], ...] = ()
+
+
+def ignore_interrupts() -> None:
+    """A local worker's start: Ctrl-C reaches the whole process group, and the parent
+    stops its workers itself; a worker forked while the parent has its own SIGTERM
+    handler must not take it, since a pool ends its workers with SIGTERM when one dies."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+@contextmanager
+def workers(jobs: int, scheduler: str | None = None) -> Iterator[Workers]:
+    """The workers of a campaign: the Dask cluster of `scheduler` when given, else `jobs`
+    local processes (this process alone for 1). Unavailable when `distributed` is not
+    installed or the scheduler cannot be reached. On leaving, the work not yet done is
+    cancelled."""
+    if scheduler is not None:
+        with _cluster(scheduler) as cluster:
+            yield cluster
+        return
+    if jobs == 1:
+        yield Workers(None, 1)
+        return
+    pool = ProcessPoolExecutor(max_workers=jobs, initializer=ignore_interrupts)
+    try:
+        yield Workers(pool, jobs)
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+@contextmanager
+def _cluster(address: str) -> Iterator[Workers]:
+    try:
+        from distributed import Client
+        from distributed.scheduler import KilledWorker
+    except ImportError as error:
+        raise Unavailable(
+            f"error: --scheduler needs Dask's `distributed`, which is not installed here "
+            f"({error})\n  = help: install the extra `{EXTRA}`: pip install 'rl1[{EXTRA}]' "
+            "(or pip install distributed), on this machine and on the workers'") from None
+    client = _connect(Client, address)
+    try:
+        # Not pure: a run submitted again after its worker died is a new task, not the
+        # failed one remembered under the same key.
+        yield Workers(client.get_executor(pure=False),  # type: ignore[no-untyped-call]
+                      _threads(client), (KilledWorker,))
+    finally:
+        # The scheduler forgets the client's tasks left, and cancels them.
+        client.close()  # type: ignore[no-untyped-call]
+
+
+def _connect(client: type[Client], address: str) -> Client:
+    from distributed.comm.core import connect
+
+    async def reach() -> None:
+        comm = await connect(address, timeout=CONNECT_TIMEOUT)  # type: ignore[no-untyped-call]
+        await comm.close()
+
+    try:
+        # Reached first with a connection of its own: a Client that fails to connect
+        # leaves an object whose collection blocks for twice the timeout and then prints
+        # a traceback.
+        asyncio.run(reach())
+        return client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
+    except (OSError, ValueError) as error:  # no server there, or a wrong address
+        raise _unreachable(address, str(error)) from None
+    except Exception:  # such as a length of exabytes read from the first bytes
+        raise _unreachable(address, "the server there answered, but not as a Dask "
+                           "scheduler") from None
+
+
+def _unreachable(address: str, why: str) -> Unavailable:
+    return Unavailable(
+        f"error: cannot reach a Dask scheduler at {address} ({why})\n"
+        f"  = help: start one there (`dask scheduler`, then `dask worker {address}` on "
+        "each machine), or give its address as tcp://HOST:8786")
+
+
+def _threads(client: Client) -> int:
+    """The threads of the cluster's workers now (more may join later)."""
+    threads: dict[str, int] = client.nthreads()  # type: ignore[no-untyped-call]
+    return sum(threads.values())

@@ -1,0 +1,222 @@
+"""Campaigns on a Dask cluster (`rl1c sim --runs N --scheduler ADDRESS`,
+compiler/executors.py): a real `dask scheduler` and two `dask worker` processes on
+127.0.0.1 make the runs, and the JSON lines and the summary are the local campaign's
+byte for byte, also when a worker is killed in the middle; without `distributed`, or
+without a scheduler at the address, a message says what to do."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+from support.campaigns import WALL_PROGRAM, WALL_WORLD
+from support.cli import rl1c
+
+from rl1.compiler.cli.sim_campaign import Setting
+
+BIN = Path(sys.executable).parent
+STARTED_WITHIN = 120  # s for the scheduler and the workers to start on a loaded machine
+
+
+@dataclass
+class Cluster:
+    address: str
+    scheduler: subprocess.Popen[bytes]
+    workers: list[subprocess.Popen[bytes]]
+    logs: Path
+
+    def log(self) -> str:
+        """What the scheduler and the workers printed, for a failed test's message."""
+        return "\n".join(f"--- {path.name}\n{path.read_text(errors='replace')}"
+                         for path in sorted(self.logs.glob("*.log")))
+
+
+def _start(command: list[str], log: Path, env: dict[str, str]) -> subprocess.Popen[bytes]:
+    with open(log, "wb") as stream:
+        return subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=stream,
+                                stderr=subprocess.STDOUT, env=env)
+
+
+@pytest.fixture
+def cluster(tmp_path: Path) -> Iterator[Cluster]:
+    """A scheduler and two single-threaded workers on 127.0.0.1. A worker killed while
+    it makes a run fails that run at once (allowed-failures 0, where Dask would try it
+    on up to three workers first), so that the campaign's own resubmission is tested."""
+    from distributed import Client
+
+    logs = tmp_path / "cluster"
+    logs.mkdir()
+    address_file = logs / "scheduler.json"  # the scheduler writes its address: no port race
+    env = {**os.environ, "DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0"}
+    processes: list[subprocess.Popen[bytes]] = []
+    try:
+        processes.append(_start(
+            [str(BIN / "dask"), "scheduler", "--host", "127.0.0.1", "--port", "0",
+             "--no-dashboard", "--scheduler-file", str(address_file)],
+            logs / "scheduler.log", env))
+        for number in range(2):
+            processes.append(_start(
+                [str(BIN / "dask"), "worker", "--scheduler-file", str(address_file),
+                 "--host", "127.0.0.1", "--nthreads", "1", "--no-nanny",
+                 "--no-dashboard", "--name", f"worker-{number}"],
+                logs / f"worker-{number}.log", env))
+        deadline = time.monotonic() + STARTED_WITHIN
+        while not address_file.exists():
+            assert time.monotonic() < deadline, "the scheduler did not start"
+            assert processes[0].poll() is None, (logs / "scheduler.log").read_text()
+            time.sleep(0.1)
+        address = json.loads(address_file.read_text())["address"]
+        with Client(address, timeout=STARTED_WITHIN,  # type: ignore[no-untyped-call]
+                    set_as_default=False) as client:
+            client.wait_for_workers(2, timeout=STARTED_WITHIN)
+        yield Cluster(address, processes[0], processes[1:], logs)
+    finally:
+        for process in processes:
+            process.kill()
+            process.wait()
+
+
+def _wall(folder: Path) -> tuple[Path, Path]:
+    program, world = folder / "wall.rob", folder / "wall.world.toml"
+    program.write_text(WALL_PROGRAM)
+    world.write_text(WALL_WORLD)
+    return program, world
+
+
+def _local(program: Path, world: Path, runs: int, out: Path) -> str:
+    """The summary of the campaign on this process alone; its lines in `out`."""
+    result = rl1c("sim", program, "--world", world, "--runs", str(runs), "--jobs", "1",
+                  "--budget", "10000", "--out", out)
+    assert result.exit_code == 0, result.output
+    return result.stdout
+
+
+def test_a_campaign_on_a_cluster_is_the_local_campaign_byte_for_byte(
+        cluster: Cluster, tmp_path: Path) -> None:
+    program, world = _wall(tmp_path)
+    local = _local(program, world, 200, tmp_path / "local.jsonl")
+    remote = rl1c("sim", program, "--world", world, "--runs", "200", "--budget", "10000",
+                  "--scheduler", cluster.address, "--out", tmp_path / "cluster.jsonl")
+    assert remote.exit_code == 0, remote.output + cluster.log()
+    assert remote.stdout == local
+    assert (tmp_path / "cluster.jsonl").read_bytes() == (tmp_path / "local.jsonl").read_bytes()
+    assert "success: " in local and "argument-range at line 4" in local  # runs of both kinds
+
+
+def test_a_worker_killed_in_a_campaign_on_a_cluster_loses_no_run(
+        cluster: Cluster, tmp_path: Path) -> None:
+    program, world = _wall(tmp_path)
+    runs = 1000
+    out = tmp_path / "cluster.jsonl"
+    with subprocess.Popen([str(BIN / "rl1c"), "sim", str(program), "--world", str(world),
+                           "--runs", str(runs), "--budget", "10000", "--scheduler",
+                           cluster.address, "--out", str(out)],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
+        deadline = time.monotonic() + STARTED_WITHIN
+        while (not out.exists() or out.read_text().count("\n") < 100) \
+                and process.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.05)
+        victim = cluster.workers[0]
+        victim.send_signal(signal.SIGKILL)
+        victim.wait()
+        assert process.poll() is None, "the campaign ended before the worker was killed"
+        stdout, stderr = process.communicate(timeout=STARTED_WITHIN)
+    assert process.returncode == 0, stderr + cluster.log()
+    assert "Traceback" not in stderr
+    local = _local(program, world, runs, tmp_path / "local.jsonl")
+    assert stdout == local  # every run counted once: the summary is exact
+    assert out.read_bytes() == (tmp_path / "local.jsonl").read_bytes()
+
+
+def test_without_distributed_the_extra_to_install_is_named(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    program, world = _wall(tmp_path)
+    out = tmp_path / "runs.jsonl"
+    out.write_text("kept\n")
+    monkeypatch.setitem(sys.modules, "distributed", None)  # what `import` then refuses
+    result = rl1c("sim", program, "--world", world, "--runs", "5", "--scheduler",
+                  "tcp://127.0.0.1:8786", "--out", out)
+    assert result.exit_code == 2
+    assert "--scheduler needs Dask's `distributed`, which is not installed" in result.stderr
+    assert "pip install 'rl1[cluster]'" in result.stderr
+    assert "Traceback" not in result.output
+    assert out.read_text() == "kept\n"  # not replaced by a campaign that never ran
+
+
+def _refusing_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port: int = probe.getsockname()[1]
+        return port  # closed: a connection is refused
+
+
+def test_an_unreachable_scheduler_is_said_with_its_address_within_seconds(
+        tmp_path: Path) -> None:
+    program, world = _wall(tmp_path)
+    out = tmp_path / "runs.jsonl"
+    out.write_text("kept\n")
+    address = f"tcp://127.0.0.1:{_refusing_port()}"
+    started = time.monotonic()
+    result = subprocess.run([str(BIN / "rl1c"), "sim", str(program), "--world", str(world),
+                             "--runs", "5", "--scheduler", address, "--out", str(out)],
+                            capture_output=True, text=True, timeout=60, check=False)
+    assert result.returncode == 2
+    assert f"error: cannot reach a Dask scheduler at {address}" in result.stderr
+    assert f"`dask worker {address}`" in result.stderr
+    assert "Traceback" not in result.stderr and "Exception ignored" not in result.stderr
+    assert out.read_text() == "kept\n"
+    assert time.monotonic() - started < 30  # 5 s of trying, and the command's start
+
+
+@pytest.mark.parametrize(("address", "why"), [
+    ("localhost", "missing port number in address 'localhost'"),
+    ("http://127.0.0.1:8786", "unknown address scheme 'http'"),
+])
+def test_an_address_that_is_none_says_why(tmp_path: Path, address: str, why: str) -> None:
+    program, world = _wall(tmp_path)
+    result = rl1c("sim", program, "--world", world, "--runs", "5", "--scheduler", address)
+    assert result.exit_code == 2
+    assert f"error: cannot reach a Dask scheduler at {address} ({why}" in result.stderr
+
+
+def test_a_server_that_is_no_scheduler_is_said(tmp_path: Path) -> None:
+    program, world = _wall(tmp_path)
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen()
+
+        def answer() -> None:  # eight bytes of a frame's length, then nothing of it
+            connection, _ = server.accept()
+            with connection:
+                connection.sendall(b"\xff" * 64)
+                connection.recv(65536)
+
+        threading.Thread(target=answer, daemon=True).start()
+        address = f"tcp://127.0.0.1:{server.getsockname()[1]}"
+        result = rl1c("sim", program, "--world", world, "--runs", "5", "--scheduler", address)
+    assert result.exit_code == 2
+    assert f"error: cannot reach a Dask scheduler at {address} (" in result.stderr
+
+
+def test_jobs_and_a_scheduler_together_are_a_usage_error(tmp_path: Path) -> None:
+    program, world = _wall(tmp_path)
+    result = rl1c("sim", program, "--world", world, "--runs", "5", "--jobs", "2",
+                  "--scheduler", "tcp://127.0.0.1:8786")
+    assert result.exit_code == 2
+    assert "--jobs counts local processes, and --scheduler gives" in result.stderr
+
+
+def test_the_command_of_the_runs_left_keeps_the_scheduler() -> None:
+    setting = Setting("a.rob", "w.toml", 0, 100, 2, "vm", 10000, "tcp://cluster:8786")
+    assert setting.rest(40, 60) == ("rl1c sim a.rob --world w.toml --runs 60 --seed 40 "
+                                    "--scheduler tcp://cluster:8786 --budget 10000")
