@@ -1,5 +1,6 @@
 """The front end in one call: source text to AST and sorted diagnostics (those the
-program's comments allow left out); `fix` makes the checker's fixes."""
+program's comments allow left out), or to the diagnostics alone (`diagnose`); `fix`
+makes the checker's fixes."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import itertools
 from collections.abc import Callable, Iterator
 from typing import NamedTuple
 
-from .checker import apply_suppressions, check
+from .checker import apply_suppressions, check, check_text
 from .frontend.ast import Program
 from .frontend.diagnostics import Diagnostic, Fix, sort_key
 from .frontend.edits import apply_edits, compatible
@@ -29,6 +30,14 @@ def analyze(text: str) -> Analysis:
     diagnostics = apply_suppressions(program, diagnostics)
     diagnostics.sort(key=sort_key)
     return Analysis(program, diagnostics)
+
+
+def diagnose(text: str) -> list[Diagnostic]:
+    """`analyze(text).diagnostics`, without holding the tree: for `rl1c check`, whose
+    memory is then the text's and the diagnostics' (checker/streaming.py)."""
+    diagnostics = check_text(text)
+    diagnostics.sort(key=sort_key)
+    return diagnostics
 
 
 MAX_FIX_ROUNDS = 10

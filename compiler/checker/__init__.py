@@ -1,7 +1,8 @@
-"""The static checker: the per-line rules (lines.py), then the whole-program rules over
-the control-flow graph (graph.py, built by cfg.py) and the data-flow analyses on it;
-`apply_suppressions` (suppression.py) then drops the warnings the program's comments
-allow."""
+"""The static checker: the per-line rules (lines.py), then the whole-program rules
+(rules.py) over the control-flow graph (graph.py, built by cfg.py) and the data-flow
+analyses on it; `apply_suppressions` (suppression.py) then drops the warnings the
+program's comments allow. `check_text` (streaming.py) does it all on a source text
+without holding its tree."""
 
 from __future__ import annotations
 
@@ -11,18 +12,14 @@ from rl1.compiler.frontend.diagnostics import Diagnostic
 
 from .cfg import build_cfg
 from .graph import ControlFlowGraph
-from .handlers import check_handlers
 from .incremental import LineMemo
-from .labels import check_labels
 from .lines import check_line
-from .loops import check_loops
-from .reachability import check_reachability
-from .reserved import check_reserved
-from .safety import check_safety
+from .rules import check_graph
+from .streaming import check_text
 from .suppression import apply_suppressions
 
 __all__ = ["ControlFlowGraph", "LineMemo", "apply_suppressions", "build_cfg", "check",
-           "check_line", "check_program"]
+           "check_line", "check_program", "check_text"]
 
 
 def check(program: Program) -> list[Diagnostic]:
@@ -38,12 +35,4 @@ def check(program: Program) -> list[Diagnostic]:
 def check_program(program: Program, memo: LineMemo | None = None) -> list[Diagnostic]:
     """The diagnostics of the whole-program rules only (the language server combines
     them with its cached per-line results, and passes a memo of the lines it keeps)."""
-    graph = build_cfg(program, memo)
-    return [
-        *check_labels(graph),
-        *check_handlers(program, graph),
-        *check_reserved(graph),
-        *check_reachability(program, graph),
-        *check_loops(graph),
-        *check_safety(program, graph),
-    ]
+    return check_graph(build_cfg(program, memo), program.span)

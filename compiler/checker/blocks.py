@@ -32,7 +32,8 @@ SegmentsOf = Callable[[Sequence[ast.Line]], Iterable[Segments]]
 class Cut:
     """A block as the cutter cut it."""
 
-    statements: list[ast.Statement]
+    # a list as cut here; streaming.py's cut keeps where they are in the source instead
+    statements: Sequence[ast.Statement]
     labels: list[ast.LabelDef]
     opaque: bool
     parts: list[Part]  # the effects of its runs that do something (summarized segments only)

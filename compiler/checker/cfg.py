@@ -43,6 +43,14 @@ def build_cfg(program: ast.Program, memo: LineMemo | None = None) -> ControlFlow
     return graph
 
 
+def graph_of(cuts: list[Cut], summaries: list[BlockEffects]) -> ControlFlowGraph:
+    """The graph of blocks cut elsewhere (streaming.py), with the effects of each but
+    the exit block."""
+    graph = _with_edges(cuts, summaries, [], None)
+    add_handler_edges(graph)
+    return graph
+
+
 def _with_edges(cuts: list[Cut], summaries: list[BlockEffects], last_cuts: list[Cut],
                 previous: ControlFlowGraph | None) -> ControlFlowGraph:
     """The blocks the cuts stand for (the exit block last), with their effects and

@@ -38,10 +38,11 @@ class BlockEffects:
     # (statement index, reserved variables its calls write, those its store writes)
     writes: list[tuple[int, int, int]]
     observes: bool
+    calls_unknown: bool  # whether a statement calls no built-in (maybe a misspelt `(END)`)
 
     @staticmethod
     def nothing() -> BlockEffects:
-        return BlockEffects([], None, 0, [], False)
+        return BlockEffects([], None, 0, [], False, False)
 
 
 # A run of one line's statements that lies in a single block: the statements, what they
@@ -97,7 +98,7 @@ def combine(parts: list[tuple[int, BlockEffects]]) -> BlockEffects:
     writes: list[tuple[int, int, int]] = []
     first_event: int | None = None
     reads = 0
-    observes = False
+    observes = calls_unknown = False
     for offset, part in parts:
         if first_event is None and part.first_event is not None:
             first_event = offset + part.first_event
@@ -108,7 +109,8 @@ def combine(parts: list[tuple[int, BlockEffects]]) -> BlockEffects:
                        for index, by_calls, by_store in part.writes]
         reads |= part.reads
         observes = observes or part.observes
-    return BlockEffects(operations, first_event, reads, writes, observes)
+        calls_unknown = calls_unknown or part.calls_unknown
+    return BlockEffects(operations, first_event, reads, writes, observes, calls_unknown)
 
 
 def line_segments(statements: tuple[ast.Statement, ...]) -> tuple[Segment, ...]:
@@ -129,11 +131,12 @@ def line_segments(statements: tuple[ast.Statement, ...]) -> tuple[Segment, ...]:
 
 
 def _summary(operations: list[device.Operation], first_event: int | None, reads: int,
-             writes: list[tuple[int, int, int]], observes: bool) -> BlockEffects | None:
+             writes: list[tuple[int, int, int]], observes: bool,
+             calls_unknown: bool) -> BlockEffects | None:
     """A run's effects; None for a run without calls, jumps or reserved variables."""
     if first_event is None and not reads and not writes:
         return None  # no calls either: nothing observes, and there are no operations
-    return BlockEffects(operations, first_event, reads, writes, observes)
+    return BlockEffects(operations, first_event, reads, writes, observes, calls_unknown)
 
 
 def summarize(statements: Sequence[ast.Statement]) -> BlockEffects | None:
@@ -143,7 +146,7 @@ def summarize(statements: Sequence[ast.Statement]) -> BlockEffects | None:
     first_event: int | None = None
     writes: list[tuple[int, int, int]] = []
     reads = 0
-    observes = False
+    observes = calls_unknown = False
     bit = RESERVED_BIT.get
     known = _FACTS.get
     var, call_type = ast.Var, ast.Call
@@ -178,7 +181,10 @@ def summarize(statements: Sequence[ast.Statement]) -> BlockEffects | None:
             if first_event is None:
                 first_event = index
             call = statement.call
-            facts = known(call.mnemonic) or _facts(call)
+            facts = known(call.mnemonic)
+            if facts is None:
+                facts = _facts(call)
+                calls_unknown = calls_unknown or call.mnemonic.upper() not in BUILTINS
             for arg in call.args:
                 if isinstance(arg, var):
                     reads |= bit(arg.name, 0)
@@ -200,4 +206,4 @@ def summarize(statements: Sequence[ast.Statement]) -> BlockEffects | None:
                 writes.append((index, 0, by_store))
         elif first_event is None:  # a jump
             first_event = index
-    return _summary(operations, first_event, reads, writes, observes)
+    return _summary(operations, first_event, reads, writes, observes, calls_unknown)

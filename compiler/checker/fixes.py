@@ -6,7 +6,7 @@ from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Edit
 
 
-def append_line(program: ast.Program, text: str) -> Edit:
-    """Add a line after the program's last line."""
-    end = program.span
-    return Edit(ast.Span(end.end_line, end.end_column, end.end_line, end.end_column), "\n" + text)
+def append_line(program: ast.Span, text: str) -> Edit:
+    """Add a line after the program's last line (`program` is the program's span)."""
+    return Edit(ast.Span(program.end_line, program.end_column, program.end_line,
+                         program.end_column), "\n" + text)

@@ -22,6 +22,7 @@ which says which blocks some path reaches.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
@@ -52,7 +53,7 @@ class Block:
     """A basic block. The graph's construction fills in its edges and effects."""
 
     index: int
-    statements: list[ast.Statement]
+    statements: Sequence[ast.Statement]  # read from the source again when not a list
     labels: list[ast.LabelDef]  # the labels naming it
     opaque: bool  # stands for a line with a syntax error
     # tuples, not lists: a program of broken lines has a block a line, so the thousands

@@ -31,7 +31,7 @@ _WHEN = {
 }
 
 
-def check_handlers(program: ast.Program, graph: ControlFlowGraph) -> list[Diagnostic]:
+def check_handlers(program: ast.Span, graph: ControlFlowGraph) -> list[Diagnostic]:
     if any(block.opaque and not block.labels for block in graph.blocks):
         return []  # the line with a syntax error may define the handler
     first: dict[int, ast.Statement] = {}
@@ -42,7 +42,7 @@ def check_handlers(program: ast.Program, graph: ControlFlowGraph) -> list[Diagno
     return [_missing(program, label, statement) for label, statement in sorted(first.items())]
 
 
-def _missing(program: ast.Program, label: int, statement: ast.Statement) -> Diagnostic:
+def _missing(program: ast.Span, label: int, statement: ast.Statement) -> Diagnostic:
     handler = f":{label} {HANDLER}"
     return Diagnostic(
         "W0301", Severity.WARNING,

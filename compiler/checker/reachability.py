@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity
-from rl1.vm.language import BUILTINS, HANDLER_LABELS
+from rl1.vm.language import HANDLER_LABELS
 
 from .fixes import append_line
 from .graph import Block, ControlFlowGraph
@@ -19,7 +19,7 @@ from .graph import Block, ControlFlowGraph
 REMOVE_OR_LABEL = "remove it, or start its line with a label and jump there"
 
 
-def check_reachability(program: ast.Program, graph: ControlFlowGraph) -> list[Diagnostic]:
+def check_reachability(program: ast.Span, graph: ControlFlowGraph) -> list[Diagnostic]:
     found: list[Diagnostic] = []
     run: list[Block] = []
     defensive = _handler_code(graph)
@@ -74,13 +74,12 @@ def _unreachable(graph: ControlFlowGraph, run: list[Block]) -> list[Diagnostic]:
                        span, help=REMOVE_OR_LABEL)]
 
 
-def _no_end(program: ast.Program, graph: ControlFlowGraph) -> list[Diagnostic]:
+def _no_end(program: ast.Span, graph: ControlFlowGraph) -> list[Diagnostic]:
     """W0603: no `(END)` anywhere, and the program can run off its last line."""
     blocks = graph.blocks
     if not graph.reachable(graph.exit) or any(block.ends or block.opaque for block in blocks):
         return []
-    if any(isinstance(statement, ast.CallStmt) and statement.call.mnemonic.upper() not in BUILTINS
-           for statement in program.statements()):
+    if any(block.effects.calls_unknown for block in blocks):
         return []  # a misspelt `(ENDD)` is reported as such (E0501): it may be the (END)
     span = fall_off_span(graph)
     if span is None:

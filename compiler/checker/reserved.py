@@ -47,8 +47,11 @@ def check_reserved(graph: ControlFlowGraph) -> list[Diagnostic]:
     for index in itertools.compress(range(len(blocks)), states):  # in C: most states are 0
         block = blocks[index]
         state = states[index]
-        if state & block.effects.reads and graph.reachable(index):
+        reads = block.effects.reads
+        if state & reads and graph.reachable(index):
             for statement in block.statements:
+                if not state & reads:
+                    break  # the state only shrinks: no read left in the block is reported
                 state = _walk(statement, state, report)
     return found
 

@@ -18,7 +18,7 @@ HELP = ("`(END)` does not stop the motion a `(MOV)` started, nor an `(MVI)` goin
 MOVING = device.MOVING | device.RUNNING  # a MOV in effect, or an MVI in the background
 
 
-def check_safety(program: ast.Program, graph: ControlFlowGraph) -> list[Diagnostic]:
+def check_safety(program: ast.Span, graph: ControlFlowGraph) -> list[Diagnostic]:
     found: list[Diagnostic] = []
     for block in graph.blocks:
         entry = graph.device_on_entry[block.index]

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import functools
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import NamedTuple
 
 from rl1.compiler.frontend import ast
@@ -51,8 +51,15 @@ def apply_suppressions(program: ast.Program, diagnostics: Iterable[Diagnostic], 
     """`diagnostics` without the warnings that the program's comments allow, with a
     W0107 for each directive, or code in one, that allows nothing. When `diagnostics`
     are not `complete` (a rule failed), a code they lack is not said to be unused."""
+    return suppressed(program.lines, diagnostics, complete=complete)
+
+
+def suppressed(lines: Sequence[ast.Line], diagnostics: Iterable[Diagnostic], *,
+               complete: bool = True) -> list[Diagnostic]:
+    """`apply_suppressions` given the program's lines, or only those whose comments
+    hold MARK (streaming.py keeps only those)."""
     diagnostics = list(diagnostics)
-    directives, problems = _directives(program)
+    directives, problems = _directives(lines)
     if not directives and not problems:
         return diagnostics
     file_wide = {code for d in directives if d.file_wide for code, _ in d.codes}
@@ -81,10 +88,10 @@ def apply_suppressions(program: ast.Program, diagnostics: Iterable[Diagnostic], 
     return kept + problems
 
 
-def _directives(program: ast.Program) -> tuple[list[Directive], list[Diagnostic]]:
+def _directives(lines: Sequence[ast.Line]) -> tuple[list[Directive], list[Diagnostic]]:
     directives: list[Directive] = []
     problems: list[Diagnostic] = []
-    for line in program.lines:
+    for line in lines:
         comment = line.comment
         if comment is None or MARK not in comment.text:
             continue

@@ -138,7 +138,7 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
                 status = EXIT_USAGE
                 text, diagnostics = source.text, None  # the file is as it was
         if diagnostics is None:
-            diagnostics = analysis.analyze(text).diagnostics
+            diagnostics = analysis.diagnose(text)
         checked.append(FileDiagnostics(source.name, text, selection.apply(diagnostics)))
     status = max(status, emit(checked, output_format, color, None))
     if output_format in ("human", "concise"):

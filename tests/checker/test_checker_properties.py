@@ -9,7 +9,7 @@ import re
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rl1.compiler.analysis import analyze
+from rl1.compiler.analysis import analyze, diagnose
 from rl1.compiler.checker import check, check_line
 from rl1.compiler.checker.lines import check_line as per_line_rule
 from rl1.compiler.frontend.parser import parse_program
@@ -110,3 +110,13 @@ def test_every_run_ending_while_moving_was_warned_about(text: str) -> None:
     result = interpret(program, device, budget=10_000)
     if result.fault is None and _motion_left_on(device):
         assert "W0701" in {d.code for d in check(program)}, text
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.one_of(rl1_text, st.text(max_size=100), programs(), traced_programs()))
+def test_the_check_without_the_tree_gives_the_same_diagnostics(text: str) -> None:
+    """`rl1c check`'s path (checker/streaming.py) against the check on the tree, which
+    the compiler runs: the same diagnostics, in the same order."""
+    expected = analyze(text).diagnostics
+    assert diagnose(text) == expected
+    assert [repr(d) for d in diagnose(text)] == [repr(d) for d in expected]

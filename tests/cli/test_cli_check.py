@@ -22,7 +22,6 @@ from support.cli import Result, rl1c
 from support.sarif import sarif_problems
 
 from rl1.compiler import analysis
-from rl1.compiler.analysis import Analysis, analyze
 from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.compiler.reporting.catalogue import CODES
@@ -104,11 +103,10 @@ def test_a_file_that_cannot_be_read_is_not_counted_as_checked(tmp_path: Path) ->
 
 
 def test_warnings_alone_exit_0(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    def only_a_warning(text: str) -> Analysis:
-        program = analyze(text).program
-        return Analysis(program, [Diagnostic("W0601", Severity.WARNING, "odd", Span(1, 1, 1, 2))])
+    def only_a_warning(text: str) -> list[Diagnostic]:
+        return [Diagnostic("W0601", Severity.WARNING, "odd", Span(1, 1, 1, 2))]
 
-    monkeypatch.setattr(analysis, "analyze", only_a_warning)
+    monkeypatch.setattr(analysis, "diagnose", only_a_warning)
     result = run("check", write(tmp_path, "A=1\n"))
     assert result.exit_code == 0
     assert "warning[W0601]: odd" in result.stdout
@@ -323,10 +321,10 @@ def test_any_bytes_get_a_report(
 def test_an_internal_error_is_a_short_message_and_exit_3(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    def broken(text: str) -> Analysis:
+    def broken(text: str) -> list[Diagnostic]:
         raise KeyError("no such rule")
 
-    monkeypatch.setattr(analysis, "analyze", broken)
+    monkeypatch.setattr(analysis, "diagnose", broken)
     monkeypatch.delenv("RL1C_BACKTRACE", raising=False)
     result = run("check", write(tmp_path, "A=1\n"))
     assert result.exit_code == 3
@@ -342,10 +340,10 @@ def test_an_internal_error_is_a_short_message_and_exit_3(
 def test_ctrl_c_ends_with_a_short_message_and_the_shells_status(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    def interrupted(text: str) -> Analysis:
+    def interrupted(text: str) -> list[Diagnostic]:
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(analysis, "analyze", interrupted)
+    monkeypatch.setattr(analysis, "diagnose", interrupted)
     result = run("check", write(tmp_path, "A=1\n"))
     assert (result.exit_code, result.stdout, result.stderr) == (130, "", "rl1c: interrupted\n")
 

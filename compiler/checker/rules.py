@@ -1,0 +1,28 @@
+"""The whole-program rules, in the order their diagnostics are listed, over a program's
+graph and its span (where a fix adds a line at the end)."""
+
+from __future__ import annotations
+
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.diagnostics import Diagnostic
+
+from .graph import ControlFlowGraph
+from .handlers import check_handlers
+from .labels import check_labels
+from .loops import check_loops
+from .reachability import check_reachability
+from .reserved import check_reserved
+from .safety import check_safety
+
+
+def check_graph(graph: ControlFlowGraph, program: ast.Span) -> list[Diagnostic]:
+    """The diagnostics of the whole-program rules on `graph`, whose program spans
+    `program`."""
+    return [
+        *check_labels(graph),
+        *check_handlers(program, graph),
+        *check_reserved(graph),
+        *check_reachability(program, graph),
+        *check_loops(graph),
+        *check_safety(program, graph),
+    ]

