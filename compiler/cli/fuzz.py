@@ -24,7 +24,7 @@ from rl1.compiler.reporting.render import EXIT_ERRORS
 from .command import EXIT_INTERNAL, PATH, Command, Failure, a_budget, at_least_one
 
 if TYPE_CHECKING:
-    from rl1.compiler.fuzz import Channel
+    from rl1.compiler.fuzz import Channel, Outcome, Reproducer
 
 SECTION = "Testing"
 
@@ -59,12 +59,17 @@ BAR_WIDTH = 30
               callback=lambda c, p, v: None if v is None else at_least_one(c, p, v),
               help="processes that run the searches (default: one per core); the "
                    "programs are the same for any J")
+@click.option("--keep-going", is_flag=True,
+              help="go on past disagreements: each kind (its signature: the engines, "
+                   "the difference and the first differing call, spec/optimization.md) "
+                   "gets a reproducer of its own, and the summary counts the programs "
+                   "of each")
 @click.option("--replay", "replay_dir", default=None, metavar="DIR", type=PATH,
               help="judge a reproducer again (a finding-N folder, as its replay.sh does) "
                    "with its engines and budget: exit status 1 while they disagree")
 def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
          seed: str | None, out_dir: str, budget: int, jobs: int | None,
-         replay_dir: str | None) -> int:
+         keep_going: bool, replay_dir: str | None) -> int:
     """Run generated programs on several engines and compare what they do.
 
     Every program (with a sensor script to match) runs on each engine; the runs must
@@ -84,7 +89,12 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
             EngineUnavailable,
             engine_named,
         )
-        from rl1.compiler.fuzz import Channel, campaign, write_reproducer
+        from rl1.compiler.fuzz import (
+            Channel,
+            Finding,
+            campaign,
+            write_reproducer,
+        )
     except ModuleNotFoundError as error:
         if (error.name or "").partition(".")[0] != "hypothesis":
             raise
@@ -129,12 +139,21 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     limit = None if seconds is not None else count or DEFAULT_COUNT
     bar = _Bar(limit, seconds)
     channel = Channel()
+    written: dict[str, Reproducer | OSError] = {}  # --keep-going: each signature's
+
+    def write(finding: Finding) -> None:  # as each is found, kept if the campaign stops
+        try:
+            written[finding.signature] = write_reproducer(out_dir, finding, engines, budget)
+        except OSError as error:
+            written[finding.signature] = error
+
     try:
         with _halted_by_signals(channel) as signalled, \
                 workers(jobs or os.cpu_count() or 1) as held:
             outcome = campaign(engines, budget, count=limit, seconds=seconds,
                                seed=seed_value, progress=bar.update, executor=held.executor,
-                               jobs=max(held.slots, 1), channel=channel)
+                               jobs=max(held.slots, 1), keep_going=keep_going,
+                               found=write if keep_going else None, channel=channel)
     except (BuildError, EngineUnavailable, Unavailable) as error:  # such as no C compiler
         raise Failure(f"error: {error}") from None
     except BrokenExecutor:
@@ -149,10 +168,14 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     summary = (f"fuzz: {outcome.programs} programs in {outcome.seconds:.1f} s "
                f"({rate:.1f} per second); engines {names}; seed {seed_value}")
     stopped = 128 + signalled[0] if signalled else 0
+    if stopped:
+        summary += ", stopped by a signal before its end"
     if outcome.finding is None:
-        click.echo(f"{summary}: " + ("stopped by a signal before its end, all agreed so "
-                                     "far" if stopped else "all agreed"))
+        click.echo(f"{summary}: " + ("all agreed so far" if stopped else "all agreed"))
         return stopped
+    if keep_going:
+        _report_groups(summary, outcome, written, engines[0].name, out_dir)
+        return stopped or EXIT_ERRORS
     finding = outcome.finding
     click.echo(f"{summary}: the engines disagree (reference: {engines[0].name})\n\n"
                f"the smallest program found:\n{_numbered(finding.case.source)}\n\n"
@@ -166,6 +189,27 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     click.echo(f"\nreproducer: {reproducer.folder} (program, sensor script, each engine's "
                f"run); replay: {reproducer.replay}")
     return stopped or EXIT_ERRORS
+
+
+def _report_groups(summary: str, outcome: Outcome, written: dict[str, Reproducer | OSError],
+                   reference: str, out_dir: str) -> None:
+    """--keep-going's summary: each signature, the most frequent first, with the programs
+    that showed it and its reproducer."""
+    from rl1.compiler.fuzz import Reproducer
+
+    groups = sorted(outcome.counts.items(), key=lambda item: (-item[1], item[0]))
+    lines = [f"{summary}: {len(groups)} kind{'s' if len(groups) != 1 else ''} of "
+             f"disagreement (reference: {reference}), by the programs that showed each:"]
+    for name, programs in groups:
+        lines.append(f"{programs:>7}  {name}")
+        match written.get(name):
+            case Reproducer(folder=folder, replay=replay):
+                lines.append(f"         reproducer: {folder}; replay: {replay}")
+            case OSError() as error:
+                lines.append(f"         reproducer: not written under {out_dir} "
+                             f"({error.strerror or error}); the campaign finds it again "
+                             "with the same --seed")
+    click.echo("\n".join(lines))
 
 
 @contextmanager

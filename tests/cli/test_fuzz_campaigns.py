@@ -120,9 +120,93 @@ def test_a_signal_stops_the_campaign_with_its_summary_and_seed(
         tmp_path: Path, signum: int, jobs: str) -> None:
     status, output = _stopped(tmp_path, signum, "--jobs", jobs)
     assert status == 128 + signum, output
-    summary = re.search(r"fuzz: ([0-9]+) programs in .*; seed ([0-9]+): stopped by a "
-                        r"signal before its end, all agreed so far", output)
+    summary = re.search(r"fuzz: ([0-9]+) programs in .*; seed ([0-9]+), stopped by a "
+                        r"signal before its end: all agreed so far", output)
     assert summary is not None, output
     assert int(summary.group(1)) > 0
     assert "Traceback" not in output
     assert not [name for name in os.listdir(tmp_path) if name.startswith("finding-")]
+
+
+# --keep-going ---------------------------------------------------------------------------
+
+
+class _TwoBugs(_BrokenShift):
+    """The broken shift, and a crash on any program with an `^` (a compiler's bug)."""
+
+    name = "two-bugs"
+
+    def run(self, case: Run, budget: int) -> Observation:
+        if "^" in case.source:
+            raise ValueError(f"no register left for {case.source.count('^')} operators")
+        return super().run(case, budget)
+
+
+def test_keep_going_groups_findings_by_signature_each_with_a_reproducer_that_shows_it(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 20)
+    monkeypatch.setattr(fuzz, "BATCH", 60)
+    engines: list[fuzz.Engine] = [VmEngine(0), _TwoBugs()]
+    written: dict[str, str] = {}
+
+    def write(finding: fuzz.Finding) -> None:
+        assert finding.signature not in written  # each signature is written once
+        written[finding.signature] = fuzz.write_reproducer(str(tmp_path), finding, engines,
+                                                           20_000).folder
+
+    outcome = _campaign(engines, 2, 120, keep_going=True, found=write)
+    assert outcome.programs == 120  # it went on past every finding
+    assert "two-bugs: crashed: ValueError: no register left for N operators" in written
+    assert len(written) >= 2 and set(written) == set(outcome.counts) == set(outcome.findings)
+    assert sum(outcome.counts.values()) <= outcome.programs
+    for name, folder in written.items():
+        # Shrunk keeping its signature: the reproducer shows the kind it is filed under.
+        case = Run((Path(folder) / fuzz.SOURCE).read_text(encoding="utf-8"),
+                   json.loads((Path(folder) / fuzz.SCRIPT).read_text(encoding="utf-8")))
+        assert fuzz.judge(case, engines, 20_000).problems
+        assert fuzz.signature(fuzz.judge(case, engines, 20_000)) == name
+
+
+@pytest.mark.parametrize(("problems", "same"), [
+    (["x: trace entry 3: MOV 1,2 at 40 ms / MOV 1,3 at 40 ms",
+      "x: trace entry 1: MOV -5,7 at 0 ms / MOV 2,2 at 0 ms"], True),
+    (["x: trace entry 3: MOV 1,2 at 40 ms / LINE LOST 0 at 40 ms",
+      "x: trace entry 3: MOV 1,2 at 40 ms / MOV 1,3 at 40 ms"], False),
+    (["x: ending: fault budget at line 3 / ended normally",
+      "x: ending: fault budget at line 12 / ended normally"], True),
+    (["x: variables: A 1 / 2", "x: variables: B 7 / -7, C 0 / 1"], True),
+    (["x: variables: A 1 / 2", "y: variables: A 1 / 2"], False),
+    (["vm-O1: ran 9 instructions, -O0 8", "vm-O1: ran 12 instructions, -O0 3"], True),
+])
+def test_a_signature_leaves_out_what_varies_between_programs_of_one_bug(
+        problems: list[str], same: bool) -> None:
+    verdicts = [fuzz.Verdict({"x": Observation({}), "y": Observation({}),
+                              "vm-O1": Observation({})}, [problem]) for problem in problems]
+    assert (fuzz.signature(verdicts[0]) == fuzz.signature(verdicts[1])) is same
+
+
+def test_keep_going_lists_each_signature_with_its_count_and_folder(tmp_path: Path) -> None:
+    result = rl1c("fuzz", "--engine", "ast", "--engine", "exec:echo not json",
+                  "--count", "3", "--seed", "4", "--keep-going", "--out", tmp_path)
+    assert result.exit_code == 1, result.output
+    # Every program disagrees (the engine prints no run): a trace cut short, or, for a
+    # program without calls, an ending; each kind with its count and its folder.
+    groups = re.findall(r"\n +([0-9]+)  exec:echo not json: [^\n]+\n +reproducer: "
+                        r"([^;]+); replay: sh (\S+)", result.stdout)
+    kinds = len(groups)
+    assert f"seed 4: {kinds} kind{'s' if kinds > 1 else ''} of disagreement (reference: " \
+        "ast), by the programs that showed each:" in result.stdout
+    assert sum(int(count) for count, _, _ in groups) == 3
+    assert sorted(folder for _, folder, _ in groups) == sorted(
+        str(tmp_path / name) for name in os.listdir(tmp_path))
+    assert all(replay == f"{folder}/replay.sh" for _, folder, replay in groups)
+
+
+def test_a_signal_keeps_the_reproducers_of_a_campaign_that_goes_on(tmp_path: Path) -> None:
+    status, output = _stopped(tmp_path, signal.SIGTERM, "--jobs", "2", "--keep-going",
+                              "--engine", "ast", "--engine", "exec:echo not json")
+    assert status == 143, output
+    assert re.search(r"fuzz: [0-9]+ programs in .*; seed [0-9]+, stopped by a signal "
+                     r"before its end: [0-9]+ kinds? of disagreement", output), output
+    folders = re.findall(r"reproducer: ([^;]+);", output)
+    assert folders and all((Path(folder) / "replay.sh").is_file() for folder in folders)
