@@ -79,7 +79,9 @@ export function rl1Language(facts: LanguageFacts): StreamLanguage<State> {
     copyState: (state) => ({ ...state }),
     token: (stream, state) => token(stream, state, facts),
     tokenTable: { handlerLabel, builtinCall, reservedVariable },
-    languageData: { commentTokens: { line: "'" } },
+    // A label (`:10`), a jump target (`#10`) and the variable `@` are words: what
+    // rename (F2) and double-click take.
+    languageData: { commentTokens: { line: "'" }, wordChars: ":#@" },
   });
 }
 
