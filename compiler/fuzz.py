@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import gc
+import itertools
 import json
 import math
 import os
@@ -43,10 +44,11 @@ from rl1.compiler.differential import (
     judge,
     signature,
 )
-from rl1.compiler.files import read_bounded, write_atomically
+from rl1.compiler.files import SourceError, read_bounded, write_atomically
 from rl1.compiler.frontend.source import read_source, split_lines
 from rl1.compiler.runner import MAX_SCRIPT_BYTES
 from rl1.compiler.strategies import Run, runs
+from rl1.vm.config import ConfigError, read_document
 from rl1.vm.faults import MAX_BUDGET
 from rl1.vm.sensor_script import ScriptError, parse_script
 
@@ -94,6 +96,7 @@ class Search:
     keep_going: bool = False
     deadline: float | None = None  # time.time() after which it generates no program
     channel: str | None = None  # the campaign's Channel folder, on this machine
+    corpus: tuple[Run, ...] = ()  # runs judged as they are, before any generated
 
 
 @dataclass
@@ -234,10 +237,16 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
     seeds = Random(task.seed)
     try:
         with contextlib.suppress(_Enough):
-            while searched.programs < task.size and (task.keep_going or not searched.findings):
+            for case in task.corpus:  # shrunk by deleting lines alone
+                target = None
+                if (task.keep_going or not searched.findings) and disagrees(case) \
+                        and not stopped():
+                    _delete_lines(searched, next(reversed(searched.findings)), task)
+            size = task.size + len(task.corpus)
+            while searched.programs < size and (task.keep_going or not searched.findings):
                 before = searched.programs
                 target, shrinks = None, 0
-                limits = settings(max_examples=task.size - searched.programs, database=None,
+                limits = settings(max_examples=size - searched.programs, database=None,
                                   deadline=None, suppress_health_check=list(HealthCheck),
                                   phases=(Phase.generate, Phase.shrink))
                 with contextlib.suppress(NoSuchExample), contextlib.suppress(_Enough):
@@ -253,6 +262,50 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
         channel.tell(task.index, searched.programs)
     gc.collect()  # a finished search is cyclic garbage: collect it now
     return searched
+
+
+CORPUS_SUFFIX = ".rob"  # the programs of a corpus folder
+SCRIPT_SUFFIXES = (".sensors.json", ".sensors.toml")  # a program's script beside it
+
+
+def read_corpus(paths: Iterable[str]) -> tuple[list[Run], list[str]]:
+    """The runs of `--corpus`: each RL/I file named, and each under a folder named (in
+    the order of their paths), with the sensor script beside it (`NAME.sensors.json` or
+    `.sensors.toml`: the examples, bench/corpus and a reproducer's `program.rob` are so
+    laid out), or none; and a warning for each file left out, saying why (it cannot be
+    read, the checker finds errors in it, its script is no valid script)."""
+    runs: list[Run] = []
+    warnings: list[str] = []
+    for path in paths:
+        files = [path] if not os.path.isdir(path) else sorted(
+            os.path.join(folder, name) for folder, _, names in os.walk(path)
+            for name in names if name.endswith(CORPUS_SUFFIX))
+        for file in files:
+            try:
+                run = _corpus_run(file)
+            except (SourceError, ScriptError, ReproducerError) as error:
+                warnings.append(f"{error}; left out of the corpus")
+                continue
+            runs.append(run)
+    return runs, warnings
+
+
+def _corpus_run(file: str) -> Run:
+    source = read_source(file).text
+    if analyze(source).has_errors:
+        raise ReproducerError(file, "the checker finds errors in it (rl1c check says which)")
+    stem = file.removesuffix(CORPUS_SUFFIX)
+    for script in (stem + suffix for suffix in SCRIPT_SUFFIXES):
+        if os.path.exists(script):
+            data = read_bounded(script, MAX_SCRIPT_BYTES, "a sensor script")
+            try:
+                document, _ = read_document(data, script, "toml" if script.endswith(
+                    ".toml") else "json")
+            except ConfigError as error:
+                raise ScriptError(str(error)) from None
+            parse_script(document, script)
+            return Run(source, document)
+    return Run(source, {})
 
 
 def _delete_lines(searched: Searched, target: str, task: Search) -> None:
@@ -281,9 +334,10 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
              seconds: float | None, seed: int, progress: Callable[[int, float], None],
              executor: Executor | None = None, jobs: int = 1, keep_going: bool = False,
              found: Callable[[Finding], None] | None = None,
-             channel: Channel | None = None) -> Outcome:
-    """Run generated programs on `engines` until `count` programs or `seconds` have
-    passed, or until they disagree (with `keep_going`, until then whatever they find);
+             channel: Channel | None = None, corpus: Sequence[Run] = ()) -> Outcome:
+    """Run the `corpus`, then generated programs, on `engines` until `count` generated
+    programs or `seconds` have passed, or until they disagree (with `keep_going`, until
+    then whatever they find);
     `progress(programs, elapsed)` as programs run, `found(finding)` on each new
     signature's smallest run. The searches run in this process, or `jobs` at a time on
     `executor`; a disagreement stops the searches after the one that found it, and is
@@ -296,7 +350,9 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
     channel = Channel() if channel is None else channel
     results: dict[int, Searched] = {}
     stop_at = math.inf  # the first search that found something, without keep_going
-    plan = searches(seed, count)
+    chunks = [tuple(corpus[start:start + BATCH]) for start in range(0, len(corpus), BATCH)]
+    plan = itertools.chain(((0, 0, chunk) for chunk in chunks),
+                           ((seed, size, ()) for seed, size in searches(seed, count)))
     index = 0
 
     def next_search() -> Search | None:
@@ -308,8 +364,9 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
         if drawn is None:
             return None
         index += 1
-        return Search(index - 1, *drawn, tuple(engines), budget, keep_going, deadline,
-                      channel.folder)
+        search_seed, size, runs_given = drawn
+        return Search(index - 1, search_seed, size, tuple(engines), budget, keep_going,
+                      deadline, channel.folder, runs_given)
 
     def keep(searched: Searched) -> None:
         nonlocal stop_at

@@ -59,6 +59,10 @@ BAR_WIDTH = 30
               callback=lambda c, p, v: None if v is None else at_least_one(c, p, v),
               help="processes that run the searches (default: one per core); the "
                    "programs are the same for any J")
+@click.option("--corpus", "corpus_paths", multiple=True, metavar="PATH", type=PATH,
+              help="programs to run first, repeatable: an RL/I file, or a folder of them "
+                   "(such as examples/, bench/corpus or --out's findings), each with the "
+                   "sensor script NAME.sensors.json or .toml beside it if there is one")
 @click.option("--keep-going", is_flag=True,
               help="go on past disagreements: each kind (its signature: the engines, "
                    "the difference and the first differing call, spec/optimization.md) "
@@ -69,7 +73,7 @@ BAR_WIDTH = 30
                    "with its engines and budget: exit status 1 while they disagree")
 def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
          seed: str | None, out_dir: str, budget: int, jobs: int | None,
-         keep_going: bool, replay_dir: str | None) -> int:
+         corpus_paths: tuple[str, ...], keep_going: bool, replay_dir: str | None) -> int:
     """Run generated programs on several engines and compare what they do.
 
     Every program (with a sensor script to match) runs on each engine; the runs must
@@ -93,6 +97,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
             Channel,
             Finding,
             campaign,
+            read_corpus,
             write_reproducer,
         )
     except ModuleNotFoundError as error:
@@ -107,10 +112,11 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     from .sim_campaign import MAX_JOBS
 
     if replay_dir is not None:
-        if engine_names or count is not None or seconds is not None or seed is not None:
+        if engine_names or count is not None or seconds is not None or seed is not None \
+                or corpus_paths:
             raise click.UsageError("--replay takes the engines and budget of the "
-                                   "reproducer: give it without --engine, --count, --time "
-                                   "and --seed")
+                                   "reproducer: give it without --engine, --count, --time, "
+                                   "--seed and --corpus")
         return _replay(replay_dir)
     if count is not None and seconds is not None:
         raise click.UsageError("give --count or --time, not both")
@@ -136,6 +142,12 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     if jobs is not None and jobs > MAX_JOBS:
         raise click.UsageError(f"argument --jobs: at most {MAX_JOBS} processes on one "
                                "machine")
+    missing = [path for path in corpus_paths if not os.path.exists(path)]
+    if missing:
+        raise click.UsageError(f"argument --corpus: {missing[0]}: no such file or folder")
+    corpus, warnings = read_corpus(corpus_paths)
+    for warning in warnings:
+        print(f"rl1c: warning: {warning}", file=sys.stderr)
     limit = None if seconds is not None else count or DEFAULT_COUNT
     bar = _Bar(limit, seconds)
     channel = Channel()
@@ -153,7 +165,8 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
             outcome = campaign(engines, budget, count=limit, seconds=seconds,
                                seed=seed_value, progress=bar.update, executor=held.executor,
                                jobs=max(held.slots, 1), keep_going=keep_going,
-                               found=write if keep_going else None, channel=channel)
+                               found=write if keep_going else None, channel=channel,
+                               corpus=corpus)
     except (BuildError, EngineUnavailable, Unavailable) as error:  # such as no C compiler
         raise Failure(f"error: {error}") from None
     except BrokenExecutor:
@@ -165,7 +178,8 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         channel.close()
     names = ", ".join(engine.name for engine in engines)
     rate = outcome.programs / outcome.seconds if outcome.seconds else 0.0
-    summary = (f"fuzz: {outcome.programs} programs in {outcome.seconds:.1f} s "
+    of_corpus = f" (the corpus of {len(corpus)} first)" if corpus else ""
+    summary = (f"fuzz: {outcome.programs} programs{of_corpus} in {outcome.seconds:.1f} s "
                f"({rate:.1f} per second); engines {names}; seed {seed_value}")
     stopped = 128 + signalled[0] if signalled else 0
     if stopped:

@@ -14,6 +14,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import pytest
+from support import ROOT
 from support.cli import rl1c
 
 from rl1.compiler import fuzz
@@ -210,3 +211,55 @@ def test_a_signal_keeps_the_reproducers_of_a_campaign_that_goes_on(tmp_path: Pat
                      r"before its end: [0-9]+ kinds? of disagreement", output), output
     folders = re.findall(r"reproducer: ([^;]+);", output)
     assert folders and all((Path(folder) / "replay.sh").is_file() for folder in folders)
+
+
+# --corpus -------------------------------------------------------------------------------
+
+BROKEN_VM = f"exec:{sys.executable} {ROOT / 'tests/support/broken_vm.py'} " \
+            "{ilc} {sensors} {budget}"
+
+
+def test_a_corpus_runs_first_and_its_disagreement_is_shrunk_and_written(
+        tmp_path: Path) -> None:
+    corpus, out = tmp_path / "corpus", tmp_path / "out"
+    corpus.mkdir()
+    (corpus / "shift.rob").write_text("' a wrong shift, with lines around it\n"
+                                      "B=2\nA=1<-1\nC=3\n", encoding="utf-8")
+    result = rl1c("fuzz", "--engine", "vm-O0", "--engine", BROKEN_VM, "--corpus", corpus,
+                  "--count", "1", "--seed", "1", "--jobs", "1", "--out", out)
+    assert result.exit_code == 1, result.output
+    assert "programs (the corpus of 1 first)" in result.stdout
+    # Its first program, whatever the generated one does; every line it does not need
+    # deleted.
+    assert (out / "finding-1" / "program.rob").read_text(encoding="utf-8") == "A=1<-1\n"
+
+
+def test_a_corpus_takes_each_program_with_the_script_beside_it(tmp_path: Path) -> None:
+    (tmp_path / "past" / "finding-1").mkdir(parents=True)
+    (tmp_path / "past" / "finding-1" / "program.rob").write_text("A=(ULT A)\n")
+    (tmp_path / "past" / "finding-1" / "program.sensors.json").write_text(
+        '{"ULT A": [12]}')
+    (tmp_path / "toml.rob").write_text("A=1\n")
+    (tmp_path / "toml.sensors.toml").write_text('comment = "none read"\n')
+    (tmp_path / "bare.rob").write_text("B=2\n")
+    (tmp_path / "wrong.rob").write_text("#10\n")  # a jump to no label
+    (tmp_path / "badscript.rob").write_text("C=3\n")
+    (tmp_path / "badscript.sensors.json").write_text('{"XYZ": 1}')
+    runs, warnings = fuzz.read_corpus([str(tmp_path / "past"), str(tmp_path / "toml.rob"),
+                                       str(tmp_path)])
+    assert runs[:2] == [Run("A=(ULT A)\n", {"ULT A": [12]}),
+                        Run("A=1\n", {"comment": "none read"})]
+    assert [run.source for run in runs[2:]] == ["B=2\n", "A=(ULT A)\n", "A=1\n"]
+    assert runs[2].script == {}
+    assert len(warnings) == 2
+    assert all(warning.endswith("; left out of the corpus") for warning in warnings)
+    assert any(str(tmp_path / "wrong.rob") in warning and "checker finds errors" in warning
+               for warning in warnings)
+    assert any(str(tmp_path / "badscript.sensors.json") in warning for warning in warnings)
+
+
+def test_a_corpus_path_that_is_not_there_is_a_usage_error(tmp_path: Path) -> None:
+    result = rl1c("fuzz", "--corpus", tmp_path / "nothing")
+    assert result.exit_code == 2
+    assert f"argument --corpus: {tmp_path / 'nothing'}: no such file or folder" \
+        in result.stderr
