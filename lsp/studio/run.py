@@ -82,7 +82,8 @@ class Run:
         self._loop = loop
         self._speed = speed
         self._simulation: Simulation | None = None
-        self._generation = 0  # the command under way's, or the next one's
+        self._generation = 0  # the run's now: a command of an older one is dropped
+        self._current = 0  # the generation of the command the worker carries out
         self._commands: queue.Queue[tuple[int, Command] | None] = queue.Queue()
         self._pausing = threading.Event()  # the command under way is to stop
         self._wake = threading.Event()  # a pacing sleep is to end
@@ -136,8 +137,9 @@ class Run:
             generation, command = item
             if generation != self._generation:
                 continue
+            self._current = generation
             try:
-                method, params = self._carry_out(command, generation)
+                method, params = self._carry_out(command)
             except Exception as error:  # a bug of ours: the page hears of it
                 log.exception("rl1c studio: the run failed")
                 method, params = "run/ended", {"status": {
@@ -152,16 +154,16 @@ class Run:
         self.over = method == "run/ended"
         self._tell(method, params)
 
-    def _carry_out(self, command: Command, generation: int) -> tuple[str, dict[str, Any]]:
+    def _carry_out(self, command: Command) -> tuple[str, dict[str, Any]]:
         session = self.session
         if command == "restart":
             session.restart()
             self._started()
         if command in ("start", "restart"):
             stop = (Stop("entry", session.line) if self._launch.stop_on_entry
-                    else self._continue(generation))
+                    else self._continue())
         elif command == "continue":
-            stop = self._continue(generation)
+            stop = self._continue()
         elif command == "stepLine":
             stop = session.step_line()
         else:
@@ -170,14 +172,18 @@ class Run:
             return "run/ended", self._ended()
         return "run/stopped", self._stopped(stop)
 
-    def _continue(self, generation: int) -> Stop:
+    def _stopping(self) -> bool:
+        """Whether the command under way is to stop: paused, or overtaken."""
+        return self._pausing.is_set() or self._current != self._generation
+
+    def _continue(self) -> Stop:
         """Line steps until one stops for a reason of its own, paced."""
         session = self.session
         self._anchor = (time.monotonic(), self._sim_time())
         self._pacing = True
         try:
             while True:
-                if self._pausing.is_set() or generation != self._generation:
+                if self._stopping():
                     return Stop("pause", session.line, "paused")
                 stop = session.step_line()
                 if stop.reason != "step":
@@ -196,7 +202,7 @@ class Run:
         if speed is not None:
             wall, simulated = self._anchor
             due = wall + (simulation.device.sim.time - simulated) / speed
-            while now < due and not self._pausing.is_set() and not self._wake.is_set():
+            while now < due and not self._stopping() and not self._wake.is_set():
                 self._frame_if_due(now)
                 self._wake.wait(min(due, self._next_frame) - now)
                 now = time.monotonic()
@@ -214,7 +220,7 @@ class Run:
         if self._next_frame <= now:  # late by a whole frame or more: no burst to catch up
             self._next_frame = now + _FRAME_INTERVAL
         params = {"frame": self._frame_now(), **self._news()}
-        self._loop.call_soon_threadsafe(self._deliver, self._generation, "run/frame", params)
+        self._loop.call_soon_threadsafe(self._deliver, self._current, "run/frame", params)
 
     def _deliver(self, generation: int, method: str, params: dict[str, Any]) -> None:
         if generation == self._generation:

@@ -5,6 +5,7 @@ and every kind of bad message answered with its JSON-RPC error, the server going
 
 from __future__ import annotations
 
+import itertools
 import json
 import time
 from collections.abc import Iterator
@@ -163,6 +164,29 @@ def test_frames_come_while_it_runs_and_pause_stops_it(client: Page) -> None:
     assert running.value.code == -32006
 
 
+def test_pausing_and_going_on_anywhere_changes_nothing(client: Page, folder: Path) -> None:
+    client.request("debug/setBreakpoints", {"lines": [], "calls": []})
+    client.request("run/launch", {**LISTING_1, "speed": 100})
+    pauses = 0
+    for delay in itertools.cycle([0.0, 0.01, 0.003, 0.05, 0.0, 0.02]):
+        time.sleep(delay)
+        client.request("debug/pause")
+        stop = client.until("run/stopped", "run/ended")
+        if stop["method"] == "run/ended":
+            break
+        pauses += 1
+        client.request(["debug/continue", "debug/stepLine", "debug/stepInstruction"][
+            pauses % 3])
+        if pauses % 3:  # a step: it stops by itself, then the run goes on
+            client.until("run/stopped")
+            client.request("debug/continue")
+    expected = rl1c_sim(folder)
+    assert pauses > 3
+    assert (stop["status"], stop["variables"], stop["instructions"], stop["deviceTime"]) == (
+        expected["status"], expected["variables"], expected["instructions"],
+        expected["device_time"])
+
+
 def test_restart_starts_again_and_stop_ends_the_run(client: Page) -> None:
     client.request("debug/setBreakpoints", {"lines": [{"line": 6}], "calls": []})
     client.request("run/launch", {**LISTING_1, "speed": None})
@@ -313,3 +337,27 @@ def test_commands_without_a_run_say_to_launch(served: Served) -> None:
             with pytest.raises(Failed, match="run/launch") as refused:
                 fresh.request(method)
             assert refused.value.code == -32005
+
+
+@pytest.mark.parametrize("command", ["debug/pause", "debug/restart", "debug/stop"])
+def test_a_long_call_at_real_time_does_not_hold_up_a_command(client: Page,
+                                                            command: str) -> None:
+    # (TIM 100) waits 10 s moving, which one instruction paced at a tenth of real time
+    # makes 100 s: a command must not wait for its end (longer than TIMEOUT).
+    client.request("debug/setBreakpoints", {"lines": [], "calls": []})
+    client.request("run/launch", {"program": {"text": "(MOV 1,1)\n(TIM 100)\n(END)\n"},
+                                  "world": {"path": "sample.world.toml"}, "speed": 0.1,
+                                  "stopOnEntry": True})
+    client.until("run/stopped")
+    client.request("debug/continue")
+    while (moving := client.until("run/frame")["frame"])["time"] < 0.01:
+        pass  # until the (TIM) is under way (the instructions before take 0.2 ms each)
+    client.request(command)
+    stop = client.until("run/stopped", "run/ended")
+    assert stop["method"] == {"debug/pause": "run/stopped", "debug/restart": "run/stopped",
+                              "debug/stop": "run/ended"}[command]
+    if command == "debug/pause":  # at the instruction after the call, as the VM stops
+        assert (stop["reason"], stop["line"]) == ("pause", 3)
+        assert stop["frame"]["time"] > moving["time"]
+    if command == "debug/restart":
+        assert (stop["reason"], stop["frame"]["time"]) == ("entry", 0)
