@@ -15,7 +15,7 @@ from collections.abc import Iterator
 from concurrent.futures import BrokenExecutor
 from contextlib import contextmanager
 from types import FrameType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TextIO
 
 import click
 
@@ -32,6 +32,8 @@ SIGNALS = (signal.SIGINT, signal.SIGTERM)  # what stops a campaign, keeping its 
 DEFAULT_COUNT = 1000
 DEFAULT_BUDGET = 20_000  # generated programs are short; a runaway is found quickly
 BAR_WIDTH = 30
+REDRAW_EVERY = 0.2  # seconds between redraws of the bar on a terminal
+PROGRESS_EVERY = 10.0  # seconds between progress lines elsewhere
 
 
 @click.command(cls=Command)
@@ -59,6 +61,10 @@ BAR_WIDTH = 30
               callback=lambda c, p, v: None if v is None else at_least_one(c, p, v),
               help="processes that run the searches (default: one per core); the "
                    "programs are the same for any J")
+@click.option("--scheduler", metavar="ADDRESS",
+              help="run the searches on the Dask cluster of this scheduler "
+                   "(tcp://HOST:8786; the extra rl1[cluster] here, rl1[fuzz] on its "
+                   "workers) instead of local processes; the same programs")
 @click.option("--corpus", "corpus_paths", multiple=True, metavar="PATH", type=PATH,
               help="programs to run first, repeatable: an RL/I file, or a folder of them "
                    "(such as examples/, bench/corpus or --out's findings), each with the "
@@ -73,7 +79,8 @@ BAR_WIDTH = 30
                    "with its engines and budget: exit status 1 while they disagree")
 def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
          seed: str | None, out_dir: str, budget: int, jobs: int | None,
-         corpus_paths: tuple[str, ...], keep_going: bool, replay_dir: str | None) -> int:
+         scheduler: str | None, corpus_paths: tuple[str, ...], keep_going: bool,
+         replay_dir: str | None) -> int:
     """Run generated programs on several engines and compare what they do.
 
     Every program (with a sensor script to match) runs on each engine; the runs must
@@ -139,6 +146,9 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     except ValueError:
         raise click.UsageError(f"argument --seed: expected a whole number, got {seed!r}"
                                ) from None
+    if jobs is not None and scheduler is not None:
+        raise click.UsageError("--jobs counts local processes, and --scheduler gives the "
+                               "searches to a cluster's workers: give one of them")
     if jobs is not None and jobs > MAX_JOBS:
         raise click.UsageError(f"argument --jobs: at most {MAX_JOBS} processes on one "
                                "machine")
@@ -161,7 +171,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
 
     try:
         with _halted_by_signals(channel) as signalled, \
-                workers(jobs or os.cpu_count() or 1) as held:
+                workers(jobs or os.cpu_count() or 1, scheduler) as held:
             outcome = campaign(engines, budget, count=limit, seconds=seconds,
                                seed=seed_value, progress=bar.update, executor=held.executor,
                                jobs=max(held.slots, 1), keep_going=keep_going,
@@ -299,25 +309,37 @@ def _unwritable(folder: str) -> str | None:
 
 
 class _Bar:
-    """A progress bar on standard error, when it is a terminal."""
+    """Progress on standard error: on a terminal a bar redrawn in place every
+    REDRAW_EVERY seconds; elsewhere (CI, a log file) a plain line every PROGRESS_EVERY
+    seconds, which a log keeps readable."""
 
-    def __init__(self, count: int | None, seconds: int | None) -> None:
+    def __init__(self, count: int | None, seconds: int | None, stream: TextIO | None = None
+                 ) -> None:
         self.count, self.seconds = count, seconds
-        self.shown = sys.stderr.isatty()
+        self.stream = stream or sys.stderr
+        self.terminal = self.stream.isatty()
+        self.shown = 0.0  # the elapsed time of the last line
 
     def update(self, programs: int, elapsed: float) -> None:
-        if not self.shown or programs % 10:
+        if elapsed - self.shown < (REDRAW_EVERY if self.terminal else PROGRESS_EVERY):
             return
-        done = programs / self.count if self.count else elapsed / (self.seconds or 1)
-        filled = int(BAR_WIDTH * min(done, 1.0))
+        self.shown = elapsed
         rate = programs / elapsed if elapsed else 0.0
-        sys.stderr.write(f"\r[{'#' * filled}{'.' * (BAR_WIDTH - filled)}] {programs} programs, "
-                         f"{rate:.0f}/s, {elapsed:.0f} s")
-        sys.stderr.flush()
+        of_count = f" of {self.count}" if self.count else ""
+        of_time = f" of {self.seconds}" if self.seconds else ""
+        done = (f"{programs}{of_count} programs, {rate:.1f} per second, "
+                f"{elapsed:.0f}{of_time} s")
+        if not self.terminal:
+            self.stream.write(f"fuzz: {done}\n")
+        else:
+            part = programs / self.count if self.count else elapsed / (self.seconds or 1)
+            filled = int(BAR_WIDTH * min(part, 1.0))
+            self.stream.write(f"\r[{'#' * filled}{'.' * (BAR_WIDTH - filled)}] {done}")
+        self.stream.flush()
 
     def close(self) -> None:
-        if self.shown:
-            sys.stderr.write("\n")
+        if self.terminal and self.shown:
+            self.stream.write("\n")
 
 
 COMMANDS = (fuzz,)

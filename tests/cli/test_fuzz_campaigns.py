@@ -3,6 +3,7 @@ going on past findings (--keep-going), seeded from a corpus, and their statistic
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import re
@@ -18,6 +19,7 @@ from support import ROOT
 from support.cli import rl1c
 
 from rl1.compiler import fuzz
+from rl1.compiler.cli import fuzz as fuzz_cli
 from rl1.compiler.differential import Observation, VmEngine
 from rl1.compiler.strategies import Run
 from rl1.vm import machine
@@ -263,3 +265,48 @@ def test_a_corpus_path_that_is_not_there_is_a_usage_error(tmp_path: Path) -> Non
     assert result.exit_code == 2
     assert f"argument --corpus: {tmp_path / 'nothing'}: no such file or folder" \
         in result.stderr
+
+
+# Progress -------------------------------------------------------------------------------
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_progress_is_a_plain_line_every_few_seconds_off_a_terminal() -> None:
+    stream = io.StringIO()
+    bar = fuzz_cli._Bar(1000, None, stream)
+    every = fuzz_cli.PROGRESS_EVERY
+    for programs, elapsed in [(1, 0.5), (10, every - 0.1), (40, every), (41, every + 1),
+                              (90, 2 * every + 3)]:
+        bar.update(programs, elapsed)
+    bar.close()
+    assert stream.getvalue() == (
+        f"fuzz: 40 of 1000 programs, {40 / every:.1f} per second, {every:.0f} s\n"
+        f"fuzz: 90 of 1000 programs, {90 / (2 * every + 3):.1f} per second, "
+        f"{2 * every + 3:.0f} s\n")
+
+
+def test_progress_on_a_terminal_is_a_bar_redrawn_in_place() -> None:
+    stream = _Terminal()
+    bar = fuzz_cli._Bar(None, 60, stream)
+    bar.update(10, 1.0)
+    bar.update(11, 1.1)  # too soon to redraw
+    bar.update(20, 30.0)
+    bar.close()
+    assert stream.getvalue() == (
+        f"\r[{'.' * 30}] 10 programs, 10.0 per second, 1 of 60 s"
+        f"\r[{'#' * 15}{'.' * 15}] 20 programs, 0.7 per second, 30 of 60 s\n")
+
+
+def test_a_campaign_in_ci_prints_progress_lines_on_standard_error(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fuzz_cli, "PROGRESS_EVERY", 0.0)
+    result = rl1c("fuzz", "--count", "12", "--seed", "5", "--jobs", "2")
+    assert result.exit_code == 0, result.output
+    lines = result.stderr.splitlines()
+    assert lines and all(re.fullmatch(r"fuzz: [0-9]+ of 12 programs, [0-9.]+ per second, "
+                                      r"[0-9]+ s", line) for line in lines), lines
+    assert "\r" not in result.stderr
