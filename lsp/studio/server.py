@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import json
 import logging
 import mimetypes
 import secrets
@@ -22,7 +21,6 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from http import HTTPStatus
 from pathlib import Path
-from typing import Any
 from urllib.parse import parse_qs, unquote, urlsplit
 
 from websockets.asyncio.server import ServerConnection, serve
@@ -30,11 +28,11 @@ from websockets.datastructures import Headers
 from websockets.exceptions import ConnectionClosed
 from websockets.http11 import Request, Response
 
-from .. import server as language_server
 from .. import transports
 from ..framing import MAX_MESSAGE
 from .connection import Connection, Studio
 from .files import Folder, Refused, Unusable
+from .language import new_session
 
 log = logging.getLogger(__name__)
 
@@ -151,9 +149,8 @@ class Server:
         path = urlsplit(connection.request.path).path if connection.request else ""
         if path == "/lsp":
             folder = self.studio.folder
-            await transports.serve_lsp_connection(
-                connection, lambda: Confined(language_server.create_server(), folder),
-                self.lsp_sessions)
+            await transports.serve_lsp_connection(connection, lambda: new_session(folder),
+                                                  self.lsp_sessions)
         elif path == "/studio":
             await self._studio(connection)
 
@@ -203,62 +200,6 @@ class _Outbox:
 
     def close(self) -> None:
         self._pump.cancel()
-
-
-class Confined:
-    """A language server session that hears only of documents in the folder: a message
-    about a document elsewhere is answered with an error (a request) or dropped."""
-
-    def __init__(self, inner: language_server.Rl1Server, folder: Folder) -> None:
-        self._inner = inner
-        self._folder = folder
-        self._writer: transports.Writer | None = None
-
-    @property
-    def exit_status(self) -> int | None:
-        return self._inner.exit_status
-
-    @property
-    def initialized(self) -> bool:
-        return self._inner.initialized
-
-    def attach(self, writer: transports.Writer) -> None:
-        self._writer = writer
-        self._inner.attach(writer)
-
-    def receive(self, body: bytes) -> None:
-        try:
-            message = json.loads(body)
-        except (ValueError, RecursionError):
-            message = None  # the session answers what is no JSON
-        if isinstance(message, dict) and (uri := _document_uri(message)) is not None \
-                and not self._inside(uri):
-            if "id" in message and self._writer is not None:
-                self._writer.write(json.dumps({"jsonrpc": "2.0", "id": message["id"], "error": {
-                    "code": -32602, "message": f"{uri} is outside {self._folder.root}, the "
-                    "folder rl1c studio was started in: open documents inside it"}}).encode())
-            return
-        self._inner.receive(body)
-
-    def end(self) -> None:
-        self._inner.end()
-
-    def _inside(self, uri: str) -> bool:
-        parsed = urlsplit(uri)
-        if parsed.scheme != "file" or parsed.netloc not in ("", "localhost"):
-            return False
-        try:
-            self._folder.resolve(unquote(parsed.path))
-        except Refused:
-            return False
-        return True
-
-
-def _document_uri(message: dict[str, Any]) -> str | None:
-    params = message.get("params")
-    document = params.get("textDocument") if isinstance(params, dict) else None
-    uri = document.get("uri") if isinstance(document, dict) else None
-    return uri if isinstance(uri, str) else None
 
 
 async def serve_studio(server: Server, port: int, listening: Callable[[int], None]) -> None:
