@@ -8,8 +8,11 @@ from __future__ import annotations
 import os
 from collections.abc import Iterator
 from pathlib import Path
+from urllib.parse import quote, unquote
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from served import Served, get, page, sample_folder, serving
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
@@ -124,6 +127,21 @@ def test_nothing_outside_the_pages_folder_is_served(served: Served, target: str)
     assert answer.status == 404
     assert b"not for the page" not in answer.body
     assert b"import" not in answer.body
+
+
+@settings(max_examples=150, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(st.one_of(st.text(max_size=300), st.lists(st.sampled_from(
+    ["studio.js", "escape.js", "..", ".", "/", "%2e", "%2f", "%00", "\x00", "index.html",
+     "~", "etc", "passwd"]), max_size=8).map("".join)))
+def test_any_path_is_answered_and_never_escapes(served: Served, path: str) -> None:
+    target = "/static/" + quote(path, safe="/.%")
+    answer = get(served, f"{target}?token={served.token}")
+    assert answer.status in (200, 404)
+    assert b"not for the page" not in answer.body
+    assert b"Traceback" not in answer.body
+    if answer.status == 200:
+        assert answer.body == (served.server.static / unquote(path).lstrip("/")).read_bytes()
 
 
 def test_only_get_is_served(served: Served) -> None:
