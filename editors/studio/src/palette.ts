@@ -44,13 +44,20 @@ export function showPalette(parent: HTMLElement, builtins: readonly Builtin[],
   }
 }
 
-/** Inserts a call at the cursor as a statement: after a `; ` when the line has code
- * before the cursor, with its first argument selected. */
+/** What goes between the code before the cursor on its line and a new statement: a
+ * `; ` after a statement, a space after a label or a `;`, nothing at the line's start. */
+function separator(before: string): string {
+  const code = before.trimEnd();
+  if (code === "") return "";
+  const spaced = code.length < before.length ? "" : " ";
+  return /^:[0-9]*$/.test(code.trimStart()) || code.endsWith(";") ? spaced : "; ";
+}
+
+/** Inserts a call at the cursor as a statement, its first argument selected (Tab goes
+ * to the next). */
 export function insertCall(editor: EditorView, template: string): void {
   const { from, to } = editor.state.selection.main;
   const line = editor.state.doc.lineAt(from);
-  const before = editor.state.sliceDoc(line.from, from).trimEnd();
-  const separator = before === "" || before.endsWith(";") ? "" : "; ";
-  snippet(separator + template)(editor, null, from, to);
+  snippet(separator(editor.state.sliceDoc(line.from, from)) + template)(editor, null, from, to);
   editor.focus();
 }
