@@ -101,11 +101,13 @@ async function start(): Promise<void> {
     }
   };
   let breakpoints: number[] = [];
+  const stopOnLost = byId<HTMLInputElement>("stop-on-lost");
   const sendBreakpoints = async (): Promise<void> => {
-    const answer = await studio.request<{ breakpoints: Binding[] | null }>(
-      "debug/setBreakpoints", { lines: breakpoints.map((line) => ({ line })) });
+    const answer = await studio.request<{ breakpoints: Binding[] | null }>("debug/setBreakpoints", {
+      lines: breakpoints.map((line) => ({ line })), lostLines: stopOnLost.checked });
     reportBindings(answer.breakpoints ?? []);
   };
+  stopOnLost.addEventListener("change", () => sendBreakpoints().catch((error: Error) => say(error.message, true)));
   const reportBindings = (bindings: Binding[]): void => {
     const refused = bindings.filter((binding) => !binding.verified);
     if (refused.length) say(refused.map((binding) => `breakpoint on line ${binding.line}: ${binding.message}`).join("; "), true);
