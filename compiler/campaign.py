@@ -17,7 +17,7 @@ from __future__ import annotations
 import gc
 import math
 from collections import deque
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 from concurrent.futures import Executor, Future
 from dataclasses import dataclass, field
 from functools import lru_cache
@@ -28,7 +28,7 @@ from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.runner import Finished, run
 from rl1.compiler.simulation import Simulation, run_status
 from rl1.vm.defaults import Engine
-from rl1.vm.sim.motion import heading_degrees
+from rl1.vm.sim.motion import Pose, heading_degrees
 from rl1.vm.sim.world import NOISELESS, World, decode_world
 
 MAX_SEED = 2**32 - 1  # `rl1c sim --seed`'s range
@@ -56,10 +56,12 @@ class Task:
     engine: Engine = "vm"
     budget: int = 0
     source_name: str = "program.rob"
+    offsets: tuple[tuple[str, float], ...] = ()  # a sweep's point: parameters moved
+    path_points: int = 0  # the most points of each run's path a record keeps (pictures)
 
 
 def task_for(program: str | bytes, world: bytes, world_name: str, engine: Engine,
-             budget: int, source_name: str) -> Task:
+             budget: int, source_name: str, path_points: int = 0) -> Task:
     """The task of a campaign of `program`: RL/I source is compiled here once, as `rl1c
     sim` compiles it for its run, for the VMs (the interpreter runs the source). The
     source must compile."""
@@ -69,7 +71,8 @@ def task_for(program: str | bytes, world: bytes, world_name: str, engine: Engine
             raise ValueError("the program has errors: a campaign runs only a program "
                              "that compiles")
         program = compiled
-    return Task(program, world, world_name, engine, budget, source_name)
+    return Task(program, world, world_name, engine, budget, source_name,
+                path_points=path_points)
 
 
 @dataclass(frozen=True, slots=True)
@@ -78,7 +81,9 @@ class Record:
     status code (ok, goal-missed, or the fault's kind) and `exit_status` its exit status;
     a success is status 0. `missed` names the goal's parts missed (each `part "name"`,
     as the report titles it), `safety` the kind of a safety stop; `device_time` is when
-    the program ended (ms), `pose` where the vehicle was at the end (after any run-on)."""
+    the program ended (ms), `pose` where the vehicle was at the end (after any run-on).
+    `varied` gives the value in the run of each parameter drawn ([vary]) or swept, and
+    `path` where the vehicle went, thinned, when the task asks for it (never in JSON)."""
 
     seed: int
     outcome: str
@@ -91,6 +96,8 @@ class Record:
     device_time: int
     pose: tuple[float, float, float]
     instructions: int | None
+    varied: tuple[tuple[str, float], ...] = ()
+    path: tuple[tuple[float, float], ...] = ()
 
     @property
     def success(self) -> bool:
@@ -103,7 +110,8 @@ class Record:
                 "goal": None if self.goal_met is None else {
                     "met": self.goal_met, "missed": list(self.missed)},
                 "device_time": self.device_time, "pose": list(self.pose),
-                "instructions": self.instructions}
+                "instructions": self.instructions,
+                **({"varied": dict(self.varied)} if self.varied else {})}
 
 
 COLLECT_EVERY = 64  # runs between full collections of a worker's garbage
@@ -132,7 +140,8 @@ def run_one(task: Task, seed: int) -> Record:
         # or interpreted each run would grow a worker without end.
         _runs_since_collection = 0
         gc.collect()
-    simulation = Simulation(world_of(task), seed)
+    world, varied = run_world(world_of(task), task.offsets, seed)
+    simulation = Simulation(world, seed)
     device = simulation.device
     finished = run(task.program, device, engine=task.engine, budget=task.budget,
                    source_name=task.source_name)
@@ -151,13 +160,35 @@ def run_one(task: Task, seed: int) -> Record:
         missed=() if verdict is None else tuple(part.title() for part in verdict.missed()),
         device_time=round(ending.ended_at * 1000),
         pose=(round(pose.x, 2), round(pose.y, 2), heading_degrees(pose.heading, 2)),
-        instructions=finished.instructions)
+        instructions=finished.instructions, varied=tuple(varied.items()),
+        path=thinned(device.sim.track, task.path_points))
+
+
+def run_world(world: World, offsets: Iterable[tuple[str, float]],
+              seed: int) -> tuple[World, dict[str, float]]:
+    """The world of the run of `seed` at a sweep's point (`offsets`: none outside a
+    sweep): the parameters swept moved, then those of [vary] drawn; and the value in
+    the run of each parameter swept or drawn."""
+    moved = dict(offsets)
+    world, drawn = world.moved(moved).drawn(seed)
+    return world, {key: world.parameter(key).value for key in moved} | drawn
+
+
+def thinned(track: Sequence[tuple[float, Pose]], most: int) -> tuple[tuple[float, float], ...]:
+    """At most `most` points of `track` (none when 0), evenly spread, its first and last
+    kept, each to the millimetre."""
+    if most < 2 or not track:
+        return ()
+    every = max(1, math.ceil((len(track) - 1) / (most - 1)))
+    kept = [*track[:-1:every], track[-1]]
+    return tuple((round(pose.x, 1), round(pose.y, 1)) for _, pose in kept)
 
 
 def noiseless(task: Task) -> bool:
-    """Whether every run of `task` is the same run: its world has no noise, the only
-    thing a seed changes."""
-    return world_of(task).noise == NOISELESS
+    """Whether every run of `task` is the same run: its world has no noise and draws
+    nothing ([vary]), the only things a seed changes."""
+    world = world_of(task)
+    return world.noise == NOISELESS and not world.varied
 
 
 RESUBMISSIONS = 2  # of a run lost with its worker: more, and the run may be what kills them

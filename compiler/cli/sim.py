@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import sys
+from typing import TYPE_CHECKING
 
 import click
 
@@ -22,6 +23,10 @@ from .command import (
     force_option,
 )
 from .streams import invalid_file, read_failure, write_file
+
+if TYPE_CHECKING:
+    from rl1.compiler.sweep import Axis
+    from rl1.vm.sim.world import World
 
 SECTION = "Simulation"
 MAX_WORLD_BYTES = 4 * 2**20
@@ -46,8 +51,10 @@ def at_least_one_or_none(ctx: click.Context, param: click.Parameter,
               help="write a page that replays the run, offline, to FILE")
 @choice_option("--format", "sim_format", choices=("text", "json"), default="text",
                help="text: for people; json: one object with the pose track, for tools")
-@click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=0, show_default=True,
-              help="the seed of the sensor noise (the world sets the noise; off by default)")
+@click.option("--seed", type=click.IntRange(0, 2**32 - 1), default=None,
+              help="the seed of the sensor noise (the world sets the noise; off by default) "
+                   "and of the world's [vary] draws (default 0; a run without --seed draws "
+                   "nothing: the world as written)")
 @choice_option("--engine", choices=ENGINES, default="vm",
                help="vm: compile, then run on the reference VM; ast: interpret the source; "
                     "c: run on the C VM of the firmware (vm/c, built on first use)")
@@ -70,6 +77,12 @@ def at_least_one_or_none(ctx: click.Context, param: click.Parameter,
               help="with --runs: make the runs on the Dask cluster of this scheduler "
                    "(tcp://HOST:8786; the extra rl1[cluster]) instead of local processes; "
                    "the same results")
+@click.option("--sweep", "sweeps", metavar="KEY=A:B:N", multiple=True,
+              help="with --runs, once or twice: a campaign at each point of the grid, KEY "
+                   "(as [vary] names it: start.x, stands.NAME.x, vehicle.k1, noise.slip) "
+                   "moved from the world's value by A to B in N steps; prints the success "
+                   "rate of each point (and a heat map for two); without --runs, N = 1: "
+                   "one run at that point")
 @click.option("--out", "out_file", metavar="FILE", type=PATH,
               help="with --runs: write each run as a JSON line to FILE (- for standard "
                    "output, the summary then on standard error), in seed order, as the "
@@ -77,9 +90,10 @@ def at_least_one_or_none(ctx: click.Context, param: click.Parameter,
 @force_option
 @color_option
 def sim(file: str, world: str | None, svg_file: str | None, html_file: str | None,
-        sim_format: str, seed: int, engine: Engine, budget: int,
+        sim_format: str, seed: int | None, engine: Engine, budget: int,
         trace_choice: TraceChoice | None, runs: int | None, jobs: int | None,
-        scheduler: str | None, out_file: str | None, force: bool, color: ColorChoice) -> int:
+        scheduler: str | None, sweeps: tuple[str, ...], out_file: str | None, force: bool,
+        color: ColorChoice) -> int:
     """Run a program (.rob source, or an .ilc file) on the simulated vehicle and world.
 
     Prints each call with the device time, its source line and the vehicle's pose after
@@ -118,12 +132,9 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
         raise click.UsageError("--jobs counts local processes, and --scheduler gives the "
                                "runs to a cluster's workers: give one of them")
     else:
-        for option, given in (("--svg", svg_file), ("--html", html_file),
-                              ("--trace", trace_choice)):
-            if given is not None:
-                raise click.UsageError(f"{option} shows one run, and --runs makes many: "
-                                       "replay one run (the summary gives its command) "
-                                       f"with {option}")
+        if trace_choice is not None:
+            raise click.UsageError("--trace shows one run, and --runs makes many: replay "
+                                   "one run (the summary gives its command) with --trace")
         if sim_format != "text":
             raise click.UsageError("--format json shows one run: a campaign writes each "
                                    "run as a JSON line with --out FILE")
@@ -135,13 +146,16 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
     except WorldError as error:
         raise invalid_file(WORLD_ROLE, world, str(error),
                            "correct it as spec/simulator.md describes") from None
+    axes = sweep_axes(sweeps, the_world, runs is not None)
     if runs is not None:
-        from .sim_campaign import Setting, run_campaign
+        from .sim_campaign import Pictures, Setting, run_campaign
 
-        setting = Setting(file, world, seed, runs, jobs or os.cpu_count() or 1, engine, budget,
-                          scheduler)
-        return run_campaign(file, world_bytes, world, setting, out_file, color)
-    simulation = Simulation(the_world, seed)
+        setting = Setting(file, world, seed or 0, runs, jobs or os.cpu_count() or 1, engine,
+                          budget, scheduler, axes)
+        return run_campaign(file, world_bytes, world, setting, out_file, color,
+                            Pictures(svg_file, html_file, force))
+    the_world = single_run_world(the_world, axes, seed)
+    simulation = Simulation(the_world, seed or 0)
     device = simulation.device
     ran = run_file(file, device, engine, budget, color, "sim")
     if isinstance(ran, int):
@@ -168,6 +182,37 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
                                      trace_choice or "short",
                                      color=use_color(color, sys.stdout), verdict=verdict))
     return int(run_status(result, verdict)["exit_status"])
+
+
+def sweep_axes(sweeps: tuple[str, ...], world: World, campaign: bool) -> tuple[Axis, ...]:
+    """The axes of `--sweep`, checked against `world`; a usage error says what is wrong.
+    Without --runs, each gives one point: the run's."""
+    from rl1.compiler.sweep import check, parse_axis
+
+    try:
+        axes = tuple(parse_axis(text) for text in sweeps)
+        check(world, axes)
+    except ValueError as error:
+        raise click.UsageError(f"--sweep: {error}") from None
+    if not campaign and any(axis.count > 1 for axis in axes):
+        raise click.UsageError("--sweep of more than one point is for a campaign: give "
+                               "--runs N, or KEY=A:A:1 for one run at that point")
+    return axes
+
+
+def single_run_world(world: World, axes: tuple[Axis, ...], seed: int | None) -> World:
+    """The world of a single run: at the point of `axes` (each of one point), and drawn
+    from [vary] when --seed is given, each value drawn said on standard error."""
+    from rl1.compiler.campaign import run_world as drawn_world
+
+    offsets = tuple((axis.key, axis.first) for axis in axes)
+    if seed is None:
+        return world.moved(dict(offsets))
+    world, values = drawn_world(world, offsets, seed)
+    if values:
+        print("rl1c: note: the world of seed " + str(seed) + ": " + ", ".join(
+            f"{key} = {value:.6g}" for key, value in values.items()), file=sys.stderr)
+    return world
 
 
 COMMANDS = (sim,)

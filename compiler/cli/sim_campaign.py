@@ -17,7 +17,7 @@ import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import BrokenExecutor
 from contextlib import ExitStack, contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from types import FrameType
 from typing import IO
 
@@ -36,11 +36,14 @@ from rl1.compiler.campaign import (
 )
 from rl1.compiler.executors import Unavailable, Workers, workers
 from rl1.compiler.reporting.render import ColorChoice
+from rl1.compiler.sweep import Axis, Point, grid, heat_map, table
 from rl1.vm.defaults import DEFAULT_BUDGET, Engine
+from rl1.vm.sim.campaign_render import Overlay, Run, heat_map_svg, html, svg
+from rl1.vm.sim.world import World
 
 from .command import EXIT_INTERNAL, Failure
 from .running import run_file
-from .streams import cannot_write, file_failure, read_ilc, same_file
+from .streams import cannot_write, file_failure, read_ilc, same_file, write_file
 
 PROGRESS_EVERY = 5.0  # s between progress lines when standard error is no terminal
 REDRAW_EVERY = 0.2  # s between redraws of the progress line on a terminal
@@ -61,6 +64,7 @@ class Setting:
     engine: Engine
     budget: int
     scheduler: str | None = None  # a Dask cluster's, instead of `jobs` local processes
+    sweep: tuple[Axis, ...] = ()  # the parameters swept (--sweep), each a campaign a point
 
     def rest(self, seed: int, runs: int) -> str:
         """The `rl1c sim --runs` command of the campaign's last `runs` runs, from `seed`."""
@@ -68,6 +72,14 @@ class Setting:
                  "--seed", str(seed)]
         words += ["--jobs", str(self.jobs)] if self.scheduler is None else [
             "--scheduler", self.scheduler]
+        return shlex.join(words + self._engine_words())
+
+    def point(self, point: Point) -> str:
+        """The `rl1c sim --runs` command of the campaign at one point of the sweep."""
+        words = ["rl1c", "sim", self.file, "--world", self.world, "--runs", str(self.runs),
+                 "--seed", str(self.seed)]
+        for axis, (_, offset) in zip(self.sweep, point, strict=True):
+            words += ["--sweep", axis.words(offset)]
         return shlex.join(words + self._engine_words())
 
     def _engine_words(self) -> list[str]:
@@ -78,9 +90,12 @@ class Setting:
             words += ["--budget", str(self.budget)]
         return words
 
-    def replay(self, seed: int) -> str:
-        """The `rl1c sim` command that makes the run of `seed` alone."""
+    def replay(self, seed: int, point: Point = ()) -> str:
+        """The `rl1c sim` command that makes the run of `seed` alone (at `point` of the
+        sweep)."""
         words = ["rl1c", "sim", self.file, "--world", self.world, "--seed", str(seed)]
+        for axis, (_, offset) in zip(self.sweep, point, strict=False):
+            words += ["--sweep", axis.words(offset)]
         return shlex.join(words + self._engine_words())
 
 
@@ -142,7 +157,7 @@ def _workers(setting: Setting) -> Iterator[Workers]:
                       file=sys.stderr)
             yield held
     except Unavailable as error:
-        raise Failure(str(error)) from None
+        raise Failure(f"error: {error}") from None
 
 
 def task_of(file: str, world: bytes, world_name: str, setting: Setting,
@@ -226,6 +241,31 @@ def summary(setting: Setting, tally: Tally, task: Task, stopped: bool) -> str:
     return "\n".join(lines) + "\n"
 
 
+@dataclass(frozen=True, slots=True)
+class Pictures:
+    """The pictures of a campaign the command line asks for (--svg, --html)."""
+
+    svg: str | None
+    html: str | None
+    force: bool
+
+    @property
+    def wanted(self) -> bool:
+        return self.svg is not None or self.html is not None
+
+
+NO_PICTURES = Pictures(None, None, False)
+PATH_POINTS = 64  # of each run's path that a record carries for the pictures
+
+
+def _refuse_inputs(pictures: Pictures, inputs: tuple[str, str]) -> None:
+    for option, target in (("--svg", pictures.svg), ("--html", pictures.html)):
+        for role, name in zip(("program", "world file"), inputs, strict=True):
+            if target is not None and os.path.exists(name) and same_file(name, target):
+                raise click.UsageError(f"{option} `{target}` is the {role} itself: give "
+                                       "another path for the picture")
+
+
 def _open_out(out: str | None, inputs: tuple[str, str]) -> IO[str] | None:
     """The file of the JSON lines, replaced as `rl1c`'s outputs are, never an input."""
     if out is None:
@@ -243,9 +283,10 @@ def _open_out(out: str | None, inputs: tuple[str, str]) -> IO[str] | None:
 
 
 def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out: str | None,
-                 color: ColorChoice) -> int:
+                 color: ColorChoice, pictures: Pictures = NO_PICTURES) -> int:
     """The campaign `setting` of the program `file` on the world file `world` (its bytes,
-    named `world_name`); its exit status: 0 when it ran to its end, whatever the rate."""
+    named `world_name`), and its `pictures`; its exit status: 0 when it ran to its end,
+    whatever the rate."""
     try:
         seeds = campaign_seeds(setting.seed, setting.runs)
     except ValueError as error:
@@ -257,6 +298,9 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     task = task_of(file, world, world_name, setting, color)
     if isinstance(task, int):
         return task
+    if pictures.wanted:
+        _refuse_inputs(pictures, (file, setting.world))
+        task = replace(task, path_points=PATH_POINTS)
     held = ExitStack()  # the workers: a cluster is reached before --out replaces a file
     current = held.enter_context(_workers(setting))
     try:
@@ -265,27 +309,29 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
         held.close()
         raise
     report = sys.stderr if out == "-" else sys.stdout
-    tally = Tally()
-    progress = Progress(setting.runs, sys.stderr)
+    points = grid(setting.sweep)
+    keeper = Keeper(setting.runs, points, lines,
+                    Overlay(setting.runs * len(points)) if pictures.wanted else None)
+    progress = Progress(setting.runs * len(points), sys.stderr)
     status = 0
     stopping = Stopping()
-    broken_at = None  # the first seed left when the workers last broke
+    broken_at = None  # the point and the first seed left when the workers last broke
     try:
         with stopping.in_effect(), held:  # the workers end while a signal only stops
-            while status == 0 and tally.runs < setting.runs:
-                left = range(setting.seed + tally.runs, seeds.stop)
+            while status == 0 and not keeper.done:
+                left = range(setting.seed + keeper.tally.runs, seeds.stop)
                 try:
-                    status = _make_runs(task, left, current, tally, lines, progress,
-                                        stopping)
+                    status = _make_runs(replace(task, offsets=keeper.point), left, current,
+                                        keeper, progress, stopping)
                 except BrokenExecutor:
-                    first_left = setting.seed + tally.runs
-                    if first_left == broken_at:
+                    first_left = setting.seed + keeper.tally.runs
+                    if (keeper.point, first_left) == broken_at:
                         status = EXIT_INTERNAL  # the same run broke them twice
                         break
-                    broken_at = first_left
+                    broken_at = keeper.point, first_left
                     progress.finish()
                     print(f"rl1c: warning: a worker process ended abruptly (killed, or out "
-                          f"of memory); the workers start again from seed {broken_at}",
+                          f"of memory); the workers start again from seed {first_left}",
                           file=sys.stderr)
                     held.close()
                     current = held.enter_context(_workers(setting))
@@ -295,25 +341,32 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
         progress.finish()
         if lines is not None and lines is not sys.stdout:
             lines.close()
-    report.write(summary(setting, tally, task, stopped=status != 0))
+    tally = keeper.tally
+    said = (sweep_summary(setting, keeper, stopped=status != 0) if setting.sweep else
+            summary(setting, tally, task, stopped=status != 0))
+    report.write(said)
     report.flush()
+    if keeper.overlay is not None:
+        _draw(pictures, keeper.overlay, keeper.tallies, setting, world_of(task), said)
     next_seed = setting.seed + tally.runs
     rest = setting.rest(next_seed, setting.runs - tally.runs)
     if status == EXIT_INTERNAL:
         print(f"rl1c: error: the run of seed {next_seed} ended its worker each time it "
-              f"was made: replay it alone ({setting.replay(next_seed)}), and if rl1c "
-              f"crashed, report it; the runs before it are kept; to go on after it: "
-              f"{setting.rest(next_seed + 1, setting.runs - tally.runs - 1)}",
+              f"was made: replay it alone ({setting.replay(next_seed, keeper.point)}), and "
+              f"if rl1c crashed, report it; the runs before it are kept"
+              + ("" if setting.sweep else "; to go on after it: "
+                 + setting.rest(next_seed + 1, setting.runs - tally.runs - 1)),
               file=sys.stderr)
     elif status:
         print("rl1c: interrupted: the runs finished are kept"
-              + ("" if out is None else f" in {out}") + "; to go on, run the seeds left: "
-              + rest, file=sys.stderr)
+              + ("" if out is None else f" in {out}") + (
+                  "; to go on, run the sweep again (each point makes the same runs)"
+                  if setting.sweep else "; to go on, run the seeds left: " + rest),
+              file=sys.stderr)
     return status
 
-
-def _make_runs(task: Task, seeds: range, held: Workers, tally: Tally,
-               lines: IO[str] | None, progress: Progress, stopping: Stopping) -> int:
+def _make_runs(task: Task, seeds: range, held: Workers, keeper: Keeper,
+               progress: Progress, stopping: Stopping) -> int:
     """Make the runs of `seeds` on `held`, keeping each; 0, the status of a signal that
     stopped them, or EXIT_INTERNAL when a run was lost with its worker each time it was
     made. BrokenExecutor when a local worker process ended abruptly, after keeping the
@@ -324,12 +377,12 @@ def _make_runs(task: Task, seeds: range, held: Workers, tally: Tally,
     try:
         for record in runs:
             with stopping.keeping():
-                _keep(record, tally, lines)
-            progress.update(tally)
+                keeper.keep(record)
+            progress.update(keeper.total)
     except ending as stop:
         with stopping.keeping():
             for record in runs.salvage():
-                _keep(record, tally, lines)
+                keeper.keep(record)
         match stop:
             case Stopped():
                 return stop.status
@@ -339,9 +392,82 @@ def _make_runs(task: Task, seeds: range, held: Workers, tally: Tally,
     return 0
 
 
-def _keep(record: Record, tally: Tally, lines: IO[str] | None) -> None:
-    tally.add(record)
-    if lines is not None:
-        lines.write(json.dumps(record.to_json(), separators=(",", ":")) + "\n")
-        lines.flush()  # a line is whole on disk when the campaign is stopped
+@dataclass(slots=True)
+class Keeper:
+    """Where each run's record goes, in the campaign's order: its JSON line, the tally of
+    its point of the sweep (of the campaign, without one) and of every run, and the
+    pictures' overlay. A point's tally is begun when the one before it is whole."""
+
+    runs: int  # at each point
+    points: list[Point]
+    lines: IO[str] | None
+    overlay: Overlay | None
+    tallies: list[Tally] = field(default_factory=lambda: [Tally()])
+    total: Tally = field(default_factory=Tally)
+
+    @property
+    def tally(self) -> Tally:
+        return self.tallies[-1]
+
+    @property
+    def point(self) -> Point:
+        return self.points[len(self.tallies) - 1]
+
+    @property
+    def done(self) -> bool:
+        return len(self.tallies) == len(self.points) and self.tally.runs == self.runs
+
+    def keep(self, record: Record) -> None:
+        self.tally.add(record)
+        self.total.add(record)
+        if self.lines is not None:
+            self.lines.write(json.dumps(record.to_json(), separators=(",", ":")) + "\n")
+            self.lines.flush()  # a line is whole on disk when the campaign is stopped
+        if self.overlay is not None:
+            self.overlay.add(Run(record.seed, record.path, record.pose[:2],
+                                 None if record.success else record.safety or record.outcome,
+                                 record.line))
+        if self.tally.runs == self.runs and len(self.tallies) < len(self.points):
+            self.tallies.append(Tally())
+
+
+def _draw(pictures: Pictures, overlay: Overlay, tallies: list[Tally], setting: Setting,
+          world: World, said: str) -> None:
+    """Write the campaign's pictures: the runs overlaid on the world, and for a sweep
+    the heat map of its success rates (the SVG then is the heat map alone)."""
+    title = (f"{os.path.basename(setting.file)} on {os.path.basename(setting.world)}: "
+             f"{overlay.runs:,} runs")
+    drawn = [svg(world, overlay, title)]
+    if setting.sweep:
+        rows, *columns = setting.sweep
+        drawn.insert(0, heat_map_svg(
+            f"success rate at each point, {setting.runs} runs a point",
+            (rows.key, rows.offsets()),
+            (columns[0].key, columns[0].offsets()) if columns else ("", [0.0]),
+            [(tally.successes, tally.runs) for tally in tallies]))
+    if pictures.svg is not None:
+        write_file(pictures.svg, drawn[0].encode(), force=pictures.force, role="SVG file")
+    if pictures.html is not None:
+        write_file(pictures.html, html(title, drawn, said).encode(), force=pictures.force,
+                   role="HTML file")
+
+
+def sweep_summary(setting: Setting, keeper: Keeper, stopped: bool) -> str:
+    """A sweep's summary for people: the success rate at each point, and a heat map of
+    two parameters."""
+    runs = keeper.total.runs
+    lines = [f"{runs} run{'s' if runs != 1 else ''} of {setting.file} on {setting.world}: "
+             f"seeds {setting.seed}..{setting.seed + setting.runs - 1} at each of "
+             f"{len(keeper.points)} points, the parameters moved from the world's values"
+             + (f" (stopped at point {len(keeper.tallies)})" if stopped else ""),
+             table(setting.sweep, keeper.points, keeper.tallies).rstrip("\n")]
+    if len(setting.sweep) == 2:
+        lines.append(heat_map(setting.sweep, keeper.tallies).rstrip("\n"))
+    made = [(tally.successes / tally.runs, i) for i, tally in enumerate(keeper.tallies)
+            if tally.runs]
+    if made:
+        weakest = keeper.points[min(made)[1]]
+        lines.append("the weakest point's campaign alone, its failures grouped with the "
+                     f"commands that replay them: {setting.point(weakest)}")
+    return "\n".join(lines) + "\n"
 
