@@ -3,8 +3,7 @@ Playwright): `rl1c studio` on Listing 1 and the scene of Fig. 4 (a copy of examp
 against issue 28's goals.
 
 - keystroke to diagnostic: a key that makes line 3's `(MOV 3,3)` a mistyped call, to the
-  error's underline in the editor (and the key that mends it, to the underline gone);
-  median of N, goal 100 ms.
+  error's underline in the editor; median of N, goal 100 ms.
 - run to the first frame: the Run button, to the run's first frame drawn (goal 100 ms),
   and to the vehicle drawn away from its start (which Listing 1's camera moves delay by
   401 ms of device time, at real time); median of N.
@@ -99,7 +98,9 @@ def start_studio(folder: Path) -> tuple[subprocess.Popen[str], str]:
 
 
 def keystrokes(page: Page, runs: int) -> list[float]:
-    """Key to underline: `V` of `(MOV 3,3)` replaced by `B`, then back."""
+    """Key to underline: an `X` typed after `MOV` in line 3's `(MOV 3,3)`, from a clean
+    state each time (the key that takes it away, and its diagnostics, in between)."""
+    clean = page.get_attribute("#editor", "data-diagnostics")  # the warnings, published
     line = page.locator("#editor .cm-line").nth(2)
     line.click()
     page.keyboard.press("End")
@@ -108,10 +109,12 @@ def keystrokes(page: Page, runs: int) -> list[float]:
     errors = "document.querySelectorAll('#editor .cm-lintRange-error').length"
     times = []
     for _ in range(runs):
+        times += watch(page, [f"{errors} > 0"], lambda: page.keyboard.type("X"))
         page.keyboard.press("Backspace")
-        times += watch(page, [f"{errors} > 0"], lambda: page.keyboard.type("B"))
-        page.keyboard.press("Backspace")
-        watch(page, [f"{errors} === 0"], lambda: page.keyboard.type("V"))
+        page.wait_for_selector(f"#editor[data-diagnostics='{clean}']", state="attached",
+                               timeout=WAIT)
+        page.locator("#editor .cm-lintRange-error").first.wait_for(state="detached",
+                                                                    timeout=WAIT)
     return times
 
 
