@@ -5,12 +5,16 @@ is refused with its key path and line."""
 
 from __future__ import annotations
 
+import json
 import math
+import re
+from pathlib import Path
 from statistics import NormalDist, fmean, pvariance
 
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from support.cli import rl1c
 
 from rl1.vm.sim.vary import Normal, Uniform, uniform_draw
 from rl1.vm.sim.world import World, WorldError, decode_world
@@ -257,3 +261,36 @@ def test_of_two_stands_of_one_name_the_last_is_drawn_and_both_are_kept() -> None
     assert [(stand.x, stand.y) for stand in varied.stands] == [(400.0, 330.0), (805.0, 100.0)]
     assert varied.goal is not None
     assert varied.goal.holds[0].marker == varied.stands[1].marker()
+
+
+# The command line -----------------------------------------------------------------------
+
+WAIT = "(TIM 1); (END)\n"
+
+
+def test_a_campaign_s_line_records_the_values_its_seed_s_run_draws(tmp_path: Path) -> None:
+    program, world_file, out = tmp_path / "w.rob", tmp_path / "w.toml", tmp_path / "r.jsonl"
+    program.write_text(WAIT)
+    world_file.write_text(VARIED)
+    result = rl1c("sim", program, "--world", world_file, "--runs", "3", "--seed", "5",
+                  "--jobs", "1", "--out", out)
+    assert result.exit_code == 0, result.output
+    lines = [json.loads(line) for line in out.read_text().splitlines()]
+    assert [line["varied"] for line in lines] == [world().drawn(seed)[1]
+                                                 for seed in (5, 6, 7)]
+    # The replay command's run draws the same world, and says so.
+    single = rl1c("sim", program, "--world", world_file, "--seed", "6", "--format", "json")
+    said = dict(re.findall(r"(\S+) = (\S+?)(?:,|$)", single.stderr.split("seed 6: ", 1)[1]))
+    assert {key: float(value) for key, value in said.items()} == pytest.approx(
+        lines[1]["varied"], rel=1e-5)
+    assert json.loads(single.stdout)["track"][0][1:3] == pytest.approx(
+        [lines[1]["varied"]["start.x"], 200.0], abs=0.01)
+
+
+def test_a_run_without_a_seed_is_the_world_as_written(tmp_path: Path) -> None:
+    program, world_file = tmp_path / "w.rob", tmp_path / "w.toml"
+    program.write_text(WAIT)
+    world_file.write_text(VARIED)
+    result = rl1c("sim", program, "--world", world_file, "--format", "json")
+    assert "note" not in result.stderr
+    assert json.loads(result.stdout)["track"][0][1:3] == [100.0, 200.0]
