@@ -14,6 +14,7 @@ from typing import cast
 
 import pytest
 from support.cli import rl1c
+from support.hold import HOLD_WORLD
 
 from rl1.compiler.campaign import Task, run_one, thinned
 from rl1.vm.sim.campaign_render import MAX_MARKS, MAX_PATHS, Overlay, Run
@@ -23,25 +24,11 @@ from rl1.vm.sim.render import MARGIN, TOP
 # A stand drawn 0 to 45 cm back from 40 cm ahead of the camera: the goal holds within
 # 60 cm, so some runs miss it (goal-missed); and a fence just right of the vehicle
 # stops those whose start is drawn near it as the vehicle turns (a collision).
-WORLD = """\
-[floor]
-size = [1000, 1000]
-[start]
-x = 200.0
-y = 500.0
-[[stands]]
-name = "bench"
-x = 290.0
-y = 500.0
-facing = 180.0
+WORLD = HOLD_WORLD.replace("[goal]", """\
 [[obstacles]]
 name = "fence"
 points = [[100, 445], [400, 445], [400, 450], [100, 450]]
-[goal]
-[[goal.hold]]
-stand = "bench"
-within = 60
-seconds = 0.5
+[goal]""") + """\
 [vary]
 stands.bench.x = { uniform = [0, 45] }
 start.y = { uniform = [-40, 0] }

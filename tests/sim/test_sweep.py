@@ -12,33 +12,11 @@ from pathlib import Path
 
 import pytest
 from support.cli import rl1c
+from support.hold import CAMERA_TO_MARKER, HOLD_WORLD, WAIT, WITHIN
 
 from rl1.compiler.campaign import Task, run_one
 from rl1.compiler.sweep import Axis, check, grid, parse_axis
 from rl1.vm.sim.world import decode_world
-
-# The vehicle's camera is 30 cm ahead of its centre, at x = 230; the stand's marker is in
-# the middle of its face, 20 cm before its centre: at x = 270, 40 cm from the camera.
-HOLD_WORLD = """\
-[floor]
-size = [1000, 1000]
-[start]
-x = 200.0
-y = 500.0
-[[stands]]
-name = "bench"
-x = 290.0
-y = 500.0
-facing = 180.0
-[goal]
-[[goal.hold]]
-stand = "bench"
-within = 60
-seconds = 0.5
-"""
-CAMERA_TO_MARKER = 40.0
-WITHIN = 60.0
-WAIT = "(TIM 1); (END)\n"
 
 
 @pytest.fixture

@@ -15,6 +15,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from support.cli import rl1c
+from support.hold import WAIT
 
 from rl1.vm.sim.vary import Normal, Uniform, uniform_draw
 from rl1.vm.sim.world import World, WorldError, decode_world
@@ -264,9 +265,6 @@ def test_of_two_stands_of_one_name_the_last_is_drawn_and_both_are_kept() -> None
 
 
 # The command line -----------------------------------------------------------------------
-
-WAIT = "(TIM 1); (END)\n"
-
 
 def test_a_campaign_s_line_records_the_values_its_seed_s_run_draws(tmp_path: Path) -> None:
     program, world_file, out = tmp_path / "w.rob", tmp_path / "w.toml", tmp_path / "r.jsonl"
