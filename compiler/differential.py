@@ -20,6 +20,7 @@ import signal
 import subprocess
 import tempfile
 import time
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal, Protocol
@@ -28,6 +29,7 @@ from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
 from rl1.compiler.interpreter import interpret
 from rl1.compiler.strategies import Run
+from rl1.vm import isa
 from rl1.vm.drive import drive
 from rl1.vm.faults import FaultKind
 from rl1.vm.hardware import Blocking
@@ -54,6 +56,7 @@ class Observation:
     document: dict[str, Any]  # as scripted.run_document gives it
     executed: int | None = None
     call_counts: tuple[int, ...] | None = None
+    opcodes: dict[str, int] | None = None  # the instructions executed by opcode, if counted
 
     @property
     def crashed(self) -> bool:
@@ -118,9 +121,11 @@ class AstEngine:
 
 @dataclass(frozen=True)
 class VmEngine:
-    """The compiler at one level, then the reference VM."""
+    """The compiler at one level, then the reference VM; `counting` the instructions
+    executed by opcode too (`rl1c fuzz --format json`), which costs a little."""
 
     level: int
+    counting: bool = field(default=False, compare=False)
     name: str = field(init=False)
 
     def __post_init__(self) -> None:
@@ -130,11 +135,26 @@ class VmEngine:
         device = ScriptedDevice(parse_script(case.script))
         # As `rl1c run` does (compiler/runner.py): the device told each call's line, the
         # run stepped by `drive`, which makes the script's losses after instruction counts.
-        machine = Machine(verify(compiled(case.source, self.level)),
-                          Blocking(device, lambda: machine.current_line()), budget)
+        machine = (_CountingMachine if self.counting else Machine)(
+            verify(compiled(case.source, self.level)),
+            Blocking(device, lambda: machine.current_line()), budget)
         result = drive(machine, device)
         return Observation(run_document(result, device.trace), machine.executed,
-                           tuple(machine.call_counts))
+                           tuple(machine.call_counts),
+                           dict(machine.opcodes) if isinstance(machine, _CountingMachine)
+                           else None)
+
+
+class _CountingMachine(Machine):
+    """The reference VM, counting the instructions it executes by opcode."""
+
+    def __init__(self, *args: Any) -> None:
+        super().__init__(*args)
+        self.opcodes: Counter[str] = Counter()
+
+    def _execute(self, instruction: isa.Instruction) -> None:
+        self.opcodes[instruction.info.name] += 1
+        super()._execute(instruction)
 
 
 @dataclass(frozen=True)

@@ -22,9 +22,10 @@ import shlex
 import shutil
 import tempfile
 import time
+from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from random import Random
 from typing import Any, TypeVar
 
@@ -32,6 +33,9 @@ from hypothesis import HealthCheck, Phase, find, settings
 from hypothesis.errors import NoSuchExample
 
 from rl1.compiler.analysis import analyze
+from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS
+from rl1.compiler.backend.lower import lower
+from rl1.compiler.backend.optimize import optimize
 from rl1.compiler.differential import (
     AstEngine,
     CEngine,
@@ -48,8 +52,10 @@ from rl1.compiler.files import SourceError, read_bounded, write_atomically
 from rl1.compiler.frontend.source import read_source, split_lines
 from rl1.compiler.runner import MAX_SCRIPT_BYTES
 from rl1.compiler.strategies import Run, runs
+from rl1.vm import isa
 from rl1.vm.config import ConfigError, read_document
 from rl1.vm.faults import MAX_BUDGET
+from rl1.vm.language import LOST_LINE_RULES
 from rl1.vm.sensor_script import ScriptError, parse_script
 
 # Hypothesis' shrinking stops after trying so many runs, with the smallest so far (on a
@@ -97,17 +103,72 @@ class Search:
     deadline: float | None = None  # time.time() after which it generates no program
     channel: str | None = None  # the campaign's Channel folder, on this machine
     corpus: tuple[Run, ...] = ()  # runs judged as they are, before any generated
+    statistics: bool = False  # whether to gather what the programs did
+
+
+@dataclass
+class Statistics:
+    """What a campaign's programs did, as `rl1c fuzz --format json` gives it
+    (spec/optimization.md, section 5): how the reference's runs ended, by status code;
+    the lost lines that sent them to a handler; the instructions each VM engine executed,
+    by opcode; and the programs in which each optimizer pass changed the IR at -O2."""
+
+    endings: Counter[str] = field(default_factory=Counter)
+    handler_jumps: int = 0
+    opcodes: dict[str, Counter[str]] = field(default_factory=dict)
+    passes: Counter[str] = field(default_factory=Counter)
+
+    def add(self, case: Run, verdict: Verdict) -> None:
+        observations = verdict.observations
+        reference = next(iter(observations.values()))  # the first engine that ran it
+        match reference.ending():
+            case {"code": str(code)}:
+                self.endings[code] += 1
+        self.handler_jumps += sum(
+            1 for entry in reference.commands()
+            if entry.get("call") == LOST and entry.get("args", [None])[0] in JUMPING_MODES)
+        for name, observation in observations.items():
+            if observation.opcodes is not None:
+                self.opcodes.setdefault(name, Counter()).update(observation.opcodes)
+        fired: set[str] = set()
+        optimize(lower(analyze(case.source).program), max(OPTIMIZATION_LEVELS),
+                 fired=fired.add)
+        self.passes.update(fired)
+
+    def merge(self, other: Statistics) -> None:
+        self.endings.update(other.endings)
+        self.handler_jumps += other.handler_jumps
+        for name, opcodes in other.opcodes.items():
+            self.opcodes.setdefault(name, Counter()).update(opcodes)
+        self.passes.update(other.passes)
+
+    def to_json(self) -> dict[str, Any]:
+        return {"endings": dict(sorted(self.endings.items())),
+                "handler_jumps": self.handler_jumps,
+                "opcodes": {name: dict(sorted(opcodes.items()))
+                            for name, opcodes in self.opcodes.items()},
+                "superinstructions": {
+                    name: {opcode: count for opcode, count in sorted(opcodes.items())
+                           if isa.BY_NAME[opcode].minor == isa.FUSED_MINOR}
+                    for name, opcodes in self.opcodes.items()},
+                "passes": dict(sorted(self.passes.items()))}
+
+
+LOST = "LINE LOST"  # a trace entry's call when the device lost the guidance line
+JUMPING_MODES = frozenset(rule.mode for rule in LOST_LINE_RULES)  # Table 4: 2 and 3
 
 
 @dataclass
 class Searched:
     """What a search found: its programs, how many of them showed each signature, and
-    the smallest run of each signature (of the first only, without `keep_going`)."""
+    the smallest run of each signature (of the first only, without `keep_going`); what
+    its programs did, when asked."""
 
     index: int
     programs: int = 0
     counts: dict[str, int] = field(default_factory=dict)
     findings: dict[str, Finding] = field(default_factory=dict)
+    statistics: Statistics | None = None
 
 
 @dataclass(frozen=True)
@@ -118,6 +179,7 @@ class Outcome:
     counts: dict[str, int] = field(default_factory=dict)  # programs of each signature
     findings: dict[str, Finding] = field(default_factory=dict)  # each signature's first
     stopped: bool = False  # halted (a signal) before its end
+    statistics: Statistics | None = None  # what the programs did, when asked
 
 
 class _Enough(BaseException):
@@ -191,7 +253,7 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
     keeping its signature). `progress(programs)` after each program. It ends early,
     with what it found, when halted, past its deadline, or on KeyboardInterrupt (Ctrl-C
     reaches a terminal's every process)."""
-    searched = Searched(task.index)
+    searched = Searched(task.index, statistics=Statistics() if task.statistics else None)
     channel = Channel(task.channel) if task.channel is not None else None
     told = time.monotonic()
     target: str | None = None  # the signature being shrunk
@@ -218,6 +280,8 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
         else:
             shrinks += 1
         verdict = judge(case, task.engines, task.budget)
+        if target is None and searched.statistics is not None:
+            searched.statistics.add(case, verdict)
         if not verdict.problems:
             return False
         found = signature(verdict)
@@ -334,7 +398,8 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
              seconds: float | None, seed: int, progress: Callable[[int, float], None],
              executor: Executor | None = None, jobs: int = 1, keep_going: bool = False,
              found: Callable[[Finding], None] | None = None,
-             channel: Channel | None = None, corpus: Sequence[Run] = ()) -> Outcome:
+             channel: Channel | None = None, corpus: Sequence[Run] = (),
+             statistics: bool = False) -> Outcome:
     """Run the `corpus`, then generated programs, on `engines` until `count` generated
     programs or `seconds` have passed, or until they disagree (with `keep_going`, until
     then whatever they find);
@@ -343,9 +408,13 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
     `executor`; a disagreement stops the searches after the one that found it, and is
     the one of the first search in order that finds one: the finding of one process.
     `channel.halt()` (from a signal handler) stops every search, keeping their counts
-    and findings."""
+    and findings. With `statistics`, the
+    Outcome says what the programs did."""
     start = time.monotonic()
     deadline = None if seconds is None else time.time() + seconds
+    if statistics:
+        engines = [replace(engine, counting=True) if isinstance(engine, VmEngine) else engine
+                   for engine in engines]
     own_channel = channel is None
     channel = Channel() if channel is None else channel
     results: dict[int, Searched] = {}
@@ -366,7 +435,7 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
         index += 1
         search_seed, size, runs_given = drawn
         return Search(index - 1, search_seed, size, tuple(engines), budget, keep_going,
-                      deadline, channel.folder, runs_given)
+                      deadline, channel.folder, runs_given, statistics)
 
     def keep(searched: Searched) -> None:
         nonlocal stop_at
@@ -402,14 +471,17 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
             channel.close()
     counts: dict[str, int] = {}
     findings: dict[str, Finding] = {}
+    gathered = Statistics() if statistics else None
     for searched in sorted(results.values(), key=lambda searched: searched.index):
+        if gathered is not None and searched.statistics is not None:
+            gathered.merge(searched.statistics)
         for name, number in searched.counts.items():
             counts[name] = counts.get(name, 0) + number
         for name, finding in searched.findings.items():
             findings.setdefault(name, finding)
     first = next(iter(findings.values()), None)
     return Outcome(done(), time.monotonic() - start, first, counts, findings,
-                   channel.everything)
+                   channel.everything, gathered)
 
 
 POLL = 0.5  # seconds between looks at the searches under way, for progress

@@ -38,29 +38,35 @@ class OptimizerError(Exception):
     """A pass broke an invariant of the IR: a bug in the compiler."""
 
 
-def optimize(program: ir.Program, level: int, *, check: bool = False) -> ir.Program:
+def optimize(program: ir.Program, level: int, *, check: bool = False,
+             fired: Callable[[str], None] | None = None) -> ir.Program:
     """The program optimized at `level` (a key of LEVELS). With `check`, `ir.validate`
     runs after every pass (the tests and `rl1c fuzz` ask for it); otherwise once at the
-    end, so that a compilation costs little more than at -O0."""
+    end, so that a compilation costs little more than at -O0. `fired(name)` after each
+    pass that changed the program (`rl1c fuzz --format json` counts them)."""
     passes = LEVELS[level]
     if not passes:
         return program
     shape = _shape(program)
     for _ in range(MAX_ROUNDS):
-        program = _run(passes, program, check)
+        program = _run(passes, program, check, fired)
         before, shape = shape, _shape(program)
         if shape == before:
             break
-    program = _run(FINAL_PASSES[level], program, check)
+    program = _run(FINAL_PASSES[level], program, check, fired)
     _validate(program, "the optimizer")
     return program
 
 
-def _run(passes: tuple[Pass, ...], program: ir.Program, check: bool) -> ir.Program:
+def _run(passes: tuple[Pass, ...], program: ir.Program, check: bool,
+         fired: Callable[[str], None] | None) -> ir.Program:
     for run in passes:
+        before = _shape(program) if fired is not None else None  # passes may edit in place
         program = run(program)
         if check:
             _validate(program, run.__name__)
+        if fired is not None and _shape(program) != before:
+            fired(run.__name__)
     return program
 
 

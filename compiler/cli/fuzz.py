@@ -7,23 +7,34 @@ when it runs: they load Hypothesis.
 
 from __future__ import annotations
 
+import json
 import os
 import random
 import signal
 import sys
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import BrokenExecutor
 from contextlib import contextmanager
+from functools import partial
 from types import FrameType
-from typing import TYPE_CHECKING, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 import click
 
 from rl1.compiler.reporting.render import EXIT_ERRORS
 
-from .command import EXIT_INTERNAL, PATH, Command, Failure, a_budget, at_least_one
+from .command import (
+    EXIT_INTERNAL,
+    PATH,
+    Command,
+    Failure,
+    a_budget,
+    at_least_one,
+    choice_option,
+)
 
 if TYPE_CHECKING:
+    from rl1.compiler.differential import Engine
     from rl1.compiler.fuzz import Channel, Outcome, Reproducer
 
 SECTION = "Testing"
@@ -74,13 +85,18 @@ PROGRESS_EVERY = 10.0  # seconds between progress lines elsewhere
                    "the difference and the first differing call, spec/optimization.md) "
                    "gets a reproducer of its own, and the summary counts the programs "
                    "of each")
+@choice_option("--format", "fuzz_format", choices=("text", "json"), default="text",
+               help="text: the summary for people; json: the summary on standard error, "
+                    "and on standard output one object with what the programs did "
+                    "(endings, handler jumps, opcodes executed, optimizer passes that "
+                    "fired, findings; spec/optimization.md, section 5)")
 @click.option("--replay", "replay_dir", default=None, metavar="DIR", type=PATH,
               help="judge a reproducer again (a finding-N folder, as its replay.sh does) "
                    "with its engines and budget: exit status 1 while they disagree")
 def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
          seed: str | None, out_dir: str, budget: int, jobs: int | None,
          scheduler: str | None, corpus_paths: tuple[str, ...], keep_going: bool,
-         replay_dir: str | None) -> int:
+         fuzz_format: str, replay_dir: str | None) -> int:
     """Run generated programs on several engines and compare what they do.
 
     Every program (with a sensor script to match) runs on each engine; the runs must
@@ -96,7 +112,6 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         from rl1.compiler.differential import (
             DEFAULT_ENGINES,
             ENGINE_NAMES,
-            Engine,
             EngineUnavailable,
             engine_named,
         )
@@ -176,7 +191,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
                                seed=seed_value, progress=bar.update, executor=held.executor,
                                jobs=max(held.slots, 1), keep_going=keep_going,
                                found=write if keep_going else None, channel=channel,
-                               corpus=corpus)
+                               corpus=corpus, statistics=fuzz_format == "json")
     except (BuildError, EngineUnavailable, Unavailable) as error:  # such as no C compiler
         raise Failure(f"error: {error}") from None
     except BrokenExecutor:
@@ -194,29 +209,54 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     stopped = 128 + signalled[0] if signalled else 0
     if stopped:
         summary += ", stopped by a signal before its end"
+    say = partial(click.echo, err=fuzz_format == "json")  # JSON alone on standard output
+    unwritten: OSError | None = None
     if outcome.finding is None:
-        click.echo(f"{summary}: " + ("all agreed so far" if stopped else "all agreed"))
-        return stopped
-    if keep_going:
-        _report_groups(summary, outcome, written, engines[0].name, out_dir)
-        return stopped or EXIT_ERRORS
-    finding = outcome.finding
-    click.echo(f"{summary}: the engines disagree (reference: {engines[0].name})\n\n"
-               f"the smallest program found:\n{_numbered(finding.case.source)}\n\n"
-               + "\n".join(finding.verdict.problems))
-    try:
-        reproducer = write_reproducer(out_dir, finding, engines, budget)
-    except OSError as error:  # such as a full disk: the finding is printed above
+        say(f"{summary}: " + ("all agreed so far" if stopped else "all agreed"))
+    elif keep_going:
+        _report_groups(summary, outcome, written, engines[0].name, out_dir, say)
+    else:
+        finding = outcome.finding
+        say(f"{summary}: the engines disagree (reference: {engines[0].name})\n\n"
+            f"the smallest program found:\n{_numbered(finding.case.source)}\n\n"
+            + "\n".join(finding.verdict.problems))
+        write(finding)
+        match written[finding.signature]:
+            case OSError() as unwritten:
+                pass
+            case reproducer:
+                say(f"\nreproducer: {reproducer.folder} (program, sensor script, each "
+                    f"engine's run); replay: {reproducer.replay}")
+    if fuzz_format == "json":
+        click.echo(json.dumps(_statistics(outcome, seed_value, engines, budget, len(corpus),
+                                          written), indent=2))
+    if unwritten is not None:  # such as a full disk: the finding is printed above
         raise Failure(f"error: cannot write the reproducer under {out_dir} "
-                      f"({error.strerror or error}); the program is above, and the "
-                      "campaign runs again with the same --seed", EXIT_ERRORS) from None
-    click.echo(f"\nreproducer: {reproducer.folder} (program, sensor script, each engine's "
-               f"run); replay: {reproducer.replay}")
-    return stopped or EXIT_ERRORS
+                      f"({unwritten.strerror or unwritten}); the program is above, and the "
+                      "campaign runs again with the same --seed", EXIT_ERRORS)
+    return stopped or (EXIT_ERRORS if outcome.finding is not None else 0)
+
+
+def _statistics(outcome: Outcome, seed: int, engines: list[Engine], budget: int,
+                corpus: int, written: dict[str, Reproducer | OSError]) -> dict[str, Any]:
+    """`--format json`: the campaign as one object (spec/optimization.md, section 5)."""
+    from rl1.compiler.fuzz import Reproducer
+
+    assert outcome.statistics is not None
+    findings = [{"signature": name, "programs": programs,
+                 "reproducer": reproducer.folder if isinstance(
+                     reproducer := written.get(name), Reproducer) else None}
+                for name, programs in sorted(outcome.counts.items(),
+                                             key=lambda item: (-item[1], item[0]))]
+    return {"programs": outcome.programs, "corpus": corpus,
+            "seconds": round(outcome.seconds, 3), "seed": seed,
+            "engines": [engine.name for engine in engines], "budget": budget,
+            "stopped": outcome.stopped, **outcome.statistics.to_json(),
+            "findings": findings}
 
 
 def _report_groups(summary: str, outcome: Outcome, written: dict[str, Reproducer | OSError],
-                   reference: str, out_dir: str) -> None:
+                   reference: str, out_dir: str, say: Callable[[str], None]) -> None:
     """--keep-going's summary: each signature, the most frequent first, with the programs
     that showed it and its reproducer."""
     from rl1.compiler.fuzz import Reproducer
@@ -233,7 +273,7 @@ def _report_groups(summary: str, outcome: Outcome, written: dict[str, Reproducer
                 lines.append(f"         reproducer: not written under {out_dir} "
                              f"({error.strerror or error}); the campaign finds it again "
                              "with the same --seed")
-    click.echo("\n".join(lines))
+    say("\n".join(lines))
 
 
 @contextmanager

@@ -310,3 +310,70 @@ def test_a_campaign_in_ci_prints_progress_lines_on_standard_error(
     assert lines and all(re.fullmatch(r"fuzz: [0-9]+ of 12 programs, [0-9.]+ per second, "
                                       r"[0-9]+ s", line) for line in lines), lines
     assert "\r" not in result.stderr
+
+
+# --format json --------------------------------------------------------------------------
+
+
+def _documented_keys() -> list[str]:
+    """The keys of `--format json` as spec/optimization.md's table lists them."""
+    spec = (ROOT / "spec" / "optimization.md").read_text(encoding="utf-8")
+    table = spec.split("`--format json` prints", 1)[1].split("\n\n", 2)[1]
+    return re.findall(r"^\| `([a-z_]+)` \|", table, re.MULTILINE)
+
+
+def _statistics(*args: str) -> dict[str, object]:
+    result = rl1c("fuzz", "--format", "json", "--seed", "3", *args)
+    assert result.exit_code in (0, 1), result.output
+    assert result.stderr.startswith("fuzz: ")  # the summary for people, apart
+    document = json.loads(result.stdout)
+    assert isinstance(document, dict)
+    return document
+
+
+def test_json_statistics_have_the_keys_the_spec_lists_and_add_up() -> None:
+    document = _statistics("--count", "30", "--jobs", "2")
+    assert list(document) == _documented_keys()
+    assert document["programs"] == 30 and document["corpus"] == 0 and not document["stopped"]
+    assert document["engines"] == ["ast", "vm-O0", "vm-O1", "vm-O2"]
+    endings = document["endings"]
+    assert isinstance(endings, dict) and sum(endings.values()) == 30
+    opcodes, fused = document["opcodes"], document["superinstructions"]
+    assert isinstance(opcodes, dict) and isinstance(fused, dict)
+    assert list(opcodes) == list(fused) == ["vm-O0", "vm-O1", "vm-O2"]
+    # Each program ends once, on (END) or a fault: -O0 ran one END per normal ending.
+    assert opcodes["vm-O0"].get("END", 0) == endings.get("ok", 0)
+    assert fused["vm-O0"] == fused["vm-O1"] == {} and fused["vm-O2"]
+    assert all(opcodes["vm-O2"][name] == count for name, count in fused["vm-O2"].items())
+    passes = document["passes"]
+    assert isinstance(passes, dict) and "fuse" in passes
+    assert all(0 < count <= 30 for count in passes.values())
+    assert document["findings"] == []
+
+
+def test_json_statistics_are_the_same_for_any_number_of_processes() -> None:
+    one, two = (_statistics("--count", "24", "--jobs", jobs) for jobs in ("1", "2"))
+    assert {**one, "seconds": 0} == {**two, "seconds": 0}
+
+
+def test_json_statistics_list_each_finding_with_its_folder(tmp_path: Path) -> None:
+    document = _statistics("--engine", "ast", "--engine", "exec:echo not json", "--count",
+                           "3", "--keep-going", "--out", str(tmp_path), "--jobs", "1")
+    findings = document["findings"]
+    assert isinstance(findings, list) and findings
+    assert sum(finding["programs"] for finding in findings) == 3
+    assert sorted(finding["reproducer"] for finding in findings) == sorted(
+        str(tmp_path / name) for name in os.listdir(tmp_path))
+
+
+def test_statistics_count_a_lost_line_that_jumps_to_its_handler() -> None:
+    # Tracing mode 3 loses the line during MOV 250 ms in: Table 4 sends it to :96.
+    lost = Run("(TRC 3); (MOV 10,10); (TIM 50); (END)\n:96 (HLD); (END)\n",
+               {"line_lost": [{"during": "MOV", "nth": 1, "after": 250}]})
+    kept = Run(lost.source, {})
+    statistics = fuzz.Statistics()
+    for case in (lost, kept):
+        statistics.add(case, fuzz.judge(case, [VmEngine(0, counting=True)], 20_000))
+    assert statistics.handler_jumps == 1
+    assert statistics.endings == {"ok": 2}
+    assert statistics.opcodes["vm-O0"]["HLD"] == 1  # the handler's, run once
