@@ -127,11 +127,12 @@ const syncAtOnce = ViewPlugin.fromClass(class {
 });
 
 /** A client with every feature the studio offers: completion, hover, signature help,
- * formatting, rename, go to definition, references, and diagnostics with quick fixes. */
-export function studioClient(onPublished: (count: number) => void,
+ * formatting, rename, go to definition, references, and diagnostics with quick fixes;
+ * `rootUri` is the served folder's. */
+export function studioClient(rootUri: string, onPublished: (count: number) => void,
                              onMessage: (message: string) => void): LSPClient {
   return new LSPClient({
-    rootUri: undefined,
+    rootUri,
     timeout: 10_000,
     notificationHandlers: {
       "window/showMessage": (_client, params: lsp.ShowMessageParams) => {

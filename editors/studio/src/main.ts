@@ -8,7 +8,7 @@ import { EditorState } from "@codemirror/state";
 import { EditorView, drawSelection, highlightActiveLine, keymap, lineNumbers } from "@codemirror/view";
 import { defaultKeymap, history, historyKeymap, indentWithTab } from "@codemirror/commands";
 import { bracketMatching, syntaxHighlighting } from "@codemirror/language";
-import { lintGutter, setDiagnostics } from "@codemirror/lint";
+import { lintGutter } from "@codemirror/lint";
 import { autocompletion, closeBrackets } from "@codemirror/autocomplete";
 import { rl1Highlight, rl1Language } from "./language";
 import { openSocket, studioClient, webSocketTransport } from "./lsp";
@@ -17,6 +17,7 @@ import { showPalette } from "./palette";
 import { WorldView } from "./world";
 import { DebugPane } from "./debugPane";
 import { Sensors } from "./sensors";
+import { WorldFile } from "./worldFile";
 import {
   Binding, Builtin, CheckDiagnostic, Ended, FileEntry, FileText, Frame, Hello, INVALID_CONFIGURATION,
   Launched, PROGRAM_HAS_ERRORS, Progress, Stopped, StudioConnection, StudioError, WorldCheck,
@@ -61,13 +62,14 @@ async function start(): Promise<void> {
     studio.request<{ files: FileEntry[] }>("files/list"), studio.request<{ builtins: Builtin[] }>("palette")]);
   const paths = (kind: FileEntry["kind"]) => files.filter((file) => file.kind === kind).map((file) => file.path);
   const programPath = chosen.get("program") ?? hello.program ?? paths("program")[0] ?? "program.rob";
-  let worldPath: string | null = chosen.has("world") ? chosen.get("world") || null : hello.world;
+  const worldPath = chosen.has("world") ? chosen.get("world") || null : hello.world;
   const program = files.some((file) => file.path === programPath)
     ? await studio.request<FileText>("files/read", { path: programPath })
     : { path: programPath, text: "", encoding: "utf-8" as const };
 
   // Without the language server the page still edits, saves and runs the program.
   const client = studioClient(
+    hello.rootUri,
     (count) => { byId("editor").dataset.diagnostics = String(count); },
     (message) => say(message, true));
   const lspLost = "the language server's connection closed: reload the page";
@@ -152,68 +154,24 @@ async function start(): Promise<void> {
   });
   showPalette(byId("palette"), builtins, editor);
 
-  // The world, and its file: checked as it is edited, drawn while it is valid.
+  // The world, and its file.
   const world = new WorldView(byId("world") as unknown as SVGSVGElement, byId("world-clock"));
+  const worldFile = new WorldFile(studio, world, byId("world-editor"), byId("world-errors"), byId("world-file"),
+                                  (error) => say(error.message, true));
+  const openWorld = async (path: string | null): Promise<void> => {
+    byId("world-pane").classList.toggle("no-world", path === null);
+    await worldFile.open(path);
+  };
   const worldSelect = byId<HTMLSelectElement>("world-name");
   fillSelect(worldSelect, paths("world"), worldPath, "no world (the scripted device)");
-  const worldErrors = byId("world-errors");
-  const worldEditor = new EditorView({
-    parent: byId("world-editor"),
-    state: EditorState.create({
-      extensions: [lineNumbers(), history(), drawSelection(), lintGutter(),
-                   keymap.of([...defaultKeymap, ...historyKeymap]),
-                   EditorView.updateListener.of((update) => { if (update.docChanged) scheduleWorldCheck(); })],
-    }),
-  });
-  const showWorldErrors = (check: WorldCheck): void => {
-    worldErrors.replaceChildren(...check.errors.map((error) => {
-      const item = document.createElement("li");
-      item.textContent = error.message;
-      return item;
-    }));
-    const doc = worldEditor.state.doc;
-    worldEditor.dispatch(setDiagnostics(worldEditor.state, check.errors.map((error) => {
-      const line = doc.line(Math.min(Math.max(error.line ?? 1, 1), doc.lines));
-      return { from: line.from, to: line.to, severity: "error", message: error.message };
-    })));
-    if (check.errors.length) byId("world-file").setAttribute("open", "");
-  };
-  let worldCheck = 0;
-  const checkWorld = async (): Promise<void> => {
-    if (worldPath === null) return;
-    const asked = ++worldCheck;
-    const check = await studio.request<WorldCheck>("world/check", { text: worldEditor.state.doc.toString(), path: worldPath });
-    if (asked !== worldCheck) return;  // edited since
-    showWorldErrors(check);
-    if (check.geometry) world.show(check.geometry);
-  };
-  let worldTimer = -1;
-  const scheduleWorldCheck = (): void => {
-    clearTimeout(worldTimer);
-    worldTimer = window.setTimeout(() => checkWorld().catch((error: Error) => say(error.message, true)), 250);
-  };
-  const openWorld = async (path: string | null): Promise<void> => {
-    worldPath = path;
-    byId("world-pane").classList.toggle("no-world", path === null);
-    const text = path === null ? "" : (await studio.request<FileText>("files/read", { path })).text;
-    worldEditor.dispatch({ changes: { from: 0, to: worldEditor.state.doc.length, insert: text } });
-    clearTimeout(worldTimer);
-    await checkWorld();
-  };
   await openWorld(worldPath);
   worldSelect.addEventListener("change", () => {
     chosen.set("world", worldSelect.value);
     window.history.replaceState(null, "", `#${chosen.toString()}`);
     openWorld(worldSelect.value || null).catch((error: Error) => say(error.message, true));
   });
-  byId("world-save").addEventListener("click", async () => {
-    if (worldPath === null) return;
-    try {
-      await studio.request("files/save", { path: worldPath, text: worldEditor.state.doc.toString() });
-      say(`saved ${worldPath}`);
-    } catch (error) {
-      say((error as Error).message, true);
-    }
+  byId("world-save").addEventListener("click", () => {
+    worldFile.save().then(() => say(`saved ${worldFile.path}`), (error: Error) => say(error.message, true));
   });
 
   // The debugger.
@@ -274,7 +232,7 @@ async function start(): Promise<void> {
     showCurrentLine(editor, null, false);
     const launched = await studio.request<Launched>("run/launch", {
       program: { text: editor.state.doc.toString(), name: programPath },
-      ...(worldPath === null ? {} : { world: { text: worldEditor.state.doc.toString(), name: worldPath } }),
+      ...(worldFile.path === null ? {} : { world: { text: worldFile.text, name: worldFile.path } }),
       speed: speed(),
       stopOnEntry,
     });
@@ -306,7 +264,7 @@ async function start(): Promise<void> {
       say(first ? `the program cannot run: line ${first.line}: ${first.message} [${first.code}]` : error.message, true);
     } else if (error instanceof StudioError && error.code === INVALID_CONFIGURATION) {
       const { errors } = error.data as WorldCheck;
-      showWorldErrors({ errors, geometry: null });
+      worldFile.showErrors(errors);
       say(`the world cannot be used: ${errors[0]?.message ?? error.message}`, true);
     } else {
       say(error.message, true);
