@@ -48,6 +48,7 @@ MODULES: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("testing", ("test",)),
     ("new", ("new",)),
     ("fuzz", ("fuzz",)),
+    ("reduce", ("reduce",)),
     ("docs", ("docs",)),
 )
 COMMAND_NAMES = tuple(name for _, names in MODULES for name in names)

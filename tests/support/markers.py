@@ -28,6 +28,8 @@ MARKS: dict[str, tuple[str, ...]] = {
     # in subprocesses, compilations under many hash seeds, searches through generated
     # programs for each form of the syntax.
     "tests/cli/test_fuzz_cli.py": ("slow",),
+    "tests/cli/test_reduce.py::test_a_fuzz_finding_of_a_planted_bug_is_reduced_with_its_engines":
+        ("slow",),
     "tests/frontend/test_strategies.py": ("slow",),
     # A language server process of its own for each test (its command line, its raw
     # protocol over standard input and output).

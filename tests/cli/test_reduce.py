@@ -1,0 +1,294 @@
+"""Reducing a case (compiler/reduce.py) and `rl1c reduce`: every pass keeps the case
+interesting, the result is the same from run to run and never larger, the original is
+never touched, and hostile commands and files end with a message and a status."""
+
+from __future__ import annotations
+
+import json
+import shlex
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from support import ROOT, SAMPLE, SAMPLE_SENSORS
+from support.cli import rl1c
+
+from rl1.compiler.analysis import analyze
+from rl1.compiler.differential import Engine, Observation, VmEngine, judge
+from rl1.compiler.reduce import Case, NotInteresting, reduce, smaller_numbers
+from rl1.compiler.strategies import Run, checked_programs, sensor_scripts
+from rl1.vm import machine
+from rl1.vm.sensor_script import decode_script
+
+PYTHON = shlex.quote(sys.executable)
+BROKEN_VM = f"exec:{PYTHON} {shlex.quote(str(ROOT / 'tests/support/broken_vm.py'))} " \
+            "{ilc} {sensors} {budget}"
+
+
+def moves(case: Case) -> bool:
+    """A planted interestingness: the checker accepts a program with a (MOV ...)."""
+    return "(MOV" in case.source
+
+
+# The passes --------------------------------------------------------------------------
+
+
+def test_a_program_is_reduced_to_the_one_statement_that_matters() -> None:
+    reduction = reduce(Case(SAMPLE.read_text(encoding="utf-8")), moves)
+    # Deleting lines and statements leaves one (MOV 3,3), its operands made 0.
+    assert reduction.case == Case("(MOV 0,0)\n")
+    assert reduction.finished and reduction.tests < 100
+
+
+class _BrokenShift:
+    """The reference VM at -O0 with `1<-1` giving 1 (a negative count shifts left by
+    nothing): a planted bug."""
+
+    name = "broken-shift"
+    level = 0
+
+    def run(self, case: Run, budget: int) -> Observation:
+        right = machine._shift_left
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(machine, "_shift_left", lambda value, count: value if count < 0
+                          else right(value, count))
+            return VmEngine(0).run(case, budget)
+
+
+def disagrees(case: Case) -> bool:
+    """Interesting: the planted bug shows (vm-O0 and the broken VM disagree)."""
+    engines: list[Engine] = [VmEngine(0), _BrokenShift()]
+    return bool(judge(Run(case.source, json.loads(case.script or "{}")), engines,
+                      20_000).problems)
+
+
+def test_terms_operands_and_hex_constants_shrink_towards_zero() -> None:
+    # What `rl1c fuzz --seed 1` found against the broken VM of tests/support/broken_vm.py.
+    reduction = reduce(Case("B=$0+$1<$FFFF\n"), disagrees)
+    assert reduction.case.source == "B=1<-1\n"
+
+
+def test_the_sensor_script_keeps_only_what_matters_with_its_numbers_made_small() -> None:
+    script = SAMPLE_SENSORS.read_text(encoding="utf-8")
+
+    def sees_far(case: Case) -> bool:  # an IMG reading whose area is over 100
+        data = json.loads(case.script or "{}")
+        return any(reading["area"] > 100 for reading in data.get("IMG", []))
+
+    reduction = reduce(Case("(MOV 3,3)\n", script), sees_far)
+    data = json.loads(reduction.case.script or "")
+    assert list(data) == ["IMG"] and len(data["IMG"]) == 1
+    reading = data["IMG"][0]
+    # Halving stops at the first half that is not interesting: 101..200.
+    assert (reading["x"], reading["y"], reading["z"]) == (0, 0, 0)
+    assert 100 < reading["area"] <= 200
+    assert reduction.case.script == '{\n  "IMG": [' + json.dumps(reading) + "]\n}\n"
+
+
+def test_a_script_nothing_needs_becomes_empty() -> None:
+    reduction = reduce(Case("(MOV 3,3)\n", SAMPLE_SENSORS.read_text(encoding="utf-8")),
+                       moves)
+    assert reduction.case == Case("(MOV 0,0)\n", "{}\n")
+
+
+def test_the_layout_is_the_formatters_when_it_stays_interesting() -> None:
+    def spaced(case: Case) -> bool:
+        return "(MOV" in case.source and "=" in case.source
+
+    reduction = reduce(Case("A = 1 ;  (MOV  3 , 3) ' a comment\n"), spaced)
+    assert reduction.case.source == "A=0; (MOV 0,0)\n"
+
+
+def test_a_case_that_is_not_interesting_is_refused() -> None:
+    with pytest.raises(NotInteresting):
+        reduce(Case("(END)\n"), moves)
+
+
+def test_the_tests_are_capped_and_the_smallest_so_far_is_kept() -> None:
+    tested: list[Case] = []
+
+    def counted(case: Case) -> bool:
+        tested.append(case)
+        return moves(case)
+
+    reduction = reduce(Case(SAMPLE.read_text(encoding="utf-8")), counted, max_tests=5)
+    assert not reduction.finished and reduction.tests == len(tested) == 5
+    assert reduction.case == max((case for case in tested if moves(case)),
+                                 key=tested.index)
+
+
+def test_a_program_the_checker_accepts_stays_accepted() -> None:
+    tested: list[str] = []
+
+    def anything(case: Case) -> bool:
+        tested.append(case.source)
+        return True
+
+    reduce(Case(SAMPLE.read_text(encoding="utf-8")), anything)
+    assert tested and not any(analyze(source).has_errors for source in tested)
+
+
+@given(st.integers(-2**17, 2**17))
+def test_smaller_numbers_are_smaller(value: int) -> None:
+    for number in smaller_numbers(value):
+        assert (abs(number), number < 0) < (abs(value), value < 0)
+    assert smaller_numbers(0) == []
+
+
+@settings(max_examples=25, deadline=None)
+@given(checked_programs(max_blocks=3), sensor_scripts(), st.data())
+def test_the_result_is_interesting_no_larger_and_the_same_every_time(
+        source: str, script: dict[str, object], data: st.DataObject) -> None:
+    text = json.dumps(script)
+    needle = data.draw(st.sampled_from(sorted(set(source.replace(" ", "")) - {"\n"})))
+
+    def interesting(case: Case) -> bool:  # a character of the program, an IMG reading
+        return needle in case.source and '"IMG"' in (case.script or "")
+
+    first, second = (reduce(Case(source, text), interesting, max_tests=300)
+                     for _ in range(2))
+    assert first == second
+    assert interesting(first.case) and first.case.size <= Case(source, text).size
+    assert not analyze(first.case.source).has_errors
+    decode_script((first.case.script or "").encode(), "script.json")
+
+
+# rl1c reduce ---------------------------------------------------------------------------
+
+
+@pytest.fixture
+def sample(tmp_path: Path) -> tuple[Path, Path]:
+    program, script = tmp_path / "sample.rob", tmp_path / "sample.sensors.json"
+    program.write_bytes(SAMPLE.read_bytes())
+    script.write_bytes(SAMPLE_SENSORS.read_bytes())
+    return program, script
+
+
+GREP = "grep -q '(MOV' sample.rob && grep -q IMG sample.sensors.json"
+
+
+def test_rl1c_reduce_writes_the_result_beside_and_leaves_the_original(
+        sample: tuple[Path, Path]) -> None:
+    program, script = sample
+    result = rl1c("reduce", program, "--sensors", script, "--interesting", GREP)
+    assert result.exit_code == 0, result.output
+    assert program.read_bytes() == SAMPLE.read_bytes()
+    assert script.read_bytes() == SAMPLE_SENSORS.read_bytes()
+    reduced = program.with_name("sample.reduced.rob")
+    assert reduced.read_text(encoding="utf-8") == "(MOV 0,0)\n"
+    assert json.loads(program.with_name("sample.sensors.reduced.json").read_bytes()) == {
+        "IMG": [{"area": 0, "x": 0, "y": 0, "z": 0}]}
+    assert result.stdout.startswith(
+        f"reduced {program}: 43 lines, 754 bytes -> 1 line, 10 bytes\n"
+        f"sensor script {script}: 27 lines, 1360 bytes -> 3 lines, 51 bytes\n")
+    assert "rl1c reduce: lines: " in result.stderr  # progress, pass by pass
+
+
+def test_rl1c_reduce_gives_the_same_bytes_every_time(sample: tuple[Path, Path]) -> None:
+    program, script = sample
+    made = []
+    for name in ("first.rob", "second.rob"):
+        out = program.with_name(name)
+        result = rl1c("reduce", program, "--sensors", script, "--interesting", GREP,
+                      "--out", out, "--sensors-out", out.with_suffix(".json"))
+        assert result.exit_code == 0, result.output
+        made.append((out.read_bytes(), out.with_suffix(".json").read_bytes()))
+    assert made[0] == made[1]
+
+
+def test_out_may_name_the_original(sample: tuple[Path, Path]) -> None:
+    program, _ = sample
+    result = rl1c("reduce", program, "--interesting", "grep -q '(MOV' sample.rob",
+                  "--out", program)
+    assert result.exit_code == 0, result.output
+    assert program.read_bytes() == b"(MOV 0,0)\n"
+
+
+def test_a_command_that_fails_on_the_original_says_so(sample: tuple[Path, Path]) -> None:
+    program, script = sample
+    result = rl1c("reduce", program, "--sensors", script, "--interesting",
+                  "echo no such thing; exit 3")
+    assert result.exit_code == 1
+    assert result.stderr == (
+        "rl1c reduce: error: the original is not interesting: `echo no such thing; exit 3`"
+        " exited with status 3 and printed, at the end: no such thing; the command must "
+        "exit 0 on the original (it runs in a new temporary folder holding sample.rob and "
+        "sample.sensors.json)\n")
+    assert not program.with_name("sample.reduced.rob").exists()
+
+
+def test_a_command_that_hangs_is_stopped_at_the_timeout(sample: tuple[Path, Path]) -> None:
+    program, _ = sample
+    started = time.monotonic()
+    result = rl1c("reduce", program, "--interesting", "sleep 60 & sleep 60", "--timeout", "1")
+    assert time.monotonic() - started < 30
+    assert result.exit_code == 1
+    assert "`sleep 60 & sleep 60` ran longer than 1 s (--timeout)" in result.stderr
+
+
+def test_a_command_that_prints_megabytes_keeps_only_the_end(
+        sample: tuple[Path, Path]) -> None:
+    program, _ = sample
+    result = rl1c("reduce", program, "--interesting",
+                  "head -c 30000000 /dev/zero | tr '\\0' y; echo; echo the end; exit 1")
+    assert result.exit_code == 1
+    assert "printed, at the end: the end;" in result.stderr and len(result.stderr) < 1000
+
+
+@pytest.mark.parametrize("args", [
+    ("missing.rob", "--interesting", "true"),
+    (".", "--interesting", "true"),
+    (str(SAMPLE), "--sensors", "missing.json", "--interesting", "true"),
+])
+def test_an_unreadable_file_is_a_message_and_status_2(args: tuple[str, ...]) -> None:
+    result = rl1c("reduce", *args)
+    assert result.exit_code == 2
+    assert "error[E0100]: cannot read the " in result.stderr
+    assert "Traceback" not in result.output
+
+
+def test_a_script_that_is_not_text_is_refused(tmp_path: Path) -> None:
+    script = tmp_path / "s.json"
+    script.write_bytes(b"\xff\xfe{}")
+    result = rl1c("reduce", SAMPLE, "--sensors", script, "--interesting", "true")
+    assert result.exit_code == 2
+    assert "is not valid: it is not UTF-8 text (byte 0)" in result.stderr
+
+
+@pytest.mark.parametrize(("args", "said"), [
+    ((), "give --interesting CMD or --engine NAME"),
+    (("--interesting", "true", "--engine", "vm-O0"), "give --interesting CMD or --engine"),
+    (("--engine", "vm-O0"), "give at least two different engines"),
+    (("--engine", "vm-O0", "--engine", "vm-O9"), "unknown engine 'vm-O9'"),
+    (("--interesting", "true", "--max-tests", "0"), "expected a whole number of at least 1"),
+])
+def test_usage_problems(args: tuple[str, ...], said: str) -> None:
+    result = rl1c("reduce", SAMPLE, *args)
+    assert result.exit_code == 2 and said in result.stderr
+
+
+def test_engines_that_agree_leave_nothing_to_reduce() -> None:
+    result = rl1c("reduce", SAMPLE, "--sensors", SAMPLE_SENSORS, "--engine", "vm-O0",
+                  "--engine", "vm-O2")
+    assert result.exit_code == 1
+    assert f"the engines agree on {SAMPLE}: nothing to reduce" in result.stderr
+
+
+def test_a_fuzz_finding_of_a_planted_bug_is_reduced_with_its_engines(tmp_path: Path) -> None:
+    # What `rl1c fuzz --seed 1` against broken_vm.py wrote (its shrinker had made it).
+    program, script = tmp_path / "program.rob", tmp_path / "program.sensors.json"
+    program.write_text("B=$0+$1<$FFFF\n", encoding="utf-8")
+    script.write_text(json.dumps({
+        "IMG": [{"area": 1000, "x": 128, "y": 100, "z": 0}],
+        "KYO": [{"centre": 0, "right": 0, "left": 0}] * 2, "ULT A": [0], "ULT C": [0],
+        "CAM R": [0, 496, 205], "FZI": [{"s": 1200, "t": 713}],
+        "line_lost": [{"time": 258}], "after_last": "repeat"}, indent=2), encoding="utf-8")
+    result = rl1c("reduce", program, "--sensors", script, "--engine", "vm-O0", "--engine",
+                  BROKEN_VM)
+    assert result.exit_code == 0, result.output
+    assert program.with_name("program.reduced.rob").read_text(encoding="utf-8") == "B=1<-1\n"
+    assert program.with_name("program.sensors.reduced.json").read_text(
+        encoding="utf-8") == "{}\n"
