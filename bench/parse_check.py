@@ -2,7 +2,9 @@
 `compile()` of a Python program of as many simple lines, in the same run.
 
 Prints lines per second for both, their ratio (goal: at least 0.4), and how time grows
-from 10,000 to 100,000 lines (goal: 10x the lines in at most 11x the time).
+from 10,000 to 100,000 lines (goal: 10x the lines in at most 11x the time); for the
+check on the tree (`analyze`, which the compiler runs) and for `rl1c check`'s, which
+holds no tree (`diagnose`, checker/streaming.py).
 
     .venv/bin/python bench/parse_check.py [--lines 100000]
 """
@@ -11,10 +13,12 @@ from __future__ import annotations
 
 import argparse
 import random
+from collections.abc import Callable
+from functools import partial
 
 from timing import best_time
 
-from rl1.compiler.analysis import analyze
+from rl1.compiler.analysis import analyze, diagnose
 
 
 def rl1_program(lines: int, seed: int = 1997) -> str:
@@ -77,19 +81,26 @@ def main() -> None:
         raise SystemExit(f"generator broken: {len(rl1_text.splitlines())} lines, "
                          f"{len(errors)} errors, e.g. {errors[:1]}")
 
-    rl1_seconds = best_time(lambda: analyze(rl1_text), options.repeats)
-    python_seconds = best_time(lambda: compile(python_text, "<bench>", "exec"), options.repeats)
-    rl1_rate, python_rate = lines / rl1_seconds, lines / python_seconds
-    for name, seconds, rate in (("RL/I parse+check ", rl1_seconds, rl1_rate),
-                                ("CPython compile()", python_seconds, python_rate)):
-        print(f"{name}: {lines} lines in {seconds:.3f} s = {rate:,.0f} lines/s")
-    print(f"ratio RL/I / CPython: {rl1_rate / python_rate:.2f} (goal >= 0.40)")
+    if diagnose(rl1_text) != analysis.diagnostics:
+        raise SystemExit("rl1c check's path and the check on the tree disagree")
 
+    python_seconds = best_time(lambda: compile(python_text, "<bench>", "exec"), options.repeats)
+    python_rate = lines / python_seconds
+    print(f"CPython compile()     : {lines} lines in {python_seconds:.3f} s = "
+          f"{python_rate:,.0f} lines/s")
     small = lines // 10
     small_text = rl1_program(small)
-    small_seconds = best_time(lambda: analyze(small_text), options.repeats)
-    print(f"growth: {small} lines {small_seconds:.3f} s, {lines} lines {rl1_seconds:.3f} s, "
-          f"time x{rl1_seconds / small_seconds:.1f} for lines x10 (goal <= 11)")
+    checks: list[tuple[str, Callable[[str], object]]] = [
+        ("analyze (the tree)", analyze), ("diagnose (rl1c check)", diagnose)]
+    for name, check in checks:
+        rl1_seconds = best_time(partial(check, rl1_text), options.repeats)
+        rl1_rate = lines / rl1_seconds
+        print(f"RL/I {name:<21}: {lines} lines in {rl1_seconds:.3f} s = {rl1_rate:,.0f} "
+              f"lines/s, ratio to CPython {rl1_rate / python_rate:.2f} (goal >= 0.40)")
+        small_seconds = best_time(partial(check, small_text), options.repeats)
+        print(f"  growth: {small} lines {small_seconds:.3f} s, {lines} lines "
+              f"{rl1_seconds:.3f} s, time x{rl1_seconds / small_seconds:.1f} for lines x10 "
+              "(goal <= 11)")
 
 
 if __name__ == "__main__":

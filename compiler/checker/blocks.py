@@ -34,9 +34,9 @@ class Cut:
 
     # a list as cut here; streaming.py's cut keeps where they are in the source instead
     statements: Sequence[ast.Statement]
-    labels: list[ast.LabelDef]
+    labels: Sequence[ast.LabelDef]
     opaque: bool
-    parts: list[Part]  # the effects of its runs that do something (summarized segments only)
+    parts: Sequence[Part]  # the effects of its runs that do something (summarized segments only)
     # what the whole block does, once the incremental memo has combined its parts; a cut
     # reused by the next walk keeps it
     effects: BlockEffects | None = None

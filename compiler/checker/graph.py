@@ -54,7 +54,7 @@ class Block:
 
     index: int
     statements: Sequence[ast.Statement]  # read from the source again when not a list
-    labels: list[ast.LabelDef]  # the labels naming it
+    labels: Sequence[ast.LabelDef]  # the labels naming it
     opaque: bool  # stands for a line with a syntax error
     # tuples, not lists: a program of broken lines has a block a line, so the thousands
     # of blocks without edges share the empty tuple

@@ -130,17 +130,16 @@ def check_text(text: str) -> list[Diagnostic]:
                 pending.append(line.label)
             if not line.ok:
                 close()
-                cuts.append(Cut((), pending, True, []))
+                # a source of broken lines has a block a line: they share what is empty
+                cuts.append(Cut((), _taken(pending), True, ()))
                 summaries.append(nothing)
-                pending = []
                 continue
             segments: tuple[Segment, ...] = line_segments(line.statements)
             start = 0
             for run, summary, closes in segments:
                 if block is None:
-                    block = _OpenBlock(Cut((), pending, False, []), index, start)
+                    block = _OpenBlock(Cut((), _taken(pending), False, ()), index, start)
                     cuts.append(block.cut)
-                    pending = []
                 if summary is not None:
                     block.parts.append((block.length, summary))
                 block.length += len(run)
@@ -150,8 +149,16 @@ def check_text(text: str) -> list[Diagnostic]:
                     close()
             del line, segments  # the next line's tree replaces this one's
         close()
-        cuts.append(Cut((), pending, False, []))
-        end = ast.Span(1, 1, last_span.end_line, last_span.end_column)
-        found += check_graph(graph_of(cuts, summaries), end)
+        cuts.append(Cut((), _taken(pending), False, ()))
+        graph = graph_of(cuts, summaries)
+        del cuts  # the blocks hold what the rules need
+        found += check_graph(graph, ast.Span(1, 1, last_span.end_line, last_span.end_column))
     return suppressed(directives, found)
+
+
+def _taken(pending: list[ast.LabelDef]) -> tuple[ast.LabelDef, ...]:
+    """The labels waiting for a block, which it takes: none is left waiting."""
+    labels = tuple(pending)
+    pending.clear()
+    return labels
 

@@ -145,12 +145,18 @@ def _syntax_error(row: ast.Row, code: str, kinds: Kinds, lexemes: list[Lexeme],
             span, help="a label `:NN` may only start a line: move it to a line of its own",
         )
     found = "the end of the line" if kind == "$END" else f"`{_excerpt(text)}`"
-    expected = sorted({TERMINAL_NAMES.get(name, name) for name in rejection.expected})
     help_text, fixes = _syntax_help(row, kinds, lexemes, rejection)
-    return Diagnostic(
-        "E0101", Severity.ERROR,
-        f"expected {_either(expected)}, found {found}", span, help=help_text, fixes=fixes,
-    )
+    return Diagnostic("E0101", Severity.ERROR, _expected(rejection.expected, found), span,
+                      help=help_text, fixes=fixes)
+
+
+@functools.lru_cache(maxsize=1024)
+def _expected(expected: frozenset[str], found: str) -> str:
+    """The message of an E0101, one string for the many lines that share it: a
+    diagnostic is kept until it is reported, and a source of a broken line on end would
+    otherwise hold its message's text once a line."""
+    names = sorted({TERMINAL_NAMES.get(name, name) for name in expected})
+    return f"expected {_either(names)}, found {found}"
 
 
 def _either(names: list[str]) -> str:
