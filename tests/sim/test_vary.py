@@ -12,7 +12,7 @@ from pathlib import Path
 from statistics import NormalDist, fmean, pvariance
 
 import pytest
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 from support.cli import rl1c
 from support.hold import WAIT
@@ -292,3 +292,55 @@ def test_a_run_without_a_seed_is_the_world_as_written(tmp_path: Path) -> None:
     result = rl1c("sim", program, "--world", world_file, "--format", "json")
     assert "note" not in result.stderr
     assert json.loads(result.stdout)["track"][0][1:3] == [100.0, 200.0]
+
+
+# Any table ------------------------------------------------------------------------------
+
+KEYS = ["start.x", "start.y", "start.heading", "stands.bench.x", "stands.bench.facing",
+        "stands.desk.y", "vehicle.k1", "vehicle.tread", "vehicle.trace_interval",
+        "vehicle.rotate_speed", "vehicle.nope", "noise.slip", "noise.odometry",
+        "noise.ultrasonic_dropout", "start.z"]
+wild = st.one_of(st.floats(-2e6, 2e6), st.integers(-10, 10), st.sampled_from(
+    [0.0, 1e-300, -1e-300, math.inf, -math.inf, math.nan]))
+small = st.floats(-50, 50)
+bounds = st.tuples(small, small).map(lambda pair: (min(pair), max(pair)))
+entry = st.one_of(  # mostly tables that may hold, then anything
+    st.fixed_dictionaries({"uniform": bounds}),
+    st.fixed_dictionaries({"normal": st.tuples(small, st.floats(1e-3, 50))},
+                          optional={"within": bounds}),
+    st.fixed_dictionaries({}, optional={key: st.tuples(wild, wild)
+                                        for key in ("uniform", "normal", "within")}))
+
+
+def _toml(value: object) -> str:
+    match value:
+        case float() if math.isnan(value):
+            return "nan"
+        case float() if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        case tuple():
+            return "[" + ", ".join(map(_toml, value)) + "]"
+    return repr(value)
+
+
+@given(st.dictionaries(st.sampled_from(KEYS), entry, max_size=5), st.integers(0, 2**32 - 1))
+# Found by it: a draw at its range's end (0 of 0..10, written in integers) took the
+# range's int, and the setting was then refused as a whole number.
+@example({"noise.slip": {"uniform": (0.0, 0.0)}}, 0)
+def test_any_vary_table_is_refused_with_its_place_or_draws_values_in_range(
+        table: dict[str, dict[str, tuple[object, object]]], seed: int) -> None:
+    text = WORLD + "[vary]\n" + "".join(
+        f"{key} = {{ " + ", ".join(f"{name} = {_toml(value)}" for name, value in
+                                   spread.items()) + " }\n"
+        for key, spread in table.items())
+    try:
+        varied = world(text)
+    except WorldError as error:
+        assert re.match(r"w\.toml:\d+: vary\.", str(error)), str(error)
+        return
+    drawn, values = varied.drawn(seed)
+    assert set(values) == set(table)
+    for key, value in values.items():
+        parameter = varied.parameter(key)
+        assert parameter.low <= value <= parameter.high
+        assert drawn.parameter(key).value == value

@@ -329,7 +329,7 @@ def _float_range(schema: type[Struct], field: str) -> tuple[float, float]:
     info = next(info for info in struct.fields if info.encode_name == field)
     kind = info.type.type if isinstance(info.type, mi.Metadata) else info.type
     assert isinstance(kind, mi.FloatType) and kind.ge is not None and kind.le is not None
-    return kind.ge, kind.le
+    return float(kind.ge), float(kind.le)  # a range of 0..10 is written in integers
 
 
 
