@@ -26,7 +26,8 @@ EXTRA = "cluster"  # pyproject.toml's extra that installs `distributed`
 
 
 class Unavailable(Exception):
-    """The executor asked for cannot be had: its message says why and what to do."""
+    """The executor asked for cannot be had: its message says why and what to do (an
+    error's message, without the word `error:` the command line puts first)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -76,7 +77,7 @@ def _cluster(address: str) -> Iterator[Workers]:
         from distributed.scheduler import KilledWorker
     except ImportError as error:
         raise Unavailable(
-            f"error: --scheduler needs Dask's `distributed`, which is not installed here "
+            f"--scheduler needs Dask's `distributed`, which is not installed here "
             f"({error})\n  = help: install the extra `{EXTRA}`: pip install 'rl1[{EXTRA}]' "
             "(or pip install distributed), on this machine and on the workers'") from None
     client = _connect(Client, address)
@@ -112,7 +113,7 @@ def _connect(client: type[Client], address: str) -> Client:
 
 def _unreachable(address: str, why: str) -> Unavailable:
     return Unavailable(
-        f"error: cannot reach a Dask scheduler at {address} ({why})\n"
+        f"cannot reach a Dask scheduler at {address} ({why})\n"
         f"  = help: start one there (`dask scheduler`, then `dask worker {address}` on "
         "each machine), or give its address as tcp://HOST:8786")
 

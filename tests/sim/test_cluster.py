@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -147,7 +148,8 @@ def test_without_distributed_the_extra_to_install_is_named(
     result = rl1c("sim", program, "--world", world, "--runs", "5", "--scheduler",
                   "tcp://127.0.0.1:8786", "--out", out)
     assert result.exit_code == 2
-    assert "--scheduler needs Dask's `distributed`, which is not installed" in result.stderr
+    assert "\nerror: --scheduler needs Dask's `distributed`, which is not installed" in (
+        "\n" + result.stderr)
     assert "pip install 'rl1[cluster]'" in result.stderr
     assert "Traceback" not in result.output
     assert out.read_text() == "kept\n"  # not replaced by a campaign that never ran
@@ -171,7 +173,7 @@ def test_an_unreachable_scheduler_is_said_with_its_address_within_seconds(
                              "--runs", "5", "--scheduler", address, "--out", str(out)],
                             capture_output=True, text=True, timeout=60, check=False)
     assert result.returncode == 2
-    assert f"error: cannot reach a Dask scheduler at {address}" in result.stderr
+    assert f"\nerror: cannot reach a Dask scheduler at {address}" in "\n" + result.stderr
     assert f"`dask worker {address}`" in result.stderr
     assert "Traceback" not in result.stderr and "Exception ignored" not in result.stderr
     assert out.read_text() == "kept\n"
@@ -220,3 +222,35 @@ def test_the_command_of_the_runs_left_keeps_the_scheduler() -> None:
     setting = Setting("a.rob", "w.toml", 0, 100, 2, "vm", 10000, "tcp://cluster:8786")
     assert setting.rest(40, 60) == ("rl1c sim a.rob --world w.toml --runs 60 --seed 40 "
                                     "--scheduler tcp://cluster:8786 --budget 10000")
+
+
+# rl1c fuzz --scheduler -------------------------------------------------------------------
+
+
+def _fuzz(*options: str) -> str:
+    """`rl1c fuzz --count 150 --seed 5` with `options`: its summary without its times."""
+    done = subprocess.run([str(BIN / "rl1c"), "fuzz", "--count", "150", "--seed", "5",
+                           *options], capture_output=True, text=True, timeout=600,
+                          check=False)
+    assert done.returncode == 0, done.stderr
+    return re.sub(r" in [\d.]+ s \([\d.]+ per second\)", "", done.stdout)
+
+
+def test_fuzzing_on_a_cluster_runs_the_programs_of_local_processes(
+        cluster: Cluster, tmp_path: Path) -> None:
+    connections = cluster.log().count("Receive client connection")
+    on_cluster = _fuzz("--scheduler", cluster.address, "--out", str(tmp_path / "out"))
+    assert cluster.log().count("Receive client connection") == connections + 1
+    assert on_cluster == _fuzz("--jobs", "1", "--out", str(tmp_path / "out"))
+    assert "fuzz: 150 programs; engines ast, vm-O0, vm-O1, vm-O2; seed 5" in on_cluster
+
+
+def test_fuzzing_with_an_unreachable_scheduler_says_so(tmp_path: Path) -> None:
+    address = f"tcp://127.0.0.1:{_refusing_port()}"
+    result = rl1c("fuzz", "--count", "10", "--scheduler", address, "--out",
+                  tmp_path / "out")
+    assert result.exit_code == 2
+    assert result.stderr.startswith(f"error: cannot reach a Dask scheduler at {address}")
+    result = rl1c("fuzz", "--count", "10", "--jobs", "2", "--scheduler", address)
+    assert result.exit_code == 2
+    assert "--jobs counts local processes, and --scheduler gives" in result.stderr
