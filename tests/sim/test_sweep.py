@@ -11,10 +11,12 @@ import re
 from pathlib import Path
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from support.cli import rl1c
 from support.hold import CAMERA_TO_MARKER, HOLD_WORLD, WAIT, WITHIN
 
-from rl1.compiler.campaign import Task, run_one
+from rl1.compiler.campaign import Task, run_one, run_world
 from rl1.compiler.sweep import Axis, check, grid, parse_axis
 from rl1.vm.sim.world import decode_world
 
@@ -158,3 +160,30 @@ def test_the_command_line_refuses_a_wrong_sweep(hold: tuple[Path, Path], args: l
     result = rl1c("sim", program, "--world", world, *args)
     assert result.exit_code == 2
     assert says in result.stderr
+
+
+KEYS = ["start.x", "start.y", "start.heading", "stands.bench.x", "stands.bench.facing",
+        "stands.desk.x", "vehicle.k1", "vehicle.trace_interval", "vehicle.image_width",
+        "noise.slip", "noise.odometry", "floor.x", "stands.x"]
+offset = st.one_of(st.floats(-100, 100), st.floats(-1e7, 1e7), st.sampled_from(
+    [0.0, math.inf, math.nan]))
+
+
+@given(st.lists(st.tuples(st.sampled_from(KEYS), offset, offset, st.integers(0, 4)),
+                max_size=3), st.integers(0, 2**32 - 1))
+def test_any_sweep_is_refused_or_moves_every_point_within_range(
+        axes: list[tuple[str, float, float, int]], seed: int) -> None:
+    world = decode_world((HOLD_WORLD + "[vary]\nstart.x = { normal = [0, 5] }\n").encode(),
+                         "w.toml")
+    try:
+        parsed = [parse_axis(f"{key}={first!r}:{last!r}:{count}")
+                  for key, first, last, count in axes]
+        check(world, parsed)
+    except ValueError:
+        return
+    for point in grid(parsed):
+        moved, values = run_world(world, point, seed)
+        for key, value in values.items():
+            parameter = world.parameter(key)
+            assert parameter.low <= value <= parameter.high
+            assert moved.parameter(key).value == value
