@@ -1,48 +1,73 @@
 // The debugger's marks in the editor: breakpoints in a gutter of their own (a click on
-// a line's gutter, or F9 on the line, sets or clears one, and they move with the text as
-// it is edited), and the line the run is on, highlighted.
+// a line's gutter, or F9 on the line, sets or clears one; a right click gives it a
+// condition; they move with the text as it is edited), and the line the run is on,
+// highlighted.
 
 import { RangeSet, StateEffect, StateField, EditorState } from "@codemirror/state";
 import { Decoration, DecorationSet, EditorView, GutterMarker, gutter, keymap } from "@codemirror/view";
 
+/** A line's breakpoint: its 1-based line, and its condition (`A<0`) if any. */
+export interface LineBreakpoint { line: number; condition: string | null }
+
 const toggleBreakpoint = StateEffect.define<number>();  // at a line's start
+const setCondition = StateEffect.define<{ at: number; condition: string | null }>();
 // A 1-based line, or none, and whether the run faulted there.
 const setCurrentLine = StateEffect.define<{ line: number | null; fault: boolean }>();
 
 class BreakpointMarker extends GutterMarker {
   override elementClass = "cm-breakpoint";
+  constructor(readonly condition: string | null) {
+    super();
+  }
+  override eq(other: BreakpointMarker) {
+    return other.condition === this.condition;
+  }
   override toDOM() {
     const dot = document.createElement("span");
-    dot.className = "cm-breakpoint-dot";
-    dot.textContent = "●";
+    dot.className = this.condition === null ? "cm-breakpoint-dot" : "cm-breakpoint-dot conditional";
+    dot.textContent = this.condition === null ? "●" : "◆";
+    dot.title = this.condition === null ? "breakpoint (right click: a condition)" : `stops when ${this.condition}`;
     return dot;
   }
 }
-const BREAKPOINT = new BreakpointMarker();
 
-const breakpointField = StateField.define<RangeSet<GutterMarker>>({
+const breakpointField = StateField.define<RangeSet<BreakpointMarker>>({
   create: () => RangeSet.empty,
   update(set, transaction) {
     set = set.map(transaction.changes);
     for (const effect of transaction.effects) {
-      if (!effect.is(toggleBreakpoint)) continue;
-      let present = false;
-      set.between(effect.value, effect.value, () => { present = true; });
-      set = present
-        ? set.update({ filter: (from) => from !== effect.value })
-        : set.update({ add: [BREAKPOINT.range(effect.value)] });
+      if (effect.is(toggleBreakpoint)) {
+        let present = false;
+        set.between(effect.value, effect.value, () => { present = true; });
+        set = present
+          ? set.update({ filter: (from) => from !== effect.value })
+          : set.update({ add: [new BreakpointMarker(null).range(effect.value)] });
+      } else if (effect.is(setCondition)) {
+        const { at, condition } = effect.value;
+        set = set.update({ filter: (from) => from !== at, add: [new BreakpointMarker(condition).range(at)] });
+      }
     }
     return set;
   },
 });
 
-/** The 1-based lines that have a breakpoint, in order. */
-function breakpointLines(state: EditorState): number[] {
-  const lines = new Set<number>();
+/** The breakpoints, by line. */
+function breakpoints(state: EditorState): LineBreakpoint[] {
+  const byLine = new Map<number, string | null>();
   for (let cursor = state.field(breakpointField).iter(); cursor.value; cursor.next()) {
-    lines.add(state.doc.lineAt(cursor.from).number);
+    byLine.set(state.doc.lineAt(cursor.from).number, cursor.value.condition);
   }
-  return [...lines].sort((a, b) => a - b);
+  return [...byLine].sort(([a], [b]) => a - b).map(([line, condition]) => ({ line, condition }));
+}
+
+/** Asks for the condition of the breakpoint on the line starting at `at` (setting one). */
+function askCondition(view: EditorView, at: number): void {
+  let now: string | null = null;
+  view.state.field(breakpointField).between(at, at, (_from, _to, marker) => { now = marker.condition; });
+  const line = view.state.doc.lineAt(at).number;
+  const answer = prompt(`Stop at line ${line} when (a value compared with 0, as ?V< compares: A<0, `
+                        + "U-L>0, d=0; empty: always):", now ?? "");
+  if (answer !== null) view.dispatch({ effects: setCondition.of({ at, condition: answer.trim() || null }) });
 }
 
 /** Highlights the line the run is on (1-based), or none, or the line it faulted on;
@@ -75,8 +100,8 @@ const currentLineField = StateField.define<DecorationSet>({
   provide: (field) => EditorView.decorations.from(field),
 });
 
-/** The gutter and the highlight; `changed` hears every change of the breakpoints' lines. */
-export function debuggerMarks(changed: (lines: number[]) => void) {
+/** The gutter and the highlight; `changed` hears every change of the breakpoints. */
+export function debuggerMarks(changed: (breakpoints: LineBreakpoint[]) => void) {
   let last = "";
   return [
     breakpointField,
@@ -85,8 +110,14 @@ export function debuggerMarks(changed: (lines: number[]) => void) {
       class: "cm-breakpoint-gutter",
       markers: (view) => view.state.field(breakpointField),
       domEventHandlers: {
-        mousedown(view, line) {
+        mousedown(view, line, event) {
+          if ((event as MouseEvent).button !== 0) return false;
           view.dispatch({ effects: toggleBreakpoint.of(line.from) });
+          return true;
+        },
+        contextmenu(view, line, event) {
+          event.preventDefault();
+          askCondition(view, line.from);
           return true;
         },
       },
@@ -99,11 +130,11 @@ export function debuggerMarks(changed: (lines: number[]) => void) {
       },
     }]),
     EditorView.updateListener.of((update) => {
-      const lines = breakpointLines(update.state);
-      const now = lines.join(",");
-      if (now !== last) {
-        last = now;
-        changed(lines);
+      const now = breakpoints(update.state);
+      const key = JSON.stringify(now);
+      if (key !== last) {
+        last = key;
+        changed(now);
       }
     }),
   ];

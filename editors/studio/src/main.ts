@@ -12,7 +12,7 @@ import { lintGutter } from "@codemirror/lint";
 import { autocompletion, closeBrackets } from "@codemirror/autocomplete";
 import { rl1Highlight, rl1Language } from "./language";
 import { openSocket, studioClient, webSocketTransport } from "./lsp";
-import { debuggerMarks, showCurrentLine } from "./breakpoints";
+import { LineBreakpoint, debuggerMarks, showCurrentLine } from "./breakpoints";
 import { showPalette } from "./palette";
 import { WorldView } from "./world";
 import { DebugPane } from "./debugPane";
@@ -102,11 +102,12 @@ async function start(): Promise<void> {
       say((error as Error).message, true);
     }
   };
-  let breakpoints: number[] = [];
+  let breakpoints: LineBreakpoint[] = [];
   const stopOnLost = byId<HTMLInputElement>("stop-on-lost");
   const sendBreakpoints = async (): Promise<void> => {
     const answer = await studio.request<{ breakpoints: Binding[] | null }>("debug/setBreakpoints", {
-      lines: breakpoints.map((line) => ({ line })), lostLines: stopOnLost.checked });
+      lines: breakpoints.map(({ line, condition }) => condition === null ? { line } : { line, condition }),
+      lostLines: stopOnLost.checked });
     reportBindings(answer.breakpoints ?? []);
   };
   stopOnLost.addEventListener("change", () => sendBreakpoints().catch((error: Error) => say(error.message, true)));
@@ -120,8 +121,8 @@ async function start(): Promise<void> {
       doc: program.text,
       extensions: [
         lineNumbers(),
-        debuggerMarks((lines) => {
-          breakpoints = lines;
+        debuggerMarks((now) => {
+          breakpoints = now;
           sendBreakpoints().catch((error: Error) => say(error.message, true));
         }),
         lintGutter(),
