@@ -25,7 +25,7 @@ import click
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.reporting.render import EXIT_ERRORS
 
-from .command import PATH, Command, Failure, a_budget, at_least_one
+from .command import EXIT_INTERRUPTED, PATH, Command, Failure, a_budget, at_least_one
 from .streams import encode_like, invalid_file, read_failure, with_suffix, write_file
 
 if TYPE_CHECKING:
@@ -126,8 +126,21 @@ def reduce(file: str, sensors: str | None, command: str | None,
               + (f", {_figures(case.script)} of script" if case.script is not None else "")
               + f" ({tests} tests)", file=sys.stderr)
 
+    latest: list[Case] = []  # the last interesting candidate: the smallest so far
+    tested = 0
+
+    def remembered(case: Case) -> bool:
+        nonlocal tested
+        tested += 1
+        found = interesting(case)
+        latest[:] = [case] if found else latest
+        return found
+
     try:
-        reduction = reduced(original, interesting, max_tests=limit, progress=progress)
+        reduction = reduced(original, remembered, max_tests=limit, progress=progress)
+        case, status = reduction.case, 0
+        ending = "" if reduction.finished else \
+            f", stopped at --max-tests {limit} with the smallest so far"
     except NotInteresting:
         why = (f"the engines agree on {file}: nothing to reduce (a candidate is "
                "interesting while they disagree)" if not isinstance(interesting, _ShellTest)
@@ -135,19 +148,21 @@ def reduce(file: str, sensors: str | None, command: str | None,
                "must exit 0 on the original (it runs in a new temporary folder holding "
                + " and ".join(files.names()) + ")")
         raise Failure(f"rl1c reduce: error: {why}", EXIT_ERRORS) from None
-    written = _write(files, reduction.case, out, sensors_out)
-    case = reduction.case
+    except KeyboardInterrupt:  # Ctrl-C: what was found is kept
+        if not latest:
+            raise
+        case, status = latest[0], EXIT_INTERRUPTED
+        ending = ", interrupted (Ctrl-C) with the smallest so far"
+    written = _write(files, case, out, sensors_out)
     lines = [f"reduced {file}: {_figures(original.source)} -> {_figures(case.source)}"]
     if script is not None and case.script is not None:
         lines.append(f"sensor script {sensors}: {_figures(script)} -> "
                      f"{_figures(case.script)}")
-    lines.append(f"{reduction.tests} tests" + ("" if reduction.finished else
-                                                f", stopped at --max-tests {limit} with the "
-                                                "smallest so far"))
+    lines.append(f"{tested} tests{ending}")
     lines.append("written: " + ", ".join(written) if written else
                  "nothing smaller is interesting: nothing written")
     click.echo("\n".join(lines))
-    return 0
+    return status
 
 
 @dataclass(frozen=True)

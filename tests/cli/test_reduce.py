@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import json
 import shlex
+import signal
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -292,3 +294,21 @@ def test_a_fuzz_finding_of_a_planted_bug_is_reduced_with_its_engines(tmp_path: P
     assert program.with_name("program.reduced.rob").read_text(encoding="utf-8") == "B=1<-1\n"
     assert program.with_name("program.sensors.reduced.json").read_text(
         encoding="utf-8") == "{}\n"
+
+
+def test_ctrl_c_keeps_the_smallest_so_far(sample: tuple[Path, Path]) -> None:
+    program, _ = sample
+    rl1c_path = str(Path(sys.executable).with_name("rl1c"))
+    slow = "grep -q '(MOV' sample.rob && sleep 0.2"
+    process = subprocess.Popen([rl1c_path, "reduce", str(program), "--interesting", slow],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert process.stderr is not None
+    first = process.stderr.readline()  # a pass made it smaller
+    assert first.startswith("rl1c reduce: lines: "), first
+    process.send_signal(signal.SIGINT)
+    stdout, _ = process.communicate(timeout=60)
+    assert process.returncode == 130
+    assert "interrupted (Ctrl-C) with the smallest so far" in stdout
+    reduced = program.with_name("sample.reduced.rob").read_text(encoding="utf-8")
+    assert "(MOV" in reduced and len(reduced) < len(SAMPLE.read_text(encoding="utf-8"))
+    assert program.read_bytes() == SAMPLE.read_bytes()

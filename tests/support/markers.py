@@ -30,6 +30,7 @@ MARKS: dict[str, tuple[str, ...]] = {
     "tests/cli/test_fuzz_cli.py": ("slow",),
     "tests/cli/test_reduce.py::test_a_fuzz_finding_of_a_planted_bug_is_reduced_with_its_engines":
         ("slow",),
+    "tests/cli/test_reduce.py::test_ctrl_c_keeps_the_smallest_so_far": ("slow",),
     "tests/frontend/test_strategies.py": ("slow",),
     # A language server process of its own for each test (its command line, its raw
     # protocol over standard input and output).
@@ -41,6 +42,9 @@ MARKS: dict[str, tuple[str, ...]] = {
     "tests/studio/test_command.py::test_it_prints_its_address_serves_there_and_stops_on_ctrl_c":
         ("slow",),
     "tests/backend/test_reproducible.py": ("slow",),
+    # rl1c check's memory per source byte, under tracemalloc in a process of its own.
+    "tests/checker/test_streaming.py::test_checking_takes_at_most_64_bytes_a_source_byte":
+        ("slow",),
     # Campaigns of simulated runs on pools of processes, and on a Dask cluster of a
     # scheduler and two workers started for each test.
     "tests/sim/test_campaign.py": ("slow",),
