@@ -437,7 +437,9 @@ def _draw(pictures: Pictures, overlay: Overlay, tallies: list[Tally], setting: S
     the heat map of its success rates (the SVG then is the heat map alone)."""
     title = (f"{os.path.basename(setting.file)} on {os.path.basename(setting.world)}: "
              f"{overlay.runs:,} runs")
-    drawn = [svg(world, overlay, title)]
+    moved = dict.fromkeys([*(axis.key for axis in setting.sweep),
+                           *(varied.key for varied in world.varied)])
+    drawn = [svg(world, overlay, title, list(moved))]
     if setting.sweep:
         rows, *columns = setting.sweep
         drawn.insert(0, heat_map_svg(

@@ -102,7 +102,7 @@ def test_the_legend_counts_each_kind(
         count = sum(1 for line in lines if not line["success"] and _kind(line) == kind)
         assert f"{kind}: {count} run" in legend
     assert f"{RUNS} paths of {RUNS} runs" in legend
-    assert "[vary] moves each run's start and stands" in legend
+    assert "the world as written; each run moves start.y, stands.bench.x" in legend
 
 
 class _Page(HTMLParser):

@@ -70,9 +70,9 @@ class Overlay:
         return KIND_COLOURS[list(self.kinds).index(kind) % len(KIND_COLOURS)]
 
 
-def svg(world: World, overlay: Overlay, title: str) -> str:
-    """The campaign's runs on the world as written (a [vary] moves the start and the
-    stands of each run; their paths show where)."""
+def svg(world: World, overlay: Overlay, title: str, moved: Sequence[str] = ()) -> str:
+    """The campaign's runs on the world as written, whose parameters `moved` (by [vary]
+    or a sweep: their keys) each run moves; the paths show where."""
     width, depth = world.floor
     plane = _Plane(world)
     body = _scene(world, plane)
@@ -94,7 +94,7 @@ def svg(world: World, overlay: Overlay, title: str) -> str:
                     f'{overlay.colour(run.kind)}" fill-opacity="0.8"><title>seed {run.seed}: '
                     f"{escape(run.kind)}{at}</title></circle>")
     below = TOP + depth + MARGIN
-    legend, height = _legend(overlay, MARGIN, below + 24, bool(world.varied))
+    legend, height = _legend(overlay, MARGIN, below + 24, moved)
     total_width = max(width + 2 * MARGIN, 560)
     total_height = below + 34 + height
     return (f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {total_width:g} '
@@ -103,7 +103,8 @@ def svg(world: World, overlay: Overlay, title: str) -> str:
             + "".join(body) + _scale(MARGIN, below + 6, width) + legend + "</svg>\n")
 
 
-def _legend(overlay: Overlay, x: float, y: float, varied: bool) -> tuple[str, float]:
+def _legend(overlay: Overlay, x: float, y: float, moved: Sequence[str]
+            ) -> tuple[str, float]:
     """The legend, a line an item: what the paths are (and which were left out), each
     kind of failure with its count (and the marks left out); its markup and height."""
     shown = len(overlay.paths)
@@ -118,9 +119,8 @@ def _legend(overlay: Overlay, x: float, y: float, varied: bool) -> tuple[str, fl
     failures = sum(overlay.kinds.values())
     if marked < failures:
         items.append(("", f"the first {marked:,} failures of {failures:,} are marked"))
-    if varied:
-        items.append(("", "the world as written: [vary] moves each run's start and "
-                          "stands"))
+    if moved:
+        items.append(("", "the world as written; each run moves " + ", ".join(moved)))
     row = 18
     parts = ['<g id="legend">']
     for i, (swatch, text) in enumerate(items):
