@@ -36,8 +36,6 @@ from rl1.compiler.frontend.parser import parse_line
 from rl1.compiler.frontend.source import LINE_BREAK, split_lines
 from rl1.vm.sensor_script import ScriptError, decode_script
 
-DEFAULT_MAX_TESTS = 2000
-
 
 @dataclass(frozen=True)
 class Case:
@@ -73,7 +71,7 @@ class _Spent(Exception):
 Progress = Callable[[str, Case, int], None]  # a pass's name, the case after it, tests
 
 
-def reduce(case: Case, interesting: Interesting, *, max_tests: int = DEFAULT_MAX_TESTS,
+def reduce(case: Case, interesting: Interesting, *, max_tests: int,
            progress: Progress | None = None) -> Reduction:
     """The smallest case the passes find that `interesting` holds for, testing at most
     `max_tests` candidates (the original among them); NotInteresting when the original

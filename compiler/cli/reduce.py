@@ -34,6 +34,7 @@ if TYPE_CHECKING:
     from rl1.compiler.reduce import Case
 
 SECTION = "Testing"
+DEFAULT_MAX_TESTS = 2000
 DEFAULT_TIMEOUT = 10  # seconds a test may take, as long as an exec: engine of rl1c fuzz
 OUTPUT_KEPT = 4096  # the end of a test's output, for the message when the original fails
 SCRIPT_ROLE = "sensor script"
@@ -63,7 +64,7 @@ SCRIPT_ROLE = "sensor script"
 @click.option("--max-tests", "max_tests", type=str, default=None, metavar="N",
               callback=lambda c, p, v: None if v is None else at_least_one(c, p, v),
               help="stop after testing so many candidates, with the smallest so far "
-                   "(default 2000)")
+                   f"(default {DEFAULT_MAX_TESTS})")
 @click.option("--timeout", type=str, default=str(DEFAULT_TIMEOUT), metavar="SECONDS",
               callback=at_least_one, show_default=True,
               help="a test that runs longer is stopped, and the candidate is not interesting")
@@ -80,9 +81,10 @@ def reduce(file: str, sensors: str | None, command: str | None,
     in the formatter's layout when it stays interesting so. The same input and command
     give the same result. The original is never changed unless --out names it. Exit
     status: 0 reduced; 1 the original is not interesting (CMD must exit 0 on it, or the
-    engines disagree on it); 2 a usage problem or a file that cannot be read."""
+    engines disagree on it); 2 a usage problem or a file that cannot be read; 130
+    Ctrl-C, the smallest case so far written."""
     from rl1.compiler.frontend.source import read_source
-    from rl1.compiler.reduce import DEFAULT_MAX_TESTS, Case, NotInteresting
+    from rl1.compiler.reduce import Case, NotInteresting
     from rl1.compiler.reduce import reduce as reduced
     from rl1.compiler.runner import MAX_SCRIPT_BYTES
 

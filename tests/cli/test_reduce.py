@@ -30,6 +30,9 @@ BROKEN_VM = f"exec:{PYTHON} {shlex.quote(str(ROOT / 'tests/support/broken_vm.py'
             "{ilc} {sensors} {budget}"
 
 
+TESTS = 2000  # the tests a reduction may run, far more than these take
+
+
 def moves(case: Case) -> bool:
     """A planted interestingness: the checker accepts a program with a (MOV ...)."""
     return "(MOV" in case.source
@@ -39,7 +42,7 @@ def moves(case: Case) -> bool:
 
 
 def test_a_program_is_reduced_to_the_one_statement_that_matters() -> None:
-    reduction = reduce(Case(SAMPLE.read_text(encoding="utf-8")), moves)
+    reduction = reduce(Case(SAMPLE.read_text(encoding="utf-8")), moves, max_tests=TESTS)
     # Deleting lines and statements leaves one (MOV 3,3), its operands made 0.
     assert reduction.case == Case("(MOV 0,0)\n")
     assert reduction.finished and reduction.tests < 100
@@ -69,7 +72,7 @@ def disagrees(case: Case) -> bool:
 
 def test_terms_operands_and_hex_constants_shrink_towards_zero() -> None:
     # What `rl1c fuzz --seed 1` found against the broken VM of tests/support/broken_vm.py.
-    reduction = reduce(Case("B=$0+$1<$FFFF\n"), disagrees)
+    reduction = reduce(Case("B=$0+$1<$FFFF\n"), disagrees, max_tests=TESTS)
     assert reduction.case.source == "B=1<-1\n"
 
 
@@ -80,7 +83,7 @@ def test_the_sensor_script_keeps_only_what_matters_with_its_numbers_made_small()
         data = json.loads(case.script or "{}")
         return any(reading["area"] > 100 for reading in data.get("IMG", []))
 
-    reduction = reduce(Case("(MOV 3,3)\n", script), sees_far)
+    reduction = reduce(Case("(MOV 3,3)\n", script), sees_far, max_tests=TESTS)
     data = json.loads(reduction.case.script or "")
     assert list(data) == ["IMG"] and len(data["IMG"]) == 1
     reading = data["IMG"][0]
@@ -92,7 +95,7 @@ def test_the_sensor_script_keeps_only_what_matters_with_its_numbers_made_small()
 
 def test_a_script_nothing_needs_becomes_empty() -> None:
     reduction = reduce(Case("(MOV 3,3)\n", SAMPLE_SENSORS.read_text(encoding="utf-8")),
-                       moves)
+                       moves, max_tests=TESTS)
     assert reduction.case == Case("(MOV 0,0)\n", "{}\n")
 
 
@@ -100,13 +103,13 @@ def test_the_layout_is_the_formatters_when_it_stays_interesting() -> None:
     def spaced(case: Case) -> bool:
         return "(MOV" in case.source and "=" in case.source
 
-    reduction = reduce(Case("A = 1 ;  (MOV  3 , 3) ' a comment\n"), spaced)
+    reduction = reduce(Case("A = 1 ;  (MOV  3 , 3) ' a comment\n"), spaced, max_tests=TESTS)
     assert reduction.case.source == "A=0; (MOV 0,0)\n"
 
 
 def test_a_case_that_is_not_interesting_is_refused() -> None:
     with pytest.raises(NotInteresting):
-        reduce(Case("(END)\n"), moves)
+        reduce(Case("(END)\n"), moves, max_tests=TESTS)
 
 
 def test_the_tests_are_capped_and_the_smallest_so_far_is_kept() -> None:
@@ -129,7 +132,7 @@ def test_a_program_the_checker_accepts_stays_accepted() -> None:
         tested.append(case.source)
         return True
 
-    reduce(Case(SAMPLE.read_text(encoding="utf-8")), anything)
+    reduce(Case(SAMPLE.read_text(encoding="utf-8")), anything, max_tests=TESTS)
     assert tested and not any(analyze(source).has_errors for source in tested)
 
 
