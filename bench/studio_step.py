@@ -3,7 +3,8 @@ time from a `debug/stepLine` request to its `run/stopped` over the WebSocket, st
 Listing 1 on the sample world line by line (median and slowest, goal 20 ms), against the
 same steps of the debugging core's Session alone in this process; and the frames a
 second of a live run at 10x real time (goal 30), with how far the simulated time kept
-to ten times the wall time.
+to ten times the wall time; and a whole run at full speed, from run/launch to run/ended,
+against a Session's continue alone.
 
 The server runs in a thread of this process, on a free port of 127.0.0.1; wall time
 (time.perf_counter), as the page sees it. The machine is shared: the figures vary.
@@ -37,6 +38,7 @@ STEP_GOAL_MS = 20.0
 FRAMES_GOAL = 30
 LIVE_SECONDS = 4.0
 SPEED = 10
+RUNS = 3  # the fastest of these: the machine is shared
 
 
 @contextlib.contextmanager
@@ -102,18 +104,39 @@ def server_steps(page: Page) -> list[float]:
             return steps
 
 
-def session_steps() -> list[float]:
-    """The same steps of a Session alone."""
+def _session() -> Session:
     image = compile_program((EXAMPLES / "sample.rob").read_text(), "sample.rob")
     assert isinstance(image, bytes)
     world = decode_world((EXAMPLES / "sample.world.toml").read_bytes(), "sample.world.toml")
-    session = Session(image, lambda: SimDevice(world))
+    return Session(image, lambda: SimDevice(world))
+
+
+def session_steps() -> list[float]:
+    """The same steps of a Session alone."""
+    session = _session()
     steps = []
     while not session.over:
         started = time.perf_counter()
         session.step_line()
         steps.append(time.perf_counter() - started)
     return steps
+
+
+def whole_run(page: Page) -> float:
+    """From run/launch at full speed to run/ended: the run, its frames and its trace."""
+    started = time.perf_counter()
+    launch(page, speed=None)
+    page.until("run/ended")
+    return time.perf_counter() - started
+
+
+def session_run() -> float:
+    """The same run by a Session's continue alone."""
+    session = _session()
+    started = time.perf_counter()
+    while not session.over:
+        session.continue_()
+    return time.perf_counter() - started
 
 
 def live(page: Page) -> tuple[int, float, float]:
@@ -136,9 +159,11 @@ def live(page: Page) -> tuple[int, float, float]:
 
 def main() -> None:
     alone = session_steps()
+    reference = min(session_run() for _ in range(RUNS))
     with studio() as address, connect(address, max_size=None) as connection:
         page = Page(connection)
         steps = server_steps(page)
+        whole = min(whole_run(page) for _ in range(RUNS))
         frames, elapsed, simulated = live(page)
     median, slowest = statistics.median(steps) * 1000, max(steps) * 1000
     print(f"line steps of Listing 1 on the sample world: {len(steps)}, request to "
@@ -146,6 +171,8 @@ def main() -> None:
           f"{STEP_GOAL_MS:g} ms: {'met' if median <= STEP_GOAL_MS else 'missed'}); the "
           f"Session alone: median {statistics.median(alone) * 1000:.3f} ms, slowest "
           f"{max(alone) * 1000:.2f} ms")
+    print(f"the whole run at full speed: run/launch to run/ended {whole * 1000:.0f} ms, a "
+          f"Session's continue alone {reference * 1000:.0f} ms ({whole / reference:.2f}x)")
     rate = frames / elapsed
     print(f"live at {SPEED}x real time: {frames} frames in {elapsed:.2f} s, {rate:.1f} a "
           f"second (goal {FRAMES_GOAL}: {'met' if rate >= FRAMES_GOAL * 0.95 else 'missed'}); "
