@@ -14,7 +14,7 @@ import logging
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from importlib.metadata import version
-from typing import Any
+from typing import Any, ClassVar
 
 from rl1.compiler.debugger import DebugError, compile_program, parse_call, parse_value
 from rl1.compiler.files import SourceError
@@ -103,24 +103,6 @@ class Connection:
         self._lines: list[tuple[int, str | None]] = []
         self._calls: list[str] = []
         self._lost_lines = False
-        self._methods: dict[str, Callable[[dict[str, Any]], Awaitable[dict[str, Any]]]] = {
-            "initialize": self._initialize,
-            "files/list": self._list,
-            "files/read": self._read,
-            "files/save": self._save,
-            "world/check": self._check_world,
-            "palette": self._palette,
-            "run/launch": self._launch,
-            "debug/setBreakpoints": self._set_breakpoints,
-            "debug/continue": self._continue,
-            "debug/stepLine": self._step_line,
-            "debug/stepInstruction": self._step_instruction,
-            "debug/pause": self._pause,
-            "debug/restart": self._restart,
-            "debug/stop": self._stop,
-            "debug/setSpeed": self._set_speed,
-            "debug/evaluate": self._evaluate,
-        }
 
     # Messages
 
@@ -143,15 +125,15 @@ class Connection:
                 '"params" (an object)')))
             return
         method, params = message["method"], message.get("params", {})
-        handler = self._methods.get(method)
+        handler = self.METHODS.get(method)
         try:
             if handler is None:
                 raise RpcError(NO_SUCH_METHOD, f"`{method}` is no method of the studio: the "
-                               f"methods are {', '.join(self._methods)} (spec/studio.md)")
+                               f"methods are {', '.join(self.METHODS)} (spec/studio.md)")
             if not isinstance(params, dict):
                 raise RpcError(INVALID_PARAMS, "`params` is not an object: send an object, "
                                "{} when there is nothing to give")
-            result = await handler(params)
+            result = await handler(self, params)
         except RpcError as error:
             self._answer(msg_id, error=error)
         except Exception as error:  # a bug of ours: the connection goes on, and says so
@@ -248,7 +230,7 @@ class Connection:
             raise RpcError(INVALID_PARAMS, "give `world` (the simulator) or `sensors` (a "
                            "sensor script), not both")
         level = params.get("level")
-        if (level is not None and level not in LEVELS) or isinstance(level, bool):
+        if level is not None and not (_whole(level) and level in LEVELS):
             raise RpcError(INVALID_PARAMS, f"`level` is {level!r}: give 0, 1, 2 or null")
         seed = params.get("seed", 0)
         if not _whole(seed) or not 0 <= seed <= MAX_SEED:
@@ -433,6 +415,27 @@ class Connection:
         except DebugError as error:
             raise RpcError(INVALID_PARAMS, str(error)) from None
         return {"value": value}
+
+    # The methods of spec/studio.md, each a coroutine of the connection and the params.
+    METHODS: ClassVar[dict[str, Callable[[Connection, dict[str, Any]],
+                                         Awaitable[dict[str, Any]]]]] = {
+        "initialize": _initialize,
+        "files/list": _list,
+        "files/read": _read,
+        "files/save": _save,
+        "world/check": _check_world,
+        "palette": _palette,
+        "run/launch": _launch,
+        "debug/setBreakpoints": _set_breakpoints,
+        "debug/continue": _continue,
+        "debug/stepLine": _step_line,
+        "debug/stepInstruction": _step_instruction,
+        "debug/pause": _pause,
+        "debug/restart": _restart,
+        "debug/stop": _stop,
+        "debug/setSpeed": _set_speed,
+        "debug/evaluate": _evaluate,
+    }
 
 
 # Params ------------------------------------------------------------------------------

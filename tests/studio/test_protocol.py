@@ -309,6 +309,10 @@ def test_files_are_listed_read_and_saved(client: Page, folder: Path) -> None:
     ('{"jsonrpc": "2.0", "id": 7, "method": "run/launch", "params": '
      '{"program": {"path": "sample.rob"}, "level": 3}}', -32602),
     ('{"jsonrpc": "2.0", "id": 7, "method": "run/launch", "params": '
+     '{"program": {"path": "sample.rob"}, "level": 1.0}}', -32602),
+    ('{"jsonrpc": "2.0", "id": 7, "method": "run/launch", "params": '
+     '{"program": {"path": "sample.rob"}, "level": true}}', -32602),
+    ('{"jsonrpc": "2.0", "id": 7, "method": "run/launch", "params": '
      '{"program": {"path": "sample.rob"}, "speed": 0}}', -32602),
     ('{"jsonrpc": "2.0", "id": 7, "method": "files/read", "params": {"path": "/etc/passwd"}}',
      -32001),
