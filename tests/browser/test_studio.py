@@ -1,0 +1,316 @@
+"""The studio (`rl1c studio`, spec/studio.md) in a real browser: Debian's chromium driven
+by Playwright for Python, as test_replay_page.py drives it (no browser of Playwright's
+own). The studio serves a copy of examples/ with Listing 1 and its world; the page opens
+with the token, shows a mistyped call's diagnostic and applies its quick fix, stops at a
+breakpoint on line 20 with the vehicle there and the variables shown, steps and runs
+on to the end; the world file's error is shown as it is edited, and on a guidance line
+made shorter the lost line and the handler jump are marked in the trace; the page is
+usable 420 px wide, with nothing on its console. A screenshot of each step is kept in
+build/studio-screenshots/."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from support import EXAMPLES, ROOT
+
+CHROMIUM = "/usr/bin/chromium"
+ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--no-first-run", "--disable-sync"]
+RL1C = str(Path(sys.executable).with_name("rl1c"))
+SCREENSHOTS = ROOT / "build" / "studio-screenshots"
+SERVING = re.compile(r"rl1c studio: serving .* at (http://127\.0\.0\.1:\d+/\?token=\S+) ")
+WAIT = 20_000  # ms: a step of the page on two shared cores
+# The page's Content-Security-Policy allows no eval, so the tests wait for selectors
+# (Playwright's wait_for_function evaluates a string).
+
+if not os.access(CHROMIUM, os.X_OK):
+    pytest.skip(f"{CHROMIUM} is missing: run tests/browser/install-chromium as root",
+                allow_module_level=True)
+sync_api = pytest.importorskip(
+    "playwright.sync_api", reason="Playwright is missing: run tests/browser/install-chromium")
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A copy of examples/, which the studio serves."""
+    copy = tmp_path_factory.mktemp("studio") / "examples"
+    shutil.copytree(EXAMPLES, copy)
+    return copy
+
+
+@pytest.fixture(scope="module")
+def studio(folder: Path) -> Iterator[str]:
+    """`rl1c studio` on Listing 1 and its world in `folder`: the page's address."""
+    with subprocess.Popen([RL1C, "studio", "sample.rob", "--world", "sample.world.toml",
+                           "--no-browser", "--port", "0"], cwd=folder, text=True,
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE) as server:
+        assert server.stdout is not None
+        first = server.stdout.readline()
+        serving = SERVING.match(first)
+        if serving is None:
+            server.kill()
+            pytest.fail(f"rl1c studio did not say where it serves: {first!r}"
+                        f"{server.communicate(timeout=30)[1]}")
+        yield serving[1]
+        server.terminate()
+        server.communicate(timeout=30)
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Any]:
+    with sync_api.sync_playwright() as playwright:
+        launched = playwright.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        yield launched
+        launched.close()
+
+
+class Studio:
+    """The page open in a fresh context, with what it logged and every request it made
+    somewhere other than the studio's server."""
+
+    def __init__(self, browser: Any, address: str, width: int) -> None:
+        self.context = browser.new_context(viewport={"width": width, "height": 900})
+        self.page = self.context.new_page()
+        self.problems: list[str] = []
+        self.elsewhere: list[str] = []
+        origin = address.split("/?", 1)[0]  # http://127.0.0.1:PORT
+        self.served = (origin, origin.replace("http", "ws", 1), "data:")
+        self.page.on("console", self._console)
+        self.page.on("pageerror", lambda error: self.problems.append(f"error: {error}"))
+        self.page.on("request", self._request)
+        self.page.goto(address)
+        self.page.wait_for_selector("body[data-ready=true]", state="attached", timeout=WAIT)
+
+    def _console(self, message: Any) -> None:
+        if message.type in ("error", "warning"):
+            self.problems.append(f"{message.type}: {message.text}")
+
+    def _request(self, request: Any) -> None:
+        if not request.url.startswith(self.served):
+            self.elsewhere.append(request.url)
+
+    def shot(self, name: str) -> None:
+        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+        self.page.screenshot(path=str(SCREENSHOTS / f"{name}.png"), full_page=True)
+
+    def line(self, number: int) -> Any:
+        """The editor's line `number` (1-based), scrolled into view."""
+        gutter = self.page.locator("#editor .cm-lineNumbers .cm-gutterElement", has_text=re.compile(
+            f"^{number}$"))
+        if gutter.count() == 0:  # not drawn: the editor draws the lines near its view
+            self.page.locator("#editor .cm-scroller").evaluate(
+                "(scroller, line) => { scroller.scrollTop = (line - 3) * "
+                "scroller.querySelector('.cm-line').offsetHeight; }", number)
+        gutter.scroll_into_view_if_needed()
+        top = gutter.bounding_box()["y"]
+        return next(line for line in self.page.locator("#editor .cm-line").all()
+                    if abs(line.bounding_box()["y"] - top) < 2)
+
+    def stop(self, reason: str) -> str:
+        self.page.wait_for_selector(f"#stop[data-reason='{reason}']", state="attached",
+                                    timeout=WAIT)
+        return self.page.text_content("#stop") or ""
+
+    def vehicle(self) -> str:
+        return self.page.get_attribute("#vehicle", "points") or ""
+
+
+@pytest.fixture
+def wide(browser: Any, studio: str) -> Iterator[Studio]:
+    opened = Studio(browser, studio, 1400)
+    yield opened
+    assert opened.problems == [], "the page logged problems"
+    assert opened.elsewhere == [], "the page asked for something besides the studio"
+    opened.context.close()
+
+
+def test_a_mistyped_call_shows_its_diagnostic_and_its_quick_fix_mends_it(wide: Studio) -> None:
+    page = wide.page
+    line = wide.line(3)
+    original = line.text_content()
+    assert original == "(SCN 0); (TRC 3); (MOV 3,3)"
+    wide.shot("01-opened")
+    assert page.locator(".cm-lintRange-error").count() == 0
+    line.click()
+    page.keyboard.press("End")
+    for _ in range(len(" 3,3)")):
+        page.keyboard.press("ArrowLeft")
+    page.keyboard.press("Backspace")
+    page.keyboard.type("B")  # (MOB 3,3)
+    mark = page.locator(".cm-lintRange-error")
+    mark.wait_for(timeout=WAIT)
+    assert mark.text_content() == "MOB"
+    mark.hover()
+    fix = page.locator(".cm-tooltip-lint .cm-diagnosticAction")
+    fix.wait_for(timeout=WAIT)
+    tooltip = page.text_content(".cm-tooltip-lint") or ""
+    assert "`MOB` is not a built-in function" in tooltip
+    assert fix.text_content() == "write `MOV`"
+    wide.shot("02-diagnostic")
+    fix.click()
+    assert wide.line(3).text_content() == original
+    page.locator(".cm-lintRange-error").first.wait_for(state="detached", timeout=WAIT)
+    wide.shot("03-quick-fix-applied")
+
+
+def test_the_palette_inserts_a_call_with_a_field_for_each_argument(wide: Studio) -> None:
+    page = wide.page
+    assert wide.line(11).text_content() == ":13"
+    wide.line(11).click()
+    page.keyboard.press("End")
+    page.click("#palette button[title^='Move: ']")  # (MOV l,r), Table 2
+    page.keyboard.type("2")  # the first field, l, is selected
+    page.keyboard.press("Tab")
+    page.keyboard.type("-2")
+    assert wide.line(11).text_content() == ":13 (MOV 2,-2)"
+    tables = page.locator("#palette .table").all_text_contents()
+    assert tables == ["Table 2: motion", "Table 3: sensing"]
+    calls = page.locator("#palette button").all_text_contents()
+    assert "(CAM P pulse)" in calls and "(ULT A)" in calls and "(END)" not in calls
+    wide.shot("04-palette")
+
+
+def test_the_editor_highlights_rl1(wide: Studio) -> None:
+    page = wide.page
+    kinds = {text: wide.line(line).locator("span", has_text=re.compile(f"^{re.escape(text)}$"))
+             .first.get_attribute("class") for line, text in (
+                 (2, "CAM"), (2, "Z"), (4, ":10"), (4, "#10"), (4, "?"), (6, "x"), (8, "A"),
+                 (9, "-450"), (41, ":96"), (1, "'SAMPLE.ROB"))}
+    assert kinds == {"CAM": "tok-builtin", "Z": "tok-selector", ":10": "tok-label",
+                     "#10": "tok-label", "?": "tok-keyword", "x": "tok-variable tok-reserved",
+                     "A": "tok-variable", "-450": "tok-number", ":96": "tok-label tok-handler",
+                     "'SAMPLE.ROB": "tok-comment"}
+    assert page.locator("#palette button").count() > 20
+
+
+def test_a_breakpoint_stops_the_vehicle_then_step_and_continue_to_the_end(wide: Studio) -> None:
+    page = wide.page
+    start = wide.vehicle()
+    assert start, "the vehicle is drawn at its start"
+    page.select_option("#speed", "10")
+    line = wide.line(20)
+    assert line.text_content() == "(STX D); (MOV 1,1)"
+    box = line.bounding_box()
+    gutter = page.locator(".cm-breakpoint-gutter").bounding_box()
+    page.mouse.click(gutter["x"] + gutter["width"] / 2, box["y"] + box["height"] / 2)
+    assert page.locator(".cm-breakpoint-dot").count() == 1
+    page.click("#run")
+    assert wide.stop("breakpoint") == "breakpoint at line 20"
+    assert page.locator(".cm-run-line").text_content() == "(STX D); (MOV 1,1)"
+    assert wide.vehicle() != start, "the vehicle moved to where line 20 runs"
+    assert int(page.get_attribute("#world", "data-frames-drawn") or 0) > 1, "it moved live"
+    assert page.locator("#variables .variable").count() == 53
+    assert page.locator("#variables .variable.changed").count() > 0
+    assert page.locator("#device dt", has_text="x (cm)").count() == 1
+    wide.shot("05-stopped-at-the-breakpoint")
+
+    page.click("#step-line")
+    assert wide.stop("step") == "step at line 21"
+    assert page.locator(".cm-run-line").text_content() == ":20 (IMG)"
+    wide.shot("06-stepped")
+
+    page.click("#continue")
+    assert wide.stop("end").startswith("ended: the program ended; goal met; ")
+    assert page.locator(".cm-run-line, .cm-fault-line").count() == 0
+    assert "(IMG) = " in (page.text_content("#trace") or "")
+    assert page.locator("#world .event.end").count() == 1
+    wide.shot("07-ended")
+
+
+def test_a_breakpoint_with_a_condition_stops_when_it_holds(wide: Studio) -> None:
+    page = wide.page
+    page.select_option("#speed", "")  # as fast as the server runs
+    line = wide.line(22)
+    assert line.text_content() == "      Y=y-160; ?Y>#29"
+    gutter = page.locator(".cm-breakpoint-gutter").bounding_box()
+    box = line.bounding_box()
+    at = {"x": gutter["x"] + gutter["width"] / 2, "y": box["y"] + box["height"] / 2}
+    page.once("dialog", lambda dialog: dialog.accept("y-160>0"))
+    page.mouse.click(at["x"], at["y"], button="right")
+    assert page.locator(".cm-breakpoint-dot.conditional").count() == 1
+    page.click("#run")
+    assert wide.stop("breakpoint") == "breakpoint at line 22: y-160>0"
+    y = int(page.text_content("#variables .variable[data-name=y] .value") or "0")
+    assert y > 160
+    page.once("dialog", lambda dialog: dialog.accept("y-"))  # not a value: refused
+    page.mouse.click(at["x"], at["y"], button="right")
+    page.wait_for_selector("#status.problem", timeout=WAIT)
+    assert (page.text_content("#status") or "").startswith("breakpoint on line 22: ")
+
+
+def test_the_world_file_shows_its_error_and_a_shorter_line_is_lost(wide: Studio) -> None:
+    page = wide.page
+    world = (EXAMPLES / "sample.world.toml").read_text(encoding="utf-8")
+    page.click("#world-file summary")
+    page.click("#world-editor .cm-content")
+    page.keyboard.press("Control+a")
+    page.keyboard.insert_text(world.replace("size = [800, 500]", "size = [800, -5]"))
+    problem = page.locator("#world-errors li")
+    problem.wait_for(timeout=WAIT)
+    assert (problem.text_content() or "").startswith("sample.world.toml:7: floor.size")
+    assert page.locator("#world-editor .cm-lintRange-error").count() == 1
+    wide.shot("08-world-file-error")
+    # The guidance line ends before the branch mark: tracing in mode 3 loses it during
+    # (MOV 3,3), and Listing 1 jumps to its handler :96.
+    page.keyboard.press("Control+a")
+    page.keyboard.insert_text(world.replace("[[0, 150], [800, 150]]", "[[0, 150], [200, 150]]"))
+    problem.first.wait_for(state="detached", timeout=WAIT)
+    page.select_option("#speed", "")  # as fast as the server runs
+    page.click("#run")
+    assert "goal missed" in wide.stop("goal-missed")
+    assert "line lost during MOV in mode 3" in (page.text_content("#trace li.lost") or "")
+    assert ":96" in (page.text_content("#trace li.handler") or "")
+    assert page.locator("#world .event.lost").count() == 1
+    wide.shot("09-line-lost")
+    page.check("#stop-on-lost")
+    page.click("#run")
+    assert wide.stop("lost-line") == ("lost-line at line 41: line lost (mode 3, MOV): "
+                                      "jump to :96")
+    assert page.locator(".cm-run-line").text_content() == ":96 (MOV 0,0)"
+
+
+def test_saving_writes_the_file(wide: Studio, folder: Path) -> None:
+    page = wide.page
+    assert wide.line(43).text_content() == "(FRE); (END)"
+    wide.line(43).click()
+    page.keyboard.press("End")
+    page.keyboard.type(" ' the end")
+    assert "unsaved" in (page.get_attribute("#program-file", "class") or "")
+    page.keyboard.press("Control+s")
+    page.wait_for_selector("#status:text('saved sample.rob')", timeout=WAIT)
+    assert (folder / "sample.rob").read_text(encoding="utf-8").endswith(
+        "(FRE); (END) ' the end\n")
+    assert "unsaved" not in (page.get_attribute("#program-file", "class") or "")
+
+
+def test_at_420_px_the_panes_stack_and_stay_usable(browser: Any, studio: str) -> None:
+    narrow = Studio(browser, studio, 420)
+    page = narrow.page
+    page.select_option("#speed", "")  # as fast as the server runs
+    page.click("#run")
+    page.wait_for_selector("body[data-run=ended]", state="attached", timeout=60_000)
+    for selector in ("#program-file", "#save", "#run", "#step-line", "#continue", "#speed",
+                     "#palette button", ".cm-content", "#world", "#stop", "#variables",
+                     "#trace", *(f"#{pane}" for pane in page.eval_on_selector_all(
+                         ".pane:not([hidden])", "panes => panes.map(pane => pane.id)") if pane)):
+        element = page.locator(selector).first
+        element.scroll_into_view_if_needed()
+        assert element.is_visible(), selector
+        box = element.bounding_box()
+        assert box is not None and box["x"] >= 0 and box["x"] + box["width"] <= 420, selector
+    assert page.evaluate("document.documentElement.scrollWidth") <= 420, "no sideways scrolling"
+    tops = [page.locator(selector).bounding_box()["y"]
+            for selector in ("#editor", "#world", "#stop", "#variables")]
+    assert tops == sorted(tops), "the editor, the world, where it stopped, the variables"
+    narrow.shot("10-at-420px")
+    assert narrow.problems == []
+    narrow.context.close()
