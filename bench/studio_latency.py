@@ -38,6 +38,7 @@ ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-net
 SERVING = re.compile(r"rl1c studio: serving .* at (http://127\.0\.0\.1:\d+/\?token=\S+) ")
 GOAL_MS = 100.0
 GOAL_FPS = 30.0
+STEP_GOAL_MS = 20.0  # the issue's, for the answer to a line step; here with its drawing
 WAIT = 30_000  # ms
 FIRST_MOVE_MS = 401.0
 """When Listing 1's (MOV 3,3) starts the vehicle on this world, in device time (its
@@ -152,7 +153,8 @@ def line_steps(page: Page, runs: int) -> list[float]:
 
 
 def frames_per_second(page: Page) -> float:
-    """Frames drawn a second while the run goes on at 10x real time, over 1.5 s."""
+    """Frames drawn a second while the run goes on at 10x real time, over 3 s (of the
+    6 s the run takes at that speed)."""
     page.select_option("#speed", "10")
     page.wait_for_selector("#run:not([disabled])", state="attached", timeout=WAIT)
     drawn = "() => [Number(document.getElementById('world').dataset.framesDrawn ?? 0), " \
@@ -161,17 +163,20 @@ def frames_per_second(page: Page) -> float:
     page.click("#run")
     while (first := page.evaluate(drawn))[0] == before:
         page.wait_for_timeout(10)
-    page.wait_for_timeout(1500)
+    page.wait_for_timeout(3000)
     last = page.evaluate(drawn)
     if last[2] != "running":
         print("  (the run ended within the window: the figure is a lower bound)")
     return float((last[0] - first[0]) / ((last[1] - first[1]) / 1000))
 
 
-def summary(name: str, times: list[float], goal: float) -> None:
+def summary(name: str, times: list[float], goal: float, past: float = 0.0) -> None:
+    """The median against the goal, `past` milliseconds that are not the studio's
+    (the program's own device time) added to it."""
     median = statistics.median(times)
+    after = f" after the first {past:.0f} ms" if past else ""
     print(f"{name}: median {median:.1f} ms, slowest {max(times):.1f} ms over {len(times)} "
-          f"(goal {goal:.0f} ms: {'met' if median <= goal else 'missed'})")
+          f"(goal {goal:.0f} ms{after}: {'met' if median <= goal + past else 'missed'})")
 
 
 def main() -> None:
@@ -194,12 +199,13 @@ def main() -> None:
                 start = page.get_attribute("#vehicle", "points") or ""
                 first, away = first_frames(page, runs, start)
                 summary("run to the first frame drawn, at real time", first, GOAL_MS)
-                summary(f"run to the vehicle drawn away from its start ({FIRST_MOVE_MS:.0f} ms "
-                        "of it Listing 1's camera moves)", away, GOAL_MS + FIRST_MOVE_MS)
-                summary("step line, click to the stop shown", line_steps(page, runs), 20.0)
+                summary("run to the vehicle drawn away from its start, at real time (Listing "
+                        "1's camera moves come first)", away, GOAL_MS, FIRST_MOVE_MS)
+                summary("step line, click to the stop drawn", line_steps(page, runs),
+                        STEP_GOAL_MS)
                 fps = frames_per_second(page)
-                print(f"frames a second at 10x real time: {fps:.1f} "
-                      f"(goal {GOAL_FPS:.0f}: {'met' if fps >= GOAL_FPS - 1 else 'missed'})")
+                print(f"frames drawn a second at 10x real time: {fps:.1f} (goal {GOAL_FPS:.0f}, "
+                      "which is also the most the server sends)")
                 browser.close()
         finally:
             server.terminate()
