@@ -278,6 +278,12 @@ def test_the_world_file_shows_its_error_and_a_shorter_line_is_lost(wide: Studio)
     assert page.locator(".cm-run-line").text_content() == ":96 (MOV 0,0)"
 
 
+def test_format_lays_the_program_out(wide: Studio) -> None:
+    assert wide.line(9).text_content() == "      c=205; d=-450; #13"
+    wide.page.click("#format")
+    sync_api.expect(wide.line(9)).to_have_text("c=205; d=-450; #13", timeout=WAIT)
+
+
 def test_saving_writes_the_file(wide: Studio, folder: Path) -> None:
     page = wide.page
     assert wide.line(43).text_content() == "(FRE); (END)"

@@ -10,6 +10,7 @@ import { defaultKeymap, history, historyKeymap, indentWithTab } from "@codemirro
 import { bracketMatching, syntaxHighlighting } from "@codemirror/language";
 import { lintGutter } from "@codemirror/lint";
 import { autocompletion, closeBrackets } from "@codemirror/autocomplete";
+import { formatDocument } from "@codemirror/lsp-client";
 import { rl1Highlight, rl1Language } from "./language";
 import { openSocket, studioClient, webSocketTransport } from "./lsp";
 import { LineBreakpoint, debuggerMarks, showCurrentLine } from "./breakpoints";
@@ -144,6 +145,7 @@ async function start(): Promise<void> {
     }),
   });
   byId("save").addEventListener("click", () => void save());
+  byId("format").addEventListener("click", () => formatDocument(editor));
   programSelect.addEventListener("change", () => {
     if (editor.state.doc.toString() !== savedText && !confirm(`${programPath} has unsaved changes: leave them?`)) {
       programSelect.value = programPath;
