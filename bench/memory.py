@@ -8,7 +8,8 @@ the peak of `rl1c check` on an empty file printed as the reference (the interpre
 the modules). A run that has not ended after --seconds is stopped, and its peak so far
 is printed with "(stopped)".
 
-    .venv/bin/python bench/memory.py [--only sim|source] [--match TEXT] [--seconds 300]
+    .venv/bin/python bench/memory.py [--only sim|source] [--command check|compile]
+                                     [--match TEXT] [--seconds 300]
 """
 
 from __future__ import annotations
@@ -102,7 +103,8 @@ def sources() -> list[tuple[str, bytes]]:
     ]
 
 
-def source_cases(folder: Path, seconds: float, match: str) -> None:
+def source_cases(folder: Path, seconds: float, match: str, commands: list[str]) -> None:
+    arguments = {"check": ["check"], "compile": ["compile", "-o", str(folder / "big.ilc")]}
     empty = folder / "empty.rob"
     empty.write_bytes(b"")
     reference, _ = peak(["check", str(empty)], seconds)
@@ -113,7 +115,7 @@ def source_cases(folder: Path, seconds: float, match: str) -> None:
             continue
         path = folder / "big.rob"
         path.write_bytes(data)
-        for command in (["check"], ["compile", "-o", str(folder / "big.ilc")]):
+        for command in (arguments[one] for one in commands):
             started = time.monotonic()
             megabytes, ending = peak([*command, str(path)], seconds)
             per_byte = (megabytes - reference) * MIB / len(data)
@@ -124,6 +126,8 @@ def source_cases(folder: Path, seconds: float, match: str) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", choices=("sim", "source"))
+    parser.add_argument("--command", choices=("check", "compile"),
+                        help="only this command on the sources")
     parser.add_argument("--match", default="", help="only the cases whose name holds this")
     parser.add_argument("--seconds", type=float, default=300.0,
                         help="stop a run after this long and print its peak so far")
@@ -133,7 +137,8 @@ def main() -> None:
         if options.only in (None, "sim"):
             sim_cases(folder, options.seconds, options.match)
         if options.only in (None, "source"):
-            source_cases(folder, options.seconds, options.match)
+            commands = [options.command] if options.command else ["check", "compile"]
+            source_cases(folder, options.seconds, options.match, commands)
 
 
 if __name__ == "__main__":

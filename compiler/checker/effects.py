@@ -86,7 +86,7 @@ def reserved_writes(call: ast.Call) -> int:
     return _facts(call).writes
 
 
-def combine(parts: list[tuple[int, BlockEffects]]) -> BlockEffects:
+def combine(parts: Sequence[tuple[int, BlockEffects]]) -> BlockEffects:
     """The effects of a block from those of its runs, each with the index in the block
     of its first statement. Summaries are shared, never changed, so one run's is reused
     as it is."""
@@ -181,10 +181,10 @@ def summarize(statements: Sequence[ast.Statement]) -> BlockEffects | None:
             if first_event is None:
                 first_event = index
             call = statement.call
-            facts = known(call.mnemonic)
-            if facts is None:
-                facts = _facts(call)
+            known_facts = known(call.mnemonic)
+            if known_facts is None:
                 calls_unknown = calls_unknown or call.mnemonic.upper() not in BUILTINS
+            facts = known_facts or _facts(call)
             for arg in call.args:
                 if isinstance(arg, var):
                     reads |= bit(arg.name, 0)
