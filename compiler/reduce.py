@@ -16,9 +16,10 @@ and, at the end, the program in the canonical layout of the formatter and the sc
 written one key a line, each only if the case stays interesting.
 
 A candidate is tested only once (the results are remembered by the candidate's digest),
-and only when it is as well-formed as the original: a program the checker accepts stays
-one (engines compare only such programs, and a bug found in one is seldom a bug of
-another), and a valid sensor script stays valid (vm/sensor_script.py).
+and only when it is no larger than the original (so the result never is, whatever the
+layouts) and as well-formed: a program the checker accepts stays one (engines compare
+only such programs, and a bug found in one is seldom a bug of another), and a valid
+sensor script stays valid (vm/sensor_script.py).
 """
 
 from __future__ import annotations
@@ -108,6 +109,7 @@ class _Test:
         self.seen: dict[bytes, bool] = {}  # a candidate's digest: whether it was interesting
         self.checked = _accepted(original.source)
         self.valid_script = original.script is not None and _valid_script(original.script)
+        self.original = original
         self.smallest = original  # the last interesting candidate: the smallest so far
 
     def __call__(self, case: Case) -> bool:
@@ -115,8 +117,8 @@ class _Test:
         known = self.seen.get(digest)
         if known is not None:
             return known
-        if (self.checked and not _accepted(case.source)) or (
-                self.valid_script and not _valid_script(case.script or "")):
+        if case.size > self.original.size or (self.checked and not _accepted(case.source)) \
+                or (self.valid_script and not _valid_script(case.script or "")):
             result = False
         else:
             if self.tests >= self.max_tests:
@@ -338,14 +340,12 @@ def script_text(data: dict[str, Any]) -> str:
 
 
 def _script(case: Case) -> dict[str, Any] | None:
-    """The case's sensor script as JSON data, None when it has none or it is no JSON
-    object (a TOML script is left as it is)."""
-    if case.script is None:
+    """The case's sensor script as JSON data; None when it has none, or one that is not
+    a valid script in JSON (a TOML script, or anything nested deeper than a script's
+    schema allows, is left as it is)."""
+    if case.script is None or not _valid_script(case.script):
         return None
-    try:
-        data = json.loads(case.script)
-    except (ValueError, RecursionError):
-        return None
+    data = json.loads(case.script)
     return data if isinstance(data, dict) else None
 
 

@@ -99,6 +99,12 @@ def reduce(file: str, sensors: str | None, command: str | None,
     if sensors is not None and os.path.basename(sensors) == os.path.basename(file):
         raise click.UsageError("the program and the sensor script have one name; the "
                                "command finds them by name in one folder: rename one")
+    for target, role in ((out, "--out"), (sensors_out, "--sensors-out")):
+        folder = os.path.dirname(os.path.abspath(target or "."))
+        if target is not None and (os.path.isdir(target) or not os.path.isdir(folder)):
+            raise click.UsageError(f"argument {role}: {target}: "
+                                   + ("it is a folder; name a file" if os.path.isdir(target)
+                                      else f"there is no folder {folder}"))
     try:
         source = read_source(file)
     except SourceError as error:

@@ -93,6 +93,22 @@ def test_the_sensor_script_keeps_only_what_matters_with_its_numbers_made_small()
     assert reduction.case.script == '{\n  "IMG": [' + json.dumps(reading) + "]\n}\n"
 
 
+def test_a_candidate_larger_than_the_original_is_never_tested() -> None:
+    compact = '{"IMG":[{"area":1000,"x":0,"y":0,"z":0}]}'
+    tested: list[Case] = []
+
+    def sees_far(case: Case) -> bool:
+        tested.append(case)
+        readings = json.loads(case.script or "{}").get("IMG", [])
+        return any(reading["area"] > 100 for reading in readings)
+
+    original = Case("(MOV 0,0)\n", compact)
+    reduction = reduce(original, sees_far, max_tests=TESTS)
+    # Written one key a line, a smaller area is a longer script: left as it was.
+    assert reduction.case == original
+    assert len(tested) > 1 and all(case.size <= original.size for case in tested)
+
+
 def test_a_script_nothing_needs_becomes_empty() -> None:
     reduction = reduce(Case("(MOV 3,3)\n", SAMPLE_SENSORS.read_text(encoding="utf-8")),
                        moves, max_tests=TESTS)
@@ -273,6 +289,29 @@ def test_a_script_that_is_not_text_is_refused(tmp_path: Path) -> None:
 def test_usage_problems(args: tuple[str, ...], said: str) -> None:
     result = rl1c("reduce", SAMPLE, *args)
     assert result.exit_code == 2 and said in result.stderr
+
+
+def test_a_script_nested_too_deeply_is_left_as_it_is(sample: tuple[Path, Path]) -> None:
+    program, script = sample
+    deep = '{"a":' * 990 + "1" + "}" * 990
+    script.write_text(deep, encoding="utf-8")
+    result = rl1c("reduce", program, "--sensors", script, "--interesting",
+                  "grep -q '(MOV' sample.rob && grep -q 1 sample.sensors.json")
+    assert result.exit_code == 0, result.output
+    figures = f"1 line, {len(deep)} bytes"
+    assert f"sensor script {script}: {figures} -> {figures}\n" in result.stdout
+    assert script.read_text(encoding="utf-8") == deep
+
+
+def test_an_output_that_cannot_be_written_is_refused_before_reducing(
+        sample: tuple[Path, Path]) -> None:
+    program, _ = sample
+    for out, said in ((program.parent, "it is a folder; name a file"),
+                      (program.parent / "none" / "x.rob", "there is no folder ")):
+        result = rl1c("reduce", program, "--interesting", "true", "--out", out)
+        assert result.exit_code == 2 and f"error: argument --out: {out}: {said}" \
+            in result.stderr
+        assert "rl1c reduce: lines" not in result.stderr
 
 
 def test_engines_that_agree_leave_nothing_to_reduce() -> None:
