@@ -10,6 +10,8 @@ name and a `run`.
 
 from __future__ import annotations
 
+import atexit
+import base64
 import contextlib
 import json
 import os
@@ -223,6 +225,142 @@ class ExecEngine:
 
 
 @dataclass(frozen=True)
+class BatchEngine:
+    """A command started once (per process) that runs one program after another
+    (spec/optimization.md, section 5, "Batch engines"): `exec-batch:COMMAND` given the
+    file compiled with -O0, `exec-batch-ON:COMMAND` at -ON. It reads a job a line on its
+    standard input and answers each with the run on a line of its standard output."""
+
+    command: str
+    level: int = 0
+    name: str = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "name", f"exec-batch{f'-O{self.level}' if self.level else ''}"
+                                         f":{self.command}")
+
+    def job(self, case: Run, budget: int) -> bytes:
+        """The job line of `case` (without its line end)."""
+        return json.dumps({"ilc": base64.b64encode(compiled(case.source, self.level))
+                           .decode("ascii"), "sensors": case.script, "budget": budget},
+                          separators=(",", ":")).encode("utf-8")
+
+    def run(self, case: Run, budget: int) -> Observation:
+        batch = _BATCHES.get(self.command)
+        if batch is None or batch.owner != os.getpid():  # not one a parent process started
+            batch = _BATCHES[self.command] = _Batch(self.command)
+        return batch.ask(self.job(case, budget))
+
+
+class _Batch:
+    """A batch engine's process, started at its first job and again after one it did
+    not answer as the protocol says (its state is then unknown)."""
+
+    def __init__(self, command: str) -> None:
+        self.command = command
+        self.owner = os.getpid()
+        self.process: subprocess.Popen[bytes] | None = None
+        self.stderr = bytearray()  # the end of its standard error
+
+    def ask(self, job: bytes) -> Observation:
+        """The engine's answer to `job`, or a status saying why there is none."""
+        if self.process is None:
+            self.process = subprocess.Popen(self.command, shell=True, stdin=subprocess.PIPE,
+                                            stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                            start_new_session=True)
+            self.stderr.clear()
+        process = self.process
+        assert process.stdin is not None and process.stdout is not None \
+            and process.stderr is not None
+        unsent, answer = memoryview(job + b"\n"), bytearray()
+        deadline = time.monotonic() + EXEC_TIMEOUT
+        with selectors.DefaultSelector() as selector:
+            os.set_blocking(process.stdin.fileno(), False)
+            selector.register(process.stdin, selectors.EVENT_WRITE)
+            selector.register(process.stdout, selectors.EVENT_READ, answer)
+            selector.register(process.stderr, selectors.EVENT_READ, self.stderr)
+            while b"\n" not in answer:
+                left = deadline - time.monotonic()
+                if left <= 0:
+                    return self._failed("timeout", "it answered no job in "
+                                        f"{EXEC_TIMEOUT:.0f} seconds")
+                for key, _ in selector.select(left):
+                    if key.fileobj is process.stdin:
+                        try:
+                            unsent = unsent[os.write(key.fd, unsent):]
+                        except BrokenPipeError:
+                            return self._failed("no-run", self._ended("reading the job"))
+                        if not unsent:
+                            selector.unregister(process.stdin)
+                        continue
+                    chunk = os.read(key.fd, 1 << 16)
+                    if not chunk and key.fileobj is process.stdout:
+                        return self._failed("no-run", self._ended("answering"))
+                    if not chunk:
+                        selector.unregister(key.fileobj)
+                    key.data.extend(chunk)
+                del self.stderr[:-STDERR_KEPT]
+                if len(answer) > EXEC_OUTPUT_LIMIT:
+                    return self._failed("too-much-output", "it printed more than "
+                                        f"{EXEC_OUTPUT_LIMIT // 2**20} MiB for one job")
+        line, rest = answer.split(b"\n", 1)
+        if rest or unsent:
+            return self._failed("no-run", "it printed more than one line for one job" if rest
+                                else "it answered before it had read the whole job")
+        return Observation(printed_run(bytes(line), bytes(self.stderr)))
+
+    def _ended(self, doing: str) -> str:
+        """What the engine, which ended, did: its exit status, its standard error's end
+        read (for at most a second, when another process holds it open)."""
+        assert self.process is not None and self.process.stderr is not None
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            self.process.wait(1)
+        deadline = time.monotonic() + 1
+        with selectors.DefaultSelector() as selector:
+            selector.register(self.process.stderr, selectors.EVENT_READ)
+            while selector.select(max(deadline - time.monotonic(), 0)):
+                chunk = os.read(self.process.stderr.fileno(), 1 << 16)
+                if not chunk:
+                    break
+                self.stderr.extend(chunk)
+                del self.stderr[:-STDERR_KEPT]
+        status = self.process.poll()
+        return (f"it ended before {doing}" + (f" (exit status {status})"
+                                              if status is not None else ""))
+
+    def _failed(self, code: str, message: str) -> Observation:
+        """The status of a job the engine did not answer; it is stopped, to start again
+        at the next job."""
+        said = self.stderr.decode("utf-8", "replace").strip().splitlines()
+        self.close()
+        return _no_run(code, message + (f"; its standard error ends: {said[-1]}"
+                                        if said else ""))
+
+    def close(self) -> None:
+        """Stop the engine and every process it started."""
+        if self.process is None:
+            return
+        process, self.process = self.process, None
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
+        for stream in (process.stdin, process.stdout, process.stderr):
+            if stream is not None:
+                with contextlib.suppress(OSError):
+                    stream.close()
+
+
+_BATCHES: dict[str, _Batch] = {}  # this process's batch engines, by command
+
+
+@atexit.register
+def _close_batches() -> None:
+    for batch in _BATCHES.values():
+        if batch.owner == os.getpid():
+            batch.close()
+
+
+@dataclass(frozen=True)
 class _Ran:
     """How a shell command ended ("done", "timeout", "too-much-output"), and what it
     printed: its standard output whole, the end of its standard error."""
@@ -340,8 +478,9 @@ DEFAULT_ENGINES = ("ast", *(f"vm-O{level}" for level in OPTIMIZATION_LEVELS))
 ENGINE_NAMES = (*DEFAULT_ENGINES, *(f"c-O{level}" for level in OPTIMIZATION_LEVELS))
 
 
-EXEC_ENGINE = re.compile(r"exec(?:-O([0-9]+))?:(.*\S.*)", re.DOTALL)
-"""`exec:COMMAND` (given the -O0 file) or `exec-ON:COMMAND` (the file at -ON)."""
+EXEC_ENGINE = re.compile(r"exec(-batch)?(?:-O([0-9]+))?:(.*\S.*)", re.DOTALL)
+"""`exec:COMMAND` (given the -O0 file) or `exec-ON:COMMAND` (the file at -ON), and the
+same with `exec-batch`."""
 
 
 def engine_named(name: str) -> Engine | None:
@@ -353,8 +492,10 @@ def engine_named(name: str) -> Engine | None:
     if name.startswith("c-O") and name[3:] in {str(level) for level in OPTIMIZATION_LEVELS}:
         return CEngine(int(name[3:]))
     if (written := EXEC_ENGINE.fullmatch(name)) is not None:
-        level = int(written.group(1) or 0)
-        return ExecEngine(written.group(2), level) if level in OPTIMIZATION_LEVELS else None
+        batch, level, command = written.group(1), int(written.group(2) or 0), written.group(3)
+        if level not in OPTIMIZATION_LEVELS:
+            return None
+        return BatchEngine(command, level) if batch else ExecEngine(command, level)
     return None
 
 

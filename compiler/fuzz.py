@@ -38,6 +38,7 @@ from rl1.compiler.backend.lower import lower
 from rl1.compiler.backend.optimize import optimize
 from rl1.compiler.differential import (
     AstEngine,
+    BatchEngine,
     CEngine,
     Engine,
     ExecEngine,
@@ -688,4 +689,7 @@ def _replay(engine: Engine, case: Run, budget: int,
     if isinstance(engine, ExecEngine):
         ilc = write(f"program-O{engine.level}.ilc", compiled(case.source, engine.level))
         return engine.command_line(ilc, SCRIPT, budget)
+    if isinstance(engine, BatchEngine):
+        job = write(f"job-O{engine.level}.json", engine.job(case, budget) + b"\n")
+        return f"{engine.command} < {job}"
     return f"# {engine.name}: no command replays it"

@@ -227,7 +227,7 @@ def _time_limit(ctx: click.Context, param: click.Parameter, value: str) -> int:
 
 
 @click.command(cls=Command)
-@click.argument("file", metavar="FILE", type=PATH)
+@click.argument("file", metavar="FILE", type=PATH, required=False)
 @click.option("--sensors", metavar="FILE", type=PATH,
               help="the sensor script: what each sensing call reads and when the line is "
                    "lost (JSON, or TOML if FILE ends in .toml; spec/sensors.md). Without one "
@@ -251,9 +251,14 @@ def _time_limit(ctx: click.Context, param: click.Parameter, value: str) -> int:
 @choice_option("--engine", choices=ENGINES, default="vm",
                help="vm: compile, then run on the reference VM; ast: interpret the source; "
                     "c: run on the C VM of the firmware (vm/c, built on first use)")
+@click.option("--batch", is_flag=True,
+              help="instead of FILE, run one .ilc file after another as `rl1c fuzz`'s "
+                   "exec-batch: engines do: a JSON job a line on standard input, the run "
+                   "a line on standard output (spec/optimization.md, section 5)")
 @color_option
-def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoice | None,
-        budget: int, time_limit: int, engine: Engine, color: ColorChoice) -> int:
+def run(file: str | None, sensors: str | None, run_format: str,
+        trace_choice: TraceChoice | None, budget: int, time_limit: int, engine: Engine,
+        batch: bool, color: ColorChoice) -> int:
     """Run a program (.rob source, or a compiled .ilc file) on the scripted device.
 
     Prints the device's trace with the source line of each entry, how the run ended and
@@ -270,6 +275,16 @@ def run(file: str, sensors: str | None, run_format: str, trace_choice: TraceChoi
     from .run_report import RunReport, render_json, render_text, select_trace
     from .running import run_file
 
+    if batch:
+        if file is not None or sensors is not None or engine == "ast":
+            raise click.UsageError("--batch reads its programs and scripts from standard "
+                                   "input, and runs them on a VM: give it without FILE, "
+                                   "--sensors and --engine ast")
+        from .run_batch import serve
+
+        return serve(sys.stdin.buffer, sys.stdout, engine, time_limit)
+    if file is None:
+        raise click.UsageError("Missing argument 'FILE'.")
     script = Script()
     if sensors is not None:
         try:

@@ -53,8 +53,10 @@ PROGRESS_EVERY = 10.0  # seconds between progress lines elsewhere
                    "of the firmware c-O0, c-O1, c-O2 (built on first use), or "
                    "exec:COMMAND ({ilc}, {sensors} and {budget} replaced; it prints the run "
                    "as `rl1c run --format json` does), given the file compiled with -O0, "
-                   "or exec-O1:COMMAND, exec-O2:COMMAND at that level. Default: ast, "
-                   "vm-O0, vm-O1, vm-O2; the first is the reference")
+                   "or exec-O1:COMMAND, exec-O2:COMMAND at that level; exec-batch:COMMAND "
+                   "(and -O1, -O2) started once, reading a job a line and answering each "
+                   "(spec/optimization.md, section 5; `rl1c run --batch` is one). Default: "
+                   "ast, vm-O0, vm-O1, vm-O2; the first is the reference")
 @click.option("--count", type=str, default=None, callback=lambda c, p, v: None if v is None
               else at_least_one(c, p, v), metavar="N",
               help=f"programs to run (default {DEFAULT_COUNT})")
@@ -151,7 +153,8 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         if engine is None:
             raise click.UsageError(f"argument --engine: unknown engine {name!r} (choose from "
                                    f"{', '.join(ENGINE_NAMES)}, or exec:COMMAND, "
-                                   "exec-O1:COMMAND, exec-O2:COMMAND)")
+                                   "exec-O1:COMMAND, exec-O2:COMMAND, the same with "
+                                   "exec-batch)")
         engines.append(engine)
     if len({engine.name for engine in engines}) < 2 or len(set(engine_names)) < len(
             engine_names):
