@@ -123,6 +123,11 @@ def test_the_layout_is_the_formatters_when_it_stays_interesting() -> None:
     assert reduction.case.source == "A=0; (MOV 0,0)\n"
 
 
+def test_lines_keep_the_originals_line_ends() -> None:
+    reduction = reduce(Case("A=1\r\n(MOV 3,3)\r\nB=2\r\n"), moves, max_tests=TESTS)
+    assert reduction.case.source == "(MOV 0,0)\r\n"
+
+
 def test_a_case_that_is_not_interesting_is_refused() -> None:
     with pytest.raises(NotInteresting):
         reduce(Case("(END)\n"), moves, max_tests=TESTS)
