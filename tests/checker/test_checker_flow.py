@@ -210,6 +210,9 @@ def test_a_misspelt_end_is_no_missing_end() -> None:
     # `(ENDD)` is E0501, with `(END)` as the guess; "no (END)" would only repeat it.
     assert codes("A=1\n(ENDD)\n") == ["E0501"]
     assert codes("A=1\n(FOO)\n") == ["E0501"]
+    assert codes("A=1\n(endd)\n") == ["E0501"]  # any spelling: the blocks' effects say so
+    # as an operand it cannot be the program's end (E0501 is said as well)
+    assert sorted(codes("A=(ENDD)\n")) == ["E0501", "W0603"]
 
 
 # Ending while moving (W0701) ------------------------------------------------------------
