@@ -107,7 +107,10 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
     With --runs N, a campaign (a mode of `rl1c sim` rather than a command of its own:
     the same program, world, engine and budget, and each run is the `rl1c sim --seed`
     run it names): exit status 0 when it ran to its end, whatever the success rate;
-    130 when stopped by Ctrl-C (143 by SIGTERM), after the summary of the runs made."""
+    130 when stopped by Ctrl-C (143 by SIGTERM), after the summary of the runs made.
+    The world's [vary] table draws for each run of a campaign, and for a run given
+    --seed; --sweep runs the campaign at each point of a grid; --svg and --html then
+    draw every run's path and failures (spec/simulator.md, "Varying the world")."""
     from rl1.compiler.simulation import Simulation, run_status
     from rl1.vm.sim.render import html, svg
     from rl1.vm.sim.world import WorldError, decode_world
