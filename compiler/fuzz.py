@@ -209,8 +209,7 @@ class Channel:
         """Stop the searches from index `first` on (every one by default: safe in a
         signal handler, which may run in the middle of a halt after a finding)."""
         self.everything = self.everything or first == 0
-        first = 0 if self.everything else min(first, self.halted_from())
-        self._put(HALT, first)
+        self._put(HALT, 0 if self.everything else min(first, self.halted_from()))
 
     def halted_from(self) -> float:
         if self.everything:

@@ -20,7 +20,7 @@ from support.cli import rl1c
 
 from rl1.compiler import fuzz
 from rl1.compiler.cli import fuzz as fuzz_cli
-from rl1.compiler.differential import Observation, VmEngine
+from rl1.compiler.differential import Engine, Observation, Verdict, VmEngine, judge, signature
 from rl1.compiler.strategies import Run
 
 pytestmark = pytest.mark.slow  # campaigns, on pools of processes
@@ -62,7 +62,7 @@ class _TwoBugs:
                             "variables": {**variables, "A": variables["A"] + 1}})
 
 
-def _campaign(engines: list[fuzz.Engine], jobs: int, count: int, **options: object
+def _campaign(engines: list[Engine], jobs: int, count: int, **options: object
               ) -> fuzz.Outcome:
     def quiet(programs: int, elapsed: float) -> None:
         pass
@@ -92,7 +92,7 @@ def test_the_finding_is_the_first_in_search_order_whatever_the_processes(
         monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 30)
     monkeypatch.setattr(fuzz, "BATCH", 5)
-    engines: list[fuzz.Engine] = [VmEngine(0), _TwoBugs()]
+    engines: list[Engine] = [VmEngine(0), _TwoBugs()]
     one, two = (_campaign(engines, jobs, 100) for jobs in (1, 2))
     assert one.finding is not None and two.finding is not None
     assert one.finding.case == two.finding.case
@@ -141,7 +141,7 @@ def test_keep_going_groups_findings_by_signature_each_with_a_reproducer_that_sho
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 20)
     monkeypatch.setattr(fuzz, "BATCH", 60)
-    engines: list[fuzz.Engine] = [VmEngine(0), _TwoBugs()]
+    engines: list[Engine] = [VmEngine(0), _TwoBugs()]
     written: dict[str, str] = {}
 
     def write(finding: fuzz.Finding) -> None:
@@ -158,8 +158,8 @@ def test_keep_going_groups_findings_by_signature_each_with_a_reproducer_that_sho
         # Shrunk keeping its signature: the reproducer shows the kind it is filed under.
         case = Run((Path(folder) / fuzz.SOURCE).read_text(encoding="utf-8"),
                    json.loads((Path(folder) / fuzz.SCRIPT).read_text(encoding="utf-8")))
-        assert fuzz.judge(case, engines, 20_000).problems
-        assert fuzz.signature(fuzz.judge(case, engines, 20_000)) == name
+        assert judge(case, engines, 20_000).problems
+        assert signature(judge(case, engines, 20_000)) == name
 
 
 @pytest.mark.parametrize(("problems", "same"), [
@@ -175,9 +175,9 @@ def test_keep_going_groups_findings_by_signature_each_with_a_reproducer_that_sho
 ])
 def test_a_signature_leaves_out_what_varies_between_programs_of_one_bug(
         problems: list[str], same: bool) -> None:
-    verdicts = [fuzz.Verdict({"x": Observation({}), "y": Observation({}),
+    verdicts = [Verdict({"x": Observation({}), "y": Observation({}),
                               "vm-O1": Observation({})}, [problem]) for problem in problems]
-    assert (fuzz.signature(verdicts[0]) == fuzz.signature(verdicts[1])) is same
+    assert (signature(verdicts[0]) == signature(verdicts[1])) is same
 
 
 def test_keep_going_lists_each_signature_with_its_count_and_folder(tmp_path: Path) -> None:
@@ -365,7 +365,7 @@ def test_statistics_count_a_lost_line_that_jumps_to_its_handler() -> None:
     kept = Run(lost.source, {})
     statistics = fuzz.Statistics()
     for case in (lost, kept):
-        statistics.add(case, fuzz.judge(case, [VmEngine(0, counting=True)], 20_000))
+        statistics.add(case, judge(case, [VmEngine(0, counting=True)], 20_000))
     assert statistics.handler_jumps == 1
     assert statistics.endings == {"ok": 2}
     assert statistics.opcodes["vm-O0"]["HLD"] == 1  # the handler's, run once
