@@ -71,11 +71,12 @@ class VaryTable(Struct, frozen=True, forbid_unknown_fields=True, kw_only=True):
 def entries(table: VaryTable) -> Iterator[tuple[tuple[str, ...], Entry]]:
     """Each entry of `table` with its path under [vary] (("stands", "s", "x")), in
     the order written within each table."""
-    for part, fixed in (("start", table.start),
-                        *((("stands", name), stand) for name, stand in table.stands.items())):
-        prefix = (part,) if isinstance(part, str) else part
-        for field in fixed.__struct_fields__:
-            entry = getattr(fixed, field)
+    poses: list[tuple[tuple[str, ...], StartEntries | StandEntries]] = [
+        (("start",), table.start),
+        *((("stands", name), stand) for name, stand in table.stands.items())]
+    for prefix, pose in poses:
+        for field in pose.__struct_fields__:
+            entry = getattr(pose, field)
             if isinstance(entry, Entry):
                 yield (*prefix, field), entry
     for kind, flat in (("vehicle", table.vehicle), ("noise", table.noise)):
