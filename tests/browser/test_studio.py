@@ -115,6 +115,13 @@ class Studio:
         return next(line for line in self.page.locator("#editor .cm-line").all()
                     if abs(line.bounding_box()["y"] - top) < 2)
 
+    def gutter(self, number: int, button: str = "left") -> None:
+        """Clicks the breakpoints' gutter beside line `number`."""
+        line = self.line(number).bounding_box()
+        gutter = self.page.locator(".cm-breakpoint-gutter").bounding_box()
+        self.page.mouse.click(gutter["x"] + gutter["width"] / 2,
+                              line["y"] + line["height"] / 2, button=button)
+
     def stop(self, reason: str) -> str:
         self.page.wait_for_selector(f"#stop[data-reason='{reason}']", state="attached",
                                     timeout=WAIT)
@@ -162,6 +169,39 @@ def test_a_mistyped_call_shows_its_diagnostic_and_its_quick_fix_mends_it(wide: S
     wide.shot("03-quick-fix-applied")
 
 
+def test_hover_completion_signature_definition_and_rename(wide: Studio) -> None:
+    page = wide.page
+    wide.line(3).locator("span", has_text=re.compile("^MOV$")).hover()
+    hover = page.locator(".cm-tooltip-hover")
+    hover.wait_for(timeout=WAIT)
+    assert "Start moving at the given wheel speeds" in (hover.text_content() or "")
+    page.mouse.move(0, 0)
+    wide.line(11).click()  # :13
+    page.keyboard.press("End")
+    page.keyboard.type(" (IM")
+    completion = page.locator(".cm-tooltip-autocomplete")
+    completion.wait_for(timeout=WAIT)
+    assert "IMG" in (completion.text_content() or "")
+    page.keyboard.press("Escape")
+    for _ in range(len("IM")):
+        page.keyboard.press("Backspace")
+    page.keyboard.type("MOV ")
+    signature = page.locator(".cm-lsp-signature-tooltip")
+    signature.wait_for(timeout=WAIT)
+    assert "(MOV l,r)" in (signature.text_content() or "")
+    wide.shot("04-signature-help")
+    page.keyboard.press("Escape")
+    wide.line(19).locator("span", has_text=re.compile("^#14$")).click()  # @--; ?@>#14
+    page.keyboard.press("F12")
+    sync_api.expect(page.locator("#editor .cm-activeLine")).to_have_text(":14 (IMG)")
+    page.keyboard.press("F2")
+    name = page.locator(".cm-lsp-rename-panel input[name=name]")
+    name.fill(":15")
+    name.press("Enter")
+    sync_api.expect(wide.line(14)).to_have_text(":15 (IMG)", timeout=WAIT)
+    assert wide.line(19).text_content() == "@--; ?@>#15"
+
+
 def test_the_palette_inserts_a_call_with_a_field_for_each_argument(wide: Studio) -> None:
     page = wide.page
     assert wide.line(11).text_content() == ":13"
@@ -176,7 +216,7 @@ def test_the_palette_inserts_a_call_with_a_field_for_each_argument(wide: Studio)
     assert tables == ["Table 2: motion", "Table 3: sensing"]
     calls = page.locator("#palette button").all_text_contents()
     assert "(CAM P pulse)" in calls and "(ULT A)" in calls and "(END)" not in calls
-    wide.shot("04-palette")
+    wide.shot("05-palette")
 
 
 def test_the_editor_highlights_rl1(wide: Studio) -> None:
@@ -197,11 +237,8 @@ def test_a_breakpoint_stops_the_vehicle_then_step_and_continue_to_the_end(wide: 
     start = wide.vehicle()
     assert start, "the vehicle is drawn at its start"
     page.select_option("#speed", "10")
-    line = wide.line(20)
-    assert line.text_content() == "(STX D); (MOV 1,1)"
-    box = line.bounding_box()
-    gutter = page.locator(".cm-breakpoint-gutter").bounding_box()
-    page.mouse.click(gutter["x"] + gutter["width"] / 2, box["y"] + box["height"] / 2)
+    assert wide.line(20).text_content() == "(STX D); (MOV 1,1)"
+    wide.gutter(20)
     assert page.locator(".cm-breakpoint-dot").count() == 1
     page.click("#run")
     assert wide.stop("breakpoint") == "breakpoint at line 20"
@@ -211,38 +248,34 @@ def test_a_breakpoint_stops_the_vehicle_then_step_and_continue_to_the_end(wide: 
     assert page.locator("#variables .variable").count() == 53
     assert page.locator("#variables .variable.changed").count() > 0
     assert page.locator("#device dt", has_text="x (cm)").count() == 1
-    wide.shot("05-stopped-at-the-breakpoint")
+    wide.shot("06-stopped-at-the-breakpoint")
 
     page.click("#step-line")
     assert wide.stop("step") == "step at line 21"
     assert page.locator(".cm-run-line").text_content() == ":20 (IMG)"
-    wide.shot("06-stepped")
+    wide.shot("07-stepped")
 
     page.click("#continue")
     assert wide.stop("end").startswith("ended: the program ended; goal met; ")
     assert page.locator(".cm-run-line, .cm-fault-line").count() == 0
     assert "(IMG) = " in (page.text_content("#trace") or "")
     assert page.locator("#world .event.end").count() == 1
-    wide.shot("07-ended")
+    wide.shot("08-ended")
 
 
 def test_a_breakpoint_with_a_condition_stops_when_it_holds(wide: Studio) -> None:
     page = wide.page
     page.select_option("#speed", "")  # as fast as the server runs
-    line = wide.line(22)
-    assert line.text_content() == "      Y=y-160; ?Y>#29"
-    gutter = page.locator(".cm-breakpoint-gutter").bounding_box()
-    box = line.bounding_box()
-    at = {"x": gutter["x"] + gutter["width"] / 2, "y": box["y"] + box["height"] / 2}
+    assert wide.line(22).text_content() == "      Y=y-160; ?Y>#29"
     page.once("dialog", lambda dialog: dialog.accept("y-160>0"))
-    page.mouse.click(at["x"], at["y"], button="right")
+    wide.gutter(22, button="right")
     assert page.locator(".cm-breakpoint-dot.conditional").count() == 1
     page.click("#run")
     assert wide.stop("breakpoint") == "breakpoint at line 22: y-160>0"
     y = int(page.text_content("#variables .variable[data-name=y] .value") or "0")
     assert y > 160
     page.once("dialog", lambda dialog: dialog.accept("y-"))  # not a value: refused
-    page.mouse.click(at["x"], at["y"], button="right")
+    wide.gutter(22, button="right")
     page.wait_for_selector("#status.problem", timeout=WAIT)
     assert (page.text_content("#status") or "").startswith("breakpoint on line 22: ")
 
@@ -258,7 +291,7 @@ def test_the_world_file_shows_its_error_and_a_shorter_line_is_lost(wide: Studio)
     problem.wait_for(timeout=WAIT)
     assert (problem.text_content() or "").startswith("sample.world.toml:7: floor.size")
     assert page.locator("#world-editor .cm-lintRange-error").count() == 1
-    wide.shot("08-world-file-error")
+    wide.shot("09-world-file-error")
     # The guidance line ends before the branch mark: tracing in mode 3 loses it during
     # (MOV 3,3), and Listing 1 jumps to its handler :96.
     page.keyboard.press("Control+a")
@@ -270,7 +303,7 @@ def test_the_world_file_shows_its_error_and_a_shorter_line_is_lost(wide: Studio)
     assert "line lost during MOV in mode 3" in (page.text_content("#trace li.lost") or "")
     assert ":96" in (page.text_content("#trace li.handler") or "")
     assert page.locator("#world .event.lost").count() == 1
-    wide.shot("09-line-lost")
+    wide.shot("10-line-lost")
     page.check("#stop-on-lost")
     page.click("#run")
     assert wide.stop("lost-line") == ("lost-line at line 41: line lost (mode 3, MOV): "
@@ -317,6 +350,6 @@ def test_at_420_px_the_panes_stack_and_stay_usable(browser: Any, studio: str) ->
     tops = [page.locator(selector).bounding_box()["y"]
             for selector in ("#editor", "#world", "#stop", "#variables")]
     assert tops == sorted(tops), "the editor, the world, where it stopped, the variables"
-    narrow.shot("10-at-420px")
+    narrow.shot("11-at-420px")
     assert narrow.problems == []
     narrow.context.close()
