@@ -16,7 +16,8 @@ import sys
 import threading
 import time
 from collections.abc import Iterator
-from dataclasses import dataclass
+from contextlib import contextmanager
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
@@ -31,10 +32,50 @@ STARTED_WITHIN = 120  # s for the scheduler and the workers to start on a loaded
 
 @dataclass
 class Cluster:
-    address: str
-    scheduler: subprocess.Popen[bytes]
-    workers: list[subprocess.Popen[bytes]]
+    """A Dask scheduler on 127.0.0.1 and its single-threaded workers, each a process of
+    its own writing a log under `logs`."""
+
     logs: Path
+    processes: list[subprocess.Popen[bytes]] = field(default_factory=list)
+    address: str = ""
+
+    @property
+    def workers(self) -> list[subprocess.Popen[bytes]]:
+        return self.processes[1:]
+
+    def start_scheduler(self) -> None:
+        address_file = self.logs / "scheduler.json"  # its address, written: no port race
+        scheduler = self._start("scheduler", "--host", "127.0.0.1", "--port", "0",
+                                "--scheduler-file", str(address_file))
+        deadline = time.monotonic() + STARTED_WITHIN
+        while not address_file.exists():
+            assert time.monotonic() < deadline, "the scheduler did not start"
+            assert scheduler.poll() is None, self.log()
+            time.sleep(0.1)
+        self.address = json.loads(address_file.read_text())["address"]
+
+    def start_worker(self) -> None:
+        self._start("worker", self.address, "--host", "127.0.0.1", "--nthreads", "1",
+                    "--no-nanny", "--name", f"worker-{len(self.workers)}")
+
+    def wait_for_workers(self, count: int) -> None:
+        from distributed import Client
+
+        with Client(self.address, timeout=STARTED_WITHIN,  # type: ignore[no-untyped-call]
+                    set_as_default=False) as client:
+            client.wait_for_workers(count, timeout=STARTED_WITHIN)
+
+    def _start(self, role: str, *options: str) -> subprocess.Popen[bytes]:
+        # A worker killed while it makes a run fails that run at once (allowed-failures
+        # 0, where Dask would try it on up to three workers first), so that the
+        # campaign's own resubmission is tested.
+        env = {**os.environ, "DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0"}
+        with open(self.logs / f"{role}-{len(self.processes)}.log", "wb") as log:
+            process = subprocess.Popen([str(BIN / "dask"), role, *options, "--no-dashboard"],
+                                       stdin=subprocess.DEVNULL, stdout=log,
+                                       stderr=subprocess.STDOUT, env=env)
+        self.processes.append(process)
+        return process
 
     def log(self) -> str:
         """What the scheduler and the workers printed, for a failed test's message."""
@@ -42,49 +83,37 @@ class Cluster:
                          for path in sorted(self.logs.glob("*.log")))
 
 
-def _start(command: list[str], log: Path, env: dict[str, str]) -> subprocess.Popen[bytes]:
-    with open(log, "wb") as stream:
-        return subprocess.Popen(command, stdin=subprocess.DEVNULL, stdout=stream,
-                                stderr=subprocess.STDOUT, env=env)
+@contextmanager
+def _cluster(folder: Path, workers: int) -> Iterator[Cluster]:
+    """A scheduler and `workers` workers, killed at the end whatever happens."""
+    logs = folder / "cluster"
+    logs.mkdir()
+    cluster = Cluster(logs)
+    try:
+        cluster.start_scheduler()
+        if workers:
+            for _ in range(workers):
+                cluster.start_worker()
+            cluster.wait_for_workers(workers)
+        yield cluster
+    finally:
+        for process in cluster.processes:
+            process.kill()
+            process.wait()
 
 
 @pytest.fixture
 def cluster(tmp_path: Path) -> Iterator[Cluster]:
-    """A scheduler and two single-threaded workers on 127.0.0.1. A worker killed while
-    it makes a run fails that run at once (allowed-failures 0, where Dask would try it
-    on up to three workers first), so that the campaign's own resubmission is tested."""
-    from distributed import Client
+    """A scheduler and two workers."""
+    with _cluster(tmp_path, 2) as started:
+        yield started
 
-    logs = tmp_path / "cluster"
-    logs.mkdir()
-    address_file = logs / "scheduler.json"  # the scheduler writes its address: no port race
-    env = {**os.environ, "DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0"}
-    processes: list[subprocess.Popen[bytes]] = []
-    try:
-        processes.append(_start(
-            [str(BIN / "dask"), "scheduler", "--host", "127.0.0.1", "--port", "0",
-             "--no-dashboard", "--scheduler-file", str(address_file)],
-            logs / "scheduler.log", env))
-        for number in range(2):
-            processes.append(_start(
-                [str(BIN / "dask"), "worker", "--scheduler-file", str(address_file),
-                 "--host", "127.0.0.1", "--nthreads", "1", "--no-nanny",
-                 "--no-dashboard", "--name", f"worker-{number}"],
-                logs / f"worker-{number}.log", env))
-        deadline = time.monotonic() + STARTED_WITHIN
-        while not address_file.exists():
-            assert time.monotonic() < deadline, "the scheduler did not start"
-            assert processes[0].poll() is None, (logs / "scheduler.log").read_text()
-            time.sleep(0.1)
-        address = json.loads(address_file.read_text())["address"]
-        with Client(address, timeout=STARTED_WITHIN,  # type: ignore[no-untyped-call]
-                    set_as_default=False) as client:
-            client.wait_for_workers(2, timeout=STARTED_WITHIN)
-        yield Cluster(address, processes[0], processes[1:], logs)
-    finally:
-        for process in processes:
-            process.kill()
-            process.wait()
+
+@pytest.fixture
+def scheduler(tmp_path: Path) -> Iterator[Cluster]:
+    """A scheduler without workers."""
+    with _cluster(tmp_path, 0) as started:
+        yield started
 
 
 def _wall(folder: Path) -> tuple[Path, Path]:
@@ -136,6 +165,28 @@ def test_a_worker_killed_in_a_campaign_on_a_cluster_loses_no_run(
     assert "Traceback" not in stderr
     local = _local(program, world, runs, tmp_path / "local.jsonl")
     assert stdout == local  # every run counted once: the summary is exact
+    assert out.read_bytes() == (tmp_path / "local.jsonl").read_bytes()
+
+
+def test_a_campaign_started_before_any_worker_says_so_and_waits_for_one(
+        scheduler: Cluster, tmp_path: Path) -> None:
+    program, world = _wall(tmp_path)
+    out, said = tmp_path / "cluster.jsonl", tmp_path / "stderr.txt"
+    with open(said, "w") as stderr, subprocess.Popen(
+            [str(BIN / "rl1c"), "sim", str(program), "--world", str(world), "--runs", "50",
+             "--budget", "10000", "--scheduler", scheduler.address, "--out", str(out)],
+            stdout=subprocess.PIPE, stderr=stderr, text=True) as process:
+        deadline = time.monotonic() + STARTED_WITHIN
+        while "has no workers yet" not in said.read_text():
+            assert process.poll() is None and time.monotonic() < deadline, said.read_text()
+            time.sleep(0.1)
+        assert not out.exists() or not out.read_text()  # no run made without a worker
+        scheduler.start_worker()
+        stdout, _ = process.communicate(timeout=STARTED_WITHIN)
+    assert process.returncode == 0, said.read_text() + scheduler.log()
+    assert (f"rl1c: note: the scheduler at {scheduler.address} has no workers yet; the runs "
+            f"wait for one (`dask worker {scheduler.address}`)") in said.read_text()
+    assert stdout == _local(program, world, 50, tmp_path / "local.jsonl")
     assert out.read_bytes() == (tmp_path / "local.jsonl").read_bytes()
 
 
