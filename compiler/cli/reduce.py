@@ -83,10 +83,8 @@ def reduce(file: str, sensors: str | None, command: str | None,
     status: 0 reduced; 1 the original is not interesting (CMD must exit 0 on it, or the
     engines disagree on it); 2 a usage problem or a file that cannot be read; 130
     Ctrl-C, the smallest case so far written."""
-    from rl1.compiler.frontend.source import read_source
     from rl1.compiler.reduce import Case, NotInteresting
     from rl1.compiler.reduce import reduce as reduced
-    from rl1.compiler.runner import MAX_SCRIPT_BYTES
 
     if (command is None) == (not engine_names):
         raise click.UsageError("give --interesting CMD or --engine NAME (at least two), "
@@ -105,23 +103,9 @@ def reduce(file: str, sensors: str | None, command: str | None,
             raise click.UsageError(f"argument {role}: {target}: "
                                    + ("it is a folder; name a file" if os.path.isdir(target)
                                       else f"there is no folder {folder}"))
-    try:
-        source = read_source(file)
-    except SourceError as error:
-        raise read_failure(error, "source file") from None
-    script_bytes: bytes | None = None
-    script: str | None = None
-    if sensors is not None:
-        try:
-            script_bytes = read_bounded(sensors, MAX_SCRIPT_BYTES, "a sensor script")
-            script = script_bytes.decode("utf-8")
-        except SourceError as error:
-            raise read_failure(error, SCRIPT_ROLE) from None
-        except UnicodeDecodeError as error:
-            raise invalid_file(SCRIPT_ROLE, sensors, f"it is not UTF-8 text (byte "
-                               f"{error.start})", "a sensor script is JSON or TOML") from None
-    files = _Files(file, source, sensors, script, script_bytes)
-    original = Case(source.text, script)
+    files = _read(file, sensors)
+    original = Case(files.source.text, files.script)
+    script = files.script
     interesting: _ShellTest | _EnginesTest
     if command is not None:
         interesting = _ShellTest(command, files, timeout)
@@ -171,6 +155,27 @@ def reduce(file: str, sensors: str | None, command: str | None,
                  "nothing smaller is interesting: nothing written")
     click.echo("\n".join(lines))
     return status
+
+
+def _read(file: str, sensors: str | None) -> _Files:
+    """The program and the script, read; a Failure (status 2) when one cannot be."""
+    from rl1.compiler.frontend.source import read_source
+    from rl1.compiler.runner import MAX_SCRIPT_BYTES
+
+    try:
+        source = read_source(file)
+    except SourceError as error:
+        raise read_failure(error, "source file") from None
+    if sensors is None:
+        return _Files(file, source, None, None, None)
+    try:
+        data = read_bounded(sensors, MAX_SCRIPT_BYTES, "a sensor script")
+        return _Files(file, source, sensors, data.decode("utf-8"), data)
+    except SourceError as error:
+        raise read_failure(error, SCRIPT_ROLE) from None
+    except UnicodeDecodeError as error:
+        raise invalid_file(SCRIPT_ROLE, sensors, f"it is not UTF-8 text (byte "
+                           f"{error.start})", "a sensor script is JSON or TOML") from None
 
 
 @dataclass(frozen=True)
