@@ -1,11 +1,14 @@
 """The studio (`rl1c studio`, spec/studio.md) in a real browser: Debian's chromium driven
 by Playwright for Python, as test_replay_page.py drives it (no browser of Playwright's
 own). The studio serves a copy of examples/ with Listing 1 and its world; the page opens
-with the token, shows a mistyped call's diagnostic and applies its quick fix, stops at a
-breakpoint on line 20 with the vehicle there and the variables shown, steps and runs
-on to the end; the world file's error is shown as it is edited, and on a guidance line
-made shorter the lost line and the handler jump are marked in the trace; the page is
-usable 420 px wide, with nothing on its console. A screenshot of each step is kept in
+with the token and shows a mistyped call's diagnostic and applies its quick fix; hover,
+completion, signature help, go to definition, rename and formatting come from the
+language server; the palette inserts a call with its arguments as fields; a breakpoint
+on line 20 stops the vehicle there with the variables shown, a step and a continue run
+to the end, and a conditional breakpoint stops where its condition holds; the world
+file's error is shown as it is edited, and on a guidance line made shorter the lost line
+and the handler jump are marked in the trace; saving writes the file; the page is usable
+420 px wide; nothing is logged on its console. A screenshot of each step is kept in
 build/studio-screenshots/."""
 
 from __future__ import annotations
