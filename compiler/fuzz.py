@@ -305,7 +305,8 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
                 target = None
                 if (task.keep_going or not searched.findings) and disagrees(case) \
                         and not stopped():
-                    _delete_lines(searched, next(reversed(searched.findings)), task)
+                    _delete_lines(searched, next(reversed(searched.findings)), task,
+                                  stopped)
             size = task.size + len(task.corpus)
             while searched.programs < size and (task.keep_going or not searched.findings):
                 before = searched.programs
@@ -317,7 +318,7 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
                     find(runs(instruction_losses=comparable), disagrees, settings=limits,
                          random=Random(seeds.getrandbits(64)))
                 if target is not None and not stopped():
-                    _delete_lines(searched, target, task)
+                    _delete_lines(searched, target, task, stopped)
                 if searched.programs == before:  # Hypothesis generated nothing more
                     break
     except KeyboardInterrupt:  # in a worker: the campaign halts it too
@@ -372,9 +373,13 @@ def _corpus_run(file: str) -> Run:
     return Run(source, {})
 
 
-def _delete_lines(searched: Searched, target: str, task: Search) -> None:
-    """The finding of `target` with the lines and statements it does not need deleted."""
+def _delete_lines(searched: Searched, target: str, task: Search,
+                  stopped: Callable[[], bool]) -> None:
+    """The finding of `target` with the lines and statements it does not need deleted
+    (none more once `stopped()`)."""
     def keeps(case: Run) -> bool:
+        if stopped():
+            return False
         verdict = judge(case, task.engines, task.budget)
         return bool(verdict.problems) and (not task.keep_going or signature(verdict) == target)
 
@@ -399,17 +404,17 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
              executor: Executor | None = None, jobs: int = 1, keep_going: bool = False,
              found: Callable[[Finding], None] | None = None,
              channel: Channel | None = None, corpus: Sequence[Run] = (),
-             statistics: bool = False) -> Outcome:
+             statistics: bool = False, lost: tuple[type[BaseException], ...] = ()
+             ) -> Outcome:
     """Run the `corpus`, then generated programs, on `engines` until `count` generated
     programs or `seconds` have passed, or until they disagree (with `keep_going`, until
-    then whatever they find);
-    `progress(programs, elapsed)` as programs run, `found(finding)` on each new
-    signature's smallest run. The searches run in this process, or `jobs` at a time on
-    `executor`; a disagreement stops the searches after the one that found it, and is
-    the one of the first search in order that finds one: the finding of one process.
-    `channel.halt()` (from a signal handler) stops every search, keeping their counts
-    and findings. With `statistics`, the
-    Outcome says what the programs did."""
+    then whatever they find); `progress(programs, elapsed)` as programs run,
+    `found(finding)` on each new signature's smallest run. The searches run in this
+    process, or `jobs` at a time on `executor` (a search lost with its worker, an error
+    of `lost`, runs again); a disagreement stops the searches after the one that found
+    it, and is the one of the first search in order that finds one, as in one process.
+    `channel.halt()` (from a signal handler) stops every search, keeping their counts and
+    findings. With `statistics`, the Outcome says what the programs did."""
     start = time.monotonic()
     deadline = None if seconds is None else time.time() + seconds
     if statistics:
@@ -465,7 +470,7 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
                 keep(search(task, told))
         else:
             _on_executor(executor, jobs, next_search, keep, channel,
-                         lambda told: progress(done() + told, time.monotonic() - start))
+                         lambda told: progress(done() + told, time.monotonic() - start), lost)
     finally:
         if own_channel:
             channel.close()
@@ -485,27 +490,36 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
 
 
 POLL = 0.5  # seconds between looks at the searches under way, for progress
+LOSSES = 2  # times a search lost with its worker (a cluster's) runs again
 
 
 def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search | None],
                  keep: Callable[[Searched], None], channel: Channel,
-                 progress: Callable[[int], None]) -> None:
+                 progress: Callable[[int], None], lost: tuple[type[BaseException], ...]
+                 ) -> None:
     """Run the searches `next_search` gives on `executor`, `jobs` at a time, keeping
-    each as it ends."""
-    pending: dict[Future[Searched], int] = {}
+    each as it ends; one lost with its worker (an error of `lost`) runs again, up to
+    LOSSES times."""
+    pending: dict[Future[Searched], Search] = {}
+    losses: dict[int, int] = {}
 
     def submit() -> None:
         while len(pending) < jobs and (task := next_search()) is not None:
-            pending[executor.submit(search, task)] = task.index
+            pending[executor.submit(search, task)] = task
 
     submit()
     while pending:
         finished, _ = wait(pending, timeout=POLL, return_when=FIRST_COMPLETED)
         for future in finished:
-            del pending[future]
+            task = pending.pop(future)
+            error = future.exception()
+            if isinstance(error, lost) and losses.get(task.index, 0) < LOSSES:
+                losses[task.index] = losses.get(task.index, 0) + 1
+                pending[executor.submit(search, task)] = task
+                continue
             keep(future.result())
         submit()
-        progress(channel.told(pending.values()))
+        progress(channel.told(task.index for task in pending.values()))
 
 
 def _deleted(case: Run, disagrees: Callable[[Run], bool]) -> Run:

@@ -194,7 +194,8 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
                                seed=seed_value, progress=bar.update, executor=held.executor,
                                jobs=max(held.slots, 1), keep_going=keep_going,
                                found=write if keep_going else None, channel=channel,
-                               corpus=corpus, statistics=fuzz_format == "json")
+                               corpus=corpus, statistics=fuzz_format == "json",
+                               lost=held.lost)
     except (BuildError, EngineUnavailable, Unavailable) as error:  # such as no C compiler
         raise Failure(f"error: {error}") from None
     except BrokenExecutor:

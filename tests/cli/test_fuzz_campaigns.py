@@ -11,8 +11,10 @@ import signal
 import subprocess
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor
+from collections.abc import Callable
+from concurrent.futures import Executor, Future, ProcessPoolExecutor
 from pathlib import Path
+from typing import Any, TypeVar
 
 import pytest
 from support import ROOT
@@ -24,6 +26,8 @@ from rl1.compiler.differential import Engine, Observation, Verdict, VmEngine, ju
 from rl1.compiler.strategies import Run
 
 pytestmark = pytest.mark.slow  # campaigns, on pools of processes
+
+T = TypeVar("T")
 
 RL1C = [str(Path(sys.executable).with_name("rl1c"))]
 
@@ -369,3 +373,40 @@ def test_statistics_count_a_lost_line_that_jumps_to_its_handler() -> None:
     assert statistics.handler_jumps == 1
     assert statistics.endings == {"ok": 2}
     assert statistics.opcodes["vm-O0"]["HLD"] == 1  # the handler's, run once
+
+
+class _Lost(Exception):
+    """A search lost with its worker, as Dask's KilledWorker says."""
+
+
+class _LosingOnce(Executor):
+    """Runs each search in this process, but loses the first submission of search 0."""
+
+    def __init__(self) -> None:
+        self.submitted: list[int] = []
+
+    def submit(self, fn: Callable[..., T], /, *args: Any, **kwargs: Any) -> Future[T]:
+        future: Future[T] = Future()
+        task = args[0]
+        self.submitted.append(task.index)
+        if self.submitted.count(task.index) == 1 and task.index == 0:
+            future.set_exception(_Lost("the worker was killed"))
+        else:
+            future.set_result(fn(*args, **kwargs))
+        return future
+
+
+def test_a_search_lost_with_its_worker_runs_again_and_the_count_is_exact(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fuzz, "BATCH", 4)
+    executor = _LosingOnce()
+
+    def on(executor: Executor, lost: tuple[type[BaseException], ...]) -> fuzz.Outcome:
+        return fuzz.campaign([VmEngine(0), VmEngine(1)], 20_000, count=12, seconds=None,
+                             seed=11, progress=lambda programs, elapsed: None,
+                             executor=executor, jobs=2, lost=lost)
+
+    assert on(executor, (_Lost,)).programs == 12
+    assert sorted(executor.submitted) == [0, 0, 1, 2]
+    with pytest.raises(_Lost):  # an error that is no loss is not hidden
+        on(_LosingOnce(), ())
