@@ -211,6 +211,11 @@ class Progress:
             self.stream.flush()
 
 
+SAME_RUNS = ("the world has no noise: every seed makes the same run, so {counted} "
+             "counted N times; give the world `noise = true`, a [noise] table "
+             "(spec/simulator.md, \"Noise\") or a [vary] table to vary the runs")
+
+
 def summary(setting: Setting, tally: Tally, task: Task, stopped: bool) -> str:
     """The campaign's summary for people."""
     lines = [f"{tally.runs} run{'s' if tally.runs != 1 else ''} of {setting.file} on "
@@ -218,9 +223,7 @@ def summary(setting: Setting, tally: Tally, task: Task, stopped: bool) -> str:
              f"{setting.seed + setting.runs - 1}"
              + (f" (stopped after {tally.runs} of {setting.runs})" if stopped else "")]
     if noiseless(task):
-        lines.append("the world has no noise: every seed makes the same run, so this is "
-                     "one outcome counted N times; give the world `noise = true` or a "
-                     "[noise] table (spec/simulator.md, \"Noise\") to vary the runs")
+        lines.append(SAME_RUNS.format(counted="this is one outcome"))
     if tally.runs == 0:
         return "\n".join(lines) + "\n"
     low, high = wilson(tally.successes, tally.runs)
@@ -342,7 +345,7 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
         if lines is not None and lines is not sys.stdout:
             lines.close()
     tally = keeper.tally
-    said = (sweep_summary(setting, keeper, stopped=status != 0) if setting.sweep else
+    said = (sweep_summary(setting, keeper, task, stopped=status != 0) if setting.sweep else
             summary(setting, tally, task, stopped=status != 0))
     report.write(said)
     report.flush()
@@ -454,7 +457,7 @@ def _draw(pictures: Pictures, overlay: Overlay, tallies: list[Tally], setting: S
                    role="HTML file")
 
 
-def sweep_summary(setting: Setting, keeper: Keeper, stopped: bool) -> str:
+def sweep_summary(setting: Setting, keeper: Keeper, task: Task, stopped: bool) -> str:
     """A sweep's summary for people: the success rate at each point, and a heat map of
     two parameters."""
     runs = keeper.total.runs
@@ -462,6 +465,8 @@ def sweep_summary(setting: Setting, keeper: Keeper, stopped: bool) -> str:
              f"seeds {setting.seed}..{setting.seed + setting.runs - 1} at each of "
              f"{len(keeper.points)} points, the parameters moved from the world's values"
              + (f" (stopped at point {len(keeper.tallies)})" if stopped else ""),
+             *([SAME_RUNS.format(counted="each point is one outcome")]
+               if noiseless(task) else []),
              table(setting.sweep, keeper.points, keeper.tallies).rstrip("\n")]
     if len(setting.sweep) == 2:
         lines.append(heat_map(setting.sweep, keeper.tallies).rstrip("\n"))

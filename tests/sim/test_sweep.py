@@ -120,6 +120,7 @@ def test_a_sweep_s_table_succeeds_exactly_where_the_stand_is_near(
     assert [(line["seed"], line["varied"]) for line in lines] == [
         (seed, {"stands.bench.x": 290.0 + x}) for x in (0, 15, 30, 45) for seed in range(3)]
     assert "the weakest point's campaign alone" in result.stdout
+    assert "so each point is one outcome counted N times" in result.stdout  # no noise
 
 
 def test_two_parameters_give_a_heat_map_of_the_known_answer(hold: tuple[Path, Path]) -> None:
