@@ -13,6 +13,7 @@ build/studio-screenshots/."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import shutil
@@ -50,9 +51,9 @@ def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return copy
 
 
-@pytest.fixture(scope="module")
-def studio(folder: Path) -> Iterator[str]:
-    """`rl1c studio` on Listing 1 and its world in `folder`: the page's address."""
+@contextlib.contextmanager
+def serving(folder: Path) -> Iterator[tuple[subprocess.Popen[str], str]]:
+    """`rl1c studio` on Listing 1 and its world in `folder`, and the page's address."""
     with subprocess.Popen([RL1C, "studio", "sample.rob", "--world", "sample.world.toml",
                            "--no-browser", "--port", "0"], cwd=folder, text=True,
                           stdout=subprocess.PIPE, stderr=subprocess.PIPE) as server:
@@ -63,9 +64,16 @@ def studio(folder: Path) -> Iterator[str]:
             server.kill()
             pytest.fail(f"rl1c studio did not say where it serves: {first!r}"
                         f"{server.communicate(timeout=30)[1]}")
-        yield serving[1]
+        yield server, serving[1]
         server.terminate()
         server.communicate(timeout=30)
+
+
+@pytest.fixture(scope="module")
+def studio(folder: Path) -> Iterator[str]:
+    """The studio the tests share: the page's address."""
+    with serving(folder) as (_, address):
+        yield address
 
 
 @pytest.fixture(scope="module")
@@ -356,3 +364,14 @@ def test_at_420_px_the_panes_stack_and_stay_usable(browser: Any, studio: str) ->
     narrow.shot("11-at-420px")
     assert narrow.problems == []
     narrow.context.close()
+
+
+def test_the_page_says_when_the_studio_is_gone(browser: Any, folder: Path) -> None:
+    with serving(folder) as (server, address):
+        gone = Studio(browser, address, 1400)
+        server.terminate()
+        server.communicate(timeout=30)
+        sync_api.expect(gone.page.locator("#status.problem")).to_have_text(
+            "disconnected: the studio's server closed the connection: start `rl1c studio` "
+            "again", timeout=WAIT)
+        gone.context.close()

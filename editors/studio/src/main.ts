@@ -77,7 +77,9 @@ async function start(): Promise<void> {
   const withLsp = lspSocket?.readyState === WebSocket.OPEN;
   if (withLsp) {
     client.connect(webSocketTransport(lspSocket));
-    lspSocket.addEventListener("close", () => say(lspLost, true));
+    lspSocket.addEventListener("close", () => {
+      if (studioSocket.readyState === WebSocket.OPEN) say(lspLost, true);  // else the studio's own word
+    });
   }
 
   // Which names are built-ins, which take a selector, which variables calls set: the palette's.
@@ -285,4 +287,5 @@ async function start(): Promise<void> {
   say(withLsp ? `serving ${hello.folder}` : lspLost, !withLsp);
 }
 
-start().catch((error: Error) => say(`the studio cannot start: ${error.message}`, true));
+start().catch((error: Error) => say(`the studio cannot start: ${error.message}. Is \`rl1c studio\` still `
+                                    + "running? Start it again and open the address it prints.", true));

@@ -120,7 +120,7 @@ export class StudioConnection {
   private readonly waiting = new Map<number, { resolve: (value: any) => void; reject: (error: Error) => void }>();
   private readonly handlers = new Map<string, Handler>();
 
-  constructor(private readonly socket: WebSocket, lost: (why: string) => void) {
+  constructor(private readonly socket: WebSocket, private readonly lost: (why: string) => void) {
     socket.addEventListener("message", (event) => this.receive(String(event.data)));
     socket.addEventListener("close", (event) => {
       for (const { reject } of this.waiting.values()) reject(new Error("the studio's server is gone"));
@@ -142,7 +142,13 @@ export class StudioConnection {
   }
 
   private receive(text: string): void {
-    const message = JSON.parse(text);
+    let message;
+    try {
+      message = JSON.parse(text);
+    } catch {
+      this.lost(`the studio's server sent something that is not JSON (${text.slice(0, 40)}): please report it`);
+      return;
+    }
     if (typeof message.id === "number" && this.waiting.has(message.id)) {
       const { resolve, reject } = this.waiting.get(message.id)!;
       this.waiting.delete(message.id);
