@@ -4,7 +4,9 @@ never touched, and hostile commands and files end with a message and a status.""
 
 from __future__ import annotations
 
+import hashlib
 import json
+import os
 import shlex
 import signal
 import subprocess
@@ -26,6 +28,7 @@ from rl1.vm import machine
 from rl1.vm.sensor_script import decode_script
 
 PYTHON = shlex.quote(sys.executable)
+RL1C = str(Path(sys.executable).with_name("rl1c"))
 BROKEN_VM = f"exec:{PYTHON} {shlex.quote(str(ROOT / 'tests/support/broken_vm.py'))} " \
             "{ilc} {sensors} {budget}"
 
@@ -182,6 +185,25 @@ def test_the_result_is_interesting_no_larger_and_the_same_every_time(
     decode_script((first.case.script or "").encode(), "script.json")
 
 
+@settings(max_examples=25, deadline=None)
+@given(checked_programs(max_blocks=3), sensor_scripts(), st.integers(2, 5))
+def test_any_predicate_sees_only_well_formed_candidates_no_larger_than_the_original(
+        source: str, script: dict[str, object], modulus: int) -> None:
+    original = Case(source, json.dumps(script))
+    tested: list[Case] = []
+
+    def erratic(case: Case) -> bool:  # no rule at all: a hash of the candidate
+        tested.append(case)
+        digest = hashlib.sha256(f"{case.source}{case.script}".encode()).digest()
+        return case == original or digest[0] % modulus == 0
+
+    reduction = reduce(original, erratic, max_tests=200)
+    assert erratic(reduction.case) and reduction.tests == len(tested) - 1
+    for case in tested:
+        assert case.size <= original.size and not analyze(case.source).has_errors
+        decode_script((case.script or "").encode(), "script.json")
+
+
 # rl1c reduce ---------------------------------------------------------------------------
 
 
@@ -214,15 +236,20 @@ def test_rl1c_reduce_writes_the_result_beside_and_leaves_the_original(
 
 
 def test_rl1c_reduce_gives_the_same_bytes_every_time(sample: tuple[Path, Path]) -> None:
+    # A command whose answer depends on more than a grep: the first IMG reading's area.
     program, script = sample
+    wide = (f"{PYTHON} -c \"import json,sys; sys.exit(json.load(open('sample.sensors.json'))"
+            "['IMG'][0]['area'] < 50)\" && grep -q '(MOV' sample.rob")
     made = []
-    for name in ("first.rob", "second.rob"):
+    for name, hash_seed in (("first.rob", "1"), ("second.rob", "2")):  # two processes
         out = program.with_name(name)
-        result = rl1c("reduce", program, "--sensors", script, "--interesting", GREP,
-                      "--out", out, "--sensors-out", out.with_suffix(".json"))
-        assert result.exit_code == 0, result.output
+        subprocess.run([RL1C, "reduce", str(program), "--sensors", str(script),
+                        "--interesting", wide, "--out", str(out), "--sensors-out",
+                        str(out.with_suffix(".json"))], check=True, capture_output=True,
+                       env={**os.environ, "PYTHONHASHSEED": hash_seed})
         made.append((out.read_bytes(), out.with_suffix(".json").read_bytes()))
     assert made[0] == made[1]
+    assert json.loads(made[0][1])["IMG"][0]["area"] >= 50
 
 
 def test_out_may_name_the_original(sample: tuple[Path, Path]) -> None:
@@ -345,9 +372,8 @@ def test_a_fuzz_finding_of_a_planted_bug_is_reduced_with_its_engines(tmp_path: P
 
 def test_ctrl_c_keeps_the_smallest_so_far(sample: tuple[Path, Path]) -> None:
     program, _ = sample
-    rl1c_path = str(Path(sys.executable).with_name("rl1c"))
     slow = "grep -q '(MOV' sample.rob && sleep 0.2"
-    process = subprocess.Popen([rl1c_path, "reduce", str(program), "--interesting", slow],
+    process = subprocess.Popen([RL1C, "reduce", str(program), "--interesting", slow],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert process.stderr is not None
     first = process.stderr.readline()  # a pass made it smaller

@@ -31,6 +31,7 @@ MARKS: dict[str, tuple[str, ...]] = {
     "tests/cli/test_reduce.py::test_a_fuzz_finding_of_a_planted_bug_is_reduced_with_its_engines":
         ("slow",),
     "tests/cli/test_reduce.py::test_ctrl_c_keeps_the_smallest_so_far": ("slow",),
+    "tests/cli/test_reduce.py::test_rl1c_reduce_gives_the_same_bytes_every_time": ("slow",),
     "tests/frontend/test_strategies.py": ("slow",),
     # A language server process of its own for each test (its command line, its raw
     # protocol over standard input and output).
