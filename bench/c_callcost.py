@@ -1,0 +1,185 @@
+"""What one device call costs inside the C VM (vm/c/rl1vm.c) on the firmware targets,
+the embedder's callbacks left out, against the goals of issue 26: at most 60 Cortex-M3
+instructions for a call with no argument plus at most 8 an argument, at most 250
+ATmega328P cycles for KYC.
+
+For each call kind the bench builds two programs: a few variables set (the call's
+arguments), then N copies of the call, then END; and the same without the calls. Each is
+linked with the VM, the loader and vm/c/test/callcost.c (a device whose callbacks answer
+done at once) into a firmware image built at -Os as firmware is, and run:
+
+- Cortex-M3 (lm3s6965evb) under qemu-system-arm with `-singlestep -d exec,nochain`: one
+  log line for each instruction the machine runs. The bench counts the lines between
+  callcost_begin and callcost_end (around rl1_step) whose function is not one of the
+  callbacks (callcost_hw_*): the machine's own instructions, exact.
+- ATmega328P under simavr: the firmware counts the cycles of rl1_step with Timer1 at the
+  CPU's clock, and those of one callback reached the way the VM reaches it (an indirect
+  call through the hardware table), which the bench subtracts once for each callback a
+  call makes (1 for an immediate call, start and poll for one started and polled).
+
+A call's cost is (run with N calls - run without) / N: dispatch, decoding, the
+arguments' range checks, the callbacks' invocation, writing the results, and the event
+point after it.
+
+    .venv/bin/python bench/c_callcost.py [--calls N] [--build FOLDER]
+
+Needs arm-none-eabi-gcc, qemu-system-arm, avr-gcc and simavr (vm/c/install-tools); a
+target without its tools is skipped, and says so.
+"""
+
+from __future__ import annotations
+
+import argparse
+import re
+import shutil
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from rl1.vm import ilc, isa
+from rl1.vm.language import VARIABLES, Feature
+
+VM_C = Path(__file__).resolve().parent.parent / "vm" / "c"
+WARN = ["-I../../spec", "-std=c99", "-Wall", "-Wextra", "-Wpedantic", "-Werror",
+        "-Wconversion", "-Wsign-conversion"]
+SOURCES = ["rl1vm.c", "rl1vm_load.c", "test/callcost.c"]
+GOAL_NO_ARGUMENT, GOAL_PER_ARGUMENT, GOAL_AVR_KYC = 60, 8, 250
+
+
+@dataclass(frozen=True)
+class Kind:
+    label: str
+    mnemonic: str           # the opcode's name in vm/isa.py
+    values: tuple[int, ...]  # each argument's value, passed in a variable of its own
+    started: bool           # started and polled (two callbacks), or immediate (one)
+
+    @property
+    def m3_goal(self) -> int:
+        return GOAL_NO_ARGUMENT + GOAL_PER_ARGUMENT * len(self.values)
+
+
+KINDS = (Kind("KYC", "KYC", (), False),
+         Kind("IMG (started and polled)", "IMG", (), True),
+         Kind("MOV a, b (two variables)", "MOV", (3, -4), False),
+         Kind("MVI a, b, c (three variables)", "MVI", (3, -4, 100), True))
+
+
+def program(kind: Kind, calls: int) -> bytes:
+    """The .ilc file: the arguments' variables set (a, b, c), then `calls` calls, END."""
+    by_name = {info.name: info for info in isa.OPCODES.values()}
+    variables = [VARIABLES.index(name) for name in "abc"[:len(kind.values)]]
+    code = b"".join(isa.encode(by_name["MOVI"], (variable, value))
+                    for variable, value in zip(variables, kind.values, strict=True))
+    args = tuple(isa.Arg(True, variable) for variable in variables)
+    code += isa.encode(by_name[kind.mnemonic], (), args) * calls + isa.encode(by_name["END"])
+    return ilc.encode(ilc.Image(code, {}, frozenset(Feature)))
+
+
+def c_source(data: bytes) -> str:
+    body = ",\n".join("    " + ", ".join(f"0x{byte:02x}" for byte in data[i:i + 12])
+                      for i in range(0, len(data), 12))
+    return ('#include "target.h"\n\n'
+            f"const uint8_t callcost_program[{len(data)}] TARGET_FLASH = {{\n{body}\n}};\n"
+            f"const uint16_t callcost_program_size = {len(data)}u;\n")
+
+
+def build(compiler: list[str], build_dir: Path, name: str, data: bytes) -> Path:
+    source = build_dir / f"{name}.c"
+    source.write_text(c_source(data), encoding="utf-8")
+    elf = build_dir / f"{name}.elf"
+    subprocess.run([*compiler, *WARN, "-Itest", "-o", str(elf), *SOURCES, str(source)],
+                   cwd=VM_C, check=True)
+    return elf
+
+
+ARM = ["arm-none-eabi-gcc", "-mcpu=cortex-m3", "-mthumb", "-Os", "-ffreestanding",
+       "-nostdlib", "-T", "test/arm.ld", "test/arm_start.c"]
+AVR = ["avr-gcc", "-mmcu=atmega328p", "-Os", "-DRL1_READ_BYTE(p)=pgm_read_byte(p)",
+       "-include", "avr/pgmspace.h", "-fno-tree-switch-conversion",
+       "-DTARGET_FLASH=PROGMEM", "test/avr_start.c"]
+# qemu's exec log: "Trace 0: 0x... [cs_base/pc/flags/cflags] function"
+TRACE = re.compile(r"^Trace \d+: \S+ \[[0-9a-f]+/([0-9a-f]+)/[0-9a-f]+/[0-9a-f]+\] (\S*)")
+
+
+def m3_instructions(elf: Path) -> int:
+    """The instructions the Cortex-M3 runs in rl1_step, the callbacks' left out."""
+    log = elf.with_suffix(".log")
+    run = subprocess.run(["qemu-system-arm", "-M", "lm3s6965evb", "-nographic",
+                          "-semihosting-config", "enable=on,target=native", "-singlestep",
+                          "-d", "exec,nochain", "-D", str(log), "-kernel", str(elf)],
+                         stdin=subprocess.DEVNULL, capture_output=True, text=True,
+                         timeout=300, check=False)
+    if run.returncode != 0:
+        raise RuntimeError(f"{elf.name} failed under qemu: {run.stdout}{run.stderr}")
+    counting, count = False, 0
+    with log.open(encoding="utf-8", errors="replace") as lines:
+        for line in lines:
+            match = TRACE.match(line)
+            if match is None:
+                continue
+            function = match.group(2)
+            if function == "callcost_end":
+                return count
+            if function == "callcost_begin":
+                counting = True
+            elif counting and not function.startswith("callcost_hw_"):
+                count += 1
+    raise RuntimeError(f"{log}: no callcost_end in qemu's log")
+
+
+def avr_cycles(elf: Path, callbacks: int) -> int:
+    """The cycles the ATmega328P spends in rl1_step, `callbacks` callbacks' left out."""
+    run = subprocess.run(["simavr", "-m", "atmega328p", "-f", "16000000", str(elf)],
+                         capture_output=True, text=True, timeout=300, check=False,
+                         errors="replace")
+    match = re.search(r"callcost: (\d+) (\d+)", run.stdout + run.stderr)
+    if match is None:
+        raise RuntimeError(f"{elf.name} failed under simavr: {run.stdout}{run.stderr}")
+    return int(match.group(1)) - callbacks * int(match.group(2))
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--calls", type=int, default=10, help="calls in a program (10)")
+    parser.add_argument("--build", type=Path, default=VM_C / "build" / "callcost")
+    options = parser.parse_args()
+    options.build.mkdir(parents=True, exist_ok=True)
+    build_dir = options.build.resolve()
+    have_arm = all(shutil.which(tool) for tool in ("arm-none-eabi-gcc", "qemu-system-arm"))
+    have_avr = all(shutil.which(tool) for tool in ("avr-gcc", "simavr"))
+    print(f"a call's cost in rl1_step, callbacks excluded: (N = {options.calls} calls - none)"
+          f" / N, -Os")
+    print(f"{'call kind':<32} {'Cortex-M3 instructions':>22} {'goal':>5}   "
+          f"{'ATmega328P cycles':>17} {'goal':>5}")
+    status = 0
+    for kind in KINDS:
+        m3 = avr = "skipped"
+        m3_over = avr_over = False
+        callbacks = 2 if kind.started else 1
+        name = kind.mnemonic.lower()
+        if have_arm:
+            with_calls, without = (m3_instructions(build(ARM, build_dir, f"{name}-{n}-m3",
+                                                         program(kind, n)))
+                                   for n in (options.calls, 0))
+            cost = (with_calls - without) / options.calls
+            m3, m3_over = f"{cost:.1f}", cost > kind.m3_goal
+        if have_avr:
+            with_calls, without = (avr_cycles(build(AVR, build_dir, f"{name}-{n}-avr",
+                                                    program(kind, n)), callbacks * n)
+                                   for n in (options.calls, 0))
+            cost = (with_calls - without) / options.calls
+            avr, avr_over = f"{cost:.1f}", kind.mnemonic == "KYC" and cost > GOAL_AVR_KYC
+        avr_goal = str(GOAL_AVR_KYC) if kind.mnemonic == "KYC" else "-"
+        print(f"{kind.label:<32} {m3:>22} {kind.m3_goal:>5}{' over' if m3_over else '     '}"
+              f" {avr:>17} {avr_goal:>5}{' over' if avr_over else ''}")
+        status |= m3_over or avr_over
+    if not have_arm:
+        print("Cortex-M3 skipped: no arm-none-eabi-gcc or qemu-system-arm (vm/c/install-tools)")
+    if not have_avr:
+        print("ATmega328P skipped: no avr-gcc or simavr (vm/c/install-tools)")
+    return int(status)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
