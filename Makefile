@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test quick lint typecheck pytest clean vscode-test vscode-package c-test
+.PHONY: demo test quick lint typecheck pytest clean vscode-test vscode-package c-test studio-check studio-page
 
 # pip byte-compiles what it installs, but an editable install leaves rl1 to its first
 # run, which cannot write bytecode where PYTHONDONTWRITEBYTECODE is set: compileall.
@@ -40,7 +40,7 @@ demo: $(STAMP)
 	@echo
 	@echo 'Next: `. .venv/bin/activate`, then the first session in README.md.'
 
-test: lint typecheck vscode-test c-test pytest
+test: lint typecheck vscode-test studio-check c-test pytest
 
 # The fast tests alone, in under a minute, while working: no test marked slow or needing
 # a C compiler, Node.js or a browser (tests/support/markers.py marks them). `make test` runs all.
@@ -92,7 +92,25 @@ vscode-test: $(VSCODE_STAMP)
 vscode-package: vscode-test
 	cd $(VSCODE) && npm run --silent package
 
+# The studio's page (editors/studio): its exact dependencies from the npm lock file, then
+# tsc. The page is committed built in lsp/studio/static/ (a pipx install needs no
+# Node.js); tests/project/test_studio_bundle.py rebuilds it apart and compares the bytes.
+# After editing its sources, `make studio-page` rebuilds it in place, to be committed.
+STUDIO := editors/studio
+STUDIO_STAMP := $(STUDIO)/node_modules/.installed
+
+$(STUDIO_STAMP): $(STUDIO)/package-lock.json
+	cd $(STUDIO) && npm ci --ignore-scripts --no-audit --no-fund
+	touch $@
+
+studio-check: $(STUDIO_STAMP)
+	cd $(STUDIO) && npm run --silent check
+
+studio-page: studio-check
+	cd $(STUDIO) && npm run --silent build
+
 clean:
 	rm -rf $(VENV) .typecheck .mypy_cache .pytest_cache .ruff_cache .hypothesis
 	rm -rf $(VSCODE)/node_modules $(VSCODE)/out $(VSCODE)/dist $(VSCODE)/rl1.vsix
+	rm -rf $(STUDIO)/node_modules
 	$(MAKE) -C vm/c clean
