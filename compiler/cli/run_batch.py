@@ -47,7 +47,7 @@ def _answer(line: bytes, engine: Engine, time_limit: int) -> dict[str, Any]:
         return _refused("bad-job", f"the job is no JSON line; expected {JOB_SHAPE}")
     match job:
         case {"ilc": str(encoded), "sensors": dict(document), "budget": int(budget)} \
-                if 1 <= budget <= MAX_BUDGET:
+                if 1 <= budget <= MAX_BUDGET and not isinstance(budget, bool):
             pass
         case _:
             return _refused("bad-job", f"expected {JOB_SHAPE} with N from 1 to {MAX_BUDGET}")

@@ -4,6 +4,7 @@ another, `rl1c run --batch` as the reference, and engines that die, lie or hang.
 from __future__ import annotations
 
 import base64
+import io
 import json
 import os
 import shlex
@@ -12,12 +13,16 @@ import time
 from pathlib import Path
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from support import ROOT
 from support.cli import rl1c
 
 from rl1.compiler import differential, fuzz
+from rl1.compiler.cli import run_batch
 from rl1.compiler.differential import BatchEngine, VmEngine, compiled, engine_named, judge
 from rl1.compiler.strategies import Run
+from rl1.vm.defaults import DEFAULT_TIME_LIMIT_MS
 
 pytestmark = pytest.mark.slow  # engine processes
 
@@ -56,6 +61,7 @@ def test_rl1c_run_batch_answers_each_job_as_rl1c_run_does(tmp_path: Path) -> Non
     ("not json", "the job is no JSON line"),
     ('{"ilc": "AA==", "sensors": {}}', "expected {\"ilc\": BASE64"),
     ('{"ilc": "AA==", "sensors": {}, "budget": 0}', "with N from 1 to"),
+    ('{"ilc": "AA==", "sensors": {}, "budget": true}', "with N from 1 to"),
     ('{"ilc": "!!", "sensors": {}, "budget": 5}', "the job's ilc is not base64"),
     ('{"ilc": "AA==", "sensors": {"XYZ": 1}, "budget": 5}', "the job's sensors"),
     ('{"ilc": "AAAA", "sensors": {}, "budget": 5}', "not valid intermediate code"),
@@ -167,3 +173,22 @@ def test_a_reproducer_of_a_batch_engine_names_its_job(tmp_path: Path) -> None:
     assert job["sensors"] == CASE.script and job["budget"] == 20_000
     assert "#   exit 3 < job-O0.json" in (folder / "replay.sh").read_text(encoding="utf-8")
     assert ROOT.exists()
+
+
+_JSON = st.recursive(st.none() | st.booleans() | st.integers() | st.text(max_size=5),
+                     lambda inner: st.lists(inner, max_size=3)
+                     | st.dictionaries(st.text(max_size=5), inner, max_size=3), max_leaves=8)
+
+
+@given(st.one_of(
+    st.binary(max_size=300).map(lambda data: data.replace(b"\n", b"")),
+    st.fixed_dictionaries({"ilc": st.one_of(_JSON, st.binary(max_size=60).map(
+        lambda data: base64.b64encode(data).decode())), "sensors": _JSON,
+        "budget": _JSON}).map(lambda job: json.dumps(job).encode()),
+))
+def test_rl1c_run_batch_answers_any_line_with_one_run_line(line: bytes) -> None:
+    answers = io.StringIO()
+    assert run_batch.serve(io.BytesIO(line + b"\n"), answers, "vm", DEFAULT_TIME_LIMIT_MS) == 0
+    answer, = answers.getvalue().splitlines()
+    document = json.loads(answer)
+    assert differential._shape_problem(document) is None  # a run, as the fuzzer reads it
