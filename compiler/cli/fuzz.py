@@ -59,7 +59,8 @@ PROGRESS_EVERY = 10.0  # seconds between progress lines elsewhere
                    "ast, vm-O0, vm-O1, vm-O2; the first is the reference")
 @click.option("--count", type=str, default=None, callback=lambda c, p, v: None if v is None
               else at_least_one(c, p, v), metavar="N",
-              help=f"programs to run (default {DEFAULT_COUNT})")
+              help=f"programs to generate and run, after any --corpus (default "
+                   f"{DEFAULT_COUNT})")
 @click.option("--time", "seconds", type=str, default=None, metavar="SECONDS",
               callback=lambda c, p, v: None if v is None else at_least_one(c, p, v),
               help="run for this long instead of a count")
