@@ -442,15 +442,18 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
         return Search(index - 1, search_seed, size, tuple(engines), budget, keep_going,
                       deadline, channel.folder, runs_given, statistics)
 
+    seen: set[str] = set()  # the signatures found so far
+
     def keep(searched: Searched) -> None:
         nonlocal stop_at
+        for name in list(searched.findings):
+            if name not in seen:
+                seen.add(name)
+                if found is not None:
+                    found(searched.findings[name])
+            elif keep_going:  # another search's came first: only counts are kept of it
+                del searched.findings[name]
         results[searched.index] = searched
-        if found is not None:
-            known = {name for other in results.values() if other is not searched
-                     for name in other.findings}
-            for name, finding in searched.findings.items():
-                if name not in known:
-                    found(finding)
         if searched.findings and not keep_going and searched.index < stop_at:
             stop_at = searched.index
             channel.halt(searched.index + 1)
