@@ -11,23 +11,35 @@ run carries its inputs (compiler/campaign.py's Task holds the program and the wo
 from __future__ import annotations
 
 import asyncio
+import contextlib
+import logging
 import signal
-from collections.abc import Iterator
-from concurrent.futures import Executor, ProcessPoolExecutor
+import threading
+import time
+import weakref
+from collections.abc import Callable, Iterator
+from concurrent.futures import Executor, Future, InvalidStateError, ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 
 if TYPE_CHECKING:
     from distributed import Client
 
-CONNECT_TIMEOUT = 5  # s: an unreachable scheduler is said in a few seconds
+CONNECT_TIMEOUT = 5  # s: an unreachable scheduler is said in a few seconds, and a lost
+# one once its client has tried as long to reconnect
+WATCH_EVERY = 0.5  # s between looks at whether a cluster's client has given up
 EXTRA = "cluster"  # pyproject.toml's extra that installs `distributed`
 
 
 class Unavailable(Exception):
     """The executor asked for cannot be had: its message says why and what to do (an
     error's message, without the word `error:` the command line puts first)."""
+
+
+class SchedulerLost(Exception):
+    """The work a cluster had not finished when the connection to its scheduler was lost
+    for good (its message names the scheduler)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -81,11 +93,13 @@ def _cluster(address: str) -> Iterator[Workers]:
             f"({error})\n  = help: install the extra `{EXTRA}`: pip install 'rl1[{EXTRA}]' "
             "(or pip install distributed), on this machine and on the workers'") from None
     client = _connect(Client, address)
+    # The client logs, with tracebacks, what the campaign says in a line of its own;
+    # Dask's configuration gives some of its loggers a level of their own.
+    for name in ["distributed", "tornado", *logging.root.manager.loggerDict]:
+        if name.partition(".")[0] in ("distributed", "tornado"):
+            logging.getLogger(name).setLevel(logging.CRITICAL)
     try:
-        # Not pure: a run submitted again after its worker died is a new task, not the
-        # failed one remembered under the same key.
-        yield Workers(client.get_executor(pure=False),  # type: ignore[no-untyped-call]
-                      _threads(client), (KilledWorker,))
+        yield Workers(_Watched(client, address), _threads(client), (KilledWorker,))
     finally:
         # The scheduler forgets the client's tasks left, and cancels them.
         client.close()  # type: ignore[no-untyped-call]
@@ -116,6 +130,69 @@ def _unreachable(address: str, why: str) -> Unavailable:
         f"cannot reach a Dask scheduler at {address} ({why})\n"
         f"  = help: start one there (`dask scheduler`, then `dask worker {address}` on "
         "each machine), or give its address as tcp://HOST:8786")
+
+
+P = ParamSpec("P")
+T = TypeVar("T")
+
+
+class _Watched(Executor):
+    """The executor of a Dask client, whose work not yet finished fails with
+    SchedulerLost once the client gives up reconnecting to its scheduler: Dask's own
+    futures are then cancelled, or wait for ever."""
+
+    def __init__(self, client: Client, address: str) -> None:
+        self._client = client
+        # Not pure: a task submitted again after its worker died is a new one, not the
+        # failed one remembered under the same key.
+        self._executor: Executor = client.get_executor(  # type: ignore[no-untyped-call]
+            pure=False)
+        self._address = address
+        self._futures: weakref.WeakSet[Future[Any]] = weakref.WeakSet()
+        threading.Thread(target=self._watch, daemon=True).start()
+
+    def _lost(self) -> bool:
+        return self._client.status in ("closing", "closed")
+
+    def _watch(self) -> None:
+        while not self._lost():
+            time.sleep(WATCH_EVERY)
+        for future in list(self._futures):
+            self._fail(future)
+
+    def _fail(self, future: Future[Any]) -> None:
+        with contextlib.suppress(InvalidStateError):  # finished, or cancelled
+            future.set_exception(SchedulerLost(
+                f"the connection to the Dask scheduler at {self._address} was lost"))
+
+    def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
+        future: Future[T] = Future()
+        self._futures.add(future)
+        if self._lost():  # given up: Dask's future would wait for ever
+            self._fail(future)
+            return future
+        dask = self._executor.submit(fn, *args, **kwargs)
+        future.add_done_callback(lambda done: done.cancelled() and dask.cancel())
+        dask.add_done_callback(lambda done: self._pass(done, future))
+        if self._lost():  # given up since, perhaps after the watcher's last look
+            self._fail(future)
+        return future
+
+    def _pass(self, dask: Future[T], future: Future[T]) -> None:
+        """Give `future` the outcome of Dask's: cancelled only by us (through
+        `future`), so a cancellation of Dask's own is the client giving up."""
+        if dask.cancelled():
+            self._fail(future)
+            return
+        with contextlib.suppress(InvalidStateError):  # cancelled by the campaign
+            error = dask.exception()
+            if error is None:
+                future.set_result(dask.result())
+            else:
+                future.set_exception(error)
+
+    def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
+        self._executor.shutdown(wait=False)  # the client's close cancels what is left
 
 
 def _threads(client: Client) -> int:

@@ -34,8 +34,8 @@ from rl1.compiler.campaign import (
     wilson,
     world_of,
 )
-from rl1.compiler.executors import Unavailable, Workers, workers
-from rl1.compiler.reporting.render import ColorChoice
+from rl1.compiler.executors import SchedulerLost, Unavailable, Workers, workers
+from rl1.compiler.reporting.render import EXIT_USAGE, ColorChoice
 from rl1.compiler.sweep import Axis, Point, grid, heat_map, table
 from rl1.vm.defaults import DEFAULT_BUDGET, Engine
 from rl1.vm.sim.campaign_render import Overlay, Run, heat_map_svg, html, svg
@@ -317,6 +317,7 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
                     Overlay(setting.runs * len(points)) if pictures.wanted else None)
     progress = Progress(setting.runs * len(points), sys.stderr)
     status = 0
+    lost: SchedulerLost | None = None
     stopping = Stopping()
     broken_at = None  # the point and the first seed left when the workers last broke
     try:
@@ -340,6 +341,8 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
                     current = held.enter_context(_workers(setting))
     except Stopped as stop:  # again, while the workers end their runs
         status = stop.status
+    except SchedulerLost as error:
+        status, lost = EXIT_USAGE, error
     finally:
         progress.finish()
         if lines is not None and lines is not sys.stdout:
@@ -361,8 +364,8 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
                  + setting.rest(next_seed + 1, setting.runs - tally.runs - 1)),
               file=sys.stderr)
     elif status:
-        print("rl1c: interrupted: the runs finished are kept"
-              + ("" if out is None else f" in {out}") + (
+        print(("rl1c: interrupted" if lost is None else f"rl1c: error: {lost}")
+              + ": the runs finished are kept" + ("" if out is None else f" in {out}") + (
                   "; to go on, run the sweep again (each point makes the same runs)"
                   if setting.sweep else "; to go on, run the seeds left: " + rest),
               file=sys.stderr)
@@ -372,11 +375,13 @@ def _make_runs(task: Task, seeds: range, held: Workers, keeper: Keeper,
                progress: Progress, stopping: Stopping) -> int:
     """Make the runs of `seeds` on `held`, keeping each; 0, the status of a signal that
     stopped them, or EXIT_INTERNAL when a run was lost with its worker each time it was
-    made. BrokenExecutor when a local worker process ended abruptly, after keeping the
-    runs finished before the first it lost."""
+    made. BrokenExecutor when a local worker process ended abruptly, SchedulerLost when
+    a cluster's scheduler was lost, after keeping the runs finished before the first
+    lost."""
     runs = Campaign(task, seeds, held.executor, WINDOW_PER_JOB * max(held.slots, 1),
                     held.lost)
-    ending: tuple[type[BaseException], ...] = (Stopped, BrokenExecutor, *held.lost)
+    ending: tuple[type[BaseException], ...] = (Stopped, BrokenExecutor, SchedulerLost,
+                                               *held.lost)
     try:
         for record in runs:
             with stopping.keeping():
@@ -389,7 +394,7 @@ def _make_runs(task: Task, seeds: range, held: Workers, keeper: Keeper,
         match stop:
             case Stopped():
                 return stop.status
-            case BrokenExecutor():
+            case BrokenExecutor() | SchedulerLost():
                 raise
         return EXIT_INTERNAL
     return 0

@@ -305,3 +305,30 @@ def test_fuzzing_with_an_unreachable_scheduler_says_so(tmp_path: Path) -> None:
     result = rl1c("fuzz", "--count", "10", "--jobs", "2", "--scheduler", address)
     assert result.exit_code == 2
     assert "--jobs counts local processes, and --scheduler gives" in result.stderr
+
+
+def test_a_scheduler_lost_in_a_campaign_keeps_its_runs_and_says_how_to_go_on(
+        cluster: Cluster, tmp_path: Path) -> None:
+    program, world = _wall(tmp_path)
+    runs = 100_000
+    out = tmp_path / "cluster.jsonl"
+    with subprocess.Popen([str(BIN / "rl1c"), "sim", str(program), "--world", str(world),
+                           "--runs", str(runs), "--budget", "10000", "--scheduler",
+                           cluster.address, "--out", str(out)],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
+        deadline = time.monotonic() + STARTED_WITHIN
+        while (not out.exists() or out.read_text().count("\n") < 50) \
+                and process.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.05)
+        cluster.processes[0].kill()  # the scheduler
+        stdout, stderr = process.communicate(timeout=STARTED_WITHIN)
+    assert process.returncode == 2, stderr
+    assert "Traceback" not in stderr
+    kept = out.read_text().count("\n")
+    assert f"{kept} runs of" in stdout and f"(stopped after {kept} of {runs})" in stdout
+    assert (f"rl1c: error: the connection to the Dask scheduler at {cluster.address} was "
+            f"lost: the runs finished are kept in {out}; to go on, run the seeds left: "
+            f"rl1c sim {program} --world {world} --runs {runs - kept} --seed {kept} "
+            f"--scheduler {cluster.address} --budget 10000") in stderr
+    _local(program, world, kept, tmp_path / "local.jsonl")
+    assert out.read_bytes() == (tmp_path / "local.jsonl").read_bytes()  # the first seeds
