@@ -73,7 +73,7 @@ class Cluster:
         with open(self.logs / f"{role}-{len(self.processes)}.log", "wb") as log:
             process = subprocess.Popen([str(BIN / "dask"), role, *options, "--no-dashboard"],
                                        stdin=subprocess.DEVNULL, stdout=log,
-                                       stderr=subprocess.STDOUT, env=env)
+                                       stderr=subprocess.STDOUT, env=env, cwd=self.logs)
         self.processes.append(process)
         return process
 
@@ -132,8 +132,11 @@ def _local(program: Path, world: Path, runs: int, out: Path) -> str:
 
 
 def test_a_campaign_on_a_cluster_is_the_local_campaign_byte_for_byte(
-        cluster: Cluster, tmp_path: Path) -> None:
-    program, world = _wall(tmp_path)
+        cluster: Cluster, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # Named from here, where the workers (in the folder of their logs) find no such
+    # files: each task carries the program and the world.
+    monkeypatch.chdir(tmp_path)
+    program, world = (Path(path.name) for path in _wall(tmp_path))
     local = _local(program, world, 200, tmp_path / "local.jsonl")
     remote = rl1c("sim", program, "--world", world, "--runs", "200", "--budget", "10000",
                   "--scheduler", cluster.address, "--out", tmp_path / "cluster.jsonl")
