@@ -51,7 +51,8 @@ GOAL_NO_ARGUMENT, GOAL_PER_ARGUMENT, GOAL_AVR_KYC = 60, 8, 250
 class Kind:
     label: str
     mnemonic: str           # the opcode's name in vm/isa.py
-    values: tuple[int, ...]  # each argument's value, passed in a variable of its own
+    values: tuple[int, ...]  # each argument's value
+    variables: bool         # each passed in a variable of its own (a, b, c), or constants
     started: bool           # started and polled (two callbacks), or immediate (one)
 
     @property
@@ -59,19 +60,24 @@ class Kind:
         return GOAL_NO_ARGUMENT + GOAL_PER_ARGUMENT * len(self.values)
 
 
-KINDS = (Kind("KYC", "KYC", (), False),
-         Kind("IMG (started and polled)", "IMG", (), True),
-         Kind("MOV a, b (two variables)", "MOV", (3, -4), False),
-         Kind("MVI a, b, c (three variables)", "MVI", (3, -4, 100), True))
+KINDS = (Kind("KYC", "KYC", (), False, False),
+         Kind("IMG (started and polled)", "IMG", (), False, True),
+         Kind("MOV 3, -4 (two constants)", "MOV", (3, -4), False, False),
+         Kind("MOV a, b (two variables)", "MOV", (3, -4), True, False),
+         Kind("MVI 3, -4, 100 (constants)", "MVI", (3, -4, 100), False, True),
+         Kind("MVI a, b, c (three variables)", "MVI", (3, -4, 100), True, True))
 
 
 def program(kind: Kind, calls: int) -> bytes:
     """The .ilc file: the arguments' variables set (a, b, c), then `calls` calls, END."""
     by_name = {info.name: info for info in isa.OPCODES.values()}
-    variables = [VARIABLES.index(name) for name in "abc"[:len(kind.values)]]
-    code = b"".join(isa.encode(by_name["MOVI"], (variable, value))
-                    for variable, value in zip(variables, kind.values, strict=True))
-    args = tuple(isa.Arg(True, variable) for variable in variables)
+    if kind.variables:
+        variables = [VARIABLES.index(name) for name in "abc"[:len(kind.values)]]
+        code = b"".join(isa.encode(by_name["MOVI"], (variable, value))
+                        for variable, value in zip(variables, kind.values, strict=True))
+        args = tuple(isa.Arg(True, variable) for variable in variables)
+    else:
+        code, args = b"", tuple(isa.Arg(False, value) for value in kind.values)
     code += isa.encode(by_name[kind.mnemonic], (), args) * calls + isa.encode(by_name["END"])
     return ilc.encode(ilc.Image(code, {}, frozenset(Feature)))
 
@@ -157,7 +163,7 @@ def main() -> int:
         m3 = avr = "skipped"
         m3_over = avr_over = False
         callbacks = 2 if kind.started else 1
-        name = kind.mnemonic.lower()
+        name = kind.mnemonic.lower() + ("-variables" if kind.variables else "")
         if have_arm:
             with_calls, without = (m3_instructions(build(ARM, build_dir, f"{name}-{n}-m3",
                                                          program(kind, n)))

@@ -4,9 +4,11 @@ targets, from the objects `make -C vm/c cross` builds at -Os, against the goals 
 at most 128 bytes, a stack of at most 256 bytes) and its anchors (EmbedVM ~3 KB with no
 verifier, Microvium 7.3 KB on Cortex-M0).
 
-Flash is text, rodata and initialized data; static RAM is data and bss, and rodata on
-AVR, whose start-up copies it to RAM: the VM must have none (on AVR it is built with
--fno-tree-switch-conversion, which would make lookup tables of its switches). The state
+Flash is text, rodata, initialized data and, on AVR, what is kept in program memory
+(.progmem: the calls' descriptors, switch tables); static RAM is data and bss, and
+rodata on AVR, whose start-up copies it to RAM: the VM must have none (on AVR it is
+built with -fno-tree-switch-conversion, which would make lookup tables of its
+switches). The state
 struct (rl1_vm) is read from the size of test/probe.c's symbol. Stack: from gcc's
 -fstack-usage, for each public entry the sum of its frame and every helper's it may call
 (nothing recurses, and each helper appears at most once on a chain), a bound that leaves
@@ -42,8 +44,8 @@ OBJECTS = ("rl1vm", "rl1vm_load")  # the VM, the loader and verifier
 Chain = dict[str, tuple[str, ...]]
 LOAD_CHAIN: Chain = {"rl1vm_load": ("rl1_load", "leb128", "starts_instruction",
                                     "rl1_op_length", "rl1_arg_in_range", "check_")}
-STEP_CHAIN: Chain = {"rl1vm": ("rl1_step", "take_event", "fault", "finish", "shifted",
-                               "call", "resume", "run", "ended"),
+STEP_CHAIN: Chain = {"rl1vm": ("rl1_step", "take_event", "fault", "take_reading", "shifted",
+                               "resume", "run", "ended"),
                      "rl1vm_load": ("rl1_op_length", "rl1_arg_in_range")}
 GOALS = {"flash": 4096, "struct": 128, "stack": 256}
 # What a bare link of the VM and verifier leaves undefined, by target: libgcc's helpers
@@ -67,7 +69,7 @@ def sizes(tool: str, path: Path, rodata_in_ram: bool) -> tuple[int, int]:
         name, size = fields[0], int(fields[1])
         if name.startswith((".data", ".bss")) or (rodata_in_ram and name.startswith(".rodata")):
             ram += size
-        if name.startswith((".text", ".rodata", ".data")):
+        if name.startswith((".text", ".rodata", ".data", ".progmem")):
             flash += size
     return flash, ram
 

@@ -9,7 +9,9 @@
  * Portability: `int` may be 16 bits (AVR). `acc` is kept as a uint16_t bit pattern, so
  * that +, - and the shifts wrap without signed overflow; a value becomes an int16_t
  * only when stored (two's complement, spec/ilc.md section 13). No table in static data
- * but the threaded dispatch's (RL1_THREADED, never built for size), which is constant.
+ * but constant ones: the calls' descriptors (rl1vm.h), which tell the call path all that
+ * differs from one call to another, and the threaded dispatch's (RL1_THREADED, never
+ * built for size).
  */
 #include "rl1vm.h"
 
@@ -18,10 +20,6 @@
  * the step under way faults when the callback returns. */
 #define REENTERED 5u
 
-/* The reserved variables the sensing calls write (spec/ilc.md 8.3), by index. */
-#define VAR_S 44u
-#define VAR_U 46u
-#define VAR_W 48u
 
 void rl1_vm_init(rl1_vm *vm, uint32_t budget)
 {
@@ -55,18 +53,9 @@ static uint16_t shifted(uint16_t x, int16_t count, bool left)
     return (uint16_t)(x >> places);
 }
 
-/* Sets of calls (RL1_OP_FRE..RL1_OP_FZI), as bit op - RL1_OP_FRE of a word: a test is
- * one AND. */
-#define CALL_BIT(op) ((uint32_t)1 << ((unsigned)(op) - (unsigned)RL1_OP_FIRST_CALL))
-/* The calls that take device time, so are started and polled (12.2): ORG MVI STR STL
- * STX ROT TIM, and IMG through ULT D (every CAM and ULT form). */
-#define TAKE_TIME (CALL_BIT(RL1_OP_ORG) | CALL_BIT(RL1_OP_MVI) | CALL_BIT(RL1_OP_STR)      \
-                   | CALL_BIT(RL1_OP_STL) | CALL_BIT(RL1_OP_STX) | CALL_BIT(RL1_OP_ROT)    \
-                   | CALL_BIT(RL1_OP_TIM)                                                  \
-                   | (CALL_BIT(RL1_OP_ULTD + 1u) - CALL_BIT(RL1_OP_IMG)))
-/* The calls whose result goes into R: KYO, IMG, CAM R, every ULT form, INP. */
-#define SET_R (CALL_BIT(RL1_OP_KYO) | CALL_BIT(RL1_OP_IMG) | CALL_BIT(RL1_OP_INP)          \
-               | (CALL_BIT(RL1_OP_ULTD + 1u) - CALL_BIT(RL1_OP_CAMR)))
+/* The calls that read something back: the VM clears their reading before the callback
+ * and takes it after (the others' reading is not looked at). */
+#define READS (RL1_CALL_SETS_R | RL1_CALL_PAIRS)
 
 /* A reading with every field zero, stored field by field: an initializer of the whole
  * struct becomes a call to memset on Cortex-M0 (gcc at any level) and with clang at -O0,
@@ -88,73 +77,64 @@ static bool broken_in(const rl1_vm *vm)
     return vm->state != (uint8_t)RL1_IN_STEP;
 }
 
-/* Takes a finished call's answer: false for a device error (an ERROR, a value out of
- * its documented range, 12.5, or a callback that broke in: then nothing is written); else writes the reserved
- * variables, then R (spec/ilc.md section 9, steps 4-6). */
-static bool finish(rl1_vm *vm, uint8_t op, rl1_status status, const rl1_reading *out)
+/* The `arity` arguments of call `op` from its operands at `at` (the mask, then 2 bytes
+ * an argument) into `args`, left to right: false at the first variable out of its
+ * parameter's range (section 9, step 2). (Out of line it would have more registers
+ * for its loop, and cost 36 bytes of flash on Cortex-M3, more than 4 KB allow.) */
+static bool arguments(const int16_t *V, uint8_t op, uint8_t arity, const uint8_t *at,
+                      int16_t *args)
 {
-    uint8_t first = 0, count = 0, k;
-    if (status != RL1_OK || broken_in(vm) || (op == RL1_OP_CAMR && (out->result < 0 || out->result > 784))
-        || (op == RL1_OP_INP && (out->result < 0 || out->result > 255))) {
+    const int16_t *range = &rl1_param_ranges[2u * rl1_flash_byte(
+        &rl1_call_first[op - RL1_OP_FIRST_CALL])];
+    uint8_t mask = RL1_BYTE(at), k;
+    for (k = 0; k < arity; k++, mask >>= 1) {
+        uint16_t field = RL1_U16(at + 1u + 2u * k);
+        int16_t value = (int16_t)field;
+        if (mask & 1u) {
+            value = V[field];
+            if (value < rl1_flash_i16(&range[2u * k])
+                || value > rl1_flash_i16(&range[2u * k + 1u])) {
+                return false;
+            }
+        }
+        args[k] = value;
+    }
+    return true;
+}
+
+/* Takes what call `op` (descriptor `call`, READS), finished, read: false, writing
+ * nothing, when its result is outside its documented range (12.5), a device error; else
+ * writes its reserved variables, then R (spec/ilc.md section 9, steps 5-6). */
+static bool take_reading(rl1_vm *vm, uint8_t op, uint8_t call, const rl1_reading *out)
+{
+    unsigned pairs = (call & RL1_CALL_PAIRS) >> RL1_CALL_PAIRS_SHIFT;
+    unsigned result = (call & RL1_CALL_RESULT) >> RL1_CALL_RESULT_SHIFT;
+    const int16_t *from = out->writes;
+    /* every checked range starts at 0 (isa_table.py): a negative result is above high */
+    if (result && (uint16_t)out->result > (uint16_t)RL1_RESULT_HIGH(result)) {
         return false;
     }
-    if (op == RL1_OP_KYO) {
-        first = VAR_U; /* u, v */
-        count = 2;
-    } else if (op == RL1_OP_IMG) {
-        first = VAR_W; /* w, x, y, z */
-        count = 4;
-    } else if (op == RL1_OP_FZI) {
-        first = VAR_S; /* s, t */
-        count = 2;
+    if (pairs) {
+        int16_t *to = &vm->V[rl1_flash_byte(&rl1_call_first[op - RL1_OP_FIRST_CALL])];
+        for (; pairs; pairs--, to += 2, from += 2) {
+            to[0] = from[0];
+            to[1] = from[1];
+        }
     }
-    for (k = 0; k < count; k++) {
-        vm->V[first + k] = out->writes[k];
-    }
-    if (CALL_BIT(op) & SET_R) {
+    if (call & RL1_CALL_SETS_R) {
         vm->R = out->result;
     }
     return true;
 }
 
-/* The call `op`, with `arity` arguments after the mask at `operands` (section 9, steps
- * 2-6): a fault, or RL1_FAULT_NONE with vm->waiting set when its first poll answered
- * busy. */
-static rl1_fault call(rl1_vm *vm, const rl1_hardware *hw, uint8_t op, uint8_t arity,
-                      const uint8_t *operands)
+/* Whether a finished call `op` (descriptor `call`) succeeded, its reading taken: false
+ * for a device error (an ERROR, a value out of its documented range, or a callback that
+ * broke in: then nothing is written). */
+static bool finished(rl1_vm *vm, uint8_t op, uint8_t call, rl1_status status,
+                     const rl1_reading *out)
 {
-    int16_t args[3];
-    rl1_reading out;
-    rl1_status status;
-    uint8_t mask, k;
-    clear_reading(&out);
-    if (arity) {
-        mask = RL1_BYTE(operands);
-        for (k = 0; k < arity; k++) { /* left to right; the first out of range faults */
-            uint16_t field = RL1_U16(operands + 1u + 2u * k);
-            if (((unsigned)mask >> k) & 1u) {
-                args[k] = vm->V[field];
-                if (!rl1_arg_in_range(op, k, args[k])) {
-                    return RL1_FAULT_ARGUMENT_RANGE;
-                }
-            } else {
-                args[k] = (int16_t)field;
-            }
-        }
-    }
-    if (CALL_BIT(op) & TAKE_TIME) {
-        if (hw->start(hw->ctx, op, arity ? args : NULL) != RL1_OK) {
-            return RL1_FAULT_DEVICE;
-        }
-        status = hw->poll(hw->ctx, &out);
-        if (status == RL1_BUSY && !broken_in(vm)) {
-            vm->waiting = op;
-            return RL1_FAULT_NONE;
-        }
-    } else {
-        status = hw->call(hw->ctx, op, arity ? args : NULL, &out);
-    }
-    return finish(vm, op, status, &out) ? RL1_FAULT_NONE : RL1_FAULT_DEVICE;
+    return status == RL1_OK && !broken_in(vm)
+        && (!(call & READS) || take_reading(vm, op, call, out));
 }
 
 /* The event point (section 9): takes a pending lost line and moves *pc to the handler
@@ -214,7 +194,7 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
                         uint16_t at)
 {
     rl1_reading out;
-    uint8_t op = vm->waiting;
+    uint8_t op = vm->waiting, call = rl1_call_descriptor(op);
     rl1_status status;
     rl1_fault kind;
     clear_reading(&out);
@@ -223,7 +203,7 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
         return RL1_WAITING;
     }
     vm->waiting = 0;
-    if (!finish(vm, op, status, &out)) {
+    if (!finished(vm, op, call, status, &out)) {
         return fault(vm, hw, RL1_FAULT_DEVICE, at, false);
     }
     kind = take_event(vm, program, &vm->pc);
@@ -394,7 +374,13 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
     const uint8_t *stop = STOP;
     rl1_fault kind = RL1_FAULT_NONE;
     rl1_state state = RL1_RUNNING;
-    uint8_t op, arity;
+    /* a call's */
+    const uint8_t *next;
+    int16_t args[3];
+    const int16_t *given; /* args, or NULL for a call without arguments */
+    rl1_reading out;
+    rl1_status status;
+    uint8_t op, call, arity;
 #ifdef RL1_COMPACT
     uint16_t operand;
 #endif
@@ -473,29 +459,61 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
         case RL1_OP_CAMR: case RL1_OP_ULTA: case RL1_OP_ULTB: case RL1_OP_ULTC: case RL1_OP_ULTD:
         case RL1_OP_LMP: case RL1_OP_INP: case RL1_OP_OUT: case RL1_OP_FZO: case RL1_OP_FZI:
             COUNTED(op_call)
+            /* A call (section 9, steps 2-6), its descriptor telling all that differs. */
             if (left < over_below) {
                 kind = RL1_FAULT_BUDGET;
                 break;
             }
             op = RL1_BYTE(ip); /* not set by a threaded jump */
-            arity = rl1_call_arity(op);
-            vm->executed = before + (n - left);
-            vm->pc = (uint16_t)(ip - code + rl1_call_length(arity));
-            kind = call(vm, hw, op, arity, ip + 1);
-            if (kind != RL1_FAULT_NONE) {
+            call = rl1_call_descriptor(op);
+            arity = call & RL1_CALL_ARITY;
+            next = ip + 1;
+            given = NULL;
+            if (arity) {
+                if (!arguments(V, op, arity, next, args)) {
+                    kind = RL1_FAULT_ARGUMENT_RANGE;
+                    break;
+                }
+                next += 1u + 2u * arity;
+                given = args;
+            }
+            /* pc past the call while its callbacks run: the line of the call under way is
+             * the one before it (vm/native.py's current_line) */
+            vm->pc = (uint16_t)(next - code);
+            if (call & READS) {
+                clear_reading(&out);
+            }
+            if (call & RL1_CALL_STARTED) {
+                if (hw->start(hw->ctx, op, given) != RL1_OK) {
+                    kind = RL1_FAULT_DEVICE;
+                    break;
+                }
+                status = hw->poll(hw->ctx, &out);
+                if (status == RL1_BUSY && !broken_in(vm)) {
+                    vm->waiting = op;
+                    vm->acc = (int16_t)acc;
+                    vm->executed = before + (n - left);
+                    return RL1_WAITING;
+                }
+            } else {
+                status = hw->call(hw->ctx, op, given, &out);
+            }
+            if (!finished(vm, op, call, status, &out)) {
+                kind = RL1_FAULT_DEVICE;
                 break;
             }
-            if (vm->waiting) {
-                vm->acc = (int16_t)acc;
-                return RL1_WAITING;
+            if (vm->mailbox.posted != vm->mailbox.taken) { /* the event point */
+                target = vm->pc;
+                kind = take_event(vm, program, &target);
+                if (kind != RL1_FAULT_NONE) {
+                    break;
+                }
+                ip = code + target;
+                stop = STOP;
+                NEXT();
             }
-            target = vm->pc;
-            kind = take_event(vm, program, &target);
-            if (kind != RL1_FAULT_NONE) {
-                break;
-            }
-            ip = code + target;
-            stop = STOP;
+            /* no jump: `stop` holds (left falls by one, ip gains one at least) */
+            ip = next;
             NEXT();
         }
         break;

@@ -7,10 +7,11 @@
  * the VM (rl1vm.c), which steps a verified program (spec/ilc.md section 12) and drives
  * the vehicle through the callbacks of rl1_hardware.h.
  *
- * No allocation, no recursion, no floating point, no static data (but the constant
- * table of the threaded dispatch, in builds for speed: rl1vm.c): all state is in the
- * caller's rl1_program and rl1_vm. Sizes are u32 and every sum of them is checked
- * before it is made, so no file, however damaged, makes the loader read outside it.
+ * No allocation, no recursion, no floating point, no static data but constant tables
+ * in flash (the calls' descriptors, and the threaded dispatch's in builds for speed:
+ * rl1vm.c): all state is in the caller's rl1_program and rl1_vm. Sizes are u32 and
+ * every sum of them is checked before it is made, so no file, however damaged, makes the
+ * loader read outside it.
  */
 #ifndef RL1VM_H
 #define RL1VM_H
@@ -144,6 +145,36 @@ typedef enum rl1_feature {
     RL1_FEATURES_KNOWN = 0x7F  /* every feature this format defines */
 } rl1_feature;
 
+/* Each call's descriptor (spec/ilc.md 8.3 and 12), from vm/language.py: for each
+   call from RL1_OP_FIRST_CALL, a byte of the bits below in RL1_CALL_DESCRIPTORS,
+   and one in RL1_CALL_FIRST: for a call with arguments, the index in
+   RL1_PARAM_RANGES of its first parameter's (low, high) pair, the others'
+   following it; for one that writes reserved variables (none takes arguments),
+   the first of them, the others following it. */
+#define RL1_CALL_ARITY 0x03u       /* how many arguments it takes, 0 to 3 */
+#define RL1_CALL_STARTED 0x04u     /* it takes device time: started, then polled */
+#define RL1_CALL_SETS_R 0x08u      /* its result goes into R */
+#define RL1_CALL_PAIRS 0x30u       /* how many pairs of reserved variables it writes,
+                                      from rl1_reading's writes */
+#define RL1_CALL_PAIRS_SHIFT 4u
+#define RL1_CALL_RESULT 0xC0u      /* its result's range: 0 for any, else
+                                      0 .. RL1_RESULT_HIGH of it */
+#define RL1_CALL_RESULT_SHIFT 6u
+#define RL1_RESULT_HIGH(kind) ((kind) == 1u ? 784 : 255)
+#define RL1_CALL_COUNT 30
+#define RL1_CALL_DESCRIPTORS \
+    {0x00, 0x00, 0x04, 0x07, 0x02, 0x05, 0x05, 0x05, 0x05, 0x01, 0x05, 0x00, 0x18, \
+     0x01, 0x2C, 0x04, 0x04, 0x04, 0x05, 0x05, 0x4C, 0x0C, 0x0C, 0x0C, 0x0C, 0x01, \
+     0x89, 0x02, 0x02, 0x10}
+#define RL1_CALL_FIRST \
+    {0, 0, 0, 0, 3, 5, 6, 7, 8, 9, 10, 11, 46, 11, 48, 12, 12, 12, 12, 13, 14, 14, \
+     14, 14, 14, 14, 15, 16, 18, 44}
+#define RL1_PARAM_COUNT 20
+#define RL1_PARAM_RANGES \
+    {-12, 12, -12, 12, -1900, 1900, -12, 12, -12, 12, 0, 180, 0, 180, -1800, 1800, \
+     -360, 360, 0, 3, 1, 100, 0, 7, 0, 180, 0, 784, 0, 1, 0, 125, 0, 125, 0, 255, \
+     INT16_MIN, INT16_MAX, INT16_MIN, INT16_MAX}
+
 /* ---- End of the generated constants ---- */
 
 /* Why a file is refused: one code per rule of spec/ilc.md section 10, in the order the
@@ -251,21 +282,55 @@ void rl1_vm_init(rl1_vm *vm, uint32_t budget);
  * operands' shape; 0 for an opcode unknown in that version. */
 uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape);
 
-/* How many arguments call `op` (RL1_OP_FRE..RL1_OP_FZI) takes, 0 to 3: two bits a
- * call, the calls from 0x40 in one word and from 0x50 in the other (a table would be
- * copied to RAM on AVR). */
-#define RL1_ARITY(op, n) ((uint32_t)(n) << (2u * ((unsigned)(op) & 0x0Fu)))
+/* The calls' descriptors and their parameters' ranges (the generated RL1_CALL_DESCRIPTORS,
+ * RL1_CALL_FIRST and RL1_PARAM_RANGES), defined once in rl1vm_load.c. Constant
+ * data: in flash on every target, on AVR in program memory (a table there would
+ * otherwise be copied to RAM at start-up), so read only through the functions below. */
+#if defined(__AVR__)
+#define RL1_IN_FLASH __attribute__((__progmem__))
+static inline uint8_t rl1_flash_byte(const uint8_t *p)
+{
+    uint8_t byte;
+    __asm__("lpm %0, Z" : "=r"(byte) : "z"(p));
+    return byte;
+}
+static inline int16_t rl1_flash_i16(const int16_t *p) /* AVR is little-endian */
+{
+    const uint8_t *at = (const uint8_t *)p;
+    return (int16_t)(uint16_t)(rl1_flash_byte(at) | (unsigned)rl1_flash_byte(at + 1) << 8);
+}
+#else
+#define RL1_IN_FLASH
+static inline uint8_t rl1_flash_byte(const uint8_t *p)
+{
+    return *p;
+}
+static inline int16_t rl1_flash_i16(const int16_t *p)
+{
+    return *p;
+}
+#endif
+extern const uint8_t rl1_call_descriptors[RL1_CALL_COUNT];
+extern const uint8_t rl1_call_first[RL1_CALL_COUNT];
+extern const int16_t rl1_param_ranges[2 * RL1_PARAM_COUNT];
+
+/* The descriptor of call `op` (RL1_OP_FRE..RL1_OP_FZI). */
+static inline uint8_t rl1_call_descriptor(uint8_t op)
+{
+    return rl1_flash_byte(&rl1_call_descriptors[op - RL1_OP_FIRST_CALL]);
+}
+
+/* How many arguments call `op` takes, 0 to 3. */
 static inline uint8_t rl1_call_arity(uint8_t op)
 {
-    uint32_t arities = op < RL1_OP_CAMU
-        ? RL1_ARITY(RL1_OP_MVI, 3) | RL1_ARITY(RL1_OP_MOV, 2) /* MVI l, r, cm; MOV l, r */
-          | RL1_ARITY(RL1_OP_STR, 1) | RL1_ARITY(RL1_OP_STL, 1) | RL1_ARITY(RL1_OP_STX, 1)
-          | RL1_ARITY(RL1_OP_ROT, 1) | RL1_ARITY(RL1_OP_TRC, 1) | RL1_ARITY(RL1_OP_TIM, 1)
-          | RL1_ARITY(RL1_OP_SCN, 1)
-        : RL1_ARITY(RL1_OP_CAMA, 1) | RL1_ARITY(RL1_OP_CAMP, 1) | RL1_ARITY(RL1_OP_LMP, 1)
-          | RL1_ARITY(RL1_OP_INP, 1) | RL1_ARITY(RL1_OP_OUT, 2) /* OUT port, data */
-          | RL1_ARITY(RL1_OP_FZO, 2);                              /* FZO a, b */
-    return (uint8_t)((arities >> (2u * (op & 0x0Fu))) & 3u);
+    return (uint8_t)(rl1_call_descriptor(op) & RL1_CALL_ARITY);
+}
+
+/* The low (0) or high (1) end of the range of the parameter at `index` in
+ * RL1_PARAM_RANGES (the call's rl1_call_first, plus the argument's place). */
+static inline int16_t rl1_param_end(uint8_t index, uint8_t end)
+{
+    return rl1_flash_i16(&rl1_param_ranges[2u * index + end]);
 }
 
 /* The length of a call with `arity` arguments: the opcode alone, or the opcode, the
@@ -276,7 +341,7 @@ static inline uint8_t rl1_call_length(uint8_t arity)
 }
 
 /* Whether `value` lies in the range of parameter `index` of call `op`. */
-bool rl1_arg_in_range(uint8_t op, uint8_t index, int32_t value);
+bool rl1_arg_in_range(uint8_t op, uint8_t index, int16_t value);
 
 #ifdef __cplusplus
 }

@@ -52,10 +52,10 @@ static uint32_t u32_at(const uint8_t *p)
 
 /* An i16 operand's value; converting a u16 above 0x7FFF to int16_t would be
  * implementation-defined. */
-static int32_t i16_at(const uint8_t *p)
+static int16_t i16_at(const uint8_t *p)
 {
     uint16_t u = u16_at(p);
-    return u < 0x8000u ? (int32_t)u : (int32_t)u - (int32_t)0x10000L;
+    return u < 0x8000u ? (int16_t)u : (int16_t)((int32_t)u - (int32_t)0x10000L);
 }
 
 /* Moves *pos over a field of `length` bytes if the file holds it. *pos never passes
@@ -201,35 +201,19 @@ static uint8_t op_feature(uint8_t op)
     }
 }
 
+/* Each call's descriptor and its parameters' ranges (rl1vm.h, generated from
+ * vm/language.py): the one copy the loader and the VM share. */
+const uint8_t rl1_call_descriptors[RL1_CALL_COUNT] RL1_IN_FLASH = RL1_CALL_DESCRIPTORS;
+const uint8_t rl1_call_first[RL1_CALL_COUNT] RL1_IN_FLASH = RL1_CALL_FIRST;
+const int16_t rl1_param_ranges[2 * RL1_PARAM_COUNT] RL1_IN_FLASH = RL1_PARAM_RANGES;
+
 /* Whether `value` lies in the range of parameter `index` of call `op`
  * (spec/language.md section 8). */
-bool rl1_arg_in_range(uint8_t op, uint8_t index, int32_t value)
+bool rl1_arg_in_range(uint8_t op, uint8_t index, int16_t value)
 {
-    int32_t low = -32768, high = 32767; /* FZO a, b */
-    switch (op) {
-    case RL1_OP_MVI: /* l, r, cm */
-        low = index == 2u ? -1900 : -12;
-        high = index == 2u ? 1900 : 12;
-        break;
-    case RL1_OP_MOV: low = -12; high = 12; break;      /* l, r */
-    case RL1_OP_STR: case RL1_OP_STL: case RL1_OP_CAMA:
-        low = 0; high = 180; break;                      /* degrees */
-    case RL1_OP_STX: low = -1800; high = 1800; break;  /* tenths */
-    case RL1_OP_ROT: low = -360; high = 360; break;    /* deg */
-    case RL1_OP_TRC: low = 0; high = 3; break;         /* mode */
-    case RL1_OP_TIM: low = 1; high = 100; break;       /* tenths */
-    case RL1_OP_SCN: low = 0; high = 7; break;         /* scene */
-    case RL1_OP_CAMP: low = 0; high = 784; break;      /* pulse */
-    case RL1_OP_LMP: low = 0; high = 1; break;         /* on */
-    case RL1_OP_INP: low = 0; high = 0x7D; break;      /* port */
-    case RL1_OP_OUT:                                    /* port, data */
-        low = 0;
-        high = index == 0u ? 0x7D : 255;
-        break;
-    default:
-        break;
-    }
-    return value >= low && value <= high;
+    uint8_t param = (uint8_t)(rl1_flash_byte(&rl1_call_first[op - RL1_OP_FIRST_CALL])
+                              + index);
+    return value >= rl1_param_end(param, 0) && value <= rl1_param_end(param, 1);
 }
 
 /* --- the container (spec/ilc.md sections 2-7) -------------------------------------- */

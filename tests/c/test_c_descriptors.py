@@ -1,0 +1,81 @@
+"""The calls' descriptors the C VM and loader read (vm/c/rl1vm.h's generated
+RL1_CALL_DESCRIPTORS, RL1_CALL_FIRST and RL1_PARAM_RANGES, defined in rl1vm_load.c) say
+of each call what vm/language.py says of its form: its arity, whether it takes device
+time (started, then polled), whether its result goes into R, the reserved variables it
+writes, and each parameter's range, read from the built library as the VM reads them.
+(test_c_constants.py holds the header's block equal to what vm/isa_table.py renders;
+this holds what that block means.)"""
+
+from __future__ import annotations
+
+import ctypes
+import shutil
+from pathlib import Path
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from rl1.vm import isa, isa_table, native
+from rl1.vm.language import BUILTINS, VARIABLES, Form, Param
+
+CALLS = isa_table.calls()
+ARITY, STARTED, SETS_R, PAIRS, PAIRS_SHIFT = 0x03, 0x04, 0x08, 0x30, 4
+
+
+@pytest.fixture(scope="module")
+def lib(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
+    if not any(shutil.which(cc) for cc in ("gcc", "cc", "clang")):
+        pytest.skip("no C compiler (gcc, cc or clang) on this machine: vm/c/install-tools "
+                    "installs one on Debian")
+    path: Path = native.library(tmp_path_factory.mktemp("c-build"), sanitize=True)
+    library = ctypes.CDLL(str(path))
+    library.rl1_arg_in_range.argtypes = [ctypes.c_uint8, ctypes.c_uint8, ctypes.c_int16]
+    library.rl1_arg_in_range.restype = ctypes.c_bool
+    return library
+
+
+def table(lib: ctypes.CDLL, name: str, kind: type[ctypes.c_uint8] | type[ctypes.c_int16],
+          size: int) -> list[int]:
+    return list((kind * size).in_dll(lib, name))
+
+
+def test_each_descriptor_says_what_the_language_says_of_its_call(lib: ctypes.CDLL) -> None:
+    descriptors = table(lib, "rl1_call_descriptors", ctypes.c_uint8, len(CALLS))
+    firsts = table(lib, "rl1_call_first", ctypes.c_uint8, len(CALLS))
+    for info, descriptor, first in zip(CALLS, descriptors, firsts, strict=True):
+        form = _form(info)
+        assert info.builtin is not None
+        pairs = (descriptor & PAIRS) >> PAIRS_SHIFT
+        written = [VARIABLES[first + k] for k in range(2 * pairs)]
+        assert (descriptor & ARITY, bool(descriptor & STARTED), bool(descriptor & SETS_R),
+                tuple(written)) == (info.arity, BUILTINS[info.builtin[0]].waits,
+                                    form.returns_value, form.writes), info.name
+
+
+def _parameters() -> list[tuple[str, int, int, Param]]:
+    """Each parameter of each call: the call's name and opcode, its place, the parameter."""
+    return [(info.name, info.opcode, index, param) for info in CALLS
+            for index, param in enumerate(_form(info).params)]
+
+
+def _form(info: isa.OpInfo) -> Form:
+    form = info.form
+    assert form is not None
+    return form
+
+
+@given(st.sampled_from(_parameters()), st.integers(-32768, 32767))
+def test_an_argument_is_in_range_exactly_when_its_parameter_allows_it(
+        lib: ctypes.CDLL, parameter: tuple[str, int, int, Param], value: int) -> None:
+    name, opcode, index, param = parameter
+    assert lib.rl1_arg_in_range(opcode, index, value) == (param.low <= value <= param.high), \
+        (name, param.name, value)
+
+
+def test_every_parameter_bound_and_its_neighbours(lib: ctypes.CDLL) -> None:
+    for name, opcode, index, param in _parameters():
+        for value in (param.low - 1, param.low, param.high, param.high + 1):
+            if -32768 <= value <= 32767:
+                assert lib.rl1_arg_in_range(opcode, index, value) == \
+                    (param.low <= value <= param.high), (name, param.name, value)
