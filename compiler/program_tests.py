@@ -13,6 +13,7 @@ for a problem of the user's files.
 from __future__ import annotations
 
 import os
+import stat
 import time
 from collections.abc import Sequence
 from concurrent.futures import BrokenExecutor, Executor
@@ -120,17 +121,33 @@ def run_test(case: Case, executor: Executor | None = None, jobs: int = 1) -> Out
     with `jobs` workers) and judge it."""
     started = time.perf_counter()
     try:
+        for name in (case.program, case.world, case.sensors):
+            _refuse_special(name)
         outcome = _judged(case, executor, jobs)
     except Unusable as error:
         outcome = Outcome("error", (str(error),))
     except SourceError as error:
-        outcome = Outcome("error", (f"cannot read {error}; {error.help}",))
+        outcome = Outcome("error", (f"cannot read {error}" + (
+            f"; {error.help}" if error.help else ""),))
     except BuildError as error:  # the C VM of --engine c
         outcome = Outcome("error", (str(error),))
     except BrokenExecutor:
         outcome = Outcome("error", ("a worker process of the success rate's runs ended "
                                     "abruptly (killed, or out of memory)",))
     return replace(outcome, seconds=time.perf_counter() - started)
+
+
+def _refuse_special(name: str | None) -> None:
+    """Unusable when the file `name` of a test is a FIFO, a device or a socket: a test
+    file from elsewhere naming one would make `rl1c test` wait forever, or read without
+    end. (A file that does not exist, or cannot be reached, is read's to report.)"""
+    try:
+        mode = os.stat(name).st_mode if name is not None else stat.S_IFREG
+    except OSError:
+        return
+    if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+        raise Unusable(f"{name} is not a regular file (a FIFO, a device or a socket); "
+                       "name a file the test reads")
 
 
 def _judged(case: Case, executor: Executor | None, jobs: int) -> Outcome:

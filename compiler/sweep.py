@@ -59,7 +59,8 @@ def parse_axis(text: str) -> Axis:
     except ValueError:
         raise ValueError(f"`{text[:80]}`: A and B are numbers, the first and the last "
                          "offset from the world's value") from None
-    count = int(match["count"][:6])
+    digits = match["count"].lstrip("0")  # no more digits than MAX_POINTS has are read
+    count = int(digits or "0") if len(digits) <= len(str(MAX_POINTS)) else MAX_POINTS + 1
     if not (math.isfinite(first) and math.isfinite(last)):
         raise ValueError(f"`{text[:80]}`: A and B are finite numbers")
     if not 1 <= count <= MAX_POINTS or (count == 1 and first != last):

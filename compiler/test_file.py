@@ -164,6 +164,11 @@ def _check(tests: TestFile, name: str, text: str) -> None:
             raise fail("name", detail=f'a second test named "{test.name}"; give each '
                                       "test a name of its own")
         seen.add(test.name)
+        for key, path in (("program", test.program), ("world", test.world),
+                          ("sensors", test.sensors)):
+            if isinstance(path, str) and "\0" in path:
+                raise fail(key, detail="a path holds no NUL character (\\u0000); write "
+                                       "the file's name from this file's folder")
         has_world = not isinstance(test.world, UnsetType)
         if has_world and not isinstance(test.sensors, UnsetType):
             raise fail("sensors", detail="a test runs on a world or on a sensor script, "

@@ -17,11 +17,12 @@ import click
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.reporting.render import EXIT_ERRORS, EXIT_USAGE, ColorChoice, use_color
 
-from .command import PATH, Command, Failure, color_option
+from .command import PATH, Command, Failure, color_option, force_option
 from .sim import at_least_one_or_none
-from .streams import cannot, file_problem, problem_text, unreadable, write_file
+from .streams import cannot, file_problem, problem_text, same_file, unreadable, write_file
 
 if TYPE_CHECKING:  # the test file's schema loads when the command runs
+    from rl1.compiler.program_tests import Case
     from rl1.compiler.test_file import Test
 
 SECTION = "Testing"
@@ -36,8 +37,9 @@ TEST_FILE_ROLE = "test file"
                    "the results are the same for any J")
 @click.option("--junit", "junit_file", metavar="FILE", type=PATH,
               help="also write the results as JUnit XML to FILE, for CI")
+@force_option
 @color_option
-def test(paths: tuple[str, ...], jobs: int | None, junit_file: str | None,
+def test(paths: tuple[str, ...], jobs: int | None, junit_file: str | None, force: bool,
          color: ColorChoice) -> int:
     """Run the tests of test files: each a program on a world or a sensor script, and
     what must hold (spec/tests.md).
@@ -54,6 +56,8 @@ def test(paths: tuple[str, ...], jobs: int | None, junit_file: str | None,
     from .test_report import MARKS, Result, junit_xml, story_text, summary_line
 
     cases = [Case(file, test) for file, tests in _load(paths or (".",)) for test in tests]
+    if junit_file is not None:
+        _refuse_junit_target(junit_file, cases)
     workers = jobs or os.cpu_count() or 1
     color_on = use_color(color, sys.stdout)
     started = time.perf_counter()
@@ -77,7 +81,8 @@ def test(paths: tuple[str, ...], jobs: int | None, junit_file: str | None,
             sys.stdout.write(story_text(result, workers, color=color_on))
     sys.stdout.write(f"{' ' + summary_line(results, seconds) + ' ':=^60}\n")
     if junit_file is not None:
-        write_file(junit_file, junit_xml(results, seconds, workers), role="JUnit file")
+        write_file(junit_file, junit_xml(results, seconds, workers), force=force,
+                   role="JUnit file")
     return EXIT_ERRORS if unpassed else 0
 
 
@@ -102,6 +107,26 @@ def _load(paths: Sequence[str]) -> list[tuple[str, list[Test]]]:
     if problems:
         raise Failure("\n".join(problem_text(problem) for problem in problems), EXIT_USAGE)
     return loaded
+
+
+def _refuse_junit_target(target: str, cases: Sequence[Case]) -> None:
+    """A usage error, before any test runs, when the JUnit file could not be written
+    (the tests' time would be lost) or would replace a file the tests read."""
+    if target in ("", "-"):
+        raise click.UsageError("--junit writes a file, and standard output carries the "
+                               "report: give --junit FILE")
+    if os.path.isdir(target):
+        raise click.UsageError(f"--junit `{target}` is a folder: give the path of a file")
+    inputs = {case.file: "test file" for case in cases}
+    for case in cases:
+        inputs |= {name: role for name, role in ((case.program, "program"),
+                                                 (case.world, "world file"),
+                                                 (case.sensors, "sensor script"))
+                   if name is not None}
+    for name, role in inputs.items():
+        if os.path.exists(name) and same_file(name, target):
+            raise click.UsageError(f"--junit `{target}` is the {role} `{name}` itself: "
+                                   "give another path for the JUnit XML")
 
 
 def _test_files(paths: Sequence[str]) -> list[str]:
