@@ -335,3 +335,21 @@ def test_a_scheduler_lost_in_a_campaign_keeps_its_runs_and_says_how_to_go_on(
             f"--scheduler {cluster.address} --budget 10000") in stderr
     _local(program, world, kept, tmp_path / "local.jsonl")
     assert out.read_bytes() == (tmp_path / "local.jsonl").read_bytes()  # the first seeds
+
+
+def test_fuzzing_on_a_cluster_whose_scheduler_is_lost_says_so(cluster: Cluster,
+                                                              tmp_path: Path) -> None:
+    connections = cluster.log().count("Receive client connection")  # the fixture's
+    with subprocess.Popen([str(BIN / "rl1c"), "fuzz", "--count", "100000", "--seed", "1",
+                           "--scheduler", cluster.address, "--out", str(tmp_path / "out")],
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
+        deadline = time.monotonic() + STARTED_WITHIN
+        while cluster.log().count("Receive client connection") == connections:
+            assert process.poll() is None and time.monotonic() < deadline
+            time.sleep(0.1)
+        cluster.processes[0].kill()  # the scheduler
+        _, stderr = process.communicate(timeout=STARTED_WITHIN)
+    assert process.returncode == 2, stderr
+    assert f"error: the connection to the Dask scheduler at {cluster.address} was lost" \
+        in stderr
+    assert "Traceback" not in stderr
