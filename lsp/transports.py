@@ -325,19 +325,28 @@ class _OneLine(logging.Filter):
         return True
 
 
-_WEBSOCKETS_LOG = logging.getLogger(f"{__name__}.websockets")
-_WEBSOCKETS_LOG.addFilter(_OneLine())
+WEBSOCKETS_LOG = logging.getLogger(f"{__name__}.websockets")
+"""The websockets library's logger for the WebSocket servers here and the studio's."""
+WEBSOCKETS_LOG.addFilter(_OneLine())
 
 
-async def serve_websocket(new_session: Callable[[], Session], host: str, port: int) -> None:
-    """Serve each WebSocket connection to HOST:PORT as a session of its own, one LSP
-    message a WebSocket message, until stopped. Needs the `websockets` package."""
-    from websockets.asyncio.server import ServerConnection, serve
-    from websockets.exceptions import ConnectionClosed
+class WebSocketSessions:
+    """The LSP sessions of one server's WebSocket connections, a session a connection,
+    at most MAX_SESSIONS. `rl1-lsp --ws` and the studio's `/lsp` (lsp/studio/) serve a
+    connection with `serve`; their server makes its connections of `connection_class`."""
 
-    sessions: set[Session] = set()
+    def __init__(self) -> None:
+        from websockets.asyncio.server import ServerConnection
 
-    async def connected(connection: ServerConnection) -> None:
+        self.sessions: set[Session] = set()
+        self.connection_class = ServerConnection
+
+    async def serve(self, connection: Any, new_session: Callable[[], Session]) -> None:
+        """Serve `connection` (of `connection_class`) as a session of its own, one LSP
+        message a WebSocket message, until it closes or the session exits."""
+        from websockets.exceptions import ConnectionClosed
+
+        sessions = self.sessions
         if len(sessions) >= MAX_SESSIONS:
             log.warning("a client beyond the %d served at once: refused", MAX_SESSIONS)
             await connection.close(1013, BUSY[:123])  # 1013: try again later
@@ -359,8 +368,20 @@ async def serve_websocket(new_session: Callable[[], Session], host: str, port: i
             session.end()
             await writer.finish()
 
-    async with serve(connected, host, port, max_size=MAX_MESSAGE, max_queue=1,
-                     origins=[None, LOCAL_ORIGIN], logger=_WEBSOCKETS_LOG) as server:
+
+async def serve_websocket(new_session: Callable[[], Session], host: str, port: int) -> None:
+    """Serve each WebSocket connection to HOST:PORT as a session of its own, one LSP
+    message a WebSocket message, until stopped. Needs the `websockets` package."""
+    from websockets.asyncio.server import ServerConnection, serve
+
+    lsp = WebSocketSessions()
+
+    async def connected(connection: ServerConnection) -> None:
+        await lsp.serve(connection, new_session)
+
+    async with serve(connected, host, port, create_connection=lsp.connection_class,
+                     max_size=MAX_MESSAGE, max_queue=1,
+                     origins=[None, LOCAL_ORIGIN], logger=WEBSOCKETS_LOG) as server:
         log.info("serving LSP over WebSocket on %s",
                  ", ".join(str(s.getsockname()) for s in server.sockets))
         await server.serve_forever()

@@ -90,7 +90,7 @@ class Server:
     gate: Gate
     studio: Studio
     static: Path = STATIC
-    lsp_sessions: set[transports.Session] = field(default_factory=set)
+    lsp: transports.WebSocketSessions = field(default_factory=transports.WebSocketSessions)
     pages: int = 0
     addresses: list[tuple[str, int]] = field(default_factory=list)  # listened on
 
@@ -149,8 +149,7 @@ class Server:
         path = urlsplit(connection.request.path).path if connection.request else ""
         if path == "/lsp":
             folder = self.studio.folder
-            await transports.serve_lsp_connection(connection, lambda: new_session(folder),
-                                                  self.lsp_sessions)
+            await self.lsp.serve(connection, lambda: new_session(folder))
         elif path == "/studio":
             await self._studio(connection)
 
@@ -205,7 +204,8 @@ class _Outbox:
 async def serve_studio(server: Server, port: int, listening: Callable[[int], None]) -> None:
     """Serve until cancelled; `listening` is told the port once the server listens."""
     async with serve(server.handle, HOST, port, process_request=server.process_request,
-                     max_size=MAX_MESSAGE, max_queue=1, logger=log,
+                     create_connection=server.lsp.connection_class, max_size=MAX_MESSAGE,
+                     max_queue=1, logger=transports.WEBSOCKETS_LOG,
                      server_header=None) as listener:
         server.addresses = [socket.getsockname()[:2] for socket in listener.sockets]
         server.gate.port = server.addresses[0][1]
