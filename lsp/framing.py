@@ -13,6 +13,7 @@ accepts LF as well as CRLF line ends, and after broken framing skips to the next
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 
 MAX_MESSAGE = 64 * 2**20
 """The largest body accepted, in bytes: 6 times the largest document analysed, which
@@ -26,17 +27,34 @@ _LENGTH = re.compile(rb"content-length:[ \t]*(\d+)[ \t]*", re.IGNORECASE)
 _FIELD = re.compile(rb"[!-9;-~]+:.*")  # any other header, such as Content-Type
 
 
+Admission = Callable[[int], str | None]
+"""Asked with a message's length at the end of its headers, before its body is read:
+None to read it, else why it is skipped (transports.InFlight: what a server's sessions
+hold between them)."""
+
+
 class Framer:
     """Splits the bytes read into message bodies, without ever holding more than one
-    message (up to `limit` bytes) and one chunk."""
+    message (up to `limit` bytes, and admitted by `admit`) and one chunk."""
 
-    def __init__(self, limit: int = MAX_MESSAGE) -> None:
+    def __init__(self, limit: int = MAX_MESSAGE, admit: Admission | None = None) -> None:
         self.limit = limit
+        self.admit = admit
         self.problems: list[str] = []  # what was skipped since last taken
         self._buffer = bytearray()
         self._length: int | None = None  # the Content-Length of the headers read so far
         self._body: int | None = None  # the headers are read: a body this long follows
         self._lost = False  # skipping up to the next Content-Length header
+
+    @property
+    def reading(self) -> int:
+        """The length of the body being read (0 between messages)."""
+        return self._body or 0
+
+    def discard(self) -> None:
+        """Let go of what is buffered: the stream has ended."""
+        self._buffer = bytearray()
+        self._body = self._length = None
 
     def feed(self, data: bytes) -> list[bytes]:
         """The bodies of the messages completed by `data`."""
@@ -52,8 +70,10 @@ class Framer:
             if self._body is not None:
                 if len(buffer) < self._body:
                     return None
-                body = bytes(buffer[:self._body])
-                del buffer[:self._body]
+                with memoryview(buffer) as view:
+                    body = bytes(view[:self._body])
+                    # A new buffer for the rest, lest the body's room be kept for good.
+                    self._buffer = bytearray(view[self._body:])
                 self._body = None
                 return body
             if self._lost:
@@ -73,6 +93,9 @@ class Framer:
             if not line:  # the end of the headers
                 if self._length is None:
                     self._skip("a message without a valid Content-Length header", end + 1)
+                    continue
+                if self.admit is not None and (refused := self.admit(self._length)):
+                    self._skip(f"a message of {self._length:,} bytes: {refused}", end + 1)
                     continue
                 self._body, self._length = self._length, None
             elif (length := _LENGTH.fullmatch(line)) is not None:

@@ -16,9 +16,11 @@ TCP and WebSocket serve up to MAX_SESSIONS clients at once, each a session of it
 rather than one client at a time: the studio opens a WebSocket per page, and an editor
 that reconnects must not find its old connection holding the server. A client beyond
 the limit is told so (an error answering its first request on TCP, close code 1013 on a
-WebSocket). What the server holds is bounded per session (its open documents,
-server.MAX_OPEN_CHARACTERS; one message being read; MAX_UNREAD bytes written that the
-client has not read), so by MAX_SESSIONS times that in all. A connection that has not
+WebSocket). What the server holds for its clients is bounded: each session's open
+documents (server.MAX_OPEN_CHARACTERS), and the bytes in flight of all sessions together
+(InFlight: messages being read, answers their clients have not read yet), so that eight
+clients sending a message of framing.MAX_MESSAGE each at once do not hold eight. A
+connection that has not
 sent `initialize` within INITIALIZE_SECONDS is closed, so that a local process cannot
 hold every place by connecting and saying nothing.
 """
@@ -27,23 +29,35 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import json
 import logging
 import os
 import re
 import threading
-from collections.abc import AsyncIterator, Callable
+from collections.abc import AsyncIterator, Callable, Iterator
 from concurrent.futures import CancelledError
 from typing import Any, BinaryIO, Protocol
 
-from .framing import CHUNK, MAX_MESSAGE, Framer, frame
+from .framing import CHUNK, MAX_MESSAGE, Admission, Framer, frame
 
 log = logging.getLogger(__name__)
 
 MAX_SESSIONS = 8
 """Clients served at once over TCP or WebSocket."""
-MAX_UNREAD = 2 * MAX_MESSAGE
-"""Bytes written to a client that it has not read yet: past this, it is disconnected."""
+FREE_IN_FLIGHT = 2**20
+"""Bytes in flight a session may always hold, whatever the others hold (an editor's
+messages and the answers to them are far smaller), so that no client starves another."""
+MAX_IN_FLIGHT = 2 * MAX_MESSAGE
+"""Bytes in flight that a server's sessions may hold between them beyond FREE_IN_FLIGHT
+each: a message that would pass it is skipped (TCP; the client is told) or its
+connection closed (WebSocket, close code 1009), and a client that would pass it by not
+reading is disconnected."""
+MEMORY_IN_FLIGHT = MAX_IN_FLIGHT + MAX_SESSIONS * FREE_IN_FLIGHT + 2 * MAX_MESSAGE
+"""The most memory a server's messages in flight take, 264 MiB: each byte in flight once,
+and the message being decoded (one at a time: sessions share one thread) twice more, as
+the text JSON decodes it to and the strings it holds. Measured by
+tests/lsp/test_hostile_transports.py (eight clients each sending MAX_MESSAGE bytes)."""
 REFUSAL_SECONDS = 10.0
 """How long a client beyond MAX_SESSIONS has to send the request that is refused."""
 INITIALIZE_SECONDS = 10.0
@@ -89,18 +103,71 @@ class Session(Protocol):
         """The connection is over: stop whatever the session still runs."""
 
 
-async def _serve_stream(session: Session, chunks: AsyncIterator[bytes]) -> None:
-    """Hand `session` each message read from a byte stream, until its end or `exit`."""
-    framer = Framer()
+class InFlight:
+    """The bytes in flight of a server's sessions (each message being read, the answers
+    written that its client has not read), each session counting its own when asked, so
+    that there is nothing to give back when a message is done or a session ends."""
+
+    def __init__(self) -> None:
+        self._held: dict[object, Callable[[], int]] = {}
+
+    @contextlib.contextmanager
+    def counting(self, session: object, held: Callable[[], int]) -> Iterator[None]:
+        """While inside, `held()` says how many bytes `session` holds."""
+        self._held[session] = held
+        try:
+            yield
+        finally:
+            del self._held[session]
+
+    def __contains__(self, session: object) -> bool:
+        return session in self._held
+
+    def refusal(self, session: object, more: int = 0) -> str | None:
+        """None if `session` may hold `more` bytes beyond what it holds, else why not."""
+        mine = self._held[session]() + more - FREE_IN_FLIGHT
+        if mine <= 0:
+            return None
+        others = sum(max(0, held() - FREE_IN_FLIGHT)
+                     for other, held in self._held.items() if other is not session)
+        if others + mine <= MAX_IN_FLIGHT:
+            return None
+        return (f"the server holds {others / 2**20:.0f} MiB of other clients' messages and "
+                f"answers, and {MAX_IN_FLIGHT // 2**20} MiB at most between them; send it "
+                "again when they are done")
+
+
+def _show_error(text: str) -> bytes:
+    """LSP's window/showMessage of an error, which a server may send at any time."""
+    return json.dumps({"jsonrpc": "2.0", "method": "window/showMessage",
+                       "params": {"type": 1, "message": f"rl1-lsp: {text}"}}).encode()
+
+
+async def _serve_stream(session: Session, chunks: AsyncIterator[bytes], framer: Framer,
+                        tell: Writer | None = None) -> None:
+    """Hand `session` each message read from a byte stream by `framer`, until its end or
+    `exit`; what it skips is logged, and told to the client through `tell`."""
     async for chunk in chunks:
-        for body in framer.feed(chunk):
-            session.receive(body)
-            if session.exit_status is not None:
-                return
-        for problem in framer.problems:
-            log.warning("skipped %s; reading on from the next Content-Length header. "
-                        "The client is breaking LSP's framing: please report it", problem)
-        framer.problems.clear()
+        if not _receive(session, framer, chunk, tell):
+            return
+
+
+def _receive(session: Session, framer: Framer, chunk: bytes, tell: Writer | None) -> bool:
+    """Hand `session` the messages that `chunk` completes; False once it has exited. A
+    function of its own, so that no message outlives it: the variables of a coroutine
+    live until it ends, and eight sessions each keeping their last message of
+    MAX_MESSAGE bytes grew the server by 577 MiB."""
+    for body in framer.feed(chunk):
+        session.receive(body)
+        if session.exit_status is not None:
+            return False
+    for problem in framer.problems:
+        log.warning("skipped %s; reading on from the next Content-Length header. "
+                    "The client is breaking LSP's framing: please report it", problem)
+        if tell is not None:
+            tell.write(_show_error(f"skipped {problem}"))
+    framer.problems.clear()
+    return True
 
 
 async def _close_unless_initialized(session: Session, close: Callable[[], object]) -> None:
@@ -176,7 +243,7 @@ def serve_stdio(session: Session, stdin: BinaryIO, stdout: BinaryIO) -> int:
     async def serve() -> None:
         session.attach(_OutputWriter(stdout))
         try:
-            await _serve_stream(session, _read_fd(stdin.fileno()))
+            await _serve_stream(session, _read_fd(stdin.fileno()), Framer())
         finally:
             session.end()
 
@@ -187,16 +254,23 @@ def serve_stdio(session: Session, stdin: BinaryIO, stdout: BinaryIO) -> int:
 # TCP ------------------------------------------------------------------------------------
 
 class _TcpWriter:
-    def __init__(self, stream: asyncio.StreamWriter) -> None:
+    def __init__(self, stream: asyncio.StreamWriter, refusal: Callable[[], str | None]
+                 ) -> None:
         self._stream = stream
+        self._refusal = refusal  # why the session may not hold what it holds, if so
+
+    @property
+    def unread(self) -> int:
+        """Bytes written that the client has not read yet."""
+        return self._stream.transport.get_write_buffer_size()
 
     def write(self, data: bytes) -> None:
         if self._stream.is_closing():
             return
         self._stream.write(frame(data))
-        if self._stream.transport.get_write_buffer_size() > MAX_UNREAD:
-            log.warning("a client has not read %s MiB the server wrote: disconnected",
-                        MAX_UNREAD // 2**20)
+        if (refused := self._refusal()) is not None:
+            log.warning("a client has not read %.0f MiB the server wrote, and %s: "
+                        "disconnected", self.unread / 2**20, refused)
             self._stream.transport.abort()
 
     def close(self) -> None:
@@ -238,6 +312,7 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
     """Serve each connection to HOST:PORT as a session of its own, until stopped."""
     sessions: set[Session] = set()
     refusing: set[asyncio.StreamWriter] = set()  # bounded too: beyond, closed at once
+    in_flight = InFlight()
 
     async def connected(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         try:
@@ -252,13 +327,22 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
                 return
             session = new_session()
             sessions.add(session)
-            session.attach(_TcpWriter(writer))
+            admit: Admission = functools.partial(in_flight.refusal, session)
+            framer = Framer(admit=admit)
+            tcp_writer = _TcpWriter(writer, functools.partial(in_flight.refusal, session))
+            session.attach(tcp_writer)
             try:
-                async with _initialize_deadline(session, writer.transport.abort):
-                    await _serve_stream(session, _read_tcp(reader, writer))
+                with in_flight.counting(session, lambda: framer.reading + tcp_writer.unread):
+                    async with _initialize_deadline(session, writer.transport.abort):
+                        await _serve_stream(session, _read_tcp(reader, writer), framer,
+                                            tcp_writer)
             finally:
                 sessions.discard(session)
                 session.end()
+                # The frames of a connection reset live on, in a reference cycle through
+                # the exception, until the garbage collector runs (it rarely does, as
+                # a buffer of 64 MiB counts as one object): let go of the message now.
+                framer.discard()
         except OSError as error:  # the client went away mid-way
             log.info("a connection ended: %s", error)
         finally:
@@ -272,20 +356,25 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
 
 # WebSocket ------------------------------------------------------------------------------
 
+def _as_bytes(message: str | bytes) -> bytes:
+    return message.encode() if isinstance(message, str) else message
+
+
 class _WebSocketWriter:
     """Sends each message as a text frame, in order, from a task of its own."""
 
-    def __init__(self, connection: Any) -> None:
+    def __init__(self, connection: Any, refusal: Callable[[], str | None]) -> None:
         self._connection = connection
+        self._refusal = refusal  # why the session may not hold what it holds, if so
         self._outbox: asyncio.Queue[str] = asyncio.Queue()
-        self._unsent = 0
+        self.unsent = 0
         self._pump = asyncio.get_running_loop().create_task(self._send_all())
 
     def write(self, data: bytes) -> None:
-        self._unsent += len(data)
-        if self._unsent > MAX_UNREAD:
-            log.warning("a client has not read %s MiB the server wrote: disconnected",
-                        MAX_UNREAD // 2**20)
+        self.unsent += len(data)
+        if (refused := self._refusal()) is not None:
+            log.warning("a client has not read %.0f MiB the server wrote, and %s: "
+                        "disconnected", self.unsent / 2**20, refused)
             self._connection.transport.abort()
             return
         self._outbox.put_nowait(data.decode())
@@ -296,7 +385,7 @@ class _WebSocketWriter:
             while True:
                 text = await self._outbox.get()
                 await self._connection.send(text)
-                self._unsent -= len(text)  # JSON as pygls writes it is ASCII
+                self.unsent -= len(text)  # JSON as pygls writes it is ASCII
                 self._outbox.task_done()
 
     async def finish(self) -> None:
@@ -331,36 +420,65 @@ WEBSOCKETS_LOG.addFilter(_OneLine())
 
 
 class WebSocketSessions:
-    """The LSP sessions of one server's WebSocket connections, a session a connection,
-    at most MAX_SESSIONS. `rl1-lsp --ws` and the studio's `/lsp` (lsp/studio/) serve a
-    connection with `serve`; their server makes its connections of `connection_class`."""
+    """The LSP sessions of one server's WebSocket connections, a session a connection:
+    at most MAX_SESSIONS, their bytes in flight bounded together (InFlight). `rl1-lsp
+    --ws` and the studio's `/lsp` (lsp/studio/) serve a connection with `serve`; their
+    server makes its connections of `connection_class`, which counts what they receive
+    (only those served here)."""
 
     def __init__(self) -> None:
         from websockets.asyncio.server import ServerConnection
+        from websockets.frames import CloseCode
+        from websockets.protocol import State
 
         self.sessions: set[Session] = set()
-        self.connection_class = ServerConnection
+        in_flight = self.in_flight = InFlight()
+
+        class Counted(ServerConnection):
+            """A connection that counts the bytes received since its last message was
+            handled, and is closed when they would pass what InFlight allows: the library
+            reads a whole message before handing it over."""
+
+            received = 0
+
+            def data_received(self, data: bytes) -> None:
+                if self.protocol.state is State.OPEN and self in in_flight:
+                    if (refused := in_flight.refusal(self, len(data))) is None:
+                        self.received += len(data)
+                    else:  # from here on the library discards what comes
+                        log.warning("closed a WebSocket connection: its message would take "
+                                    "more than %.0f MiB, and %s", (self.received + len(data))
+                                    / 2**20, refused)
+                        self.received = 0
+                        self.protocol.fail(CloseCode.MESSAGE_TOO_BIG,
+                                           "the server is reading other clients' large "
+                                           "messages: send it again later")
+                super().data_received(data)
+
+        self.connection_class = Counted
 
     async def serve(self, connection: Any, new_session: Callable[[], Session]) -> None:
         """Serve `connection` (of `connection_class`) as a session of its own, one LSP
         message a WebSocket message, until it closes or the session exits."""
         from websockets.exceptions import ConnectionClosed
 
-        sessions = self.sessions
+        assert isinstance(connection, self.connection_class)
+        sessions, in_flight = self.sessions, self.in_flight
         if len(sessions) >= MAX_SESSIONS:
             log.warning("a client beyond the %d served at once: refused", MAX_SESSIONS)
             await connection.close(1013, BUSY[:123])  # 1013: try again later
             return
         session = new_session()
         sessions.add(session)
-        writer = _WebSocketWriter(connection)
+        writer = _WebSocketWriter(connection, functools.partial(in_flight.refusal, connection))
         session.attach(writer)
         try:
-            async with _initialize_deadline(session, connection.transport.abort):
-                async for message in connection:
-                    session.receive(message.encode() if isinstance(message, str) else message)
-                    if session.exit_status is not None:
-                        break
+            with in_flight.counting(connection, lambda: connection.received + writer.unsent):
+                async with _initialize_deadline(session, connection.transport.abort):
+                    while session.exit_status is None:
+                        # Not bound to a variable, which would keep it until the next.
+                        session.receive(_as_bytes(await connection.recv()))
+                        connection.received = 0
         except ConnectionClosed as closed:  # such as a message over MAX_MESSAGE
             log.info("a WebSocket connection ended: %s", closed)
         finally:

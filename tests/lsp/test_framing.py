@@ -58,3 +58,40 @@ def test_a_message_over_the_limit_is_skipped_and_said() -> None:
     framer = Framer(limit=10)
     assert framer.feed(framed(b"x" * 11) + framed(b"ok")) == [b"ok"]
     assert framer.problems == ["a message of 11 bytes, over the limit of 10"]
+
+
+plain_bodies = st.lists(st.binary(max_size=300).filter(
+    lambda body: b"content-length" not in body.lower()), max_size=8)
+
+
+@given(plain_bodies, st.integers(2, 300), st.lists(st.integers(0, 3000)))
+def test_a_message_not_admitted_is_skipped_whole_and_the_next_read(
+        messages: list[bytes], admitted: int, cuts: list[int]) -> None:
+    """The transports' shared bound on bytes in flight: asked with each message's length
+    before its body is read; a message refused is skipped, and said."""
+    asked: list[int] = []
+
+    def admit(length: int) -> str | None:
+        asked.append(length)
+        return None if length <= admitted else "too much in flight"
+
+    data = b"".join(framed(body) + framed(b"ok") for body in messages)
+    framer = Framer(admit=admit)
+    assert feed_in_pieces(framer, data, cuts) == [
+        read for body in messages
+        for read in ([body] if len(body) <= admitted else []) + [b"ok"]]
+    assert asked == [length for body in messages for length in (len(body), 2)]
+    assert framer.problems == [f"a message of {len(body):,} bytes: too much in flight"
+                               for body in messages if len(body) > admitted]
+
+
+def test_reading_is_the_length_of_the_body_being_read_until_it_is_whole() -> None:
+    framer = Framer()
+    assert framer.feed(b"Content-Length: 5\r\n\r\nab") == []
+    assert framer.reading == 5
+    assert framer.feed(b"cde") == [b"abcde"]
+    assert framer.reading == 0
+    framer.feed(b"Content-Length: 5\r\n\r\nab")
+    framer.discard()
+    assert framer.reading == 0
+    assert framer.feed(b"Content-Length: 2\r\n\r\nok") == [b"ok"]

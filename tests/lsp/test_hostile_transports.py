@@ -9,8 +9,10 @@ connections that send nothing cannot hold every place."""
 from __future__ import annotations
 
 import contextlib
+import json
 import logging
 import socket
+import threading
 import time
 from collections.abc import Iterator
 
@@ -18,14 +20,19 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from support.hostile import (
+    GROWTH_BOUND_MIB,
+    INITIALIZE,
     HostileConnection,
     ServedLsp,
+    _frame,
+    _send_hostile,
     hostile_connections,
     transport_attack,
     ws_frame,
     ws_handshake,
 )
 
+from rl1.lsp.framing import MAX_MESSAGE
 from rl1.lsp.transports import INITIALIZE_SECONDS, MAX_SESSIONS
 
 pytest.importorskip("websockets")
@@ -82,6 +89,44 @@ def test_known_hard_inputs(transport: str, sent: bytes) -> None:
     server = ServedLsp(transport)
     try:
         assert transport_attack(server, HostileConnection(chunks=(sent,), copies=7)) == []
+    finally:
+        server.stop()
+
+
+def _largest_message(transport: str) -> tuple[bytes, ...]:
+    """An initialize, then a notification of MAX_MESSAGE bytes (a string of "a"s), which
+    the server reads and decodes whole: on TCP its headers, then the body in pieces."""
+    head = b'{"jsonrpc":"2.0","method":"x","params":"'
+    body = head + b"a" * (MAX_MESSAGE - len(head) - 2) + b'"}'
+    if transport == "ws":
+        return ws_frame(1, json.dumps(INITIALIZE).encode()), ws_frame(1, body)
+    pieces = [body[start:start + 2**20] for start in range(0, len(body), 2**20)]
+    return _frame(INITIALIZE), b"Content-Length: %d\r\n\r\n" % len(body), *pieces
+
+
+@pytest.mark.parametrize("transport", TRANSPORTS)
+def test_eight_clients_sending_the_largest_message_at_once_stay_in_the_bound(
+        transport: str) -> None:
+    """Issue 23: each session read a message of MAX_MESSAGE bytes whatever the others
+    held, and kept the last one it read, so that eight grew the server by 577 MiB (the
+    campaign) to 1 GiB and more; the bytes in flight of all sessions are now bounded
+    together, those beyond refused, and the other clients are served."""
+    server = ServedLsp(transport)
+    attack = HostileConnection(chunks=_largest_message(transport))
+    connections: list[socket.socket | None] = []
+    try:
+        senders = [threading.Thread(target=lambda: connections.append(
+            _send_hostile(server, attack))) for _ in range(MAX_SESSIONS)]
+        for sender in senders:
+            sender.start()
+        for sender in senders:
+            sender.join()
+        for connection in connections:
+            if connection is not None:
+                connection.close()
+        peak = server.peak_mib() - server.started_mib
+        assert peak < GROWTH_BOUND_MIB, f"{peak:.0f} MiB at its peak"
+        assert transport_attack(server, HostileConnection(chunks=(b"",), copies=0)) == []
     finally:
         server.stop()
 

@@ -38,7 +38,11 @@ from hypothesis import strategies as st
 from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.strategies import programs
 from rl1.lsp.framing import MAX_MESSAGE
-from rl1.lsp.transports import BUSY, MAX_SESSIONS
+from rl1.lsp.transports import (
+    BUSY,
+    MAX_SESSIONS,
+    MEMORY_IN_FLIGHT,
+)
 from rl1.vm import native
 from rl1.vm.sim.world import WorldError, decode_world
 
@@ -287,10 +291,10 @@ LSP_SERVER = [sys.executable, "-m", "rl1.lsp"]
 PROBE_SECONDS = 15.0
 """How long the well-behaved client after each input waits for each answer (a few seconds
 on an idle machine; more on a loaded one, before a hung server is called hung)."""
-GROWTH_BOUND_MIB = MAX_SESSIONS * MAX_MESSAGE // 2**20 + 64
-"""How far the server's resident memory may grow past what it held once started: one
-message being read (framing.MAX_MESSAGE) by each session at most, as transports.py
-bounds it, and what the allocator keeps."""
+GROWTH_BOUND_MIB = MEMORY_IN_FLIGHT // 2**20 + 64
+"""How far the server's resident memory may grow past what it held once started, at its
+peak: what its messages in flight may take (transports.MEMORY_IN_FLIGHT, all sessions
+together), and what the allocator keeps."""
 SECRET = "file:///hostile/secret.rob"
 """The document every hostile connection opens: no other session may hear of it."""
 WS_GUID = b"258EAFA5-E914-47DA-95CA-C5AB0DC85B11"
@@ -345,6 +349,13 @@ class ServedLsp:
                 if line.startswith("VmRSS:"):
                     return int(line.split()[1]) / 1024
         return 0.0
+
+    def peak_mib(self) -> float:
+        """The most resident memory the process has held, from /proc."""
+        for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024
+        raise AssertionError("no VmHWM")
 
     def _read_stderr(self, stream: IO[bytes]) -> None:
         with stream:
@@ -436,10 +447,10 @@ def _hostile_stream(draw: st.DrawFn) -> tuple[bytes, ...]:
             b"Content-Type: \xff\xfe", b"content-length:" + b" " * 9000 + b"3", b"",
             b"\r\n" * 1000, b"Content-Length: 3\n"]))
         return (*start, header + b"\r\n\r\n" + body)
-    if kind == "bomb":  # a huge length, then data streamed: read in bounded memory
+    if kind == "bomb":  # a huge length or the largest, then data: read in bounded memory
+        told = draw(st.sampled_from([99999999999, MAX_MESSAGE]))
         mebibytes = draw(st.integers(1, 24))
-        return (*start, b"Content-Length: 99999999999\r\n\r\n",
-                *([b"[" * 2**20] * mebibytes))
+        return (*start, b"Content-Length: %d\r\n\r\n" % told, *([b"[" * 2**20] * mebibytes))
     return (*start, draw(st.binary(max_size=2000)))
 
 
@@ -459,7 +470,9 @@ def ws_frame(opcode: int, payload: bytes, fin: bool = True, masked: bool = True,
     if not masked:
         return head + payload
     mask = os.urandom(4)
-    return head + mask + bytes(byte ^ mask[i % 4] for i, byte in enumerate(payload))
+    repeated = (mask * (len(payload) // 4 + 1))[:len(payload)]
+    masked = int.from_bytes(payload, "big") ^ int.from_bytes(repeated, "big")
+    return head + mask + masked.to_bytes(len(payload), "big")
 
 
 @st.composite
