@@ -197,7 +197,8 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
                                found=write if keep_going else None, channel=channel,
                                corpus=corpus, statistics=fuzz_format == "json",
                                lost=held.lost)
-    except (BuildError, EngineUnavailable, Unavailable, SchedulerLost) as error:  # no cc
+    # Such as no C compiler for c-ON, or a cluster that cannot be had or was lost.
+    except (BuildError, EngineUnavailable, Unavailable, SchedulerLost) as error:
         raise Failure(f"error: {error}") from None
     except BrokenExecutor:
         raise Failure("error: a worker process ended abruptly (killed, or out of memory); "
