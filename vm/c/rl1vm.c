@@ -77,28 +77,33 @@ static bool broken_in(const rl1_vm *vm)
     return vm->state != (uint8_t)RL1_IN_STEP;
 }
 
-/* The `arity` arguments of call `op` from its operands at `at` (the mask, then 2 bytes
- * an argument) into `args`, left to right: false at the first variable out of its
- * parameter's range (section 9, step 2). (Out of line it would have more registers
- * for its loop, and cost 36 bytes of flash on Cortex-M3, more than 4 KB allow.) */
+/* The `arity` (1 to 3) arguments of call `op` from its operands at `at` (the mask, then
+ * 2 bytes an argument) into `args`, left to right: false at the first variable out of
+ * its parameter's range (section 9, step 2). Called once, so inlined: kept out of line
+ * (gcc's noinline) it costs Cortex-M3 flash that the 4 KB goal has no room for. */
 static bool arguments(const int16_t *V, uint8_t op, uint8_t arity, const uint8_t *at,
                       int16_t *args)
 {
     const int16_t *range = &rl1_param_ranges[2u * rl1_flash_byte(
         &rl1_call_first[op - RL1_OP_FIRST_CALL])];
-    uint8_t mask = RL1_BYTE(at), k;
-    for (k = 0; k < arity; k++, mask >>= 1) {
-        uint16_t field = RL1_U16(at + 1u + 2u * k);
-        int16_t value = (int16_t)field;
+    const uint8_t *const end = at + 2u * arity;
+    uint8_t mask = RL1_BYTE(at);
+    do { /* arity is 1 at least */
+        uint16_t field = RL1_U16(at + 1u);
+        at += 2;
         if (mask & 1u) {
-            value = V[field];
-            if (value < rl1_flash_i16(&range[2u * k])
-                || value > rl1_flash_i16(&range[2u * k + 1u])) {
+            int16_t value = V[field];
+            if (value < rl1_flash_i16(range) || value > rl1_flash_i16(range + 1)) {
                 return false;
             }
+            *args = value;
+        } else {
+            *args = (int16_t)field;
         }
-        args[k] = value;
-    }
+        args++;
+        range += 2;
+        mask >>= 1;
+    } while (at != end);
     return true;
 }
 
