@@ -261,12 +261,31 @@ NO_PICTURES = Pictures(None, None, False)
 PATH_POINTS = 64  # of each run's path that a record carries for the pictures
 
 
-def _refuse_inputs(pictures: Pictures, inputs: tuple[str, str]) -> None:
+def _refuse_targets(pictures: Pictures, inputs: tuple[str, str], out: str | None) -> None:
+    """A usage error, before any run, for a picture that would replace an input, the
+    other picture or the runs' JSON lines, or that could not be written (the runs
+    would be made for nothing)."""
+    others = {"--out": out}
     for option, target in (("--svg", pictures.svg), ("--html", pictures.html)):
+        if target is None:
+            continue
         for role, name in zip(("program", "world file"), inputs, strict=True):
-            if target is not None and os.path.exists(name) and same_file(name, target):
+            if os.path.exists(name) and same_file(name, target):
                 raise click.UsageError(f"{option} `{target}` is the {role} itself: give "
                                        "another path for the picture")
+        stream = os.path.exists(target) and not os.path.isfile(target)  # /dev/null
+        for other, name in others.items():
+            if not stream and name is not None and (
+                    os.path.realpath(name) == os.path.realpath(target)):
+                raise click.UsageError(f"{option} and {other} both name `{target}`: give "
+                                       "each its own file")
+        others[option] = target
+        if os.path.isdir(target):
+            raise click.UsageError(f"{option} `{target}` is a folder: give the path of a "
+                                   "file for the picture")
+        if not os.path.isdir(os.path.dirname(os.path.abspath(target))):
+            raise click.UsageError(f"{option} `{target}`: its folder does not exist; "
+                                   "create it, or write the picture elsewhere")
 
 
 def _open_out(out: str | None, inputs: tuple[str, str]) -> IO[str] | None:
@@ -302,7 +321,7 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     if isinstance(task, int):
         return task
     if pictures.wanted:
-        _refuse_inputs(pictures, (file, setting.world))
+        _refuse_targets(pictures, (file, setting.world), out)
         task = replace(task, path_points=PATH_POINTS)
     held = ExitStack()  # the workers: a cluster is reached before --out replaces a file
     current = held.enter_context(_workers(setting))
