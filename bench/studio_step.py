@@ -174,8 +174,9 @@ def main() -> None:
     print(f"the whole run at full speed: run/launch to run/ended {whole * 1000:.0f} ms, a "
           f"Session's continue alone {reference * 1000:.0f} ms ({whole / reference:.2f}x)")
     rate = frames / elapsed
+    kept = frames >= FRAMES_GOAL * elapsed - 1  # one frame: where the window cuts the grid
     print(f"live at {SPEED}x real time: {frames} frames in {elapsed:.2f} s, {rate:.1f} a "
-          f"second (goal {FRAMES_GOAL}: {'met' if rate >= FRAMES_GOAL * 0.95 else 'missed'}); "
+          f"second (goal {FRAMES_GOAL}: {'met' if kept else 'missed'}); "
           f"simulated {simulated:.2f} s, {simulated / elapsed:.2f}x the wall time")
 
 
