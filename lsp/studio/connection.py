@@ -24,7 +24,7 @@ from rl1.vm.sensor_script import Script, ScriptError, decode_script
 from rl1.vm.sim.world import World, WorldError, decode_world
 
 from . import shapes
-from .files import MAX_FILE_BYTES, Folder, Refused, Unusable
+from .files import MAX_FILE_BYTES, Changed, Folder, Refused, Unusable, version_of
 from .run import DEFAULT_SPEED, FRAMES_PER_SECOND, MAX_SPEED, MIN_SPEED, Launch, Run
 
 log = logging.getLogger(__name__)
@@ -39,6 +39,7 @@ PROGRAM_ERRORS = -32003
 INVALID_CONFIG = -32004
 NO_RUN = -32005
 RUNNING = -32006
+CHANGED = -32007
 
 LEVELS = (0, 1, 2)
 MAX_BREAKPOINTS = 10_000
@@ -179,16 +180,20 @@ class Connection:
     async def _read(self, params: dict[str, Any]) -> dict[str, Any]:
         path = _string(params, "path")
         data = await _files(asyncio.to_thread(self._studio.folder.read, path))
+        version = version_of(data)
         if path.endswith(".rob"):
             try:
                 source = decode(data, path)
             except SourceError as error:
                 raise RpcError(FILE_UNUSABLE, _said(error)) from None
-            return {"path": path, "text": source.text, "encoding": source.encoding}
-        return {"path": path, "text": _utf8(data, path), "encoding": "utf-8"}
+            return {"path": path, "text": source.text, "encoding": source.encoding,
+                    "version": version}
+        return {"path": path, "text": _utf8(data, path), "encoding": "utf-8",
+                "version": version}
 
     async def _save(self, params: dict[str, Any]) -> dict[str, Any]:
         path, text = _string(params, "path"), _string(params, "text")
+        over = _string(params, "version") if params.get("version") is not None else None
         encoding = params.get("encoding", "utf-8")
         if encoding not in ("utf-8", "cp932"):
             raise RpcError(INVALID_PARAMS, f"`encoding` is {encoding!r}: give \"utf-8\" or "
@@ -199,8 +204,8 @@ class Connection:
             raise RpcError(FILE_UNUSABLE, f"`{path}` cannot be written in {encoding}: "
                            f"{text[error.start:error.end]!r} has no {encoding} form; save "
                            "it in utf-8") from None
-        await _files(asyncio.to_thread(self._studio.folder.save, path, data))
-        return {"path": path, "size": len(data)}
+        await _files(asyncio.to_thread(self._studio.folder.save, path, data, over))
+        return {"path": path, "size": len(data), "version": version_of(data)}
 
     async def _check_world(self, params: dict[str, Any]) -> dict[str, Any]:
         text = _string(params, "text")
@@ -493,6 +498,8 @@ async def _files(work: Awaitable[Any]) -> Any:
         raise RpcError(FILE_REFUSED, str(refused)) from None
     except Unusable as unusable:
         raise RpcError(FILE_UNUSABLE, str(unusable)) from None
+    except Changed as changed:
+        raise RpcError(CHANGED, str(changed)) from None
 
 
 def _utf8(data: bytes, path: str) -> str:

@@ -9,6 +9,7 @@ are written.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import stat
 from dataclasses import dataclass
@@ -36,6 +37,15 @@ class Refused(Exception):
 
 class Unusable(Exception):
     """A file that cannot be read or written; the message says why and what to do."""
+
+
+class Changed(Exception):
+    """A file changed since the page read it: saving would lose what changed."""
+
+
+def version_of(data: bytes) -> str:
+    """What a page keeps of a file it read, to save over that content only."""
+    return hashlib.sha256(data).hexdigest()
 
 
 @dataclass(frozen=True, slots=True)
@@ -104,9 +114,10 @@ class Folder:
                            "most the studio opens")
         return data
 
-    def save(self, path: str, data: bytes) -> None:
+    def save(self, path: str, data: bytes, over: str | None = None) -> None:
         """Put `data` in the file `path` all at once (a program, a world, a sensor
-        script), replacing it or making it in an existing folder."""
+        script), replacing it or making it in an existing folder; when `over` is given,
+        only over the content of that version (Changed otherwise)."""
         resolved = self.resolve(path)
         for name in (path, resolved.name):
             if kind_of(name) is None:
@@ -125,6 +136,14 @@ class Folder:
         if len(data) > MAX_FILE_BYTES:
             raise Unusable(f"`{path}` would be larger than {MAX_FILE_BYTES // 2**20} MiB, "
                            "the most the studio writes")
+        if over is not None:
+            try:
+                now = version_of(self.read(path))
+            except Unusable:
+                now = None  # gone, or unreadable: not the version read
+            if now != over:
+                raise Changed(f"`{path}` has changed since it was read (another program "
+                              "wrote it): read it again, or save under another name")
         try:
             write_atomically(resolved, data)
         except OSError as error:

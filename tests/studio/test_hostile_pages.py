@@ -14,7 +14,8 @@ from served import Failed, Page, Served, page, sample_folder, serving
 
 from rl1.lsp.studio.connection import Connection
 
-ERRORS = {-32700, -32600, -32601, -32602, -32001, -32002, -32003, -32004, -32005, -32006}
+ERRORS = {-32700, -32600, -32601, -32602, -32001, -32002, -32003, -32004, -32005, -32006,
+          -32007}
 JSON = st.recursive(
     st.none() | st.booleans() | st.integers(-2**40, 2**40) | st.floats(allow_nan=False)
     | st.text(max_size=20) | st.sampled_from(["sample.rob", "sample.world.toml", "../x.rob",
@@ -22,7 +23,8 @@ JSON = st.recursive(
     lambda inner: st.lists(inner, max_size=4) | st.dictionaries(
         st.sampled_from(["path", "text", "name", "program", "world", "sensors", "level",
                          "seed", "speed", "stopOnEntry", "lines", "calls", "lostLines",
-                         "line", "condition", "expression", "encoding"]), inner, max_size=5),
+                         "line", "condition", "expression", "encoding", "version"]), inner,
+        max_size=5),
     max_leaves=12)
 METHODS = st.sampled_from(sorted(Connection.METHODS)) | st.text(max_size=12)
 
@@ -45,7 +47,7 @@ def client(served: Served) -> Iterator[Page]:
           suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(method=METHODS, params=st.dictionaries(st.sampled_from(
     ["path", "text", "program", "world", "sensors", "level", "speed", "lines", "calls",
-     "expression", "stopOnEntry", "encoding"]), JSON, max_size=4))
+     "expression", "stopOnEntry", "encoding", "version"]), JSON, max_size=4))
 def test_any_request_is_answered(client: Page, method: str, params: dict[str, Any]) -> None:
     try:
         client.request(method, params)

@@ -282,7 +282,7 @@ def test_files_are_listed_read_and_saved(client: Page, folder: Path) -> None:
     text = "'ロボット\n(END)\n"  # a legacy comment
     saved = client.request("files/save", {"path": "new.rob", "text": text,
                                           "encoding": "cp932"})
-    assert saved == {"path": "new.rob", "size": 16}
+    assert (saved["path"], saved["size"]) == ("new.rob", 16)
     assert (folder / "new.rob").read_bytes() == text.encode("cp932")
     assert client.request("files/read", {"path": "new.rob"})["encoding"] == "cp932"
     for params, code in [({"path": "../x.rob", "text": ""}, -32001),
@@ -295,6 +295,28 @@ def test_files_are_listed_read_and_saved(client: Page, folder: Path) -> None:
     with pytest.raises(Failed) as missing:
         client.request("files/read", {"path": "nothing.rob"})
     assert missing.value.code == -32002
+
+
+def test_a_save_over_a_file_changed_since_it_was_read_is_refused(client: Page,
+                                                                  folder: Path) -> None:
+    (folder / "edited.rob").write_text("(END)\n")
+    read = client.request("files/read", {"path": "edited.rob"})
+    saved = client.request("files/save", {"path": "edited.rob", "text": "A=1\n(END)\n",
+                                          "version": read["version"]})
+    assert saved["version"] == client.request("files/read", {"path": "edited.rob"})["version"]
+    (folder / "edited.rob").write_text("B=2\n(END)\n")  # another editor saves it
+    with pytest.raises(Failed) as changed:
+        client.request("files/save", {"path": "edited.rob", "text": "C=3\n(END)\n",
+                                      "version": saved["version"]})
+    assert changed.value.code == -32007
+    assert "read it again" in str(changed.value)
+    assert (folder / "edited.rob").read_text() == "B=2\n(END)\n"
+    (folder / "edited.rob").unlink()  # deleted meanwhile: not the version read either
+    with pytest.raises(Failed) as gone:
+        client.request("files/save", {"path": "edited.rob", "text": "C=3\n(END)\n",
+                                      "version": saved["version"]})
+    assert gone.value.code == -32007
+    assert not (folder / "edited.rob").exists()
 
 
 @pytest.mark.parametrize(("message", "code"), [
