@@ -88,3 +88,13 @@ def test_a_port_in_use_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatc
     assert "cannot listen on 127.0.0.1:" in ran.stderr
     assert "choose another port" in ran.stderr
     assert "Traceback" not in ran.stderr
+
+
+def test_without_the_websockets_package_it_says_which_extra_to_install(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setitem(sys.modules, "websockets", None)  # `import websockets` fails
+    ran = rl1c("studio", "--no-browser")
+    assert ran.exit_code == 2
+    assert ran.stderr == ("rl1c studio: error: the studio needs the websockets package: "
+                          "pip install 'rl1[ws]'\n")
