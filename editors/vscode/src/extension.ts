@@ -1,7 +1,9 @@
 // The VS Code side of RL/I: highlighting comes from the TextMate grammar alone; this
 // starts the `rl1-lsp` language server for diagnostics, hover and completion, and runs
-// `rl1c` for the commands Check, Compile, Run and Show disassembly and the `rl1` tasks.
+// `rl1c` for the commands Check, Compile, Run, Show disassembly and Simulate and the `rl1`
+// tasks, and `rl1-dap` for the debugger of type `rl1`.
 
+import * as fs from 'node:fs';
 import * as path from 'node:path';
 import * as vscode from 'vscode';
 import { LanguageClient, LanguageClientOptions, ServerOptions } from 'vscode-languageclient/node';
@@ -10,14 +12,24 @@ import {
   COMMANDS,
   disassemble,
   Rl1cError,
-  rl1cPath,
   TASK_TYPE,
+  Tool,
+  TOOL_SETTINGS,
+  toolPath,
   TaskCommand,
   taskCommandLine,
   TaskError,
   taskRequest,
 } from './rl1cCommand';
 import { DEFAULT_SERVER, serverCommand, SettingError } from './serverCommand';
+import {
+  DEBUG_TYPE,
+  launchForFile,
+  replayFor,
+  WORLD_SETTING,
+  worldFor,
+  wroteReplay,
+} from './debugging';
 
 const DISASSEMBLY_SCHEME = 'rl1-dis';
 
@@ -31,6 +43,7 @@ const HANDLERS: Record<CommandId, () => Promise<void>> = {
   'rl1.compile': () => runTask('compile'),
   'rl1.run': runWithSensors,
   'rl1.showDisassembly': showDisassembly,
+  'rl1.simulate': simulate,
 };
 
 // A disassembly view's URI is its source's path with `.ils` added, in this scheme.
@@ -56,6 +69,12 @@ export async function activate(context: vscode.ExtensionContext): Promise<void> 
     vscode.tasks.registerTaskProvider(TASK_TYPE, {
       provideTasks: () => providedTasks(),
       resolveTask: (task) => resolvedTask(task),
+    }),
+    vscode.debug.registerDebugAdapterDescriptorFactory(DEBUG_TYPE, {
+      createDebugAdapterDescriptor: () => new vscode.DebugAdapterExecutable(tool('rl1-dap'), []),
+    }),
+    vscode.debug.registerDebugConfigurationProvider(DEBUG_TYPE, {
+      resolveDebugConfiguration: (_folder, configuration) => resolvedLaunch(configuration),
     }),
     vscode.workspace.onDidChangeConfiguration((change) => {
       if (change.affectsConfiguration('rl1.server')) {
@@ -141,14 +160,20 @@ async function offerSettings(message: string): Promise<void> {
   }
 }
 
-function rl1c(): string {
+/** Where a tool of the rl1 package is, by its setting or beside the language server. */
+function tool(name: Tool): string {
   const folder = vscode.workspace.workspaceFolders?.[0]?.uri.fsPath;
   const server = vscode.workspace.getConfiguration('rl1.server');
-  return rl1cPath(
-    vscode.workspace.getConfiguration('rl1.rl1c').get('path'),
+  return toolPath(
+    name,
+    vscode.workspace.getConfiguration().get(TOOL_SETTINGS[name]),
     serverCommand(server.get('path'), server.get('args'), folder).command,
     folder,
   );
+}
+
+function rl1c(): string {
+  return tool('rl1c');
 }
 
 /** The RL/I file in the active editor, saved so that rl1c reads what the user sees. */
@@ -222,12 +247,10 @@ async function runWithSensors(): Promise<void> {
   }
 }
 
-async function startTask(definition: vscode.TaskDefinition & { file: string }): Promise<void> {
+async function startTask(definition: vscode.TaskDefinition & { file: string }): Promise<vscode.TaskExecution | undefined> {
   const scope = vscode.workspace.getWorkspaceFolder(vscode.Uri.file(definition.file)) ?? vscode.TaskScope.Workspace;
   const task = buildTask(definition, scope);
-  if (task !== undefined) {
-    await vscode.tasks.executeTask(task);
-  }
+  return task === undefined ? undefined : await vscode.tasks.executeTask(task);
 }
 
 async function showDisassembly(): Promise<void> {
@@ -254,5 +277,77 @@ async function disassembly(view: vscode.Uri): Promise<string> {
       return `; RL/I: ${error.message}.\n`;
     }
     throw error;
+  }
+}
+
+/**
+ * A launch configuration to start: launch.json's as written, or, when there is none
+ * (F5 on an RL/I file), the file in the world or with the sensor script beside it.
+ */
+function resolvedLaunch(configuration: vscode.DebugConfiguration): vscode.DebugConfiguration | undefined {
+  if (configuration.type !== undefined || configuration.request !== undefined) {
+    return configuration;
+  }
+  const document = vscode.window.activeTextEditor?.document;
+  if (document?.languageId !== 'rl1' || document.uri.scheme !== 'file') {
+    void vscode.window.showErrorMessage('RL/I: open an RL/I file (.rob) saved on disk to debug it, or add a launch.json.');
+    return undefined;
+  }
+  const launch = launchForFile(document.fileName, fs.existsSync);
+  if (launch === undefined) {
+    void vscode.window.showErrorMessage(
+      `RL/I: ${path.basename(document.fileName)} has no world or sensor script beside it ` +
+        '(NAME.world.toml, NAME.sensors.toml): add one, or a launch.json (Add Configuration… offers both).',
+    );
+  }
+  return launch;
+}
+
+/** RL/I: Simulate: `rl1c sim` on the current file in a world, in a terminal; then offers the replay. */
+async function simulate(): Promise<void> {
+  const file = await currentFile();
+  if (file === undefined) {
+    return;
+  }
+  const folder = vscode.workspace.workspaceFolders?.[0]?.uri.fsPath;
+  let world;
+  try {
+    world = worldFor(file, vscode.workspace.getConfiguration().get(WORLD_SETTING), folder, fs.existsSync);
+  } catch (error) {
+    report(error);
+    return;
+  }
+  if (world === undefined) {
+    const picked = await vscode.window.showOpenDialog({
+      title: `RL/I: the world to simulate ${path.basename(file)} in (set ${WORLD_SETTING}, or put NAME.world.toml beside it)`,
+      openLabel: 'Simulate in this world',
+      defaultUri: vscode.Uri.file(path.dirname(file)),
+      filters: { 'World files': ['toml'] },
+    });
+    world = picked?.[0]?.fsPath;
+    if (world === undefined) {
+      return;
+    }
+  }
+  // Listening before the task starts: a short run can end before executeTask returns.
+  const ended = vscode.tasks.onDidEndTaskProcess(async (end) => {
+    const { definition } = end.execution.task;
+    if (definition.type !== TASK_TYPE || definition.command !== 'sim' || definition.file !== file) {
+      return;
+    }
+    ended.dispose();
+    if (wroteReplay(end.exitCode)) {
+      const replay = replayFor(file);
+      const choice = await vscode.window.showInformationMessage(
+        `RL/I: the run's replay is in ${path.basename(replay)}.`,
+        'Open Replay',
+      );
+      if (choice === 'Open Replay') {
+        await vscode.env.openExternal(vscode.Uri.file(replay));
+      }
+    }
+  });
+  if ((await startTask({ type: TASK_TYPE, command: 'sim', file, world })) === undefined) {
+    ended.dispose();
   }
 }

@@ -5,6 +5,7 @@ import { execFile } from 'node:child_process';
 import * as fs from 'node:fs/promises';
 import * as os from 'node:os';
 import * as path from 'node:path';
+import { simulateCommandLine } from './debugging';
 import { CommandLine, expand, SettingError } from './serverCommand';
 
 /** Every command the extension contributes; package.json declares the same list. */
@@ -14,33 +15,41 @@ export const COMMANDS = [
   'rl1.compile',
   'rl1.run',
   'rl1.showDisassembly',
+  'rl1.simulate',
 ] as const;
 export type CommandId = (typeof COMMANDS)[number];
 
 export const TASK_TYPE = 'rl1';
-export const TASK_COMMANDS = ['check', 'compile', 'run'] as const;
+export const TASK_COMMANDS = ['check', 'compile', 'run', 'sim'] as const;
 export type TaskCommand = (typeof TASK_COMMANDS)[number];
 
+/** The commands of the rl1 package the extension runs besides the language server. */
+export type Tool = 'rl1c' | 'rl1-dap';
+
+/** The setting that names each tool's path. */
+export const TOOL_SETTINGS: Record<Tool, string> = { rl1c: 'rl1.rl1c.path', 'rl1-dap': 'rl1.dap.path' };
+
 /**
- * Where `rl1c` is: the setting `rl1.rl1c.path` when given, else beside the language
- * server when that is given as a path (both come from the same Python environment),
- * else `rl1c` on PATH.
+ * Where a tool of the rl1 package is: its setting (`rl1.rl1c.path`, `rl1.dap.path`)
+ * when given, else beside the language server when that is given as a path (all come
+ * from the same Python environment), else the tool on PATH.
  */
-export function rl1cPath(setting: unknown, serverCommand: string, workspaceFolder: string | undefined): string {
+export function toolPath(tool: Tool, setting: unknown, serverCommand: string, workspaceFolder: string | undefined): string {
+  const name = TOOL_SETTINGS[tool];
   if (setting !== undefined && setting !== null && typeof setting !== 'string') {
     throw new SettingError(
-      `rl1.rl1c.path must be a string such as "/path/to/rl1/.venv/bin/rl1c", not ${JSON.stringify(setting)}`,
+      `${name} must be a string such as "/path/to/rl1/.venv/bin/${tool}", not ${JSON.stringify(setting)}`,
     );
   }
   const written = (setting ?? '').trim();
   if (written !== '') {
-    return expand('rl1.rl1c.path', written, workspaceFolder);
+    return expand(name, written, workspaceFolder);
   }
   if (path.basename(serverCommand) === serverCommand) {
-    return 'rl1c';
+    return tool;
   }
   // `rl1-lsp.exe` in a Windows virtual environment sits beside `rl1c.exe`.
-  return path.join(path.dirname(serverCommand), 'rl1c' + path.extname(serverCommand));
+  return path.join(path.dirname(serverCommand), tool + path.extname(serverCommand));
 }
 
 /** What a task of type `rl1` in tasks.json asks for; settings.json may hold any JSON. */
@@ -48,6 +57,7 @@ export interface TaskRequest {
   command: TaskCommand;
   file: string;
   sensors?: string;
+  world?: string;
 }
 
 /** A task definition that cannot be run; the message says which property and what to write. */
@@ -55,7 +65,7 @@ export class TaskError extends Error {}
 
 /** The task request for a definition's raw values; `file` defaults to the current file. */
 export function taskRequest(definition: Record<string, unknown>, currentFile: string | undefined): TaskRequest {
-  const { command, file, sensors } = definition;
+  const { command, file, sensors, world } = definition;
   if (typeof command !== 'string' || !(TASK_COMMANDS as readonly string[]).includes(command)) {
     throw new TaskError(
       `an rl1 task's "command" must be one of ${TASK_COMMANDS.map((name) => `"${name}"`).join(', ')}, ` +
@@ -68,6 +78,15 @@ export function taskRequest(definition: Record<string, unknown>, currentFile: st
   const target = file ?? currentFile;
   if (target === undefined) {
     throw new TaskError(`the rl1 "${command}" task needs a file: open an RL/I file, or give "file" in tasks.json`);
+  }
+  if (command === 'sim') {
+    if (typeof world !== 'string' || world === '') {
+      throw new TaskError(
+        'the rl1 "sim" task needs "world", the world file (TOML), ' +
+          'e.g. "${workspaceFolder}/examples/sample.world.toml"',
+      );
+    }
+    return { command: 'sim', file: target, world };
   }
   if (command !== 'run') {
     return { command: command as TaskCommand, file: target };
@@ -90,6 +109,8 @@ export function taskCommandLine(rl1c: string, request: TaskRequest): CommandLine
       return { command: rl1c, args: [request.file] };
     case 'run':
       return { command: rl1c, args: ['run', request.file, '--sensors', request.sensors ?? ''] };
+    case 'sim':
+      return simulateCommandLine(rl1c, request.file, request.world ?? '');
   }
 }
 

@@ -5,8 +5,9 @@ import * as assert from 'node:assert/strict';
 import * as fs from 'node:fs';
 import * as path from 'node:path';
 import { test } from 'node:test';
-import { ProcessExecution, registered, Task } from './fakeVscode';
+import { DebugAdapterExecutable, ProcessExecution, registered, Task } from './fakeVscode';
 import { activate } from '../extension';
+import { DEBUG_TYPE } from '../debugging';
 import { COMMANDS, TASK_COMMANDS, TASK_TYPE } from '../rl1cCommand';
 import { PACKAGE_ROOT } from './textmate';
 
@@ -23,7 +24,7 @@ test('activating registers a handler for every command package.json declares, an
 
 test('the commands that act on a file say so when no RL/I file is open', async () => {
   await activated;
-  for (const id of ['rl1.check', 'rl1.compile', 'rl1.run', 'rl1.showDisassembly']) {
+  for (const id of ['rl1.check', 'rl1.compile', 'rl1.run', 'rl1.showDisassembly', 'rl1.simulate']) {
     registered.errors.length = 0;
     await registered.commands.get(id)?.();
     assert.deepEqual(registered.errors, ['RL/I: open an RL/I file (.rob) saved on disk first.'], id);
@@ -46,6 +47,23 @@ test('a run task without a sensor script is refused with what to write', async (
   const provider = registered.taskProviders.get(TASK_TYPE);
   assert.equal(provider?.resolveTask({ definition: { type: TASK_TYPE, command: 'run', file: '/r/a.rob' } }), undefined);
   assert.match(registered.errors.join('\n'), /the rl1 "run" task needs "sensors"/);
+});
+
+test('the debugger of type rl1 runs rl1-dap, found as rl1c is', async () => {
+  await activated;
+  assert.deepEqual([...registered.debugAdapters.keys()], [DEBUG_TYPE]);
+  const descriptor = registered.debugAdapters.get(DEBUG_TYPE)?.createDebugAdapterDescriptor({});
+  assert.deepEqual(descriptor, new DebugAdapterExecutable('rl1-dap', []));
+});
+
+test('a launch.json configuration is started as written; none without an RL/I file says what to do', async () => {
+  await activated;
+  const provider = registered.debugConfigurations.get(DEBUG_TYPE);
+  const written = { type: DEBUG_TYPE, request: 'launch', name: 'x', program: '/r/a.rob', sensors: '/r/s.toml' };
+  assert.equal(provider?.resolveDebugConfiguration(undefined, written), written);
+  registered.errors.length = 0;
+  assert.equal(provider?.resolveDebugConfiguration(undefined, {}), undefined);
+  assert.match(registered.errors.join('\n'), /open an RL\/I file \(\.rob\) saved on disk to debug it, or add a launch\.json/);
 });
 
 test('the task type declares the commands the task provider runs', () => {

@@ -9,9 +9,19 @@ export interface TaskProvider {
   resolveTask(task: { definition: Record<string, unknown>; scope?: unknown }): unknown;
 }
 
+export interface DebugAdapterFactory {
+  createDebugAdapterDescriptor(session: unknown): unknown;
+}
+
+export interface DebugConfigurationProvider {
+  resolveDebugConfiguration(folder: unknown, configuration: Record<string, unknown>): unknown;
+}
+
 export const registered = {
   commands: new Map<string, Handler>(),
   taskProviders: new Map<string, TaskProvider>(),
+  debugAdapters: new Map<string, DebugAdapterFactory>(),
+  debugConfigurations: new Map<string, DebugConfigurationProvider>(),
   schemes: [] as string[],
   errors: [] as string[],
 };
@@ -42,10 +52,19 @@ export class ProcessExecution {
   ) {}
 }
 
+/** vscode.DebugAdapterExecutable keeps its constructor's arguments. */
+export class DebugAdapterExecutable {
+  constructor(
+    readonly command: string,
+    readonly args: string[],
+  ) {}
+}
+
 const vscode = {
   EventEmitter,
   Task,
   ProcessExecution,
+  DebugAdapterExecutable,
   TaskScope: { Workspace: 2 },
   window: {
     activeTextEditor: undefined,
@@ -74,6 +93,17 @@ const vscode = {
   tasks: {
     registerTaskProvider: (type: string, provider: TaskProvider) => {
       registered.taskProviders.set(type, provider);
+      return disposable;
+    },
+    onDidEndTaskProcess: () => disposable,
+  },
+  debug: {
+    registerDebugAdapterDescriptorFactory: (type: string, factory: DebugAdapterFactory) => {
+      registered.debugAdapters.set(type, factory);
+      return disposable;
+    },
+    registerDebugConfigurationProvider: (type: string, provider: DebugConfigurationProvider) => {
+      registered.debugConfigurations.set(type, provider);
       return disposable;
     },
   },

@@ -2,19 +2,19 @@ import * as assert from 'node:assert/strict';
 import * as fs from 'node:fs';
 import * as path from 'node:path';
 import { test } from 'node:test';
-import { disassemble, Finished, Rl1cError, rl1cPath, taskCommandLine, TaskError, taskRequest } from '../rl1cCommand';
+import { disassemble, Finished, Rl1cError, taskCommandLine, TaskError, taskRequest, toolPath } from '../rl1cCommand';
 import { CommandLine, SettingError } from '../serverCommand';
 
 test('rl1c is found beside a server given as a path, else on PATH', () => {
-  assert.equal(rl1cPath(undefined, 'rl1-lsp', undefined), 'rl1c');
-  assert.equal(rl1cPath('', '/work/robot/.venv/bin/rl1-lsp', undefined), path.join('/work/robot/.venv/bin', 'rl1c'));
-  assert.equal(rl1cPath(null, '/venv/Scripts/rl1-lsp.exe', undefined), path.join('/venv/Scripts', 'rl1c.exe'));
+  assert.equal(toolPath('rl1c', undefined, 'rl1-lsp', undefined), 'rl1c');
+  assert.equal(toolPath('rl1c', '', '/work/robot/.venv/bin/rl1-lsp', undefined), path.join('/work/robot/.venv/bin', 'rl1c'));
+  assert.equal(toolPath('rl1c', null, '/venv/Scripts/rl1-lsp.exe', undefined), path.join('/venv/Scripts', 'rl1c.exe'));
 });
 
 test('rl1.rl1c.path wins, expanded as rl1.server.path is', () => {
-  assert.equal(rl1cPath('${workspaceFolder}/bin/rl1c', '/elsewhere/rl1-lsp', '/work/robot'), '/work/robot/bin/rl1c');
-  assert.throws(() => rl1cPath(7, 'rl1-lsp', undefined), /rl1\.rl1c\.path must be a string/);
-  assert.throws(() => rl1cPath('${workspaceFolder}/rl1c', 'rl1-lsp', undefined), SettingError);
+  assert.equal(toolPath('rl1c', '${workspaceFolder}/bin/rl1c', '/elsewhere/rl1-lsp', '/work/robot'), '/work/robot/bin/rl1c');
+  assert.throws(() => toolPath('rl1c', 7, 'rl1-lsp', undefined), /rl1\.rl1c\.path must be a string/);
+  assert.throws(() => toolPath('rl1c', '${workspaceFolder}/rl1c', 'rl1-lsp', undefined), SettingError);
 });
 
 test('each task runs the rl1c command line for its file', () => {
@@ -30,13 +30,18 @@ test('each task runs the rl1c command line for its file', () => {
     command: 'rl1c',
     args: ['run', '/r/a.rob', '--sensors', '/r/s.toml'],
   });
+  assert.deepEqual(taskCommandLine('rl1c', taskRequest({ command: 'sim', world: '/r/w.toml' }, '/r/a.rob')), {
+    command: 'rl1c',
+    args: ['sim', '/r/a.rob', '--world', '/r/w.toml', '--html', path.join('/r', 'a.replay.html')],
+  });
 });
 
 test('task definitions that cannot run are refused with what to write', () => {
-  assert.throws(() => taskRequest({ command: 'fmt' }, '/r/a.rob'), /"command" must be one of "check", "compile", "run", not "fmt"/);
+  assert.throws(() => taskRequest({ command: 'fmt' }, '/r/a.rob'), /"command" must be one of "check", "compile", "run", "sim", not "fmt"/);
   assert.throws(() => taskRequest({ command: 'check', file: 3 }, '/r/a.rob'), /"file" must be a path/);
   assert.throws(() => taskRequest({ command: 'check' }, undefined), /open an RL\/I file, or give "file"/);
   assert.throws(() => taskRequest({ command: 'run' }, '/r/a.rob'), TaskError);
+  assert.throws(() => taskRequest({ command: 'sim' }, '/r/a.rob'), /the rl1 "sim" task needs "world"/);
 });
 
 /** A stand-in for rl1c that records its command lines and answers with `answers` in turn. */
