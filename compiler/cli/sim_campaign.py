@@ -280,7 +280,7 @@ def _refuse_targets(pictures: Pictures, inputs: tuple[str, str], out: str | None
                 raise click.UsageError(f"{option} and {other} both name `{target}`: give "
                                        "each its own file")
         others[option] = target
-        if os.path.isdir(target):
+        if os.path.isdir(target or "."):
             raise click.UsageError(f"{option} `{target}` is a folder: give the path of a "
                                    "file for the picture")
         if not os.path.isdir(os.path.dirname(os.path.abspath(target))):

@@ -1,8 +1,8 @@
 """A campaign's pictures onto hostile targets, each refused before any run: --svg and
 --out naming one file (the JSON lines were replaced by the picture, the runs lost),
---svg and --html naming one file (the page replaced the picture), a folder or a path
-in a missing folder (found only after every run was made). A device such as /dev/null
-may still take every output."""
+--svg and --html naming one file (the page replaced the picture), a folder, an empty
+path or a path in a missing folder (found only after every run was made). A device such
+as /dev/null may still take every output."""
 
 from __future__ import annotations
 
@@ -34,6 +34,7 @@ def campaign(*options: str) -> tuple[int, str, str]:
     (("--html", "./runs.txt", "--out", "runs.txt"), "--html and --out both name"),
     (("--svg", "p.svg", "--html", "./p.svg"), "--html and --svg both name `./p.svg`"),
     (("--svg", "folder"), "--svg `folder` is a folder"),
+    (("--svg", ""), "--svg `` is a folder"),  # the current one
     (("--html", "missing/p.html"), "--html `missing/p.html`: its folder does not exist"),
 ])
 def test_a_picture_onto_a_hostile_target_is_refused_before_any_run(

@@ -9,6 +9,12 @@ refused with status 2 and a message naming the file. `cache_attack` damages the 
 engine's build cache and runs `rl1c run --engine c` from it, in a process of its own.
 `transport_attack` sends `rl1-lsp --tcp` or `--ws` (a `ServedLsp`, started once for many
 inputs) hostile connections, then checks that a well-behaved client is still served.
+`test_file_attack` runs `rl1c test` on a hostile test file beside files no test should
+read (a FIFO, a link loop, /dev/zero); `vary_attack` a campaign with pictures and a
+seeded run on a world with a hostile [vary] table and hostile --sweep arguments;
+`new_attack` `rl1c new` into each kind of place; `output_attack` `--junit` and a
+campaign's pictures onto inputs, folders, links and read-only files. Each also checks
+that no input changed.
 """
 
 from __future__ import annotations
@@ -24,6 +30,7 @@ import os
 import re
 import shutil
 import socket
+import stat
 import subprocess
 import sys
 import tempfile
@@ -36,6 +43,7 @@ from typing import IO, Any
 from hypothesis import strategies as st
 
 from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.cli.project_template import FILES
 from rl1.compiler.strategies import programs
 from rl1.lsp.framing import MAX_MESSAGE
 from rl1.lsp.transports import (
@@ -59,6 +67,8 @@ STATUSES = {
     "dis": {0, 1, 2},
     "asm": {0, 1, 2},
     "sim": {0, 1, 2, 10, 11, 12, 13, 20},  # 20: the program ended but missed its goal
+    "test": {0, 1, 2},
+    "new": {0, 2},
 }
 BUDGET = "20000"  # instructions: a runaway input ends quickly
 
@@ -673,4 +683,322 @@ def transport_attack(server: ServedLsp, attack: HostileConnection) -> list[str]:
     elif found:  # start afresh, so that one problem is not counted again and again
         server.stop()
         server.start()
+    return found
+
+
+# Program tests, [vary] and sweeps, campaigns' outputs, rl1c new ------------------------
+
+PROJECT = {name: text.encode() for name, text in FILES.items()}
+"""`rl1c new`'s files: a program, a world with a goal, a sensor script, a test file."""
+HOSTILE_PATHS = [
+    "fifo.rob", "loop.rob", "folder.rob", "zero.rob", "missing.rob", "/dev/zero",
+    "../main.rob", ".", "a\\u0000b.rob", "x" * 5000, "main.world.toml", "main.tests.toml",
+    "main.sensors.toml", "main.rob", "main.rob/", "hostile.ilc"]
+"""Paths a hostile test file names, as TOML writes them; what the special ones are is
+`_project`'s."""
+MAX_HOSTILE_RUNS = 60  # of a success rate the harness runs (a mutation may ask 100,000)
+
+
+def _project(folder: Path) -> Path:
+    """`folder`/project with `rl1c new`'s files and files no test should read: a FIFO,
+    a symbolic link loop, a folder, a link to /dev/zero and a damaged .ilc file."""
+    project = folder / "project"
+    if not project.exists():
+        project.mkdir()
+        for name, data in PROJECT.items():
+            (project / name).parent.mkdir(parents=True, exist_ok=True)
+            (project / name).write_bytes(data)
+        os.mkfifo(project / "fifo.rob")
+        (project / "loop.rob").symlink_to("loop.rob")
+        (project / "folder.rob").mkdir()
+        (project / "zero.rob").symlink_to("/dev/zero")
+        (project / "hostile.ilc").write_bytes(SEED_ILC_FILES[0][:40])
+    return project
+
+
+def _contents(folder: Path) -> dict[str, bytes | str]:
+    """Every entry under `folder` (links not followed): a regular file's bytes, else what
+    it is; so that a command that must change nothing can be held to it."""
+    found: dict[str, bytes | str] = {}
+    for path in sorted(folder.rglob("*")):
+        mode = path.lstat().st_mode
+        name = str(path.relative_to(folder))
+        found[name] = path.read_bytes() if stat.S_ISREG(mode) else (
+            f"link to {os.readlink(path)}" if stat.S_ISLNK(mode) else stat.filemode(mode))
+    return found
+
+
+def _toml_string(text: str) -> str:
+    return '"' + text.replace('"', '\\"') + '"'
+
+
+def _replace_value(draw: st.DrawFn, document: bytes, values: list[str]) -> bytes:
+    """`document` with the value of one of its `key = value` lines replaced by one of
+    `values`."""
+    assignments = list(re.finditer(rb"(?m)^(\s*[\w.\"]+\s*=\s*)(.*?)(\s*(#.*)?)$", document))
+    chosen = draw(st.sampled_from(assignments))
+    value = draw(st.sampled_from(values)).encode()
+    return document[:chosen.start(2)] + value + document[chosen.end(2):]
+
+
+@st.composite
+def hostile_test_files(draw: st.DrawFn) -> bytes:
+    """Arbitrary bytes; `rl1c new`'s test file and the examples' mutated byte by byte,
+    with a value replaced by a hostile one or a hostile path, or with a hostile key."""
+    kind = draw(st.sampled_from(["bytes", "mutated", "value", "path", "key"]))
+    if kind == "bytes":
+        return draw(st.binary(max_size=400))
+    seed = draw(st.sampled_from([PROJECT["main.tests.toml"],
+                                 (EXAMPLES / "listing1.tests.toml").read_bytes()]))
+    match kind:
+        case "mutated":
+            return _mutated(seed, draw)
+        case "value":
+            return _replace_value(draw, seed, HOSTILE_VALUES)
+        case "path":
+            return _replace_value(draw, seed, [_toml_string(path) for path in HOSTILE_PATHS])
+    line = draw(st.sampled_from([
+        b"expect.nope = 1", b"test = 5", b"[[test.expect]]", b"[test]", b"nope = 1",
+        b'expect.calls = ["MOV 99999999999,1", "CAM", ""]', b"expect.variables = { AA = 1 }",
+        b"expect.success = { runs = 0, at_least = 2 }", b"seed = 4294967295",
+        b"expect = 5", b'engine = "ast"', b'world = "main.world.toml"', b'name = ""']))
+    return seed + b"\n" + line + b"\n"
+
+
+def test_file_attack(data: bytes, folder: Path) -> list[str]:
+    """`rl1c test` on the test file `data` in a project with hostile neighbours (a FIFO,
+    a link loop, /dev/zero...), with --junit: a file the loader refuses must end with
+    status 2 and a message naming it, before any test runs; no input may change; a
+    JUnit file is written only when the tests ran."""
+    from rl1.compiler.test_file import Success, load_test_file
+    from rl1.vm.config import ConfigError
+
+    project = _project(folder)
+    tests, junit = project / "hostile.tests.toml", folder / "report.xml"
+    tests.write_bytes(data)
+    junit.unlink(missing_ok=True)
+    before = _contents(project)
+    try:
+        loaded = load_test_file(data, str(tests)).test
+    except ConfigError:
+        loaded = None
+    if loaded is not None and any(isinstance(test.expect.success, Success)
+                                  and test.expect.success.runs > MAX_HOSTILE_RUNS
+                                  for test in loaded):
+        return []  # valid, and too long to run here
+    result = rl1c("test", tests, "--jobs", "1", "--junit", junit)
+    found = _problems("test", result, junit if result.exit_code == 2 else None)
+    if loaded is None and (result.exit_code != 2 or result.stdout or not result.stderr
+                           .startswith(f"error[E0100]: the test file `{tests}` is not valid")):
+        found.append(f"test: a bad test file gave status {result.exit_code}: "
+                     f"{result.output_bytes[-300:]!r}")
+    if loaded is not None and result.exit_code in (0, 1) and not junit.exists():
+        found.append(f"test: status {result.exit_code} without the JUnit file")
+    if _contents(project) != before:
+        found.append("test: an input of the tests changed")
+    return found
+
+
+VARY_KEYS = [
+    "start.x", "start.y", "start.heading", "stands.stand.x", "stands.stand.facing",
+    "stands.nope.y", "vehicle.tread", "vehicle.trace_interval", "vehicle.camera_fov",
+    "vehicle.tilt_down", "vehicle.rotate_speed", "vehicle.nope", "noise.slip",
+    "noise.image_px", "noise.nope", "start", "nope.x", "start.x.y", '"start.x"']
+HOSTILE_NUMBERS = ["0", "-0.0", "1", "-1", "5", "-5", "0.001", "1e6", "-1e6", "1e7", "nan",
+                   "inf", "-inf", "5e-324", "1e-300", "9" * 400, '"x"', "[]", "true"]
+"""Numbers (and not) where a [vary] distribution or a --sweep wants one."""
+
+
+@st.composite
+def _distributions(draw: st.DrawFn) -> str:
+    number = st.sampled_from(HOSTILE_NUMBERS)
+    kind = draw(st.sampled_from(["uniform", "normal", "within", "both", "odd"]))
+    pair = f"[{draw(number)}, {draw(number)}]"
+    match kind:
+        case "uniform":
+            return f"{{ uniform = {pair} }}"
+        case "normal":
+            return f"{{ normal = {pair} }}"
+        case "within":
+            return f"{{ normal = {pair}, within = [{draw(number)}, {draw(number)}] }}"
+        case "both":
+            return f"{{ uniform = {pair}, normal = {pair} }}"
+    return draw(st.sampled_from(
+        ["{ }", "{ uniform = [0, 1], within = [0, 1] }", "{ x = 1 }", "{ uniform = [0] }",
+         "{ normal = [0, 1, 2] }", *HOSTILE_VALUES]))
+
+
+@st.composite
+def hostile_vary_worlds(draw: st.DrawFn) -> bytes:
+    """A world (the examples', `rl1c new`'s) with a [vary] table of hostile entries:
+    keys naming nothing, distributions inverted, not finite, of sd 0, with bounds
+    outside the value's range, of the wrong type."""
+    world = draw(st.sampled_from([*SEED_WORLDS, PROJECT["main.world.toml"]]))
+    entries = draw(st.lists(st.tuples(st.sampled_from(VARY_KEYS), _distributions()),
+                            min_size=1, max_size=3))
+    return world + b"\n[vary]\n" + "".join(f"{key} = {value}\n"
+                                           for key, value in entries).encode()
+
+
+@st.composite
+def hostile_sweeps(draw: st.DrawFn) -> tuple[str, ...]:
+    """`--sweep` arguments: none to three, of keys naming nothing or swept twice, of
+    offsets not finite or out of range, of counts zero, padded or huge, or not
+    KEY=A:B:N at all."""
+    offset = st.sampled_from(["0", "1", "-1", "-5", "5", "1e6", "nan", "inf", "x", ""])
+    count = st.sampled_from(["1", "2", "3", "0", "002", "10001", "9" * 30, "", "-1", "2.5"])
+    axis = st.builds(lambda key, a, b, n: f"{key}={a}:{b}:{n}", st.sampled_from(VARY_KEYS),
+                     offset, offset, count)
+    junk = st.sampled_from(["", "=", "start.x", "start.x=1:2", "start.x==1:2:3",
+                            "start.x=1:2:3:4", "=0:1:2", " start.x = 0 : 1 : 2 "])
+    return tuple(draw(st.lists(st.one_of(axis, axis, junk), max_size=3)))
+
+
+def vary_attack(world_data: bytes, sweeps: tuple[str, ...], folder: Path) -> list[str]:
+    """`rl1c sim` on the world `world_data` with `sweeps`: a campaign with its pictures
+    and JSON lines, and the one run of a seed. A world the loader refuses ends with
+    status 2 and a message naming it; a campaign that did not run writes nothing."""
+    world, program = folder / "hostile.world.toml", folder / "run.rob"
+    outputs = [folder / "runs.svg", folder / "runs.html", folder / "runs.jsonl"]
+    world.write_bytes(world_data)
+    program.write_bytes(SIM_PROGRAM)
+    for output in outputs:
+        output.unlink(missing_ok=True)
+    sweep_options = [word for text in sweeps for word in ("--sweep", text)]
+    campaign = rl1c("sim", program, "--world", world, "--runs", "2", "--jobs", "1",
+                    "--budget", BUDGET, "--svg", outputs[0], "--html", outputs[1],
+                    "--out", outputs[2], *sweep_options)
+    found = _problems("sim", campaign, None)
+    if campaign.exit_code != 0:
+        found += [f"sim --runs: failed with status {campaign.exit_code} but wrote {output}"
+                  for output in outputs if output.exists()]
+    one_run = rl1c("sim", program, "--world", world, "--seed", "1", "--format", "json",
+                   "--budget", BUDGET, *sweep_options)
+    found += _problems("sim", one_run, None)
+    try:
+        decode_world(world_data, str(world))
+    except WorldError:
+        said = f"error[E0100]: the world file `{world}` is not valid: {world}"
+        for result in (campaign, one_run):
+            if result.exit_code != 2 or not result.stderr.startswith(said):
+                found.append(f"sim: a bad world gave status {result.exit_code}: "
+                             f"{result.output_bytes[-300:]!r}")
+    return found
+
+
+NEW_TARGETS = ["missing", "empty", "link-to-empty", "file", "link-to-file", "dangling-link",
+               "link-loop", "not-empty", "hidden-file", "fifo", "under-a-file",
+               "missing-parent", "dash"]
+"""What `rl1c new` is given: the first three are a project's place, the rest refused."""
+
+
+def new_attack(kind: str, folder: Path) -> list[str]:
+    """`rl1c new` into the target `kind` of NEW_TARGETS, made in `folder`: a new or empty
+    folder gets the whole project (status 0); anything else status 2 and no change at
+    all, not even a temporary folder left behind."""
+    place = folder / "place"
+    place.mkdir()
+    (place / "kept.txt").write_text("kept")
+    target = place / "project"
+    match kind:
+        case "empty":
+            target.mkdir()
+        case "link-to-empty":
+            (place / "empty").mkdir()
+            target.symlink_to("empty")
+        case "file":
+            target.write_text("kept")
+        case "link-to-file":
+            target.symlink_to("kept.txt")
+        case "dangling-link":
+            target.symlink_to("nowhere")
+        case "link-loop":
+            target.symlink_to("project")
+        case "not-empty":
+            target.mkdir()
+            (target / "main.rob").write_text("(END)\n")
+        case "hidden-file":
+            target.mkdir()
+            (target / ".keep").write_text("")
+        case "fifo":
+            os.mkfifo(target)
+        case "under-a-file":
+            target = place / "kept.txt" / "project"
+        case "missing-parent":
+            target = place / "missing" / "project"
+        case "dash":
+            target = Path("-")
+    before = _contents(place)
+    result = rl1c("new", target)
+    found = _problems("new", result, None)
+    if kind in ("missing", "empty", "link-to-empty"):
+        if result.exit_code != 0:
+            found.append(f"new into {kind}: status {result.exit_code}: {result.output[-300:]!r}")
+        elif {name: (target / name).read_bytes() for name in PROJECT} != PROJECT:
+            found.append(f"new into {kind}: the project is not whole")
+    elif result.exit_code != 2:
+        found.append(f"new into {kind}: status {result.exit_code}: {result.output[-300:]!r}")
+    elif _contents(place) != before:
+        found.append(f"new into {kind}: refused, but changed {place}")
+    return found
+
+
+OUTPUT_TARGETS = ["-", "", "folder", "missing/report", "program", "world", "test file",
+                  "link to the program", "link loop", "read-only", "the other output",
+                  "/dev/null"]
+"""Where a hostile command line writes `rl1c test --junit` and a campaign's pictures."""
+
+
+def _output_target(kind: str, project: Path, other: Path) -> str:
+    match kind:
+        case "folder":
+            return str(project / "folder.rob")
+        case "missing/report":
+            return str(project / "missing" / "report")
+        case "program" | "world" | "test file":
+            return str(project / {"program": "main.rob", "world": "main.world.toml",
+                                  "test file": "main.tests.toml"}[kind])
+        case "link to the program":
+            (project / "to-program").unlink(missing_ok=True)
+            (project / "to-program").symlink_to("main.rob")
+            return str(project / "to-program")
+        case "link loop":
+            return str(project / "loop.rob")
+        case "read-only":
+            target = project / "read-only.out"
+            if not target.exists():
+                target.write_text("kept")
+                target.chmod(0o444)
+            return str(target)
+        case "the other output":
+            return str(other)
+    return kind
+
+
+def output_attack(command: str, kind: str, folder: Path) -> list[str]:
+    """`rl1c test --junit` (command "test") or `rl1c sim --runs --svg --html` ("svg",
+    "html") writing to the target `kind` of OUTPUT_TARGETS: no input changes, a
+    read-only file stays as it was without --force, and a command that failed wrote
+    nothing new."""
+    project = _project(folder)
+    other = folder / "other.out"
+    target = _output_target(kind, project, other)
+    before = _contents(project)
+    created = target not in ("-", "/dev/null") and not os.path.lexists(target)
+    if command == "test":
+        result = rl1c("test", project / "main.tests.toml", "--jobs", "1", "--junit", target)
+    else:
+        pictures = {"svg": ["--svg", target, "--html", str(other)],
+                    "html": ["--html", target, "--out", str(other)]}[command]
+        result = rl1c("sim", project / "main.rob", "--world", project / "main.world.toml",
+                      "--runs", "2", "--jobs", "1", "--budget", BUDGET, *pictures)
+    found = _problems("test" if command == "test" else "sim", result, None)
+    refused = {"program", "world", "test file", "read-only", "link to the program",
+               *(["the other output"] if command != "test" else [])}
+    if result.exit_code == 0 and kind in refused:
+        found.append(f"{command} onto {kind}: status 0, where it is refused")
+    if _contents(project) != before:
+        found.append(f"{command} onto {kind}: changed a file of the project")
+    if result.exit_code == 2 and created and os.path.lexists(target):
+        found.append(f"{command} onto {kind}: failed but wrote {target}")
     return found
