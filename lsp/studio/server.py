@@ -39,7 +39,7 @@ log = logging.getLogger(__name__)
 HOST = "127.0.0.1"
 STATIC = Path(__file__).with_name("static")
 TOKEN_PLACEHOLDER = "__RL1_STUDIO_TOKEN__"
-BUILD_HELP = "cd editors/studio && npm ci && npm run build"
+BUILD_HELP = "make studio-page"  # in the checkout: the page's packages, then esbuild
 MAX_UNSENT = 2 * MAX_MESSAGE
 """Bytes a page may leave unread before it is disconnected."""
 _TYPES = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=utf-8",
@@ -217,7 +217,8 @@ _NOT_BUILT = f"""<!doctype html>
 <html lang="en"><head><meta charset="utf-8"><title>RL/I studio: the page is not built</title>
 </head><body><h1>The studio's page is not built</h1>
 <p>rl1c studio serves the page from <code>{STATIC}</code>, which has no
-<code>index.html</code>. Build it from its sources (Node.js needed once), then reload:</p>
+<code>index.html</code>. Build it from its sources in editors/studio/ (Node.js needed),
+in the checkout's folder, then reload:</p>
 <pre>{BUILD_HELP}</pre>
 <p>An installed rl1 package ships the page built; this is a checkout without it.</p>
 </body></html>
