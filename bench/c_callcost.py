@@ -8,8 +8,9 @@ arguments), then N copies of the call, then END; and the same without the calls.
 linked with the VM, the loader and vm/c/test/callcost.c (a device whose callbacks answer
 done at once) into a firmware image built at -Os as firmware is, and run:
 
-- Cortex-M3 (lm3s6965evb) under qemu-system-arm with `-singlestep -d exec,nochain`: one
-  log line for each instruction the machine runs. The bench counts the lines between
+- Cortex-M3 (lm3s6965evb) under qemu-system-arm with `-singlestep -d exec,nochain`
+  (`-one-insn-per-tb` from qemu 8.1): one log line for each instruction the machine
+  runs. The bench counts the lines between
   callcost_begin and callcost_end (around rl1_step) whose function is not one of the
   callbacks (callcost_hw_*): the machine's own instructions, exact.
 - ATmega328P under simavr: the firmware counts the cycles of rl1_step with Timer1 at the
@@ -108,12 +109,21 @@ AVR = ["avr-gcc", "-mmcu=atmega328p", "-Os", "-DRL1_READ_BYTE(p)=pgm_read_byte(p
 TRACE = re.compile(r"^Trace \d+: \S+ \[[0-9a-f]+/([0-9a-f]+)/[0-9a-f]+/[0-9a-f]+\] (\S*)")
 
 
+def one_instruction_a_block() -> str:
+    """qemu's option for one instruction a translation block: -singlestep until 8.1
+    renamed it."""
+    usage = subprocess.run(["qemu-system-arm", "-help"], capture_output=True, text=True,
+                           check=False).stdout
+    return "-one-insn-per-tb" if "-one-insn-per-tb" in usage else "-singlestep"
+
+
 def m3_instructions(elf: Path) -> int:
     """The instructions the Cortex-M3 runs in rl1_step, the callbacks' left out."""
     log = elf.with_suffix(".log")
     run = subprocess.run(["qemu-system-arm", "-M", "lm3s6965evb", "-nographic",
-                          "-semihosting-config", "enable=on,target=native", "-singlestep",
-                          "-d", "exec,nochain", "-D", str(log), "-kernel", str(elf)],
+                          "-semihosting-config", "enable=on,target=native",
+                          one_instruction_a_block(), "-d", "exec,nochain", "-D", str(log),
+                          "-kernel", str(elf)],
                          stdin=subprocess.DEVNULL, capture_output=True, text=True,
                          timeout=300, check=False)
     if run.returncode != 0:
