@@ -5,6 +5,7 @@ and every kind of bad message answered with its JSON-RPC error, the server going
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import json
 import time
@@ -15,6 +16,7 @@ from typing import Any
 import pytest
 from served import Failed, Page, Served, page, sample_folder, serving
 from support.cli import rl1c
+from websockets.exceptions import ConnectionClosed
 
 from rl1.lsp.studio.run import FRAMES_PER_SECOND
 from rl1.vm.language import BUILTINS, VARIABLES
@@ -387,3 +389,23 @@ def test_a_long_call_at_real_time_does_not_hold_up_a_command(client: Page,
         assert stop["frame"]["time"] > moving["time"]
     if command == "debug/restart":
         assert (stop["reason"], stop["frame"]["time"]) == ("entry", 0)
+
+
+def test_a_page_beyond_eight_is_told_to_close_one(folder: Path) -> None:
+    with serving(folder) as served, contextlib.ExitStack() as pages:
+        opened = [pages.enter_context(page(served)) for _ in range(8)]
+        assert all(each.request("initialize") for each in opened)
+        with page(served) as ninth, pytest.raises(ConnectionClosed) as closed:
+            ninth.request("initialize")
+        assert closed.value.rcvd is not None
+        assert closed.value.rcvd.code == 1013
+        assert "8 pages" in closed.value.rcvd.reason
+        pages.close()
+        # The places are given back once the server has seen the pages close.
+        for _ in range(100):
+            with page(served) as again, contextlib.suppress(ConnectionClosed):
+                assert again.request("initialize")
+                break
+            time.sleep(0.05)
+        else:
+            raise AssertionError("no place was given back")
