@@ -46,13 +46,14 @@ MAX_FIX_ROUNDS = 10
 
 
 class Fixed(NamedTuple):
-    """The text with the fixes made, how many were made, its analysis, and how many of
-    the diagnostics `keep` accepts are left with a fix (without `unsafe`: an unsafe one;
-    with it: one that would be made over an unsafe fix's result, in another run)."""
+    """The text with the fixes made, how many were made, its diagnostics (`diagnose`'s:
+    no tree is held), and how many of the diagnostics `keep` accepts are left with a fix
+    (without `unsafe`: an unsafe one; with it: one that would be made over an unsafe
+    fix's result, in another run)."""
 
     text: str
     fixes: int
-    analysis: Analysis
+    diagnostics: list[Diagnostic]
     left: int
 
 
@@ -67,25 +68,25 @@ def fix(text: str, keep: Callable[[Diagnostic], bool] = lambda _: True, *,
     removal of a label nobody jumps to must not be made on it), and an unsafe fix's
     consequences wait for another run. `rl1c check --fix` and the language server's
     "fix all" both make their fixes through this function."""
-    analysis = analyze(text)
+    diagnostics = diagnose(text)
     made = 0
     for done in range(MAX_FIX_ROUNDS):
-        fixes = compatible(_fixes(analysis, keep, unsafe and done == 0))
+        fixes = compatible(_fixes(diagnostics, keep, unsafe and done == 0))
         if not fixes:
             break
         text = apply_edits(text, [edit for one in fixes for edit in one.edits])
         made += len(fixes)
-        analysis = analyze(text)
+        diagnostics = diagnose(text)
         if not all(one.safe for one in fixes):
             break
-    left = sum(1 for d in analysis.diagnostics if keep(d) and d.fixes)
-    return Fixed(text, made, analysis, left)
+    left = sum(1 for d in diagnostics if keep(d) and d.fixes)
+    return Fixed(text, made, diagnostics, left)
 
 
-def _fixes(analysis: Analysis, keep: Callable[[Diagnostic], bool], unsafe: bool
+def _fixes(diagnostics: list[Diagnostic], keep: Callable[[Diagnostic], bool], unsafe: bool
            ) -> Iterator[Fix]:
     """The first fix that may be made of each diagnostic `keep` accepts."""
-    for diagnostic in analysis.diagnostics:
+    for diagnostic in diagnostics:
         if keep(diagnostic):
             yield from itertools.islice((one for one in diagnostic.fixes
                                          if one.safe or unsafe), 1)

@@ -126,7 +126,7 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
         text, diagnostics = source.text, None
         if fix:
             fixing = analysis.fix(source.text, keep=selection.reports, unsafe=unsafe_fixes)
-            text, diagnostics = fixing.text, fixing.analysis.diagnostics
+            text, diagnostics = fixing.text, fixing.diagnostics
             try:
                 if fixing.fixes:
                     write_back(source, fixing.text, force=force)

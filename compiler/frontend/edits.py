@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 
 from .diagnostics import Edit, Fix
-from .source import LINE_BREAK
+from .source import LINE_BREAK, LineIndex
 
 _Place = tuple[int, int]  # (line, column)
 
@@ -31,15 +31,14 @@ def apply_edits(text: str, edits: Sequence[Edit]) -> str:
     """`text` with `edits`, which must not overlap, made. A line break in an edit's text
     is written as the text's first line end (LF if it has none), so that a file keeps
     its line ends; a place past the end of a line is its end."""
-    breaks = list(LINE_BREAK.finditer(text))
-    line_end = breaks[0].group() if breaks else "\n"
-    starts = [0, *(found.end() for found in breaks)]
-    ends = [*(found.start() for found in breaks), len(text)]
+    first_break = LINE_BREAK.search(text)
+    line_end = first_break.group() if first_break else "\n"
+    lines = LineIndex(text)  # 8 bytes a line: `rl1c check --fix` of a long source
 
     def offset(line: int, column: int) -> int:
-        if line > len(starts):
+        if line > len(lines):
             return len(text)
-        return min(starts[line - 1] + column - 1, ends[line - 1])
+        return lines.start(line - 1) + min(column - 1, len(lines[line - 1]))
 
     placed = sorted(((offset(e.span.line, e.span.column),
                       offset(e.span.end_line, e.span.end_column), e.text) for e in edits),

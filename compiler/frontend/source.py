@@ -70,6 +70,10 @@ class LineIndex:
     def __len__(self) -> int:
         return len(self._starts)
 
+    def start(self, index: int) -> int:
+        """Where line `index` (0-based) starts in the text."""
+        return self._starts[index]
+
     def __getitem__(self, index: int) -> str:
         """Line `index` (0-based) without its line end."""
         start = self._starts[index]

@@ -45,8 +45,8 @@ def fixable_programs(draw: st.DrawFn) -> str:
 @given(programs() | fixable_programs())
 def test_after_fix_no_diagnostic_with_a_safe_fix_is_left(text: str) -> None:
     fixed = fix(text)
-    assert [d.code for d in fixed.analysis.diagnostics if fixable(d)] == []
-    assert fixed.analysis.diagnostics == analyze(fixed.text).diagnostics
+    assert [d.code for d in fixed.diagnostics if fixable(d)] == []
+    assert fixed.diagnostics == analyze(fixed.text).diagnostics
     assert (fixed.fixes == 0) == (fixed.text == text)
 
 
@@ -63,7 +63,7 @@ def test_fix_keeps_the_line_ends_and_changes_nothing_a_second_time(text: str) ->
 @given(programs(), st.sampled_from(["W", "E", "W06", "E05"]))
 def test_fix_makes_only_the_fixes_of_what_it_keeps(text: str, prefix: str) -> None:
     fixed = fix(text, keep=lambda d: d.code.startswith(prefix))
-    left = [d for d in fixed.analysis.diagnostics if fixable(d) and d.code.startswith(prefix)]
+    left = [d for d in fixed.diagnostics if fixable(d) and d.code.startswith(prefix)]
     assert left == []
     if not any(fixable(d) and d.code.startswith(prefix) for d in analyze(text).diagnostics):
         assert fixed.text == text
@@ -109,7 +109,7 @@ def test_a_label_fixed_to_two_digits_is_kept_though_nothing_jumps_to_it() -> Non
     # Unsafe fixes too: W0205's removal would change what the E0201 fix wrote.
     unsafe = fix(text, unsafe=True)
     assert unsafe.text == ":05 (TIM 10)\n(END)\n"
-    assert [d.code for d in unsafe.analysis.diagnostics] == ["W0205"] and unsafe.left == 1
+    assert [d.code for d in unsafe.diagnostics] == ["W0205"] and unsafe.left == 1
     # A second run judges the label as it now stands.
     assert fix(unsafe.text, unsafe=True).text == "(TIM 10)\n(END)\n"
 
@@ -135,7 +135,7 @@ def test_fixes_that_remove_or_change_what_the_program_does_are_unsafe(text: str,
                                                                        code: str) -> None:
     (found,) = [d for d in analyze(text).diagnostics if d.code == code]
     assert found.fixes and not any(one.safe for one in found.fixes)
-    assert code not in {d.code for d in fix(text, unsafe=True).analysis.diagnostics}
+    assert code not in {d.code for d in fix(text, unsafe=True).diagnostics}
 
 
 def test_fixes_that_meet_at_one_place_wait_for_the_next_round() -> None:
@@ -154,6 +154,46 @@ def test_apply_edits_writes_line_breaks_as_the_text_ends_its_lines() -> None:
     edits = [Edit(Span(2, 4, 2, 4), "\nC=3"), Edit(Span(1, 1, 1, 2), "Z")]
     assert apply_edits(text, edits) == "Z=1\r\nB=2\r\nC=3"
     assert apply_edits("A=1", [Edit(Span(1, 99, 1, 99), "\n(END)")]) == "A=1\n(END)"
+
+
+def edits_made_as_before(text: str, edits: list[Edit]) -> str:
+    """apply_edits as it was before it indexed the lines in 8 bytes a line (a match
+    object and two ints a line took 50 bytes a source byte of `rl1c check --fix`): the
+    reference the property below holds it to."""
+    breaks = list(LINE_BREAK.finditer(text))
+    line_end = breaks[0].group() if breaks else "\n"
+    starts = [0, *(found.end() for found in breaks)]
+    ends = [*(found.start() for found in breaks), len(text)]
+
+    def offset(line: int, column: int) -> int:
+        if line > len(starts):
+            return len(text)
+        return min(starts[line - 1] + column - 1, ends[line - 1])
+
+    placed = sorted(((offset(e.span.line, e.span.column),
+                      offset(e.span.end_line, e.span.end_column), e.text) for e in edits),
+                    key=lambda item: item[0], reverse=True)
+    for start, end, new in placed:
+        text = text[:start] + new.replace("\n", line_end) + text[end:]
+    return text
+
+
+@st.composite
+def texts_and_an_edit(draw: st.DrawFn) -> tuple[str, list[Edit]]:
+    text = draw(st.text(alphabet="AB=1 \r\n", max_size=30))
+    line = draw(st.integers(1, 6))
+    column = draw(st.integers(1, 8))
+    end_line = draw(st.integers(line, 7))
+    end_column = draw(st.integers(1 if end_line > line else column, 9))
+    new = draw(st.sampled_from(["", "Z", "\n(END)", "; "]))
+    return text, [Edit(Span(line, column, end_line, end_column), new)]
+
+
+@settings(max_examples=500, deadline=None)
+@given(texts_and_an_edit())
+def test_apply_edits_places_an_edit_as_it_did(case: tuple[str, list[Edit]]) -> None:
+    text, edits = case
+    assert apply_edits(text, edits) == edits_made_as_before(text, edits)
 
 
 def test_compatible_drops_a_fix_that_overlaps_or_meets_one_kept_before() -> None:
