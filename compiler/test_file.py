@@ -22,6 +22,7 @@ server checks a test file without loading the back end.
 from __future__ import annotations
 
 import os
+import re
 from typing import Annotated, Literal
 
 import msgspec
@@ -60,6 +61,10 @@ CallText = Annotated[str, Meta(min_length=1, max_length=80, extra={
     "expected": 'a call as the trace shows it, such as "MOV 3,3" or "IMG"'})]
 Path = Annotated[str, Meta(min_length=1, max_length=4096, description=(
     "a path from the test file's folder"))]
+
+
+CONTROL = re.compile("[\x00-\x1f\x7f-\x9f]")
+"""A control character (C0, DEL, C1): none in a path; shown as U+FFFD in a name."""
 
 
 def is_test_file(name: str) -> bool:
@@ -164,11 +169,13 @@ def _check(tests: TestFile, name: str, text: str) -> None:
             raise fail("name", detail=f'a second test named "{test.name}"; give each '
                                       "test a name of its own")
         seen.add(test.name)
-        for key, path in (("program", test.program), ("world", test.world),
-                          ("sensors", test.sensors)):
-            if isinstance(path, str) and "\0" in path:
-                raise fail(key, detail="a path holds no NUL character (\\u0000); write "
-                                       "the file's name from this file's folder")
+        # The report prints paths: a control character would reach the terminal (an
+        # escape sequence), and NUL no file's name holds.
+        for key, value in (("program", test.program), ("world", test.world),
+                           ("sensors", test.sensors)):
+            if isinstance(value, str) and (found := CONTROL.search(value)):
+                raise fail(key, detail=f"holds the control character U+{ord(found[0]):04X}; "
+                                       "write it without one")
         has_world = not isinstance(test.world, UnsetType)
         if has_world and not isinstance(test.sensors, UnsetType):
             raise fail("sensors", detail="a test runs on a world or on a sensor script, "

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from rl1.compiler.program_tests import Case, Outcome, Status, Story
 from rl1.compiler.reporting.render import FileDiagnostics, diagnostic_blocks
-from rl1.compiler.test_file import Success
+from rl1.compiler.test_file import CONTROL, Success
 from rl1.vm.defaults import DEFAULT_BUDGET
 from rl1.vm.scripted import LOST, ScriptedDevice, TraceEntry
 from rl1.vm.sim.device import SimEntry
@@ -37,7 +37,7 @@ class Result:
     @property
     def title(self) -> str:
         """`examples/listing1.tests.toml: the test's name`, as the report heads it."""
-        return f"{self.case.file}: {self.case.test.name}"
+        return f"{self.case.file}: {CONTROL.sub(chr(0xFFFD), self.case.test.name)}"
 
 
 def _setting(case: Case, jobs: int) -> Setting:

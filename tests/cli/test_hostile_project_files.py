@@ -1,9 +1,10 @@
 """Hostile test files, outputs and sweeps that once ended badly, each held here: a test
-file naming a FIFO (rl1c test waited forever) or a path with a NUL character (an
-internal error); a symbolic link loop (a message ending in "; "); --junit onto a file the
-tests read (replaced), `-` (a file named `-`), a folder (found after every test ran) or
-a read-only file (which said to give a --force that rl1c test did not have); and a
---sweep whose N had leading zeros (read as its first six digits)."""
+file naming a FIFO (rl1c test waited forever), a path with a NUL character (an
+internal error), a name with an escape sequence (written to the terminal), a symbolic
+link loop (a message ending in "; "); --junit onto a file the tests read (replaced),
+`-` (a file named `-`), a folder (found after every test ran) or a read-only file
+(which said to give a --force that rl1c test did not have); and a --sweep whose N had
+leading zeros (read as its first six digits)."""
 
 from __future__ import annotations
 
@@ -53,7 +54,18 @@ def test_a_path_with_a_nul_character_is_refused_with_its_line(tmp_path: Path,
     result = rl1c("test", tests)
     assert result.exit_code == 2, result.output
     line = 3 if key == "program" else 4
-    assert f"t.tests.toml:{line}: test[0].{key}: a path holds no NUL character" in result.stderr
+    assert (f"t.tests.toml:{line}: test[0].{key}: holds the control character U+0000"
+            in result.stderr)
+
+
+def test_a_name_with_an_escape_sequence_never_reaches_the_terminal(tmp_path: Path) -> None:
+    tests = project(tmp_path)
+    text = tests.read_text(encoding="utf-8").replace('"it ends"', '"it \\u001b[2J ends"')
+    tests.write_text(text + "expect.variables = { A = 5 }\n", encoding="utf-8")
+    result = rl1c("test", tests)
+    assert result.exit_code == 1
+    assert "t.tests.toml: it \ufffd[2J ends" in result.stdout
+    assert "\x1b" not in result.output
 
 
 def test_a_symbolic_link_loop_says_what_happened_without_a_dangling_help(
