@@ -74,7 +74,7 @@ def test_command_names_complete_with_file_names() -> None:
     assert completions([], "ch") == [("check", "plain"), ("ch", "file")]
     names = [value for value, kind in completions([], "") if kind == "plain"]
     assert names == sorted(["check", "fmt", "explain", "compile", "run", "dis", "asm", "sim",
-                            "test", "new", "fuzz", "docs"])
+                            "test", "new", "studio", "fuzz", "reduce", "docs"])
 
 
 def test_options_and_their_choices_complete() -> None:
