@@ -1,0 +1,210 @@
+"""Host instructions per bytecode instruction in the C VM (vm/c/rl1vm.c), with device
+calls counted apart from the other instructions, against the goal of issue 26: at most
+10 host instructions for each instruction that is not a call.
+
+For bench/corpus/ (with Listing 1) and bench/unseen/, each program on its sensor script
+at -O2, with the threaded build (what hosts build) and the switch one (RL1_THREADED=0):
+vm/c's conformance runner (`--once`, the Makefile's -O2 runner) runs the programs under
+`valgrind --tool=callgrind --dump-instr=yes`, which counts each machine instruction
+executed at each address. `addr2line -i` names, for each address of rl1_step and the
+functions it reaches in rl1vm.c, the source line of `run()` it was compiled from, through
+any inlined functions (a helper such as take_event, inlined at a call and at a jump,
+belongs to the place it was inlined into). So the split is by counting, not by a model:
+
+- a call: the instructions of the call case of `run()` (from its first `case` to its
+  `NEXT()`, threaded its own jump to the next instruction included) and of `resume()`
+  (a started call polled again in a later step);
+- dispatch: the head of `run()`'s loop (up to `switch (op)`), which each instruction
+  pays alike with the switch, and threaded only at a step's start and near its limit;
+  it is shared out evenly over every instruction;
+- the rest of rl1_step is the other instructions' cost, with each step's entry and exit.
+
+The embedder's callbacks (vm/c/test/scripted.c) are other functions: not counted. The
+sum over the addresses is checked against bench/c_speed.py's count (rl1_step inclusive
+less the callbacks), so nothing is lost or counted twice. Calls are not split by kind:
+they share one path, and its instructions cannot tell which kind ran them
+(bench/c_callcost.py measures each kind on the targets).
+
+    .venv/bin/python bench/c_host_cost.py
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+from c_speed import C_FOLDER, CORPUS, NOT_CALLS, callgrind_cost, compiled, vector, write_vectors
+
+ROOT = Path(__file__).resolve().parent.parent
+VM_SOURCE = C_FOLDER / "rl1vm.c"
+SETS = {"corpus": CORPUS, "unseen": sorted((ROOT / "bench" / "unseen").glob("*.rob"))}
+BUILDS = {"threaded": "", "switch": " -DRL1_THREADED=0"}
+LEVEL = 2
+GOAL = 10
+
+
+@dataclass(frozen=True)
+class Regions:
+    """Line ranges of `run()` in rl1vm.c (each inclusive), found from the source's text."""
+
+    loop: range       # the dispatch loop: everything but the step's entry and exit
+    dispatch: range   # the loop's head, up to `switch (op)`
+    call_case: range  # the call case, from its first `case` to its NEXT()
+
+    @staticmethod
+    def of(source: str) -> Regions:
+        lines = source.splitlines()
+
+        def first(pattern: str, after: int = 0) -> int:
+            return next(number for number, text in enumerate(lines, 1)
+                        if number > after and re.search(pattern, text))
+
+        head = first(r"^\s*for \(;;\) \{")
+        call = first(r"^\s*case RL1_OP_\w+: case", head)
+        return Regions(range(head, first(r"^\s*vm->pc = \(uint16_t\)\(ip - code\);", head)),
+                       range(head, first(r"^\s*switch \(op\) \{", head) + 1),
+                       range(call, first(r"^\s*ip = next;", call) + 2))
+
+
+def self_costs(out: Path, source: Path) -> dict[int, int]:
+    """Instructions executed at each address of rl1_step and the static functions of
+    `source`, from a
+    callgrind file written with --dump-instr=yes (positions: address, line; each absolute,
+    relative +n/-n, or * for the last). A `calls=` line's next line is the callee's
+    inclusive cost at the calling instruction: its position counts, its cost does not."""
+    names: dict[str, str] = {}
+    costs: dict[int, int] = {}
+    address = 0
+    in_file = counted = skip_next = False
+    for line in out.read_text(encoding="utf-8").splitlines():
+        # files (fl, fi, fe, cfi, cfl) share one table of compressed names, functions
+        # (fn, cfn) another
+        if found := re.match(r"(c?fl|fi|fe|cfi|c?fn)=\((\d+)\)(?: (.*))?$", line):
+            kind, key, name = found.groups()
+            table = "function" if kind.endswith("fn") else "file"
+            name = names.setdefault(f"{table} {key}", name or "")
+            if kind == "fl":
+                in_file = name == str(source)
+            elif kind == "fn":  # rl1_step and the static functions it alone reaches
+                counted = in_file and (name == "rl1_step" or not name.startswith("rl1_"))
+            continue
+        if line.startswith("calls="):
+            skip_next = True
+            continue
+        fields = line.split()
+        if not fields or not re.match(r"0x[0-9a-f]+$|[+-]\d+$|\*$", fields[0]):
+            continue
+        position = fields[0]
+        if position.startswith("0x"):
+            address = int(position, 16)
+        elif position != "*":
+            address += int(position)
+        if counted and not skip_next and len(fields) == 3:
+            costs[address] = costs.get(address, 0) + int(fields[2])
+        skip_next = False
+    return costs
+
+
+def run_lines(binary: Path, addresses: list[int]) -> Iterator[tuple[int, int | None, bool]]:
+    """For each address: the line of `run()` it comes from (None outside run) and whether
+    it is inside `resume()`."""
+    text = subprocess.run(["addr2line", "-a", "-f", "-i", "-e", str(binary),
+                           *(hex(a) for a in addresses)], check=True, capture_output=True,
+                          text=True).stdout.splitlines()
+    index = 0
+    for address in addresses:
+        assert int(text[index], 16) == address, text[index]
+        index += 1
+        run_line: int | None = None
+        in_resume = False
+        while index < len(text) and not text[index].startswith("0x"):
+            function, where = text[index], text[index + 1]
+            index += 2
+            if function == "run" and where.startswith(f"{VM_SOURCE}:"):
+                run_line = int(where.rsplit(":", 1)[1].split()[0])
+            in_resume |= function == "resume"
+        yield address, run_line, in_resume
+
+
+def programs(paths: list[Path]) -> list[dict[str, object]]:
+    vectors = []
+    for path in paths:
+        sensors_path = path.with_suffix(".sensors.json")
+        sensors = (json.loads(sensors_path.read_text(encoding="utf-8"))
+                   if sensors_path.exists() else {})
+        vectors.append(vector(path.stem, compiled(path.read_text(encoding="utf-8"),
+                                                  path.name, LEVEL), sensors))
+    return vectors
+
+
+def measure(binary: Path, vectors_file: Path, executed: int, calls: int, folder: Path,
+            regions: Regions) -> str:
+    out = folder / "callgrind.out"
+    subprocess.run(["valgrind", "--tool=callgrind", "--dump-instr=yes",
+                    f"--callgrind-out-file={out}", str(binary), "--once", str(vectors_file)],
+                   check=True, capture_output=True)
+    costs = self_costs(out, VM_SOURCE)
+    call_cost = dispatch = steps = 0
+    for address, line, in_resume in run_lines(binary, sorted(costs)):
+        if in_resume or (line is not None and line in regions.call_case):
+            call_cost += costs[address]
+        elif line is None or line not in regions.loop:
+            steps += costs[address]
+        elif line in regions.dispatch:
+            dispatch += costs[address]
+    total = sum(costs.values())
+    expected = callgrind_cost(binary, vectors_file, folder)
+    assert total == expected, f"{total:,} instructions by address, {expected:,} by function"
+    share = dispatch / executed
+    per_call = call_cost / calls + share
+    others = executed - calls
+    per_other = (total - steps - call_cost - share * calls) / others
+    return (f"{per_other:6.2f} per other instruction ({others:,})   (goal: at most {GOAL})"
+            f"   {per_call:7.1f} per call ({calls:,})   [{total:,} in all: "
+            f"{steps:,} the steps' entries and exits]")
+
+
+def main() -> int:
+    missing = [tool for tool in ("valgrind", "addr2line", "callgrind_annotate", "make")
+               if shutil.which(tool) is None]
+    if missing:
+        print(f"bench/c_host_cost.py needs {', '.join(missing)} (vm/c/install-tools "
+              "installs them on Debian)", file=sys.stderr)
+        return 2
+    regions = Regions.of(VM_SOURCE.read_text(encoding="utf-8"))
+    host_cc = shutil.which("gcc") or "cc"
+    print(f"host instructions per bytecode instruction, the programs at -O{LEVEL} "
+          "(callgrind, each address's count placed by addr2line -i)")
+    with tempfile.TemporaryDirectory(prefix="rl1-c-host-cost-") as scratch:
+        folder = Path(scratch)
+        binaries = {}
+        for build, flags in BUILDS.items():
+            (folder / build).mkdir()
+            binaries[build] = folder / build / "vectors-fast"
+            # -no-pie: callgrind's addresses are then the file's, which addr2line reads
+            subprocess.run(["make", "-s", "-C", str(C_FOLDER), f"BUILD={folder / build}",
+                            f"HOST_CC={host_cc} -no-pie{flags}", str(binaries[build])],
+                           check=True)
+        for name, paths in SETS.items():
+            if not paths:
+                continue
+            vectors = programs(paths)
+            vectors_file = folder / f"{name}.txt"
+            executed = write_vectors(vectors_file, vectors)
+            calls = sum(1 for v in vectors if isinstance(trace := v["trace"], list)
+                        for entry in trace if entry["call"] not in NOT_CALLS)
+            for build, binary in binaries.items():
+                figures = measure(binary, vectors_file, executed, calls, folder, regions)
+                print(f"   {name} ({len(vectors)} programs), {build:8} {figures}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
