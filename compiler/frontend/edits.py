@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import bisect
+import itertools
 from collections.abc import Iterable, Sequence
 
 from .diagnostics import Edit, Fix
@@ -13,18 +15,49 @@ _Place = tuple[int, int]  # (line, column)
 def compatible(fixes: Iterable[Fix]) -> list[Fix]:
     """The fixes, in order, less any with an edit that overlaps, or inserts at the same
     place as, an edit of a fix kept before it: made together, they could not each do
-    what it says (two lines added at the end would come in an order neither chose)."""
-    taken: list[tuple[_Place, _Place]] = []
+    what it says (two lines added at the end would come in an order neither chose).
+
+    The kept edits meet none of the others, so each is looked for by bisection among
+    them, sorted: a source with a fix on each line has hundreds of thousands. (A fix
+    whose own edits meet, or end before they start, would break that order: from it
+    on, every kept edit is looked at.)"""
+    starts: list[_Place] = []  # the kept edits' spans, sorted, as their starts and ends
+    ends: list[_Place] = []
+    apart = True  # whether the kept edits are in order and meet none of the others
     kept: list[Fix] = []
     for fix in fixes:
         spans = [((e.span.line, e.span.column), (e.span.end_line, e.span.end_column))
                  for e in fix.edits]
-        if any((start < t_end and t_start < end) or start == t_start
-               for start, end in spans for t_start, t_end in taken):
+        if any(_meets_one(span, starts, ends) if apart and span[0] <= span[1]
+               else any(_meet(span, taken) for taken in zip(starts, ends, strict=True))
+               for span in spans):
             continue
-        taken += spans
+        apart = apart and all(start <= end for start, end in spans) and not any(
+            _meet(one, other) for index, one in enumerate(spans) for other in spans[:index])
+        for start, end in spans:
+            index = bisect.bisect_left(starts, start)
+            starts.insert(index, start)
+            ends.insert(index, end)
         kept.append(fix)
     return kept
+
+
+def _meet(span: tuple[_Place, _Place], other: tuple[_Place, _Place]) -> bool:
+    """Whether two edits' spans overlap or start at the same place."""
+    (start, end), (other_start, other_end) = span, other
+    return (start < other_end and other_start < end) or start == other_start
+
+
+def _meets_one(span: tuple[_Place, _Place], starts: list[_Place], ends: list[_Place]
+               ) -> bool:
+    """`_meet` of `span` (which ends where or after it starts) and any of the spans given
+    by their sorted starts and ends, which are in order and meet none of the others:
+    only its neighbours may meet it."""
+    start, end = span
+    index = bisect.bisect_left(starts, start)
+    if index < len(starts) and (starts[index] == start or starts[index] < end):
+        return True
+    return index > 0 and start < ends[index - 1]
 
 
 def apply_edits(text: str, edits: Sequence[Edit]) -> str:
@@ -42,7 +75,16 @@ def apply_edits(text: str, edits: Sequence[Edit]) -> str:
 
     placed = sorted(((offset(e.span.line, e.span.column),
                       offset(e.span.end_line, e.span.end_column), e.text) for e in edits),
-                    key=lambda item: item[0], reverse=True)
+                    key=lambda item: item[0])
+    if any(one[0] == other[0] for one, other in itertools.pairwise(placed)):
+        # two at one place: made one by one from the end, each on the last one's text
+        for start, end, new in sorted(placed, key=lambda item: item[0], reverse=True):
+            text = text[:start] + new.replace("\n", line_end) + text[end:]
+        return text
+    pieces: list[str] = []  # a piece an edit, not a copy of the text an edit
+    done = 0  # where the text not yet in pieces starts
     for start, end, new in placed:
-        text = text[:start] + new.replace("\n", line_end) + text[end:]
-    return text
+        pieces += [text[done:start], new.replace("\n", line_end)]
+        done = end
+    pieces.append(text[done:])
+    return "".join(pieces)

@@ -8,7 +8,7 @@ from __future__ import annotations
 import re
 
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from rl1.compiler.analysis import analyze, fix
@@ -179,21 +179,63 @@ def edits_made_as_before(text: str, edits: list[Edit]) -> str:
 
 
 @st.composite
-def texts_and_an_edit(draw: st.DrawFn) -> tuple[str, list[Edit]]:
-    text = draw(st.text(alphabet="AB=1 \r\n", max_size=30))
+def an_edit(draw: st.DrawFn) -> Edit:
     line = draw(st.integers(1, 6))
     column = draw(st.integers(1, 8))
     end_line = draw(st.integers(line, 7))
     end_column = draw(st.integers(1 if end_line > line else column, 9))
     new = draw(st.sampled_from(["", "Z", "\n(END)", "; "]))
-    return text, [Edit(Span(line, column, end_line, end_column), new)]
+    return Edit(Span(line, column, end_line, end_column), new)
 
 
-@settings(max_examples=500, deadline=None)
-@given(texts_and_an_edit())
-def test_apply_edits_places_an_edit_as_it_did(case: tuple[str, list[Edit]]) -> None:
-    text, edits = case
+@settings(max_examples=1000, deadline=None)
+@given(st.text(alphabet="AB=1 \r\n", max_size=30), st.lists(an_edit(), max_size=4))
+def test_apply_edits_makes_edits_as_it_did(text: str, edits: list[Edit]) -> None:
+    """Any edits that do not overlap (two may insert at one place)."""
+    def overlap(one: Edit, other: Edit) -> bool:
+        a, b = one.span, other.span
+        return (a.line, a.column) < (b.end_line, b.end_column) \
+            and (b.line, b.column) < (a.end_line, a.end_column)
+
+    assume(not any(overlap(one, other) for index, one in enumerate(edits)
+                   for other in edits[:index]))
     assert apply_edits(text, edits) == edits_made_as_before(text, edits)
+
+
+def test_two_edits_at_one_place_are_made_one_after_the_other() -> None:
+    insert, replace = Edit(Span(1, 1, 1, 1), "Y"), Edit(Span(1, 1, 1, 3), "X")
+    for edits in ([insert, replace], [replace, insert]):
+        assert apply_edits("AB=1", edits) == edits_made_as_before("AB=1", edits)
+    assert apply_edits("AB=1", [replace, insert]) == "YX=1"
+
+
+def compatible_as_before(fixes: list[Fix]) -> list[Fix]:
+    """compatible as it was before it bisected (each fix looked at every kept edit, so a
+    fix a line took time of the square of the lines): the property's reference."""
+    taken: list[tuple[tuple[int, int], tuple[int, int]]] = []
+    kept: list[Fix] = []
+    for one in fixes:
+        spans = [((e.span.line, e.span.column), (e.span.end_line, e.span.end_column))
+                 for e in one.edits]
+        if any((start < t_end and t_start < end) or start == t_start
+               for start, end in spans for t_start, t_end in taken):
+            continue
+        taken += spans
+        kept.append(one)
+    return kept
+
+
+places = st.tuples(st.integers(1, 3), st.integers(1, 4))
+some_fixes = st.lists(st.lists(st.tuples(places, places), min_size=1, max_size=3).map(
+    lambda spans: Fix("f", tuple(Edit(Span(*start, *end), "") for start, end in spans))),
+    max_size=8)
+
+
+@settings(max_examples=1000, deadline=None)
+@given(some_fixes)
+def test_compatible_keeps_the_fixes_it_kept_before(fixes: list[Fix]) -> None:
+    """Any spans, even those that end before they start, and fixes whose edits meet."""
+    assert compatible(fixes) == compatible_as_before(fixes)
 
 
 def test_compatible_drops_a_fix_that_overlaps_or_meets_one_kept_before() -> None:
