@@ -40,7 +40,7 @@ MARKS: dict[str, tuple[str, ...]] = {
     "tests/cli/test_hostile_inputs.py": ("slow",),
     "tests/lsp/test_hostile_transports.py": ("slow",),
     # rl1c studio in a process of its own, stopped by Ctrl-C.
-    "tests/studio/test_command.py::test_it_prints_its_address_serves_there_and_stops_on_ctrl_c":
+    "tests/studio/test_studio_command.py::test_it_prints_its_address_serves_there_and_stops_on_ctrl_c":
         ("slow",),
     "tests/backend/test_reproducible.py": ("slow",),
     # rl1c check's memory per source byte, under tracemalloc in a process of its own.
