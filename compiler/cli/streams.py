@@ -28,8 +28,8 @@ from rl1.compiler.reporting.render import (
     Format,
     diagnostic_blocks,
     exit_status,
-    report,
     use_color,
+    write_report,
 )
 
 from .command import Failure
@@ -144,7 +144,7 @@ def emit(files: list[FileDiagnostics], output_format: Format, color: ColorChoice
     the command prints its own summary); the exit status they call for."""
     stream = sys.stderr if err else sys.stdout
     colored = output_format == "human" and use_color(color, stream)
-    stream.write(report(files, output_format, color=colored, action=action))
+    write_report(stream, files, output_format, color=colored, action=action)
     return exit_status(files)
 
 

@@ -9,9 +9,10 @@ them. Diagnostics stay data until here; nothing else turns them into text.
 
 from __future__ import annotations
 
+import io
 import os
 import unicodedata
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from typing import IO, Any, Literal, NamedTuple
 
 from rl1.compiler.frontend.ast import Span
@@ -64,18 +65,36 @@ def report(
     action: str | None = "check",
 ) -> str:
     """The diagnostics of `files`, in the order given, as one text ending in a newline
-    (empty for people when there is nothing to say). `action` names what failed in the
-    human closing line of each file: "could not check `x.rob`"; None leaves those lines
-    out, for a command that ends with one `summary` of every file."""
-    if output_format == "json":
-        return _json_report(files)
-    if output_format == "sarif":
-        return _sarif_report(files)
-    if output_format == "concise":
-        return "".join(concise_line(file, d) for file in files for d in _ordered(file.diagnostics))
-    rendered = (_HumanRenderer(file, color).render(action) for file in files)
-    # Each diagnostic ends in a blank line; a file's closing line needs one after it.
-    return ("" if action is None else "\n").join(text for text in rendered if text)
+    (empty for people when there is nothing to say): what `write_report` writes."""
+    text = io.StringIO()
+    write_report(text, files, output_format, color=color, action=action)
+    return text.getvalue()
+
+
+def write_report(
+    stream: IO[str],
+    files: Sequence[FileDiagnostics],
+    output_format: Format = "human",
+    *,
+    color: bool = False,
+    action: str | None = "check",
+) -> None:
+    """Writes the diagnostics of `files` on `stream`, in the order given, each as soon as
+    it is rendered, so that a report of a million diagnostics never lies whole in memory
+    (issue 23, item 10). `action` names what failed in the human closing line of each
+    file: "could not check `x.rob`"; None leaves those lines out, for a command that
+    ends with one `summary` of every file."""
+    match output_format:
+        case "json":
+            _write_json(stream, files)
+        case "sarif":
+            _write_sarif(stream, files)
+        case "concise":
+            for file in files:
+                for diagnostic in _ordered(file.diagnostics):
+                    stream.write(concise_line(file, diagnostic))
+        case "human":
+            _write_human(stream, files, color, action)
 
 
 def diagnostic_blocks(file: FileDiagnostics, *, color: bool = False) -> str:
@@ -220,6 +239,24 @@ def excerpt(line: str, first: int, last: int) -> tuple[str, int, int]:
     return "".join(pieces), caret, max(1, cell_of(max(first, last)) - caret)
 
 
+def _write_human(stream: IO[str], files: Sequence[FileDiagnostics], color: bool,
+                 action: str | None) -> None:
+    """Each file's diagnostics, then its closing line (with an `action`), the files
+    apart by a blank line (with an `action`: each diagnostic ends in one, a file's
+    closing line needs one after it). A file with nothing to say writes nothing."""
+    separator = ""
+    for file in files:
+        if not file.diagnostics:
+            continue
+        stream.write(separator)
+        renderer = _HumanRenderer(file, color)
+        for diagnostic in _ordered(file.diagnostics):
+            stream.write(renderer.diagnostic(diagnostic))
+        if action is not None:
+            stream.write(renderer.summary(action))
+            separator = "\n"
+
+
 class _HumanRenderer:
     """The rustc-like text of one file's diagnostics and its closing summary."""
 
@@ -230,13 +267,6 @@ class _HumanRenderer:
 
     def paint(self, text: str, role: str) -> str:
         return f"{_STYLES[role]}{text}{_RESET}" if self.color else text
-
-    def render(self, action: str | None) -> str:
-        blocks = [self.diagnostic(d) for d in _ordered(self.file.diagnostics)]
-        summary = self.summary(action) if action is not None else ""
-        if summary:
-            blocks.append(summary)
-        return "".join(blocks)
 
     def diagnostic(self, diagnostic: Diagnostic) -> str:
         level = diagnostic.severity.value
@@ -327,22 +357,36 @@ def concise_line(file: FileDiagnostics, diagnostic: Diagnostic) -> str:
 # JSON -------------------------------------------------------------------------------
 
 
-def _json_report(files: Sequence[FileDiagnostics]) -> str:
-    items = [
-        {
-            "file": file.name,
-            **_json_span(d.span),
-            "severity": d.severity.value,
-            "code": d.code,
-            "message": d.message,
-            "help": d.help,
-            "fixes": [_json_fix(fix) for fix in d.fixes],
-            "related": [{**_json_span(r.span), "message": r.message} for r in d.related],
-        }
-        for file in files
-        for d in _ordered(file.diagnostics)
-    ]
-    return _json_text(items)
+def _write_json(stream: IO[str], files: Sequence[FileDiagnostics]) -> None:
+    """One JSON array of the diagnostics, each written as it is rendered."""
+    _write_array(stream, (_json_item(file, d) for file in files
+                          for d in _ordered(file.diagnostics)), 0)
+    stream.write("\n")
+
+
+def _json_item(file: FileDiagnostics, d: Diagnostic) -> dict[str, Any]:
+    return {
+        "file": file.name,
+        **_json_span(d.span),
+        "severity": d.severity.value,
+        "code": d.code,
+        "message": d.message,
+        "help": d.help,
+        "fixes": [_json_fix(fix) for fix in d.fixes],
+        "related": [{**_json_span(r.span), "message": r.message} for r in d.related],
+    }
+
+
+def _write_array(stream: IO[str], items: Iterator[object], depth: int) -> None:
+    """The array of `items` as `_json_text` lays it out at nesting `depth` (the array's
+    own), written an item at a time: its text is the same as of the whole list."""
+    inner = "\n" + "  " * (depth + 1)
+    separator = "[" + inner
+    for item in items:
+        stream.write(separator)
+        stream.write(_json_text(item)[:-1].replace("\n", inner))
+        separator = "," + inner
+    stream.write("[]" if separator.startswith("[") else "\n" + "  " * depth + "]")
 
 
 def _json_text(value: object) -> str:
@@ -366,13 +410,14 @@ def _json_fix(fix: Fix) -> dict[str, Any]:
 # SARIF ------------------------------------------------------------------------------
 
 
-def _sarif_report(files: Sequence[FileDiagnostics]) -> str:
+# Where the results array lies in the SARIF log: its text is cut there, to write the
+# results one at a time between the two halves.
+_RESULTS_HOLE = '"results": []\n'
+_RESULTS_DEPTH = 3  # the log, its runs, the run: the results array is at this nesting
+
+
+def _write_sarif(stream: IO[str], files: Sequence[FileDiagnostics]) -> None:
     rule_index = {code: index for index, code in enumerate(CODES)}
-    results = [
-        _sarif_result(file, d, rule_index)
-        for file in files
-        for d in _ordered(file.diagnostics)
-    ]
     log = {
         "$schema": SARIF_SCHEMA,
         "version": "2.1.0",
@@ -383,10 +428,15 @@ def _sarif_report(files: Sequence[FileDiagnostics]) -> str:
                 "rules": [_sarif_rule(code) for code in CODES],
             }},
             "columnKind": "unicodeCodePoints",  # as our Span columns count
-            "results": results,
+            "results": [],
         }],
     }
-    return _json_text(log)
+    head, hole, tail = _json_text(log).rpartition(_RESULTS_HOLE)
+    assert hole, "the results are the last member of the run"
+    stream.write(head + '"results": ')
+    _write_array(stream, (_sarif_result(file, d, rule_index) for file in files
+                          for d in _ordered(file.diagnostics)), _RESULTS_DEPTH)
+    stream.write("\n" + tail)
 
 
 def _sarif_rule(code: str) -> dict[str, Any]:

@@ -360,6 +360,28 @@ def test_a_reader_that_stops_early_ends_the_output_quietly() -> None:
     assert (process.returncode, errors) == (1, b"")  # 0 had the output been read
 
 
+
+@pytest.mark.parametrize("output_format", ["human", "json", "sarif"])
+def test_a_report_streamed_onto_a_closed_pipe_or_a_full_disk_ends_cleanly(
+        tmp_path: Path, output_format: str) -> None:
+    # The report is written a diagnostic at a time (issue 23, item 10): a reader gone
+    # after the first lines, or a disk full in the middle, ends as when it was one write.
+    path = write(tmp_path, "A=1 B=2\n" * 3000)
+    command = [str(Path(sys.executable).with_name("rl1c")), "check", "--format",
+               output_format, path]
+    with subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE) as process:
+        assert process.stdout is not None
+        process.stdout.read(100)
+        process.stdout.close()
+        _, errors = process.communicate()
+    assert (process.returncode, errors) == (1, b"")
+    if not Path("/dev/full").exists():
+        return
+    with open("/dev/full", "wb") as full:
+        ended = subprocess.run(command, stdout=full, stderr=subprocess.PIPE, check=False)
+    assert ended.returncode == 2
+    assert ended.stderr.decode().startswith("rl1c: error: cannot write the output: No space")
+
 # rl1c explain ----------------------------------------------------------------------------
 
 
