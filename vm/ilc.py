@@ -28,7 +28,7 @@ MAGIC = b"RLIC"
 # The newest version this module reads. A writer writes the oldest minor version that
 # holds what the file carries: the source digest came in 1.1, and each instruction's
 # version is in vm/isa.py.
-VERSION_MAJOR, VERSION_MINOR = 1, 2
+VERSION_MAJOR, VERSION_MINOR = 1, 3
 DIGEST_MINOR = 1  # the first minor version with the source digest section
 DIGEST_SIZE = 16  # the first 16 bytes of SHA-256
 

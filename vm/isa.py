@@ -13,6 +13,8 @@ lists for that opcode, so an instruction's length is known from its first byte.
 - ADDR: 2 bytes, an unsigned offset into the code section (an instruction boundary).
 - ARGS: a call's arguments: 1 mask byte (bit i set: argument i is a variable), then
   2 bytes per argument, an IMM or a variable index. Calls with no argument have none.
+  The compact calls of format 1.3 (opcode = the call's | COMPACT_CALL_BIT) take 1 byte
+  per argument: a BYTE or a variable index.
 """
 
 from __future__ import annotations
@@ -41,6 +43,12 @@ class OpInfo:
     builtin: tuple[str, str | None] | None = None  # (mnemonic, selector) for calls
     arity: int = 0  # number of call arguments
     minor: int = 0  # the format minor version that added it (a file using it says so)
+    arg_size: int = 2  # bytes per call argument: 1 in the compact calls
+
+    @property
+    def compact(self) -> bool:
+        """Whether it is a compact call (arguments of a byte each)."""
+        return self.arg_size == 1
 
     @property
     def length(self) -> int:
@@ -49,7 +57,7 @@ class OpInfo:
             if operand in (Operand.VAR, Operand.BYTE):
                 size += 1
             elif operand is Operand.ARGS:
-                size += 1 + 2 * self.arity
+                size += 1 + self.arg_size * self.arity
             else:
                 size += 2
         return size
@@ -80,6 +88,13 @@ STORE_JUMP_IF = {"=": 0x35, ">": 0x36, "<": 0x37}  # store acc, then jump on it
 # 8 by the kinds of the two operands, the operator in the low 3 bits as in the ALU block.
 # An expression's load and first operation in one: `V=a-b` is COMPUTE then STV.
 COMPUTE_VAR_VAR, COMPUTE_VAR_IMM, COMPUTE_RESULT_VAR, COMPUTE_RESULT_IMM = 0x60, 0x68, 0x70, 0x78
+
+# The compact calls (-O2, format 1.3): a call whose constant arguments fit a byte, with a
+# byte an argument; its opcode is the call's with this bit set, so that the C VM clears
+# it to find the call (a call's descriptor, and the opcode its callbacks are given).
+COMPACT_MINOR = 3
+COMPACT_CALL_BIT = 0x80
+COMPACT_SUFFIX = "S"  # MOVS 4, 4: MOV 4, 4 in 4 bytes instead of 6
 
 # The built-in forms, in opcode order from CALL_BASE; END is opcode 0.
 CALL_BASE = 0x40
@@ -150,13 +165,20 @@ def _table() -> dict[int, OpInfo]:
         rows.append(OpInfo(CALL_BASE + index, name, (Operand.ARGS,) if arity else (),
                            form.summary + (" R = result." if form.returns_value else ""),
                            (mnemonic, selector), arity))
+        if arity:
+            rows.append(OpInfo(COMPACT_CALL_BIT | (CALL_BASE + index), name + COMPACT_SUFFIX,
+                               (Operand.ARGS,), form.summary
+                               + (" R = result." if form.returns_value else "")
+                               + " Arguments of a byte.",
+                               (mnemonic, selector), arity, COMPACT_MINOR, arg_size=1))
     return {row.opcode: row for row in rows}
 
 
 OPCODES: dict[int, OpInfo] = _table()
 BY_NAME: dict[str, OpInfo] = {info.name: info for info in OPCODES.values()}
 BY_FORM: dict[tuple[str, str | None], OpInfo] = {
-    info.builtin: info for info in OPCODES.values() if info.builtin is not None
+    info.builtin: info for info in OPCODES.values()
+    if info.builtin is not None and not info.compact
 }
 
 
@@ -200,6 +222,10 @@ class DecodeError(Exception):
         self.offset = offset
 
 
+# How a call argument is encoded, by (bytes an argument, whether it is a variable).
+_ARG_FORMATS = {(2, True): "<H", (2, False): "<h", (1, True): "<B", (1, False): "<b"}
+
+
 def decode_at(code: bytes, offset: int) -> Instruction:
     """Decode the instruction at `offset`; DecodeError for an unknown opcode or one cut
     off by the end of the code. Operand values are not range-checked here."""
@@ -230,9 +256,9 @@ def decode_at(code: bytes, offset: int) -> Instruction:
             position += 1
             for index in range(info.arity):
                 is_var = bool(mask >> index & 1)
-                fmt = "<H" if is_var else "<h"
+                fmt = _ARG_FORMATS[info.arg_size, is_var]
                 args.append(Arg(is_var, struct.unpack_from(fmt, code, position)[0]))
-                position += 2
+                position += info.arg_size
     return Instruction(offset, info, tuple(operands), tuple(args))
 
 
@@ -253,5 +279,5 @@ def encode(info: OpInfo, operands: tuple[int, ...] = (), args: tuple[Arg, ...] =
             mask = sum(1 << index for index, arg in enumerate(args) if arg.is_var)
             out.append(mask)
             for arg in args:
-                out += struct.pack("<H" if arg.is_var else "<h", arg.value)
+                out += struct.pack(_ARG_FORMATS[info.arg_size, arg.is_var], arg.value)
     return bytes(out)

@@ -50,7 +50,8 @@ def operands(info: isa.OpInfo) -> str:
     if isa.Operand.ARGS in info.operands:
         form = info.form
         assert form is not None
-        return "mask, " + ", ".join(param.name for param in form.params)
+        names = ", ".join(param.name for param in form.params)
+        return f"mask, {names}" + (" (a byte each)" if info.compact else "")
     return ", ".join(_OPERAND_TEXT[operand] for operand in info.operands) or "—"
 
 
@@ -61,6 +62,9 @@ def serves(info: isa.OpInfo) -> str:
         assert form is not None
         words = " ".join(filter(None, [mnemonic, selector,
                                        ",".join(param.name for param in form.params)]))
+        if info.compact:
+            return (f"`({words})`, constants in -128..127 "
+                    f"(-O2; format 1.{isa.COMPACT_MINOR})")
         return f"`({words})`"
     if info.name in _SERVES:
         return _SERVES[info.name]
@@ -103,7 +107,8 @@ _ANY = (-32768, 32767)
 def calls() -> list[isa.OpInfo]:
     """The built-in calls, in opcode order from isa.CALL_BASE."""
     return sorted((info for info in isa.OPCODES.values() if info.opcode >= isa.CALL_BASE
-                   and info.builtin is not None), key=lambda info: info.opcode)
+                   and info.builtin is not None and not info.compact),
+                  key=lambda info: info.opcode)
 
 
 def _form(info: isa.OpInfo) -> Form:
@@ -213,8 +218,7 @@ def render_c() -> str:
     each call's descriptor, between C_BEGIN and C_END."""
     opcodes = [f"    RL1_OP_{info.name} = 0x{info.opcode:02X},"
                for info in sorted(isa.OPCODES.values(), key=lambda i: i.opcode)]
-    last_call = max(info.opcode for info in isa.OPCODES.values()
-                    if info.builtin is not None)
+    last_call = calls()[-1].opcode
     features = [f"    RL1_FEATURE_{feature.name} = 0x{1 << feature.value:02X},"
                 for feature in Feature]
     known = sum(1 << feature.value for feature in Feature)
@@ -229,6 +233,10 @@ def render_c() -> str:
         f"    RL1_OP_FIRST_CALL = 0x{isa.CALL_BASE:02X},",
         f"    RL1_OP_LAST_CALL = 0x{last_call:02X}",
         "} rl1_opcode;",
+        "",
+        f"/* A compact call (format 1.{isa.COMPACT_MINOR}, a byte an argument) is its call's "
+        "opcode with this bit. */",
+        f"#define RL1_COMPACT_CALL_BIT 0x{isa.COMPACT_CALL_BIT:02X}u",
         "",
         "/* The device features (spec/ilc.md 4.3): bits of rl1_program's `features`. */",
         "typedef enum rl1_feature {",

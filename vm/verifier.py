@@ -124,7 +124,7 @@ class _CodeVerifier:
                                            f"arguments beyond its {info.arity}",
                             Refusal.BAD_MASK)
         for index, (arg, param) in enumerate(zip(instruction.args, form.params, strict=True)):
-            position = mask_position + 1 + 2 * index
+            position = mask_position + 1 + info.arg_size * index
             if arg.is_var:
                 self.check_variable(position, arg.value, f"{info.name} argument {param.name}")
             elif not param.low <= arg.value <= param.high:

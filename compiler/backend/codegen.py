@@ -149,7 +149,10 @@ def _instruction(instruction: ir.Instruction) -> _MachineOp:
         return _compute(instruction)
     args = tuple(isa.Arg(True, VARIABLE_INDEX[arg.name]) if isinstance(arg, ir.Var)
                  else isa.Arg(False, arg.value) for arg in instruction.args)
-    return _MachineOp(isa.BY_FORM[instruction.mnemonic, instruction.selector], (), args, line)
+    call = isa.BY_FORM[instruction.mnemonic, instruction.selector]
+    if instruction.compact:
+        call = isa.OPCODES[call.opcode | isa.COMPACT_CALL_BIT]
+    return _MachineOp(call, (), args, line)
 
 
 def _compute(compute: ir.Compute) -> _MachineOp:

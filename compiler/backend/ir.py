@@ -124,12 +124,14 @@ class StepVar:
 
 @dataclass(frozen=True, slots=True)
 class Call:
-    """A built-in call other than END; one that returns a value sets R."""
+    """A built-in call other than END; one that returns a value sets R. `compact` (-O2,
+    once its constants fit a byte each) is written as the compact call of format 1.3."""
 
     mnemonic: str
     selector: str | None
     args: tuple[Argument, ...]
     line: int
+    compact: bool = False
 
     @property
     def form(self) -> Form:
@@ -145,7 +147,7 @@ class Call:
 
     def __str__(self) -> str:
         words = [self.mnemonic, *([self.selector] if self.selector else [])]
-        text = "call " + " ".join(words)
+        text = ("compact call " if self.compact else "call ") + " ".join(words)
         return text + (" " + ", ".join(map(str, self.args)) if self.args else "")
 
 
@@ -414,6 +416,8 @@ def _call_problems(call: Call) -> Iterator[str]:
     for arg, param in zip(call.args, form.params, strict=True):
         if isinstance(arg, Imm) and not param.low <= arg.value <= param.high:
             yield f"line {call.line}: `{call}`: {param.name} must lie in {param.low}..{param.high}"
+        if call.compact and isinstance(arg, Imm) and not -0x80 <= arg.value <= 0x7F:
+            yield f"line {call.line}: `{call}`: {param.name} does not fit a byte"
 
 
 # Printing ---------------------------------------------------------------------------

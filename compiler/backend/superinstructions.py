@@ -17,9 +17,13 @@ fused jump is a jump, where the budget is checked and an event taken); no path l
   operands in one instruction. (A constant first is folded by -O1 or stays: `0-M`.)
   A load whose value is also stored before the operation (`D=(ULT A); E=D-G`) becomes
   the moves, then the load-and-operate: one instruction fewer again.
+- A call whose constant arguments each fit a byte (`MOV 4,4`, `TRC 30`) becomes a compact
+  call (format 1.3): a byte an argument instead of two.
 """
 
 from __future__ import annotations
+
+from dataclasses import replace
 
 from . import flow, ir
 
@@ -27,8 +31,17 @@ from . import flow, ir
 def fuse(program: ir.Program) -> ir.Program:
     for block in program:
         _fuse_branch(block)
-        block.instructions = _computes(_moves(block.instructions, block.terminator))
+        block.instructions = [_compact(instruction) for instruction in
+                              _computes(_moves(block.instructions, block.terminator))]
     return program
+
+
+def _compact(instruction: ir.Instruction) -> ir.Instruction:
+    if isinstance(instruction, ir.Call) and instruction.args and all(
+            not isinstance(arg, ir.Imm) or -0x80 <= arg.value <= 0x7F
+            for arg in instruction.args):
+        return replace(instruction, compact=True)
+    return instruction
 
 
 def _reloadable(load: ir.Load, stores: list[ir.Instruction],

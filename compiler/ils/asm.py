@@ -298,8 +298,9 @@ class _Assembler:
         for operand in info.operands:
             if operand is isa.Operand.ARGS:
                 arg_tokens = [next(operand_tokens) for _ in range(info.arity)]
-                args = tuple(self.argument(arg_token) for arg_token in arg_tokens)
-                self.origins += [(position + 1 + 2 * index, number, arg_token.column)
+                args = tuple(self.argument(arg_token, info) for arg_token in arg_tokens)
+                self.origins += [(position + 1 + info.arg_size * index, number,
+                                  arg_token.column)
                                  for index, arg_token in enumerate(arg_tokens)]
                 continue
             operand_token = next(operand_tokens)
@@ -345,9 +346,11 @@ class _Assembler:
         return tokens
 
     @staticmethod
-    def argument(token: _Token) -> isa.Arg:
+    def argument(token: _Token, call: isa.OpInfo) -> isa.Arg:
         if token.kind == "name":
             return isa.Arg(True, _variable(token))
+        if call.compact:
+            return isa.Arg(False, _number(token, -0x80, 0x7F, "byte constant"))
         return isa.Arg(False, _number(token, -0x8000, 0x7FFF, "constant"))
 
     def resolve(self, token: _Token) -> int:

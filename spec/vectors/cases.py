@@ -59,7 +59,7 @@ class Case:
 def all_cases() -> list[Case]:
     return [*arithmetic(), *shifts(), *control(), *calls(), *tracing(), *events(), *faults(),
             *sample(), *intermediate(),
-            *fused()]
+            *fused(), *compact()]
 
 
 def _straight(group: str, name: str, covers: str, program: Straight) -> Case:
@@ -276,14 +276,15 @@ def _safe(params: tuple[Param, ...], values: list[int]) -> bool:
     return not (len(params) == 3 and values[0] + values[1] == 0 and values[2] != 0)
 
 
-def _form_with_arguments(form: tuple[str, str | None]) -> Case:
-    """Both ends of every parameter's range, as constants, as variables, and mixed."""
+def _form_with_arguments(form: tuple[str, str | None], compact: bool = False) -> Case:
+    """Both ends of every parameter's range, as constants, as variables, and mixed;
+    `compact`: of the range's part that fits a byte, at -O2 (the compact calls)."""
     spec = BUILTINS[form[0]].form(form[1])
     assert spec is not None
     params = spec.params
     names = "abc"[:len(params)]
-    lows = [param.low for param in params]
-    highs = [param.high for param in params]
+    lows = [max(param.low, -0x80) if compact else param.low for param in params]
+    highs = [min(param.high, 0x7F) if compact else param.high for param in params]
     assert _safe(params, lows) and _safe(params, highs)
     variables: dict[str, int] = {}
     lines: list[str] = []
@@ -306,6 +307,14 @@ def _form_with_arguments(form: tuple[str, str | None]) -> Case:
         call(highs, [True] + [False] * (len(params) - 1))
         call(lows, [False] + [True] * (len(params) - 1))
     label = "-".join(filter(None, form)).lower()
+    if compact:
+        return Case("compact", f"compact-call-{label}",
+                    f"{_call(form, list(names))} as a compact call (-O2, format 1.3): both "
+                    "ends of each range within -128..127, as constants, as variables and "
+                    "mixed", "".join(line + "\n" for line in lines),
+                    {name: value for name, value in variables.items() if value},
+                    trace=tuple(calls), sensors=REPEAT if form == ("INP", None) else {},
+                    level=2)
     return Case("calls", f"call-{label}", f"{_call(form, list(names))} with both ends of each "
                 "range, as constants, as variables and mixed",
                 "".join(line + "\n" for line in lines),
@@ -316,7 +325,7 @@ def _form_with_arguments(form: tuple[str, str | None]) -> Case:
 def calls() -> Iterator[Case]:
     group = "calls"
     for info in sorted(isa.OPCODES.values(), key=lambda info: info.opcode):
-        if info.builtin is not None and info.arity:
+        if info.builtin is not None and info.arity and not info.compact:
             yield _form_with_arguments(info.builtin)
     yield Case(group, "calls-without-arguments",
                "FRE, HLD, ORG, KYC, CAM Z, CAM U, CAM D; the built-ins that wait take "
@@ -559,7 +568,7 @@ def _in_range(param: Param) -> int:
 def _range_faults() -> Iterator[Case]:
     for info in sorted(isa.OPCODES.values(), key=lambda info: info.opcode):
         spec = info.form
-        if info.builtin is None or spec is None:
+        if info.builtin is None or spec is None or info.compact:
             continue
         for index, param in enumerate(spec.params):
             if (param.low, param.high) == (-32768, 32767):
@@ -793,3 +802,67 @@ def fused() -> Iterator[Case]:
                 "O": 1200, "P": 75, "Q": 103, "R": 97, "S": 0, "T": 103, "U": 103, "V": 800,
                 "W": 12, "X": 105, "Y": 95, "Z": 4, "a": 102, "b": 98, "c": 400, "d": 25},
                {"ULT A": [300], "ULT B": [3], "ULT C": [100] * 14}, level=2)
+
+
+# --- compact: the compact calls of format 1.3, as -O2 compiles them ------------------------
+
+
+def compact() -> Iterator[Case]:
+    for info in sorted(isa.OPCODES.values(), key=lambda info: info.opcode):
+        if info.compact:
+            assert info.builtin is not None
+            yield _form_with_arguments(info.builtin, compact=True)
+            yield _compact_with_variables(info)
+            yield from _compact_range_faults(info)
+
+
+def _compact_range_faults(info: isa.OpInfo) -> Iterator[Case]:
+    """A compact call's variable argument just out of its range, each side (intermediate
+    code, the others in range)."""
+    form = info.form
+    assert form is not None and info.builtin is not None
+    names = "abc"[:info.arity]
+    label = "-".join(filter(None, info.builtin)).lower()
+    for index, param in enumerate(form.params):
+        if (param.low, param.high) == (-32768, 32767):
+            continue  # no 16-bit value is out of this range
+        for side, bad in (("below", param.low - 1), ("above", param.high + 1)):
+            values = [_in_range(other) for other in form.params]
+            values[index] = bad
+            stores = "".join(f"  LDI {value}\n  STV {name}\n"
+                             for name, value in zip(names, values, strict=True))
+            yield Case("compact", f"compact-range-{label}-{param.name}-{side}",
+                       f"{info.name}'s argument {param.name} {side} {param.low}..{param.high} "
+                       f"(the value {bad} in a variable; intermediate code)",
+                       stores + f"  {info.name} {', '.join(names)}\n",
+                       {name: value for name, value in zip(names, values, strict=True)
+                        if value},
+                       status="argument-range", fault_line=1, language="ils")
+
+
+def _compact_with_variables(info: isa.OpInfo) -> Case:
+    """A compact call on variables only, then mixed, written as intermediate code: -O2
+    knows the constants that RL/I assigns, and compiles them into the call."""
+    form = info.form
+    assert form is not None and info.builtin is not None
+    names = "abc"[:info.arity]
+    ends = ([max(param.low, -0x80) for param in form.params],
+            [min(param.high, 0x7F) for param in form.params])
+    lines: list[str] = []
+    calls: list[TraceItem] = []
+    for values in ends:
+        lines += [f"  MOVB {name}, {value}" for name, value in zip(names, values, strict=True)]
+        lines.append(f"  {info.name} {', '.join(names)}")
+        calls.append((None, " ".join(filter(None, info.builtin)), tuple(values)))
+    mixed = [ends[0][0], *ends[1][1:]]  # the first a constant, the others variables
+    if _safe(form.params, mixed):
+        lines.append(f"  {info.name} {', '.join([str(mixed[0]), *names[1:]])}")
+        calls.append((None, calls[-1][1], tuple(mixed)))
+    label = "-".join(filter(None, info.builtin)).lower()
+    return Case("compact", f"compact-variables-{label}",
+                f"{info.name} on variables at both ends of each range within -128..127, "
+                "then a constant and variables (intermediate code)",
+                "".join(line + "\n" for line in lines),
+                {name: value for name, value in zip(names, ends[1], strict=True) if value},
+                trace=tuple(calls), sensors=REPEAT if info.builtin == ("INP", None) else {},
+                language="ils")

@@ -101,7 +101,7 @@ def refused() -> list[FileCase]:
         FileCase("size-overflow", "debug_size so large that header_size + code_size + 10 + "
                  "debug_size wraps a u32 to 30, inside a newer minor version's file: "
                  "truncated, not accepted",
-                 ilc_file(minor=3, sizes={"debug": 2**32 - 46 + 30}), 6, len(BASE)),
+                 ilc_file(minor=4, sizes={"debug": 2**32 - 46 + 30}), 6, len(BASE)),
         FileCase("digest-truncated", "a version 1.1 file whose source digest is cut short",
                  ilc_file(minor=1, trailing=DIGEST[:10]), 6, len(BASE) + 10),
         FileCase("extra-byte", "a byte after the last section of a 1.0 file",
@@ -141,6 +141,19 @@ def refused() -> list[FileCase]:
                  ilc_file(bytes.fromhex("07000100"), debug=b"", minor=1), 13, 24),
         FileCase("fused-variable", "MOVV whose second variable is 53, in a 1.2 file",
                  ilc_file(bytes.fromhex("07003500"), debug=b"", minor=2), 15, 26),
+        FileCase("newer-compact-call", "MOVS, a compact call of version 1.3, in a 1.2 file",
+                 ilc_file(bytes.fromhex("c40004fc00"), minor=2, debug=b""), 13, 24),
+        FileCase("compact-call-without-arguments", "0xC0, FRE's opcode with the compact "
+                 "call's bit: FRE has no arguments, so no compact call",
+                 ilc_file(bytes.fromhex("c000"), minor=3, debug=b""), 13, 24),
+        FileCase("compact-variable", "MOVS whose second argument names variable 53",
+                 ilc_file(bytes.fromhex("c4020435"), minor=3, debug=b""), 15, 27),
+        FileCase("compact-mask", "MOVS's mask marks a third argument",
+                 ilc_file(bytes.fromhex("c4040404"), minor=3, debug=b""), 15, 25),
+        FileCase("compact-range", "MOVS with a constant argument of -13 (l is -12..12)",
+                 ilc_file(bytes.fromhex("c400f304"), minor=3, debug=b""), 15, 26),
+        FileCase("compact-cut", "MOVS cut off by the end of the code: it is 4 bytes",
+                 ilc_file(bytes.fromhex("c40004"), minor=3, debug=b""), 14, 24),
         FileCase("cut-instruction", "LDI cut off by the end of the code", _code(b"\x02\x05"),
                  14, 24),
         FileCase("variable-operand", "STV with variable index 53", _code(b"\x04\x35"), 15, 25),
@@ -184,10 +197,14 @@ def accepted() -> list[FileCase]:
                                             trailing=DIGEST)),
         FileCase("version-1.2-stripped", "minor version 2 without a debug section",
                  ilc_file(FUSED, features=0, minor=2, debug=b"")),
-        FileCase("newer-minor-header", "minor version 3 with 4 header bytes 1.2 does not "
-                 "know", ilc_file(minor=3, header_extra=b"\1\2\3\4", trailing=DIGEST)),
-        FileCase("newer-minor-trailing", "minor version 3 with a section after the source "
-                 "digest", ilc_file(minor=3, trailing=DIGEST + b"\xaa\xbb\xcc")),
+        FileCase("version-1.3", "minor version 3: compact calls, a variable and a constant "
+                 "of -12 as MOVS's arguments, then a wide MOV",
+                 ilc_file(bytes.fromhex("c40100f4" "440000000000" "00"), minor=3,
+                          debug=b"")),
+        FileCase("newer-minor-header", "minor version 4 with 4 header bytes 1.3 does not "
+                 "know", ilc_file(minor=4, header_extra=b"\1\2\3\4", trailing=DIGEST)),
+        FileCase("newer-minor-trailing", "minor version 4 with a section after the source "
+                 "digest", ilc_file(minor=4, trailing=DIGEST + b"\xaa\xbb\xcc")),
         FileCase("optional-flag", "optional flag bits 8 and 15", ilc_file(flags=0x8100)),
         FileCase("sparse-line-map", "one line entry for four instructions",
                  ilc_file(debug=debug_section(count=1, entries=b"\x00\x01"))),

@@ -97,7 +97,9 @@ def compile_both(case: Case) -> tuple[bytes, bytes]:
     written by hand, the assembled file and the same stripped."""
     if case.language == "ils":
         try:
-            full = assemble(f".source {json.dumps(source_name(case))}\n.line 1\n"
+            # the digest of the text itself, which a file of format 1.1 or newer carries
+            digest = f'.digest "{ilc.source_digest(case.source).hex()}"\n'
+            full = assemble(f".source {json.dumps(source_name(case))}\n{digest}.line 1\n"
                             + case.source)
         except AsmError as error:
             raise VectorError(f"{case.name}: the .ils text does not assemble: {error}") from None

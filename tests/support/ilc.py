@@ -10,7 +10,7 @@ import zlib
 from hypothesis import strategies as st
 
 from rl1.vm import ilc, isa
-from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES, Feature
+from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES, Feature, Param
 
 
 def with_crc(data: bytes | bytearray) -> bytes:
@@ -47,10 +47,17 @@ def instruction_bytes(draw: st.DrawFn, info: isa.OpInfo, offsets: list[int]) -> 
     params = form.params if form is not None else ()
     args = tuple(
         isa.Arg(True, draw(variable_indexes)) if draw(st.booleans())
-        else isa.Arg(False, draw(st.integers(param.low, param.high)))
+        else isa.Arg(False, draw(st.integers(*_constant_range(param, info))))
         for param in params
     )
     return isa.encode(info, tuple(operands), args)
+
+
+def _constant_range(param: Param, call: isa.OpInfo) -> tuple[int, int]:
+    """A constant argument's range: its parameter's, within a byte in a compact call."""
+    if call.compact:
+        return max(param.low, -0x80), min(param.high, 0x7F)
+    return param.low, param.high
 
 
 @st.composite

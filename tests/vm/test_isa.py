@@ -28,7 +28,8 @@ def instructions(draw: st.DrawFn) -> tuple[isa.OpInfo, tuple[int, ...], tuple[is
             operands.append(draw(st.integers(0, 65535)))
     args = tuple(
         isa.Arg(True, draw(st.integers(0, 52))) if draw(st.booleans())
-        else isa.Arg(False, draw(st.integers(-32768, 32767)))
+        else isa.Arg(False, draw(st.integers(-128, 127) if info.compact
+                                 else st.integers(-32768, 32767)))
         for _ in range(info.arity)
     )
     return info, tuple(operands), args

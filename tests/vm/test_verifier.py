@@ -122,18 +122,21 @@ def test_constant_arguments_are_checked_against_the_builtin_table(
 ) -> None:
     assert info.form is not None
     params = info.form.params
+    # what a constant argument can hold: 16 bits, or a byte in a compact call
+    lowest, highest = (-0x80, 0x7F) if info.compact else (-0x8000, 0x7FFF)
 
     def call_with(value: int) -> bytes:
-        args = tuple(const(value if i == index else p.low) for i, p in enumerate(params))
+        args = tuple(const(value if i == index else max(p.low, lowest))
+                     for i, p in enumerate(params))
         return file_of(isa.encode(info, (), args))
 
     low, high = params[index].low, params[index].high
-    verify(call_with(low))
-    verify(call_with(high))
+    verify(call_with(max(low, lowest)))
+    verify(call_with(min(high, highest)))
     for outside in (low - 1, high + 1):
-        if -0x8000 <= outside <= 0x7FFF:  # a range as wide as 16 bits has no outside
+        if lowest <= outside <= highest:  # a range as wide as the field has no outside
             error = refusal(call_with(outside))
-            assert error.offset == CODE + 2 + 2 * index
+            assert error.offset == CODE + 2 + info.arg_size * index
             assert f"= {outside} is out of range {low}..{high}" in error.message
 
 

@@ -78,23 +78,25 @@ static bool broken_in(const rl1_vm *vm)
 }
 
 /* The `arity` (1 to 3) arguments of call `op` from its operands at `at` (the mask, then
- * 2 bytes an argument) into `args`, left to right: false at the first variable out of
- * its parameter's range (section 9, step 2). Called once, so inlined: kept out of line
- * (gcc's noinline) it costs Cortex-M3 flash that the 4 KB goal has no room for. */
-static bool arguments(const int16_t *V, uint8_t op, uint8_t arity, const uint8_t *at,
-                      int16_t *args)
+ * `width` bytes an argument: 2, or 1 in a compact call) into `args`, left to right; the
+ * end of the call's operands, or NULL at the first variable out of its parameter's
+ * range (section 9, step 2). Called once, so inlined: kept out of line (gcc's noinline)
+ * it costs Cortex-M3 flash that the 4 KB goal has no room for. */
+static const uint8_t *arguments(const int16_t *V, uint8_t op, uint8_t arity, uint8_t width,
+                                const uint8_t *at, int16_t *args)
 {
     const int16_t *range = &rl1_param_ranges[2u * rl1_flash_byte(
         &rl1_call_first[op - RL1_OP_FIRST_CALL])];
-    const uint8_t *const end = at + 2u * arity;
+    const uint8_t *const end = at + width * arity;
     uint8_t mask = RL1_BYTE(at);
     do { /* arity is 1 at least */
-        uint16_t field = RL1_U16(at + 1u);
-        at += 2;
+        /* a variable's index, or a constant */
+        int16_t field = width == 1u ? (int8_t)RL1_BYTE(at + 1u) : (int16_t)RL1_U16(at + 1u);
+        at += width;
         if (mask & 1u) {
             int16_t value = V[field];
             if (value < rl1_flash_i16(range) || value > rl1_flash_i16(range + 1)) {
-                return false;
+                return NULL;
             }
             *args = value;
         } else {
@@ -104,7 +106,7 @@ static bool arguments(const int16_t *V, uint8_t op, uint8_t arity, const uint8_t
         range += 2;
         mask >>= 1;
     } while (at != end);
-    return true;
+    return end + 1;
 }
 
 /* Takes what call `op` (descriptor `call`, READS), finished, read: false, writing
@@ -199,7 +201,8 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
                         uint16_t at)
 {
     rl1_reading out;
-    uint8_t op = vm->waiting, call = rl1_call_descriptor(op);
+    uint8_t op = (uint8_t)(vm->waiting & ~RL1_COMPACT_CALL_BIT); /* as in the code */
+    uint8_t call = rl1_call_descriptor(op);
     rl1_status status;
     rl1_fault kind;
     clear_reading(&out);
@@ -337,7 +340,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
     /* Each valid opcode's case (the verifier refuses the others). The empty asm makes
      * the table's address opaque, so that it stays in a register rather than being
      * remade in each case's jump, which would then be too long to keep in the case. */
-    __extension__ static const void *const table[128] = {
+    __extension__ static const void *const table[256] = {
 #define TARGET(o) [o] = &&op_##o
 #define TARGETS7(o0, o1, o2, o3, o4, o5, o6)                                              \
         TARGET(o0), TARGET(o1), TARGET(o2), TARGET(o3), TARGET(o4), TARGET(o5), TARGET(o6)
@@ -353,6 +356,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
         TARGET(RL1_OP_JMP), TARGET(RL1_OP_JZ), TARGET(RL1_OP_JGT), TARGET(RL1_OP_JLT),
         TARGET(RL1_OP_DJGT), TARGET(RL1_OP_SJZ), TARGET(RL1_OP_SJGT), TARGET(RL1_OP_SJLT),
         [RL1_OP_FIRST_CALL ... RL1_OP_LAST_CALL] = &&op_call,
+        [RL1_OP_MVIS ... RL1_OP_FZOS] = &&op_call, /* the compact calls */
         TARGETS7(RL1_OP_ADDVV, RL1_OP_SUBVV, RL1_OP_ANDVV, RL1_OP_ORVV, RL1_OP_XORVV,
                  RL1_OP_SHLVV, RL1_OP_SHRVV),
         TARGETS7(RL1_OP_ADDVI, RL1_OP_SUBVI, RL1_OP_ANDVI, RL1_OP_ORVI, RL1_OP_XORVI,
@@ -385,7 +389,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
     const int16_t *given; /* args, or NULL for a call without arguments */
     rl1_reading out;
     rl1_status status;
-    uint8_t op, call, arity;
+    uint8_t op, call, arity, width;
 #ifdef RL1_COMPACT
     uint16_t operand;
 #endif
@@ -463,6 +467,10 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
         case RL1_OP_CAMZ: case RL1_OP_CAMU: case RL1_OP_CAMD: case RL1_OP_CAMA: case RL1_OP_CAMP:
         case RL1_OP_CAMR: case RL1_OP_ULTA: case RL1_OP_ULTB: case RL1_OP_ULTC: case RL1_OP_ULTD:
         case RL1_OP_LMP: case RL1_OP_INP: case RL1_OP_OUT: case RL1_OP_FZO: case RL1_OP_FZI:
+        case RL1_OP_MVIS: case RL1_OP_MOVS: case RL1_OP_STRS: case RL1_OP_STLS:
+        case RL1_OP_STXS: case RL1_OP_ROTS: case RL1_OP_TRCS: case RL1_OP_TIMS:
+        case RL1_OP_SCNS: case RL1_OP_CAMAS: case RL1_OP_CAMPS: case RL1_OP_LMPS:
+        case RL1_OP_INPS: case RL1_OP_OUTS: case RL1_OP_FZOS: /* the compact calls (1.3) */
             COUNTED(op_call)
             /* A call (section 9, steps 2-6), its descriptor telling all that differs. */
             if (left < over_below) {
@@ -470,16 +478,20 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
                 break;
             }
             op = RL1_BYTE(ip); /* not set by a threaded jump */
+            /* a compact call (format 1.3) is its call with a byte an argument: the
+             * descriptor and the callbacks see the call's own opcode */
+            width = (op & RL1_COMPACT_CALL_BIT) ? 1u : 2u;
+            op &= (uint8_t)~RL1_COMPACT_CALL_BIT;
             call = rl1_call_descriptor(op);
             arity = call & RL1_CALL_ARITY;
             next = ip + 1;
             given = NULL;
             if (arity) {
-                if (!arguments(V, op, arity, next, args)) {
+                next = arguments(V, op, arity, width, next, args);
+                if (next == NULL) {
                     kind = RL1_FAULT_ARGUMENT_RANGE;
                     break;
                 }
-                next += 1u + 2u * arity;
                 given = args;
             }
             /* pc past the call while its callbacks run: the line of the call under way is
@@ -495,7 +507,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
                 }
                 status = hw->poll(hw->ctx, &out);
                 if (status == RL1_BUSY && !broken_in(vm)) {
-                    vm->waiting = op;
+                    vm->waiting = RL1_BYTE(ip); /* as in the code: a compact call's too */
                     vm->acc = (int16_t)acc;
                     vm->executed = before + (n - left);
                     return RL1_WAITING;
@@ -566,6 +578,7 @@ static rl1_state step(rl1_vm *vm, const rl1_program *program, const rl1_hardware
                       uint32_t n)
 {
     uint16_t at;
+    uint8_t shape;
     if (!vm->begun) {
         uint8_t posted = vm->mailbox.posted;
         vm->begun = 1;
@@ -577,8 +590,9 @@ static rl1_state step(rl1_vm *vm, const rl1_program *program, const rl1_hardware
         }
     }
     /* the instruction at hand: the call in progress (pc is past it), or the next */
-    at = vm->waiting ? (uint16_t)(vm->pc - rl1_call_length(rl1_call_arity(vm->waiting)))
-                     : vm->pc;
+    at = vm->waiting
+         ? (uint16_t)(vm->pc - rl1_op_length(vm->waiting, program->minor, &shape))
+         : vm->pc;
     if (abort_pending(vm)) {
         return fault(vm, hw, RL1_FAULT_ABORTED, at, false);
     }

@@ -129,9 +129,27 @@ typedef enum rl1_opcode {
     RL1_OP_XORRI = 0x7C,
     RL1_OP_SHLRI = 0x7D,
     RL1_OP_SHRRI = 0x7E,
+    RL1_OP_MVIS = 0xC3,
+    RL1_OP_MOVS = 0xC4,
+    RL1_OP_STRS = 0xC5,
+    RL1_OP_STLS = 0xC6,
+    RL1_OP_STXS = 0xC7,
+    RL1_OP_ROTS = 0xC8,
+    RL1_OP_TRCS = 0xC9,
+    RL1_OP_TIMS = 0xCA,
+    RL1_OP_SCNS = 0xCD,
+    RL1_OP_CAMAS = 0xD2,
+    RL1_OP_CAMPS = 0xD3,
+    RL1_OP_LMPS = 0xD9,
+    RL1_OP_INPS = 0xDA,
+    RL1_OP_OUTS = 0xDB,
+    RL1_OP_FZOS = 0xDC,
     RL1_OP_FIRST_CALL = 0x40,
     RL1_OP_LAST_CALL = 0x5D
 } rl1_opcode;
+
+/* A compact call (format 1.3, a byte an argument) is its call's opcode with this bit. */
+#define RL1_COMPACT_CALL_BIT 0x80u
 
 /* The device features (spec/ilc.md 4.3): bits of rl1_program's `features`. */
 typedef enum rl1_feature {

@@ -21,7 +21,8 @@
 #define DIGEST_SIZE 16u
 #define DIGEST_MINOR 1u      /* the first minor version with a source digest */
 #define FUSED_MINOR 2u       /* the superinstructions, MOVV ... SJLT and ADDVV ... SHRRI, came in 1.2 */
-#define KNOWN_MINOR 2u       /* the newest minor version this reader knows */
+#define COMPACT_MINOR 3u     /* the compact calls, MVIS ... FZOS, came in 1.3 */
+#define KNOWN_MINOR 3u       /* the newest minor version this reader knows */
 #define REQUIRED_FLAGS 0x00FFu
 #define VARIABLES 53u
 #define MAX_U16 0xFFFFu
@@ -102,49 +103,33 @@ static uint32_t file_crc(const loader *ld)
 #define VAR_IMM RL1_SHAPE_VAR_IMM
 #define ARGS RL1_SHAPE_ARGS
 
+/* Four nibbles, the first lowest. */
+#define FOUR(a, b, c, d) ((a) | (b) << 4 | (c) << 8 | (unsigned)(d) << 12)
+
 /* The operands of `op`, and 0 bytes for an opcode the file's minor version does not
  * define (a superinstruction in a 1.0 or 1.1 file is unknown there). */
 uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape)
 {
+    uint8_t width = 2u; /* bytes a call's argument */
     *shape = NONE;
     if (minor >= FUSED_MINOR) {
-        if (op == RL1_OP_MOVV) {
-            *shape = VAR_VAR;
-            return 3;
-        }
-        if (op == RL1_OP_MOVI) {
-            *shape = VAR_IMM;
-            return 4;
-        }
-        if (op == RL1_OP_MOVR) {
-            *shape = VAR;
-            return 2;
-        }
-        if (op == RL1_OP_MOVB) {
-            *shape = VAR; /* a variable, then a signed byte, which needs no check */
-            return 3;
+        /* Four kinds in a row, their shapes and lengths a nibble each in a constant
+         * (no table: on AVR it would be copied to RAM). MOVV, MOVI, MOVR, MOVB: */
+        if (op >= RL1_OP_MOVV && op <= RL1_OP_MOVB) {
+            unsigned nibble = 4u * (unsigned)(op - RL1_OP_MOVV);
+            *shape = (uint8_t)(FOUR(VAR_VAR, VAR_IMM, VAR, VAR) >> nibble & 15u);
+            return (uint8_t)(FOUR(3u, 4u, 2u, 3u) >> nibble & 15u);
         }
         if (op >= RL1_OP_DJGT && op <= RL1_OP_SJLT) {
             *shape = VAR_ADDR; /* DJGT, SJZ, SJGT, SJLT */
             return 4;
         }
-        /* The load-and-operate blocks, operator in the low 3 bits (7 is unused).
-         * No table: on AVR it would be copied to RAM. */
+        /* The load-and-operate blocks of 8, operator in the low 3 bits (7 is unused):
+         * ADDVV ... SHRVV, ADDVI ... SHRVI, ADDRV ... SHRRV, ADDRI ... SHRRI. */
         if (op >= RL1_OP_ADDVV && op <= RL1_OP_SHRRI && (op & 7u) != 7u) {
-            if (op < RL1_OP_ADDVI) {
-                *shape = VAR_VAR; /* ADDVV ... SHRVV */
-                return 3;
-            }
-            if (op < RL1_OP_ADDRV) {
-                *shape = VAR_IMM; /* ADDVI ... SHRVI */
-                return 4;
-            }
-            if (op < RL1_OP_ADDRI) {
-                *shape = VAR; /* ADDRV ... SHRRV */
-                return 2;
-            }
-            *shape = IMM; /* ADDRI ... SHRRI */
-            return 3;
+            unsigned nibble = 4u * (op >> 3 & 3u);
+            *shape = (uint8_t)(FOUR(VAR_VAR, VAR_IMM, VAR, IMM) >> nibble & 15u);
+            return (uint8_t)(FOUR(3u, 4u, 2u, 3u) >> nibble & 15u);
         }
     }
     if (op == RL1_OP_END || op == RL1_OP_LDR || (op >= RL1_OP_ADDR && op <= RL1_OP_SHRR)) {
@@ -167,10 +152,15 @@ uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape)
         *shape = VAR_ADDR; /* JZ, JGT, JLT */
         return 4;
     }
+    if (minor >= COMPACT_MINOR && (op & RL1_COMPACT_CALL_BIT)) {
+        op ^= RL1_COMPACT_CALL_BIT; /* a compact call (1.3): a byte an argument */
+        width = 1u;
+    }
     if (op >= RL1_OP_FIRST_CALL && op <= RL1_OP_LAST_CALL) {
         uint8_t arity = rl1_call_arity(op);
         *shape = arity ? ARGS : NONE;
-        return rl1_call_length(arity);
+        /* a compact call without arguments is no instruction (width - 1 bytes: 0) */
+        return arity ? (uint8_t)(2u + (unsigned)width * arity) : (uint8_t)(width - 1u);
     }
     return 0;
 }
@@ -435,19 +425,21 @@ static rl1_refusal check_variable(loader *ld, uint32_t index, uint32_t offset)
     return index < VARIABLES ? RL1_ACCEPTED : fail(ld, RL1_BAD_VARIABLE, offset);
 }
 
-/* A call's mask and arguments; `at` is the mask's file offset. */
-static rl1_refusal check_call(loader *ld, uint8_t op, uint8_t length, uint32_t at)
+/* A call's mask and arguments, `width` bytes each; `at` is the mask's file offset. */
+static rl1_refusal check_call(loader *ld, uint8_t op, uint8_t width, uint32_t at)
 {
-    uint8_t mask = BYTE(ld->file + at), arity = (uint8_t)((length - 2u) / 2u), k;
+    uint8_t mask = BYTE(ld->file + at), arity = rl1_call_arity(op), k;
     rl1_refusal status = RL1_ACCEPTED;
     if (mask >> arity) {
         return fail(ld, RL1_BAD_MASK, at);
     }
     for (k = 0; k < arity && status == RL1_ACCEPTED; k++) {
-        uint32_t field = at + 1u + 2u * k;
+        uint32_t field = at + 1u + (uint32_t)width * k;
+        int16_t value = width == 1u ? (int8_t)BYTE(ld->file + field)
+                                    : i16_at(ld->file + field);
         if (((unsigned)mask >> k) & 1u) {
-            status = check_variable(ld, u16_at(ld->file + field), field);
-        } else if (!rl1_arg_in_range(op, k, i16_at(ld->file + field))) {
+            status = check_variable(ld, (uint16_t)value, field);
+        } else if (!rl1_arg_in_range(op, k, value)) {
             status = fail(ld, RL1_ARGUMENT_RANGE, field);
         }
     }
@@ -463,7 +455,7 @@ static rl1_refusal check_instructions(loader *ld, const rl1_program *program, ui
     while (pos < program->code_size) {
         uint8_t op = BYTE(program->code + pos), length, feature;
         uint32_t at = base + pos;
-        uint8_t shape;
+        uint8_t shape, width;
         rl1_refusal status = RL1_ACCEPTED;
         length = rl1_op_length(op, program->minor, &shape);
         if (length == 0u) {
@@ -472,13 +464,17 @@ static rl1_refusal check_instructions(loader *ld, const rl1_program *program, ui
         if (length > program->code_size - pos) {
             return fail(ld, RL1_CUT_OFF, at);
         }
+        /* a compact call (the only opcodes from RL1_COMPACT_CALL_BIT, the high bit): its
+         * call's, with a byte an argument */
+        width = (uint8_t)(2u - (op >> 7));
+        op &= (uint8_t)~RL1_COMPACT_CALL_BIT;
         if (shape == VAR || shape == VAR_ADDR || shape == VAR_VAR || shape == VAR_IMM) {
             status = check_variable(ld, BYTE(ld->file + at + 1u), at + 1u);
         }
         if (status == RL1_ACCEPTED && shape == VAR_VAR) {
             status = check_variable(ld, BYTE(ld->file + at + 2u), at + 2u);
         } else if (shape == ARGS) {
-            status = check_call(ld, op, length, at + 1u);
+            status = check_call(ld, op, width, at + 1u);
         }
         if (status != RL1_ACCEPTED) {
             return status;
