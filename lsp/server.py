@@ -106,6 +106,16 @@ class Rl1Protocol(LanguageServerProtocol):
         self.exit_status: int | None = None
         """Set by `exit`, as LSP gives it: the session is over."""
 
+    # pygls caches these two with functools.lru_cache on the method, keyed by the protocol
+    # too, which keeps the last 128 sessions alive after they end, each with its
+    # connection and the last message the WebSocket library read (64 MiB each, found by
+    # issue 23's campaign): looked up without the cache.
+    def get_message_type(self, method: str) -> type[Any] | None:  # type: ignore[override]
+        return types.METHOD_TO_TYPES.get(method, (None,))[0]
+
+    def get_result_type(self, method: str) -> type[Any] | None:  # type: ignore[override]
+        return types.METHOD_TO_TYPES.get(method, (None, None))[1]
+
     def receive(self, body: bytes) -> None:
         """Handle one message's body."""
         try:

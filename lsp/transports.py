@@ -356,8 +356,13 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
 
 # WebSocket ------------------------------------------------------------------------------
 
-def _as_bytes(message: str | bytes) -> bytes:
-    return message.encode() if isinstance(message, str) else message
+def _hand_over(session: Session, body: bytes) -> int:
+    """Hand `session` a WebSocket message's bytes (not decoded to text first: the
+    session's JSON reader checks UTF-8, and one copy fewer is 64 MiB less at the peak);
+    returns the bytes it leaves in flight: the websockets library keeps the last frame
+    it read (in a variable of its parser) until it has read the next."""
+    session.receive(body)
+    return len(body)
 
 
 class _WebSocketWriter:
@@ -477,14 +482,20 @@ class WebSocketSessions:
                 async with _initialize_deadline(session, connection.transport.abort):
                     while session.exit_status is None:
                         # Not bound to a variable, which would keep it until the next.
-                        session.receive(_as_bytes(await connection.recv()))
-                        connection.received = 0
+                        connection.received = _hand_over(
+                            session, await connection.recv(decode=False))
         except ConnectionClosed as closed:  # such as a message over MAX_MESSAGE
             log.info("a WebSocket connection ended: %s", closed)
         finally:
             sessions.discard(session)
             session.end()
             await writer.finish()
+            # The exception that ended the library's parser (a client gone without
+            # closing) keeps, through its traceback, the parser's variables, the last
+            # frame read among them, in a reference cycle that only the garbage collector
+            # frees, rarely on a quiet server: let go of them now.
+            if (ended := connection.protocol.parser_exc) is not None:
+                ended.__traceback__ = None
 
 
 async def serve_websocket(new_session: Callable[[], Session], host: str, port: int) -> None:

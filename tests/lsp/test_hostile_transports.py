@@ -11,6 +11,7 @@ from __future__ import annotations
 import contextlib
 import json
 import logging
+import re
 import socket
 import threading
 import time
@@ -94,9 +95,10 @@ def test_known_hard_inputs(transport: str, sent: bytes) -> None:
 
 
 def _largest_message(transport: str) -> tuple[bytes, ...]:
-    """An initialize, then a notification of MAX_MESSAGE bytes (a string of "a"s), which
-    the server reads and decodes whole: on TCP its headers, then the body in pieces."""
-    head = b'{"jsonrpc":"2.0","method":"x","params":"'
+    """An initialize, then a request of MAX_MESSAGE bytes (a string of "a"s, id 2), which
+    the server reads and decodes whole, and answers: on TCP its headers, then the body in
+    pieces."""
+    head = b'{"jsonrpc":"2.0","id":2,"method":"x","params":"'
     body = head + b"a" * (MAX_MESSAGE - len(head) - 2) + b'"}'
     if transport == "ws":
         return ws_frame(1, json.dumps(INITIALIZE).encode()), ws_frame(1, body)
@@ -127,6 +129,31 @@ def test_eight_clients_sending_the_largest_message_at_once_stay_in_the_bound(
         peak = server.peak_mib() - server.started_mib
         assert peak < GROWTH_BOUND_MIB, f"{peak:.0f} MiB at its peak"
         assert transport_attack(server, HostileConnection(chunks=(b"",), copies=0)) == []
+    finally:
+        server.stop()
+
+
+@pytest.mark.parametrize("transport", TRANSPORTS)
+def test_a_server_keeps_no_message_of_the_clients_that_have_left(transport: str) -> None:
+    """Issue 23: a session kept its last message after it ended (in a coroutine's
+    variable, a connection reset's reference cycle, pygls' cache of 128 sessions, the
+    WebSocket library's parser), so that eight clients one after the other grew the
+    server by eight messages of MAX_MESSAGE bytes."""
+    server = ServedLsp(transport)
+    attack = HostileConnection(chunks=_largest_message(transport))
+    try:
+        for _ in range(MAX_SESSIONS):
+            connection = _send_hostile(server, attack)
+            assert connection is not None
+            with connection:  # the answer to the message says that it has been handled
+                heard = b""
+                while not re.search(rb'"id":\s*2\b', heard):
+                    chunk = connection.recv(65536)
+                    assert chunk, f"the server closed the connection: {server.stop()[-300:]}"
+                    heard += chunk
+        assert transport_attack(server, HostileConnection(chunks=(b"",), copies=0)) == []
+        kept = server.resident_mib() - server.started_mib
+        assert kept < MAX_MESSAGE / 2**20, f"{kept:.0f} MiB kept after the clients left"
     finally:
         server.stop()
 
