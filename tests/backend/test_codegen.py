@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from support import SAMPLE
 
 from rl1.compiler.analysis import analyze
-from rl1.compiler.backend import ir
+from rl1.compiler.backend import driver, ir
 from rl1.compiler.backend.codegen import CodegenError, generate
 from rl1.compiler.backend.lower import lower
 from rl1.compiler.frontend.parser import parse_program
@@ -305,3 +305,19 @@ def test_a_move_of_a_constant_that_fits_a_byte_is_movb() -> None:
     assert image.code[7:10] == bytes([0x0A, var("A"), 0x80])  # -128, signed
     cells = machine.run(verify(ilc.encode(image)), ScriptedDevice(Script())).variables
     assert cells[var("A")] == -129
+
+
+
+def test_a_call_whose_constants_fit_a_byte_is_compact_at_o2_only() -> None:
+    source = "(MOV 4,-4); (ROT 127); (ROT 128); A=(ULT A); (OUT 3,A); (FRE); (END)\n"
+    files = {level: ilc.read(driver.compile_text(source, "t.rob", level=level,
+                                                 strip_debug=True).output or b"")
+             for level in (1, 2)}
+    calls = {level: [name for name in names(file.image) if name not in ("LDR", "STV", "MOVR")]
+             for level, file in files.items()}
+    assert calls[1] == ["MOV", "ROT", "ROT", "ULTA", "OUT", "FRE", "END"]
+    assert calls[2] == ["MOVS", "ROTS", "ROT", "ULTA", "OUTS", "FRE", "END"]
+    code = files[2].image.code
+    assert code[:4] == bytes([0xC4, 0, 4, 0xFC])  # a byte an argument, -4 signed
+    assert code[-6:-2] == bytes([0xDB, 0b10, 3, var("A")])  # OUTS 3, A
+    assert (files[1].header.minor, files[2].header.minor) == (0, isa.COMPACT_MINOR)

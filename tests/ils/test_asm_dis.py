@@ -108,6 +108,8 @@ def test_the_disassembly_shows_the_header_tables_offsets_and_source() -> None:
     ("LDI 40000", 1, 5, "constant 40000 is out of range -32768..32767"),
     ("LDI $10000", 1, 5, "out of range"),
     ("MOVB A, 128", 1, 9, "byte constant 128 is out of range -128..127"),
+    ("TIMS 128", 1, 6, "byte constant 128 is out of range -128..127"),
+    ("MOVS 0, 13", 1, 9, "MOVS argument r = 13 is out of range -12..12"),
     ("END\nFOO", 2, 1, "unknown instruction FOO"),
     ("LDV AB", 1, 5, "expected a variable (A-Z, a-z or @), found 'AB'"),
     ("MOV 1", 1, 1, "MOV takes 2 operands, found 1"),

@@ -356,6 +356,7 @@ static void test_snapshot_waiting(void)
 {
     run r, restored;
     rl1_vm snapshot;
+    uint8_t shape;
     start(&r, patrol_ilc, patrol_ilc_size, CALL, NOTHING, 0);
     r.device.busy_polls = 1000;
     expect("snapshot while waiting", "the state", step(&r, 100), RL1_WAITING);
@@ -365,7 +366,8 @@ static void test_snapshot_waiting(void)
     restored.vm.begun = 0;
     restored.vm.mailbox.posted = restored.vm.mailbox.taken = 0;
     restored.vm.pc = (uint16_t)(restored.vm.pc
-                                - rl1_call_length(rl1_call_arity(restored.vm.waiting)));
+                                - rl1_op_length(restored.vm.waiting, restored.program.minor,
+                                                &shape));
     restored.vm.waiting = 0;
     restored.vm.executed -= 1;
     expect("snapshot while waiting", "pc", restored.vm.pc, PATROL_TIM);
