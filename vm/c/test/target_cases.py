@@ -83,7 +83,7 @@ def source(batch: list[bytes]) -> str:
 VECTORS = Path(__file__).resolve().parents[3] / "spec" / "vectors"
 CALLS = {form_name(info.builtin).replace(" ", "_"): opcode
          for opcode, info in isa.OPCODES.items() if info.builtin and info.form is not None
-         and opcode >= isa.CALL_BASE} | {"LINE_LOST": 0x100, "STOP": 0x101}
+         and opcode >= isa.CALL_BASE and not info.compact} | {"LINE_LOST": 0x100, "STOP": 0x101}
 SCRIPT_KINDS = {"sensor": 0, "loss time": 1, "loss during": 2, "loss instruction": 3,
                 "fail": 4, "stop_fails": 5, "after_last": 6}  # scripted.h's enum script_kind
 
