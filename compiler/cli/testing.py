@@ -53,7 +53,7 @@ def test(paths: tuple[str, ...], jobs: int | None, junit_file: str | None, force
     from rl1.compiler.program_tests import Case, run_test
     from rl1.compiler.test_file import Success
 
-    from .test_report import MARKS, Result, junit_xml, story_text, summary_line
+    from .test_report import MARKS, Result, finished, junit_xml, summary_line
 
     cases = [Case(file, test) for file, tests in _load(paths or (".",)) for test in tests]
     if junit_file is not None:
@@ -69,7 +69,8 @@ def test(paths: tuple[str, ...], jobs: int | None, junit_file: str | None, force
             if case.file != file:
                 sys.stdout.write(("\n" if file is not None else "") + f"{case.file} ")
                 file = case.file
-            results.append(Result(case, run_test(case, executor, workers)))
+            results.append(finished(case, run_test(case, executor, workers), workers,
+                                    color=color_on))
             sys.stdout.write(MARKS[results[-1].outcome.status])
             sys.stdout.flush()
     seconds = time.perf_counter() - started
@@ -78,10 +79,10 @@ def test(paths: tuple[str, ...], jobs: int | None, junit_file: str | None, force
     if unpassed:
         sys.stdout.write(f"\n{' FAILURES ':=^60}\n")
         for result in unpassed:
-            sys.stdout.write(story_text(result, workers, color=color_on))
+            sys.stdout.write(result.printed)
     sys.stdout.write(f"{' ' + summary_line(results, seconds) + ' ':=^60}\n")
     if junit_file is not None:
-        write_file(junit_file, junit_xml(results, seconds, workers), force=force,
+        write_file(junit_file, junit_xml(results, seconds), force=force,
                    role="JUnit file")
     return EXIT_ERRORS if unpassed else 0
 
