@@ -135,18 +135,21 @@ CALLS = [info for info in isa.OPCODES.values() if info.form is not None and info
 def test_every_parameter_bound_and_mask(c_loader: Loader, info: isa.OpInfo) -> None:
     assert info.form is not None
     params = info.form.params
+    # a field's values: 16 bits, or a byte in a compact call
+    low_end, high_end = (-0x80, 0x7F) if info.compact else (-0x8000, 0x7FFF)
+    lows = [max(p.low, low_end) for p in params]
     for index, param in enumerate(params):
         for value in (param.low - 1, param.low, param.high, param.high + 1):
-            if not -0x8000 <= value <= 0x7FFF:
+            if not low_end <= value <= high_end:
                 continue
-            args = tuple(isa.Arg(False, value if i == index else p.low)
-                         for i, p in enumerate(params))
+            args = tuple(isa.Arg(False, value if i == index else low)
+                         for i, low in enumerate(lows))
             assert_agree(c_loader, file_of(isa.encode(info, (), args)))
-        for variable in (52, 53, 0xFFFF):
-            args = tuple(isa.Arg(i == index, variable if i == index else p.low)
-                         for i, p in enumerate(params))
+        for variable in (52, 53, 0xFF if info.compact else 0xFFFF):
+            args = tuple(isa.Arg(i == index, variable if i == index else low)
+                         for i, low in enumerate(lows))
             assert_agree(c_loader, file_of(isa.encode(info, (), args)))
-    lowest = isa.encode(info, (), tuple(isa.Arg(False, p.low) for p in params))
+    lowest = isa.encode(info, (), tuple(isa.Arg(False, low) for low in lows))
     for mask in range(256):
         assert_agree(c_loader, file_of(lowest[:1] + bytes([mask]) + lowest[2:]))
     feature = BUILTINS[info.builtin[0]].feature if info.builtin else None
