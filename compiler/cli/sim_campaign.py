@@ -265,7 +265,7 @@ def _refuse_targets(pictures: Pictures, inputs: tuple[str, str], out: str | None
     """A usage error, before any run, for a picture that would replace an input, the
     other picture or the runs' JSON lines, or that could not be written (the runs
     would be made for nothing)."""
-    others = {"--out": out}
+    others: dict[str, str | None] = {"--out": out}
     for option, target in (("--svg", pictures.svg), ("--html", pictures.html)):
         if target is None:
             continue
@@ -274,9 +274,9 @@ def _refuse_targets(pictures: Pictures, inputs: tuple[str, str], out: str | None
                 raise click.UsageError(f"{option} `{target}` is the {role} itself: give "
                                        "another path for the picture")
         stream = os.path.exists(target) and not os.path.isfile(target)  # /dev/null
-        for other, name in others.items():
-            if not stream and name is not None and (
-                    os.path.realpath(name) == os.path.realpath(target)):
+        for other, taken in others.items():
+            if not stream and taken is not None and (
+                    os.path.realpath(taken) == os.path.realpath(target)):
                 raise click.UsageError(f"{option} and {other} both name `{target}`: give "
                                        "each its own file")
         others[option] = target

@@ -481,8 +481,8 @@ def ws_frame(opcode: int, payload: bytes, fin: bool = True, masked: bool = True,
         return head + payload
     mask = os.urandom(4)
     repeated = (mask * (len(payload) // 4 + 1))[:len(payload)]
-    masked = int.from_bytes(payload, "big") ^ int.from_bytes(repeated, "big")
-    return head + mask + masked.to_bytes(len(payload), "big")
+    hidden = int.from_bytes(payload, "big") ^ int.from_bytes(repeated, "big")
+    return head + mask + hidden.to_bytes(len(payload), "big")
 
 
 @st.composite
