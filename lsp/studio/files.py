@@ -77,6 +77,9 @@ class Folder:
         if not path or "\x00" in path:
             raise Refused(f"`{path!r}` is no file's path: give one relative to the folder, "
                           "such as `sample.rob`")
+        if path.endswith(("/", "/.")):  # `main.rob/` would name main.rob
+            raise Refused(f"`{path}` names a folder: give the path of a file, such as "
+                          "`sample.rob`")
         if ".." in PurePosixPath(path).parts or ".." in Path(path).parts:
             raise Refused(f"`{path}` has a `..`: give a path inside {self.root}")
         try:
@@ -165,11 +168,12 @@ class Folder:
                     continue
                 place = Path(folder, name)
                 try:
-                    size = place.stat().st_size
+                    status = place.stat()
                     inside = place.resolve().is_relative_to(self.root)
                 except (OSError, RuntimeError):
                     continue
-                if inside:
+                size = status.st_size
+                if inside and stat.S_ISREG(status.st_mode):  # no FIFO the page would open
                     entries.append(Entry(self.relative(place), kind, size))
             if len(entries) > MAX_LISTED or visited > MAX_VISITED:
                 truncated = True

@@ -62,7 +62,9 @@ class Gate:
     def refusal(self, request: Request) -> str | None:
         """Why `request` is refused, or None."""
         hosts = {f"{HOST}:{self.port}", f"localhost:{self.port}"}
-        if request.headers.get("Host") not in hosts:
+        if len(request.headers.get_all("Origin")) > 1:
+            return "a request with two Origin headers: send one"
+        if request.headers.get_all("Host") not in ([host] for host in hosts):
             return ("the request names another host than this server: open the address "
                     "rl1c studio printed")
         tokens = parse_qs(urlsplit(request.path).query).get("token", [])

@@ -83,12 +83,16 @@ class Answer:
     body: bytes
 
 
-def get(served: Served, target: str, headers: dict[str, str] | None = None,
+def get(served: Served, target: str,
+        headers: dict[str, str] | list[tuple[str, str]] | None = None,
         method: str = "GET") -> Answer:
-    """An HTTP request for `target` exactly as written (no normalizing of `..`)."""
-    sent = {"Host": f"127.0.0.1:{served.port}", **(headers or {})}
+    """An HTTP request for `target` exactly as written (no normalizing of `..`); headers
+    as a list may repeat a name, and a Host among them replaces the server's."""
+    given = list(headers.items()) if isinstance(headers, dict) else list(headers or [])
+    own_host = [] if any(name == "Host" for name, _ in given) else [
+        ("Host", f"127.0.0.1:{served.port}")]
     request = f"{method} {target} HTTP/1.1\r\n" + "".join(
-        f"{name}: {value}\r\n" for name, value in sent.items()) + "\r\n"
+        f"{name}: {value}\r\n" for name, value in own_host + given) + "\r\n"
     with socket.create_connection(("127.0.0.1", served.port), timeout=TIMEOUT) as client:
         client.sendall(request.encode())
         received = b""

@@ -139,6 +139,20 @@ def test_saving_into_a_missing_folder_says_to_make_it(folder: Folder) -> None:
         folder.save("nowhere/a.rob", b"")
 
 
+@pytest.mark.parametrize("path", ["a.rob/", "a.rob/.", "./a.rob/"])
+def test_a_path_naming_a_folder_is_refused_though_a_file_has_its_name(folder: Folder,
+                                                                       path: str) -> None:
+    with pytest.raises(Refused, match="folder"):
+        folder.read(path)
+
+
+def test_the_listing_leaves_out_what_is_no_regular_file(folder: Folder) -> None:
+    os.mkfifo(folder.root / "pipe.rob")
+    entries, _ = folder.listing()
+    assert "pipe.rob" not in [entry.path for entry in entries]
+    assert "a.rob" in [entry.path for entry in entries]
+
+
 def test_the_listing_has_the_studios_files_sorted(folder: Folder) -> None:
     (folder.root / ".hidden").mkdir()
     (folder.root / ".hidden" / "h.rob").write_text("")

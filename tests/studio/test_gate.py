@@ -95,6 +95,18 @@ def test_another_host_is_refused(served: Served, host: str) -> None:
     assert b"host" in answer.body
 
 
+@pytest.mark.parametrize("name", ["Host", "Origin"])
+def test_a_header_given_twice_is_refused(served: Served, name: str) -> None:
+    # Two Hosts or two Origins, one of them right, are a 403, not the server's error.
+    own = f"127.0.0.1:{served.port}" if name == "Host" else f"http://127.0.0.1:{served.port}"
+    answer = get(served, f"/?token={served.token}", [("Host", f"127.0.0.1:{served.port}"),
+                                                     *([] if name == "Host" else [(name, own)]),
+                                                     (name, own if name == "Host" else
+                                                      "http://evil.example")])
+    assert answer.status == 403, answer
+    assert name.lower().encode() in answer.body.lower()
+
+
 def test_it_listens_on_the_loopback_address_only(served: Served) -> None:
     assert served.server.addresses == [("127.0.0.1", served.port)]
 
