@@ -150,7 +150,7 @@ class Statistics:
                             for name, opcodes in self.opcodes.items()},
                 "superinstructions": {
                     name: {opcode: count for opcode, count in sorted(opcodes.items())
-                           if isa.BY_NAME[opcode].minor == isa.FUSED_MINOR}
+                           if isa.BY_NAME[opcode].minor >= isa.FUSED_MINOR}
                     for name, opcodes in self.opcodes.items()},
                 "passes": dict(sorted(self.passes.items()))}
 

@@ -24,6 +24,7 @@ from rl1.compiler import fuzz
 from rl1.compiler.cli import fuzz as fuzz_cli
 from rl1.compiler.differential import Engine, Observation, Verdict, VmEngine, judge, signature
 from rl1.compiler.strategies import Run
+from rl1.vm import isa
 
 pytestmark = pytest.mark.slow  # campaigns, on pools of processes
 
@@ -341,6 +342,9 @@ def test_json_statistics_have_the_keys_the_spec_lists_and_add_up() -> None:
     assert opcodes["vm-O0"].get("END", 0) == endings.get("ok", 0)
     assert fused["vm-O0"] == fused["vm-O1"] == {} and fused["vm-O2"]
     assert all(opcodes["vm-O2"][name] == count for name, count in fused["vm-O2"].items())
+    # -O2's own opcodes: 1.2's superinstructions and 1.3's compact calls alike.
+    assert {isa.BY_NAME[name].minor for name in fused["vm-O2"]} == {isa.FUSED_MINOR,
+                                                                    isa.COMPACT_MINOR}
     passes = document["passes"]
     assert isinstance(passes, dict) and "fuse" in passes
     assert all(0 < count <= 30 for count in passes.values())
