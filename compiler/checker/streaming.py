@@ -130,9 +130,14 @@ def check_text(text: str) -> list[Diagnostic]:
                 pending.append(line.label)
             if not line.ok:
                 close()
-                # a source of broken lines has a block a line: they share what is empty
-                cuts.append(Cut((), _taken(pending), True, ()))
-                summaries.append(nothing)
+                # Consecutive broken lines are one opaque block (blank lines between them
+                # too): each line's block would reach the next and be reached by the same
+                # jumps (every jump to a missing label goes to every opaque block), so no
+                # rule tells them apart; a labelled one keeps a block of its own, which
+                # the label rules read.
+                if pending or not _merges_into(cuts):
+                    cuts.append(Cut((), _taken(pending), True, ()))
+                    summaries.append(nothing)
                 continue
             segments: tuple[Segment, ...] = line_segments(line.statements)
             start = 0
@@ -154,6 +159,12 @@ def check_text(text: str) -> list[Diagnostic]:
         del cuts  # the blocks hold what the rules need
         found += check_graph(graph, ast.Span(1, 1, last_span.end_line, last_span.end_column))
     return suppressed(directives, found)
+
+
+def _merges_into(cuts: list[Cut]) -> bool:
+    """Whether a broken line without a label joins the last block cut: an opaque block
+    without labels, which no statement has followed."""
+    return bool(cuts) and cuts[-1].opaque and not cuts[-1].labels
 
 
 def _taken(pending: list[ast.LabelDef]) -> tuple[ast.LabelDef, ...]:

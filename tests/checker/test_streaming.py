@@ -33,6 +33,11 @@ def assert_same(text: str) -> None:
     "(MOV 3,3)\r\nA=u\rB=v ' rl1: allow W0401\n(END)",  # every line end, no final one
     "A=(ENDD)\n(ENDD)\n",  # an unknown call as an operand and as a statement
     "(TRC 3); (MVI 1,1,50)\n" * 3 + "(END)\n",
+    # consecutive broken lines, which the streaming check makes one block: labelled
+    # or not, after a jump or `(END)`, around blank lines, jumped to by a missing label
+    "A=1 B=2\n\nC=3 D=4\n:10 E=5 F=6\nG=7 H=8\n#20\nI=9 J=1\nK=2 L=3\n",
+    "(END)\nA=1 B=2\nC=3 D=4\n:10\nE=5 F=6\n' note\nG=7 H=8\n:20 A=1; #10\n",
+    ":A\n:B\nA=1 B=2\n#30\n(MOV 1,1) X\n:96 (TRC 2) Y\nA=1 B=2\n",
 ])
 def test_programs_with_each_rule_give_the_same_diagnostics(text: str) -> None:
     assert_same(text)
