@@ -10,7 +10,7 @@ from typing import NamedTuple
 
 from .checker import apply_suppressions, check, check_text
 from .frontend.ast import Program
-from .frontend.diagnostics import Diagnostic, Fix, sort_key
+from .frontend.diagnostics import Diagnostic, Fix, sort_by_place, sort_key
 from .frontend.edits import apply_edits, compatible
 from .frontend.parser import parse_program
 
@@ -36,7 +36,7 @@ def diagnose(text: str) -> list[Diagnostic]:
     """`analyze(text).diagnostics`, without holding the tree: for `rl1c check`, whose
     memory is then the text's and the diagnostics' (checker/streaming.py)."""
     diagnostics = check_text(text)
-    diagnostics.sort(key=sort_key)
+    sort_by_place(diagnostics)
     return diagnostics
 
 

@@ -7,6 +7,7 @@ The catalogue of codes (titles and the long explanations of `rl1c explain`) live
 from __future__ import annotations
 
 from enum import Enum
+from operator import attrgetter
 from typing import NamedTuple
 
 from .ast import Span
@@ -61,3 +62,16 @@ class Diagnostic(NamedTuple):
 
 def sort_key(diagnostic: Diagnostic) -> tuple[int, int, str]:
     return (diagnostic.span.line, diagnostic.span.column, diagnostic.code)
+
+
+# sort_key's parts, last first, each an object the diagnostic already holds
+_PLACE_PARTS = (attrgetter("code"), attrgetter("span.column"), attrgetter("span.line"))
+
+
+def sort_by_place(diagnostics: list[Diagnostic]) -> None:
+    """Sort `diagnostics` in place into sort_key's order (equal keys keep their order)
+    without a key tuple a diagnostic, which a source of a syntax error a line would
+    hold 9 bytes a source byte of while sorting (bench/memory.py): stable sorts by each
+    part of the key, the last first, whose keys the diagnostics hold already."""
+    for part in _PLACE_PARTS:
+        diagnostics.sort(key=part)

@@ -16,7 +16,7 @@ from collections.abc import Iterator, Sequence
 from typing import IO, Any, Literal, NamedTuple
 
 from rl1.compiler.frontend.ast import Span
-from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity, sort_key
+from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity, sort_by_place
 from rl1.compiler.frontend.source import LineIndex, split_lines
 
 from .catalogue import CODES
@@ -153,7 +153,9 @@ def use_color(choice: ColorChoice, stream: IO[Any]) -> bool:
 
 
 def _ordered(diagnostics: Sequence[Diagnostic]) -> list[Diagnostic]:
-    return sorted(diagnostics, key=sort_key)
+    ordered = list(diagnostics)
+    sort_by_place(ordered)
+    return ordered
 
 
 # Human ------------------------------------------------------------------------------
