@@ -60,7 +60,8 @@ def test_a_blocks_statements_are_read_from_its_lines_again() -> None:
 
 
 # Two kinds of bench/memory.py's sources, at a size tracemalloc measures in seconds (its
-# third, a syntax error a line, is above the bound: the diagnostics alone take 83 B/B).
+# third, a syntax error a line, is above the bound: its diagnostics alone, an E0101 with
+# its fix a line, take 67 B/B; test_broken_lines_cost_little_beyond_their_diagnostics).
 SOURCES = {
     "lines of 19,999 characters": ";".join(["A=1"] * 4999) + "\n",
     "`A=1` lines": "A=1\n",
@@ -86,3 +87,27 @@ def test_checking_takes_at_most_64_bytes_a_source_byte(kind: str) -> None:
     measured = subprocess.run([sys.executable, "-c", script, SOURCES[kind]],
                               capture_output=True, text=True, check=True)
     assert float(measured.stdout) <= 64
+
+
+BEYOND_DIAGNOSTICS = textwrap.dedent("""
+    import sys, tracemalloc
+    from rl1.compiler.analysis import diagnose
+    text = "A=1 B=2\\n" * ({characters} // 8)
+    tracemalloc.start()
+    found = diagnose(text)
+    kept, peak = tracemalloc.get_traced_memory()
+    print(len(found), (peak - kept) / len(text))
+""")
+
+
+def test_broken_lines_cost_little_beyond_their_diagnostics() -> None:
+    """A source of a syntax error a line (bench/memory.py's third) holds its diagnostics
+    and little else at its peak: consecutive broken lines are one block of the graph
+    (they were a block each: 62 B/B beyond the diagnostics), and sorting takes no key
+    tuple a diagnostic (9 B/B)."""
+    script = BEYOND_DIAGNOSTICS.format(characters=SOURCE_CHARACTERS)
+    measured = subprocess.run([sys.executable, "-c", script], capture_output=True,
+                              text=True, check=True)
+    count, beyond = measured.stdout.split()
+    assert int(count) == SOURCE_CHARACTERS // 8  # an E0101 a line
+    assert float(beyond) <= 8
