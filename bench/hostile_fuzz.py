@@ -29,6 +29,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 from support.cli import rl1c  # noqa: E402  (tests/ is put on the path just above)
 from support.hostile import (  # noqa: E402
+    GROWTH_BOUND_MIB,
     HostileConnection,
     ServedLsp,
     _mutated,
@@ -157,6 +158,8 @@ def main() -> None:
             campaign(f"{name} (hostile clients, then a well-behaved one)",
                      hostile_connections(transport), functools.partial(_on, server), share,
                      batch_size=10)  # up to seconds each
+            print(f"  its peak memory: {server.peak_mib() - server.started_mib:.0f} MiB over "
+                  f"what it held once started (bound {GROWTH_BOUND_MIB} MiB)")
         finally:
             server.stop()
 
