@@ -120,6 +120,8 @@ async function start(): Promise<void> {
     documentSelector: [
       { scheme: 'file', language: 'rl1' },
       { scheme: 'untitled', language: 'rl1' },
+      // rl1c test's files: the server shows what rl1c test would refuse in them.
+      { scheme: 'file', pattern: '**/*.tests.toml' },
     ],
     outputChannel: output,
   };
