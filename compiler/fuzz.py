@@ -27,7 +27,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import dataclass, field, replace
 from random import Random
-from typing import Any, TypeVar
+from typing import Any
 
 from hypothesis import HealthCheck, Phase, find, settings
 from hypothesis.errors import NoSuchExample
@@ -50,7 +50,8 @@ from rl1.compiler.differential import (
     signature,
 )
 from rl1.compiler.files import SourceError, read_bounded, write_atomically
-from rl1.compiler.frontend.source import read_source, split_lines
+from rl1.compiler.frontend.source import read_source
+from rl1.compiler.reduce import Case, NotInteresting, reduce, script_text
 from rl1.compiler.runner import MAX_SCRIPT_BYTES
 from rl1.compiler.strategies import Run, runs
 from rl1.vm import isa
@@ -63,12 +64,13 @@ from rl1.vm.sensor_script import ScriptError, parse_script
 # planted shift bug it went on for 1,100 to 1,700 runs to save a character or two, which
 # deleting lines and statements then does in far fewer).
 SHRINK_ATTEMPTS = 500
+# Then compiler/reduce.py's passes, for at most so many runs (38 on that bug).
+REDUCE_TESTS = 500
 # Programs per search. Hypothesis' runner keeps what it learnt of every run it generated
 # (about 130 KB each) until the search ends, so a long campaign is many short searches,
 # each seeded from --seed, with their garbage collected in between; and the searches are
 # what processes share, so that a campaign of 1,000 keeps ten of them busy.
 BATCH = 100
-LABEL = re.compile(r"[ \t\f\v]*:[0-9]*")  # a label where a line starts (language 3.1)
 SOURCE = "program.rob"
 SCRIPT = "program.sensors.json"
 ENGINES = "engines.json"  # the engines a reproducer names, and the budget
@@ -375,15 +377,15 @@ def _corpus_run(file: str) -> Run:
 
 def _delete_lines(searched: Searched, target: str, task: Search,
                   stopped: Callable[[], bool]) -> None:
-    """The finding of `target` with the lines and statements it does not need deleted
-    (none more once `stopped()`)."""
+    """The finding of `target` reduced further by `_reduced` (no further once
+    `stopped()`)."""
     def keeps(case: Run) -> bool:
         if stopped():
             return False
         verdict = judge(case, task.engines, task.budget)
         return bool(verdict.problems) and (not task.keep_going or signature(verdict) == target)
 
-    smallest = _deleted(searched.findings[target].case, keeps)
+    smallest = _reduced(searched.findings[target].case, keeps)
     searched.findings[target] = Finding(smallest, judge(smallest, task.engines, task.budget))
 
 
@@ -525,59 +527,21 @@ def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search
         progress(channel.told(task.index for task in pending.values()))
 
 
-def _deleted(case: Run, disagrees: Callable[[Run], bool]) -> Run:
-    """The run with its comments gone and each label on a line of its own, then the
-    lines, and the statements of each line, that the disagreement does not need (and
-    the checker does not miss) deleted, in halves, quarters... down to one, until
-    nothing more goes: the last step of shrinking, cheap where Hypothesis' is slow (a
-    slow `exec:` engine)."""
-    def source(lines: list[list[str]]) -> str:
-        return "".join(";".join(statements) + "\n" for statements in lines)
+def _reduced(case: Run, disagrees: Callable[[Run], bool]) -> Run:
+    """The run reduced by compiler/reduce.py's passes while it disagrees, in at most
+    REDUCE_TESTS runs: lines, statements and terms deleted, operands and the sensor
+    script's numbers made smaller, its readings and losses deleted, then the formatter's
+    layout; the last step of shrinking, cheap where Hypothesis' is slow (a slow `exec:`
+    engine)."""
+    def still(candidate: Case) -> bool:
+        return disagrees(Run(candidate.source, json.loads(candidate.script or "{}")))
 
-    def keeps(lines: list[list[str]]) -> bool:
-        text = source(lines)
-        return not analyze(text).has_errors and disagrees(Run(text, case.script))
-
-    lines: list[list[str]] = []
-    for line in split_lines(case.source):
-        label = LABEL.match(line)
-        code = line.split("'", 1)[0][label.end() if label else 0:]
-        lines += [[label.group().strip()]] if label else []
-        lines += [code.split(";")] if code.strip(" \t\f\v;") else []
-    if not keeps(lines):
-        return case  # the checker objects to the program laid out so
-    while True:
-        before = len(source(lines))
-        lines = _reduce(lines, keeps)
-        for row in range(len(lines)):
-            lines[row] = _reduce(lines[row], _in_row(lines, row, keeps))
-        if len(source(lines)) == before:
-            return Run(source(lines), case.script)
-
-
-def _in_row(lines: list[list[str]], row: int, keeps: Callable[[list[list[str]]], bool]
-            ) -> Callable[[list[str]], bool]:
-    """`keeps` for the statements of one line, the others as they are."""
-    return lambda statements: keeps([*lines[:row], statements, *lines[row + 1:]])
-
-
-T = TypeVar("T")
-
-
-def _reduce(items: list[T], keeps: Callable[[list[T]], bool]) -> list[T]:
-    """`items` without the runs of them that `keeps` does not need, trying runs of half
-    their number first, then of a quarter, down to single items; never empty."""
-    size = len(items) // 2
-    while size >= 1:
-        start = 0
-        while start < len(items):
-            shorter = items[:start] + items[start + size:]
-            if shorter and keeps(shorter):
-                items = shorter
-            else:
-                start += size
-        size //= 2
-    return items
+    try:
+        reduced = reduce(Case(case.source, script_text(case.script)), still,
+                         max_tests=REDUCE_TESTS).case
+    except NotInteresting:  # judged again, it agrees: an engine that varies
+        return case
+    return Run(reduced.source, json.loads(reduced.script or "{}"))
 
 
 FINDING_FOLDER = "finding-"  # each finding's folder under --out: finding-1, finding-2...

@@ -7,6 +7,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import shlex
 import signal
 import subprocess
@@ -20,6 +21,7 @@ from hypothesis import strategies as st
 from support import ROOT, SAMPLE, SAMPLE_SENSORS
 from support.cli import rl1c
 
+from rl1.compiler import fuzz
 from rl1.compiler.analysis import analyze
 from rl1.compiler.differential import Engine, Observation, VmEngine, judge
 from rl1.compiler.reduce import Case, NotInteresting, reduce, smaller_numbers
@@ -351,6 +353,19 @@ def test_engines_that_agree_leave_nothing_to_reduce() -> None:
                   "--engine", "vm-O2")
     assert result.exit_code == 1
     assert f"the engines agree on {SAMPLE}: nothing to reduce" in result.stderr
+
+
+def test_rl1c_fuzz_reduces_its_finding_with_these_passes(monkeypatch: pytest.MonkeyPatch
+                                                        ) -> None:
+    # Hypothesis' shrinking for 40 runs, then lines and statements deleted, left
+    # ` j=$0011\t<$FA8D^ $0100+t +136&$41c` and a script of seven keys.
+    monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 40)
+    engines: list[Engine] = [VmEngine(0), _BrokenShift()]
+    outcome = fuzz.campaign(engines, 20_000, count=300, seconds=None, seed=1,
+                            progress=lambda programs, elapsed: None)
+    assert outcome.finding is not None
+    assert re.fullmatch(r"[A-Za-z@]=1<-1(\r\n|\r|\n)", outcome.finding.case.source)
+    assert outcome.finding.case.script == {}
 
 
 def test_a_fuzz_finding_of_a_planted_bug_is_reduced_with_its_engines(tmp_path: Path) -> None:

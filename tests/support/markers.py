@@ -32,6 +32,7 @@ MARKS: dict[str, tuple[str, ...]] = {
         ("slow",),
     "tests/cli/test_reduce.py::test_ctrl_c_keeps_the_smallest_so_far": ("slow",),
     "tests/cli/test_reduce.py::test_rl1c_reduce_gives_the_same_bytes_every_time": ("slow",),
+    "tests/cli/test_reduce.py::test_rl1c_fuzz_reduces_its_finding_with_these_passes": ("slow",),
     "tests/frontend/test_strategies.py": ("slow",),
     # A language server process of its own for each test (its command line, its raw
     # protocol over standard input and output).
