@@ -100,6 +100,16 @@ def write_atomically(path: str | Path, data: bytes, *, force: bool = False) -> N
         raise
 
 
+def refuses_writing(path: str | Path) -> bool:
+    """Whether write_atomically would refuse `path` without `force`: an existing file
+    that is read-only (for anyone, even root)."""
+    try:
+        status = os.stat(path)
+    except OSError:
+        return False
+    return _read_only(Path(path), status)
+
+
 def _read_only(path: Path, status: os.stat_result) -> bool:
     """No write permission bit at all (`chmod 444`), or none for this user."""
     writable_bits = stat.S_IWUSR | stat.S_IWGRP | stat.S_IWOTH

@@ -22,11 +22,18 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
-from rl1.compiler.files import SourceError, read_bounded
+from rl1.compiler.files import SourceError, read_bounded, refuses_writing
 from rl1.compiler.reporting.render import EXIT_ERRORS
 
 from .command import EXIT_INTERRUPTED, PATH, Command, Failure, a_budget, at_least_one
-from .streams import encode_like, invalid_file, read_failure, with_suffix, write_file
+from .streams import (
+    encode_like,
+    invalid_file,
+    read_failure,
+    same_file,
+    with_suffix,
+    write_file,
+)
 
 if TYPE_CHECKING:
     from rl1.compiler.differential import Engine
@@ -97,12 +104,10 @@ def reduce(file: str, sensors: str | None, command: str | None,
     if sensors is not None and os.path.basename(sensors) == os.path.basename(file):
         raise click.UsageError("the program and the sensor script have one name; the "
                                "command finds them by name in one folder: rename one")
-    for target, role in ((out, "--out"), (sensors_out, "--sensors-out")):
-        folder = os.path.dirname(os.path.abspath(target or "."))
-        if target is not None and (os.path.isdir(target) or not os.path.isdir(folder)):
-            raise click.UsageError(f"argument {role}: {target}: "
-                                   + ("it is a folder; name a file" if os.path.isdir(target)
-                                      else f"there is no folder {folder}"))
+    if command is not None and not command.strip():
+        raise click.UsageError("argument --interesting: the command is empty; give the "
+                               "shell command that exits 0 on an interesting case")
+    _check_targets(file, sensors, out, sensors_out)
     files = _read(file, sensors)
     original = Case(files.source.text, files.script)
     script = files.script
@@ -155,6 +160,39 @@ def reduce(file: str, sensors: str | None, command: str | None,
                  "nothing smaller is interesting: nothing written")
     click.echo("\n".join(lines))
     return status
+
+
+def _check_targets(file: str, sensors: str | None, out: str | None,
+                   sensors_out: str | None) -> None:
+    """A usage error, before any test, for an output that could not be written or would
+    replace an input other than its own (--out may name the program it reduces), so that
+    a reduction is never made for nothing or lost."""
+    program_out = out or with_suffix(file, ".reduced.rob")
+    script_out = (sensors_out or with_suffix(sensors, ".reduced.json")
+                  if sensors is not None else None)
+    for target, role, others in (
+            (program_out, "--out", [(sensors, "the sensor script"),
+                                    (script_out, "--sensors-out")]),
+            (script_out, "--sensors-out", [(file, "the program")])):
+        if target is None:
+            continue
+        if target == "-":
+            raise click.UsageError(f"argument {role}: the result is written to a file: "
+                                   "give its path")
+        folder = os.path.dirname(os.path.abspath(target))
+        problem = ("it is a folder; name a file" if os.path.isdir(target) else
+                   f"there is no folder {folder}" if not os.path.isdir(folder) else
+                   f"the folder {folder} is not writable; write elsewhere"
+                   if not os.access(folder, os.W_OK) else
+                   "it is read-only; remove it or give another path"
+                   if refuses_writing(target) else None)
+        for other, name in others:
+            if problem is None and other is not None and (
+                    os.path.abspath(other) == os.path.abspath(target)
+                    or (os.path.exists(other) and same_file(other, target))):
+                problem = f"it is {name}: give each its own file"
+        if problem is not None:
+            raise click.UsageError(f"argument {role}: {target}: {problem}")
 
 
 def _read(file: str, sensors: str | None) -> _Files:

@@ -348,6 +348,34 @@ def test_an_output_that_cannot_be_written_is_refused_before_reducing(
         assert "rl1c reduce: lines" not in result.stderr
 
 
+def test_an_output_onto_another_input_or_nowhere_is_refused_before_reducing(
+        sample: tuple[Path, Path]) -> None:
+    program, script = sample
+    read_only = program.with_name("kept.rob")
+    read_only.write_bytes(b"")
+    read_only.chmod(0o444)
+    for args, said in (
+            (("--out", script), f"argument --out: {script}: it is the sensor script"),
+            (("--sensors-out", program), f"argument --sensors-out: {program}: it is the "
+                                         "program"),
+            (("--out", "x.rob", "--sensors-out", "x.rob"), "argument --out: x.rob: it is "
+                                                           "--sensors-out"),
+            (("--out", "-"), "argument --out: the result is written to a file"),
+            (("--out", read_only), f"argument --out: {read_only}: it is read-only")):
+        result = rl1c("reduce", program, "--sensors", script, "--interesting", GREP, *args)
+        assert result.exit_code == 2 and said in result.stderr, (args, result.output)
+        assert "rl1c reduce: lines" not in result.stderr  # refused before any test
+    assert program.read_bytes() == SAMPLE.read_bytes()
+    assert script.read_bytes() == SAMPLE_SENSORS.read_bytes()
+    assert not Path("-").exists()
+
+
+@pytest.mark.parametrize("command", ["", "   "])
+def test_an_empty_command_is_refused(command: str) -> None:
+    result = rl1c("reduce", SAMPLE, "--interesting", command)
+    assert result.exit_code == 2 and "the command is empty" in result.stderr
+
+
 def test_engines_that_agree_leave_nothing_to_reduce() -> None:
     result = rl1c("reduce", SAMPLE, "--sensors", SAMPLE_SENSORS, "--engine", "vm-O0",
                   "--engine", "vm-O2")
