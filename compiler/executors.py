@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
+import hashlib
 import logging
 import signal
 import threading
@@ -21,7 +23,10 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, Future, InvalidStateError, ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
+
+from rl1 import vm
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -93,6 +98,11 @@ def _cluster(address: str) -> Iterator[Workers]:
             f"({error})\n  = help: install the extra `{EXTRA}`: pip install 'rl1[{EXTRA}]' "
             "(or pip install distributed), on this machine and on the workers'") from None
     client = _connect(Client, address)
+    try:
+        _same_rl1(client, address)
+    except Unavailable:
+        client.close()  # type: ignore[no-untyped-call]
+        raise
     # The client logs, with tracebacks, what the campaign says in a line of its own;
     # Dask's configuration gives some of its loggers a level of their own.
     for name in ["distributed", "tornado", *logging.root.manager.loggerDict]:
@@ -103,6 +113,36 @@ def _cluster(address: str) -> Iterator[Workers]:
     finally:
         # The scheduler forgets the client's tasks left, and cancels them.
         client.close()  # type: ignore[no-untyped-call]
+
+
+@functools.cache
+def sources_digest() -> str:
+    """The SHA-256 of the Python sources of rl1's compiler and VM as installed here: two
+    machines with one digest make the same runs; a worker with another runs another
+    rl1, whose results would not be this one's (or an internal error)."""
+    digest = hashlib.sha256()
+    for package in (Path(__file__).parent, Path(vm.__file__).parent):
+        for path in sorted(package.rglob("*.py")):
+            digest.update(path.relative_to(package.parent).as_posix().encode() + b"\0")
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def _same_rl1(client: Client, address: str) -> None:
+    """Unavailable when a worker of the cluster now runs another rl1 (a worker joining
+    later is not checked)."""
+    try:
+        theirs: dict[str, str] = client.run(sources_digest)  # type: ignore[no-untyped-call]
+    except Exception as error:  # such as a worker without rl1, which cannot run it
+        raise Unavailable(f"the workers of the Dask scheduler at {address} cannot run "
+                          f"rl1 ({type(error).__name__}: {error})\n  = help: install "
+                          "this rl1 on each worker's machine") from None
+    others = sorted(worker for worker, digest in theirs.items() if digest != sources_digest())
+    if others:
+        raise Unavailable(
+            f"the Dask workers {', '.join(others)} of the scheduler at {address} run "
+            "another rl1 than this one (its sources differ), whose runs would not be this "
+            "rl1's\n  = help: install the same rl1 there, and restart those workers")
 
 
 def _connect(client: type[Client], address: str) -> Client:

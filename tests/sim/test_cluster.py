@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import shutil
 import signal
 import socket
 import subprocess
@@ -21,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
+from support import ROOT
 from support.campaigns import WALL_PROGRAM, WALL_WORLD
 from support.cli import rl1c
 
@@ -54,9 +56,10 @@ class Cluster:
             time.sleep(0.1)
         self.address = json.loads(address_file.read_text())["address"]
 
-    def start_worker(self) -> None:
+    def start_worker(self, python_path: Path | None = None) -> None:
         self._start("worker", self.address, "--host", "127.0.0.1", "--nthreads", "1",
-                    "--no-nanny", "--name", f"worker-{len(self.workers)}")
+                    "--no-nanny", "--name", f"worker-{len(self.workers)}",
+                    python_path=python_path)
 
     def wait_for_workers(self, count: int) -> None:
         from distributed import Client
@@ -65,11 +68,13 @@ class Cluster:
                     set_as_default=False) as client:
             client.wait_for_workers(count, timeout=STARTED_WITHIN)
 
-    def _start(self, role: str, *options: str) -> subprocess.Popen[bytes]:
+    def _start(self, role: str, *options: str, python_path: Path | None = None
+               ) -> subprocess.Popen[bytes]:
         # A worker killed while it makes a run fails that run at once (allowed-failures
         # 0, where Dask would try it on up to three workers first), so that the
         # campaign's own resubmission is tested.
-        env = {**os.environ, "DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0"}
+        env = {**os.environ, "DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0",
+               **({"PYTHONPATH": str(python_path)} if python_path else {})}
         with open(self.logs / f"{role}-{len(self.processes)}.log", "wb") as log:
             process = subprocess.Popen([str(BIN / "dask"), role, *options, "--no-dashboard"],
                                        stdin=subprocess.DEVNULL, stdout=log,
@@ -243,6 +248,29 @@ def test_an_address_that_is_none_says_why(tmp_path: Path, address: str, why: str
     result = rl1c("sim", program, "--world", world, "--runs", "5", "--scheduler", address)
     assert result.exit_code == 2
     assert f"error: cannot reach a Dask scheduler at {address} ({why}" in result.stderr
+
+
+def test_a_worker_running_another_rl1_is_refused_before_any_run(
+        scheduler: Cluster, tmp_path: Path) -> None:
+    # A worker left from another checkout: rl1 found first on its PYTHONPATH, a copy of
+    # this one with one line more.
+    other = tmp_path / "other" / "rl1"
+    for package in ("compiler", "vm"):
+        shutil.copytree(ROOT / package, other / package,
+                        ignore=shutil.ignore_patterns("__pycache__", "c", "node_modules"))
+    with open(other / "compiler" / "campaign.py", "a", encoding="utf-8") as changed:
+        changed.write("# another rl1\n")
+    scheduler.start_worker()
+    scheduler.start_worker(python_path=other.parent)
+    scheduler.wait_for_workers(2)
+    program, world = _wall(tmp_path)
+    out = tmp_path / "runs.jsonl"
+    result = rl1c("sim", program, "--world", world, "--runs", "5", "--scheduler",
+                  scheduler.address, "--out", out)
+    assert result.exit_code == 2, result.output + scheduler.log()
+    assert re.search(r"error: the Dask workers tcp://127\.0\.0\.1:\d+ of the scheduler at "
+                     + re.escape(scheduler.address) + " run another rl1", result.stderr)
+    assert "install the same rl1 there" in result.stderr and not out.exists()
 
 
 def test_a_server_that_is_no_scheduler_is_said(tmp_path: Path) -> None:
