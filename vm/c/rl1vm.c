@@ -495,8 +495,11 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
                 given = args;
             }
             /* pc past the call while its callbacks run: the line of the call under way is
-             * the one before it (vm/native.py's current_line) */
+             * the one before it (vm/native.py's current_line); and the instructions run so
+             * far, the call included, which a device that times them reads (the
+             * simulator's clock: vm/drive.py's drive_clocked) */
             vm->pc = (uint16_t)(next - code);
+            vm->executed = before + (n - left);
             if (call & READS) {
                 clear_reading(&out);
             }
