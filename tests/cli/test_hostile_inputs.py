@@ -16,6 +16,7 @@ from hypothesis import HealthCheck, given, settings
 from support.hostile import (
     NEW_TARGETS,
     OUTPUT_TARGETS,
+    attack_with_test_file,
     hostile_ilc_files,
     hostile_sources,
     hostile_sweeps,
@@ -26,7 +27,6 @@ from support.hostile import (
     new_attack,
     output_attack,
     source_attack,
-    test_file_attack,
     vary_attack,
     world_attack,
 )
@@ -78,7 +78,7 @@ def test_sim_survives_known_hard_world_values(value: bytes, tmp_path: Path) -> N
           suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 @given(data=hostile_test_files())
 def test_rl1c_test_survives_hostile_test_files(data: bytes, tmp_path: Path) -> None:
-    assert test_file_attack(data, tmp_path) == []
+    assert attack_with_test_file(data, tmp_path) == []
 
 
 @pytest.mark.parametrize("path", ["fifo.rob", "loop.rob", "zero.rob", "folder.rob",
@@ -86,7 +86,7 @@ def test_rl1c_test_survives_hostile_test_files(data: bytes, tmp_path: Path) -> N
 def test_rl1c_test_survives_a_test_file_naming_a_hostile_file(path: str,
                                                                tmp_path: Path) -> None:
     data = f'[[test]]\nname = "x"\nprogram = "{path}"\n'.encode()
-    assert test_file_attack(data, tmp_path) == []
+    assert attack_with_test_file(data, tmp_path) == []
 
 
 @settings(max_examples=60, deadline=None,

@@ -9,7 +9,7 @@ refused with status 2 and a message naming the file. `cache_attack` damages the 
 engine's build cache and runs `rl1c run --engine c` from it, in a process of its own.
 `transport_attack` sends `rl1-lsp --tcp` or `--ws` (a `ServedLsp`, started once for many
 inputs) hostile connections, then checks that a well-behaved client is still served.
-`test_file_attack` runs `rl1c test` on a hostile test file beside files no test should
+`attack_with_test_file` runs `rl1c test` on a hostile test file beside files no test should
 read (a FIFO, a link loop, /dev/zero); `vary_attack` a campaign with pictures and a
 seeded run on a world with a hostile [vary] table and hostile --sweep arguments;
 `new_attack` `rl1c new` into each kind of place; `output_attack` `--junit` and a
@@ -765,7 +765,7 @@ def hostile_test_files(draw: st.DrawFn) -> bytes:
     return seed + b"\n" + line + b"\n"
 
 
-def test_file_attack(data: bytes, folder: Path) -> list[str]:
+def attack_with_test_file(data: bytes, folder: Path) -> list[str]:
     """`rl1c test` on the test file `data` in a project with hostile neighbours (a FIFO,
     a link loop, /dev/zero...), with --junit: a file the loader refuses must end with
     status 2 and a message naming it, before any test runs; no input may change; a
