@@ -168,9 +168,9 @@ typedef struct {
  * hardware. Once RL1_ENDED or RL1_FAULTED, a step does nothing and says so again.
  *
  * Inside a callback (which runs inside a step), vm->state reads RL1_IN_STEP and the
- * locals of the step hold what is not yet written back: vm->acc and vm->executed are
- * stale, vm->pc is just past the call under way (so that rl1_line_at(program, vm->pc - 1)
- * names its source line), and a call writes its reserved variables and R only after its
+ * locals of the step hold what is not yet written back: vm->acc is stale; vm->pc is just
+ * past the call under way (so that rl1_line_at(program, vm->pc - 1) names its source
+ * line) and vm->executed counts the instructions run, the call included; and a call writes its reserved variables and R only after its
  * callback returns. A callback may read vm->V, post into vm->mailbox and call rl1_abort; it must
  * not call rl1_step or rl1_vm_init on the VM that called it: the nested rl1_step does
  * nothing and returns RL1_FAULTED, and when the callback returns the step faults
