@@ -170,7 +170,8 @@ typedef struct {
  * Inside a callback (which runs inside a step), vm->state reads RL1_IN_STEP and the
  * locals of the step hold what is not yet written back: vm->acc is stale; vm->pc is just
  * past the call under way (so that rl1_line_at(program, vm->pc - 1) names its source
- * line) and vm->executed counts the instructions run, the call included; and a call writes its reserved variables and R only after its
+ * line); vm->executed counts the instructions run, the call included, when the VM is
+ * built with RL1_EXECUTED_IN_CALLS=1 (a simulator's build), and is stale otherwise; a call writes its reserved variables and R only after its
  * callback returns. A callback may read vm->V, post into vm->mailbox and call rl1_abort; it must
  * not call rl1_step or rl1_vm_init on the VM that called it: the nested rl1_step does
  * nothing and returns RL1_FAULTED, and when the callback returns the step faults

@@ -53,7 +53,9 @@ C_FOLDER = Path(__file__).resolve().parent / "c"
 HEADER_FOLDER = Path(__file__).resolve().parent.parent / "spec"
 SOURCES = (C_FOLDER / "rl1vm.c", C_FOLDER / "rl1vm_load.c", C_FOLDER / "test" / "ffi.c")
 HEADERS = (C_FOLDER / "rl1vm.h", HEADER_FOLDER / "rl1_hardware.h")
-FLAGS = ("-std=c99", "-O2", "-shared", "-fPIC")
+# RL1_EXECUTED_IN_CALLS: vm->executed current inside a callback, which the simulator's
+# clock reads (drive_clocked); firmware builds leave it out (vm/c/README.md).
+FLAGS = ("-std=c99", "-O2", "-shared", "-fPIC", "-DRL1_EXECUTED_IN_CALLS=1")
 SANITIZE = ("-fsanitize=undefined", "-fno-sanitize-recover=all")
 NO_PC = 0xFFFF
 MOV, MVI = 0, 1  # RL1_MOV, RL1_MVI
