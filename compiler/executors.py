@@ -132,7 +132,7 @@ def _same_rl1(client: Client, address: str) -> None:
     """Unavailable when a worker of the cluster now runs another rl1 (a worker joining
     later is not checked)."""
     try:
-        theirs: dict[str, str] = client.run(sources_digest)  # type: ignore[no-untyped-call]
+        theirs: dict[str, str] = client.run(sources_digest)
     except Exception as error:  # such as a worker without rl1, which cannot run it
         raise Unavailable(f"the workers of the Dask scheduler at {address} cannot run "
                           f"rl1 ({type(error).__name__}: {error})\n  = help: install "
