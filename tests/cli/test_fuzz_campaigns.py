@@ -19,6 +19,7 @@ from typing import Any, TypeVar
 import pytest
 from support import ROOT
 from support.cli import rl1c
+from support.planted import BROKEN_VM
 
 from rl1.compiler import fuzz
 from rl1.compiler.cli import fuzz as fuzz_cli
@@ -214,8 +215,6 @@ def test_a_signal_keeps_the_reproducers_of_a_campaign_that_goes_on(tmp_path: Pat
 
 # --corpus -------------------------------------------------------------------------------
 
-BROKEN_VM = f"exec:{sys.executable} {ROOT / 'tests/support/broken_vm.py'} " \
-            "{ilc} {sensors} {budget}"
 
 
 def test_a_corpus_runs_first_and_its_disagreement_is_shrunk_and_written(

@@ -17,6 +17,7 @@ from hypothesis import find, given
 from hypothesis import strategies as st
 from support import ROOT
 from support.cli import rl1c
+from support.planted import BROKEN_VM, BrokenShift
 
 from rl1.compiler import differential, fuzz
 from rl1.compiler.differential import (
@@ -30,12 +31,8 @@ from rl1.compiler.differential import (
 )
 from rl1.compiler.frontend.source import split_lines
 from rl1.compiler.strategies import Run
-from rl1.vm import machine
 
-PYTHON = shlex.quote(sys.executable)
 RL1C = shlex.quote(str(Path(sys.executable).with_name("rl1c")))
-BROKEN_VM = f"exec:{PYTHON} {shlex.quote(str(ROOT / 'tests/support/broken_vm.py'))} " \
-            "{ilc} {sensors} {budget}"
 
 
 def test_the_built_in_engines_agree_and_the_summary_says_so() -> None:
@@ -99,21 +96,6 @@ def test_an_engine_that_crashes_is_a_finding_shrunk_like_a_disagreement(
     assert len(split_lines(outcome.finding.case.source)) <= 5
 
 
-class _BrokenShift:
-    """The reference VM at -O0 with `1<-1` giving 1 (a negative count shifts left by
-    nothing), in this process: a planted bug found in a few programs."""
-
-    name = "broken-shift"
-    level = 0
-
-    def run(self, case: Run, budget: int) -> Observation:
-        right = machine._shift_left
-        with pytest.MonkeyPatch.context() as patch:
-            patch.setattr(machine, "_shift_left", lambda value, count: value if count < 0
-                          else right(value, count))
-            return VmEngine(0).run(case, budget)
-
-
 class _Clock:
     """time.monotonic for fuzz.py on a machine so loaded that a minute passes between
     two runs."""
@@ -130,7 +112,7 @@ def test_a_seed_gives_the_same_reproducer_however_long_the_runs_take(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     # Shrinking was bounded by 20 seconds: a loaded machine wrote a larger reproducer.
     monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 60)
-    engines: list[Engine] = [VmEngine(0), _BrokenShift()]
+    engines: list[Engine] = [VmEngine(0), BrokenShift()]
     folders = []
     for clock in (time, _Clock()):
         monkeypatch.setattr(fuzz, "time", clock)

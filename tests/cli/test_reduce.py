@@ -18,21 +18,19 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from support import ROOT, SAMPLE, SAMPLE_SENSORS
+from support import SAMPLE, SAMPLE_SENSORS
 from support.cli import rl1c
+from support.planted import BROKEN_VM, BrokenShift
 
 from rl1.compiler import fuzz
 from rl1.compiler.analysis import analyze
-from rl1.compiler.differential import Engine, Observation, VmEngine, judge
+from rl1.compiler.differential import Engine, VmEngine, judge
 from rl1.compiler.reduce import Case, NotInteresting, reduce, smaller_numbers
 from rl1.compiler.strategies import Run, checked_programs, sensor_scripts
-from rl1.vm import machine
 from rl1.vm.sensor_script import decode_script
 
 PYTHON = shlex.quote(sys.executable)
 RL1C = str(Path(sys.executable).with_name("rl1c"))
-BROKEN_VM = f"exec:{PYTHON} {shlex.quote(str(ROOT / 'tests/support/broken_vm.py'))} " \
-            "{ilc} {sensors} {budget}"
 
 
 TESTS = 2000  # the tests a reduction may run, far more than these take
@@ -53,24 +51,9 @@ def test_a_program_is_reduced_to_the_one_statement_that_matters() -> None:
     assert reduction.finished and reduction.tests < 100
 
 
-class _BrokenShift:
-    """The reference VM at -O0 with `1<-1` giving 1 (a negative count shifts left by
-    nothing): a planted bug."""
-
-    name = "broken-shift"
-    level = 0
-
-    def run(self, case: Run, budget: int) -> Observation:
-        right = machine._shift_left
-        with pytest.MonkeyPatch.context() as patch:
-            patch.setattr(machine, "_shift_left", lambda value, count: value if count < 0
-                          else right(value, count))
-            return VmEngine(0).run(case, budget)
-
-
 def disagrees(case: Case) -> bool:
     """Interesting: the planted bug shows (vm-O0 and the broken VM disagree)."""
-    engines: list[Engine] = [VmEngine(0), _BrokenShift()]
+    engines: list[Engine] = [VmEngine(0), BrokenShift()]
     return bool(judge(Run(case.source, json.loads(case.script or "{}")), engines,
                       20_000).problems)
 
@@ -388,7 +371,7 @@ def test_rl1c_fuzz_reduces_its_finding_with_these_passes(monkeypatch: pytest.Mon
     # Hypothesis' shrinking for 40 runs, then lines and statements deleted, left
     # ` j=$0011\t<$FA8D^ $0100+t +136&$41c` and a script of seven keys.
     monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 40)
-    engines: list[Engine] = [VmEngine(0), _BrokenShift()]
+    engines: list[Engine] = [VmEngine(0), BrokenShift()]
     outcome = fuzz.campaign(engines, 20_000, count=300, seconds=None, seed=1,
                             progress=lambda programs, elapsed: None)
     assert outcome.finding is not None
