@@ -151,19 +151,27 @@ def test_a_campaign_on_a_cluster_is_the_local_campaign_byte_for_byte(
     assert "success: " in local and "argument-range at line 4" in local  # runs of both kinds
 
 
+def _under_way(program: Path, world: Path, runs: int, address: str, out: Path, made: int
+               ) -> subprocess.Popen[str]:
+    """`rl1c sim --runs` on the cluster at `address`, once it has written `made` runs to
+    `out` (or ended, or taken too long)."""
+    process = subprocess.Popen([str(BIN / "rl1c"), "sim", str(program), "--world", str(world),
+                                "--runs", str(runs), "--budget", "10000", "--scheduler",
+                                address, "--out", str(out)],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + STARTED_WITHIN
+    while (not out.exists() or out.read_text().count("\n") < made) \
+            and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return process
+
+
 def test_a_worker_killed_in_a_campaign_on_a_cluster_loses_no_run(
         cluster: Cluster, tmp_path: Path) -> None:
     program, world = _wall(tmp_path)
     runs = 1000
     out = tmp_path / "cluster.jsonl"
-    with subprocess.Popen([str(BIN / "rl1c"), "sim", str(program), "--world", str(world),
-                           "--runs", str(runs), "--budget", "10000", "--scheduler",
-                           cluster.address, "--out", str(out)],
-                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
-        deadline = time.monotonic() + STARTED_WITHIN
-        while (not out.exists() or out.read_text().count("\n") < 100) \
-                and process.poll() is None and time.monotonic() < deadline:
-            time.sleep(0.05)
+    with _under_way(program, world, runs, cluster.address, out, made=100) as process:
         victim = cluster.workers[0]
         victim.send_signal(signal.SIGKILL)
         victim.wait()
@@ -343,14 +351,7 @@ def test_a_scheduler_lost_in_a_campaign_keeps_its_runs_and_says_how_to_go_on(
     program, world = _wall(tmp_path)
     runs = 100_000
     out = tmp_path / "cluster.jsonl"
-    with subprocess.Popen([str(BIN / "rl1c"), "sim", str(program), "--world", str(world),
-                           "--runs", str(runs), "--budget", "10000", "--scheduler",
-                           cluster.address, "--out", str(out)],
-                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as process:
-        deadline = time.monotonic() + STARTED_WITHIN
-        while (not out.exists() or out.read_text().count("\n") < 50) \
-                and process.poll() is None and time.monotonic() < deadline:
-            time.sleep(0.05)
+    with _under_way(program, world, runs, cluster.address, out, made=50) as process:
         cluster.processes[0].kill()  # the scheduler
         stdout, stderr = process.communicate(timeout=STARTED_WITHIN)
     assert process.returncode == 2, stderr
