@@ -98,16 +98,16 @@ def _cluster(address: str) -> Iterator[Workers]:
             f"({error})\n  = help: install the extra `{EXTRA}`: pip install 'rl1[{EXTRA}]' "
             "(or pip install distributed), on this machine and on the workers'") from None
     client = _connect(Client, address)
-    try:
-        _same_rl1(client, address)
-    except Unavailable:
-        client.close()  # type: ignore[no-untyped-call]
-        raise
     # The client logs, with tracebacks, what the campaign says in a line of its own;
     # Dask's configuration gives some of its loggers a level of their own.
     for name in ["distributed", "tornado", *logging.root.manager.loggerDict]:
         if name.partition(".")[0] in ("distributed", "tornado"):
             logging.getLogger(name).setLevel(logging.CRITICAL)
+    try:
+        _same_rl1(client, address)
+    except Unavailable:
+        client.close()  # type: ignore[no-untyped-call]
+        raise
     try:
         yield Workers(_Watched(client, address), _threads(client), (KilledWorker,))
     finally:
@@ -133,6 +133,9 @@ def _same_rl1(client: Client, address: str) -> None:
     later is not checked)."""
     try:
         theirs: dict[str, str] = client.run(sources_digest)
+    except OSError as error:  # the scheduler gone since it was reached
+        raise Unavailable(f"the connection to the Dask scheduler at {address} was lost "
+                          f"({error})") from None
     except Exception as error:  # such as a worker without rl1, which cannot run it
         raise Unavailable(f"the workers of the Dask scheduler at {address} cannot run "
                           f"rl1 ({type(error).__name__}: {error})\n  = help: install "
