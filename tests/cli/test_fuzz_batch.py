@@ -17,6 +17,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from support import ROOT
 from support.cli import rl1c
+from support.processes import ends_within
 
 from rl1.compiler import differential, fuzz
 from rl1.compiler.cli import run_batch
@@ -122,7 +123,7 @@ def test_a_dead_lying_or_hanging_engine_is_a_run_that_disagrees_never_a_hang(
     engine = _batch(command)
     started = time.monotonic()
     observation = engine.run(CASE, 20_000)
-    assert time.monotonic() - started < 5
+    assert time.monotonic() - started < 60  # a hang guard: the timeout is 1 s
     status = observation.document["status"]
     assert observation.ending()["code"] == code  # type: ignore[index]
     if said:
@@ -153,12 +154,7 @@ def test_a_stopped_engine_leaves_no_process_behind(tmp_path: Path) -> None:
     engine = _batch(f"sleep 300 & echo $! > {pid_file}; cat > /dev/null")
     assert engine.run(CASE, 20_000).ending()["code"] == "timeout"  # type: ignore[index]
     pid = int(pid_file.read_text(encoding="ascii"))
-    for _ in range(50):  # the kill is sent; the process goes within moments
-        stat = Path(f"/proc/{pid}/stat")
-        if not stat.exists() or stat.read_text().split()[2] == "Z":
-            break
-        time.sleep(0.1)
-    else:
+    if not ends_within(pid, seconds=10.0):
         os.kill(pid, 9)
         pytest.fail("the engine's child still runs")
 
