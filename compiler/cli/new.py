@@ -51,9 +51,11 @@ def new(folder: str) -> int:
         else:
             os.chmod(building, 0o777 & ~_umask())  # mkdtemp's folder is the owner's alone
             os.rename(building, target)
-    except OSError as error:
+    except BaseException as error:  # Ctrl-C too: the temporary folder never stays
         with contextlib.suppress(OSError):
             shutil.rmtree(building)
+        if not isinstance(error, OSError):
+            raise
         if os.path.isdir(target) and os.listdir(target):  # filled in the meantime
             _refuse_unless_empty(folder, target)
         raise _cannot_create(folder, error) from None
@@ -79,7 +81,7 @@ def _move_into(building: str, target: str) -> None:
             os.rename(os.path.join(building, entry), destination)
             moved.append(destination)
         os.rmdir(building)
-    except OSError:
+    except BaseException:  # Ctrl-C too: the folder is left as empty as it was
         for destination in moved:
             with contextlib.suppress(OSError):
                 if os.path.isdir(destination) and not os.path.islink(destination):

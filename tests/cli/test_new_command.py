@@ -165,3 +165,28 @@ def test_a_failure_on_the_way_leaves_nothing(tmp_path: Path,
     assert "cannot create the project folder" in result.stderr
     assert "no space left on device" in result.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(("empty_folder", "interrupted_at"),
+                         [(False, 1), (True, 1), (True, 2), (True, 4)])
+def test_ctrl_c_on_the_way_leaves_nothing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                          interrupted_at: int, empty_folder: bool) -> None:
+    # Only an OSError was cleaned up: Ctrl-C left a hidden `.robot.XXXX.tmp` beside DIR,
+    # or, moving into an empty DIR, the files moved so far.
+    folder = tmp_path / "robot"
+    if empty_folder:
+        folder.mkdir()
+    rename = os.rename
+    calls = []
+
+    def interrupted(source: str, target: str) -> None:
+        calls.append(target)
+        if len(calls) == interrupted_at:
+            raise KeyboardInterrupt
+        rename(source, target)
+
+    monkeypatch.setattr(os, "rename", interrupted)
+    result = rl1c("new", folder)
+    assert result.exit_code == 130
+    assert [path.name for path in tmp_path.iterdir()] == (["robot"] if empty_folder else [])
+    assert not empty_folder or list(folder.iterdir()) == []
