@@ -333,7 +333,7 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     report = sys.stderr if out == "-" else sys.stdout
     points = grid(setting.sweep)
     keeper = Keeper(setting.runs, points, lines,
-                    Overlay(setting.runs * len(points)) if pictures.wanted else None)
+                    Overlay() if pictures.wanted else None)
     progress = Progress(setting.runs * len(points), sys.stderr)
     status = 0
     lost: SchedulerLost | None = None

@@ -13,6 +13,8 @@ from pathlib import Path
 from typing import cast
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from support.cli import rl1c
 from support.hold import HOLD_WORLD
 
@@ -164,14 +166,26 @@ def test_a_sweep_s_picture_is_its_heat_map(tmp_path: Path) -> None:
 
 def test_a_picture_keeps_a_bounded_sample_of_a_large_campaign() -> None:
     total = 10_000
-    overlay = Overlay(total)
+    overlay = Overlay()
     path = tuple((float(i), 0.0) for i in range(64))
     for seed in range(total):
         overlay.add(Run(seed, path, (0.0, 0.0), "collision" if seed % 3 == 0 else None))
-    assert len(overlay.paths) == MAX_PATHS
-    assert [run.seed for run in overlay.paths] == list(range(0, total, total // MAX_PATHS))
+    assert MAX_PATHS // 2 <= len(overlay.paths) <= MAX_PATHS
+    assert [run.seed for run in overlay.paths] == list(range(0, total, overlay.every))
     assert len(overlay.marks) == MAX_MARKS
     assert overlay.kinds == {"collision": 3334}
+
+
+@given(st.integers(1, 5 * MAX_PATHS))
+def test_a_campaign_stopped_at_any_point_shows_paths_spread_over_its_runs(runs: int) -> None:
+    # The sample was every ceil(planned / MAX_PATHS)-th run: a campaign of 100,000 runs
+    # stopped by Ctrl-C after 300 showed the paths of 2.
+    overlay = Overlay()
+    for seed in range(runs):
+        overlay.add(Run(seed, (), (0.0, 0.0)))
+    assert len(overlay.paths) == min(runs, len(range(0, runs, overlay.every)))
+    assert min(runs, MAX_PATHS // 2) <= len(overlay.paths) <= MAX_PATHS
+    assert [run.seed for run in overlay.paths] == list(range(0, runs, overlay.every))
 
 
 def test_a_record_carries_a_thinned_path_only_when_asked() -> None:

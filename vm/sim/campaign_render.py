@@ -10,7 +10,6 @@ evenly over the campaign, and the first MAX_MARKS failures; the picture says so.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from html import escape
@@ -43,23 +42,26 @@ class Run:
 
 @dataclass(slots=True)
 class Overlay:
-    """What a picture keeps of a campaign of `total` runs, given in order: the paths of
-    every `every`-th run, at most MAX_PATHS, and the first MAX_MARKS failures; and the
-    counts of all."""
+    """What a picture keeps of a campaign's runs, given in order: the paths of every
+    `every`-th run, and the first MAX_MARKS failures; and the counts of all.
 
-    total: int
+    `every` doubles (and every other path kept goes) each time the paths would pass
+    MAX_PATHS, so that however many runs were planned, a campaign stopped at any point
+    shows from MAX_PATHS / 2 to MAX_PATHS paths spread evenly over the runs it made."""
+
     runs: int = 0
+    every: int = 1
     paths: list[Run] = field(default_factory=list)
     marks: list[Run] = field(default_factory=list)
     kinds: dict[str, int] = field(default_factory=dict)  # failures of each kind, in order
 
-    @property
-    def every(self) -> int:
-        return max(1, math.ceil(self.total / MAX_PATHS))
-
     def add(self, run: Run) -> None:
-        if self.runs % self.every == 0 and len(self.paths) < MAX_PATHS:
-            self.paths.append(run)
+        if self.runs % self.every == 0:
+            if len(self.paths) == MAX_PATHS:
+                self.every *= 2
+                self.paths = self.paths[::2]
+            if self.runs % self.every == 0:
+                self.paths.append(run)
         self.runs += 1
         if run.kind is not None:
             self.kinds[run.kind] = self.kinds.get(run.kind, 0) + 1
