@@ -42,9 +42,15 @@ class Unavailable(Exception):
     error's message, without the word `error:` the command line puts first)."""
 
 
-class SchedulerLost(Exception):
-    """The work a cluster had not finished when the connection to its scheduler was lost
-    for good (its message names the scheduler)."""
+class ClusterLost(Exception):
+    """The work a cluster had not finished when it could no longer do it: the connection
+    to its scheduler lost for good, or a worker that joined later runs another rl1 (its
+    message says which)."""
+
+
+class _OtherRl1(Exception):
+    """Raised on a worker whose rl1 is not the client's; its argument is the worker's
+    address."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -130,7 +136,7 @@ def sources_digest() -> str:
 
 def _same_rl1(client: Client, address: str) -> None:
     """Unavailable when a worker of the cluster now runs another rl1 (a worker joining
-    later is not checked)."""
+    later is checked by each task it is given: `_checked`)."""
     try:
         theirs: dict[str, str] = client.run(sources_digest)
     except OSError as error:  # the scheduler gone since it was reached
@@ -181,7 +187,7 @@ T = TypeVar("T")
 
 class _Watched(Executor):
     """The executor of a Dask client, whose work not yet finished fails with
-    SchedulerLost once the client gives up reconnecting to its scheduler: Dask's own
+    ClusterLost once the client gives up reconnecting to its scheduler: Dask's own
     futures are then cancelled, or wait for ever."""
 
     def __init__(self, client: Client, address: str) -> None:
@@ -205,7 +211,7 @@ class _Watched(Executor):
 
     def _fail(self, future: Future[Any]) -> None:
         with contextlib.suppress(InvalidStateError):  # finished, or cancelled
-            future.set_exception(SchedulerLost(
+            future.set_exception(ClusterLost(
                 f"the connection to the Dask scheduler at {self._address} was lost"))
 
     def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
@@ -214,7 +220,7 @@ class _Watched(Executor):
         if self._lost():  # given up: Dask's future would wait for ever
             self._fail(future)
             return future
-        dask = self._executor.submit(fn, *args, **kwargs)
+        dask = self._executor.submit(_checked, sources_digest(), fn, *args, **kwargs)
         future.add_done_callback(lambda done: done.cancelled() and dask.cancel())
         dask.add_done_callback(lambda done: self._pass(done, future))
         if self._lost():  # given up since, perhaps after the watcher's last look
@@ -229,6 +235,11 @@ class _Watched(Executor):
             return
         with contextlib.suppress(InvalidStateError):  # cancelled by the campaign
             error = dask.exception()
+            if isinstance(error, _OtherRl1):
+                error = ClusterLost(
+                    f"the Dask worker {error.args[0]}, which joined the scheduler at "
+                    f"{self._address} after the start, runs another rl1 than this one (its "
+                    "sources differ; install the same rl1 there, and restart that worker)")
             if error is None:
                 future.set_result(dask.result())
             else:
@@ -236,6 +247,17 @@ class _Watched(Executor):
 
     def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
         self._executor.shutdown(wait=False)  # the client's close cancels what is left
+
+
+def _checked(digest: str, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> T:
+    """`fn(*args, **kwargs)` on a cluster's worker, once it is known to run the client's
+    rl1 (whose sources have `digest`): the workers were checked when the campaign began,
+    but one may join later."""
+    if sources_digest() != digest:
+        from distributed import get_worker
+
+        raise _OtherRl1(get_worker().address)
+    return fn(*args, **kwargs)
 
 
 def _threads(client: Client) -> int:

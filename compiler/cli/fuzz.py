@@ -131,7 +131,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         raise Failure("error: rl1c fuzz generates programs with Hypothesis, an optional "
                       "part of rl1 that is not installed here; install it with "
                       "`pip install 'rl1[fuzz]'` (or `pip install hypothesis`)") from None
-    from rl1.compiler.executors import SchedulerLost, Unavailable, workers
+    from rl1.compiler.executors import ClusterLost, Unavailable, workers
     from rl1.vm.native import BuildError
 
     from .sim_campaign import MAX_JOBS
@@ -198,7 +198,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
                                corpus=corpus, statistics=fuzz_format == "json",
                                lost=held.lost)
     # Such as no C compiler for c-ON, or a cluster that cannot be had or was lost.
-    except (BuildError, EngineUnavailable, Unavailable, SchedulerLost) as error:
+    except (BuildError, EngineUnavailable, Unavailable, ClusterLost) as error:
         raise Failure(f"error: {error}") from None
     except BrokenExecutor:
         raise Failure("error: a worker process ended abruptly (killed, or out of memory); "

@@ -34,7 +34,7 @@ from rl1.compiler.campaign import (
     wilson,
     world_of,
 )
-from rl1.compiler.executors import SchedulerLost, Unavailable, Workers, workers
+from rl1.compiler.executors import ClusterLost, Unavailable, Workers, workers
 from rl1.compiler.reporting.render import EXIT_USAGE, ColorChoice
 from rl1.compiler.sweep import Axis, Point, grid, heat_map, table
 from rl1.vm.defaults import DEFAULT_BUDGET, Engine
@@ -336,7 +336,7 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
                     Overlay() if pictures.wanted else None)
     progress = Progress(setting.runs * len(points), sys.stderr)
     status = 0
-    lost: SchedulerLost | None = None
+    lost: ClusterLost | None = None
     stopping = Stopping()
     broken_at = None  # the point and the first seed left when the workers last broke
     try:
@@ -360,7 +360,7 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
                     current = held.enter_context(_workers(setting))
     except Stopped as stop:  # again, while the workers end their runs
         status = stop.status
-    except SchedulerLost as error:
+    except ClusterLost as error:
         status, lost = EXIT_USAGE, error
     finally:
         progress.finish()
@@ -394,12 +394,12 @@ def _make_runs(task: Task, seeds: range, held: Workers, keeper: Keeper,
                progress: Progress, stopping: Stopping) -> int:
     """Make the runs of `seeds` on `held`, keeping each; 0, the status of a signal that
     stopped them, or EXIT_INTERNAL when a run was lost with its worker each time it was
-    made. BrokenExecutor when a local worker process ended abruptly, SchedulerLost when
+    made. BrokenExecutor when a local worker process ended abruptly, ClusterLost when
     a cluster's scheduler was lost, after keeping the runs finished before the first
     lost."""
     runs = Campaign(task, seeds, held.executor, WINDOW_PER_JOB * max(held.slots, 1),
                     held.lost)
-    ending: tuple[type[BaseException], ...] = (Stopped, BrokenExecutor, SchedulerLost,
+    ending: tuple[type[BaseException], ...] = (Stopped, BrokenExecutor, ClusterLost,
                                                *held.lost)
     try:
         for record in runs:
@@ -413,7 +413,7 @@ def _make_runs(task: Task, seeds: range, held: Workers, keeper: Keeper,
         match stop:
             case Stopped():
                 return stop.status
-            case BrokenExecutor() | SchedulerLost():
+            case BrokenExecutor() | ClusterLost():
                 raise
         return EXIT_INTERNAL
     return 0

@@ -258,18 +258,22 @@ def test_an_address_that_is_none_says_why(tmp_path: Path, address: str, why: str
     assert f"error: cannot reach a Dask scheduler at {address} ({why}" in result.stderr
 
 
-def test_a_worker_running_another_rl1_is_refused_before_any_run(
-        scheduler: Cluster, tmp_path: Path) -> None:
-    # A worker left from another checkout: rl1 found first on its PYTHONPATH, a copy of
-    # this one with one line more.
-    other = tmp_path / "other" / "rl1"
+def _other_rl1(folder: Path) -> Path:
+    """The PYTHONPATH of a worker left from another checkout: rl1 found first there, a
+    copy of this one with one line more."""
+    other = folder / "other" / "rl1"
     for package in ("compiler", "vm"):
         shutil.copytree(ROOT / package, other / package,
                         ignore=shutil.ignore_patterns("__pycache__", "c", "node_modules"))
     with open(other / "compiler" / "campaign.py", "a", encoding="utf-8") as changed:
         changed.write("# another rl1\n")
+    return other.parent
+
+
+def test_a_worker_running_another_rl1_is_refused_before_any_run(
+        scheduler: Cluster, tmp_path: Path) -> None:
     scheduler.start_worker()
-    scheduler.start_worker(python_path=other.parent)
+    scheduler.start_worker(python_path=_other_rl1(tmp_path))
     scheduler.wait_for_workers(2)
     program, world = _wall(tmp_path)
     out = tmp_path / "runs.jsonl"
@@ -279,6 +283,32 @@ def test_a_worker_running_another_rl1_is_refused_before_any_run(
     assert re.search(r"error: the Dask workers tcp://127\.0\.0\.1:\d+ of the scheduler at "
                      + re.escape(scheduler.address) + " run another rl1", result.stderr)
     assert "install the same rl1 there" in result.stderr and not out.exists()
+
+
+def test_a_worker_running_another_rl1_that_joins_later_stops_the_campaign(
+        scheduler: Cluster, tmp_path: Path) -> None:
+    # Only the workers there at the start were checked: a later one made runs of its own
+    # rl1, which the campaign kept as this one's.
+    program, world = _wall(tmp_path)
+    out, said = tmp_path / "runs.jsonl", tmp_path / "stderr.txt"
+    with open(said, "w") as stderr, subprocess.Popen(
+            [str(BIN / "rl1c"), "sim", str(program), "--world", str(world), "--runs", "50",
+             "--budget", "10000", "--scheduler", scheduler.address, "--out", str(out)],
+            stdout=subprocess.PIPE, stderr=stderr, text=True) as process:
+        deadline = time.monotonic() + STARTED_WITHIN
+        while "has no workers yet" not in said.read_text():
+            assert process.poll() is None and time.monotonic() < deadline, said.read_text()
+            time.sleep(0.1)
+        scheduler.start_worker(python_path=_other_rl1(tmp_path))
+        stdout, _ = process.communicate(timeout=STARTED_WITHIN)
+    assert process.returncode == 2, said.read_text() + scheduler.log()
+    assert re.search(r"rl1c: error: the Dask worker tcp://127\.0\.0\.1:\d+, which joined the "
+                     f"scheduler at {re.escape(scheduler.address)} after the start, runs "
+                     r"another rl1 than this one \(its sources differ; install the same rl1 "
+                     r"there, and restart that worker\): the runs finished are kept",
+                     said.read_text()), said.read_text()
+    assert "Traceback" not in said.read_text()
+    assert out.read_text() == "" and "(stopped after 0 of 50)" in stdout
 
 
 def test_a_server_that_is_no_scheduler_is_said(tmp_path: Path) -> None:
