@@ -395,7 +395,7 @@ class Connection:
         self.close()
         self.notify("run/ended", {"status": None, "variables": None, "instructions": None,
                                   "deviceTime": None, "goal": None, "frame": None,
-                                  "trace": [], "events": []})
+                                  "trace": [], "events": [], "image": None})
         return {}
 
     async def _set_speed(self, params: dict[str, Any]) -> dict[str, Any]:

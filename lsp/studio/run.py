@@ -39,6 +39,7 @@ from rl1.vm.sensor_script import Script
 from rl1.vm.sim.device import SimDevice, SimEntry
 from rl1.vm.sim.motion import Pose, heading_degrees
 from rl1.vm.sim.render import describe_call
+from rl1.vm.sim.sightings import SightingImages
 from rl1.vm.sim.simulator import Event, Simulator
 from rl1.vm.sim.world import World
 
@@ -91,6 +92,9 @@ class Run:
         self._anchor = (0.0, 0.0)  # the wall time and simulated time the pace is kept from
         self._next_frame = -math.inf  # when the next frame is due (time.monotonic)
         self._told_trace = self._told_events = 0
+        # The (IMG)s counted when an image was last told, in any notification, in a stop.
+        self._imaged = self._imaged_at_stop = 0
+        self._images = None if launch.world is None else SightingImages(launch.world)
         self._seen: dict[str, int] = {}
         self.busy = False  # a command is under way (the loop's view)
         self.over = False  # the run has ended (the loop's view)
@@ -254,6 +258,7 @@ class Run:
     def _started(self) -> None:
         """A start of the run (the launch, a restart): nothing told of it yet."""
         self._told_trace = self._told_events = 0
+        self._imaged = self._imaged_at_stop = 0
         self._seen = self.session.variables
         self._next_frame = -math.inf
 
@@ -264,7 +269,7 @@ class Run:
         return {"reason": stop.reason, "line": stop.line, "text": stop.text,
                 "variables": variables, "changed": changed,
                 "device": self.session.device_state(), "frame": self._frame_now(),
-                **self._news()}
+                **self._news(stop=True)}
 
     def _ended(self) -> dict[str, Any]:
         session = self.session
@@ -285,15 +290,17 @@ class Run:
         return {"status": status, "variables": result.named(),
                 "instructions": session.machine.executed, "deviceTime": device_time,
                 "goal": None if verdict is None else verdict.to_json(),
-                "frame": self._frame_now(), **self._news()}
+                "frame": self._frame_now(), **self._news(stop=True)}
 
     def _frame_now(self) -> dict[str, Any] | None:
         if self._simulation is None:
             return None
         return frame(self._simulation.device.sim, self.session.line)
 
-    def _news(self) -> dict[str, Any]:
-        """The trace entries and events since the last told."""
+    def _news(self, stop: bool = False) -> dict[str, Any]:
+        """The trace entries and events since the last told, and the last (IMG)'s image
+        when one came since then (in a stop: since the last stop, so that a frame the
+        connection dropped loses none the page keeps)."""
         trace = self.session.trace
         new_trace = trace[self._told_trace:]
         self._told_trace = len(trace)
@@ -303,7 +310,21 @@ class Run:
             events = recorded[self._told_events:]
             self._told_events = len(recorded)
         return {"trace": [trace_entry(entry) for entry in new_trace],
-                "events": [event_json(event) for event in events]}
+                "events": [event_json(event) for event in events],
+                "image": self._new_image(stop)}
+
+    def _new_image(self, stop: bool) -> dict[str, Any] | None:
+        if self._simulation is None or self._images is None:
+            return None
+        sightings = self._simulation.device.sightings
+        if sightings.added == (self._imaged_at_stop if stop else self._imaged):
+            return None
+        self._imaged = sightings.added
+        if stop:
+            self._imaged_at_stop = sightings.added
+        latest = sightings.latest
+        assert latest is not None
+        return self._images.encoded(latest)
 
 
 def pose_json(pose: Pose) -> list[float]:

@@ -150,12 +150,13 @@ def test_the_replay_frames_are_the_images_the_camera_saw(
     _, page = pictures
     frames = replay_data(page)["frames"]
     assert len(frames) == 2
-    *_, columns, rows, bits, window, reading = frames[0]
+    columns, rows, bits, window, reading = (frames[0][key] for key in (
+        "columns", "rows", "bits", "window", "reading"))
     assert isinstance(bits, str) and isinstance(columns, int) and isinstance(rows, int)
     image = np.unpackbits(np.frombuffer(base64.b64decode(bits), dtype=np.uint8))
     # The line across the window: the set pixels are the area IMG returned.
     assert int(image[:columns * rows].sum()) == reading[0] == 156
-    assert window == [98, 117, 158, 123] and frames[1][7][0] == 0  # the line lost at last
+    assert window == [98, 117, 158, 123] and frames[1]["reading"][0] == 0  # the line lost at last
 
 
 def test_the_page_holds_the_plots_and_nothing_from_outside(
@@ -173,7 +174,7 @@ def test_a_replay_page_holds_a_bounded_number_of_frames() -> None:
     frames = replay_data(html(world, [(0.0, Pose(500, 500, 0))], [], [], "",
                               sightings))["frames"]
     assert len(frames) <= MAX_FRAMES
-    assert frames[0][0] == 0 and frames[-1][0] > 99 - 100 / MAX_FRAMES
+    assert frames[0]["time"] == 0 and frames[-1]["time"] > 99 - 100 / MAX_FRAMES
 
 
 def test_sightings_keep_the_first_and_the_last() -> None:

@@ -11,24 +11,22 @@ a log of calls and events with their source lines, the camera's binary image at 
 
 from __future__ import annotations
 
-import base64
 import json
 import math
 from collections.abc import Callable, Iterable, Sequence
 from html import escape
 from itertools import pairwise
+from typing import Any
 
-import numpy as np
-
-from .camera import Scenery, View, focal
+from .camera import View, focal
 from .device import SimEntry
 from .geometry import Point, rectangle
 from .goal import Goal, Verdict
 from .motion import Pose
-from .sightings import Sighting
+from .sightings import Sighting, SightingImages
 from .simulator import Event
 from .ultrasonic import SENSORS
-from .world import Scene, World
+from .world import World
 
 OUTLINE_EVERY = 40.0  # cm of travel (or, turning, its equivalent) between two outlines
 REPLAY_CALLS = 10_000
@@ -57,7 +55,6 @@ _PATH = "#1565c0"
 _CAMERA = "#0a8"
 _ULTRASONIC = "#c2185b"
 _TEXT = 'font-family="sans-serif"'
-_EMPTY_SCENE = Scene((), (0, 0, 1, 1))
 
 
 class _Plane:
@@ -415,22 +412,12 @@ def _svg(world: World, track: Sequence[tuple[float, Pose]], events: Sequence[Eve
 
 # The replay page -----------------------------------------------------------------------
 
-def _frames(world: World, sightings: Sequence[Sighting]) -> list[list[object]]:
+def _frames(world: World, sightings: Sequence[Sighting]) -> list[dict[str, Any]]:
     """The camera's binary image at each of at most MAX_FRAMES sightings, spread over the
-    run: [time, left, top, columns, rows, bits (packed, base64), window, reading]."""
-    chosen = sightings[::_every(sightings, MAX_FRAMES)]
-    sceneries: dict[int, Scenery] = {}
-    frames: list[list[object]] = []
-    for sighting in chosen:
-        scenery = sceneries.get(sighting.scene)
-        if scenery is None:
-            scenery = sceneries[sighting.scene] = Scenery(
-                world, world.scenes.get(sighting.scene, _EMPTY_SCENE))
-        image, (left, top) = scenery.render(sighting.view)
-        bits = base64.b64encode(np.packbits(image, axis=None).tobytes()).decode()
-        frames.append([round(sighting.time, 3), left, top, image.shape[1], image.shape[0],
-                       bits, list(scenery.window), list(sighting.reading)])
-    return frames
+    run (SightingImages.encoded)."""
+    images = SightingImages(world)
+    return [images.encoded(sighting)
+            for sighting in sightings[::_every(sightings, MAX_FRAMES)]]
 
 
 def wheel_speeds(world: World, track: Sequence[tuple[float, Pose]]
@@ -626,11 +613,11 @@ camera.width = run.image[0]; camera.height = run.image[1];
 const cursors = Array.from(document.querySelectorAll(".plot .cursor"));
 let time = 0, playing = false, last = null, shownLog = -1, shownFrame = -2;
 // The index of the last item whose time is at or before t (-1: none).
-function upTo(items, t) {{
+function upTo(items, t, timeOf = item => item[0]) {{
   let lo = -1, hi = items.length - 1;
   while (lo < hi) {{
     const mid = (lo + hi + 1) >> 1;
-    if (items[mid][0] <= t) lo = mid; else hi = mid - 1;
+    if (timeOf(items[mid]) <= t) lo = mid; else hi = mid - 1;
   }}
   return lo;
 }}
@@ -663,14 +650,14 @@ function drawLog() {{
   lineShown.textContent = call ? "line " + call[2] + ": " + call[3] : "";
 }}
 function drawCamera() {{
-  const i = upTo(run.frames, time), j = upTo(run.sights, time);
+  const i = upTo(run.frames, time, frame => frame.time), j = upTo(run.sights, time);
   sight.setAttribute("points", j < 0 ? "" : run.sights[j][1].map(([x, y]) =>
     screen(x, y)).join(" "));
   if (i === shownFrame) return;
   shownFrame = i;
   context.fillStyle = "#000"; context.fillRect(0, 0, camera.width, camera.height);
   if (i < 0) {{ frameText.textContent = "no IMG yet"; return; }}
-  const [t, left, top, columns, rows, bits, win, reading] = run.frames[i];
+  const {{time: t, left, top, columns, rows, bits, window: win, reading}} = run.frames[i];
   const bytes = atob(bits), pixels = context.createImageData(camera.width, camera.height);
   for (let r = 0; r < rows; r++) for (let c = 0; c < columns; c++) {{
     const k = r * columns + c;
