@@ -11,6 +11,7 @@ from typing import Any
 
 from rl1.compiler.frontend.diagnostics import Diagnostic
 from rl1.compiler.reporting.render import FileDiagnostics, report
+from rl1.vm.device import READING_NAMES
 from rl1.vm.language import BUILTINS, Builtin, Form
 from rl1.vm.sim.geometry import Point
 from rl1.vm.sim.goal import Region
@@ -70,7 +71,7 @@ def palette() -> list[dict[str, Any]]:
 
 def _builtin(builtin: Builtin) -> dict[str, Any]:
     return {"mnemonic": builtin.mnemonic, "name": builtin.name, "group": builtin.group,
-            "waits": builtin.waits,
+            "waits": builtin.waits, "readings": list(READING_NAMES.get(builtin.mnemonic, ())),
             "forms": [_form(builtin.mnemonic, form) for form in builtin.forms]}
 
 

@@ -274,6 +274,45 @@ def test_a_breakpoint_stops_the_vehicle_then_step_and_continue_to_the_end(wide: 
     wide.shot("08-ended")
 
 
+def test_the_camera_pane_shows_the_image_img_saw_and_the_plots_its_readings(
+        wide: Studio) -> None:
+    page = wide.page
+    page.select_option("#speed", "")  # as fast as the server runs
+    wide.gutter(20)
+    page.click("#run")
+    assert wide.stop("breakpoint") == "breakpoint at line 20"
+    page.wait_for_selector("#camera[data-time]", state="attached", timeout=WAIT)
+    # Lines 13-19 centred the camera on the stand's two LEDs (scene 2): the last (IMG).
+    reading = re.search(r"\(IMG\) at [0-9.]+ s in scene 2: area (\d+), x (\d+), y (\d+)",
+                        page.text_content("#camera-caption") or "")
+    assert reading is not None
+    area, x, y = map(int, reading.groups())
+    width, height, white, mean_x, mean_y = page.eval_on_selector("#camera", """camera => {
+        const data = camera.getContext("2d").getImageData(0, 0, camera.width,
+                                                           camera.height).data;
+        let white = 0, sumX = 0, sumY = 0;
+        for (let p = 0; p < data.length; p += 4) {
+          if (data[p] === 255 && data[p + 1] === 255 && data[p + 2] === 255) {
+            const i = p / 4;
+            white++; sumX += i % camera.width; sumY += Math.floor(i / camera.width);
+          }
+        }
+        return [camera.width, camera.height, white, sumX / white, sumY / white];
+    }""")
+    assert (width, height) == (256, 240)  # the world's image, pixel for pixel
+    # The world has no noise: the white pixels are the area (IMG) read, less those the
+    # centroid's cross covers (13 across, 13 down), and their centre is its x, y.
+    assert area > 0 and area - 26 <= white <= area
+    assert abs(mean_x - x) <= 1.5 and abs(mean_y - y) <= 1.5
+    wheels = page.locator("#plots svg[data-name='wheel speeds'] polyline.series")
+    assert [wheels.nth(i).get_attribute("data-name") for i in range(2)] == ["left", "right"]
+    assert all(wheels.nth(i).get_attribute("points") for i in range(2)), "wheel speeds drawn"
+    image = page.locator("#plots svg[data-name='IMG'] polyline.series")
+    assert image.count() == 4 and (image.first.get_attribute("points") or "").count(",") > 2
+    assert (page.text_content("#plots") or "").count("IMG: area ") == 1
+    wide.shot("12-camera-and-plots")
+
+
 def test_a_breakpoint_with_a_condition_stops_when_it_holds(wide: Studio) -> None:
     page = wide.page
     page.select_option("#speed", "")  # as fast as the server runs

@@ -1,7 +1,8 @@
-"""The studio's camera pane as the protocol feeds it (spec/studio.md, CameraImage): a stop
-or a frame after an (IMG) carries the binary image the simulator rendered, exactly the
-replay page's frame of that sighting (vm/sim/render.py); nothing when no (IMG) came
-since, so that an image is sent once; and none on the scripted device."""
+"""The studio's camera pane and sensor plots as the protocol feeds them (spec/studio.md):
+a stop or a frame after an (IMG) carries the binary image the simulator rendered
+(CameraImage), exactly the replay page's frame of that sighting (vm/sim/render.py);
+nothing when no (IMG) came since, so that an image is sent once; none on the scripted
+device; and the palette names each value of a reading, for the plots."""
 
 from __future__ import annotations
 
@@ -131,3 +132,20 @@ def test_the_scripted_device_sends_no_image(client: Page) -> None:
     ended = client.until("run/ended")
     assert any(entry["call"] == "IMG" for entry in ended["trace"])
     assert ended["image"] is None
+
+
+def test_the_palette_names_each_value_of_a_reading_for_the_plots(client: Page) -> None:
+    builtins = {builtin["mnemonic"]: builtin for builtin in client.request("palette")["builtins"]}
+    assert builtins["IMG"]["readings"] == ["area", "x", "y", "angle"]
+    assert builtins["KYO"]["readings"] == ["centre", "right", "left"]
+    assert builtins["ULT"]["readings"] == builtins["MOV"]["readings"] == []
+    client.request("debug/setBreakpoints", {"lines": [], "calls": []})
+    client.request("run/launch", {**LISTING_1, "speed": None})
+    ended = client.until("run/ended")
+    trace = [entry for message in client.skipped if message["method"] == "run/frame"
+             for entry in message["params"]["trace"]] + ended["trace"]
+    # Every value of a reading of several has its name; a reading of one, its call's.
+    for entry in trace:
+        if "result" in entry:
+            names = builtins[entry["call"].split()[0]]["readings"]
+            assert len(entry["result"]) == (len(names) if names else 1), entry

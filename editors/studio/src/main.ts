@@ -17,7 +17,8 @@ import { LineBreakpoint, debuggerMarks, showCurrentLine } from "./breakpoints";
 import { showPalette } from "./palette";
 import { WorldView } from "./world";
 import { DebugPane } from "./debugPane";
-import { Sensors } from "./sensors";
+import { CameraPane } from "./camera";
+import { SensorPlots } from "./sensors";
 import { WorldFile } from "./worldFile";
 import {
   Binding, Builtin, CheckDiagnostic, Ended, FileEntry, FileText, Frame, Hello, INVALID_CONFIGURATION,
@@ -182,7 +183,9 @@ async function start(): Promise<void> {
   // The debugger.
   const pane = new DebugPane(byId("stop"), byId("variables"), byId("device"),
                              byId<HTMLOListElement>("trace"), facts.reserved);
-  const sensors = new Sensors(byId("plots"), byId<HTMLCanvasElement>("camera"), byId("camera-caption"));
+  const camera = new CameraPane(byId("camera-pane"), byId<HTMLCanvasElement>("camera"), byId("camera-caption"));
+  const plots = new SensorPlots(byId("plots-pane"), byId("plots"),
+                                new Map(builtins.map((builtin) => [builtin.mnemonic, builtin.readings])));
   let state: RunState = "none";
   const controls: Record<string, RunState[]> = {
     run: ["none", "stopped", "ended"], pause: ["running"], "step-line": ["none", "stopped", "ended"],
@@ -199,7 +202,8 @@ async function start(): Promise<void> {
   const progress = (notice: Progress): void => {
     if (notice.frame) world.frame(notice.frame);
     world.events(notice.events);
-    sensors.add(notice.trace, notice.frame);
+    camera.show(notice.image, notice.frame);
+    plots.add(notice.trace, notice.frame);
   };
   studio.on("run/frame", (frame: Progress) => {
     progress(frame);
@@ -233,7 +237,8 @@ async function start(): Promise<void> {
   const launch = async (stopOnEntry: boolean): Promise<void> => {
     world.reset();
     pane.clear();
-    sensors.clear();
+    camera.clear();
+    plots.clear();
     showCurrentLine(editor, null, false);
     const launched = await studio.request<Launched>("run/launch", {
       program: { text: editor.state.doc.toString(), name: programPath },

@@ -28,7 +28,15 @@ export interface Form {
   writes: string[];
   snippet: string;
 }
-export interface Builtin { mnemonic: string; name: string; group: string; waits: boolean; forms: Form[] }
+export interface Builtin {
+  mnemonic: string;
+  name: string;
+  group: string;
+  waits: boolean;
+  /** What each value of a reading of several is, in order (IMG: area, x, y, angle). */
+  readings: string[];
+  forms: Form[];
+}
 
 interface Named { name: string; points: Point[] }
 export interface Geometry {
@@ -74,10 +82,27 @@ export interface TraceEntry {
   text: string;
 }
 
+/** The binary image the simulator rendered at an (IMG): the part from column `left` and
+ * row `top`, `columns` by `rows`, its pixels row by row packed eight to a byte (the
+ * first in the high bit), base64; `window` x0, y0, x1, y1 (end exclusive). */
+export interface CameraImage {
+  time: number;
+  scene: number;
+  size: [number, number];
+  left: number;
+  top: number;
+  columns: number;
+  rows: number;
+  bits: string;
+  window: [number, number, number, number];
+  reading: [number, number, number];
+}
+
 export interface RunEvent { time: number; kind: "lost" | "found" | "handler" | "fault" | "end"; text: string; pose: Point }
 
-/** What every notification of a run carries since the one before. */
-export interface Progress { frame: Frame | null; trace: TraceEntry[]; events: RunEvent[] }
+/** What every notification of a run carries since the one before: `image` only after a
+ * new (IMG). */
+export interface Progress { frame: Frame | null; trace: TraceEntry[]; events: RunEvent[]; image: CameraImage | null }
 
 export interface Stopped extends Progress {
   reason: "entry" | "step" | "breakpoint" | "call" | "lost-line" | "pause";

@@ -1,43 +1,48 @@
-// The sensors as the run reads them: a plot over time of each call that reads a value
-// (its first result: an ultrasonic distance, an image's area, the distance counters),
-// from the trace the server sends, and the camera's pane: where it looks (the frame's
-// pan, tilt and scene) and what the last (IMG) reported, its centroid and area drawn on
-// the image's 256 x 240 pixels. The protocol carries the numbers, not the image.
+// The sensor plots over the run's time, as the replay page of `rl1c sim --html` draws
+// them: for each call that reads something, a series for each value it returns (named as
+// the palette names them, IMG's area, x, y and angle; a reading of one value by its call),
+// from the trace the server sends; and, on a world, the wheels' speeds from the frames.
+// The plots share one time axis, from 0 to the latest time told.
 
 import type { Frame, TraceEntry } from "./protocol";
 
 const SVG = "http://www.w3.org/2000/svg";
 const POINTS = 2000;  // a series keeps every other point past this
 const WIDTH = 300, HEIGHT = 70;
+export const WHEELS = "wheel speeds";
 
-interface Series { points: [number, number][]; line: SVGPolylineElement; label: HTMLElement }
+interface Series { name: string; points: [number, number][]; line: SVGPolylineElement }
+/** `steps`: a reading holds its value until the next; the wheels' speeds change between frames. */
+interface Plot { series: Series[]; steps: boolean; label: HTMLElement }
 
-export class Sensors {
-  private readonly series = new Map<string, Series>();
+export class SensorPlots {
+  private readonly plots = new Map<string, Plot>();
+  private end = 0;
   private scheduled = false;
-  private lastImage: TraceEntry | null = null;
-  private lastFrame: Frame | null = null;
 
-  constructor(private readonly plots: HTMLElement, private readonly camera: HTMLCanvasElement,
-              private readonly caption: HTMLElement) {}
+  /** `readings`: the names of the values of each call that reads several (the palette's). */
+  constructor(private readonly pane: HTMLElement, private readonly holder: HTMLElement,
+              private readonly readings: ReadonlyMap<string, readonly string[]>) {}
 
   clear(): void {
-    this.series.clear();
-    this.plots.replaceChildren();
-    this.lastImage = null;
-    this.lastFrame = null;
-    this.hidePanes();
+    this.plots.clear();
+    this.end = 0;
+    this.holder.replaceChildren();
+    this.pane.hidden = true;
   }
 
   add(entries: readonly TraceEntry[], frame: Frame | null): void {
-    if (frame) this.lastFrame = frame;
     for (const entry of entries) {
       if (!entry.result?.length) continue;
-      const name = entry.text.split(" = ")[0];
-      if (entry.call === "IMG") this.lastImage = entry;
-      const series = this.series.get(name) ?? this.newSeries(name);
-      series.points.push([entry.time, entry.result[0]]);
-      if (series.points.length > POINTS) series.points = series.points.filter((_, i) => i % 2 === 0);
+      const names = this.readings.get(entry.call.split(" ")[0]);
+      const plot = this.plot(entry.call, names?.length ? names : [entry.call], true);
+      plot.series.forEach((series, i) => add(series, entry.time, entry.result![i]));
+      this.end = Math.max(this.end, entry.time);
+    }
+    if (frame) {
+      const plot = this.plot(WHEELS, ["left", "right"], false);
+      plot.series.forEach((series, i) => add(series, frame.time, frame.wheels[i]));
+      this.end = Math.max(this.end, frame.time);
     }
     if (!this.scheduled && (entries.length || frame)) {
       this.scheduled = true;
@@ -45,68 +50,58 @@ export class Sensors {
     }
   }
 
-  private newSeries(name: string): Series {
+  private plot(name: string, values: readonly string[], steps: boolean): Plot {
+    const known = this.plots.get(name);
+    if (known) return known;
     const svg = document.createElementNS(SVG, "svg");
     svg.setAttribute("class", "plot");
     svg.setAttribute("viewBox", `0 0 ${WIDTH} ${HEIGHT}`);
     svg.setAttribute("preserveAspectRatio", "none");
     svg.dataset.name = name;
-    const line = document.createElementNS(SVG, "polyline");
-    line.setAttribute("class", "series");
-    line.setAttribute("vector-effect", "non-scaling-stroke");
-    svg.append(line);
+    const series = values.map((value, i) => {
+      const line = document.createElementNS(SVG, "polyline");
+      line.setAttribute("class", `series series-${i}`);
+      line.setAttribute("vector-effect", "non-scaling-stroke");
+      line.dataset.name = value;
+      svg.append(line);
+      return { name: value, points: [], line };
+    });
     const label = document.createElement("div");
     label.className = "plot-label";
-    this.plots.append(label, svg);
-    const series = { points: [], line, label };
-    this.series.set(name, series);
-    return series;
-  }
-
-  private hidePanes(): void {
-    this.plots.closest<HTMLElement>(".pane")!.hidden = this.series.size === 0;
-    this.camera.closest<HTMLElement>(".pane")!.hidden = this.lastFrame === null && this.lastImage === null;
+    this.holder.append(label, svg);
+    const plot = { series, steps, label };
+    this.plots.set(name, plot);
+    return plot;
   }
 
   private draw(): void {
-    this.hidePanes();
-    for (const [name, { points, line, label }] of this.series) {
-      const times = points.map(([time]) => time), values = points.map(([, value]) => value);
-      const t0 = Math.min(...times), t1 = Math.max(...times, t0 + 1e-9);
+    this.pane.hidden = this.plots.size === 0;
+    const span = this.end || 1;
+    for (const [name, { series, steps, label }] of this.plots) {
+      const values = series.flatMap(({ points }) => points.map(([, value]) => value));
       const low = Math.min(...values), high = Math.max(...values, low + 1);
-      line.setAttribute("points", points.map(([time, value]) =>
-        `${((time - t0) / (t1 - t0) * WIDTH).toFixed(1)},${(HEIGHT - 4 - (value - low) / (high - low) * (HEIGHT - 16)).toFixed(1)}`).join(" "));
-      label.textContent = `${name}: ${values[values.length - 1]} (${low}..${high})`;
-    }
-    this.drawCamera();
-  }
-
-  private drawCamera(): void {
-    const context = this.camera.getContext("2d");
-    if (!context) return;
-    const { width, height } = this.camera;
-    context.fillStyle = "#000";
-    context.fillRect(0, 0, width, height);
-    const looks = this.lastFrame
-      ? `pan ${this.lastFrame.pan}, tilted ${this.lastFrame.tilt}, scene ${this.lastFrame.scene}` : "";
-    const image = this.lastImage?.result;
-    if (this.lastImage && image) {
-      const [area, x, y] = image;
-      if (area > 0) {
-        context.fillStyle = "rgba(255, 255, 255, 0.35)";
-        context.beginPath();
-        context.arc(x, y, Math.sqrt(area / Math.PI), 0, 2 * Math.PI);
-        context.fill();
-        context.strokeStyle = "#f33";
-        context.beginPath();
-        context.moveTo(x - 8, y); context.lineTo(x + 8, y);
-        context.moveTo(x, y - 8); context.lineTo(x, y + 8);
-        context.stroke();
+      const at = (time: number, value: number): string =>
+        `${(time / span * WIDTH).toFixed(1)},${(HEIGHT - 4 - (value - low) / (high - low) * (HEIGHT - 16)).toFixed(1)}`;
+      for (const { points, line } of series) {
+        const drawn = points.flatMap(([time, value], i) =>
+          steps && i ? [at(time, points[i - 1][1]), at(time, value)] : [at(time, value)]);
+        if (steps && points.length) drawn.push(at(this.end, points[points.length - 1][1]));
+        line.setAttribute("points", drawn.join(" "));
       }
-      this.caption.textContent = `${looks}; (IMG) at ${this.lastImage.time.toFixed(2)} s: area ${area}, `
-        + `x ${x}, y ${y} (the circle has its area)`;
-    } else {
-      this.caption.textContent = looks ? `${looks}; no (IMG) yet` : "";
+      label.replaceChildren(`${name}: `, ...series.flatMap(({ name: value, points }, i) => {
+        const shown = document.createElement("span");
+        shown.className = `series-${i}`;
+        shown.textContent = `${series.length > 1 ? `${value} ` : ""}${points[points.length - 1]?.[1] ?? ""}`;
+        return i ? [", ", shown] : [shown];
+      }), ` (${low}..${high})`);
     }
   }
+}
+
+/** A point of a series; a value that holds as it was adds nothing (the stops' frames). */
+function add(series: Series, time: number, value: number): void {
+  const last = series.points[series.points.length - 1];
+  if (last && last[0] === time && last[1] === value) return;
+  series.points.push([time, value]);
+  if (series.points.length > POINTS) series.points = series.points.filter((_, i) => i % 2 === 0);
 }
