@@ -445,20 +445,28 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
                       deadline, channel.folder, runs_given, statistics)
 
     seen: set[str] = set()  # the signatures found so far
+    untold = 0  # the first search whose findings are not yet told
 
-    def keep(searched: Searched) -> None:
-        nonlocal stop_at
+    def tell(searched: Searched) -> None:
         for name in list(searched.findings):
             if name not in seen:
                 seen.add(name)
                 if found is not None:
                     found(searched.findings[name])
-            elif keep_going:  # another search's came first: only counts are kept of it
+            elif keep_going:  # an earlier search's is kept: only counts are of this one
                 del searched.findings[name]
+
+    def keep(searched: Searched) -> None:
+        nonlocal stop_at, untold
         results[searched.index] = searched
         if searched.findings and not keep_going and searched.index < stop_at:
             stop_at = searched.index
             channel.halt(searched.index + 1)
+        # A signature's finding is the first search's in order that has one, whatever
+        # order the searches end in: told once every search before it has ended.
+        while untold in results:
+            tell(results[untold])
+            untold += 1
 
     def done() -> int:
         return sum(searched.programs for searched in results.values())

@@ -10,6 +10,7 @@ import re
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import Executor, Future, ProcessPoolExecutor
@@ -166,6 +167,56 @@ def test_keep_going_groups_findings_by_signature_each_with_a_reproducer_that_sho
                    json.loads((Path(folder) / fuzz.SCRIPT).read_text(encoding="utf-8")))
         assert judge(case, engines, 20_000).problems
         assert signature(judge(case, engines, 20_000)) == name
+
+
+class _LastFirst(Executor):
+    """Runs each search at once in this process, but makes it known only when the next
+    one is submitted (or a second after the last): of the searches under way, the latest
+    always ends first, as a slow first search on a pool makes it."""
+
+    def __init__(self) -> None:
+        self._held: list[tuple[Future[Any], Any]] = []
+        self._timer: threading.Timer | None = None
+
+    def submit(self, fn: Callable[..., T], /, *args: Any, **kwargs: Any) -> Future[T]:
+        if self._timer is not None:
+            self._timer.cancel()
+        future: Future[T] = Future()
+        future.set_running_or_notify_cancel()
+        result = fn(*args, **kwargs)
+        if self._held:  # this one ends now, the one held later
+            future.set_result(result)
+        else:
+            self._held.append((future, result))
+        self._timer = threading.Timer(1.0, self._release)
+        self._timer.start()
+        return future
+
+    def _release(self) -> None:
+        if self._held:
+            future, result = self._held.pop()
+            future.set_result(result)
+
+
+def test_keep_going_finds_the_same_reproducers_whatever_order_the_searches_end_in(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # A signature's finding was the first search's to end: the first search's own,
+    # found too by later ones, was dropped when they ended before it.
+    monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 10)
+    monkeypatch.setattr(fuzz, "BATCH", 10)
+    engines: list[Engine] = [VmEngine(0), _TwoBugs()]
+
+    def quiet(programs: int, elapsed: float) -> None:
+        pass
+
+    told: dict[str, list[fuzz.Finding]] = {"in order": [], "last first": []}
+    outcomes = {order: fuzz.campaign(
+        engines, 20_000, count=60, seconds=None, seed=11, progress=quiet,
+        executor=executor, jobs=2, keep_going=True, found=told[order].append)
+        for order, executor in (("in order", None), ("last first", _LastFirst()))}
+    assert told["in order"] and told["last first"] == told["in order"]
+    assert outcomes["last first"].findings == outcomes["in order"].findings
+    assert outcomes["last first"].counts == outcomes["in order"].counts
 
 
 @pytest.mark.parametrize(("problems", "same"), [
