@@ -64,7 +64,7 @@ def pixels_in_window(image: dict[str, Any]) -> int:
 def made(entry: dict[str, Any], time: float) -> bool:
     """Whether the trace's `entry` is the (IMG) an image of `time` shows (the trace gives
     times to 0.1 ms, an image to 1 ms)."""
-    return entry["call"] == "IMG" and abs(entry["time"] - time) <= 0.0005 + 1e-9
+    return bool(entry["call"] == "IMG" and abs(entry["time"] - time) <= 0.0005 + 1e-9)
 
 
 def test_the_first_img_sends_the_replay_pages_image(client: Page, folder: Path,
