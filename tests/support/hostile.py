@@ -653,6 +653,14 @@ class _Probe:
         return f"the next client got no diagnostics in {PROBE_SECONDS:.0f} s: {self.heard}"
 
 
+def serve_one_after_another(server: ServedLsp, clients: int) -> None:
+    """Serve `clients` well-behaved clients (as after each hostile input), each leaving
+    before the next comes; AssertionError when one is not served."""
+    for _ in range(clients):
+        if (said := _Probe(server).run()) is not None:
+            raise AssertionError(f"{server.transport}: {said[:300]}")
+
+
 def transport_attack(server: ServedLsp, attack: HostileConnection) -> list[str]:
     """The hostile connections of `attack`, then a well-behaved client, which must be
     served (initialize answered, diagnostics of its document within PROBE_SECONDS, nothing

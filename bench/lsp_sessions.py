@@ -1,0 +1,53 @@
+"""The language server's memory as clients come and go: `rl1-lsp --tcp` and `--ws`, each
+in a process of its own, serve well-behaved clients one after another (each opens a
+document, gets its diagnostics and leaves; tests/support/hostile.py's probe). After a
+warm-up, prints the server's resident memory per client served, which must stay near
+zero (what ended sessions leave behind; issue 23 found 0.31 MiB a client), and, as the
+reference in the same run, what the server held once started; with the time a client
+takes to be served.
+
+    .venv/bin/python bench/lsp_sessions.py [--clients 300]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tests"))
+
+from support.hostile import ServedLsp, serve_one_after_another  # noqa: E402  (tests/ is put on the path just above)
+
+WARM_UP = 20  # clients served before measuring: imports, caches, the allocator's first arenas
+
+
+def measure(transport: str, clients: int) -> None:
+    server = ServedLsp(transport)
+    try:
+        serve_one_after_another(server, WARM_UP)
+        before = server.resident_mib()
+        start = time.perf_counter()
+        serve_one_after_another(server, clients)
+        seconds = time.perf_counter() - start
+        grown = server.resident_mib() - before
+        print(f"rl1-lsp --{transport}: {clients} clients one after another grew the server by "
+              f"{grown:.1f} MiB, {grown / clients:.3f} MiB a client ({grown / clients / before:.2%}"
+              f" of the {before:.0f} MiB it held after {WARM_UP} clients); "
+              f"{seconds / clients * 1000:.0f} ms a client")
+    finally:
+        server.stop()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--clients", type=int, default=300)
+    options = parser.parse_args()
+    for transport in ("tcp", "ws"):
+        measure(transport, options.clients)
+
+
+if __name__ == "__main__":
+    main()
