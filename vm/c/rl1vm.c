@@ -137,8 +137,11 @@ static bool take_reading(rl1_vm *vm, uint8_t op, uint8_t call, const rl1_reading
 /* Whether a finished call `op` (descriptor `call`) succeeded, its reading taken: false
  * for a device error (an ERROR, a value out of its documented range, or a callback that
  * broke in: then nothing is written). */
-static bool finished(rl1_vm *vm, uint8_t op, uint8_t call, rl1_status status,
-                     const rl1_reading *out)
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline bool finished(rl1_vm *vm, uint8_t op, uint8_t call, rl1_status status,
+                            const rl1_reading *out)
 {
     return status == RL1_OK && !broken_in(vm)
         && (!(call & READS) || take_reading(vm, op, call, out));
@@ -283,22 +286,34 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
 /* acc = first op second, for the seven operators of one operand kind, opcodes `o0`..`o6`
  * (spec/ilc.md 8.2: base + the operator's index), each its own case: a second dispatch
  * on the operator would cost as much. */
-#define OPERATOR_CASES(o0, o1, o2, o3, o4, o5, o6, first, second, size)                  \
+#define BITWISE_CASES(o0, o1, o2, o3, o4, first, second, size)                           \
     CASE(o0) acc = (uint16_t)((uint16_t)(first) + (second)); ip += (size); NEXT();       \
     CASE(o1) acc = (uint16_t)((uint16_t)(first) - (second)); ip += (size); NEXT();       \
     CASE(o2) acc = (uint16_t)((uint16_t)(first) & (second)); ip += (size); NEXT();       \
     CASE(o3) acc = (uint16_t)((uint16_t)(first) | (second)); ip += (size); NEXT();       \
-    CASE(o4) acc = (uint16_t)((uint16_t)(first) ^ (second)); ip += (size); NEXT();       \
+    CASE(o4) acc = (uint16_t)((uint16_t)(first) ^ (second)); ip += (size); NEXT()
+#define OPERATOR_CASES(o0, o1, o2, o3, o4, o5, o6, first, second, size)                  \
+    BITWISE_CASES(o0, o1, o2, o3, o4, first, second, size);                              \
     CASE(o5) acc = shifted((uint16_t)(first), (int16_t)(second), true); ip += (size); NEXT(); \
     CASE(o6) acc = shifted((uint16_t)(first), (int16_t)(second), false); ip += (size); NEXT()
 
-/* The operators on acc and a variable or an immediate (format 1.0). */
-#define ALU_CASES(o0, o1, o2, o3, o4, o5, o6, operand, size)                              \
-    OPERATOR_CASES(o0, o1, o2, o3, o4, o5, o6, acc, operand, size)
+/* The operators on acc and a variable or an immediate (format 1.0). Built for size, the
+ * two shifts go to `compute` below, as the superinstructions do: the other five stay
+ * cases of their own, so that the switch keeps enough cases for gcc -Os to make it a
+ * jump table (with fewer it makes a tree of comparisons, 10 instructions to reach a
+ * call on Cortex-M3 where the table takes 3). */
+#ifdef RL1_COMPACT
+#define ALU_CASES(o0, o1, o2, o3, o4, o5, o6, second, size)                               \
+    BITWISE_CASES(o0, o1, o2, o3, o4, acc, second, size);                                \
+    CASE(o5) CASE(o6) operand = (second); ip += (size); goto compute
+#else
+#define ALU_CASES(o0, o1, o2, o3, o4, o5, o6, second, size)                               \
+    OPERATOR_CASES(o0, o1, o2, o3, o4, o5, o6, acc, second, size)
+#endif
 
 /* The load-and-operate superinstructions (format 1.2): acc = first op second, the
- * operator in the low 3 bits as in ALU_CASES; also the operations on R (`first` is then
- * acc). Built for size (-Os, or RL1_COMPACT defined), each kind only decodes its
+ * operator in the low 3 bits as in OPERATOR_CASES; also the operations on R (`first` is
+ * then acc). Built for size (-Os, or RL1_COMPACT defined), each kind only decodes its
  * operands and the operators are one switch for all of them: on Cortex-M3 that is 296
  * bytes of flash fewer, which keeps the VM and verifier within 4 KB. Otherwise each is a
  * case of its own, which the host's branch predictor prefers (the computation of
@@ -506,9 +521,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
              * instructions a call on Cortex-M3, which firmware does not pay */
             vm->executed = before + (n - left);
 #endif
-            if (call & READS) {
-                clear_reading(&out);
-            }
+            clear_reading(&out);
             if (call & RL1_CALL_STARTED) {
                 if (hw->start(hw->ctx, op, given) != RL1_OK) {
                     kind = RL1_FAULT_DEVICE;
@@ -530,13 +543,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
             }
             if (vm->mailbox.posted != vm->mailbox.taken) { /* the event point */
                 target = vm->pc;
-                kind = take_event(vm, program, &target);
-                if (kind != RL1_FAULT_NONE) {
-                    break;
-                }
-                ip = code + target;
-                stop = STOP;
-                NEXT();
+                goto event_point;
             }
             /* no jump: `stop` holds (left falls by one, ip gains one at least) */
             ip = next;
@@ -563,6 +570,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
             kind = RL1_FAULT_BUDGET;
             break;
         }
+    event_point: /* the call's, after the watchdog before it (section 9) */
         if (vm->mailbox.posted != vm->mailbox.taken) {
             kind = take_event(vm, program, &target);
             if (kind != RL1_FAULT_NONE) {
