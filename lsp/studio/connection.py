@@ -153,10 +153,12 @@ class Connection:
             answer["result"] = result
         self._send(json.dumps(answer))
 
-    def notify(self, method: str, params: dict[str, Any]) -> None:
+    def notify(self, method: str, params: dict[str, Any]) -> bool:
+        """Send a notification; False when it is a frame dropped for the backlog."""
         if method == "run/frame" and self._backlog() > FRAME_BACKLOG:
-            return
+            return False
         self._send(json.dumps({"jsonrpc": "2.0", "method": method, "params": params}))
+        return True
 
     def close(self) -> None:
         """The page has gone: its run stops."""

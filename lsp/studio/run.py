@@ -46,7 +46,9 @@ from rl1.vm.sim.world import World
 log = logging.getLogger(__name__)
 
 Command = Literal["start", "continue", "stepLine", "stepInstruction", "restart"]
-Tell = Callable[[str, dict[str, Any]], None]
+Tell = Callable[[str, dict[str, Any]], bool]
+"""Sends a notification to the page; False when it was dropped (a `run/frame` to a page
+that has fallen behind)."""
 
 FRAMES_PER_SECOND = 30
 """The most `run/frame`s a second of wall time."""
@@ -92,6 +94,8 @@ class Run:
         self._anchor = (0.0, 0.0)  # the wall time and simulated time the pace is kept from
         self._next_frame = -math.inf  # when the next frame is due (time.monotonic)
         self._told_trace = self._told_events = 0
+        # What a dropped frame carried, and its generation (the loop's, like `busy`).
+        self._held: tuple[int, dict[str, Any]] | None = None
         # The (IMG)s counted when an image was last told, in any notification, in a stop.
         self._imaged = self._imaged_at_stop = 0
         self._images = None if launch.world is None else SightingImages(launch.world)
@@ -156,7 +160,7 @@ class Run:
             return
         self.busy = False
         self.over = method == "run/ended"
-        self._tell(method, params)
+        self._send(generation, method, params)
 
     def _carry_out(self, command: Command) -> tuple[str, dict[str, Any]]:
         session = self.session
@@ -228,7 +232,20 @@ class Run:
 
     def _deliver(self, generation: int, method: str, params: dict[str, Any]) -> None:
         if generation == self._generation:
-            self._tell(method, params)
+            self._send(generation, method, params)
+
+    def _send(self, generation: int, method: str, params: dict[str, Any]) -> None:
+        """Tell the page, on the loop. What a dropped frame carried (trace entries,
+        events, an image) goes in the next notification of the same run instead, so the
+        page's trace misses nothing."""
+        held, self._held = self._held, None
+        if held is not None and held[0] == generation and "trace" in params:
+            before = held[1]
+            params = {**params, "trace": before["trace"] + params["trace"],
+                      "events": before["events"] + params["events"],
+                      "image": params["image"] or before["image"]}
+        if not self._tell(method, params):
+            self._held = generation, params
 
     # The device
 

@@ -18,6 +18,7 @@ from served import Failed, Page, Served, page, sample_folder, serving
 from support.cli import rl1c
 from websockets.exceptions import ConnectionClosed
 
+from rl1.lsp.studio import connection
 from rl1.lsp.studio.run import FRAMES_PER_SECOND
 from rl1.vm.language import BUILTINS, VARIABLES
 
@@ -110,6 +111,20 @@ def test_listing_1_stops_at_line_20_steps_and_ends_as_rl1c_sim_does(client: Page
     trace = [*before, *stepped["trace"], *told(client, ended)]
     assert [{key: value for key, value in entry.items() if key != "text"}
             for entry in trace] == expected["trace"]
+
+
+def test_frames_dropped_for_a_page_behind_lose_no_trace_entry(
+        client: Page, folder: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # A frame dropped for the backlog took its trace entries and events with it.
+    monkeypatch.setattr(connection, "FRAME_BACKLOG", -1)  # the page always behind
+    client.request("debug/setBreakpoints", {"lines": [], "calls": []})
+    client.request("run/launch", {**LISTING_1, "speed": None})
+    ended = client.until("run/ended")
+    assert not [message for message in client.skipped if message["method"] == "run/frame"]
+    expected = rl1c_sim(folder)
+    assert [{key: value for key, value in entry.items() if key != "text"}
+            for entry in ended["trace"]] == expected["trace"]
+    assert ended["image"] is not None  # the last (IMG)'s, whichever frame carried it
 
 
 def test_stop_on_entry_then_step_an_instruction(client: Page) -> None:
