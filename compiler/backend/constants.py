@@ -95,8 +95,8 @@ def _meet(states: list[Known]) -> Known:
     """What every state knows alike, in the first state's order (a set of items would
     order it by hash, and the variable _holding picks with it: PYTHONHASHSEED would
     change the bytes)."""
-    if len(states) <= 1:
-        return dict(states[0]) if states else {}  # a block with one way in: most of them
+    if len(states) <= 1:  # a block with one way in: most of them (_fold copies it)
+        return states[0] if states else {}
     first, *rest = states
     shared = first.items() & rest[0].items()  # the set only tests: the order is first's
     for state in rest[1:]:

@@ -13,7 +13,7 @@ from collections.abc import Callable
 from . import ir
 from .constants import fold_constants
 from .control import simplify_control
-from .copies import propagate_copies
+from .copies import cancel_equal_operands, propagate_copies
 from .dead_stores import remove_dead_stores
 from .peephole import rewrite_steps
 from .signs import decide_branches
@@ -23,15 +23,27 @@ Pass = Callable[[ir.Program], ir.Program]
 
 # -O1: the passes whose output every format 1.0 reader runs. The control pass comes
 # first so that the others see merged blocks, and last so that it removes what they
-# made unreachable.
-O1_PASSES: tuple[Pass, ...] = (simplify_control, fold_constants, decide_branches,
+# made unreachable. Algebra comes before constant folding, which carries on what it
+# leaves (`A-A+7` is 7); the branches the signs decide come after the passes within
+# blocks, which seldom change what that flow finds.
+O1_PASSES: tuple[Pass, ...] = (simplify_control, cancel_equal_operands, fold_constants,
                                propagate_copies, rewrite_steps, remove_dead_stores,
-                               simplify_control)
+                               decide_branches, simplify_control)
 LEVELS: dict[int, tuple[Pass, ...]] = {0: (), 1: O1_PASSES, 2: O1_PASSES}
 # What runs once after a level's passes stop changing the program: -O2's fusion, which
 # the other passes need not know.
 FINAL_PASSES: dict[int, tuple[Pass, ...]] = {0: (), 1: (), 2: (fuse,)}
 MAX_ROUNDS = 8  # a round seldom finds anything after the third
+
+# What lets the rounds skip a pass that could change nothing (compile time: the data
+# flows of constant folding and the signs cost the most), each held by a property test
+# (tests/backend/test_pass_properties.py). A pass that a second run leaves as it is:
+IDEMPOTENT: frozenset[Pass] = frozenset({fold_constants, propagate_copies, rewrite_steps})
+# The passes to which a pass's changes never give anything to do: copy propagation keeps
+# what every variable and the accumulator hold at every point, and the control flow.
+GIVES_NO_WORK_TO: dict[Pass, frozenset[Pass]] = {
+    propagate_copies: frozenset({fold_constants, decide_branches}),
+}
 
 
 class OptimizerError(Exception):
@@ -47,30 +59,56 @@ def optimize(program: ir.Program, level: int, *, check: bool = False,
     passes = LEVELS[level]
     if not passes:
         return program
-    shape = _shape(program)
-    for _ in range(MAX_ROUNDS):
-        program = _run(passes, program, check, fired)
-        before, shape = shape, _shape(program)
-        if shape == before:
-            break
-    program = _run(FINAL_PASSES[level], program, check, fired)
+    program = _to_fixpoint(passes, program, check, fired)
+    for run in FINAL_PASSES[level]:
+        program, _ = _run_one(run, program, _shape(program), check, fired)
     _validate(program, "the optimizer")
     return program
 
 
-def _run(passes: tuple[Pass, ...], program: ir.Program, check: bool,
-         fired: Callable[[str], None] | None) -> ir.Program:
-    for run in passes:
-        before = _shape(program) if fired is not None else None  # passes may edit in place
-        program = run(program)
-        if check:
-            _validate(program, run.__name__)
-        if fired is not None and _shape(program) != before:
-            fired(run.__name__)
+def _to_fixpoint(passes: tuple[Pass, ...], program: ir.Program, check: bool,
+                 fired: Callable[[str], None] | None) -> ir.Program:
+    """The passes in rounds until none has work left: a pass has work while the
+    program changed since its last run (wherever it stands in the round) in a way that
+    could give it some: all passes at first; then, after a change, every pass but those
+    IDEMPOTENT and GIVES_NO_WORK_TO rule out. So the rounds stop where the last of them
+    settles, not at the end of a round that only says so."""
+    shape = _shape(program)
+    due = [True] * len(passes)
+    for count in range(MAX_ROUNDS * len(passes)):
+        index = count % len(passes)
+        run = passes[index]
+        if not due[index]:
+            continue
+        due = [flag and other is not run for flag, other in zip(due, passes, strict=True)]
+        program, after = _run_one(run, program, shape, check, fired)
+        if after != shape:
+            spared = GIVES_NO_WORK_TO.get(run, frozenset()) \
+                | ({run} if run in IDEMPOTENT else set())
+            due = [flag or other not in spared for flag, other in zip(due, passes, strict=True)]
+            shape = after
+        if not any(due):
+            break
     return program
 
 
-def _shape(program: ir.Program) -> list[tuple[object, ...]]:
+Shape = list[tuple[object, ...]]
+
+
+def _run_one(run: Pass, program: ir.Program, before: Shape, check: bool,
+             fired: Callable[[str], None] | None) -> tuple[ir.Program, Shape]:
+    """The program after one pass, and its shape (`before`: its shape before, which
+    the caller keeps, as a pass may edit the program in place)."""
+    program = run(program)
+    if check:
+        _validate(program, run.__name__)
+    after = _shape(program)
+    if fired is not None and after != before:
+        fired(run.__name__)
+    return program, after
+
+
+def _shape(program: ir.Program) -> Shape:
     """The whole program as comparable values (instructions are frozen dataclasses)."""
     return [(block.id, *block.instructions, block.terminator) for block in program]
 

@@ -55,9 +55,7 @@ def decide_branches(program: ir.Program) -> ir.Program:
     following = program.following()
     branches = {block.id: block.terminator for block in program
                 if not block.instructions and isinstance(block.terminator, ir.Branch)}
-    tracked = _tracked(program)
-    exits = {block_id: _exit_state(program.blocks[block_id], state, tracked)
-             for block_id, state in _solve(program, tracked).items()}
+    exits = _solve(program, _tracked(program))
     for block_id, state in exits.items():
         block = program.blocks[block_id]
         if isinstance(block.terminator, ir.Branch):
@@ -83,15 +81,16 @@ def _threaded(terminator: ir.Terminator, state: State,
         return target if decided is None else decided.target
 
     match terminator:
-        case ir.Jump(target=target):
+        case ir.Jump(target=target) if target in branches:
             return dataclasses.replace(terminator, target=past(target, state))
-        case ir.Branch(var=var, relation=relation, if_true=if_true, if_false=if_false):
+        case ir.Branch(var=var, relation=relation, if_true=if_true, if_false=if_false) \
+                if if_true in branches or if_false in branches:
             signs = state.get(var.name, ANY)
             return dataclasses.replace(
                 terminator, if_true=past(if_true, {**state, var.name: frozenset(relation)}),
                 if_false=past(if_false, {**state, var.name: signs - {relation}}))
         case _:
-            return terminator
+            return terminator  # no way into a block that only branches
 
 
 def _rewritten(branch: ir.Branch, state: State, following: ir.BlockId | None
@@ -133,9 +132,10 @@ def _tracked(program: ir.Program) -> frozenset[str]:
 
 
 def _solve(program: ir.Program, tracked: frozenset[str]) -> dict[ir.BlockId, State]:
-    """What is known where each block some path reaches starts: the union (the signs
-    any path allows) over its predecessors' edges and the program's or a handler's
-    start. A worklist in layout order; a decided branch's other edge is not followed."""
+    """What is known where each block some path reaches ends (before its terminator),
+    from what is known where it starts: the union (the signs any path allows) over its
+    predecessors' edges and the program's or a handler's start. A worklist in layout
+    order; a decided branch's other edge is not followed."""
     starts: dict[ir.BlockId, list[State]] = {block_id: [] for block_id in program.blocks}
     starts[program.entry].append(dict.fromkeys(
         [name for name in VARIABLES if name in tracked], frozenset("=")))
@@ -144,6 +144,7 @@ def _solve(program: ir.Program, tracked: frozenset[str]) -> dict[ir.BlockId, Sta
     incoming: dict[ir.BlockId, dict[ir.BlockId, State]] = {
         block_id: {} for block_id in program.blocks}
     entries: dict[ir.BlockId, State] = {}
+    exits: dict[ir.BlockId, State] = {}
     work = deque(flow.roots(program))
     queued = set(work)
     while work:
@@ -156,12 +157,13 @@ def _solve(program: ir.Program, tracked: frozenset[str]) -> dict[ir.BlockId, Sta
         block = program.blocks[block_id]
         for target in block.terminator.targets:
             incoming[target].pop(block_id, None)
-        for target, leaving in _edges(block, _exit_state(block, state, tracked)):
+        exits[block_id] = _exit_state(block, state, tracked)
+        for target, leaving in _edges(block, exits[block_id]):
             incoming[target][block_id] = leaving
             if target not in queued:
                 queued.add(target)
                 work.append(target)
-    return entries
+    return exits
 
 
 def _join(states: list[State]) -> State:

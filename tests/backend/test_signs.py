@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend import ir, optimize
-from rl1.compiler.backend.copies import propagate_copies
+from rl1.compiler.backend.copies import cancel_equal_operands
 from rl1.compiler.backend.lower import lower
 from rl1.compiler.backend.signs import decide_branches
 from rl1.compiler.differential import AstEngine, VmEngine, judge
@@ -138,7 +138,7 @@ def test_the_negated_loop_runs_as_before_in_fewer_instructions(readings: list[in
 def test_an_operation_on_the_accumulators_own_value_is_folded(expression: str,
                                                                 value: int | None) -> None:
     source = f"A=(INP 1)\nB={expression}\n(OUT 1,B); (END)\n"
-    code = instructions(optimized(source, propagate_copies))
+    code = instructions(optimized(source, cancel_equal_operands))
     operator = {"-": "sub", "^": "xor", "&": "and", "|": "or"}[expression[1]]
     assert f"{operator} A" not in code
     if value is not None:
@@ -148,7 +148,8 @@ def test_an_operation_on_the_accumulators_own_value_is_folded(expression: str,
 
 
 def test_an_operation_on_another_variable_is_kept() -> None:
-    code = instructions(optimized("A=(INP 1); C=(INP 2)\nB=A-C\n(END)\n", propagate_copies))
+    code = instructions(optimized("A=(INP 1); C=(INP 2)\nB=A-C\n(END)\n",
+                                  cancel_equal_operands))
     assert "sub C" in code
 
 
