@@ -61,12 +61,17 @@ class Kind:
         return GOAL_NO_ARGUMENT + GOAL_PER_ARGUMENT * len(self.values)
 
 
+# The compact calls (MOVS, MVIS: a byte an argument) are what -O2 writes for these.
 KINDS = (Kind("KYC", "KYC", (), False, False),
          Kind("IMG (started and polled)", "IMG", (), False, True),
          Kind("MOV 3, -4 (two constants)", "MOV", (3, -4), False, False),
          Kind("MOV a, b (two variables)", "MOV", (3, -4), True, False),
+         Kind("MOVS 3, -4 (compact)", "MOVS", (3, -4), False, False),
+         Kind("MOVS a, b (compact)", "MOVS", (3, -4), True, False),
          Kind("MVI 3, -4, 100 (constants)", "MVI", (3, -4, 100), False, True),
-         Kind("MVI a, b, c (three variables)", "MVI", (3, -4, 100), True, True))
+         Kind("MVI a, b, c (three variables)", "MVI", (3, -4, 100), True, True),
+         Kind("MVIS 3, -4, 100 (compact)", "MVIS", (3, -4, 100), False, True),
+         Kind("MVIS a, b, c (compact)", "MVIS", (3, -4, 100), True, True))
 
 
 def program(kind: Kind, calls: int) -> bytes:

@@ -77,36 +77,69 @@ static bool broken_in(const rl1_vm *vm)
     return vm->state != (uint8_t)RL1_IN_STEP;
 }
 
+/* Inlined wherever it is called, so that each call site gets code of its own. */
+#if defined(__GNUC__)
+#define ALWAYS_INLINE __attribute__((always_inline)) inline
+#else
+#define ALWAYS_INLINE
+#endif
+
+/* The signed byte at p + k, without the implementation-defined conversion to int8_t. */
+#define S8_AT(p, k)                                                                      \
+    ((int16_t)((int16_t)RL1_BYTE((p) + (k)) - (int16_t)((RL1_BYTE((p) + (k)) & 0x80u) << 1)))
+
+/* A variable argument's value, from its index in *arg, into *arg: false when it is out
+ * of its parameter's range, low and high at range[0] and range[1]. */
+static ALWAYS_INLINE bool variable_argument(const int16_t *V, const int16_t *range,
+                                            int16_t *arg)
+{
+    int16_t value = V[*arg];
+    if (value < rl1_flash_i16(range) || value > rl1_flash_i16(range + 1)) {
+        return false;
+    }
+    *arg = value;
+    return true;
+}
+
 /* The `arity` (1 to 3) arguments of call `op` from its operands at `at` (the mask, then
- * `width` bytes an argument: 2, or 1 in a compact call) into `args`, left to right; the
- * end of the call's operands, or NULL at the first variable out of its parameter's
- * range (section 9, step 2). Called once, so inlined: kept out of line (gcc's noinline)
- * it costs Cortex-M3 flash that the 4 KB goal has no room for. */
-static const uint8_t *arguments(const int16_t *V, uint8_t op, uint8_t arity, uint8_t width,
+ * the arguments: 2 bytes each, a byte in a compact call) into `args`, left to right:
+ * the end of the call's operands, or NULL when a variable is out of its parameter's
+ * range (section 9, step 2; which one does not matter, the fault is the call's).
+ * First each argument's field, a constant's value or a variable's index: an index is 0
+ * to 52, which reads the same as a signed byte and as a full call's i16 (its high byte
+ * is 0: the verifier checked it), so that the fields need no look at the mask. Then,
+ * when there are variables, their values (the mask has no bit at or above the arity:
+ * checked too). Unrolled, the last argument first, each at fixed offsets. */
+static const uint8_t *arguments(const int16_t *V, uint8_t op, uint8_t arity,
                                 const uint8_t *at, int16_t *args)
 {
-    const int16_t *range = &rl1_param_ranges[2u * rl1_flash_byte(
-        &rl1_call_first[op - RL1_OP_FIRST_CALL])];
-    const uint8_t *const end = at + width * arity;
     uint8_t mask = RL1_BYTE(at);
-    do { /* arity is 1 at least */
-        /* a variable's index, or a constant */
-        int16_t field = width == 1u ? (int8_t)RL1_BYTE(at + 1u) : (int16_t)RL1_U16(at + 1u);
-        at += width;
-        if (mask & 1u) {
-            int16_t value = V[field];
-            if (value < rl1_flash_i16(range) || value > rl1_flash_i16(range + 1)) {
-                return NULL;
-            }
-            *args = value;
-        } else {
-            *args = (int16_t)field;
+    const int16_t *range;
+    if (op & RL1_COMPACT_CALL_BIT) {
+        switch (arity) {
+        case 3: args[2] = S8_AT(at, 3); /* fall through */
+        case 2: args[1] = S8_AT(at, 2); /* fall through */
+        default: args[0] = S8_AT(at, 1);
         }
-        args++;
-        range += 2;
-        mask >>= 1;
-    } while (at != end);
-    return end + 1;
+        at += arity;
+    } else {
+        switch (arity) {
+        case 3: args[2] = (int16_t)RL1_U16(at + 5); /* fall through */
+        case 2: args[1] = (int16_t)RL1_U16(at + 3); /* fall through */
+        default: args[0] = (int16_t)RL1_U16(at + 1);
+        }
+        at += 2u * arity;
+    }
+    if (mask) {
+        range = &rl1_param_ranges[2u * rl1_flash_byte(
+            &rl1_call_first[(op & (uint8_t)~RL1_COMPACT_CALL_BIT) - RL1_OP_FIRST_CALL])];
+        if (((mask & 1u) && !variable_argument(V, range, &args[0]))
+            || ((mask & 2u) && !variable_argument(V, range + 2, &args[1]))
+            || ((mask & 4u) && !variable_argument(V, range + 4, &args[2]))) {
+            return NULL;
+        }
+    }
+    return at + 1;
 }
 
 /* Takes what call `op` (descriptor `call`, READS), finished, read: false, writing
@@ -199,31 +232,6 @@ static rl1_state ended(rl1_vm *vm, const rl1_hardware *hw, uint16_t at)
         ? fault(vm, hw, RL1_FAULT_DEVICE, at, true) : RL1_ENDED;
 }
 
-/* Resumes the call in progress at code offset `at` (12.2): polls it once. */
-static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
-                        uint16_t at)
-{
-    rl1_reading out;
-    uint8_t op = (uint8_t)(vm->waiting & ~RL1_COMPACT_CALL_BIT); /* as in the code */
-    uint8_t call = rl1_call_descriptor(op);
-    rl1_status status;
-    rl1_fault kind;
-    clear_reading(&out);
-    status = hw->poll(hw->ctx, &out);
-    if (status == RL1_BUSY && !broken_in(vm)) {
-        return RL1_WAITING;
-    }
-    vm->waiting = 0;
-    if (!finished(vm, op, call, status, &out)) {
-        return fault(vm, hw, RL1_FAULT_DEVICE, at, false);
-    }
-    kind = take_event(vm, program, &vm->pc);
-    if (kind != RL1_FAULT_NONE) {
-        return fault(vm, hw, kind, at, false);
-    }
-    return RL1_RUNNING;
-}
-
 /* Where no case applies, so that the compiler's jump table needs no range check. */
 #if defined(__GNUC__)
 #define UNREACHABLE() __builtin_unreachable()
@@ -235,8 +243,7 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
 #define U8_AT(k) RL1_BYTE(ip + (k))
 #define U16_AT(k) RL1_U16(ip + (k))
 #define VAR_AT(k) V[U8_AT(k)]
-/* A signed byte, without the implementation-defined conversion to int8_t. */
-#define S8_AT(k) ((int16_t)((int16_t)U8_AT(k) - (int16_t)((U8_AT(k) & 0x80u) << 1)))
+#define S8(k) S8_AT(ip, k)
 
 /* How one instruction hands over to the next. A switch in a loop has one indirect jump
  * for all instructions, which the host's branch predictor guesses from little; GCC and
@@ -348,11 +355,13 @@ static rl1_state resume(rl1_vm *vm, const rl1_program *program, const rl1_hardwa
  * instruction (`code`, which every ip passes). */
 #define STOP (left >= (uint32_t)(end - ip) ? end : code)
 
-/* Runs at most n instructions from vm->pc. The hot state lives in locals and goes back
- * into *vm at every exit: pc, acc, and the instructions run (n - left). `ip` stays on an
- * instruction's first byte until it is done, so that a fault or an end points at it. */
+/* Runs at most n instructions from code offset `at`, the instruction at hand: vm->pc, or
+ * the call in progress (12.2), which is first polled once (vm->pc is then past it). The
+ * hot state lives in locals and goes back into *vm at every exit: pc, acc, and the
+ * instructions run (n - left). `ip` stays on an instruction's first byte until it is
+ * done, so that a fault or an end points at it. */
 static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
-                     uint32_t n)
+                     uint32_t n, uint16_t at)
 {
 #if RL1_THREADED
     /* Each valid opcode's case (the verifier refuses the others). The empty asm makes
@@ -390,7 +399,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
     __asm__("" : "+r"(targets));
 #endif
     const uint8_t *const code = program->code, *const end = code + program->code_size;
-    const uint8_t *ip = code + vm->pc;
+    const uint8_t *ip = code + at;
     int16_t *const V = vm->V;
     int16_t *variable, value;
     uint16_t acc = (uint16_t)vm->acc, target = 0;
@@ -407,10 +416,16 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
     const int16_t *given; /* args, or NULL for a call without arguments */
     rl1_reading out;
     rl1_status status;
-    uint8_t op, call, arity, width;
+    uint8_t op, call, arity;
 #ifdef RL1_COMPACT
     uint16_t operand;
 #endif
+    if (vm->waiting) { /* its opcode as in the code: a compact call's too */
+        op = (uint8_t)(vm->waiting & ~RL1_COMPACT_CALL_BIT);
+        call = rl1_call_descriptor(op);
+        next = code + vm->pc;
+        goto poll;
+    }
     for (;;) {
         if (ip >= stop) { /* one comparison an instruction while the limit is far */
             if (left == 0u) { /* the step's limit */
@@ -449,7 +464,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
         CASE(RL1_OP_MOVV) VAR_AT(1) = VAR_AT(2); ip += 3; NEXT();          /* v, w */
         CASE(RL1_OP_MOVI) VAR_AT(1) = (int16_t)U16_AT(2); ip += 4; NEXT(); /* v, i */
         CASE(RL1_OP_MOVR) VAR_AT(1) = vm->R; ip += 2; NEXT();              /* v */
-        CASE(RL1_OP_MOVB) VAR_AT(1) = S8_AT(2); ip += 3; NEXT();           /* v, b */
+        CASE(RL1_OP_MOVB) VAR_AT(1) = S8(2); ip += 3; NEXT();           /* v, b */
         ALU_CASES(RL1_OP_ADDV, RL1_OP_SUBV, RL1_OP_ANDV, RL1_OP_ORV, RL1_OP_XORV,
                   RL1_OP_SHLV, RL1_OP_SHRV, (uint16_t)VAR_AT(1), 2);
         ALU_CASES(RL1_OP_ADDI, RL1_OP_SUBI, RL1_OP_ANDI, RL1_OP_ORI, RL1_OP_XORI,
@@ -476,19 +491,10 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
                       RL1_OP_SHLRV, RL1_OP_SHRRV, vm->R, (uint16_t)VAR_AT(1), 2);
         COMPUTE_CASES(RL1_OP_ADDRI, RL1_OP_SUBRI, RL1_OP_ANDRI, RL1_OP_ORRI, RL1_OP_XORRI,
                       RL1_OP_SHLRI, RL1_OP_SHRRI, vm->R, U16_AT(1), 3);
+        /* The calls, the compact ones (format 1.3) among them, and no other opcode: the
+         * verifier refuses the others. The default, so that the compact calls (above
+         * the other cases) need no comparison of their own. */
         default:
-            UNREACHABLE(); /* the verifier refuses every other opcode */
-            break;
-        case RL1_OP_FRE: case RL1_OP_HLD: case RL1_OP_ORG: case RL1_OP_MVI: case RL1_OP_MOV:
-        case RL1_OP_STR: case RL1_OP_STL: case RL1_OP_STX: case RL1_OP_ROT: case RL1_OP_TRC:
-        case RL1_OP_TIM: case RL1_OP_KYC: case RL1_OP_KYO: case RL1_OP_SCN: case RL1_OP_IMG:
-        case RL1_OP_CAMZ: case RL1_OP_CAMU: case RL1_OP_CAMD: case RL1_OP_CAMA: case RL1_OP_CAMP:
-        case RL1_OP_CAMR: case RL1_OP_ULTA: case RL1_OP_ULTB: case RL1_OP_ULTC: case RL1_OP_ULTD:
-        case RL1_OP_LMP: case RL1_OP_INP: case RL1_OP_OUT: case RL1_OP_FZO: case RL1_OP_FZI:
-        case RL1_OP_MVIS: case RL1_OP_MOVS: case RL1_OP_STRS: case RL1_OP_STLS:
-        case RL1_OP_STXS: case RL1_OP_ROTS: case RL1_OP_TRCS: case RL1_OP_TIMS:
-        case RL1_OP_SCNS: case RL1_OP_CAMAS: case RL1_OP_CAMPS: case RL1_OP_LMPS:
-        case RL1_OP_INPS: case RL1_OP_OUTS: case RL1_OP_FZOS: /* the compact calls (1.3) */
             COUNTED(op_call)
             /* A call (section 9, steps 2-6), its descriptor telling all that differs. */
             if (left < over_below) {
@@ -498,20 +504,19 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
             op = RL1_BYTE(ip); /* not set by a threaded jump */
             /* a compact call (format 1.3) is its call with a byte an argument: the
              * descriptor and the callbacks see the call's own opcode */
-            width = (op & RL1_COMPACT_CALL_BIT) ? 1u : 2u;
-            op &= (uint8_t)~RL1_COMPACT_CALL_BIT;
-            call = rl1_call_descriptor(op);
+            call = rl1_call_descriptor((uint8_t)(op & ~RL1_COMPACT_CALL_BIT));
             arity = call & RL1_CALL_ARITY;
             next = ip + 1;
             given = NULL;
             if (arity) {
-                next = arguments(V, op, arity, width, next, args);
+                next = arguments(V, op, arity, next, args);
                 if (next == NULL) {
                     kind = RL1_FAULT_ARGUMENT_RANGE;
                     break;
                 }
                 given = args;
             }
+            op &= (uint8_t)~RL1_COMPACT_CALL_BIT;
             /* pc past the call while its callbacks run: the line of the call under way is
              * the one before it (vm/native.py's current_line) */
             vm->pc = (uint16_t)(next - code);
@@ -521,12 +526,13 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
              * instructions a call on Cortex-M3, which firmware does not pay */
             vm->executed = before + (n - left);
 #endif
-            clear_reading(&out);
             if (call & RL1_CALL_STARTED) {
                 if (hw->start(hw->ctx, op, given) != RL1_OK) {
                     kind = RL1_FAULT_DEVICE;
                     break;
                 }
+            poll:
+                clear_reading(&out);
                 status = hw->poll(hw->ctx, &out);
                 if (status == RL1_BUSY && !broken_in(vm)) {
                     vm->waiting = RL1_BYTE(ip); /* as in the code: a compact call's too */
@@ -534,7 +540,9 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
                     vm->executed = before + (n - left);
                     return RL1_WAITING;
                 }
+                vm->waiting = 0;
             } else {
+                clear_reading(&out);
                 status = hw->call(hw->ctx, op, given, &out);
             }
             if (!finished(vm, op, call, status, &out)) {
@@ -613,13 +621,7 @@ static rl1_state step(rl1_vm *vm, const rl1_program *program, const rl1_hardware
     if (abort_pending(vm)) {
         return fault(vm, hw, RL1_FAULT_ABORTED, at, false);
     }
-    if (vm->waiting) {
-        rl1_state state = resume(vm, program, hw, at);
-        if (state != RL1_RUNNING) {
-            return state;
-        }
-    }
-    return run(vm, program, hw, n);
+    return run(vm, program, hw, n, at);
 }
 
 rl1_state rl1_step(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
