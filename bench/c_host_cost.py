@@ -12,8 +12,8 @@ any inlined functions (a helper such as take_event, inlined at a call and at a j
 belongs to the place it was inlined into). So the split is by counting, not by a model:
 
 - a call: the instructions of the call case of `run()` (from its first `case` to its
-  `NEXT()`, threaded its own jump to the next instruction included) and of `resume()`
-  (a started call polled again in a later step);
+  `NEXT()`, threaded its own jump to the next instruction included) and the block
+  before the loop that polls a started call again in a later step;
 - dispatch: the head of `run()`'s loop (up to `switch (op)`), which each instruction
   pays alike with the switch, and threaded only at a step's start and near its limit;
   it is shared out evenly over every instruction;
@@ -56,7 +56,8 @@ class Regions:
 
     loop: range       # the dispatch loop: everything but the step's entry and exit
     dispatch: range   # the loop's head, up to `switch (op)`
-    call_case: range  # the call case, from its first `case` to its NEXT()
+    call_case: range  # the call case, from its `default:` to its NEXT()
+    resume: range     # before the loop: a started call polled again
 
     @staticmethod
     def of(source: str) -> Regions:
@@ -67,10 +68,11 @@ class Regions:
                         if number > after and re.search(pattern, text))
 
         head = first(r"^\s*for \(;;\) \{")
-        call = first(r"^\s*case RL1_OP_\w+: case", head)
+        call = first(r"^\s*default:$", head)
         return Regions(range(head, first(r"^\s*vm->pc = \(uint16_t\)\(ip - code\);", head)),
                        range(head, first(r"^\s*switch \(op\) \{", head) + 1),
-                       range(call, first(r"^\s*ip = next;", call) + 2))
+                       range(call, first(r"^\s*ip = next;", call) + 2),
+                       range(first(r"^\s*if \(vm->waiting\) \{"), head))
 
 
 def self_costs(out: Path, source: Path) -> dict[int, int]:
@@ -112,9 +114,8 @@ def self_costs(out: Path, source: Path) -> dict[int, int]:
     return costs
 
 
-def run_lines(binary: Path, addresses: list[int]) -> Iterator[tuple[int, int | None, bool]]:
-    """For each address: the line of `run()` it comes from (None outside run) and whether
-    it is inside `resume()`."""
+def run_lines(binary: Path, addresses: list[int]) -> Iterator[tuple[int, int | None]]:
+    """For each address: the line of `run()` it comes from (None outside run)."""
     text = subprocess.run(["addr2line", "-a", "-f", "-i", "-e", str(binary),
                            *(hex(a) for a in addresses)], check=True, capture_output=True,
                           text=True).stdout.splitlines()
@@ -123,14 +124,12 @@ def run_lines(binary: Path, addresses: list[int]) -> Iterator[tuple[int, int | N
         assert int(text[index], 16) == address, text[index]
         index += 1
         run_line: int | None = None
-        in_resume = False
         while index < len(text) and not text[index].startswith("0x"):
             function, where = text[index], text[index + 1]
             index += 2
             if function == "run" and where.startswith(f"{VM_SOURCE}:"):
                 run_line = int(where.rsplit(":", 1)[1].split()[0])
-            in_resume |= function == "resume"
-        yield address, run_line, in_resume
+        yield address, run_line
 
 
 def programs(paths: list[Path]) -> list[dict[str, object]]:
@@ -152,8 +151,8 @@ def measure(binary: Path, vectors_file: Path, executed: int, calls: int, folder:
                    check=True, capture_output=True)
     costs = self_costs(out, VM_SOURCE)
     call_cost = dispatch = steps = 0
-    for address, line, in_resume in run_lines(binary, sorted(costs)):
-        if in_resume or (line is not None and line in regions.call_case):
+    for address, line in run_lines(binary, sorted(costs)):
+        if line is not None and (line in regions.call_case or line in regions.resume):
             call_cost += costs[address]
         elif line is None or line not in regions.loop:
             steps += costs[address]

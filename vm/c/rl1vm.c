@@ -167,19 +167,6 @@ static bool take_reading(rl1_vm *vm, uint8_t op, uint8_t call, const rl1_reading
     return true;
 }
 
-/* Whether a finished call `op` (descriptor `call`) succeeded, its reading taken: false
- * for a device error (an ERROR, a value out of its documented range, or a callback that
- * broke in: then nothing is written). */
-#if defined(__GNUC__)
-__attribute__((always_inline))
-#endif
-static inline bool finished(rl1_vm *vm, uint8_t op, uint8_t call, rl1_status status,
-                            const rl1_reading *out)
-{
-    return status == RL1_OK && !broken_in(vm)
-        && (!(call & READS) || take_reading(vm, op, call, out));
-}
-
 /* The event point (section 9): takes a pending lost line and moves *pc to the handler
  * Table 4 names for it (mode 2: MOV :98, MVI :99; mode 3: MOV :96, MVI :97; no other
  * mode jumps). The fault missing-handler when that handler is absent; the fault aborted
@@ -541,11 +528,23 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
                     return RL1_WAITING;
                 }
                 vm->waiting = 0;
+                if (status != RL1_OK) {
+                    kind = RL1_FAULT_DEVICE;
+                    break;
+                }
             } else {
                 clear_reading(&out);
-                status = hw->call(hw->ctx, op, given, &out);
+                if (hw->call(hw->ctx, op, given, &out) != RL1_OK) {
+                    kind = RL1_FAULT_DEVICE;
+                    break;
+                }
             }
-            if (!finished(vm, op, call, status, &out)) {
+            /* a device error: an ERROR (above), a callback that broke in, or a reading
+             * out of its documented range (then nothing is written) */
+            if (broken_in(vm)
+                || ((call & READS)
+                    && !take_reading(vm, (uint8_t)(RL1_BYTE(ip) & ~RL1_COMPACT_CALL_BIT),
+                                     call, &out))) {
                 kind = RL1_FAULT_DEVICE;
                 break;
             }
