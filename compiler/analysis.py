@@ -9,8 +9,9 @@ from collections.abc import Callable, Iterator
 from typing import NamedTuple
 
 from .checker import apply_suppressions, check, check_text
+from .checker.compact import CompactDiagnostics
 from .frontend.ast import Program
-from .frontend.diagnostics import Diagnostic, Fix, sort_by_place, sort_key
+from .frontend.diagnostics import Diagnostic, Fix, sort_key
 from .frontend.edits import apply_edits, compatible
 from .frontend.parser import parse_program
 
@@ -33,11 +34,14 @@ def analyze(text: str) -> Analysis:
 
 
 def diagnose(text: str) -> list[Diagnostic]:
-    """`analyze(text).diagnostics`, without holding the tree: for `rl1c check`, whose
-    memory is then the text's and the diagnostics' (checker/streaming.py)."""
-    diagnostics = check_text(text)
-    sort_by_place(diagnostics)
-    return diagnostics
+    """`analyze(text).diagnostics`, without holding the tree (checker/streaming.py)."""
+    return list(check_text(text))
+
+
+def diagnose_compactly(text: str) -> CompactDiagnostics:
+    """`diagnose(text)`, holding those of single lines as a few bytes each until they are
+    read (checker/compact.py): for `rl1c check`, whose memory is then the text's."""
+    return check_text(text)
 
 
 MAX_FIX_ROUNDS = 10

@@ -10,7 +10,8 @@ block's first statement, the reads of reserved variables that may be unset, the
 targets written in a busy loop) have its lines parsed again as they read
 (`SourceStatements`). The diagnostics are the same as those of the tree's check
 (`analysis.analyze`, which the compiler needs for its tree), and a property test holds
-the two equal.
+the two equal. The diagnostics of single lines are held as their line and kind, and
+built again when read (compact.py).
 """
 
 from __future__ import annotations
@@ -20,16 +21,16 @@ from typing import overload
 
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.collector import collector_paused
-from rl1.compiler.frontend.diagnostics import Diagnostic
+from rl1.compiler.frontend.diagnostics import Diagnostic, sort_by_place
 from rl1.compiler.frontend.parser import parse_line
 from rl1.compiler.frontend.source import LineIndex, iter_lines
 
 from .blocks import Cut
 from .cfg import graph_of
+from .compact import CompactDiagnostics, LineDiagnostics, parsed_line
 from .effects import BlockEffects, Segment, combine, line_segments
-from .lines import check_line
 from .rules import check_graph
-from .suppression import MARK, suppressed
+from .suppression import MARK, Suppressions
 
 
 class SourceStatements(Sequence[ast.Statement]):
@@ -95,10 +96,11 @@ class _OpenBlock:
         self.last: ast.Statement | None = None
 
 
-def check_text(text: str) -> list[Diagnostic]:
-    """Every diagnostic of `text`, in no particular order, those its comments allow left
-    out: what `check` and `apply_suppressions` give on `parse_program`'s tree."""
-    found: list[Diagnostic] = []
+def check_text(text: str) -> CompactDiagnostics:
+    """Every diagnostic of `text`, in sort_key's order, those its comments allow left
+    out: what `check` and `apply_suppressions` give on `parse_program`'s tree, sorted."""
+    held = LineDiagnostics()  # those of single lines
+    others: list[Diagnostic] = []
     directives: list[ast.Line] = []  # the lines whose comments may be directives
     lines = LineIndex(text)
     cuts: list[Cut] = []
@@ -119,10 +121,13 @@ def check_text(text: str) -> list[Diagnostic]:
 
     with collector_paused():
         for index, line_text in enumerate(iter_lines(text)):
-            line, problems = parse_line(line_text, index + 1)
+            line, found = parsed_line(line_text, index + 1)
             last_span = line.span
-            found += problems
-            found += check_line(line)
+            for diagnostic in found:
+                if diagnostic.span.line == index + 1:
+                    held.add(index + 1, lines.start(index), diagnostic)
+                else:  # none is, but one would be found again on its own line
+                    others.append(diagnostic)
             if line.comment is not None and MARK in line.comment.text:
                 directives.append(line)
             if line.label is not None:
@@ -152,13 +157,20 @@ def check_text(text: str) -> list[Diagnostic]:
                 start += len(run)
                 if closes:
                     close()
-            del line, segments  # the next line's tree replaces this one's
+            del line, segments, found  # the next line's tree replaces this one's
         close()
         cuts.append(Cut((), _taken(pending), False, ()))
         graph = graph_of(cuts, summaries)
         del cuts  # the blocks hold what the rules need
-        found += check_graph(graph, ast.Span(1, 1, last_span.end_line, last_span.end_column))
-    return suppressed(directives, found)
+        others += check_graph(graph, ast.Span(1, 1, last_span.end_line, last_span.end_column))
+    suppressions = Suppressions(directives)
+    if not suppressions.empty:
+        held = held.kept(suppressions.reports)
+        others = [d for d in others
+                  if suppressions.reports(d.code, d.severity, d.span.line)]
+        others += suppressions.problems()
+    sort_by_place(others)
+    return CompactDiagnostics(text, held, suppressions.reports, others)
 
 
 def _merges_into(cuts: list[Cut]) -> bool:

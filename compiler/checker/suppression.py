@@ -58,34 +58,59 @@ def suppressed(lines: Sequence[ast.Line], diagnostics: Iterable[Diagnostic], *,
                complete: bool = True) -> list[Diagnostic]:
     """`apply_suppressions` given the program's lines, or only those whose comments
     hold MARK (streaming.py keeps only those)."""
-    diagnostics = list(diagnostics)
-    directives, problems = _directives(lines)
-    if not directives and not problems:
-        return diagnostics
-    file_wide = {code for d in directives if d.file_wide for code, _ in d.codes}
-    on_line: dict[int, set[str]] = {}
-    for directive in directives:
-        if not directive.file_wide:
-            on_line.setdefault(directive.line, set()).update(code for code, _ in directive.codes)
-    kept: list[Diagnostic] = []
-    used: set[tuple[int | None, str]] = set()  # (line, code); None for the whole file
-    for diagnostic in diagnostics:
-        code, line = diagnostic.code, diagnostic.span.line
-        if diagnostic.severity is not Severity.WARNING:
-            kept.append(diagnostic)
-        elif code in on_line.get(line, ()):
-            used.add((line, code))
-        elif code in file_wide:
-            used.add((None, code))
+    suppressions = Suppressions(lines)
+    if suppressions.empty:
+        return list(diagnostics)
+    kept = [d for d in diagnostics if suppressions.reports(d.code, d.severity, d.span.line)]
+    return kept + suppressions.problems(complete=complete)
+
+
+class Suppressions:
+    """The directives of a program's lines: which warnings they allow (noting each
+    directive's codes that allowed one), and then the W0107s of those that allowed
+    nothing. The streaming check asks it of each diagnostic's code, severity and line,
+    without the diagnostic (checker/compact.py keeps none)."""
+
+    def __init__(self, lines: Sequence[ast.Line]) -> None:
+        self._directives, self._problems = _directives(lines)
+        self._file_wide = {code for d in self._directives if d.file_wide
+                           for code, _ in d.codes}
+        self._on_line: dict[int, set[str]] = {}
+        for directive in self._directives:
+            if not directive.file_wide:
+                self._on_line.setdefault(directive.line, set()).update(
+                    code for code, _ in directive.codes)
+        self._used: set[tuple[int | None, str]] = set()  # (line, code); None: the file
+
+    @property
+    def empty(self) -> bool:
+        """No directive, and nothing to say of one: every diagnostic is reported."""
+        return not self._directives and not self._problems
+
+    def reports(self, code: str, severity: Severity, line: int) -> bool:
+        """Whether a diagnostic `code` of `severity` on `line` is reported: no directive
+        allows it (only warnings can be allowed); a directive that does is noted."""
+        if severity is not Severity.WARNING:
+            return True
+        if code in self._on_line.get(line, ()):
+            self._used.add((line, code))
+        elif code in self._file_wide:
+            self._used.add((None, code))
         else:
-            kept.append(diagnostic)
-    for directive in directives if complete else ():
-        scope = None if directive.file_wide else directive.line
-        for code, span in directive.codes:
-            if (scope, code) not in used:
-                where = "in this file" if directive.file_wide else "on this line"
-                problems.append(_unused(f"no {code} is reported {where}", span))
-    return kept + problems
+            return True
+        return False
+
+    def problems(self, *, complete: bool = True) -> list[Diagnostic]:
+        """The W0107s: a directive that is none or names no warning code, and (when the
+        diagnostics `reports` was asked of are `complete`) a code that allowed nothing."""
+        problems = list(self._problems)
+        for directive in self._directives if complete else ():
+            scope = None if directive.file_wide else directive.line
+            for code, span in directive.codes:
+                if (scope, code) not in self._used:
+                    where = "in this file" if directive.file_wide else "on this line"
+                    problems.append(_unused(f"no {code} is reported {where}", span))
+        return problems
 
 
 def _directives(lines: Sequence[ast.Line]) -> tuple[list[Directive], list[Diagnostic]]:

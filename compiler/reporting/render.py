@@ -12,8 +12,8 @@ from __future__ import annotations
 import io
 import os
 import unicodedata
-from collections.abc import Iterator, Sequence
-from typing import IO, Any, Literal, NamedTuple
+from collections.abc import Iterable, Iterator, Sequence
+from typing import IO, Any, Literal, NamedTuple, Protocol, runtime_checkable
 
 from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity, sort_by_place
@@ -39,6 +39,18 @@ _ELLIPSIS = "..."
 
 SARIF_SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
 _SARIF_LEVELS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
+
+
+@runtime_checkable
+class Ordered(Protocol):
+    """Diagnostics in sort_key's order already, which say their severities without being
+    built: checker/compact.py's, a source's million syntax errors held as a few bytes
+    each. A report writes them as they come, built one at a time, and counts them
+    without building them (the module imports no checker: `rl1c explain` loads none)."""
+
+    def __iter__(self) -> Iterator[Diagnostic]: ...
+
+    def severities(self) -> Iterator[Severity]: ...
 
 
 class FileDiagnostics(NamedTuple):
@@ -116,8 +128,8 @@ def summary(files: Sequence[FileDiagnostics], fixed: int = 0, left: int = 0,
     unread = len(files) - len(read)
     if unread and not read:
         return f"no file checked: {_plural(unread, 'file')} could not be read\n"
-    errors = sum(d.is_error for file in read for d in file.diagnostics)
-    warnings = sum(d.severity is Severity.WARNING for file in read for d in file.diagnostics)
+    counts = _counts(file.diagnostics for file in read)
+    errors, warnings = counts[Severity.ERROR], counts[Severity.WARNING]
     notes = [f"{_plural(fixed, 'problem')} fixed"] if fixed else []
     if left:
         notes.append(fixes_not_made(left, unsafe))
@@ -140,7 +152,8 @@ def exit_status(files: Sequence[FileDiagnostics]) -> int:
     """2 when a file could not be read, else 1 when any diagnostic is an error, else 0."""
     if any(file.text is None for file in files):
         return EXIT_USAGE
-    if any(d.is_error for file in files for d in file.diagnostics):
+    if any(severity is Severity.ERROR for file in files
+           for severity in _severities(file.diagnostics)):
         return EXIT_ERRORS
     return EXIT_OK
 
@@ -152,10 +165,27 @@ def use_color(choice: ColorChoice, stream: IO[Any]) -> bool:
     return choice == "always"
 
 
-def _ordered(diagnostics: Sequence[Diagnostic]) -> list[Diagnostic]:
+def _ordered(diagnostics: Sequence[Diagnostic]) -> Iterable[Diagnostic]:
+    if isinstance(diagnostics, Ordered):
+        return diagnostics
     ordered = list(diagnostics)
     sort_by_place(ordered)
     return ordered
+
+
+def _severities(diagnostics: Sequence[Diagnostic]) -> Iterator[Severity]:
+    if isinstance(diagnostics, Ordered):
+        return diagnostics.severities()
+    return (diagnostic.severity for diagnostic in diagnostics)
+
+
+def _counts(files: Iterable[Sequence[Diagnostic]]) -> dict[Severity, int]:
+    """How many diagnostics of each severity the files have."""
+    counts = dict.fromkeys(Severity, 0)
+    for diagnostics in files:
+        for severity in _severities(diagnostics):
+            counts[severity] += 1
+    return counts
 
 
 # Human ------------------------------------------------------------------------------
@@ -318,9 +348,7 @@ class _HumanRenderer:
         return out
 
     def summary(self, action: str) -> str:
-        counts = {severity: 0 for severity in Severity}
-        for diagnostic in self.file.diagnostics:
-            counts[diagnostic.severity] += 1
+        counts = _counts([self.file.diagnostics])
         errors, warnings = counts[Severity.ERROR], counts[Severity.WARNING]
         emitted = ", ".join(
             _plural(count, noun) for count, noun in ((errors, "error"), (warnings, "warning"))

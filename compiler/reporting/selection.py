@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from typing import NamedTuple
 
+from rl1.compiler.checker.compact import CompactDiagnostics
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 
 from .catalogue import CODES
@@ -38,9 +39,12 @@ class Selection(NamedTuple):
     def reports(self, diagnostic: Diagnostic) -> bool:
         """Errors always; a warning when it is selected (every one by default) and not
         ignored (an ignored code stays ignored whatever selects it)."""
-        if diagnostic.severity is not Severity.WARNING:
+        return self.reports_kind(diagnostic.code, diagnostic.severity)
+
+    def reports_kind(self, code: str, severity: Severity) -> bool:
+        """`reports` of a diagnostic of `code` and `severity`."""
+        if severity is not Severity.WARNING:
             return True
-        code = diagnostic.code
         selected = self.select is None or code.startswith(self.select)
         return selected and not (self.ignore and code.startswith(self.ignore))
 
@@ -51,6 +55,10 @@ class Selection(NamedTuple):
             return kept
         return [d._replace(severity=Severity.ERROR)
                 if d.severity is Severity.WARNING else d for d in kept]
+
+    def apply_compact(self, diagnostics: CompactDiagnostics) -> CompactDiagnostics:
+        """`apply` to diagnostics held compactly (checker/compact.py), none built."""
+        return diagnostics.selected(self.reports_kind, bool(self.warnings_as_errors))
 
 
 def parse_codes(words: Sequence[str]) -> tuple[str, ...]:

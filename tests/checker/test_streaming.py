@@ -59,32 +59,45 @@ def test_a_blocks_statements_are_read_from_its_lines_again() -> None:
         statements[3]
 
 
-# Two kinds of bench/memory.py's sources, at a size tracemalloc measures in seconds (its
-# third, a syntax error a line, is above the bound: its diagnostics alone, an E0101 with
-# its fix a line, take 67 B/B; test_broken_lines_cost_little_beyond_their_diagnostics).
+# bench/memory.py's sources, at a size tracemalloc measures in seconds.
 SOURCES = {
     "lines of 19,999 characters": ";".join(["A=1"] * 4999) + "\n",
     "`A=1` lines": "A=1\n",
+    "lines with a syntax error": "A=1 B=2\n",
 }
 SOURCE_CHARACTERS = 256 * 1024
 
 MEASURE = textwrap.dedent("""
-    import sys, tracemalloc
-    from rl1.compiler.analysis import diagnose
-    line = sys.argv[1]
+    import io, sys, tracemalloc
+    from rl1.compiler.analysis import diagnose_compactly
+    from rl1.compiler.reporting.render import FileDiagnostics, exit_status, summary, write_report
+    from rl1.compiler.reporting.selection import Selection
+    line, output_format = sys.argv[1:]
     text = line * ({characters} // len(line))
+
+    class Nowhere(io.TextIOBase):
+        def write(self, text):
+            return len(text)
+
     tracemalloc.start()
-    diagnose(text)
+    held = Selection().apply_compact(diagnose_compactly(text))
+    files = [FileDiagnostics("big.rob", text, held)]
+    write_report(Nowhere(), files, output_format)
+    summary(files), exit_status(files)
     print(tracemalloc.get_traced_memory()[1] / len(text))
 """)
 
 
+@pytest.mark.parametrize("output_format", ["human", "sarif"])
 @pytest.mark.parametrize("kind", SOURCES)
-def test_checking_takes_at_most_64_bytes_a_source_byte(kind: str) -> None:
-    """The peak of the allocations of `diagnose` beyond its text (in a process of its
-    own, so that no other test's caches count), against spec/language.md's bound."""
+def test_checking_takes_at_most_64_bytes_a_source_byte(kind: str, output_format: str) -> None:
+    """The peak of the allocations of what `rl1c check` does beyond reading its text (in
+    a process of its own, so that no other test's caches count), against
+    spec/language.md's bound. A syntax error a line took 67 B/B in its diagnostics alone
+    (an E0101 with its fix, 516 bytes of objects a line) before they were held compactly
+    (checker/compact.py)."""
     script = MEASURE.format(characters=SOURCE_CHARACTERS)
-    measured = subprocess.run([sys.executable, "-c", script, SOURCES[kind]],
+    measured = subprocess.run([sys.executable, "-c", script, SOURCES[kind], output_format],
                               capture_output=True, text=True, check=True)
     assert float(measured.stdout) <= 64
 
@@ -102,9 +115,9 @@ BEYOND_DIAGNOSTICS = textwrap.dedent("""
 
 def test_broken_lines_cost_little_beyond_their_diagnostics() -> None:
     """A source of a syntax error a line (bench/memory.py's third) holds its diagnostics
-    and little else at its peak: consecutive broken lines are one block of the graph
-    (they were a block each: 62 B/B beyond the diagnostics), and sorting takes no key
-    tuple a diagnostic (9 B/B)."""
+    (`diagnose`'s list, which `--fix` reads) and little else at its peak: consecutive
+    broken lines are one block of the graph (they were a block each: 62 B/B beyond the
+    diagnostics), and sorting takes no key tuple a diagnostic (9 B/B)."""
     script = BEYOND_DIAGNOSTICS.format(characters=SOURCE_CHARACTERS)
     measured = subprocess.run([sys.executable, "-c", script], capture_output=True,
                               text=True, check=True)

@@ -22,6 +22,7 @@ from support.cli import Result, rl1c
 from support.sarif import sarif_problems
 
 from rl1.compiler import analysis
+from rl1.compiler.checker.compact import CompactDiagnostics, LineDiagnostics
 from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.compiler.reporting.catalogue import CODES
@@ -103,10 +104,11 @@ def test_a_file_that_cannot_be_read_is_not_counted_as_checked(tmp_path: Path) ->
 
 
 def test_warnings_alone_exit_0(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    def only_a_warning(text: str) -> list[Diagnostic]:
-        return [Diagnostic("W0601", Severity.WARNING, "odd", Span(1, 1, 1, 2))]
+    def only_a_warning(text: str) -> CompactDiagnostics:
+        warning = Diagnostic("W0601", Severity.WARNING, "odd", Span(1, 1, 1, 2))
+        return CompactDiagnostics(text, LineDiagnostics(), lambda *_: True, [warning])
 
-    monkeypatch.setattr(analysis, "diagnose", only_a_warning)
+    monkeypatch.setattr(analysis, "diagnose_compactly", only_a_warning)
     result = run("check", write(tmp_path, "A=1\n"))
     assert result.exit_code == 0
     assert "warning[W0601]: odd" in result.stdout
@@ -324,7 +326,7 @@ def test_an_internal_error_is_a_short_message_and_exit_3(
     def broken(text: str) -> list[Diagnostic]:
         raise KeyError("no such rule")
 
-    monkeypatch.setattr(analysis, "diagnose", broken)
+    monkeypatch.setattr(analysis, "diagnose_compactly", broken)
     monkeypatch.delenv("RL1C_BACKTRACE", raising=False)
     result = run("check", write(tmp_path, "A=1\n"))
     assert result.exit_code == 3
@@ -343,7 +345,7 @@ def test_ctrl_c_ends_with_a_short_message_and_the_shells_status(
     def interrupted(text: str) -> list[Diagnostic]:
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(analysis, "diagnose", interrupted)
+    monkeypatch.setattr(analysis, "diagnose_compactly", interrupted)
     result = run("check", write(tmp_path, "A=1\n"))
     assert (result.exit_code, result.stdout, result.stderr) == (130, "", "rl1c: interrupted\n")
 
