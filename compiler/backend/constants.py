@@ -43,7 +43,8 @@ Known = dict[str, int]
 
 
 def fold_constants(program: ir.Program) -> ir.Program:
-    for block_id, folded in _solve(program).items():
+    zeros = _always_zero(program)
+    for block_id, folded in _solve(program, zeros).items():
         block = program.blocks[block_id]  # a block no path reaches is control.py's to remove
         block.instructions, block.terminator = folded.instructions, folded.terminator
     return program
@@ -56,13 +57,41 @@ class _Folded:
     known: Known  # where the block ends
 
 
-def _solve(program: ir.Program) -> dict[ir.BlockId, _Folded]:
+def _always_zero(program: ir.Program) -> frozenset[str]:
+    """The variables that hold 0 wherever the flow goes, which it need not follow (its
+    states are smaller, compile time): in a program without handlers (where nothing is
+    known), those that nothing writes, as nothing names them."""
+    if program.handlers:
+        return frozenset()
+    named: set[str] = set()
+    for block in program:
+        for instruction in block.instructions:
+            match instruction:
+                case ir.Call(args=args):
+                    named.update(instruction.form.writes)
+                    named.update(arg.name for arg in args if isinstance(arg, ir.Var))
+                case ir.Load(source=ir.Var(name=name)) | ir.Operate(source=ir.Var(name=name)):
+                    named.add(name)
+                case ir.Store(target=target) | ir.StepVar(target=target):
+                    named.add(target.name)
+                case ir.Move(target=target, source=source):
+                    named.update(operand.name for operand in (target, source)
+                                 if isinstance(operand, ir.Var))
+                case ir.Compute(first=first, second=second):
+                    named.update(operand.name for operand in (first, second)
+                                 if isinstance(operand, ir.Var))
+        if isinstance(block.terminator, ir.Branch | ir.StoreBranch | ir.DecrementBranch):
+            named.add(block.terminator.var.name)
+    return frozenset(VARIABLES) - named
+
+
+def _solve(program: ir.Program, zeros: frozenset[str]) -> dict[ir.BlockId, _Folded]:
     """Each reachable block folded from what is known where it starts: the meet (the
     values all agree on) of what its predecessors know at their ends, and of the start
     of the program or a handler's entry. A worklist in layout order, each block queued
-    once at a time."""
+    once at a time. The variables in `zeros` are left out of what is known."""
     starts: dict[ir.BlockId, list[Known]] = {block_id: [] for block_id in program.blocks}
-    starts[program.entry].append(dict.fromkeys(VARIABLES, 0))
+    starts[program.entry].append({name: 0 for name in VARIABLES if name not in zeros})
     for block_id in program.handlers.values():
         starts[block_id].append({})
     # For each block, what each predecessor visited so far knows where it leads there.
@@ -80,7 +109,7 @@ def _solve(program: ir.Program) -> dict[ir.BlockId, _Folded]:
             continue
         entries[block_id] = known
         before = folded.get(block_id)
-        after = folded[block_id] = _fold(program.blocks[block_id], dict(known))
+        after = folded[block_id] = _fold(program.blocks[block_id], dict(known), zeros)
         for target in before.terminator.targets if before else ():
             incoming[target].pop(block_id, None)
         for target in after.terminator.targets:
@@ -112,7 +141,7 @@ def _value(operand: ir.Operand, known: Known) -> int | None:
     return None  # R: the device's answer
 
 
-def _fold(block: ir.Block, known: Known) -> _Folded:
+def _fold(block: ir.Block, known: Known, zeros: frozenset[str]) -> _Folded:
     out: list[ir.Instruction] = []
     acc: int | None = None  # the accumulator's value, when known
     pending = False  # whether that known value has yet to be loaded into the accumulator
@@ -125,7 +154,7 @@ def _fold(block: ir.Block, known: Known) -> _Folded:
         if pending:
             assert acc is not None
             holder = loaded_from if loaded_from is not None \
-                and known.get(loaded_from.name) == acc else _holding(known, acc)
+                and known.get(loaded_from.name) == acc else _holding(known, zeros, acc)
             out.append(ir.Load(holder or ir.Imm(acc), line))
             pending = False
 
@@ -179,10 +208,11 @@ def _fold(block: ir.Block, known: Known) -> _Folded:
     return _Folded(out, _terminator(block.terminator, known), known)
 
 
-def _holding(known: Known, value: int) -> ir.Var | None:
-    """The first variable, in the language's order, that holds the value: one rule, so
-    that the same source gives the same bytes."""
-    return next((ir.Var(name) for name in VARIABLES if known.get(name) == value), None)
+def _holding(known: Known, zeros: frozenset[str], value: int) -> ir.Var | None:
+    """The first variable, in the language's order, that holds the value (those of
+    `zeros` hold 0): one rule, so that the same source gives the same bytes."""
+    return next((ir.Var(name) for name in VARIABLES
+                 if known.get(name, 0 if name in zeros else None) == value), None)
 
 
 def _set(known: Known, name: str, value: int | None) -> None:

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections import deque
+from functools import cache
 
 from rl1.compiler.frontend.ast import Relation
 from rl1.vm.language import VARIABLES
@@ -225,17 +226,24 @@ def _exit_state(block: ir.Block, entry: State, tracked: frozenset[str]) -> State
             case ir.Call():
                 for name in instruction.form.writes:
                     state.pop(name, None)
-                low, high = instruction.form.result_range
-                result = frozenset(sign for sign, present in
-                                   (("<", low < 0), ("=", low <= 0 <= high), (">", high > 0))
-                                   if present)
+                result = _result_signs(instruction.form.result_range)
     return state
+
+
+@cache
+def _result_signs(result_range: tuple[int, int]) -> Signs:
+    low, high = result_range
+    return frozenset(sign for sign, present in
+                     (("<", low < 0), ("=", low <= 0 <= high), (">", high > 0)) if present)
+
+
+_SIGN_OF = {-1: frozenset("<"), 0: frozenset("="), 1: frozenset(">")}
 
 
 def _operand(operand: ir.Operand, state: State, result: Signs) -> Signs:
     match operand:
         case ir.Imm(value=value):
-            return frozenset("<" if value < 0 else "=" if value == 0 else ">")
+            return _SIGN_OF[(value > 0) - (value < 0)]
         case ir.Var(name=name):
             return state.get(name, ANY)
         case _:

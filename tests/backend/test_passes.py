@@ -286,6 +286,18 @@ def test_a_folded_value_is_loaded_from_a_variable_that_holds_it() -> None:
         "store D", "end"]
 
 
+def test_a_zero_is_loaded_from_the_first_variable_that_holds_it_named_or_not() -> None:
+    # The flow leaves out the variables nothing names (they hold 0 everywhere), and the
+    # load of a 0 still takes the first in the language's order: B, which no statement
+    # names (for A=0 too); then A, once A holds 0 and comes first.
+    assert code(after(fold_constants, "A=(INP 1); C=0-A; A=0; D=0-C")) == [
+        "call INP 1", "load R", "store A", "load B", "sub A", "store C", "load B",
+        "store A", "load A", "sub C", "store D", "end"]
+    # At a handler's entry nothing is known, a variable nothing names included.
+    program = after(fold_constants, "(TRC 2); (MOV 1,1); (END)\n:96 C=0-A; (END)\n")
+    assert code(program, program.handlers[96])[:2] == ["load 0", "sub A"]
+
+
 def test_a_commutative_operation_on_what_the_accumulator_holds_drops_the_load() -> None:
     # d=...; D=D+d: the accumulator holds d, so `load D; add d` is `add D`.
     assert code(after(propagate_copies, "d=(KYO)-1; D=D+d; E=E-d")) == [
