@@ -53,8 +53,9 @@ static uint16_t shifted(uint16_t x, int16_t count, bool left)
     return (uint16_t)(x >> places);
 }
 
-/* The calls that read something back: the VM clears their reading before the callback
- * and takes it after (the others' reading is not looked at). */
+/* The calls that read something back: the VM takes their reading after the callback
+ * (the others' is not looked at). Every call's is cleared before: a test of the
+ * descriptor would cost as much as the clearing. */
 #define READS (RL1_CALL_SETS_R | RL1_CALL_PAIRS)
 
 /* A reading with every field zero, stored field by field: an initializer of the whole
@@ -77,7 +78,8 @@ static bool broken_in(const rl1_vm *vm)
     return vm->state != (uint8_t)RL1_IN_STEP;
 }
 
-/* Inlined wherever it is called, so that each call site gets code of its own. */
+/* Inlined at each call, where gcc -Os would call a function out of line: on the call
+ * path a call costs more instructions than the function's body. */
 #if defined(__GNUC__)
 #define ALWAYS_INLINE __attribute__((always_inline)) inline
 #else
@@ -218,13 +220,6 @@ static rl1_state ended(rl1_vm *vm, const rl1_hardware *hw, uint16_t at)
     return hw->end(hw->ctx) != RL1_OK || broken_in(vm)
         ? fault(vm, hw, RL1_FAULT_DEVICE, at, true) : RL1_ENDED;
 }
-
-/* Where no case applies, so that the compiler's jump table needs no range check. */
-#if defined(__GNUC__)
-#define UNREACHABLE() __builtin_unreachable()
-#else
-#define UNREACHABLE() ((void)0)
-#endif
 
 /* The operand bytes of the instruction at ip. */
 #define U8_AT(k) RL1_BYTE(ip + (k))
