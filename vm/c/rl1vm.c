@@ -156,11 +156,13 @@ static bool take_reading(rl1_vm *vm, uint8_t op, uint8_t call, const rl1_reading
     if (result && (uint16_t)out->result > (uint16_t)RL1_RESULT_HIGH(result)) {
         return false;
     }
-    if (pairs) {
+    if (pairs) { /* one or two: rl1_reading has four writes */
         int16_t *to = &vm->V[rl1_flash_byte(&rl1_call_first[op - RL1_OP_FIRST_CALL])];
-        for (; pairs; pairs--, to += 2, from += 2) {
-            to[0] = from[0];
-            to[1] = from[1];
+        to[0] = from[0];
+        to[1] = from[1];
+        if (pairs > 1u) {
+            to[2] = from[2];
+            to[3] = from[3];
         }
     }
     if (call & RL1_CALL_SETS_R) {
