@@ -16,7 +16,9 @@ fused jump is a jump, where the budget is checked and an event taken); no path l
   become one load-and-operate (`E=L-M`, `A=(IMG)-180`): an expression's first two
   operands in one instruction. (A constant first is folded by -O1 or stays: `0-M`.)
   A load whose value is also stored before the operation (`D=(ULT A); E=D-G`) becomes
-  the moves, then the load-and-operate: one instruction fewer again.
+  the moves, then the load-and-operate: one instruction fewer again; also when calls
+  or steps that leave the accumulator and the load's source as they are come between
+  (`I=(INP 2); (LMP 0); E=I-128`, where copy propagation dropped the load of I).
 - A call whose constant arguments each fit a byte (`MOV 4,4`, `TRC 30`) becomes a compact
   call (format 1.3): a byte an argument instead of two.
 """
@@ -24,6 +26,7 @@ fused jump is a jump, where the budget is checked and an event taken); no path l
 from __future__ import annotations
 
 from dataclasses import replace
+from itertools import takewhile
 
 from . import flow, ir
 
@@ -44,16 +47,43 @@ def _compact(instruction: ir.Instruction) -> ir.Instruction:
     return instruction
 
 
-def _reloadable(load: ir.Load, stores: list[ir.Instruction],
-                following: list[ir.Instruction]) -> bool:
-    """Whether the load can come again after its stores became moves and fuse with the
-    operation after them: the stores leave its source as it was, and that operation
-    makes a load-and-operate (so the load costs nothing)."""
-    return (isinstance(load.source, ir.Var | ir.Result)
+def _reload(load: ir.Load, stores: list[ir.Instruction], following: list[ir.Instruction]
+            ) -> ir.Var | ir.Result | None:
+    """What the load can come again from after its stores became moves, to fuse with the
+    operation after them and after the calls and steps `_between` them: its source, or
+    else a variable it was stored into, that those leave as it is. None when no such
+    operation makes a load-and-operate (so that the load costs nothing), or a store
+    changes the source."""
+    between = _between(following)
+    operation = following[len(between):][:1]
+    if not (isinstance(load.source, ir.Var | ir.Result)
             and all(isinstance(store, ir.Store) and store.target != load.source
                     for store in stores)
-            and bool(following) and isinstance(following[0], ir.Operate)
-            and isinstance(following[0].source, ir.Var | ir.Imm))
+            and operation and isinstance(operation[0], ir.Operate)
+            and isinstance(operation[0].source, ir.Var | ir.Imm)):
+        return None
+    holders = [load.source, *(store.target for store in stores if isinstance(store, ir.Store))]
+    return next((holder for holder in holders
+                 if all(_keeps(instruction, holder) for instruction in between)), None)
+
+
+def _between(following: list[ir.Instruction]) -> list[ir.Instruction]:
+    """The calls and steps at the start of `following`: they leave the accumulator as
+    it is."""
+    return list(takewhile(lambda instruction: isinstance(instruction, ir.Call | ir.StepVar),
+                          following))
+
+
+def _keeps(instruction: ir.Instruction, holder: ir.Var | ir.Result) -> bool:
+    """Whether a call or step leaves what `holder` holds (R is the last call's only
+    until another call: ir.validate)."""
+    match instruction, holder:
+        case ir.Call(), ir.Var(name=name):
+            return name not in instruction.form.writes
+        case ir.StepVar(target=target), _:
+            return target != holder
+        case _:
+            return False
 
 
 def _computes(instructions: list[ir.Instruction]) -> list[ir.Instruction]:
@@ -95,15 +125,20 @@ def _moves(instructions: list[ir.Instruction], terminator: ir.Terminator
         while end < len(instructions) and isinstance(instructions[end], ir.Store):
             end += 1
         stores = instructions[index + 1:end]
-        if isinstance(load, ir.Load) and stores and (
-                flow.acc_dead_after(instructions, end, terminator)
-                or _reloadable(load, stores, instructions[end:end + 1])):
+        acc_dead = flow.acc_dead_after(instructions, end, terminator)
+        reload = _reload(load, stores, instructions[end:]) \
+            if isinstance(load, ir.Load) and stores and not acc_dead else None
+        if isinstance(load, ir.Load) and stores and (acc_dead or reload is not None):
             out += [ir.Move(store.target, load.source, store.line)
                     for store in stores if isinstance(store, ir.Store)]
-            if not flow.acc_dead_after(instructions, end, terminator):
+            if reload is not None:
                 # `D=(ULT A); E=D-G`: moves, then the load fuses on with the operation,
-                # on that operation's line (the stores' lines came after the load's)
-                out.append(ir.Load(load.source, instructions[end].line))
+                # on that operation's line (the stores' lines came after the load's);
+                # `I=(INP 2); (LMP 0); E=I-128`: after the call, from I
+                between = _between(instructions[end:])
+                out += between
+                end += len(between)
+                out.append(ir.Load(reload, instructions[end].line))
             index = end
         else:
             out.append(load)

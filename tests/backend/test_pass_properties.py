@@ -43,8 +43,15 @@ def decide_branches_after_control(program: ir.Program) -> ir.Program:
     return decide_branches(simplify_control(program))
 
 
+def fuse_after_copies(program: ir.Program) -> ir.Program:
+    """fuse where -O2 runs it: after copy propagation, which drops loads that it then
+    makes again after the calls between (`I=(INP 2); (LMP 0); E=I-128`)."""
+    return fuse(propagate_copies(program))
+
+
 PASSES = (fold_constants, decide_branches, decide_branches_after_control, propagate_copies,
-          cancel_equal_operands, remove_dead_stores, rewrite_steps, simplify_control, fuse)
+          cancel_equal_operands, remove_dead_stores, rewrite_steps, simplify_control, fuse,
+          fuse_after_copies)
 # Not simplify_control: removing blocks can make jumps to thread that it saw as none.
 IDEMPOTENT = (*sorted(optimize.IDEMPOTENT, key=lambda run_pass: run_pass.__name__), fuse)
 NO_WORK = [(giver, receiver) for giver, receivers in optimize.GIVES_NO_WORK_TO.items()

@@ -323,6 +323,28 @@ def test_stores_before_the_operation_become_moves_and_the_load_fuses_after_them(
     assert code(fuse(program)) == ["load A", "store B", "store A", "sub C", "store A", "end"]
 
 
+def test_the_load_fuses_after_calls_and_steps_from_what_they_leave_as_it_was() -> None:
+    # Copy propagation drops the load of I after (LMP 0), which leaves the accumulator:
+    # the load comes again from I (R is the last call's only until another call).
+    source = "I=(INP 2); (LMP 0); N++; E=I-128; ?E<#10\n:10 (END)"
+    assert code(fuse(after(propagate_copies, source))) == [
+        "compact call INP 2", "move I, R", "compact call LMP 0", "inc N", "load I sub 128",
+        "store E; if E<0 then L10 else B1"]
+    assert judge(Run(source, {"INP": {"2": [100]}}), ENGINES, 20_000).problems == []
+    # FZI writes s: the load comes again from B, the other variable that holds it; with
+    # none left, the stores stay.
+    s, inp, fzi = Var("s"), Call("INP", None, (Imm(2),), 1), Call("FZI", None, (), 1)
+    program = jumps(("B0", [], End(1)))
+    program.blocks["B0"].instructions = [inp, Load(ir.R, 1), Store(s, 1), Store(B, 1), fzi,
+                                         Operate("-", Imm(1), 1), Store(C, 1)]
+    assert code(fuse(program)) == ["compact call INP 2", "move s, R", "move B, R", "call FZI",
+                                   "load B sub 1", "store C", "end"]
+    program.blocks["B0"].instructions = [inp, Load(ir.R, 1), Store(s, 1), fzi,
+                                         Operate("-", Imm(1), 1), Store(C, 1)]
+    assert code(fuse(program)) == ["compact call INP 2", "load R", "store s", "call FZI",
+                                   "sub 1", "store C", "end"]
+
+
 def test_a_load_that_fuses_after_moves_of_later_lines_takes_its_operations_line() -> None:
     # Found by a 50,000-program rl1c fuzz campaign: the reloaded R kept line 2, after the
     # move of line 3, and the line map (lines never decrease) refused the file.
