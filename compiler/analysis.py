@@ -5,7 +5,7 @@ makes the checker's fixes."""
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from typing import NamedTuple
 
 from .checker import apply_suppressions, check, check_text
@@ -50,14 +50,15 @@ MAX_FIX_ROUNDS = 10
 
 
 class Fixed(NamedTuple):
-    """The text with the fixes made, how many were made, its diagnostics (`diagnose`'s:
-    no tree is held), and how many of the diagnostics `keep` accepts are left with a fix
-    (without `unsafe`: an unsafe one; with it: one that would be made over an unsafe
-    fix's result, in another run)."""
+    """The text with the fixes made, how many were made, its diagnostics (held compactly,
+    as `diagnose_compactly` gives them: neither a tree nor the diagnostics are held), and
+    how many of the diagnostics `keep` accepts are left with a fix (without `unsafe`: an
+    unsafe one; with it: one that would be made over an unsafe fix's result, in another
+    run)."""
 
     text: str
     fixes: int
-    diagnostics: list[Diagnostic]
+    diagnostics: CompactDiagnostics
     left: int
 
 
@@ -72,7 +73,7 @@ def fix(text: str, keep: Callable[[Diagnostic], bool] = lambda _: True, *,
     removal of a label nobody jumps to must not be made on it), and an unsafe fix's
     consequences wait for another run. `rl1c check --fix` and the language server's
     "fix all" both make their fixes through this function."""
-    diagnostics = diagnose(text)
+    diagnostics = diagnose_compactly(text)
     made = 0
     for done in range(MAX_FIX_ROUNDS):
         fixes = compatible(_fixes(diagnostics, keep, unsafe and done == 0))
@@ -80,14 +81,14 @@ def fix(text: str, keep: Callable[[Diagnostic], bool] = lambda _: True, *,
             break
         text = apply_edits(text, [edit for one in fixes for edit in one.edits])
         made += len(fixes)
-        diagnostics = diagnose(text)
+        diagnostics = diagnose_compactly(text)
         if not all(one.safe for one in fixes):
             break
     left = sum(1 for d in diagnostics if keep(d) and d.fixes)
     return Fixed(text, made, diagnostics, left)
 
 
-def _fixes(diagnostics: list[Diagnostic], keep: Callable[[Diagnostic], bool], unsafe: bool
+def _fixes(diagnostics: Iterable[Diagnostic], keep: Callable[[Diagnostic], bool], unsafe: bool
            ) -> Iterator[Fix]:
     """The first fix that may be made of each diagnostic `keep` accepts."""
     for diagnostic in diagnostics:

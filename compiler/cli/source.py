@@ -137,9 +137,9 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
                                                 "to make its fixes")), file=sys.stderr)
                 status = EXIT_USAGE
                 text, diagnostics = source.text, None  # the file is as it was
-        reported = (selection.apply_compact(analysis.diagnose_compactly(text))
-                    if diagnostics is None else selection.apply(diagnostics))
-        checked.append(FileDiagnostics(source.name, text, reported))
+        if diagnostics is None:
+            diagnostics = analysis.diagnose_compactly(text)
+        checked.append(FileDiagnostics(source.name, text, selection.apply_compact(diagnostics)))
     status = max(status, emit(checked, output_format, color, None))
     if output_format in ("human", "concise"):
         sys.stdout.write(summary(checked, fixed, left, unsafe_fixes))

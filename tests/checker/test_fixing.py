@@ -46,7 +46,7 @@ def fixable_programs(draw: st.DrawFn) -> str:
 def test_after_fix_no_diagnostic_with_a_safe_fix_is_left(text: str) -> None:
     fixed = fix(text)
     assert [d.code for d in fixed.diagnostics if fixable(d)] == []
-    assert fixed.diagnostics == analyze(fixed.text).diagnostics
+    assert list(fixed.diagnostics) == analyze(fixed.text).diagnostics
     assert (fixed.fixes == 0) == (fixed.text == text)
 
 
