@@ -98,7 +98,7 @@ class _OpenBlock:
 
 def check_text(text: str) -> CompactDiagnostics:
     """Every diagnostic of `text`, in sort_key's order, those its comments allow left
-    out: what `check` and `apply_suppressions` give on `parse_program`'s tree, sorted."""
+    out: what `check` and `apply_suppressions` give on `parse_program`'s tree."""
     held = LineDiagnostics()  # those of single lines
     others: list[Diagnostic] = []
     directives: list[ast.Line] = []  # the lines whose comments may be directives
@@ -126,7 +126,7 @@ def check_text(text: str) -> CompactDiagnostics:
             for diagnostic in found:
                 if diagnostic.span.line == index + 1:
                     held.add(index + 1, lines.start(index), diagnostic)
-                else:  # none is, but one would be found again on its own line
+                else:  # none is; built again, it would be looked for on its own line
                     others.append(diagnostic)
             if line.comment is not None and MARK in line.comment.text:
                 directives.append(line)
