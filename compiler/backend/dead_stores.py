@@ -23,10 +23,8 @@ ALL = frozenset(VARIABLES)
 
 
 def remove_dead_stores(program: ir.Program) -> ir.Program:
-    events = flow.takes_events(program)
-    live_in = _live_in(program, events)
-    for block in program:
-        block.instructions, _ = _sweep(block, _live_out(block, live_in, events))
+    for block_id, kept in _solve(program, flow.takes_events(program)).items():
+        program.blocks[block_id].instructions = kept
     return program
 
 
@@ -40,21 +38,25 @@ def _live_out(block: ir.Block, live_in: dict[ir.BlockId, frozenset[str]],
     return live | {terminator.var.name} if isinstance(terminator, ir.Branch) else live
 
 
-def _live_in(program: ir.Program, events: bool) -> dict[ir.BlockId, frozenset[str]]:
+def _solve(program: ir.Program, events: bool) -> dict[ir.BlockId, list[ir.Instruction]]:
+    """Each block's instructions without its dead ones, from what is live where each
+    block starts: a worklist, each block swept again when what is live after it grows
+    (its last sweep is the one with the final liveness)."""
     preds = program.predecessors()
     live_in: dict[ir.BlockId, frozenset[str]] = {}
+    kept: dict[ir.BlockId, list[ir.Instruction]] = {}
     work = list(program.blocks)  # popped from the end: the last block first
     queued = set(work)
     while work:
         block_id = work.pop()
         queued.discard(block_id)
         block = program.blocks[block_id]
-        _, live = _sweep(block, _live_out(block, live_in, events))
+        kept[block_id], live = _sweep(block, _live_out(block, live_in, events))
         if live_in.get(block_id) != live:
             live_in[block_id] = live
             work.extend(pred for pred in preds[block_id] if pred not in queued)
             queued.update(preds[block_id])
-    return live_in
+    return kept
 
 
 def _sweep(block: ir.Block, live_out: frozenset[str]

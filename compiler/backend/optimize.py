@@ -23,10 +23,11 @@ Pass = Callable[[ir.Program], ir.Program]
 
 # -O1: the passes whose output every format 1.0 reader runs. The control pass comes
 # first so that the others see merged blocks, and last so that it removes what they
-# made unreachable. Algebra comes before constant folding, which carries on what it
-# leaves (`A-A+7` is 7); the branches the signs decide come after the passes within
-# blocks, which seldom change what that flow finds.
-O1_PASSES: tuple[Pass, ...] = (simplify_control, cancel_equal_operands, fold_constants,
+# made unreachable. Algebra comes after constant folding, which gives it work (`0+B` is
+# `B`) and carries on what it leaves (`A-A+7` is 7) when it finds any, which is seldom;
+# the branches the signs decide come after the passes within blocks, which seldom
+# change what that flow finds.
+O1_PASSES: tuple[Pass, ...] = (simplify_control, fold_constants, cancel_equal_operands,
                                propagate_copies, rewrite_steps, remove_dead_stores,
                                decide_branches, simplify_control)
 LEVELS: dict[int, tuple[Pass, ...]] = {0: (), 1: O1_PASSES, 2: O1_PASSES}
@@ -42,7 +43,7 @@ IDEMPOTENT: frozenset[Pass] = frozenset({fold_constants, propagate_copies, rewri
 # The passes to which a pass's changes never give anything to do: copy propagation keeps
 # what every variable and the accumulator hold at every point, and the control flow.
 GIVES_NO_WORK_TO: dict[Pass, frozenset[Pass]] = {
-    propagate_copies: frozenset({fold_constants, decide_branches}),
+    propagate_copies: frozenset({fold_constants, cancel_equal_operands, decide_branches}),
 }
 
 

@@ -125,22 +125,22 @@ def _moves(instructions: list[ir.Instruction], terminator: ir.Terminator
         while end < len(instructions) and isinstance(instructions[end], ir.Store):
             end += 1
         stores = instructions[index + 1:end]
-        acc_dead = flow.acc_dead_after(instructions, end, terminator)
-        reload = _reload(load, stores, instructions[end:]) \
-            if isinstance(load, ir.Load) and stores and not acc_dead else None
-        if isinstance(load, ir.Load) and stores and (acc_dead or reload is not None):
-            out += [ir.Move(store.target, load.source, store.line)
-                    for store in stores if isinstance(store, ir.Store)]
-            if reload is not None:
-                # `D=(ULT A); E=D-G`: moves, then the load fuses on with the operation,
-                # on that operation's line (the stores' lines came after the load's);
-                # `I=(INP 2); (LMP 0); E=I-128`: after the call, from I
-                between = _between(instructions[end:])
-                out += between
-                end += len(between)
-                out.append(ir.Load(reload, instructions[end].line))
-            index = end
-        else:
+        reload = None
+        if not (isinstance(load, ir.Load) and stores and (
+                flow.acc_dead_after(instructions, end, terminator)
+                or (reload := _reload(load, stores, instructions[end:])) is not None)):
             out.append(load)
             index += 1
+            continue
+        out += [ir.Move(store.target, load.source, store.line)
+                for store in stores if isinstance(store, ir.Store)]
+        if reload is not None:
+            # `D=(ULT A); E=D-G`: moves, then the load fuses on with the operation, on
+            # that operation's line (the stores' lines came after the load's);
+            # `I=(INP 2); (LMP 0); E=I-128`: after the call, from I
+            between = _between(instructions[end:])
+            out += between
+            end += len(between)
+            out.append(ir.Load(reload, instructions[end].line))
+        index = end
     return out
