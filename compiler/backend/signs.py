@@ -169,8 +169,8 @@ def _solve(program: ir.Program, tracked: frozenset[str]) -> dict[ir.BlockId, Sta
 
 def _join(states: list[State]) -> State:
     """The signs any of the states allows, in the first state's order (deterministic)."""
-    if len(states) <= 1:
-        return dict(states[0]) if states else {}
+    if len(states) <= 1:  # a block with one way in: most of them (_exit_state copies it)
+        return states[0] if states else {}
     first, *rest = states
     shared = set(first).intersection(*rest)
     joined: State = {}
@@ -184,11 +184,12 @@ def _join(states: list[State]) -> State:
 
 def _edges(block: ir.Block, state: State) -> list[tuple[ir.BlockId, State]]:
     terminator = block.terminator
-    if not isinstance(terminator, ir.Branch):
+    if isinstance(terminator, ir.StoreBranch | ir.DecrementBranch):
         forgotten = {name: signs for name, signs in state.items()
-                     if not isinstance(terminator, ir.StoreBranch | ir.DecrementBranch)
-                     or name != terminator.var.name}
+                     if name != terminator.var.name}
         return [(target, forgotten) for target in terminator.targets]
+    if not isinstance(terminator, ir.Branch):
+        return [(target, state) for target in terminator.targets]
     name = terminator.var.name
     signs = state.get(name, ANY)
     decided = _decided(terminator, signs)
