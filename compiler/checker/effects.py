@@ -90,27 +90,58 @@ def combine(parts: Sequence[tuple[int, BlockEffects]]) -> BlockEffects:
     """The effects of a block from those of its runs, each with the index in the block
     of its first statement. Summaries are shared, never changed, so one run's is reused
     as it is."""
-    if not parts:
-        return BlockEffects.nothing()
-    if len(parts) == 1 and parts[0][0] == 0:
-        return parts[0][1]
-    operations: list[device.Operation] = []
-    writes: list[tuple[int, int, int]] = []
-    first_event: int | None = None
-    reads = 0
-    observes = calls_unknown = False
+    combining = Combining()
     for offset, part in parts:
-        if first_event is None and part.first_event is not None:
-            first_event = offset + part.first_event
+        combining.add(offset, part)
+    return combining.result()
+
+
+class Combining:
+    """`combine` as the runs come, holding their combined effects rather than each run's
+    (checker/streaming.py: a block of a million lines that each write a reserved
+    variable held a million summaries until it ended)."""
+
+    __slots__ = ("_alone", "_calls_unknown", "_first_event", "_observes", "_operations",
+                 "_reads", "_runs", "_writes")
+
+    def __init__(self) -> None:
+        self._runs = 0
+        self._alone: BlockEffects | None = None  # the only run's, at offset 0
+        self._operations: list[device.Operation] = []
+        self._writes: list[tuple[int, int, int]] = []
+        self._first_event: int | None = None
+        self._reads = 0
+        self._observes = self._calls_unknown = False
+
+    def add(self, offset: int, part: BlockEffects) -> None:
+        """Add the effects of the run whose first statement is at `offset`."""
+        self._runs += 1
+        self._alone = part if self._runs == 1 and offset == 0 else None
+        if self._first_event is None and part.first_event is not None:
+            self._first_event = offset + part.first_event
         if part.operations:
-            operations += [(offset + index, kind, value) for index, kind, value in part.operations]
+            self._operations += [(offset + index, kind, value)
+                                 for index, kind, value in part.operations]
         if part.writes:
-            writes += [(offset + index, by_calls, by_store)
-                       for index, by_calls, by_store in part.writes]
-        reads |= part.reads
-        observes = observes or part.observes
-        calls_unknown = calls_unknown or part.calls_unknown
-    return BlockEffects(operations, first_event, reads, writes, observes, calls_unknown)
+            self._writes += [(offset + index, by_calls, by_store)
+                             for index, by_calls, by_store in part.writes]
+        self._reads |= part.reads
+        self._observes = self._observes or part.observes
+        self._calls_unknown = self._calls_unknown or part.calls_unknown
+
+    @property
+    def empty(self) -> bool:
+        """Whether no run was added."""
+        return not self._runs
+
+    def result(self) -> BlockEffects:
+        """The block's effects: the only run's itself, or the runs' combined."""
+        if self._alone is not None:
+            return self._alone
+        if self.empty:
+            return BlockEffects.nothing()
+        return BlockEffects(self._operations, self._first_event, self._reads, self._writes,
+                            self._observes, self._calls_unknown)
 
 
 def line_segments(statements: tuple[ast.Statement, ...]) -> tuple[Segment, ...]:

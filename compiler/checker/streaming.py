@@ -28,7 +28,7 @@ from rl1.compiler.frontend.source import LineIndex, iter_lines
 from .blocks import Cut
 from .cfg import graph_of
 from .compact import CompactDiagnostics, LineDiagnostics, parsed_line
-from .effects import BlockEffects, Segment, combine, line_segments
+from .effects import BlockEffects, Combining, Segment, line_segments
 from .rules import check_graph
 from .suppression import MARK, Suppressions
 
@@ -83,16 +83,16 @@ class SourceStatements(Sequence[ast.Statement]):
 
 class _OpenBlock:
     """The block being cut: where its statements start, how many, the effects of its
-    runs, the last statement seen."""
+    runs combined as they come, the last statement seen."""
 
-    __slots__ = ("cut", "first", "last", "length", "parts", "start")
+    __slots__ = ("cut", "effects", "first", "last", "length", "start")
 
     def __init__(self, cut: Cut, first: int, start: int) -> None:
         self.cut = cut
         self.first = first
         self.start = start
         self.length = 0
-        self.parts: list[tuple[int, BlockEffects]] = []
+        self.effects = Combining()
         self.last: ast.Statement | None = None
 
 
@@ -116,7 +116,7 @@ def check_text(text: str) -> CompactDiagnostics:
             assert block.last is not None  # a block opens with its first run
             block.cut.statements = SourceStatements(lines, block.first, block.start,
                                                     block.length, block.last)
-            summaries.append(combine(block.parts) if block.parts else nothing)
+            summaries.append(nothing if block.effects.empty else block.effects.result())
             block = None
 
     with collector_paused():
@@ -151,7 +151,7 @@ def check_text(text: str) -> CompactDiagnostics:
                     block = _OpenBlock(Cut((), _taken(pending), False, ()), index, start)
                     cuts.append(block.cut)
                 if summary is not None:
-                    block.parts.append((block.length, summary))
+                    block.effects.add(block.length, summary)
                 block.length += len(run)
                 block.last = run[-1]
                 start += len(run)

@@ -64,6 +64,9 @@ SOURCES = {
     "lines of 19,999 characters": ";".join(["A=1"] * 4999) + "\n",
     "`A=1` lines": "A=1\n",
     "lines with a syntax error": "A=1 B=2\n",
+    # a block of a million runs that write a reserved variable: 128 B/B when it held
+    # each run's effects until it ended (effects.Combining)
+    "`t=1` lines": "t=1\n",
 }
 SOURCE_CHARACTERS = 256 * 1024
 
