@@ -285,8 +285,12 @@ class Rl1Server(LanguageServer):
         self.protocol.receive(body)
 
     def end(self) -> None:
-        """The session is over: stop its checks, which would publish to no one."""
+        """The session is over: stop its checks, which would publish to no one, and let
+        go of its documents and their analysis, most of what it holds, now: a session
+        is a web of reference cycles, which only the garbage collector frees."""
         self.checks.stop()
+        for uri in list(self.documents):
+            self.forget(uri)
 
 
 def create_server() -> Rl1Server:

@@ -208,17 +208,29 @@ def return_large_buffers() -> None:
         ctypes.CDLL(None).mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD)
 
 
-def _collect_when_ended() -> None:
-    """Collect the garbage of a session that ends, once the task serving it has let go
-    of it. A session is a web of reference cycles (pygls' server and protocol, and the
-    handlers that close over the server), freed only by a collection of the oldest
-    generation; and the front end's pauses of the collector (compiler/frontend/
+class _Collector:
+    """Collects the garbage of ended sessions, once every MAX_SESSIONS of them. What a
+    session leaves after its end (server.Rl1Server.end lets go of its documents) is a
+    web of reference cycles, pygls' server, protocol and converter and the handlers
+    that close over the server, some 0.3 MiB, freed only by a collection of the
+    oldest generation; and the front end's pauses of the collector (compiler/frontend/
     collector.py) move every object there at once, where CPython starts a collection
     only when enough objects have reached it through the younger generations, which
-    none then do. So ended sessions were never freed: 0.31 MiB each, and after about
-    1,000 clients the hostile harness's bound was passed (issue 23). A collection costs
-    a few times what starting a session does (bench/lsp_sessions.py)."""
-    asyncio.get_running_loop().call_soon(gc.collect)
+    none then do. So ended sessions were never freed, and after about 1,000 clients
+    the hostile harness's bound was passed (issue 23). A collection walks every object
+    of the server, a few times what starting a session costs (bench/lsp_sessions.py):
+    hence one for several sessions, at most MAX_SESSIONS of them left to it."""
+
+    def __init__(self) -> None:
+        self._ended = 0
+
+    def ended(self) -> None:
+        """A session has ended: collect, once the task serving it has let go of it, if
+        it is the MAX_SESSIONS-th since the last collection."""
+        self._ended += 1
+        if self._ended >= MAX_SESSIONS:
+            self._ended = 0
+            asyncio.get_running_loop().call_soon(gc.collect)
 
 
 # Standard input and output ----------------------------------------------------------------
@@ -346,6 +358,7 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
     sessions: set[Session] = set()
     refusing: set[asyncio.StreamWriter] = set()  # bounded too: beyond, closed at once
     in_flight = InFlight()
+    collector = _Collector()
 
     async def connected(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         try:
@@ -372,7 +385,7 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
             finally:
                 sessions.discard(session)
                 session.end()
-                _collect_when_ended()
+                collector.ended()
                 # The frames of a connection reset live on, in a reference cycle through
                 # the exception, until the garbage collector runs (it rarely does, as
                 # a buffer of 64 MiB counts as one object): let go of the message now.
@@ -473,6 +486,7 @@ class WebSocketSessions:
         return_large_buffers()
         self.sessions: set[Session] = set()
         in_flight = self.in_flight = InFlight()
+        self._collector = _Collector()
 
         class Counted(ServerConnection):
             """A connection that counts the bytes received since its last message was
@@ -541,7 +555,7 @@ class WebSocketSessions:
             # frees, rarely on a quiet server: let go of them now.
             if (ended := connection.protocol.parser_exc) is not None:
                 ended.__traceback__ = None
-            _collect_when_ended()
+            self._collector.ended()
 
 
 async def serve_websocket(new_session: Callable[[], Session], host: str, port: int) -> None:
