@@ -9,6 +9,7 @@ to write them all.
 
 from __future__ import annotations
 
+import functools
 import itertools
 from collections.abc import Callable
 
@@ -103,13 +104,18 @@ def _read(var: ast.Var, state: int, on_read: OnRead | None) -> None:
 
 
 def _unset(var: ast.Var) -> Diagnostic:
-    writers = writers_of(var.name)
+    message, help_text = _unset_texts(var.name)
+    return Diagnostic("W0401", Severity.WARNING, message, var.span, help=help_text)
+
+
+@functools.cache
+def _unset_texts(name: str) -> tuple[str, str]:
+    """The message and help of a W0401 on `name`: one pair of strings for every read (a
+    source that reads `s` on each of a million lines held 57 bytes a source byte of
+    copies of them)."""
+    writers = writers_of(name)
     calls = " or ".join(f"`({builtin.mnemonic})`" for builtin, _ in writers)
     sets = "; ".join(f"`({builtin.mnemonic})` sets {', '.join(form.writes)}"
                      for builtin, form in writers)
-    return Diagnostic(
-        "W0401", Severity.WARNING,
-        f"`{var.name}` is read here, but on some path no {calls} has set it yet",
-        var.span,
-        help=f"until then it holds 0: call {calls} before reading `{var.name}` ({sets})",
-    )
+    return (f"`{name}` is read here, but on some path no {calls} has set it yet",
+            f"until then it holds 0: call {calls} before reading `{name}` ({sets})")

@@ -127,3 +127,11 @@ def test_broken_lines_cost_little_beyond_their_diagnostics() -> None:
     count, beyond = measured.stdout.split()
     assert int(count) == SOURCE_CHARACTERS // 8  # an E0101 a line
     assert float(beyond) <= 8
+
+
+def test_the_warnings_of_reads_of_one_unset_variable_share_their_texts() -> None:
+    """A source that reads `s` unset on each of its lines holds one message and one help
+    of W0401 for them all (it held 57 B/B of copies: 124 B/B at its peak, 66 now)."""
+    found = [d for d in diagnose("A=s\nB=s+s\n" * 3) if d.code == "W0401"]
+    assert len(found) == 9
+    assert len({id(d.message) for d in found}) == len({id(d.help) for d in found}) == 1
