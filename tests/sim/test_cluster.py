@@ -184,10 +184,11 @@ def test_a_worker_killed_in_a_campaign_on_a_cluster_loses_no_run(
     assert out.read_bytes() == (tmp_path / "local.jsonl").read_bytes()
 
 
-def test_a_campaign_started_before_any_worker_says_so_and_waits_for_one(
-        scheduler: Cluster, tmp_path: Path) -> None:
-    program, world = _wall(tmp_path)
-    out, said = tmp_path / "cluster.jsonl", tmp_path / "stderr.txt"
+@contextmanager
+def _waiting_for_workers(scheduler: Cluster, program: Path, world: Path, out: Path,
+                         said: Path) -> Iterator[subprocess.Popen[str]]:
+    """`rl1c sim --runs 50` on `scheduler`, which has no workers, once it has said so
+    (its standard error goes to `said`)."""
     with open(said, "w") as stderr, subprocess.Popen(
             [str(BIN / "rl1c"), "sim", str(program), "--world", str(world), "--runs", "50",
              "--budget", "10000", "--scheduler", scheduler.address, "--out", str(out)],
@@ -196,6 +197,14 @@ def test_a_campaign_started_before_any_worker_says_so_and_waits_for_one(
         while "has no workers yet" not in said.read_text():
             assert process.poll() is None and time.monotonic() < deadline, said.read_text()
             time.sleep(0.1)
+        yield process
+
+
+def test_a_campaign_started_before_any_worker_says_so_and_waits_for_one(
+        scheduler: Cluster, tmp_path: Path) -> None:
+    program, world = _wall(tmp_path)
+    out, said = tmp_path / "cluster.jsonl", tmp_path / "stderr.txt"
+    with _waiting_for_workers(scheduler, program, world, out, said) as process:
         assert not out.exists() or not out.read_text()  # no run made without a worker
         scheduler.start_worker()
         stdout, _ = process.communicate(timeout=STARTED_WITHIN)
@@ -291,14 +300,7 @@ def test_a_worker_running_another_rl1_that_joins_later_stops_the_campaign(
     # rl1, which the campaign kept as this one's.
     program, world = _wall(tmp_path)
     out, said = tmp_path / "runs.jsonl", tmp_path / "stderr.txt"
-    with open(said, "w") as stderr, subprocess.Popen(
-            [str(BIN / "rl1c"), "sim", str(program), "--world", str(world), "--runs", "50",
-             "--budget", "10000", "--scheduler", scheduler.address, "--out", str(out)],
-            stdout=subprocess.PIPE, stderr=stderr, text=True) as process:
-        deadline = time.monotonic() + STARTED_WITHIN
-        while "has no workers yet" not in said.read_text():
-            assert process.poll() is None and time.monotonic() < deadline, said.read_text()
-            time.sleep(0.1)
+    with _waiting_for_workers(scheduler, program, world, out, said) as process:
         scheduler.start_worker(python_path=_other_rl1(tmp_path))
         stdout, _ = process.communicate(timeout=STARTED_WITHIN)
     assert process.returncode == 2, said.read_text() + scheduler.log()

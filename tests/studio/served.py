@@ -76,6 +76,10 @@ def sample_folder(into: Path) -> Path:
     return into
 
 
+LISTING_1 = {"program": {"path": "sample.rob"}, "world": {"path": "sample.world.toml"}}
+"""A launch of Listing 1 on its world, in a `sample_folder`."""
+
+
 @dataclass(frozen=True)
 class Answer:
     status: int

@@ -14,10 +14,8 @@ from typing import Any
 
 import numpy as np
 import pytest
-from served import Page, Served, page, sample_folder, serving
+from served import LISTING_1, Page, Served, page, sample_folder, serving
 from support.cli import rl1c
-
-LISTING_1 = {"program": {"path": "sample.rob"}, "world": {"path": "sample.world.toml"}}
 
 
 @pytest.fixture(scope="module")

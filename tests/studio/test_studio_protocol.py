@@ -14,15 +14,13 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from served import Failed, Page, Served, page, sample_folder, serving
+from served import LISTING_1, Failed, Page, Served, page, sample_folder, serving
 from support.cli import rl1c
 from websockets.exceptions import ConnectionClosed
 
 from rl1.lsp.studio import connection
 from rl1.lsp.studio.run import FRAMES_PER_SECOND
 from rl1.vm.language import BUILTINS, VARIABLES
-
-LISTING_1 = {"program": {"path": "sample.rob"}, "world": {"path": "sample.world.toml"}}
 
 
 @pytest.fixture(scope="module")
