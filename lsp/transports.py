@@ -403,6 +403,18 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
 
 # WebSocket ------------------------------------------------------------------------------
 
+def refuse_websocket(connection: Any, reason: str) -> None:
+    """Close a WebSocket `connection` (websockets' asyncio ServerConnection) at once with
+    code 1013 (try again later) and `reason`: failed, not closed, because while close()
+    waits for the client's answer the library reads its messages, up to max_size a frame,
+    counted nowhere."""
+    from websockets.frames import CloseCode
+
+    connection.protocol.fail(CloseCode.TRY_AGAIN_LATER, reason[:123])
+    connection.send_data()
+    connection.transport.close()
+
+
 def _hand_over(session: Session, body: bytes) -> int:
     """Hand `session` a WebSocket message's bytes (not decoded to text first: the
     session's JSON reader checks UTF-8, and one copy fewer is 64 MiB less at the peak);
@@ -520,17 +532,12 @@ class WebSocketSessions:
         """Serve `connection` (of `connection_class`) as a session of its own, one LSP
         message a WebSocket message, until it closes or the session exits."""
         from websockets.exceptions import ConnectionClosed
-        from websockets.frames import CloseCode
 
         assert isinstance(connection, self.connection_class)
         sessions, in_flight = self.sessions, self.in_flight
         if len(sessions) >= MAX_SESSIONS:
             log.warning("a client beyond the %d served at once: refused", MAX_SESSIONS)
-            # Failed, not closed: while close() waits for the client's answer, the
-            # library reads its messages, up to max_size a frame, counted nowhere.
-            connection.protocol.fail(CloseCode.TRY_AGAIN_LATER, BUSY[:123])
-            connection.send_data()
-            connection.transport.close()
+            refuse_websocket(connection, BUSY)
             return
         session = new_session()
         sessions.add(session)

@@ -158,7 +158,9 @@ class Server:
     async def _studio(self, connection: ServerConnection) -> None:
         if self.pages >= transports.MAX_SESSIONS:
             log.warning("a page beyond the %d served at once: refused", transports.MAX_SESSIONS)
-            await connection.close(1013, "rl1c studio serves 8 pages at once: close one")
+            transports.refuse_websocket(
+                connection, f"rl1c studio serves {transports.MAX_SESSIONS} pages at once: "
+                "close one")
             return
         self.pages += 1
         outbox = _Outbox(connection)
