@@ -9,8 +9,11 @@ Pausing is not enough: what was built while paused is still the youngest generat
 which the next collections walk three times over as it ages (a quarter of the time to
 check 100,000 lines, bench/parse_check.py). So the pause ends by moving every object
 to the oldest generation at once: `gc.freeze()` then `gc.unfreeze()`, as their docs
-say, put all tracked objects in the oldest generation without walking them. Nothing
-is leaked: garbage moved there is collected by the next full collection.
+say, put all tracked objects in the oldest generation without walking them. Garbage
+moved there waits for the next full collection, which CPython starts only once enough
+objects have reached that generation the usual way: in a short command that is never,
+and nothing is lost; a long-lived process must collect now and then itself (the
+language server does when a session ends: lsp/transports.py).
 """
 
 from __future__ import annotations
