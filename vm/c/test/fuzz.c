@@ -6,7 +6,9 @@
  * twice on a random device whose answers (errors, busy polls, readings, lost lines) come
  * from a generator seeded by the bytes, once in one step and once in random steps, and
  * traps when the VM breaks a rule of spec/ilc.md section 12 (a step's count, the budget's
- * bound, a state after the end) or when the two runs differ. */
+ * bound, a state after the end) or when the two runs differ; the sliced run is also
+ * restored from a snapshot taken between two of its steps, a waiting call's among them,
+ * into another rl1_vm, which must end as the run did. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -108,30 +110,54 @@ static rl1_status poll(void *ctx, rl1_reading *out)
     return answer(ctx, true);
 }
 
+#define TO_THE_END 0xFFFFFFFFu /* go's `until`: no step number stops it */
+
+/* Steps *vm to its end (or to step number `until`) on `hw`, in one step or in steps of
+ * sizes from *slicer; checks each step's rules. */
+static rl1_state go(const rl1_program *program, const rl1_hardware *hw, rl1_vm *vm,
+                    device *slicer, bool sliced, uint32_t *steps, uint32_t until)
+{
+    rl1_state state = (rl1_state)vm->state;
+    uint32_t before, n;
+    while (GOING(state) && *steps != until) {
+        n = sliced ? next(slicer) % 9u : 0xFFFFFFFFu;
+        before = vm->executed;
+        state = rl1_step(vm, program, hw, n);
+        if ((state == RL1_RUNNING && vm->executed - before != n) || vm->executed - before > n
+            || (vm->pc > program->code_size && vm->pc != 0xFFFFu) || ++*steps > MAX_STEPS) {
+            __builtin_trap();
+        }
+    }
+    return state;
+}
+
 /* Runs `program` with the device seeded by `seed`: in one step (slices 0) or in steps of
- * random sizes; checks each step's rules, and leaves the final state in *vm. */
+ * random sizes; checks each step's rules, and leaves the final state in *vm. Sliced, it
+ * also takes a snapshot (the VM's state, the device's, the slicer's) at a random step,
+ * a waiting call's among them, and runs a copy of the VM restored from it to the end:
+ * the copy must end exactly as the run did (spec/ilc.md 12.1: the state is all). */
 static void run(const rl1_program *program, uint32_t seed, bool sliced, rl1_vm *vm)
 {
     device d = {seed | 1u, NULL, 0};
     device slicer = {seed ^ 0x9E3779B9u, NULL, 0};
+    device saved_d, saved_slicer;
     rl1_hardware hw = {NULL, begin, call, start, poll, NULL, NULL};
-    uint32_t budget = 1u + (seed % 4000u), steps = 0, before, n;
-    rl1_state state = RL1_RUNNING, again;
+    uint32_t budget = 1u + (seed % 4000u), steps = 0, saved_steps;
+    uint32_t snapshot_at = 1u + (seed >> 12) % 64u;
+    rl1_state state, again;
+    rl1_vm saved, restored;
     hw.ctx = &d;
     hw.stop = begin;
     hw.end = begin;
     rl1_vm_init(vm, budget);
     d.mailbox = &vm->mailbox;
     slicer.state |= 1u;
-    while (GOING(state)) {
-        n = sliced ? next(&slicer) % 9u : 0xFFFFFFFFu;
-        before = vm->executed;
-        state = rl1_step(vm, program, &hw, n);
-        if ((state == RL1_RUNNING && vm->executed - before != n) || vm->executed - before > n
-            || (vm->pc > program->code_size && vm->pc != 0xFFFFu) || ++steps > MAX_STEPS) {
-            __builtin_trap();
-        }
-    }
+    state = go(program, &hw, vm, &slicer, sliced, &steps, sliced ? snapshot_at : TO_THE_END);
+    saved = *vm;
+    saved_d = d;
+    saved_slicer = slicer;
+    saved_steps = steps;
+    state = go(program, &hw, vm, &slicer, sliced, &steps, TO_THE_END);
     /* The budget is passed by less than the code's instructions (spec/ilc.md 9). */
     if (vm->executed > budget + program->code_size
         || (vm->fault != RL1_FAULT_NONE) != (state == RL1_FAULTED)
@@ -141,6 +167,17 @@ static void run(const rl1_program *program, uint32_t seed, bool sliced, rl1_vm *
     again = rl1_step(vm, program, &hw, 5);
     if (again != state) {
         __builtin_trap();
+    }
+    if (sliced) {
+        restored = saved;
+        d = saved_d;
+        d.mailbox = &restored.mailbox;
+        slicer = saved_slicer;
+        again = go(program, &hw, &restored, &slicer, true, &saved_steps, TO_THE_END);
+        /* rl1_vm has no padding on the hosts that fuzz (128 bytes of fields) */
+        if (again != state || memcmp(&restored, vm, sizeof restored) != 0) {
+            __builtin_trap();
+        }
     }
 }
 
