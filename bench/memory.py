@@ -97,8 +97,8 @@ def sources() -> list[tuple[str, bytes]]:
         ("lines of 19,999 characters", statements + b"\n"),
         ("`A=1` lines", b"A=1\n"),
         ("lines with a syntax error", b"A=1 B=2\n"),
-        # The program-wide rules' costliest: a block a line, and a line's effects held
-        # until its block ends (not yet within the bound: issue 23, item 10).
+        # The program-wide rules' costliest: a block a line, and a block of a million
+        # lines whose effects are combined as they come.
         ("`(END)` lines, a block each", b"(END)\n"),
         ("`t=1` lines, reserved writes", b"t=1\n"),
     ]

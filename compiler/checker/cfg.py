@@ -11,13 +11,13 @@ from __future__ import annotations
 
 import itertools
 import operator
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 
 from rl1.compiler.frontend import ast
 
 from .blocks import Cut, cut, runs_of
 from .effects import BlockEffects, summarize
-from .graph import JUMPS, Block, ControlFlowGraph
+from .graph import JUMPS, Block, ControlFlowGraph, ReadAgain
 from .handler_edges import add_handler_edges
 from .incremental import LineMemo
 
@@ -43,10 +43,13 @@ def build_cfg(program: ast.Program, memo: LineMemo | None = None) -> ControlFlow
     return graph
 
 
-def graph_of(cuts: list[Cut], summaries: list[BlockEffects]) -> ControlFlowGraph:
-    """The graph of blocks cut elsewhere (streaming.py), with the effects of each but
-    the exit block."""
-    graph = _with_edges(cuts, summaries, [], None)
+def graph_of(blocks: list[Block], summaries: list[BlockEffects]) -> ControlFlowGraph:
+    """The graph of blocks cut elsewhere as Blocks without edges (streaming.py, which
+    holds no Cut besides: a block each costs), with the effects of each but the exit
+    block."""
+    labelled, opaque, labels = _labels_of(blocks)
+    _link(blocks, range(len(blocks) - 1), summaries, labels, opaque)
+    graph = ControlFlowGraph(blocks, labels, labelled, opaque)
     add_handler_edges(graph)
     return graph
 
@@ -58,14 +61,7 @@ def _with_edges(cuts: list[Cut], summaries: list[BlockEffects], last_cuts: list[
     memo built from `last_cuts`: when the blocks keep their numbers, the labels and the
     opaque blocks, a block cut the same keeps its edges, so its Block is taken over
     (edited in place: the memo's last graph is not kept by anyone else)."""
-    # the few labelled and opaque blocks among thousands, found in C
-    labelled = list(itertools.compress(range(len(cuts)), map(_LABELS, cuts)))
-    opaque = list(itertools.compress(range(len(cuts)), map(_OPAQUE, cuts)))
-    labels: dict[int, int] = {}  # label number -> the block its first definition names
-    for index in labelled:
-        for label in cuts[index].labels:
-            if label.number is not None:
-                labels.setdefault(label.number, index)
+    labelled, opaque, labels = _labels_of(cuts)
     exit_index = len(cuts) - 1
     nothing = BlockEffects.nothing()  # never changed, so one does for all empty blocks
     if (previous is None or len(last_cuts) != len(cuts) or previous.labels != labels
@@ -83,24 +79,53 @@ def _with_edges(cuts: list[Cut], summaries: list[BlockEffects], last_cuts: list[
                                   block_cut.opaque, (), (), nothing)
         if changed and changed[-1] == exit_index:
             changed.pop()  # the exit block has no effects nor edges
+    _link(blocks, changed, summaries, labels, opaque)
+    return ControlFlowGraph(blocks, labels, labelled, opaque)
+
+
+def _labels_of(cuts: Sequence[Cut | Block]) -> tuple[list[int], list[int], dict[int, int]]:
+    """The labelled blocks and the opaque ones, in order, and the block each label's
+    first definition names."""
+    # the few labelled and opaque blocks among thousands, found in C
+    labelled = list(itertools.compress(range(len(cuts)), map(_LABELS, cuts)))
+    opaque = list(itertools.compress(range(len(cuts)), map(_OPAQUE, cuts)))
+    labels: dict[int, int] = {}  # label number -> the block its first definition names
+    for index in labelled:
+        for label in cuts[index].labels:
+            if label.number is not None:
+                labels.setdefault(label.number, index)
+    return labelled, opaque, labels
+
+
+def _link(blocks: list[Block], changed: Iterable[int], summaries: list[BlockEffects],
+          labels: dict[int, int], opaque: list[int]) -> None:
+    """Give the `changed` blocks their effects and ordinary edges."""
+    exit_index = len(blocks) - 1
     named = sorted(set(labels.values()))
     for index in changed:
         block = blocks[index]
         summary = summaries[index]
         block.effects = summary
         following = block.index + 1
-        last = block.statements[-1] if block.statements else None
+        jump, ends = _ending(block.statements)
         if block.opaque:
             block.successors = tuple(dict.fromkeys([following, *named, exit_index]))
-        elif isinstance(last, JUMPS):
-            block.jump = last
-            number = last.target.number
+        elif jump is not None:
+            block.jump = jump
+            number = jump.target.number
             target = labels.get(number) if number is not None else None
             found = opaque if target is None else [target]
-            if isinstance(last, ast.Goto):
+            if isinstance(jump, ast.Goto):
                 block.successors = tuple(found)
             else:
                 block.successors = (following, *(other for other in found if other != following))
-        elif last is None or not ast.is_end(last):
+        elif not ends:
             block.successors = (following,)
-    return ControlFlowGraph(blocks, labels, labelled, opaque)
+
+
+def _ending(statements: Sequence[ast.Statement]) -> tuple[ast.Goto | ast.CondJump | None, bool]:
+    """The jump that ends a block of `statements`, if one does, and whether `(END)` does."""
+    if isinstance(statements, ReadAgain):
+        return statements.jump, statements.ends
+    last = statements[-1] if statements else None
+    return (last if isinstance(last, JUMPS) else None), last is not None and ast.is_end(last)

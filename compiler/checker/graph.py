@@ -22,6 +22,7 @@ which says which blocks some path reaches.
 
 from __future__ import annotations
 
+from abc import abstractmethod
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import NamedTuple
@@ -36,6 +37,25 @@ JUMPS = (ast.Goto, ast.CondJump)
 def closes_block(statement: ast.Statement) -> bool:
     """Whether a block ends after `statement`: a jump or `(END)`."""
     return isinstance(statement, JUMPS) or ast.is_end(statement)
+
+
+class ReadAgain(Sequence[ast.Statement]):
+    """A block's statements held as where they are in the source and read from it again
+    (checker/streaming.py), which say how the block ends without reading its last
+    statement: the graph asks every block, and keeping every last statement's tree cost
+    hundreds of bytes a block."""
+
+    __slots__ = ()
+
+    @property
+    @abstractmethod
+    def jump(self) -> ast.Goto | ast.CondJump | None:
+        """The `#NN` or `?V..#NN` that ends the block, if one does."""
+
+    @property
+    @abstractmethod
+    def ends(self) -> bool:
+        """Whether the block ends with `(END)`."""
 
 
 class HandlerEdge(NamedTuple):
@@ -68,6 +88,8 @@ class Block:
     @property
     def ends(self) -> bool:
         """Whether the block ends with `(END)`."""
+        if isinstance(self.statements, ReadAgain):
+            return self.statements.ends
         return bool(self.statements) and ast.is_end(self.statements[-1])
 
 

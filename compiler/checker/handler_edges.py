@@ -22,7 +22,11 @@ def trace(graph: ControlFlowGraph) -> tuple[list[int], list[device.Triggers]]:
     """The state on entry to every block (0: unreachable) and, per block, the handlers a
     lost line may jump to from it."""
     blocks = graph.blocks
-    triggers: list[device.Triggers] = [{} for _ in blocks]
+    # one empty dict for all the blocks without triggers (those no path reaches among
+    # them): a visit replaces a block's, none is changed; a dict a block was 64 bytes a
+    # block of a program of thousands
+    none: device.Triggers = {}
+    triggers = [none] * len(blocks)
 
     def transfer(index: int, state: int) -> tuple[int, list[tuple[int, int]]]:
         block = blocks[index]
@@ -30,7 +34,8 @@ def trace(graph: ControlFlowGraph) -> tuple[list[int], list[device.Triggers]]:
             return device.START, []
         # A block's last visit is with its final state, so its last triggers are final.
         effects = block.effects
-        out, triggers[index] = device.run(effects.operations, effects.first_event, state)
+        out, found = device.run(effects.operations, effects.first_event, state)
+        triggers[index] = found or none
         return out, [(graph.labels[label], entry)
                      for label, (_, entry) in triggers[index].items() if label in graph.labels]
 

@@ -25,28 +25,42 @@ from rl1.compiler.frontend.diagnostics import Diagnostic, sort_by_place
 from rl1.compiler.frontend.parser import parse_line
 from rl1.compiler.frontend.source import LineIndex, iter_lines
 
-from .blocks import Cut
 from .cfg import graph_of
 from .compact import CompactDiagnostics, LineDiagnostics, parsed_line
 from .effects import BlockEffects, Combining, Segment, line_segments
+from .graph import Block, ReadAgain
 from .rules import check_graph
 from .suppression import MARK, Suppressions
 
 
-class SourceStatements(Sequence[ast.Statement]):
+class SourceStatements(ReadAgain):
     """The statements of one block, found by parsing its lines again when they are read:
-    from statement `start` of line `first` (0-based indices) to the block's last,
-    `last`, which is kept (every block's end is read: its jump, its `(END)`)."""
+    from statement `start` of line `first` to the block's last, statement `last_start`
+    of line `last_line` (0-based indices). Of that last statement only a jump is kept
+    (the graph's edges and the busy-loop rule read every block's), and whether it is
+    `(END)`: its tree cost 330 bytes a block."""
 
-    __slots__ = ("_first", "_length", "_lines", "_start", "last")
+    __slots__ = ("_ends", "_first", "_jump", "_last_line", "_last_start", "_length", "_lines",
+                 "_start")
 
     def __init__(self, lines: LineIndex, first: int, start: int, length: int,
-                 last: ast.Statement) -> None:
+                 last_line: int, last_start: int, last: ast.Statement) -> None:
         self._lines = lines
         self._first = first
         self._start = start
         self._length = length
-        self.last = last
+        self._last_line = last_line
+        self._last_start = last_start
+        self._jump = last if isinstance(last, ast.Goto | ast.CondJump) else None
+        self._ends = ast.is_end(last)
+
+    @property
+    def jump(self) -> ast.Goto | ast.CondJump | None:
+        return self._jump
+
+    @property
+    def ends(self) -> bool:
+        return self._ends
 
     def __len__(self) -> int:
         return self._length
@@ -62,7 +76,10 @@ class SourceStatements(Sequence[ast.Statement]):
             return tuple(self[position] for position in range(self._length)[index])
         position = range(self._length)[index]  # IndexError as a list gives it
         if position == self._length - 1:
-            return self.last
+            if self._jump is not None:
+                return self._jump
+            line = parse_line(self._lines[self._last_line], self._last_line + 1)[0]
+            return line.statements[self._last_start]
         for found, statement in enumerate(self):
             if found == position:
                 return statement
@@ -82,18 +99,42 @@ class SourceStatements(Sequence[ast.Statement]):
 
 
 class _OpenBlock:
-    """The block being cut: where its statements start, how many, the effects of its
-    runs combined as they come, the last statement seen."""
+    """The block being cut, its graph block made: where its statements start, how many,
+    the effects of its runs combined as they come, the last statement seen and where."""
 
-    __slots__ = ("cut", "effects", "first", "last", "length", "start")
+    __slots__ = ("block", "effects", "first", "last", "last_line", "last_start", "length",
+                 "start")
 
-    def __init__(self, cut: Cut, first: int, start: int) -> None:
-        self.cut = cut
+    def __init__(self, block: Block, first: int, start: int) -> None:
+        self.block = block
         self.first = first
         self.start = start
         self.length = 0
         self.effects = Combining()
         self.last: ast.Statement | None = None
+        self.last_line = self.last_start = 0
+
+
+class _SharedEffects:
+    """One object for the blocks whose effects are equal, which summaries, shared and
+    never changed, allow: 290 bytes a block of `(END)` alone. The first LIMIT different
+    ones are remembered, so that a program of unlike blocks holds no more than before."""
+
+    LIMIT = 4096
+    __slots__ = ("_known",)
+
+    def __init__(self) -> None:
+        self._known: dict[tuple[object, ...], BlockEffects] = {}
+
+    def __call__(self, effects: BlockEffects) -> BlockEffects:
+        key = (tuple(effects.operations), effects.first_event, effects.reads,
+               tuple(effects.writes), effects.observes, effects.calls_unknown)
+        known = self._known.get(key)
+        if known is not None:
+            return known
+        if len(self._known) < self.LIMIT:
+            self._known[key] = effects
+        return effects
 
 
 def check_text(text: str) -> CompactDiagnostics:
@@ -103,21 +144,24 @@ def check_text(text: str) -> CompactDiagnostics:
     others: list[Diagnostic] = []
     directives: list[ast.Line] = []  # the lines whose comments may be directives
     lines = LineIndex(text)
-    cuts: list[Cut] = []
+    blocks: list[Block] = []  # the graph's, without edges until all are cut
     summaries: list[BlockEffects] = []
     nothing = BlockEffects.nothing()
+    shared = _SharedEffects()
     pending: list[ast.LabelDef] = []  # labels seen since the last statement
-    block: _OpenBlock | None = None
+    cutting: _OpenBlock | None = None
     last_span = ast.Span(1, 1, 1, 1)
 
     def close() -> None:
-        nonlocal block
-        if block is not None:
-            assert block.last is not None  # a block opens with its first run
-            block.cut.statements = SourceStatements(lines, block.first, block.start,
-                                                    block.length, block.last)
-            summaries.append(nothing if block.effects.empty else block.effects.result())
-            block = None
+        nonlocal cutting
+        if cutting is not None:
+            assert cutting.last is not None  # a block opens with its first run
+            cutting.block.statements = SourceStatements(
+                lines, cutting.first, cutting.start, cutting.length, cutting.last_line,
+                cutting.last_start, cutting.last)
+            effects = cutting.effects
+            summaries.append(nothing if effects.empty else shared(effects.result()))
+            cutting = None
 
     with collector_paused():
         for index, line_text in enumerate(iter_lines(text)):
@@ -140,28 +184,29 @@ def check_text(text: str) -> CompactDiagnostics:
                 # jumps (every jump to a missing label goes to every opaque block), so no
                 # rule tells them apart; a labelled one keeps a block of its own, which
                 # the label rules read.
-                if pending or not _merges_into(cuts):
-                    cuts.append(Cut((), _taken(pending), True, ()))
+                if pending or not _merges_into(blocks):
+                    blocks.append(Block(len(blocks), (), _taken(pending), True, (), (), nothing))
                     summaries.append(nothing)
                 continue
             segments: tuple[Segment, ...] = line_segments(line.statements)
             start = 0
             for run, summary, closes in segments:
-                if block is None:
-                    block = _OpenBlock(Cut((), _taken(pending), False, ()), index, start)
-                    cuts.append(block.cut)
+                if cutting is None:
+                    made = Block(len(blocks), (), _taken(pending), False, (), (), nothing)
+                    cutting = _OpenBlock(made, index, start)
+                    blocks.append(cutting.block)
                 if summary is not None:
-                    block.effects.add(block.length, summary)
-                block.length += len(run)
-                block.last = run[-1]
+                    cutting.effects.add(cutting.length, summary)
+                cutting.length += len(run)
                 start += len(run)
+                cutting.last, cutting.last_line, cutting.last_start = run[-1], index, start - 1
                 if closes:
                     close()
             del line, segments, found  # the next line's tree replaces this one's
         close()
-        cuts.append(Cut((), _taken(pending), False, ()))
-        graph = graph_of(cuts, summaries)
-        del cuts  # the blocks hold what the rules need
+        blocks.append(Block(len(blocks), (), _taken(pending), False, (), (), nothing))
+        graph = graph_of(blocks, summaries)
+        summaries.clear()  # the blocks hold their effects
         others += check_graph(graph, ast.Span(1, 1, last_span.end_line, last_span.end_column))
     suppressions = Suppressions(directives)
     if not suppressions.empty:
@@ -173,10 +218,10 @@ def check_text(text: str) -> CompactDiagnostics:
     return CompactDiagnostics(text, held, suppressions.reports, others)
 
 
-def _merges_into(cuts: list[Cut]) -> bool:
+def _merges_into(blocks: list[Block]) -> bool:
     """Whether a broken line without a label joins the last block cut: an opaque block
     without labels, which no statement has followed."""
-    return bool(cuts) and cuts[-1].opaque and not cuts[-1].labels
+    return bool(blocks) and blocks[-1].opaque and not blocks[-1].labels
 
 
 def _taken(pending: list[ast.LabelDef]) -> tuple[ast.LabelDef, ...]:

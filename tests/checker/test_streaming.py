@@ -47,8 +47,9 @@ def test_a_blocks_statements_are_read_from_its_lines_again() -> None:
     text = "A=1; B=2\n\n' comment\nC=3; #10\n"
     lines = LineIndex(text)
     last = parse_line(lines[3], 4)[0].statements[1]
-    statements = SourceStatements(lines, 0, 1, 3, last)  # from B=2 to #10
+    statements = SourceStatements(lines, 0, 1, 3, 3, 1, last)  # from B=2 to #10
     assert len(statements) == 3
+    assert statements.jump is last and not statements.ends
     assert [(s.span.line, s.span.column) for s in statements] == [(1, 6), (4, 1), (4, 6)]
     assert statements[-1] is last and statements[2] is last
     assert isinstance(statements[0], ast.Assign) and statements[0].target.name == "B"
@@ -59,6 +60,19 @@ def test_a_blocks_statements_are_read_from_its_lines_again() -> None:
         statements[3]
 
 
+def test_a_blocks_last_statement_is_kept_only_when_it_jumps() -> None:
+    """An `(END)` that ends a block is read from its line again, as the others are."""
+    text = "A=1\nB=2; (END); C=3\n"
+    lines = LineIndex(text)
+    end = parse_line(lines[1], 2)[0].statements[1]
+    statements = SourceStatements(lines, 0, 0, 3, 1, 1, end)  # from A=1 to (END)
+    assert statements.ends and statements.jump is None
+    last = statements[-1]
+    assert last is not end and last == end
+    assert (last.span.line, last.span.column) == (2, 6)
+    assert [ast.is_end(s) for s in statements] == [False, False, True]
+
+
 # bench/memory.py's sources, at a size tracemalloc measures in seconds.
 SOURCES = {
     "lines of 19,999 characters": ";".join(["A=1"] * 4999) + "\n",
@@ -67,6 +81,9 @@ SOURCES = {
     # a block of a million runs that write a reserved variable: 128 B/B when it held
     # each run's effects until it ended (effects.Combining)
     "`t=1` lines": "t=1\n",
+    # a block a line: 178 B/B when each block's record was a Cut, a Block, the tree of its
+    # last statement and effects of its own, and each block had a dict of triggers
+    "`(END)` lines": "(END)\n",
 }
 SOURCE_CHARACTERS = 256 * 1024
 
