@@ -24,12 +24,13 @@ from support.scripts import MOVING_STARTS, scripts
 
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
 from rl1.compiler.strategies import checked_programs
-from rl1.vm import native
+from rl1.vm import ilc, isa, native
 from rl1.vm.device import FormKey, Outcome
 from rl1.vm.drive import Stepper, drive
-from rl1.vm.faults import RunResult
+from rl1.vm.faults import FaultKind, RunResult
 from rl1.vm.hardware import BUSY, Answer, Blocking, Hardware, Status
-from rl1.vm.machine import Machine
+from rl1.vm.language import VARIABLES, Feature
+from rl1.vm.machine import Machine, State
 from rl1.vm.scripted import LossAfter, Script, ScriptedDevice, parse_script
 from rl1.vm.verifier import verify
 
@@ -185,6 +186,56 @@ def test_misbehaving_hardware_gives_the_same_faults(c_vm: ctypes.CDLL, start: st
                      c_device)
     assert got == expected
 
+
+CALLS = [info for info in isa.OPCODES.values() if info.form is not None and info.arity]
+FAILING_SENSORS = parse_script({}, "none.json")  # every sensing call is a device error
+
+
+@pytest.mark.parametrize("info", CALLS, ids=[info.name for info in CALLS])
+def test_a_variable_argument_at_either_end_of_its_range(c_vm: ctypes.CDLL,
+                                                        info: isa.OpInfo) -> None:
+    # Every call, full-width and compact (format 1.3), each parameter given a variable, the
+    # first or the last, holding the range's ends, one past them and the i16 ends: within
+    # the range the device gets the value, outside it the call faults argument-range, on
+    # both VMs alike, stepped whole and an instruction at a time.
+    assert info.form is not None
+    params = info.form.params
+    low_end, high_end = (-0x80, 0x7F) if info.compact else (-0x8000, 0x7FFF)
+    constants = [min(max(param.low, low_end), high_end) for param in params]
+    load, store, end = (isa.BY_NAME[name] for name in ("LDI", "STV", "END"))
+    for index, param in enumerate(params):
+        for value in {param.low - 1, param.low, param.high, param.high + 1, -0x8000, 0x7FFF}:
+            if not -0x8000 <= value <= 0x7FFF:
+                continue
+            for variable in (0, len(VARIABLES) - 1):
+                args = tuple(isa.Arg(k == index, variable if k == index else constant)
+                             for k, constant in enumerate(constants))
+                code = (isa.encode(load, (value,)) + isa.encode(store, (variable,))
+                        + isa.encode(info, (), args) + isa.encode(end))
+                data = ilc.encode(ilc.Image(code, {}, frozenset(Feature)))
+                run = assert_same_runs(c_vm, data, FAILING_SENSORS, 100)
+                fault = run.result.fault
+                out_of_range = not param.low <= value <= param.high
+                assert (fault is not None and fault.kind is FaultKind.ARGUMENT_RANGE) == (
+                    out_of_range), (info.name, index, value, variable)
+                for limit in (0, 1):
+                    assert stepped(c_vm, data, limit) == stepped(None, data, limit)
+
+
+def stepped(lib: ctypes.CDLL | None, data: bytes, limit: int) -> list[object]:
+    """Each step's state, instructions run and variables, stepping by 1 and `limit` in
+    turn, then the result and the trace; on the C VM, or on the reference VM when `lib`
+    is None."""
+    device = ScriptedDevice(FAILING_SENSORS)
+    machine: Machine | native.NativeMachine = (
+        Machine(verify(data), Blocking(device), 100) if lib is None
+        else native.NativeMachine(data, Blocking(device), 100, lib))
+    steps: list[object] = []
+    state = State.RUNNING
+    while state in (State.RUNNING, State.WAITING):
+        state = machine.step(limit if len(steps) % 2 else 1)
+        steps.append((state, machine.executed, tuple(machine.variables)))
+    return [*steps, machine.result, list(device.trace)]
 
 def test_a_machine_without_a_compiler_is_told_what_to_do(
     monkeypatch: pytest.MonkeyPatch, tmp_path: Path,
