@@ -152,3 +152,11 @@ def test_the_warnings_of_reads_of_one_unset_variable_share_their_texts() -> None
     found = [d for d in diagnose("A=s\nB=s+s\n" * 3) if d.code == "W0401"]
     assert len(found) == 9
     assert len({id(d.message) for d in found}) == len({id(d.help) for d in found}) == 1
+
+
+def test_the_warnings_of_writes_of_one_reserved_variable_share_their_message() -> None:
+    """A source that writes `t` on each of its lines makes the message of W0402 once (a
+    tenth of `rl1c check`'s time went to making it again for each line)."""
+    found = [d for d in diagnose("t=1\nA=2; t=3\n" * 3) if d.code == "W0402"]
+    assert len(found) == 6
+    assert len({id(d.message) for d in found}) == 1
