@@ -101,6 +101,8 @@ def sources() -> list[tuple[str, bytes]]:
         # lines whose effects are combined as they come.
         ("`(END)` lines, a block each", b"(END)\n"),
         ("`t=1` lines, reserved writes", b"t=1\n"),
+        # a diagnostic of a program-wide rule a line (W0401: `s` may be unset)
+        ("`A=s` lines, unset reads", b"A=s\n"),
     ]
 
 

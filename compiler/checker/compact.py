@@ -10,7 +10,9 @@ parser and `check_line` give on a line are kept as their line's number, where it
 starts, and their kind (code and severity): 14 bytes each. Reading them parses their
 line again (what a line gives is a function of its text and its number), keeps what
 was kept of them, and merges them into the others, which are few and held whole (the
-program-wide rules', the W0107s of suppression comments). Reading costs a second parse
+program-wide rules', the W0107s of suppression comments). Of the program-wide rules',
+W0401 alone may be one a line; its reads are held by line too, with their column, and
+built again from their line (reserved.unset_reads). Reading costs a second parse
 of each line held: `rl1c check` on a source of a syntax error a line takes about 1.4
 times the processor time it took when they were held whole, and a twelfth of the memory.
 """
@@ -27,6 +29,7 @@ from rl1.compiler.frontend.parser import parse_line
 from rl1.compiler.frontend.source import LINE_BREAK
 
 from .lines import check_line
+from .reserved import unset_reads
 
 Kind = tuple[str, Severity]
 """What a held diagnostic is known by until it is built: its code and severity."""
@@ -43,42 +46,75 @@ def parsed_line(text: str, number: int) -> tuple[ast.Line, list[Diagnostic]]:
     return line, found
 
 
+UNSET_READ: Kind = ("W0401", Severity.WARNING)
+"""The kind of the one program-wide rule's diagnostics held by line: a read of a
+reserved variable that may be unset (reserved.py), one a line in a source of `A=s`
+lines, 250 bytes each held whole."""
+
+
 class LineDiagnostics:
     """The diagnostics of single lines while a text is checked, each held as its line's
-    number, where the line starts in the text, and an index into the kinds seen (4, 8
-    and 2 bytes): a text's lines are found again without an index of them all."""
+    number, where the line starts in the text, an index into the kinds seen, and the
+    column of a read that W0401 reports, 0 for a diagnostic the line gives alone (4, 8,
+    2 and 4 bytes): a text's lines are found again without an index of them all."""
 
-    __slots__ = ("_index", "kinds", "numbers", "of_kind", "starts")
+    __slots__ = ("_index", "columns", "kinds", "numbers", "of_kind", "starts")
 
     def __init__(self, kinds: list[Kind] | None = None) -> None:
         self.numbers = array("I")  # 32 bits: a source holds far fewer lines
         self.starts = array("q")
         self.of_kind = array("H")
+        self.columns = array("I")
         self.kinds: list[Kind] = kinds or []
         self._index = {kind: index for index, kind in enumerate(self.kinds)}
 
-    def add(self, number: int, start: int, diagnostic: Diagnostic) -> None:
-        """Hold `diagnostic`, given by line `number`, which starts at `start` in the
-        text (the next lines' come after)."""
-        kind = (diagnostic.code, diagnostic.severity)
+    def add(self, number: int, start: int, kind: Kind, column: int = 0) -> None:
+        """Hold a diagnostic of `kind` given by line `number`, which starts at `start`
+        in the text (the next lines' come after); `column` is that of the read a W0401
+        reports."""
         index = self._index.get(kind)
         if index is None:
             index = self._index[kind] = len(self.kinds)
             self.kinds.append(kind)
+        self._append(number, start, index, column)
+
+    def _append(self, number: int, start: int, index: int, column: int) -> None:
         self.numbers.append(number)
         self.starts.append(start)
         self.of_kind.append(index)
+        self.columns.append(column)
+
+    def _entries(self) -> Iterator[tuple[int, int, int, int]]:
+        return zip(self.numbers, self.starts, self.of_kind, self.columns, strict=True)
 
     def kept(self, keeps: Keeps) -> LineDiagnostics:
         """Those that `keeps` keeps."""
         kept = LineDiagnostics(self.kinds)
-        for number, start, index in zip(self.numbers, self.starts, self.of_kind, strict=True):
+        for number, start, index, column in self._entries():
             code, severity = self.kinds[index]
             if keeps(code, severity, number):
-                kept.numbers.append(number)
-                kept.starts.append(start)
-                kept.of_kind.append(index)
+                kept._append(number, start, index, column)
         return kept
+
+    def merged(self, other: LineDiagnostics) -> LineDiagnostics:
+        """These and `other`'s, in the order of their lines."""
+        merged = LineDiagnostics(list(self.kinds))
+        for kind in other.kinds:
+            merged._index.setdefault(kind, len(merged.kinds))
+            if len(merged.kinds) < len(merged._index):
+                merged.kinds.append(kind)
+        renumbered = [merged._index[kind] for kind in other.kinds]
+        theirs = other._entries()
+        their = next(theirs, None)
+        for entry in self._entries():
+            while their is not None and their[0] < entry[0]:
+                merged._append(their[0], their[1], renumbered[their[2]], their[3])
+                their = next(theirs, None)
+            merged._append(*entry)
+        while their is not None:
+            merged._append(their[0], their[1], renumbered[their[2]], their[3])
+            their = next(theirs, None)
+        return merged
 
 
 class CompactDiagnostics(Sequence[Diagnostic]):
@@ -132,7 +168,8 @@ class CompactDiagnostics(Sequence[Diagnostic]):
             end = position + 1
             while end < len(numbers) and numbers[end] == number:
                 end += 1
-            built = self._built(number, self._held.starts[position])
+            built = self._built(number, self._held.starts[position],
+                                self._held.columns[position:end])
             if len(built) != end - position:
                 raise AssertionError(f"line {number} gave other diagnostics than it did")
             position = end
@@ -161,13 +198,15 @@ class CompactDiagnostics(Sequence[Diagnostic]):
                 return diagnostic
         raise AssertionError("fewer diagnostics were built than were held")
 
-    def _built(self, number: int, start: int) -> list[Diagnostic]:
+    def _built(self, number: int, start: int, columns: Sequence[int]) -> list[Diagnostic]:
         """The diagnostics held of line `number`, which starts at `start` in the text,
-        built again, in sort_key's order."""
+        built again, in sort_key's order; `columns` are the held ones' columns of reads."""
         end = LINE_BREAK.search(self._text, start)
         text = self._text[start:end.start() if end else len(self._text)]
-        built = [self._made_error(d) if self._as_errors else d
-                 for d in parsed_line(text, number)[1]
+        line, found = parsed_line(text, number)
+        if any(columns):
+            found += unset_reads(line, [column for column in columns if column])
+        built = [self._made_error(d) if self._as_errors else d for d in found
                  if d.span.line == number and self._keeps(d.code, d.severity, number)]
         built.sort(key=_place_in_line)
         return built

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import functools
 import itertools
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
@@ -24,7 +24,10 @@ from .graph import ControlFlowGraph
 OnRead = Callable[[ast.Var], None]
 
 
-def check_reserved(graph: ControlFlowGraph) -> list[Diagnostic]:
+def check_reserved(graph: ControlFlowGraph, on_unset: OnRead | None = None
+                   ) -> list[Diagnostic]:
+    """The W0401s of `graph`; with `on_unset`, each read it would report is handed to
+    it instead (the streaming check holds them compactly: compact.py)."""
     blocks = graph.blocks
 
     # "May be unset" only shrinks, so a block's effect is `state & keep`, and a handler
@@ -45,6 +48,8 @@ def check_reserved(graph: ControlFlowGraph) -> list[Diagnostic]:
     def report(var: ast.Var) -> None:
         found.append(_unset(var))
 
+    reported = report if on_unset is None else on_unset
+
     for index in itertools.compress(range(len(blocks)), states):  # in C: most states are 0
         block = blocks[index]
         state = states[index]
@@ -53,7 +58,24 @@ def check_reserved(graph: ControlFlowGraph) -> list[Diagnostic]:
             for statement in block.statements:
                 if not state & reads:
                     break  # the state only shrinks: no read left in the block is reported
-                state = _walk(statement, state, report)
+                state = _walk(statement, state, reported)
+    return found
+
+
+def unset_reads(line: ast.Line, columns: Iterable[int]) -> list[Diagnostic]:
+    """The W0401s of the reads in `line` at `columns`, which check_reserved reported:
+    built again from the line (compact.py). A read it reported is one `_walk` reports
+    from every variable unset, since its state only lacks what the calls before the read
+    in the statement set, and those are left out from every state."""
+    wanted = set(columns)
+    found: list[Diagnostic] = []
+
+    def report(var: ast.Var) -> None:
+        if var.span.column in wanted:
+            found.append(_unset(var))
+
+    for statement in line.statements:
+        _walk(statement, ALL_RESERVED, report)
     return found
 
 

@@ -11,17 +11,18 @@ from .handlers import check_handlers
 from .labels import check_labels
 from .loops import check_loops
 from .reachability import check_reachability
-from .reserved import check_reserved
+from .reserved import OnRead, check_reserved
 from .safety import check_safety
 
 
-def check_graph(graph: ControlFlowGraph, program: ast.Span) -> list[Diagnostic]:
+def check_graph(graph: ControlFlowGraph, program: ast.Span,
+                on_unset: OnRead | None = None) -> list[Diagnostic]:
     """The diagnostics of the whole-program rules on `graph`, whose program spans
-    `program`."""
+    `program`; with `on_unset`, the reads W0401 reports are handed to it instead."""
     return [
         *check_labels(graph),
         *check_handlers(program, graph),
-        *check_reserved(graph),
+        *check_reserved(graph, on_unset),
         *check_reachability(program, graph),
         *check_loops(graph),
         *check_safety(program, graph),

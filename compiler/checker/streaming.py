@@ -26,7 +26,7 @@ from rl1.compiler.frontend.parser import parse_line
 from rl1.compiler.frontend.source import LineIndex, iter_lines
 
 from .cfg import graph_of
-from .compact import CompactDiagnostics, LineDiagnostics, parsed_line
+from .compact import UNSET_READ, CompactDiagnostics, LineDiagnostics, parsed_line
 from .effects import BlockEffects, Combining, Segment, line_segments
 from .graph import Block, ReadAgain
 from .rules import check_graph
@@ -169,7 +169,8 @@ def check_text(text: str) -> CompactDiagnostics:
             last_span = line.span
             for diagnostic in found:
                 if diagnostic.span.line == index + 1:
-                    held.add(index + 1, lines.start(index), diagnostic)
+                    held.add(index + 1, lines.start(index),
+                             (diagnostic.code, diagnostic.severity))
                 else:  # none is; built again, it would be looked for on its own line
                     others.append(diagnostic)
             if line.comment is not None and MARK in line.comment.text:
@@ -207,7 +208,15 @@ def check_text(text: str) -> CompactDiagnostics:
         blocks.append(Block(len(blocks), (), _taken(pending), False, (), (), nothing))
         graph = graph_of(blocks, summaries)
         summaries.clear()  # the blocks hold their effects
-        others += check_graph(graph, ast.Span(1, 1, last_span.end_line, last_span.end_column))
+        unset = LineDiagnostics()  # W0401's reads, in the order of their lines
+
+        def unset_read(var: ast.Var) -> None:
+            number = var.span.line
+            unset.add(number, lines.start(number - 1), UNSET_READ, var.span.column)
+
+        others += check_graph(graph, ast.Span(1, 1, last_span.end_line, last_span.end_column),
+                              unset_read)
+        held = held.merged(unset)
     suppressions = Suppressions(directives)
     if not suppressions.empty:
         held = held.kept(suppressions.reports)
