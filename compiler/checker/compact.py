@@ -100,8 +100,8 @@ class LineDiagnostics:
         """These and `other`'s, in the order of their lines."""
         merged = LineDiagnostics(list(self.kinds))
         for kind in other.kinds:
-            merged._index.setdefault(kind, len(merged.kinds))
-            if len(merged.kinds) < len(merged._index):
+            if kind not in merged._index:
+                merged._index[kind] = len(merged.kinds)
                 merged.kinds.append(kind)
         renumbered = [merged._index[kind] for kind in other.kinds]
         theirs = other._entries()

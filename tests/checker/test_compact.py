@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rl1.compiler.analysis import analyze, diagnose_compactly
-from rl1.compiler.checker.compact import CompactDiagnostics
+from rl1.compiler.checker.compact import UNSET_READ, CompactDiagnostics, LineDiagnostics
 from rl1.compiler.frontend.diagnostics import Severity
 from rl1.compiler.reporting.render import (
     FORMATS,
@@ -79,3 +79,22 @@ def test_warnings_made_errors_are_counted_and_written_as_errors() -> None:
     assert list(held.severities()) == [Severity.ERROR, Severity.ERROR]
     assert summary([FileDiagnostics("p.rob", text, held)]) == (
         "1 file checked: 2 errors, 0 warnings\n")
+
+
+def test_merged_held_diagnostics_keep_the_order_of_their_lines_and_their_kinds() -> None:
+    """The streaming check holds W0401's reads apart until the rules end, then merges
+    them with the lines' own diagnostics, whose kinds they may share or not."""
+    own = LineDiagnostics()
+    own.add(1, 0, ("E0101", Severity.ERROR))
+    own.add(3, 10, ("W0402", Severity.WARNING))
+    reads = LineDiagnostics()
+    reads.add(2, 5, UNSET_READ, 3)
+    reads.add(3, 10, ("W0402", Severity.WARNING))
+    reads.add(4, 14, UNSET_READ, 1)
+    merged = own.merged(reads)
+    assert list(merged.numbers) == [1, 2, 3, 3, 4]
+    assert list(merged.starts) == [0, 5, 10, 10, 14]
+    assert list(merged.columns) == [0, 3, 0, 0, 1]
+    assert [merged.kinds[index] for index in merged.of_kind] == [
+        ("E0101", Severity.ERROR), UNSET_READ, ("W0402", Severity.WARNING),
+        ("W0402", Severity.WARNING), UNSET_READ]
