@@ -21,7 +21,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from support import ROOT
-from support.ilc import damaged, images, with_crc
+from support.ilc import CALLS_WITH_ARGUMENTS, damaged, images, with_crc
 
 from rl1.vm import ilc, isa, native
 from rl1.vm.language import BUILTINS, Feature
@@ -128,10 +128,10 @@ def test_every_opcode_whole_cut_and_in_every_position(c_loader: Loader, opcode: 
         assert_agree(c_loader, file_of(code, frozenset()))
 
 
-CALLS = [info for info in isa.OPCODES.values() if info.form is not None and info.arity]
 
 
-@pytest.mark.parametrize("info", CALLS, ids=[info.name for info in CALLS])
+@pytest.mark.parametrize("info", CALLS_WITH_ARGUMENTS,
+                         ids=[info.name for info in CALLS_WITH_ARGUMENTS])
 def test_every_parameter_bound_and_mask(c_loader: Loader, info: isa.OpInfo) -> None:
     assert info.form is not None
     params = info.form.params

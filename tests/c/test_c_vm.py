@@ -20,6 +20,7 @@ from hypothesis import strategies as st
 from support import ROOT
 from support.cli import rl1c
 from support.hardware import Relay
+from support.ilc import CALLS_WITH_ARGUMENTS
 from support.scripts import MOVING_STARTS, scripts
 
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
@@ -187,11 +188,11 @@ def test_misbehaving_hardware_gives_the_same_faults(c_vm: ctypes.CDLL, start: st
     assert got == expected
 
 
-CALLS = [info for info in isa.OPCODES.values() if info.form is not None and info.arity]
 FAILING_SENSORS = parse_script({}, "none.json")  # every sensing call is a device error
 
 
-@pytest.mark.parametrize("info", CALLS, ids=[info.name for info in CALLS])
+@pytest.mark.parametrize("info", CALLS_WITH_ARGUMENTS,
+                         ids=[info.name for info in CALLS_WITH_ARGUMENTS])
 def test_a_variable_argument_at_either_end_of_its_range(c_vm: ctypes.CDLL,
                                                         info: isa.OpInfo) -> None:
     # Every call, full-width and compact (format 1.3), each parameter given a variable, the

@@ -23,6 +23,9 @@ def with_crc(data: bytes | bytearray) -> bytes:
 
 
 OPCODE_INFOS = sorted(isa.OPCODES.values(), key=lambda info: info.opcode)
+CALLS_WITH_ARGUMENTS = [info for info in isa.OPCODES.values()
+                        if info.form is not None and info.arity]
+"""Every call that takes arguments, full-width and compact."""
 variable_indexes = st.integers(0, len(VARIABLES) - 1)
 
 
