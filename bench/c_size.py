@@ -21,7 +21,7 @@ call libgcc's helpers on Cortex-M0 at -Os and on AVR, which every gcc link inclu
 (after -nostdlib, add -lgcc). NEEDS is that set for each target, as vm/c/README.md
 states it (tests/c/test_c_bare_link.py holds the two equal).
 
-    python3 bench/c_size.py [BUILD-FOLDER]      (default vm/c/build)
+    python3 bench/c_size.py [BUILD-FOLDER]      (default vm/c/build, made first)
 
 Sizes do not depend on the machine's load, so `make -C vm/c test` runs this as a check:
 exit status 1 when a goal is missed (static RAM anywhere, an undefined symbol other than
@@ -112,8 +112,12 @@ def undefined_symbols(prefix: str, paths: list[Path], linked: Path) -> frozenset
 
 
 def main() -> int:
-    build = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).parent.parent / \
-        "vm" / "c" / "build"
+    vm_c = Path(__file__).parent.parent / "vm" / "c"
+    if len(sys.argv) > 1:
+        build = Path(sys.argv[1])
+    else:  # the default folder is brought up to date first: its objects may be stale
+        build = vm_c / "build"
+        subprocess.run(["make", "-s", "-C", str(vm_c), "cross"], check=False)
     print("-Os          flash: VM + verifier = total   static RAM   rl1_vm   "
           "stack bound: rl1_load, rl1_step")
     status = 0
