@@ -216,7 +216,8 @@ def check_text(text: str) -> CompactDiagnostics:
 
         others += check_graph(graph, ast.Span(1, 1, last_span.end_line, last_span.end_column),
                               unset_read)
-        held = held.merged(unset)
+        if unset.numbers:  # a copy of the lines' own, which may be one a line
+            held = held.merged(unset)
     suppressions = Suppressions(directives)
     if not suppressions.empty:
         held = held.kept(suppressions.reports)
