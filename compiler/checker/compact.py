@@ -19,6 +19,7 @@ times the processor time it took when they were held whole, and a twelfth of the
 
 from __future__ import annotations
 
+import itertools
 from array import array
 from collections.abc import Callable, Iterator, Sequence
 from typing import overload
@@ -54,9 +55,10 @@ lines, 250 bytes each held whole."""
 
 class LineDiagnostics:
     """The diagnostics of single lines while a text is checked, each held as its line's
-    number, where the line starts in the text, an index into the kinds seen, and the
-    column of a read that W0401 reports, 0 for a diagnostic the line gives alone (4, 8,
-    2 and 4 bytes): a text's lines are found again without an index of them all."""
+    number, where the line starts in the text, an index into the kinds seen (4, 8 and 2
+    bytes), and once a W0401 is held, the column of each read that W0401 reports, 0 for
+    a diagnostic the line gives alone (4 bytes): a text's lines are found again without
+    an index of them all."""
 
     __slots__ = ("_index", "columns", "kinds", "numbers", "of_kind", "starts")
 
@@ -64,7 +66,7 @@ class LineDiagnostics:
         self.numbers = array("I")  # 32 bits: a source holds far fewer lines
         self.starts = array("q")
         self.of_kind = array("H")
-        self.columns = array("I")
+        self.columns: array[int] | None = None  # None until a read's column is held
         self.kinds: list[Kind] = kinds or []
         self._index = {kind: index for index, kind in enumerate(self.kinds)}
 
@@ -79,13 +81,24 @@ class LineDiagnostics:
         self._append(number, start, index, column)
 
     def _append(self, number: int, start: int, index: int, column: int) -> None:
+        if column and self.columns is None:
+            self.columns = array("I", [0]) * len(self.numbers)
+        if self.columns is not None:
+            self.columns.append(column)
         self.numbers.append(number)
         self.starts.append(start)
         self.of_kind.append(index)
-        self.columns.append(column)
+
+    def columns_of(self, start: int, end: int) -> Sequence[int]:
+        """The columns of the reads held from position `start` to `end` (0: none)."""
+        return self.columns[start:end] if self.columns is not None else ()
 
     def _entries(self) -> Iterator[tuple[int, int, int, int]]:
-        return zip(self.numbers, self.starts, self.of_kind, self.columns, strict=True)
+        columns = self.columns
+        if columns is None:
+            return zip(self.numbers, self.starts, self.of_kind,
+                       itertools.repeat(0, len(self.numbers)), strict=True)
+        return zip(self.numbers, self.starts, self.of_kind, columns, strict=True)
 
     def kept(self, keeps: Keeps) -> LineDiagnostics:
         """Those that `keeps` keeps."""
@@ -169,7 +182,7 @@ class CompactDiagnostics(Sequence[Diagnostic]):
             while end < len(numbers) and numbers[end] == number:
                 end += 1
             built = self._built(number, self._held.starts[position],
-                                self._held.columns[position:end])
+                                self._held.columns_of(position, end))
             if len(built) != end - position:
                 raise AssertionError(f"line {number} gave other diagnostics than it did")
             position = end

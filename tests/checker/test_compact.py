@@ -94,7 +94,8 @@ def test_merged_held_diagnostics_keep_the_order_of_their_lines_and_their_kinds()
     merged = own.merged(reads)
     assert list(merged.numbers) == [1, 2, 3, 3, 4]
     assert list(merged.starts) == [0, 5, 10, 10, 14]
-    assert list(merged.columns) == [0, 3, 0, 0, 1]
+    assert merged.columns is not None and list(merged.columns) == [0, 3, 0, 0, 1]
+    assert own.columns is None  # none is held before a read is
     assert [merged.kinds[index] for index in merged.of_kind] == [
         ("E0101", Severity.ERROR), UNSET_READ, ("W0402", Severity.WARNING),
         ("W0402", Severity.WARNING), UNSET_READ]
