@@ -73,9 +73,9 @@ def apply_edits(text: str, edits: Sequence[Edit]) -> str:
             return len(text)
         return lines.start(line - 1) + min(column - 1, len(lines[line - 1]))
 
-    placed = sorted(((offset(e.span.line, e.span.column),
-                      offset(e.span.end_line, e.span.end_column), e.text) for e in edits),
-                    key=lambda item: item[0])
+    placed = _lines_kept_apart(text, sorted(
+        ((offset(e.span.line, e.span.column), offset(e.span.end_line, e.span.end_column),
+          e.text) for e in edits), key=lambda item: item[0]))
     if any(one[0] == other[0] for one, other in itertools.pairwise(placed)):
         # two at one place: made one by one from the end, each on the last one's text
         for start, end, new in sorted(placed, key=lambda item: item[0], reverse=True):
@@ -88,3 +88,19 @@ def apply_edits(text: str, edits: Sequence[Edit]) -> str:
         done = end
     pieces.append(text[done:])
     return "".join(pieces)
+
+
+def _lines_kept_apart(text: str, placed: list[tuple[int, int, str]]
+                      ) -> list[tuple[int, int, str]]:
+    """The edits placed (start, end, text; in order), one that empties a line between a
+    CR and an LF made to end that line with a CR instead: emptied, its text would leave
+    the two as one CRLF, a line less, and every line after it renumbered (an unused
+    label alone on its line, removed)."""
+    kept = list(placed)
+    for index, (start, end, new) in enumerate(placed):
+        alone = (index == 0 or placed[index - 1][1] < start) and (
+            index + 1 == len(placed) or placed[index + 1][0] > end)
+        if new == "" and start < end and alone and text[start - 1:start] == "\r" \
+                and text[end:end + 1] == "\n":
+            kept[index] = (start, end + 1, "\r")
+    return kept
