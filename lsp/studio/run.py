@@ -240,9 +240,12 @@ class Run:
         page's trace misses nothing."""
         held, self._held = self._held, None
         if held is not None and held[0] == generation and "trace" in params:
+            # Extended, not added: a page behind for long drops many frames in a row,
+            # and copying what they held at each would grow as its square.
             before = held[1]
-            params = {**params, "trace": before["trace"] + params["trace"],
-                      "events": before["events"] + params["events"],
+            before["trace"].extend(params["trace"])
+            before["events"].extend(params["events"])
+            params = {**params, "trace": before["trace"], "events": before["events"],
                       "image": params["image"] or before["image"]}
         if not self._tell(method, params):
             self._held = generation, params
