@@ -93,14 +93,16 @@ def apply_edits(text: str, edits: Sequence[Edit]) -> str:
 def _lines_kept_apart(text: str, placed: list[tuple[int, int, str]]
                       ) -> list[tuple[int, int, str]]:
     """The edits placed (start, end, text; in order), one that empties a line between a
-    CR and an LF made to end that line with a CR instead: emptied, its text would leave
-    the two as one CRLF, a line less, and every line after it renumbered (an unused
-    label alone on its line, removed)."""
+    CR and an LF made to end that line with a CR instead (or with a CRLF, when an LF
+    follows, which a CR would join): emptied, its text would leave the two as one CRLF,
+    a line less, and every line after it renumbered (an unused label alone on its
+    line, removed)."""
     kept = list(placed)
     for index, (start, end, new) in enumerate(placed):
         alone = (index == 0 or placed[index - 1][1] < start) and (
             index + 1 == len(placed) or placed[index + 1][0] > end)
         if new == "" and start < end and alone and text[start - 1:start] == "\r" \
                 and text[end:end + 1] == "\n":
-            kept[index] = (start, end + 1, "\r")
+            joins_next = text[end + 1:end + 2] == "\n"
+            kept[index] = (start, end, "\r") if joins_next else (start, end + 1, "\r")
     return kept
