@@ -12,6 +12,7 @@ from rl1.compiler.analysis import fix as fix_text
 from rl1.compiler.checker.suppression import MARK
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Severity
+from rl1.compiler.frontend.edits import apply_edits
 from rl1.compiler.frontend.source import LINE_BREAK
 from rl1.compiler.reporting.selection import Selection
 
@@ -25,11 +26,55 @@ _PROJECTS = ProjectFiles()
 FIX_ALL = "Apply every safe fix (as `rl1c check --fix`)"
 
 
-def _edit(document: Document, fix: Fix, columns: Columns) -> types.WorkspaceEdit:
+def fix_edit(document: Document, fix: Fix, columns: Columns) -> types.WorkspaceEdit:
+    """The fix as one edit, whose text is what `rl1c check --fix` writes there
+    (apply_edits), not the fix's edits as given, which an editor would make otherwise:
+    apply_edits writes a line break in an edit's text as the document's first line end,
+    and keeps a line it empties between a lone CR and an LF apart, where the two would
+    join. The edits are made in the lines around them only: from the line before the
+    first (apply_edits looks at its end) to the line after the last (whose start it
+    looks at, and may take in)."""
+    first = max(min(min(edit.span.line for edit in fix.edits), document.line_count) - 1, 1)
+    last = min(max(edit.span.end_line for edit in fix.edits) + 1, document.line_count)
+    before = document.text_of_lines(first, last)
+    lead, moved = "", 0  # what goes before the lines, and how many lines up they move
+    if first > 1:
+        # After a line that ends as the document's first (the line end apply_edits
+        # writes), and a character that keeps that end from joining an LF they start
+        # with: line `first` is the second, and the edits fall after it.
+        lead, moved = document.line_end(1) + "x", first - 2
+    after = apply_edits(lead + before, [
+        Edit(ast.Span(edit.span.line - moved, edit.span.column,
+                      edit.span.end_line - moved, edit.span.end_column), edit.text)
+        for edit in fix.edits])[len(lead):]
+    start, end, text = _difference(before, after)
+    span = ast.Span(*_place(before, start, first), *_place(before, end, first))
     return types.WorkspaceEdit(changes={document.uri: [
-        types.TextEdit(range=document.range_of(edit.span, columns), new_text=edit.text)
-        for edit in fix.edits
-    ]})
+        types.TextEdit(range=document.range_of(span, columns), new_text=text)]})
+
+
+def _difference(before: str, after: str) -> tuple[int, int, str]:
+    """Where `after` differs from `before`: the start and end in `before` of what lies
+    between the text both start with and the text both end with, and what `after` has
+    there; neither end between a CR and an LF, where LSP has no position."""
+    start, alike = 0, min(len(before), len(after))
+    while start < alike and before[start] == after[start]:
+        start += 1
+    if start > 0 and before[start - 1 : start + 1] == "\r\n":
+        start -= 1
+    same_end = 0
+    while same_end < alike - start and before[-1 - same_end] == after[-1 - same_end]:
+        same_end += 1
+    end = len(before) - same_end
+    if end < len(before) and before[end - 1 : end + 1] == "\r\n":
+        end, same_end = end + 1, same_end - 1
+    return start, end, after[start : len(after) - same_end]
+
+
+def _place(text: str, offset: int, first: int) -> tuple[int, int]:
+    """The 1-based line and column of `offset` in `text`, which starts at line `first`."""
+    breaks = list(LINE_BREAK.finditer(text, 0, offset))
+    return first + len(breaks), offset - (breaks[-1].end() if breaks else 0) + 1
 
 
 def _on_lines(diagnostic: Diagnostic, first: int, last: int) -> bool:
@@ -57,7 +102,7 @@ def code_actions(document: Document, diagnostics: list[Diagnostic], requested: t
                     title=fix.title,
                     kind=types.CodeActionKind.QuickFix,
                     diagnostics=[to_lsp(diagnostic, document, columns)],
-                    edit=_edit(document, fix, columns),
+                    edit=fix_edit(document, fix, columns),
                     # An editor may make a preferred fix unasked: only a safe one.
                     is_preferred=len(diagnostic.fixes) == 1 and fix.safe,
                 ))
@@ -66,7 +111,7 @@ def code_actions(document: Document, diagnostics: list[Diagnostic], requested: t
                 actions.append(types.CodeAction(
                     title=allow.title, kind=types.CodeActionKind.QuickFix,
                     diagnostics=[to_lsp(diagnostic, document, columns)],
-                    edit=_edit(document, allow, columns)))
+                    edit=fix_edit(document, allow, columns)))
     wants_fix_all = only is None or any(types.CodeActionKind.SourceFixAll.startswith(kind)
                                         for kind in only)
     if wants_fix_all and any(one.safe for diagnostic in diagnostics for one in diagnostic.fixes):

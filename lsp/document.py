@@ -91,8 +91,16 @@ class Document:
         return self._size
 
     def text(self) -> str:
-        pairs = zip(self._lines, self._endings, strict=True)
+        return self.text_of_lines(1, len(self._lines))
+
+    def text_of_lines(self, first: int, last: int) -> str:
+        """The text of 1-based lines `first` to `last`, each with its line end."""
+        pairs = zip(self._lines[first - 1 : last], self._endings[first - 1 : last], strict=True)
         return "".join(line.text + ending for line, ending in pairs)
+
+    def line_end(self, number: int) -> str:
+        """How 1-based line `number` ends: LF, CRLF, CR, or "" (the last line)."""
+        return self._endings[number - 1]
 
     def line_text(self, number: int) -> str:
         """The text of 1-based line `number`, "" outside the document."""

@@ -369,7 +369,9 @@ async def test_quick_fixes_come_from_the_checker(client: Client) -> None:
     mvi = fixes["write `MVI`"]
     assert mvi.edit is not None and mvi.edit.changes is not None
     (edit,) = mvi.edit.changes[uri]
-    assert (edit.range.start, edit.new_text) == (types.Position(9, 1), "MVI")
+    # What the fix changes: `MVX` made `MVI`.
+    assert (edit.range, edit.new_text) == (
+        types.Range(types.Position(9, 3), types.Position(9, 4)), "I")
     assert mvi.diagnostics and mvi.diagnostics[0].code == "E0501"
     upper = {a.title for a in await actions_at(client, uri, 5)}
     assert "write `MOV`" in upper
@@ -377,7 +379,9 @@ async def test_quick_fixes_come_from_the_checker(client: Client) -> None:
     assert handler, "the checker offers to add the missing :97 handler"
     assert handler[0].edit is not None and handler[0].edit.changes is not None
     (added,) = handler[0].edit.changes[uri]
-    assert added.new_text.startswith("\n:97")
+    # After the last line (the text both ways ends with a line end, which the edit keeps).
+    assert (added.range.start, added.range.end, added.new_text) == (
+        types.Position(12, 0), types.Position(12, 0), ":97 (MOV 0,0); (END)\n")
 
 
 @pytest.mark.parametrize("line, allowed", [
