@@ -211,12 +211,12 @@ def return_large_buffers() -> None:
 class _Collector:
     """Collects the garbage of ended sessions, once every MAX_SESSIONS of them. What a
     session leaves after its end (server.Rl1Server.end lets go of its documents) is a
-    web of reference cycles, pygls' server, protocol and converter and the handlers
-    that close over the server, some 0.3 MiB, freed only by a collection of the
-    oldest generation; and the front end's pauses of the collector (compiler/frontend/
-    collector.py) move every object there at once, where CPython starts a collection
-    only when enough objects have reached it through the younger generations, which
-    none then do. So ended sessions were never freed, and after about 1,000 clients
+    web of reference cycles, pygls' server and protocol and the handlers that close
+    over the server, freed only by a collection of the oldest generation; and the
+    front end's pauses of the collector (compiler/frontend/collector.py) move every
+    object there at once, where CPython starts a collection only when enough objects
+    have reached it through the younger generations, which none then do. So ended
+    sessions were never freed, and after about 1,000 clients
     the hostile harness's bound was passed (issue 23). A collection walks every object
     of the server, a few times what starting a session costs (bench/lsp_sessions.py):
     hence one for several sessions, at most MAX_SESSIONS of them left to it."""
