@@ -208,18 +208,19 @@ def return_large_buffers() -> None:
         ctypes.CDLL(None).mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD)
 
 
-class _Collector:
-    """Collects the garbage of ended sessions, once every MAX_SESSIONS of them. What a
-    session leaves after its end (server.Rl1Server.end lets go of its documents) is a
-    web of reference cycles, pygls' server and protocol and the handlers that close
-    over the server, freed only by a collection of the oldest generation; and the
-    front end's pauses of the collector (compiler/frontend/collector.py) move every
-    object there at once, where CPython starts a collection only when enough objects
-    have reached it through the younger generations, which none then do. So ended
-    sessions were never freed, and after about 1,000 clients
-    the hostile harness's bound was passed (issue 23). A collection walks every object
-    of the server, a few times what starting a session costs (bench/lsp_sessions.py):
-    hence one for several sessions, at most MAX_SESSIONS of them left to it."""
+class Collector:
+    """Collects the garbage of ended sessions (and the studio's ended pages), once
+    every MAX_SESSIONS of them. What a session leaves after its end (server.Rl1Server.
+    end lets go of its documents) is a web of reference cycles, pygls' server and
+    protocol and the handlers that close over the server, freed only by a collection
+    of the oldest generation; and the front end's pauses of the collector (compiler/
+    frontend/collector.py) move every object there at once, where CPython starts a
+    collection only when enough objects have reached it through the younger
+    generations, which none then do. So ended sessions were never freed, and after
+    about 1,000 clients the hostile harness's bound was passed (issue 23). A collection
+    walks every object of the server, a few times what starting a session costs
+    (bench/lsp_sessions.py): hence one for several sessions, at most MAX_SESSIONS of
+    them left to it."""
 
     def __init__(self) -> None:
         self._ended = 0
@@ -358,7 +359,7 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
     sessions: set[Session] = set()
     refusing: set[asyncio.StreamWriter] = set()  # bounded too: beyond, closed at once
     in_flight = InFlight()
-    collector = _Collector()
+    collector = Collector()
 
     async def connected(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         try:
@@ -498,7 +499,7 @@ class WebSocketSessions:
         return_large_buffers()
         self.sessions: set[Session] = set()
         in_flight = self.in_flight = InFlight()
-        self._collector = _Collector()
+        self.collector = Collector()  # the studio's pages' too
 
         class Counted(ServerConnection):
             """A connection that counts the bytes received since its last message was
@@ -562,7 +563,7 @@ class WebSocketSessions:
             # frees, rarely on a quiet server: let go of them now.
             if (ended := connection.protocol.parser_exc) is not None:
                 ended.__traceback__ = None
-            self._collector.ended()
+            self.collector.ended()
 
 
 async def serve_websocket(new_session: Callable[[], Session], host: str, port: int) -> None:

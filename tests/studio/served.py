@@ -1,14 +1,18 @@
 """The studio's server as the tests meet it: served in a thread of the test process on a
-free port of 127.0.0.1 (`serving`), raw HTTP requests sent byte for byte (`get`), and a
-page's `/studio` connection driven as JSON-RPC (`Page`)."""
+free port of 127.0.0.1 (`serving`) or as `rl1c studio` in a process of its own
+(`StudioProcess`, whose memory is its own), raw HTTP requests sent byte for byte (`get`),
+and a page's `/studio` connection driven as JSON-RPC (`Page`)."""
 
 from __future__ import annotations
 
 import asyncio
 import contextlib
 import json
+import re
 import shutil
 import socket
+import subprocess
+import sys
 import threading
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -171,3 +175,54 @@ def page(served: Served, origin: str | None = None) -> Iterator[Page]:
     with connect(served.url("/studio", scheme="ws"), max_size=None, open_timeout=TIMEOUT,
                  origin=None if origin is None else Origin(origin)) as connection:
         yield Page(connection)
+
+
+RL1C = [sys.executable, "-c", "from rl1.compiler.cli.main import rl1c; rl1c()"]
+ADDRESS = re.compile(r"^rl1c studio: serving (?P<folder>.+) at "
+                     r"(?P<url>http://127\.0\.0\.1:(?P<port>\d+)/\?token=(?P<token>[\w-]+)) "
+                     r"\(Ctrl-C stops it\)$")
+"""The line `rl1c studio` prints first."""
+
+
+class StudioProcess:
+    """`rl1c studio --no-browser` serving `folder`, in a process of its own."""
+
+    def __init__(self, folder: Path) -> None:
+        self.process = subprocess.Popen([*RL1C, "studio", "--no-browser"], cwd=folder,
+                                        stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                        text=True)
+        assert self.process.stdout is not None
+        shown = ADDRESS.match(self.process.stdout.readline().rstrip("\n"))
+        if shown is None:
+            self.stop()
+            raise AssertionError("rl1c studio did not print its address")
+        self.port, self.token = int(shown["port"]), shown["token"]
+
+    def url(self, path: str) -> str:
+        return f"ws://127.0.0.1:{self.port}{path}?token={self.token}"
+
+    def resident_mib(self) -> float:
+        """Resident memory, from /proc."""
+        for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+        raise AssertionError("no VmRSS")
+
+    def stop(self) -> None:
+        self.process.kill()
+        self.process.wait(TIMEOUT)
+
+
+def pages_one_after_another(studio: StudioProcess, pages: int) -> None:
+    """`pages` pages, each leaving before the next comes, as a user's: each launches
+    Listing 1 on its world, stops on entry, steps a line and sets a breakpoint, and is
+    closed stopped (its run held, not ended). The folder is a `sample_folder`."""
+    for _ in range(pages):
+        with connect(studio.url("/studio"), max_size=None, open_timeout=TIMEOUT) as socket_:
+            client = Page(socket_)
+            client.request("initialize")
+            client.request("run/launch", {**LISTING_1, "stopOnEntry": True})
+            client.until("run/stopped")
+            client.request("debug/setBreakpoints", {"lines": [{"line": 3}]})
+            client.request("debug/stepLine")
+            client.until("run/stopped", "run/ended")

@@ -5,7 +5,6 @@ outside the folder, of another kind, or a port in use refused with status 2."""
 from __future__ import annotations
 
 import json
-import re
 import signal
 import socket
 import subprocess
@@ -13,14 +12,10 @@ import sys
 from pathlib import Path
 
 import pytest
-from served import sample_folder
+from served import ADDRESS, RL1C, sample_folder
 from support.cli import rl1c
 from websockets.sync.client import connect
 
-RL1C = [sys.executable, "-c", "from rl1.compiler.cli.main import rl1c; rl1c()"]
-ADDRESS = re.compile(r"^rl1c studio: serving (?P<folder>.+) at "
-                     r"(?P<url>http://127\.0\.0\.1:(?P<port>\d+)/\?token=(?P<token>[\w-]+)) "
-                     r"\(Ctrl-C stops it\)$")
 TIMEOUT = 60
 
 
