@@ -152,8 +152,9 @@ typedef struct {
     uint32_t executed;          /* instructions run, the one that faulted included. A
                                    run that never ends (a patrol) is given more by
                                    setting it back between steps: the budget then
-                                   bounds what runs after (vm/c/README.md) */
-    uint32_t budget;            /* 1 .. 2^31 - 1 (12.6) */
+                                   bounds what runs after (vm/c/README.md). It
+                                   stops at 2^32 - 1 rather than wrap */
+    uint32_t budget;            /* any u32; rl1c takes 1 .. 2^31 - 1 (12.6) */
     rl1_mailbox mailbox;        /* the device posts here */
     /* the run */
     uint8_t waiting;            /* opcode of the call in progress, 0 for none */

@@ -378,6 +378,11 @@ class NativeMachine:
     def executed(self) -> int:
         return int(self._vm.executed)
 
+    @executed.setter
+    def executed(self, count: int) -> None:
+        """Set back between steps, as firmware tops up a patrol's budget (vm/c/README.md)."""
+        self._vm.executed = count
+
     @property
     def state(self) -> State:
         return State(self._vm.state)

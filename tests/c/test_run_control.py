@@ -158,3 +158,56 @@ def test_a_callback_that_steps_the_c_vm_again_faults_the_step(c_vm: ctypes.CDLL)
     assert result.fault.message.startswith("a callback stepped the VM that called it")
     assert result.variables[2] == 0  # C
     assert [entry.call for entry in device.trace] == ["KYC", "STOP"]
+
+
+COUNT_TOP = 2**32 - 1  # where the C VM's u32 count stops
+
+
+def _steps_from(machine: Machine | native.NativeMachine, device: ScriptedDevice,
+                count: int, slices: list[int]) -> list[object]:
+    """Each step's state, count (at most COUNT_TOP) and variables, the count first set to
+    `count` between steps as firmware tops up a patrol's budget; then the result and the
+    trace. Bounded: a run past its budget that the watchdog misses would run for hours."""
+    machine.executed = count
+    steps: list[object] = []
+    for limit in slices:
+        state = machine.step(limit)
+        steps.append((state, min(machine.executed, COUNT_TOP), tuple(machine.variables)))
+        if state not in GOING:
+            break
+    return [*steps, machine.result, list(device.trace)]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.sampled_from(MOVING_STARTS), checked_programs(max_blocks=3), scripts(),
+       st.sampled_from((2**31 - 1, 2**31, 2**32 - 2, COUNT_TOP)), st.integers(-40, 3),
+       st.lists(st.integers(0, 9), min_size=1, max_size=40), st.sampled_from(OPTIMIZATION_LEVELS))
+def test_a_budget_near_2_to_the_32_faults_both_vms_alike(
+        c_vm: ctypes.CDLL, start: str, text: str, script: Script, budget: int, offset: int,
+        slices: list[int], level: int) -> None:
+    # The count set near the budget, then stepped in slices: the same steps, fault and
+    # trace on both VMs; the C VM's count stops at 2^32 - 1 where the reference VM's goes
+    # on (it wrapped to 0, and the run went on past its budget).
+    data = _compiled(start + text, level)
+    count = min(budget + offset, COUNT_TOP)
+    runs = []
+    for make in (lambda hw: Machine(verify(data), hw, budget),
+                 lambda hw: native.NativeMachine(data, hw, budget, c_vm)):
+        device = ScriptedDevice(script)
+        runs.append(_steps_from(make(Blocking(device)), device, count, slices + [50] * 20))
+    assert runs[1] == runs[0]
+
+
+def test_a_count_that_passes_2_to_the_32_between_steps_stops_there(c_vm: ctypes.CDLL) -> None:
+    """With the budget 2^32 - 1 and steps of one instruction, the count wrapped to 0 and
+    the loop ran on; now it stops at 2^32 - 1 and the loop's jump faults, as in Python."""
+    data = _compiled(":10 A=A+1; B=B+1; C=C+1; D=D+1; #10\n")
+    runs = []
+    for make in (lambda hw: Machine(verify(data), hw, COUNT_TOP),
+                 lambda hw: native.NativeMachine(data, hw, COUNT_TOP, c_vm)):
+        device = ScriptedDevice(Script())
+        runs.append(_steps_from(make(Blocking(device)), device, COUNT_TOP - 2, [1] * 20))
+    assert runs[1] == runs[0]
+    result = runs[0][-2]
+    assert isinstance(result, RunResult) and result.fault is not None
+    assert (result.fault.kind, result.fault.line) == (FaultKind.BUDGET, 1)

@@ -223,6 +223,15 @@ static rl1_state ended(rl1_vm *vm, const rl1_hardware *hw, uint16_t at)
         ? fault(vm, hw, RL1_FAULT_DEVICE, at, true) : RL1_ENDED;
 }
 
+/* The instructions run in all: `before` the step and `ran` in it. The count stops at
+ * UINT32_MAX rather than wrap, so that a run given a budget near 2^32 still faults at its
+ * next jump or call once past it, as the reference VM, which counts on, does (rl1vm.h). */
+static uint32_t counted(uint32_t before, uint32_t ran)
+{
+    uint32_t sum = before + ran;
+    return sum < before ? UINT32_MAX : sum;
+}
+
 /* The operand bytes of the instruction at ip. */
 #define U8_AT(k) RL1_BYTE(ip + (k))
 #define U16_AT(k) RL1_U16(ip + (k))
@@ -512,7 +521,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
             /* the instructions run so far, the call included, for a device that times
              * them (the simulator's clock, vm/drive.py's drive_clocked): about 12
              * instructions a call on Cortex-M3, which firmware does not pay */
-            vm->executed = before + (n - left);
+            vm->executed = counted(before, n - left);
 #endif
             if (call & RL1_CALL_STARTED) {
                 if (hw->start(hw->ctx, op, given) != RL1_OK) {
@@ -525,7 +534,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
                 if (status == RL1_BUSY && !broken_in(vm)) {
                     vm->waiting = RL1_BYTE(ip); /* as in the code: a compact call's too */
                     vm->acc = (int16_t)acc;
-                    vm->executed = before + (n - left);
+                    vm->executed = counted(before, n - left);
                     return RL1_WAITING;
                 }
                 vm->waiting = 0;
@@ -614,7 +623,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
     }
     vm->pc = (uint16_t)(ip - code);
     vm->acc = (int16_t)acc;
-    vm->executed = before + (n - left);
+    vm->executed = counted(before, n - left);
     if (kind != RL1_FAULT_NONE) {
         return fault(vm, hw, kind, vm->pc, false);
     }

@@ -268,10 +268,17 @@ rl1_refusal rl1_load(rl1_program *program, const uint8_t *file, uint32_t size,
  * before it). It walks the line map, so it costs one pass over it: for fault reports. */
 uint16_t rl1_line_at(const rl1_program *program, uint16_t code_offset);
 
-/* Makes `vm` ready for a run with the watchdog `budget` (1 .. 2^31 - 1, spec/ilc.md
- * 12.6): every other field zero. Then call rl1_step with the program (loaded by
- * rl1_load) and the hardware until it answers RL1_ENDED or RL1_FAULTED; the device
- * posts lost lines into vm->mailbox with rl1_post_line_lost. */
+/* Makes `vm` ready for a run with the watchdog `budget` (spec/ilc.md 12.6): every other
+ * field zero. Then call rl1_step with the program (loaded by rl1_load) and the hardware
+ * until it answers RL1_ENDED or RL1_FAULTED; the device posts lost lines into
+ * vm->mailbox with rl1_post_line_lost.
+ *
+ * Every u32 budget works as in the reference VM (`rl1c run --budget` takes 1 .. 2^31 -
+ * 1): the run faults at its first jump or call with more than `budget` instructions run.
+ * vm->executed stops at 2^32 - 1 rather than wrap, so a budget near 2^32 is met all the
+ * same (the count then reads 2^32 - 1 where the reference VM's goes on). A run that
+ * never ends is given more by setting vm->executed back between steps (vm/c/README.md,
+ * "Run control"): the budget cannot switch the watchdog off. */
 void rl1_vm_init(rl1_vm *vm, uint32_t budget);
 
 /* --- Internal: the instruction set, shared by the loader and the VM ----------------- */
