@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import gc
 import math
+import time
 from collections import deque
 from collections.abc import Iterable, Iterator, Sequence
 from concurrent.futures import Executor, Future
@@ -192,14 +193,56 @@ def noiseless(task: Task) -> bool:
 
 
 RESUBMISSIONS = 2  # of a run lost with its worker: more, and the run may be what kills them
+TASK_SECONDS = 0.5  # of runs a task makes: a task's cost on a cluster (about 20 ms on a
+# loaded machine) then weighs little, and a stopped campaign loses little of what ran
+MOST_RUNS_A_TASK = 64  # so that a window of tasks holds at most 64 records a task
+
+
+@dataclass(frozen=True, slots=True)
+class Batch:
+    """What a task brings back: the records of its seeds, in their order, and the
+    seconds it took to make them (which size the tasks that follow)."""
+
+    records: tuple[Record, ...]
+    seconds: float
+
+
+def run_batch(task: Task, seeds: tuple[int, ...]) -> Batch:
+    """The runs of `task` with `seeds`, one after the other: a campaign's task."""
+    started = time.perf_counter()
+    records = tuple(run_one(task, seed) for seed in seeds)
+    return Batch(records, time.perf_counter() - started)
+
+
+def runs_a_task(runs: int, seconds: float) -> int:
+    """How many runs the next task makes, when `runs` runs have taken `seconds` so far:
+    as many as fill TASK_SECONDS, from 1 (also while none has been timed) to
+    MOST_RUNS_A_TASK. A run's cost varies with its seed, so the mean of all is used."""
+    if runs == 0 or seconds * MOST_RUNS_A_TASK <= TASK_SECONDS * runs:
+        return 1 if runs == 0 else MOST_RUNS_A_TASK
+    return max(1, int(TASK_SECONDS * runs / seconds))
+
+
+@dataclass(slots=True)
+class _Part:
+    """Runs submitted as one task: their seeds, the task's future, how many of its
+    records the campaign has yielded, and how many times these runs have been made."""
+
+    seeds: tuple[int, ...]
+    future: Future[Batch]
+    tries: int = 1
+    taken: int = 0
 
 
 class Campaign:
     """The runs of `task` over `seeds` on `executor` (in this process when None), as an
-    iterator of their records in seed order, with at most `window` runs submitted and not
-    yet yielded. A run that fails with an error of `lost` (a Dask cluster's KilledWorker:
-    its worker died) is submitted again, at most RESUBMISSIONS times. `salvage` ends it
-    early, keeping the runs already finished that follow the last yielded without a gap."""
+    iterator of their records in seed order. The runs go in tasks of several seeds each
+    (`runs_a_task`: about TASK_SECONDS of runs), with at most `window` tasks submitted
+    and not yet yielded whole. A task that fails with an error of `lost` (a Dask
+    cluster's KilledWorker: its worker died) is submitted again a run a task, so that a
+    run that kills its worker is told from those beside it; each run is made at most
+    1 + RESUBMISSIONS times. `salvage` ends it early, keeping the runs already finished
+    that follow the last yielded without a gap."""
 
     def __init__(self, task: Task, seeds: Iterable[int], executor: Executor | None,
                  window: int, lost: tuple[type[BaseException], ...] = ()) -> None:
@@ -208,39 +251,57 @@ class Campaign:
         self._executor = executor
         self._window = window
         self._lost = lost
-        self._pending: deque[tuple[int, Future[Record]]] = deque()
+        self._pending: deque[_Part] = deque()
+        self._timed_runs = 0
+        self._timed_seconds = 0.0
 
     def __iter__(self) -> Iterator[Record]:
         if self._executor is None:
             for seed in self._seeds:
                 yield run_one(self._task, seed)
             return
-        for seed in islice(self._seeds, self._window):
-            self._submit(seed)
+        self._fill()
         while self._pending:
-            record = self._first_record()
-            # The next run is submitted before this one leaves the queue: a broken pool
-            # refuses it, and salvage must still find this record.
-            for seed in islice(self._seeds, 1):
-                self._submit(seed)
+            part, records = self._first_records()
+            # Counted before it is yielded, each record, so that a signal between two
+            # instructions finds it either yielded or salvaged, never both or neither.
+            while part.taken < len(records):
+                record = records[part.taken]
+                part.taken += 1
+                yield record
             self._pending.popleft()
-            yield record
+            self._fill()  # after: a broken pool refuses it, and salvage finds the rest
 
-    def _submit(self, seed: int) -> None:
-        assert self._executor is not None
-        self._pending.append((seed, self._executor.submit(run_one, self._task, seed)))
+    def _fill(self) -> None:
+        while len(self._pending) < self._window:
+            seeds = tuple(islice(self._seeds, runs_a_task(self._timed_runs,
+                                                          self._timed_seconds)))
+            if not seeds:
+                return
+            self._pending.append(_Part(seeds, self._submit(seeds)))
 
-    def _first_record(self) -> Record:
-        """The record of the first run in flight, submitted again in its place while it
-        is lost with its worker."""
+    def _submit(self, seeds: tuple[int, ...]) -> Future[Batch]:
         assert self._executor is not None
-        for _ in range(RESUBMISSIONS):
-            seed, future = self._pending[0]
+        return self._executor.submit(run_batch, self._task, seeds)
+
+    def _first_records(self) -> tuple[_Part, tuple[Record, ...]]:
+        """The first task in flight and its records; lost with its worker, its runs are
+        submitted again in its place, a task each."""
+        while True:
+            part = self._pending[0]
             try:
-                return future.result()
+                batch = part.future.result()
             except self._lost:
-                self._pending[0] = seed, self._executor.submit(run_one, self._task, seed)
-        return self._pending[0][1].result()
+                if part.tries > RESUBMISSIONS:
+                    raise
+                again = [_Part((seed,), self._submit((seed,)), part.tries + 1)
+                         for seed in part.seeds]
+                # One assignment: a signal finds the queue before or after, whole.
+                self._pending = deque([*again, *islice(self._pending, 1, None)])
+                continue
+            self._timed_runs += len(batch.records)
+            self._timed_seconds += batch.seconds
+            return part, batch.records
 
     def salvage(self) -> list[Record]:
         """Stop: cancel the runs not yet made, and return the finished runs that follow
@@ -248,13 +309,14 @@ class Campaign:
         campaign are its first seeds, and the next campaign can start where it ended)."""
         finished: list[Record] = []
         gap = False
-        for _, future in self._pending:
+        for part in self._pending:
+            future = part.future
             gap = gap or not future.done() or future.cancelled() \
                 or future.exception() is not None
             if gap:
-                future.cancel()  # a run already started ends on its own, unread
+                future.cancel()  # a task already started ends on its own, unread
             else:
-                finished.append(future.result())
+                finished.extend(future.result().records[part.taken:])
         self._pending.clear()
         return finished
 

@@ -19,7 +19,7 @@ import time
 from collections.abc import Callable
 from concurrent.futures import BrokenExecutor, Executor, Future
 from pathlib import Path
-from typing import ParamSpec, TypeVar
+from typing import ParamSpec, TypeVar, cast
 
 import pytest
 from hypothesis import given
@@ -28,14 +28,19 @@ from support.campaigns import DROPOUT, WALL_PROGRAM, WALL_WORLD
 from support.cli import rl1c
 
 from rl1.compiler.campaign import (
+    MOST_RUNS_A_TASK,
     RESUBMISSIONS,
     SEEDS_KEPT,
+    TASK_SECONDS,
+    Batch,
     Campaign,
     Record,
     Tally,
     Task,
     campaign_seeds,
+    run_batch,
     run_one,
+    runs_a_task,
     task_for,
     wilson,
 )
@@ -216,21 +221,71 @@ def test_a_workers_memory_stays_flat_over_runs_of_source() -> None:
     assert len(gc.get_objects()) - before < 20_000  # at most COLLECT_EVERY runs' garbage
 
 
-def test_a_campaign_holds_at_most_its_window_of_runs_in_flight() -> None:
-    submitted: list[int] = []
+P = ParamSpec("P")
+T = TypeVar("T")
 
-    class Counting:  # the Executor interface, making each run at once
-        def submit(self, fn, *args):  # type: ignore[no-untyped-def]
-            from concurrent.futures import Future
-            submitted.append(args[1])
-            future: Future[Record] = Future()
-            future.set_result(fn(*args))
-            return future
 
-    runs = iter(Campaign(wall_task(), range(100), Counting(), 4))  # type: ignore[arg-type]
-    for taken in range(1, 20):
+class Lost(Exception):
+    """A task lost with its worker, as a Dask cluster's KilledWorker says it."""
+
+
+class Instant(Executor):
+    """The Executor interface, making each task at once, as if it took no time (so the
+    campaign's tasks soon reach MOST_RUNS_A_TASK runs), and noting each task's seeds;
+    those of the run of `losing` it fails, its first `losses` times, as a Dask cluster's
+    KilledWorker does when the task's worker died."""
+
+    def __init__(self, losing: int | None = None, losses: int = 0) -> None:
+        self.submitted: list[tuple[int, ...]] = []
+        self.losing = losing
+        self.losses = losses
+
+    def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
+        task, seeds = args
+        assert isinstance(task, Task) and isinstance(seeds, tuple)
+        self.submitted.append(seeds)
+        future: Future[T] = Future()
+        if self.losing in seeds and self.losses > 0:
+            self.losses -= 1
+            future.set_exception(Lost(f"the worker of seeds {seeds} died"))
+        else:
+            future.set_result(cast(T, Batch(run_batch(task, seeds).records, 0.0)))
+        return future
+
+    def made(self, seed: int) -> int:
+        """How many times the run of `seed` was submitted."""
+        return sum(seed in seeds for seeds in self.submitted)
+
+
+def test_a_campaign_holds_at_most_its_window_of_tasks_in_flight() -> None:
+    instant = Instant()
+    runs = iter(Campaign(wall_task(), range(400), instant, 4))
+    for taken in range(1, 300):
         next(runs)
-        assert len(submitted) <= taken + 4
+        whole = sum(max(seeds) < taken for seeds in instant.submitted)
+        assert len(instant.submitted) - whole <= 4
+    # The first window before any run is timed, a run a task; then as many as fill
+    # TASK_SECONDS, here the most a task makes.
+    assert instant.submitted[:4] == [(0,), (1,), (2,), (3,)]
+    assert instant.submitted[4] == tuple(range(4, 4 + MOST_RUNS_A_TASK))
+
+
+@given(runs=st.integers(0, 10**6), seconds=st.floats(0, 10**5, allow_nan=False))
+def test_a_task_makes_about_task_seconds_of_runs(runs: int, seconds: float) -> None:
+    size = runs_a_task(runs, seconds)
+    assert 1 <= size <= MOST_RUNS_A_TASK
+    if runs == 0:  # nothing timed yet
+        assert size == 1
+        return
+    each = seconds / runs
+    assert size == 1 or size * each <= TASK_SECONDS  # not more than fill it
+    assert size == MOST_RUNS_A_TASK or (size + 1) * each > TASK_SECONDS  # nor fewer
+
+
+def test_a_batch_is_the_runs_of_its_seeds() -> None:
+    task = compiled_wall_task()
+    assert run_batch(task, (5, 3, 9)).records == tuple(run_one(task, seed)
+                                                      for seed in (5, 3, 9))
 
 
 @pytest.mark.parametrize("jobs", ["1", "2"])
@@ -344,10 +399,6 @@ def test_campaign_options_out_of_place_are_usage_errors(
     assert message in result.stderr
 
 
-P = ParamSpec("P")
-T = TypeVar("T")
-
-
 class BrokenAfter(Executor):
     """An executor that makes its first `runs` submissions at once, then refuses every
     other as a pool whose worker died does."""
@@ -375,52 +426,38 @@ def test_a_run_finished_when_the_pool_breaks_is_kept() -> None:
     assert [record.seed for record in made] == [0, 1]
 
 
-class Lost(Exception):
-    """A run lost with its worker, as a Dask cluster's KilledWorker says it."""
-
-
-class Losing(Executor):
-    """An executor that makes each run at once, except the first `losses` submissions of
-    the run of `seed`, which it loses."""
-
-    def __init__(self, seed: int, losses: int) -> None:
-        self.seed = seed
-        self.losses = losses
-        self.submitted: list[int] = []
-
-    def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
-        seed = args[1]
-        assert isinstance(seed, int)
-        self.submitted.append(seed)
-        future: Future[T] = Future()
-        if seed == self.seed and self.losses > 0:
-            self.losses -= 1
-            future.set_exception(Lost(f"the worker of seed {seed} died"))
-        else:
-            future.set_result(fn(*args, **kwargs))
-        return future
-
-
-def test_a_run_lost_with_its_worker_is_made_again_in_its_place() -> None:
+@pytest.mark.parametrize("seed", [3, 6])  # a task of its own, and one of a batch
+def test_a_run_lost_with_its_worker_is_made_again_in_its_place(seed: int) -> None:
     task = compiled_wall_task()
-    losing = Losing(seed=3, losses=RESUBMISSIONS)
-    made = list(Campaign(task, range(8), losing, window=4, lost=(Lost,)))
-    assert made == list(Campaign(task, range(8), None, 1))
-    assert losing.submitted.count(3) == 1 + RESUBMISSIONS
+    losing = Instant(losing=seed, losses=RESUBMISSIONS)
+    made = list(Campaign(task, range(20), losing, window=4, lost=(Lost,)))
+    assert made == list(Campaign(task, range(20), None, 1))
+    assert losing.made(seed) == 1 + RESUBMISSIONS
+    if seed == 6:  # its batch's runs made again a task each, once
+        assert losing.submitted[4:7] == [tuple(range(4, 20)), (4,), (5,)]
+        assert losing.made(19) == 2
 
 
 def test_a_run_lost_each_time_it_is_made_stops_the_campaign_after_the_runs_before_it() -> None:
-    campaign = Campaign(compiled_wall_task(), range(8), Losing(seed=3, losses=99), window=4,
-                        lost=(Lost,))
+    campaign = Campaign(compiled_wall_task(), range(20), Instant(losing=6, losses=99),
+                        window=4, lost=(Lost,))
     made: list[Record] = []
     with pytest.raises(Lost):
         made.extend(campaign)
-    assert [record.seed for record in made] == [0, 1, 2]
+    assert [record.seed for record in made] == [0, 1, 2, 3, 4, 5]
     assert campaign.salvage() == []  # the runs after it are not the next seeds
 
 
 def test_an_error_that_is_no_lost_worker_is_not_made_again() -> None:
-    losing = Losing(seed=1, losses=1)
+    losing = Instant(losing=1, losses=1)
     with pytest.raises(Lost):
         list(Campaign(compiled_wall_task(), range(4), losing, window=2))
-    assert losing.submitted.count(1) == 1
+    assert losing.made(1) == 1
+
+
+def test_a_stopped_campaign_keeps_the_rest_of_a_batch_it_was_yielding() -> None:
+    campaign = Campaign(compiled_wall_task(), range(200), Instant(), window=2)
+    runs = iter(campaign)
+    made = [next(runs) for _ in range(10)]  # in the third task, of 64 runs from seed 2
+    made.extend(campaign.salvage())
+    assert [record.seed for record in made] == list(range(2 + 2 * MOST_RUNS_A_TASK))
