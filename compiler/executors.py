@@ -111,11 +111,12 @@ def _cluster(address: str) -> Iterator[Workers]:
             logging.getLogger(name).setLevel(logging.CRITICAL)
     try:
         _same_rl1(client, address)
+        slots = _threads(client, address)
     except Unavailable:
         client.close()  # type: ignore[no-untyped-call]
         raise
     try:
-        yield Workers(_Watched(client, address), _threads(client), (KilledWorker,))
+        yield Workers(_Watched(client, address), slots, (KilledWorker,))
     finally:
         # The scheduler forgets the client's tasks left, and cancels them.
         client.close()  # type: ignore[no-untyped-call]
@@ -140,8 +141,7 @@ def _same_rl1(client: Client, address: str) -> None:
     try:
         theirs: dict[str, str] = client.run(sources_digest)
     except OSError as error:  # the scheduler gone since it was reached
-        raise Unavailable(f"the connection to the Dask scheduler at {address} was lost "
-                          f"({error})") from None
+        raise _connection_lost(address, error) from None
     except Exception as error:  # such as a worker without rl1, which cannot run it
         raise Unavailable(f"the workers of the Dask scheduler at {address} cannot run "
                           f"rl1 ({type(error).__name__}: {error})\n  = help: install "
@@ -260,7 +260,16 @@ def _checked(digest: str, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwar
     return fn(*args, **kwargs)
 
 
-def _threads(client: Client) -> int:
+def _threads(client: Client, address: str) -> int:
     """The threads of the cluster's workers now (more may join later)."""
-    threads: dict[str, int] = client.nthreads()  # type: ignore[no-untyped-call]
+    try:
+        threads: dict[str, int] = client.nthreads()  # type: ignore[no-untyped-call]
+    except OSError as error:  # the scheduler gone since it was reached (not a file
+        # that could not be written, as the command line takes an OSError to be)
+        raise _connection_lost(address, error) from None
     return sum(threads.values())
+
+
+def _connection_lost(address: str, error: OSError) -> Unavailable:
+    return Unavailable(f"the connection to the Dask scheduler at {address} was lost "
+                       f"({error})")

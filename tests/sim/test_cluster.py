@@ -27,6 +27,7 @@ from support.campaigns import WALL_PROGRAM, WALL_WORLD
 from support.cli import rl1c
 
 from rl1.compiler.cli.sim_campaign import Setting
+from rl1.compiler.executors import Unavailable, _threads
 
 BIN = Path(sys.executable).parent
 STARTED_WITHIN = 120  # s for the scheduler and the workers to start on a loaded machine
@@ -344,6 +345,18 @@ def test_the_command_of_the_runs_left_keeps_the_scheduler() -> None:
     setting = Setting("a.rob", "w.toml", 0, 100, 2, "vm", 10000, "tcp://cluster:8786")
     assert setting.rest(40, 60) == ("rl1c sim a.rob --world w.toml --runs 60 --seed 40 "
                                     "--scheduler tcp://cluster:8786 --budget 10000")
+
+
+def test_a_scheduler_lost_while_its_workers_are_counted_is_said_so() -> None:
+    # Lost just after it was reached: the ConnectionResetError went through as an
+    # OSError, which the command line reported as "cannot write the output".
+    class Reset:  # a client whose scheduler is gone
+        def nthreads(self) -> dict[str, int]:
+            raise ConnectionResetError(104, "Connection reset by peer")
+
+    with pytest.raises(Unavailable, match=r"^the connection to the Dask scheduler at "
+                       r"tcp://127\.0\.0\.1:8786 was lost \(\[Errno 104\] Connection reset"):
+        _threads(Reset(), "tcp://127.0.0.1:8786")  # type: ignore[arg-type]
 
 
 # rl1c fuzz --scheduler -------------------------------------------------------------------
