@@ -98,7 +98,8 @@ def _select(block: ir.Block, following: ir.BlockId | None) -> list[_MachineOp]:
     ops = [_instruction(instruction) for instruction in block.instructions]
     terminator = block.terminator
     if isinstance(terminator, ir.End):
-        ops.append(_MachineOp(isa.BY_NAME["END"], (), (), terminator.line))
+        if terminator.written:
+            ops.append(_MachineOp(isa.BY_NAME["END"], (), (), terminator.line))
         return ops
     if isinstance(terminator, ir.Jump):
         otherwise = terminator.target

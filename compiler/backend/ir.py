@@ -260,14 +260,18 @@ class DecrementBranch:
 
 @dataclass(frozen=True, slots=True)
 class End:
+    """The end of the run: an END, or with `written` False (the last block's, from -O1
+    on: final_end.py) none, as running past the last instruction ends the run alike."""
+
     line: int
+    written: bool = True
 
     @property
     def targets(self) -> tuple[BlockId, ...]:
         return ()
 
     def __str__(self) -> str:
-        return "end"
+        return "end" if self.written else "end (past the last instruction)"
 
 
 Terminator = Jump | Branch | StoreBranch | DecrementBranch | End
@@ -337,12 +341,25 @@ def validate(program: Program) -> list[str]:
             for target in block.successors if target not in program.blocks
         )
     problems.extend(_decreasing_lines(program))
+    problems.extend(_ends_not_written(program))
     for label, block_id in program.handlers.items():
         if label not in HANDLER_LABELS:
             problems.append(f"handler :{label} is not one of :96-:99")
         if block_id not in program.blocks:
             problems.append(f"handler :{label} names {block_id}, which is not a block")
     return problems
+
+
+def _ends_not_written(program: Program) -> Iterator[str]:
+    """An end left unwritten only where the run passes the last instruction: in the last
+    block, after an instruction of its own (an empty block's start would be the offset
+    past the code, which no jump or handler may name: spec/ilc.md, section 10)."""
+    last = next(reversed(program.blocks.values()), None)
+    for block in program:
+        if isinstance(block.terminator, End) and not block.terminator.written \
+                and (block is not last or not block.instructions):
+            yield f"{block.id}: its end is left unwritten, but the run would not pass the " \
+                  "last instruction there"
 
 
 def _decreasing_lines(program: Program) -> Iterator[str]:
@@ -371,7 +388,7 @@ def _block_problems(block: Block) -> Iterator[str]:
         if not isinstance(instruction, Load | Operate | Store | StepVar | Call | Move | Compute):
             yield f"holds {instruction!r}, which is not an instruction"
             continue
-        for operand in _operands(instruction):
+        for operand in operands(instruction):
             if isinstance(operand, Var) and operand.name not in VARIABLES:
                 yield f"line {instruction.line}: `{operand.name}` is not a variable"
             elif isinstance(operand, Imm) and not -0x8000 <= operand.value <= 0x7FFF:
@@ -392,7 +409,9 @@ def _block_problems(block: Block) -> Iterator[str]:
         yield f"branches on `{terminator.var.name}`, which is not a variable"
 
 
-def _operands(instruction: Instruction) -> tuple[Operand, ...]:
+def operands(instruction: Instruction) -> tuple[Operand, ...]:
+    """What an instruction names: the variables it reads or writes, constants and R (a
+    call's reserved variables left out)."""
     if isinstance(instruction, Load | Operate):
         return (instruction.source,)
     if isinstance(instruction, Store | StepVar):

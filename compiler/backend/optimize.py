@@ -15,9 +15,11 @@ from .constants import fold_constants
 from .control import simplify_control
 from .copies import cancel_equal_operands, propagate_copies
 from .dead_stores import remove_dead_stores
+from .final_end import leave_out_final_end
 from .peephole import rewrite_steps
 from .signs import decide_branches
 from .superinstructions import fuse
+from .tails import merge_tails
 
 Pass = Callable[[ir.Program], ir.Program]
 
@@ -31,9 +33,13 @@ O1_PASSES: tuple[Pass, ...] = (simplify_control, fold_constants, cancel_equal_op
                                propagate_copies, rewrite_steps, remove_dead_stores,
                                decide_branches, simplify_control)
 LEVELS: dict[int, tuple[Pass, ...]] = {0: (), 1: O1_PASSES, 2: O1_PASSES}
-# What runs once after a level's passes stop changing the program: -O2's fusion, which
-# the other passes need not know.
-FINAL_PASSES: dict[int, tuple[Pass, ...]] = {0: (), 1: (), 2: (fuse,)}
+# What runs once after a level's passes stop changing the program, on the instructions
+# they leave: -O2's fusion, which the other passes need not know; then the tails merged
+# (a tail split off would hide from the passes what its block does), and last the final
+# END left out, on the layout the code generator keeps. -O1, the default, which the
+# debugger steps by line, keeps every statement's instructions on its own line, and END.
+FINAL_PASSES: dict[int, tuple[Pass, ...]] = {
+    0: (), 1: (), 2: (fuse, merge_tails, leave_out_final_end)}
 MAX_ROUNDS = 8  # a round seldom finds anything after the third
 
 # What lets the rounds skip a pass that could change nothing (compile time: the data

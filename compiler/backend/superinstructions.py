@@ -6,9 +6,14 @@ other passes know nothing of what it makes).
 Keeps: every variable's value after every statement; every call; the jumps taken (a
 fused jump is a jump, where the budget is checked and an event taken); no path longer.
 
-- `store V` then a branch on V (`A=(IMG)-180; ?A<#10`) becomes one store-and-branch.
+- `store V` then a branch on V (`A=(IMG)-180; ?A<#10`) becomes one store-and-branch,
+  also when stores of other variables, or moves and steps that neither read nor write V,
+  come between (`E=I-P; P=I; ?E>#20`: the store of E goes after the move, which leaves
+  the accumulator as it is).
 - `dec V` then a branch on V > 0 (`@--; ?@>#14`, a counted loop) becomes one
-  decrement-and-branch.
+  decrement-and-branch, also past instructions that neither read nor write V (`@--;
+  A=B; ?@>#10`). No call comes between in either case: a call sees the variables, and
+  can fault.
 - `load x` then stores of it, when nothing reads the accumulator after them, become
   moves (`A=B`, `A=5`, `A=(IMG)`): one instruction per store instead of one more (the
   code generator writes a constant move as MOVB, a byte shorter, when it fits a byte).
@@ -34,8 +39,10 @@ from . import flow, ir
 def fuse(program: ir.Program) -> ir.Program:
     for block in program:
         _fuse_branch(block)
+        block.instructions = _moves(block.instructions, block.terminator)
+        _fuse_branch(block)  # again, past the moves just made (`E=I-P; P=I; ?E>#20`)
         block.instructions = [_compact(instruction) for instruction in
-                              _computes(_moves(block.instructions, block.terminator))]
+                              _computes(block.instructions)]
     return program
 
 
@@ -100,19 +107,32 @@ def _computes(instructions: list[ir.Instruction]) -> list[ir.Instruction]:
 
 
 def _fuse_branch(block: ir.Block) -> None:
+    """The branch fused with the last instruction of the block that mentions its
+    variable, when that is a store of it (or a decrement, for a branch on > 0) and no
+    call comes after it (a call sees every variable, and can fault): what follows it
+    neither reads nor writes the variable, so it can go before the write; past a store,
+    it must also leave the accumulator as it is."""
     branch = block.terminator
-    if not isinstance(branch, ir.Branch) or not block.instructions:
+    if not isinstance(branch, ir.Branch):
         return
-    last = block.instructions[-1]
-    if isinstance(last, ir.Store) and last.target == branch.var:
-        block.instructions = block.instructions[:-1]
+    instructions = block.instructions
+    index = next((index for index in reversed(range(len(instructions)))
+                  if isinstance(instructions[index], ir.Call)
+                  or branch.var in ir.operands(instructions[index])), None)
+    if index is None:
+        return
+    write, after = instructions[index], instructions[index + 1:]
+    if isinstance(write, ir.Store) and write.target == branch.var and all(
+            isinstance(instruction, ir.Store | ir.Move | ir.StepVar) for instruction in after):
         block.terminator = ir.StoreBranch(branch.var, branch.relation, branch.if_true,
                                           branch.if_false, branch.line)
-    elif (isinstance(last, ir.StepVar) and last.target == branch.var and last.step == "--"
-            and branch.relation == ">"):
-        block.instructions = block.instructions[:-1]
+    elif isinstance(write, ir.StepVar) and write.target == branch.var \
+            and write.step == "--" and branch.relation == ">":
         block.terminator = ir.DecrementBranch(branch.var, branch.if_true, branch.if_false,
                                               branch.line)
+    else:
+        return
+    block.instructions = [*instructions[:index], *after]
 
 
 def _moves(instructions: list[ir.Instruction], terminator: ir.Terminator

@@ -315,9 +315,10 @@ def test_a_call_whose_constants_fit_a_byte_is_compact_at_o2_only() -> None:
              for level in (1, 2)}
     calls = {level: [name for name in names(file.image) if name not in ("LDR", "STV", "MOVR")]
              for level, file in files.items()}
+    # (-O2 leaves the final END out: running past the code ends the run)
     assert calls[1] == ["MOV", "ROT", "ROT", "ULTA", "OUT", "FRE", "END"]
-    assert calls[2] == ["MOVS", "ROTS", "ROT", "ULTA", "OUTS", "FRE", "END"]
+    assert calls[2] == ["MOVS", "ROTS", "ROT", "ULTA", "OUTS", "FRE"]
     code = files[2].image.code
     assert code[:4] == bytes([0xC4, 0, 4, 0xFC])  # a byte an argument, -4 signed
-    assert code[-6:-2] == bytes([0xDB, 0b10, 3, var("A")])  # OUTS 3, A
+    assert code[-5:-1] == bytes([0xDB, 0b10, 3, var("A")])  # OUTS 3, A
     assert (files[1].header.minor, files[2].header.minor) == (0, isa.COMPACT_MINOR)

@@ -9,6 +9,7 @@ from dataclasses import dataclass, replace
 
 import pytest
 from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend import ir, optimize
@@ -17,17 +18,21 @@ from rl1.compiler.backend.constants import fold_constants
 from rl1.compiler.backend.control import simplify_control
 from rl1.compiler.backend.copies import cancel_equal_operands, propagate_copies
 from rl1.compiler.backend.dead_stores import remove_dead_stores
+from rl1.compiler.backend.final_end import leave_out_final_end
 from rl1.compiler.backend.lower import lower
 from rl1.compiler.backend.peephole import rewrite_steps
 from rl1.compiler.backend.signs import decide_branches
 from rl1.compiler.backend.superinstructions import fuse
+from rl1.compiler.backend.tails import merge_tails
 from rl1.compiler.differential import (
+    AstEngine,
     Observation,
     VmEngine,
     budget_violations,
     differences,
+    judge,
 )
-from rl1.compiler.strategies import Run, runs
+from rl1.compiler.strategies import Run, runs, sensor_scripts
 from rl1.vm import ilc
 from rl1.vm.hardware import Blocking
 from rl1.vm.machine import Machine
@@ -51,7 +56,9 @@ def fuse_after_copies(program: ir.Program) -> ir.Program:
 
 PASSES = (fold_constants, decide_branches, decide_branches_after_control, propagate_copies,
           cancel_equal_operands, remove_dead_stores, rewrite_steps, simplify_control, fuse,
-          fuse_after_copies)
+          fuse_after_copies, merge_tails, leave_out_final_end)
+# The passes whose work needs shapes that runs() seldom makes (shaped_runs below).
+SHAPED_PASSES = (fuse, fuse_after_copies, merge_tails, leave_out_final_end)
 # Not simplify_control: removing blocks can make jumps to thread that it saw as none.
 IDEMPOTENT = (*sorted(optimize.IDEMPOTENT, key=lambda run_pass: run_pass.__name__), fuse)
 NO_WORK = [(giver, receiver) for giver, receivers in optimize.GIVES_NO_WORK_TO.items()
@@ -95,6 +102,83 @@ def test_each_pass_alone_keeps_what_is_observable(run_pass: optimize.Pass, case:
     optimized = OnePassEngine(run_pass).run(case, BUDGET)
     assert differences(unoptimized, optimized) == []
     assert budget_violations(unoptimized, optimized, BUDGET) == []
+
+
+# Programs of the shapes the later passes look for, from short statements on a few
+# variables (so that tails are often alike): an if-else whose ways end alike and join; a
+# loop whose body ends as the code before it does; a branch on a variable written before
+# moves, steps and calls; each on readings of the script, so that either way runs.
+_NAMES = "BCDEF"
+
+
+@st.composite
+def _statement(draw: st.DrawFn) -> str:
+    target, source = draw(st.sampled_from(_NAMES)), draw(st.sampled_from(_NAMES))
+    return draw(st.sampled_from([
+        f"{target}={source}", f"{target}={draw(st.integers(-3, 200))}",
+        f"{target}={source}{draw(st.sampled_from('+-&<'))}{draw(st.integers(0, 3))}",
+        f"{target}=A-{source}", f"{target}++", f"{target}--", "(TIM 1)",
+        f"(OUT 1,{source})"]))
+
+
+def _statements(draw: st.DrawFn, most: int = 3) -> str:
+    return "; ".join(draw(st.lists(_statement(), max_size=most))) or "G++"
+
+
+@st.composite
+def _shaped_program(draw: st.DrawFn) -> str:
+    tail, first, second = _statements(draw), _statements(draw), _statements(draw)
+    relation = draw(st.sampled_from("=<>"))
+    variable = draw(st.sampled_from("A" + _NAMES))
+    shape = draw(st.sampled_from(("if-else", "loop", "branch")))
+    if shape == "if-else":
+        lines = [f"?{variable}{relation}#20", f"{first}; {tail}; #30", f":20 {second}; {tail}",
+                 f":30 {_statements(draw)}"]
+    elif shape == "loop":
+        lines = [f"@=3; {tail}", f":10 {first}; @--; ?@=#20", f"{second}; {tail}; #10",
+                 ":20 G++"]
+    else:
+        lines = [f":10 {variable}=A-{draw(st.integers(0, 3))}; {first}; ?{variable}"
+                 f"{relation}#20", f"@--; {second}; ?@>#10", ":20 G++"]
+    ending = draw(st.sampled_from(["(END)", "(MOV 0,0)", "(MOV 0,0); (END)"]))
+    return "\n".join(["(TRC 0); @=2; A=(ULT A)", *lines, ending]) + "\n"
+
+
+@st.composite
+def shaped_runs(draw: st.DrawFn) -> Run:
+    return Run(draw(_shaped_program()), draw(sensor_scripts()))
+
+
+@pytest.mark.parametrize("run_pass", SHAPED_PASSES, ids=lambda run_pass: run_pass.__name__)
+@settings(max_examples=80, deadline=None, suppress_health_check=list(HealthCheck))
+@given(case=shaped_runs())
+def test_each_later_pass_alone_keeps_what_is_observable_where_it_has_work(
+        run_pass: optimize.Pass, case: Run) -> None:
+    unoptimized = VmEngine(0).run(case, BUDGET)
+    optimized = OnePassEngine(run_pass).run(case, BUDGET)
+    assert differences(unoptimized, optimized) == []
+    assert budget_violations(unoptimized, optimized, BUDGET) == []
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck))
+@given(case=shaped_runs())
+def test_every_level_runs_the_shaped_programs_as_the_interpreter_does(case: Run) -> None:
+    engines = (AstEngine(), VmEngine(0), VmEngine(1), VmEngine(2))
+    assert judge(case, engines, BUDGET).problems == []
+
+
+def test_the_shaped_programs_give_the_later_passes_work() -> None:
+    """So that the property above tests them: each pass changes a good share."""
+    @settings(max_examples=100, deadline=None, suppress_health_check=list(HealthCheck))
+    @given(case=shaped_runs())
+    def tally(case: Run) -> None:
+        for run_pass in SHAPED_PASSES:
+            before = ir.format_program(lowered(case.source))
+            changed[run_pass] += ir.format_program(run_pass(lowered(case.source))) != before
+
+    changed = dict.fromkeys(SHAPED_PASSES, 0)
+    tally()
+    assert all(count >= 10 for count in changed.values()), changed
 
 
 @pytest.mark.parametrize("run_pass", IDEMPOTENT, ids=lambda run_pass: run_pass.__name__)

@@ -8,10 +8,12 @@ from hypothesis import strategies as st
 from support.semantics import operate
 
 from rl1.compiler.backend import ir, optimize
+from rl1.compiler.backend.codegen import generate
 from rl1.compiler.backend.constants import fold_constants
 from rl1.compiler.backend.control import simplify_control
 from rl1.compiler.backend.copies import propagate_copies
 from rl1.compiler.backend.dead_stores import remove_dead_stores
+from rl1.compiler.backend.final_end import leave_out_final_end
 from rl1.compiler.backend.ir import (
     Block,
     Branch,
@@ -29,9 +31,15 @@ from rl1.compiler.backend.ir import (
 from rl1.compiler.backend.lower import lower
 from rl1.compiler.backend.peephole import rewrite_steps
 from rl1.compiler.backend.superinstructions import fuse
+from rl1.compiler.backend.tails import merge_tails
 from rl1.compiler.differential import AstEngine, VmEngine, judge
 from rl1.compiler.frontend.parser import parse_program
 from rl1.compiler.strategies import Run
+from rl1.vm import ilc
+from rl1.vm.hardware import Blocking
+from rl1.vm.machine import Machine
+from rl1.vm.scripted import ScriptedDevice, parse_script
+from rl1.vm.verifier import verify
 
 A, B, C, X = Var("A"), Var("B"), Var("C"), Var("x")
 ENGINES = (AstEngine(), VmEngine(0), VmEngine(1), VmEngine(2))
@@ -250,6 +258,100 @@ def test_a_load_and_its_stores_become_moves_when_the_accumulator_is_dead() -> No
     assert fused.blocks["B0"].instructions == [Load(Imm(5), 1), Store(A, 1)]
 
 
+def test_a_store_fuses_with_its_branch_past_what_leaves_it_and_the_accumulator() -> None:
+    # `P=I` becomes a move, which leaves the accumulator holding I-P for E.
+    assert code(after(fuse, "I=(INP 3); E=I-P; P=I; ?E>#20\n:20 (END)")) == [
+        "compact call INP 3", "move I, R", "load I sub P", "move P, I",
+        "store E; if E>0 then L20 else B1"]
+    # Stores of other variables and steps: they leave the accumulator too.
+    assert code(fuse(after(propagate_copies, "E=A-1; F=E; @++; ?E>#20\n:20 (END)"))) == [
+        "load A sub 1", "store F", "inc @", "store E; if E>0 then L20 else B1"]
+
+
+@pytest.mark.parametrize("text", [
+    "E=A-1; (TIM 1); ?E>#20\n:20 (END)",  # the call sees E, and can fault
+    "E=A-1; B=E; ?E>#20\n:20 (END)",  # the move reads E
+    "E=A-1; B=C+1; ?E>#20\n:20 (END)",  # the accumulator no longer holds E
+])
+def test_a_store_stays_apart_from_its_branch_past_a_call_a_read_or_a_new_value(text: str
+                                                                               ) -> None:
+    assert isinstance(after(fuse, text).blocks["B0"].terminator, Branch)
+
+
+def test_a_decrement_fuses_with_its_branch_past_what_neither_reads_nor_writes_it() -> None:
+    program = after(fuse, "@=3\n:10 @--; A=B+1; C=D; ?@>#10\n(END)")
+    assert code(program, "L10") == ["load B add 1", "store A", "move C, D",
+                                     "dec @; if @>0 then L10 else B1"]
+    for text in ("@=3\n:10 @--; A=@; ?@>#10\n(END)", "@=3\n:10 @--; (TIM 1); ?@>#10\n(END)"):
+        assert isinstance(after(fuse, text).blocks["L10"].terminator, Branch)
+
+
+# Tails merged, the final END left out (-O2) -----------------------------------------------------
+
+IF_ELSE = "A=(KYO); ?A>#20\nB=5; C=7; D=C; #30\n:20 B=6; C=7; D=C\n:30 (MOV B,C); (END)"
+
+
+def test_a_jumping_block_shares_the_tail_of_the_block_that_falls_through() -> None:
+    program = after(merge_tails, IF_ELSE)
+    assert list(program.blocks) == ["B0", "B1", "L20", "B2", "L30"]
+    assert code(program, "B1") == ["load 5", "store B", "jump B2"]
+    assert code(program, "L20") == ["load 6", "store B", "jump B2"]  # laid out before B2
+    assert code(program, "B2") == ["load 7", "store C", "load C", "store D", "jump L30"]
+    assert [item.line for item in program.blocks["B2"].instructions] == [3] * 4  # L20's
+
+
+@pytest.mark.parametrize("centre", [1, -1])
+def test_a_shared_tail_runs_as_many_instructions_on_either_way(centre: int) -> None:
+    script = {"KYO": [{"centre": centre, "right": 0, "left": 0}]}
+    runs = [run_program(program, script) for program in (lowered(IF_ELSE),
+                                                        after(merge_tails, IF_ELSE))]
+    assert runs[0] == runs[1]  # the same variables, at the same count
+
+
+def run_program(program: Program, script: dict[str, object]) -> tuple[list[int], int]:
+    """The final variables of the program's code, and the instructions it ran."""
+    device = ScriptedDevice(parse_script(script))
+    machine = Machine(verify(ilc.encode(generate(program, "t.rob"))), Blocking(device))
+    return list(machine.run().variables), machine.executed
+
+
+@pytest.mark.parametrize("text", [
+    # a call: it names its own line when it faults
+    "A=(KYO); ?A>#20\n(TIM 1); #30\n:20 (TIM 1)\n:30 (END)",
+    # the tail would read the accumulator set before it
+    "A=(KYO); ?A>#20\nB=A+5; #30\n:20 B=A+6\n:30 (END)",
+    # the falling block jumps too: the jumping block's path would take one jump more
+    "A=(KYO)\n:10 ?A>#20\nB=5; #10\n:20 B=5; #10",
+    # events: one taken at the jump, now before the tail, would see B before it
+    "(TRC 3)\nA=(KYO); ?A>#20\nB=5; #30\n:20 B=5\n:30 (END)\n:96 (END)\n:97 (END)\n"
+    ":98 (END)\n:99 (END)",
+])
+def test_tails_stay_apart_where_merging_would_change_a_line_a_value_or_a_path(text: str
+                                                                              ) -> None:
+    before = ir.format_program(lowered(text))
+    assert ir.format_program(after(merge_tails, text)) == before
+
+
+def test_the_final_end_is_left_out_after_an_instruction_of_the_last_block() -> None:
+    program = after(leave_out_final_end, "A=(KYO); (MOV A,A); (END)")
+    assert code(program)[-1] == "end (past the last instruction)"
+    code_names = [instruction.info.name for instruction in
+                  verify(ilc.encode(generate(program, "t.rob"))).instructions]
+    assert code_names[-1] == "MOV"  # no END: running past the code ends the run
+    # An empty last block stays: a jump to it would name the offset past the code.
+    kept = after(leave_out_final_end, "A=(KYO); ?A>#10\n(MOV A,A)\n:10 (END)")
+    assert code(kept, "L10") == ["end"]
+
+
+def test_validation_refuses_an_unwritten_end_the_run_would_not_pass_the_code_at() -> None:
+    program = jumps(("B0", [StepVar(A, "++", 1)], End(1, written=False)),
+                    ("B1", [StepVar(A, "++", 2)], End(2)))
+    assert ir.validate(program) == [
+        "B0: its end is left unwritten, but the run would not pass the last instruction there"]
+    empty = jumps(("B0", [], End(1, written=False)))
+    assert len(ir.validate(empty)) == 1
+
+
 # The pipeline ---------------------------------------------------------------------------------
 
 
@@ -367,7 +469,8 @@ def test_the_load_and_operate_instructions_run_as_their_two_instructions_do() ->
     verdict = judge(Run(source, script), ENGINES, 20_000)
     assert verdict.problems == []
     assert verdict.observations["vm-O2"].document["variables"]["E"] == 125
-    # One instruction saved per expression (its load), and per A=(ULT A) (a move).
+    # One instruction saved per expression (its load), and per A=(ULT A) (a move); and
+    # the final END, left out.
     unoptimized = verdict.observations["vm-O0"].executed
     assert unoptimized is not None
-    assert verdict.observations["vm-O2"].executed == unoptimized - 5 - 2
+    assert verdict.observations["vm-O2"].executed == unoptimized - 5 - 2 - 1
