@@ -8,9 +8,11 @@ executes on the program's sensor script, the code section's bytes, and the compi
 time (source to .ilc bytes, the best of several). Goals (issue 25): -O2 at least 40%
 fewer instructions and 30% fewer bytes, -O1 at least 15% fewer instructions, compile
 time at most 2x. Every pair of runs is also compared as spec/optimization.md says; a
-disagreement stops the benchmark.
+disagreement stops the benchmark. With --profile, where the level's code bytes and
+executed instructions go in each set, by opcode: what a pass to come would have to take.
 
     .venv/bin/python bench/optimizer.py [--level 2] [--set corpus|unseen] [--repeat 5]
+                                        [--profile]
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+from collections import Counter
 from pathlib import Path
 
 from timing import best_time
@@ -26,6 +29,7 @@ from rl1.compiler.backend.driver import compile_text
 from rl1.compiler.differential import AstEngine, VmEngine, judge
 from rl1.compiler.strategies import Run
 from rl1.vm import ilc
+from rl1.vm.verifier import verify
 
 ROOT = Path(__file__).parent.parent
 SETS = {
@@ -48,13 +52,17 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5, help="compiles of each; the best counts")
     parser.add_argument("--set", choices=sorted(SETS), action="append",
                         help="the set measured (repeatable; both when left out)")
+    parser.add_argument("--profile", action="store_true",
+                        help="also the level's code bytes and executed instructions by opcode")
     options = parser.parse_args()
     for name in options.set or sorted(SETS):
-        measure(name, SETS[name], options.level, options.repeat)
+        measure(name, SETS[name], options.level, options.repeat, options.profile)
 
 
-def measure(name: str, programs: list[Path], level: int, repeat: int) -> None:
+def measure(name: str, programs: list[Path], level: int, repeat: int, profile: bool) -> None:
     ratios: dict[str, list[float]] = {"instructions": [], "bytes": [], "compile": []}
+    code_bytes: Counter[str] = Counter()  # by opcode, over the set's code at `level`
+    executed_by_opcode: Counter[str] = Counter()
     print(f"{name}: -O{level} against -O0, per program (ratio = -O{level} / -O0)")
     print(f"{'program':<16}{'instructions':>22}{'':>8}{'code bytes':>16}{'':>8}"
           f"{'compile ms':>18}{'':>8}")
@@ -62,10 +70,13 @@ def measure(name: str, programs: list[Path], level: int, repeat: int) -> None:
         source = path.read_text(encoding="utf-8")
         script = json.loads(path.with_name(path.stem + ".sensors.json").read_text("utf-8"))
         script.pop("comment", None)
-        verdict = judge(Run(source, script), (AstEngine(), VmEngine(0), VmEngine(level)),
-                        BUDGET)
+        verdict = judge(Run(source, script),
+                        (AstEngine(), VmEngine(0), VmEngine(level, counting=profile)), BUDGET)
         if verdict.problems:
             raise SystemExit(f"{path.name}: the levels disagree: {verdict.problems}")
+        executed_by_opcode.update(verdict.observations[f"vm-O{level}"].opcodes or {})
+        for instruction in verify(_compile(source, level)).instructions:
+            code_bytes[instruction.info.name] += instruction.info.length
         executed: list[float] = [verdict.observations[f"vm-O{n}"].executed or 0
                                  for n in (0, level)]
         sizes: list[float] = [len(ilc.decode(_compile(source, n)).code) for n in (0, level)]
@@ -80,11 +91,25 @@ def measure(name: str, programs: list[Path], level: int, repeat: int) -> None:
     means = {key: geometric_mean(values) for key, values in ratios.items()}
     fewer_instructions, fewer_bytes = GOALS.get(level, (0.0, 0.0))
     print(f"geometric mean over {len(programs)} programs of {name}: "
-          f"instructions x{means['instructions']:.2f} "
+          f"instructions x{means['instructions']:.3f} "
           f"({1 - means['instructions']:.0%} fewer, goal >= {fewer_instructions:.0%}), "
-          f"code bytes x{means['bytes']:.2f} "
+          f"code bytes x{means['bytes']:.3f} "
           f"({1 - means['bytes']:.0%} fewer, goal >= {fewer_bytes:.0%}), "
           f"compile time x{means['compile']:.2f} (goal <= 2)\n")
+    if profile:
+        print_profile(name, level, code_bytes, executed_by_opcode)
+
+
+def print_profile(name: str, level: int, code_bytes: Counter[str],
+                  executed: Counter[str]) -> None:
+    total_bytes, total_executed = code_bytes.total(), executed.total()
+    print(f"{name}: where -O{level} goes, by opcode: code bytes of {total_bytes}, "
+          f"instructions executed of {total_executed}")
+    for opcode in sorted(code_bytes.keys() | executed.keys(),
+                         key=lambda opcode: (-code_bytes[opcode], -executed[opcode], opcode)):
+        print(f"  {opcode:<8}{code_bytes[opcode]:>6}{code_bytes[opcode] / total_bytes:>7.1%}"
+              f"{executed[opcode]:>8}{executed[opcode] / total_executed:>7.1%}")
+    print()
 
 
 def _compile_ms(source: str, level: int, repeat: int) -> float:
