@@ -90,34 +90,40 @@ def sim_cases(folder: Path, seconds: float, match: str) -> None:
             (folder / f"run.{kind}").unlink(missing_ok=True)
 
 
-def sources() -> list[tuple[str, bytes]]:
-    """8 MiB sources that are each costly in their own way, as the line each repeats."""
+def sources() -> list[tuple[str, bytes, bytes]]:
+    """8 MiB sources that are each costly in their own way, as their first line and the
+    line each repeats."""
     statements = b";".join([b"A=1"] * 4999)  # 19,999 characters of code
     return [
-        ("lines of 19,999 characters", statements + b"\n"),
-        ("`A=1` lines", b"A=1\n"),
-        ("lines with a syntax error", b"A=1 B=2\n"),
+        ("lines of 19,999 characters", b"", statements + b"\n"),
+        ("`A=1` lines", b"", b"A=1\n"),
+        ("lines with a syntax error", b"", b"A=1 B=2\n"),
         # The program-wide rules' costliest: a block a line, and a block of a million
         # lines whose effects are combined as they come.
-        ("`(END)` lines, a block each", b"(END)\n"),
-        ("`t=1` lines, reserved writes", b"t=1\n"),
+        ("`(END)` lines, a block each", b"", b"(END)\n"),
+        ("`t=1` lines, reserved writes", b"", b"t=1\n"),
         # a diagnostic of a program-wide rule a line (W0401: `s` may be unset)
-        ("`A=s` lines, unset reads", b"A=s\n"),
+        ("`A=s` lines, unset reads", b"", b"A=s\n"),
+        # a block a line that jumps back to the first line, and one that also falls
+        # through (a loop of every line)
+        ("`#01` lines after `:01`, a jump each", b":01\n", b"#01\n"),
+        ("`?A=#01` lines after `:01`", b":01\n", b"?A=#01\n"),
     ]
 
 
-def write_filled(path: Path, line: bytes) -> int:
-    """Write `line` as many times as SOURCE_BYTES holds into `path`, a few at a time,
-    and return the bytes written. A child's peak is at least the peak of this process
-    when it started the child (Linux gives a child's ru_maxrss the larger of its own and
-    that of the process it replaced), so this one never holds a source: holding them
-    all made every figure at least this process's 37 MB (53 MB with five sources)."""
-    count = SOURCE_BYTES // len(line)
+def write_filled(path: Path, head: bytes, line: bytes) -> int:
+    """Write `head`, then `line` as many times as SOURCE_BYTES holds, into `path`, a few
+    at a time, and return the bytes written. A child's peak is at least the peak of this
+    process when it started the child (Linux gives a child's ru_maxrss the larger of its
+    own and that of the process it replaced), so this one never holds a source: holding
+    them all made every figure at least this process's 37 MB (53 MB with five sources)."""
+    count = (SOURCE_BYTES - len(head)) // len(line)
     chunk = max(1, 65536 // len(line))
     with path.open("wb") as file:
+        file.write(head)
         for written in range(0, count, chunk):
             file.write(line * min(chunk, count - written))
-    return count * len(line)
+    return len(head) + count * len(line)
 
 
 def source_cases(folder: Path, seconds: float, match: str, commands: list[str]) -> None:
@@ -127,16 +133,16 @@ def source_cases(folder: Path, seconds: float, match: str, commands: list[str]) 
     reference, _ = peak(["check", str(empty)], seconds)
     print(f"rl1c check and compile on 8 MiB sources: peak resident MB, and bytes per source "
           f"byte above `rl1c check` on an empty file ({reference:.1f} MB); bound: 64")
-    for name, line in sources():
+    for name, head, line in sources():
         if match not in name:
             continue
         path = folder / "big.rob"
-        size = write_filled(path, line)
+        size = write_filled(path, head, line)
         for command in (arguments[one] for one in commands):
             started = time.monotonic()
             megabytes, ending = peak([*command, str(path)], seconds)
             per_byte = (megabytes - reference) * MIB / size
-            print(f"  {command[0]:<8} {name:<38} {megabytes:8.1f} MB {per_byte:6.1f} B/B  "
+            print(f"  {command[0]:<8} {name:<40} {megabytes:8.1f} MB {per_byte:6.1f} B/B  "
                   f"{ending} after {time.monotonic() - started:.0f} s")
 
 

@@ -102,6 +102,9 @@ def _link(blocks: list[Block], changed: Iterable[int], summaries: list[BlockEffe
     """Give the `changed` blocks their effects and ordinary edges."""
     exit_index = len(blocks) - 1
     named = sorted(set(labels.values()))
+    # the successors of a `#NN` depend on its target alone: one tuple for each (48
+    # bytes a block of a program that jumps on every line)
+    gotos: dict[int | None, tuple[int, ...]] = {}
     for index in changed:
         block = blocks[index]
         summary = summaries[index]
@@ -116,7 +119,10 @@ def _link(blocks: list[Block], changed: Iterable[int], summaries: list[BlockEffe
             target = labels.get(number) if number is not None else None
             found = opaque if target is None else [target]
             if isinstance(jump, ast.Goto):
-                block.successors = tuple(found)
+                successors = gotos.get(target)
+                if successors is None:
+                    successors = gotos[target] = tuple(found)
+                block.successors = successors
             else:
                 block.successors = (following, *(other for other in found if other != following))
         elif not ends:

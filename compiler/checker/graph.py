@@ -50,7 +50,8 @@ class ReadAgain(Sequence[ast.Statement]):
     @property
     @abstractmethod
     def jump(self) -> ast.Goto | ast.CondJump | None:
-        """The `#NN` or `?V..#NN` that ends the block, if one does."""
+        """What the `#NN` or `?V..#NN` that ends the block does, if one does: as
+        `Block.jump`, one that may stand for the jumps of other blocks too."""
 
     @property
     @abstractmethod
@@ -81,8 +82,11 @@ class Block:
     successors: tuple[int, ...] = ()
     handlers: tuple[HandlerEdge, ...] = ()
     effects: BlockEffects = field(default_factory=BlockEffects.nothing)
-    # the `#NN` or `?V..#NN` that ends the block, if one does: a field, not a property,
-    # so that the rules gather the jumps of thousands of blocks in C (attrgetter)
+    # what the `#NN` or `?V..#NN` that ends the block does, if one does: its kind, its
+    # target, the variable it tests. The streaming check gives blocks that jump alike
+    # one jump (a tree a block cost 260 bytes), so its place may be another block's:
+    # where the block's own is, is its last statement. A field, not a property, so that
+    # the rules gather the jumps of thousands of blocks in C (attrgetter).
     jump: ast.Goto | ast.CondJump | None = None
 
     @property

@@ -32,14 +32,23 @@ def check_labels(graph: ControlFlowGraph) -> list[Diagnostic]:
     jumps = list(filter(None, map(operator.attrgetter("jump"), graph.blocks)))
     targets = {jump.target.number for jump in jumps}
     blind = any(not graph.blocks[index].labels for index in graph.opaque)
-    if not blind:
-        found.extend(_undefined(jump.target, first) for jump in jumps
-                     if jump.target.number is not None
-                     and jump.target.number not in first)
+    missing = {number for number in targets if number is not None and number not in first}
+    if missing and not blind:
+        # a block's jump may stand for others' (graph.Block.jump): its place is that of
+        # the block's last statement
+        found.extend(_undefined(_written(block.statements[-1]), first)
+                     for block in graph.blocks
+                     if block.jump is not None and block.jump.target.number in missing)
     if not graph.opaque:
         found.extend(_unused(graph, number, label) for number, label in first.items()
                      if number not in targets and number not in HANDLER_LABELS)
     return found
+
+
+def _written(jump: ast.Statement) -> ast.LabelRef:
+    """The target of the jump a block ends with, as written."""
+    assert isinstance(jump, ast.Goto | ast.CondJump)
+    return jump.target
 
 
 def _defined_twice(label: ast.LabelDef, earlier: ast.LabelDef) -> Diagnostic:

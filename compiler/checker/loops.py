@@ -23,22 +23,31 @@ HELP = ("read a sensor inside the loop (e.g. `A=(IMG)-180`, `(KYO)`, `A=(ULT A)`
 
 def check_loops(graph: ControlFlowGraph) -> list[Diagnostic]:
     blocks = graph.blocks
-    blind = [graph.reachable(block.index) and not block.opaque and not block.handlers
-             and not block.effects.observes for block in blocks]
+    blind = bytearray(graph.reachable(block.index) and not block.opaque and not block.handlers
+                      and not block.effects.observes for block in blocks)
     found: list[Diagnostic] = []
+    # the blocks of the component looked at: a byte a block, where a set of a loop of
+    # every block took 70 bytes a block
+    members = bytearray(len(blocks))
     for component in cycles([block.successors for block in blocks], blind):
-        members = set(component)
+        for index in component:
+            members[index] = True
         diagnostic = _busy(graph, [blocks[index] for index in sorted(component)], members)
         if diagnostic is not None:
             found.append(diagnostic)
+        for index in component:
+            members[index] = False
     return found
 
 
-def _busy(graph: ControlFlowGraph, loop: list[Block], members: set[int]) -> Diagnostic | None:
+def _busy(graph: ControlFlowGraph, loop: list[Block], members: bytearray) -> Diagnostic | None:
+    """W0604 for the cycle of `loop`'s blocks (in order), whose indices `members` marks,
+    if it is busy."""
     tested: set[str] = set()
     for block in loop:
         jump = block.jump
-        if isinstance(jump, ast.CondJump) and not set(block.successors) <= members:
+        if isinstance(jump, ast.CondJump) and not all(members[index]
+                                                      for index in block.successors):
             tested.add(jump.var.name)
     written = {statement.target.name for block in loop for statement in block.statements
                if isinstance(statement, ast.Assign | ast.IncDec)}
@@ -56,15 +65,18 @@ def _busy(graph: ControlFlowGraph, loop: list[Block], members: set[int]) -> Diag
 
 
 def _backward_jump(graph: ControlFlowGraph, loop: list[Block],
-                   members: set[int]) -> tuple[ast.Goto | ast.CondJump, ast.LabelDef]:
+                   members: bytearray) -> tuple[ast.Goto | ast.CondJump, ast.LabelDef]:
     """The last jump back to a label inside the loop, and that label. Every cycle has
     one: fall-through only goes forward, and handler edges never leave a blind block."""
     for block in reversed(loop):
         jump = block.jump
         number = jump.target.number if jump is not None else None
         target = graph.labels.get(number) if number is not None else None
-        if jump is not None and target is not None and target in members \
+        if jump is not None and target is not None and members[target] \
                 and target <= block.index:
             head = next(label for label in graph.blocks[target].labels if label.number == number)
-            return jump, head
+            # block.jump may stand for others' jumps (graph.Block.jump): the block's own
+            written = block.statements[-1]
+            assert isinstance(written, ast.Goto | ast.CondJump)
+            return written, head
     raise AssertionError("a cycle without a backward jump")

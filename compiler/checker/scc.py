@@ -1,20 +1,24 @@
 """Strongly connected components (Tarjan's algorithm, with an explicit stack so that a
-100,000-line program cannot exhaust Python's recursion limit)."""
+100,000-line program cannot exhaust Python's recursion limit). Its numbers are held in
+arrays: a program of a block a line has as many nodes as lines, and a list of ints
+took 64 bytes a node for their objects alone (bench/memory.py's jumps)."""
 
 from __future__ import annotations
 
+from array import array
 from collections.abc import Sequence
 
 
-def cycles(successors: Sequence[Sequence[int]], included: Sequence[bool]) -> list[list[int]]:
+def cycles(successors: Sequence[Sequence[int]], included: Sequence[bool]
+           ) -> list[array[int]]:
     """The components of the subgraph of `included` nodes that hold a cycle: more than
     one node, or one node with an edge to itself."""
     count = len(successors)
-    order = [-1] * count  # discovery number, -1 while undiscovered
-    low = [0] * count
-    on_stack = [False] * count
-    stack: list[int] = []
-    found: list[list[int]] = []
+    order = array("i", [-1]) * count  # discovery number, -1 while undiscovered
+    low = array("i", [0]) * count
+    on_stack = bytearray(count)
+    stack = array("q")
+    found: list[array[int]] = []
     counter = 0
     for root in range(count):
         if not included[root] or order[root] >= 0:
@@ -23,12 +27,14 @@ def cycles(successors: Sequence[Sequence[int]], included: Sequence[bool]) -> lis
         counter += 1
         stack.append(root)
         on_stack[root] = True
-        work = [(root, 0)]  # (node, index of its next successor to look at)
+        # the path being walked: its nodes, and the index of each one's next successor
+        # to look at
+        work, positions = array("q", [root]), array("q", [0])
         while work:
-            node, position = work[-1]
+            node, position = work[-1], positions[-1]
             following = successors[node]
             if position < len(following):
-                work[-1] = (node, position + 1)
+                positions[-1] = position + 1
                 successor = following[position]
                 if not included[successor]:
                     continue
@@ -37,16 +43,18 @@ def cycles(successors: Sequence[Sequence[int]], included: Sequence[bool]) -> lis
                     counter += 1
                     stack.append(successor)
                     on_stack[successor] = True
-                    work.append((successor, 0))
+                    work.append(successor)
+                    positions.append(0)
                 elif on_stack[successor]:
                     low[node] = min(low[node], order[successor])
                 continue
             work.pop()
+            positions.pop()
             if work:
-                parent = work[-1][0]
+                parent = work[-1]
                 low[parent] = min(low[parent], low[node])
             if low[node] == order[node]:
-                component = []
+                component = array("q")
                 while True:
                     member = stack.pop()
                     on_stack[member] = False

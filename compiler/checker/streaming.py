@@ -16,8 +16,10 @@ built again when read (compact.py).
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
-from typing import overload
+import itertools
+from array import array
+from collections.abc import Callable, Hashable, Iterator, Sequence
+from typing import Generic, TypeVar, overload
 
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.collector import collector_paused
@@ -32,38 +34,63 @@ from .graph import Block, ReadAgain
 from .rules import check_graph
 from .suppression import MARK, Suppressions
 
+Value = TypeVar("Value")
+
+
+class BlockPlaces:
+    """Where the statements of each block cut are in the source, as numbers in arrays
+    indexed by the block's number: from statement `start` of line `first` to the block's
+    last, statement `last_start` of line `last_line` (0-based indices), `length` in all.
+    20 bytes a block, where an object of them with a line's number took 124."""
+
+    __slots__ = ("first", "last_line", "last_start", "length", "lines", "start")
+
+    def __init__(self, lines: LineIndex) -> None:
+        self.lines = lines
+        self.first = array("I")
+        self.start = array("I")
+        self.length = array("I")
+        self.last_line = array("I")
+        self.last_start = array("I")
+
+    def add(self, block: int, first: int, start: int, length: int, last_line: int,
+            last_start: int) -> None:
+        """Hold the place of block number `block`, past those held (the blocks between,
+        which hold no statements, get zeros)."""
+        columns = (self.first, self.start, self.length, self.last_line, self.last_start)
+        missing = block - len(self.first)
+        for column, value in zip(columns, (first, start, length, last_line, last_start),
+                                 strict=True):
+            if missing:
+                column.extend(itertools.repeat(0, missing))
+            column.append(value)
+
 
 class SourceStatements(ReadAgain):
-    """The statements of one block, found by parsing its lines again when they are read:
-    from statement `start` of line `first` to the block's last, statement `last_start`
-    of line `last_line` (0-based indices). Of that last statement only a jump is kept
-    (the graph's edges and the busy-loop rule read every block's), and whether it is
-    `(END)`: its tree cost 330 bytes a block."""
+    """The statements of block number `index`, found by parsing its lines again, where
+    `places` says they are, when they are read. Of the last statement only what the
+    graph asks of every block is kept (`ending`): what its jump does (shared with other
+    blocks, as `Block.jump`), or True for `(END)`, or False. Its tree cost 330 bytes a
+    block."""
 
-    __slots__ = ("_ends", "_first", "_jump", "_last_line", "_last_start", "_length", "_lines",
-                 "_start")
+    __slots__ = ("_ending", "_index", "_places")
 
-    def __init__(self, lines: LineIndex, first: int, start: int, length: int,
-                 last_line: int, last_start: int, last: ast.Statement) -> None:
-        self._lines = lines
-        self._first = first
-        self._start = start
-        self._length = length
-        self._last_line = last_line
-        self._last_start = last_start
-        self._jump = last if isinstance(last, ast.Goto | ast.CondJump) else None
-        self._ends = ast.is_end(last)
+    def __init__(self, places: BlockPlaces, index: int,
+                 ending: ast.Goto | ast.CondJump | bool) -> None:
+        self._places = places
+        self._index = index
+        self._ending = ending
 
     @property
     def jump(self) -> ast.Goto | ast.CondJump | None:
-        return self._jump
+        return None if isinstance(self._ending, bool) else self._ending
 
     @property
     def ends(self) -> bool:
-        return self._ends
+        return self._ending is True
 
     def __len__(self) -> int:
-        return self._length
+        return self._places.length[self._index]
 
     @overload
     def __getitem__(self, index: int) -> ast.Statement: ...
@@ -73,24 +100,25 @@ class SourceStatements(ReadAgain):
 
     def __getitem__(self, index: int | slice) -> ast.Statement | Sequence[ast.Statement]:
         if isinstance(index, slice):
-            return tuple(self[position] for position in range(self._length)[index])
-        position = range(self._length)[index]  # IndexError as a list gives it
-        if position == self._length - 1:
-            if self._jump is not None:
-                return self._jump
-            line = parse_line(self._lines[self._last_line], self._last_line + 1)[0]
-            return line.statements[self._last_start]
+            return tuple(self[position] for position in range(len(self))[index])
+        position = range(len(self))[index]  # IndexError as a list gives it
+        if position == len(self) - 1:
+            places = self._places
+            number = places.last_line[self._index]
+            line = parse_line(places.lines[number], number + 1)[0]
+            return line.statements[places.last_start[self._index]]
         for found, statement in enumerate(self):
             if found == position:
                 return statement
         raise AssertionError("a block holds fewer statements than it counted")
 
     def __iter__(self) -> Iterator[ast.Statement]:
-        left = self._length
-        number = self._first
-        start = self._start
+        places = self._places
+        left = places.length[self._index]
+        number = places.first[self._index]
+        start = places.start[self._index]
         while left:
-            statements = parse_line(self._lines[number], number + 1)[0].statements
+            statements = parse_line(places.lines[number], number + 1)[0].statements
             taken = statements[start:start + left]
             yield from taken
             left -= len(taken)
@@ -115,26 +143,39 @@ class _OpenBlock:
         self.last_line = self.last_start = 0
 
 
-class _SharedEffects:
-    """One object for the blocks whose effects are equal, which summaries, shared and
-    never changed, allow: 290 bytes a block of `(END)` alone. The first LIMIT different
-    ones are remembered, so that a program of unlike blocks holds no more than before."""
+class _Shared(Generic[Value]):
+    """One object for equal values that are shared and never changed (effects, jumps),
+    known by `key`: 290 bytes a block of `(END)` alone, 260 a block that jumps. The
+    first LIMIT different ones are remembered, so that a program of unlike blocks holds
+    no more than before."""
 
     LIMIT = 4096
-    __slots__ = ("_known",)
+    __slots__ = ("_key", "_known")
 
-    def __init__(self) -> None:
-        self._known: dict[tuple[object, ...], BlockEffects] = {}
+    def __init__(self, key: Callable[[Value], Hashable]) -> None:
+        self._key = key
+        self._known: dict[Hashable, Value] = {}
 
-    def __call__(self, effects: BlockEffects) -> BlockEffects:
-        key = (tuple(effects.operations), effects.first_event, effects.reads,
-               tuple(effects.writes), effects.observes, effects.calls_unknown)
+    def __call__(self, value: Value) -> Value:
+        key = self._key(value)
         known = self._known.get(key)
         if known is not None:
             return known
         if len(self._known) < self.LIMIT:
-            self._known[key] = effects
-        return effects
+            self._known[key] = value
+        return value
+
+
+def _effects_key(effects: BlockEffects) -> Hashable:
+    return (tuple(effects.operations), effects.first_event, effects.reads,
+            tuple(effects.writes), effects.observes, effects.calls_unknown)
+
+
+def _jump_key(jump: ast.Goto | ast.CondJump) -> Hashable:
+    """What the rules read of a block's jump (graph.Block.jump): all but its place."""
+    if isinstance(jump, ast.Goto):
+        return jump.target.text, jump.target.number
+    return jump.target.text, jump.target.number, jump.var.name, jump.relation
 
 
 def check_text(text: str) -> CompactDiagnostics:
@@ -144,10 +185,12 @@ def check_text(text: str) -> CompactDiagnostics:
     others: list[Diagnostic] = []
     directives: list[ast.Line] = []  # the lines whose comments may be directives
     lines = LineIndex(text)
+    places = BlockPlaces(lines)
     blocks: list[Block] = []  # the graph's, without edges until all are cut
     summaries: list[BlockEffects] = []
     nothing = BlockEffects.nothing()
-    shared = _SharedEffects()
+    shared = _Shared(_effects_key)
+    shared_jump: _Shared[ast.Goto | ast.CondJump] = _Shared(_jump_key)
     pending: list[ast.LabelDef] = []  # labels seen since the last statement
     cutting: _OpenBlock | None = None
     last_span = ast.Span(1, 1, 1, 1)
@@ -155,10 +198,15 @@ def check_text(text: str) -> CompactDiagnostics:
     def close() -> None:
         nonlocal cutting
         if cutting is not None:
-            assert cutting.last is not None  # a block opens with its first run
-            cutting.block.statements = SourceStatements(
-                lines, cutting.first, cutting.start, cutting.length, cutting.last_line,
-                cutting.last_start, cutting.last)
+            last = cutting.last
+            assert last is not None  # a block opens with its first run
+            block = cutting.block
+            places.add(block.index, cutting.first, cutting.start, cutting.length,
+                       cutting.last_line, cutting.last_start)
+            block.statements = SourceStatements(
+                places, block.index,
+                shared_jump(last) if isinstance(last, ast.Goto | ast.CondJump)
+                else ast.is_end(last))
             effects = cutting.effects
             summaries.append(nothing if effects.empty else shared(effects.result()))
             cutting = None

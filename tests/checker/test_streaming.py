@@ -10,9 +10,11 @@ import sys
 import textwrap
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from rl1.compiler.analysis import analyze, diagnose
-from rl1.compiler.checker.streaming import SourceStatements
+from rl1.compiler.checker.streaming import BlockPlaces, SourceStatements
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.parser import parse_line
 from rl1.compiler.frontend.source import LineIndex
@@ -51,11 +53,14 @@ def test_a_blocks_statements_are_read_from_its_lines_again() -> None:
     text = "A=1; B=2\n\n' comment\nC=3; #10\n"
     lines = LineIndex(text)
     last = parse_line(lines[3], 4)[0].statements[1]
-    statements = SourceStatements(lines, 0, 1, 3, 3, 1, last)  # from B=2 to #10
+    places = BlockPlaces(lines)
+    places.add(2, 0, 1, 3, 3, 1)  # block 2, from B=2 to #10; blocks 0 and 1 hold none
+    assert list(places.length) == [0, 0, 3]
+    statements = SourceStatements(places, 2, last)
     assert len(statements) == 3
     assert statements.jump is last and not statements.ends
     assert [(s.span.line, s.span.column) for s in statements] == [(1, 6), (4, 1), (4, 6)]
-    assert statements[-1] is last and statements[2] is last
+    assert statements[-1] == last and statements[2] == last
     assert isinstance(statements[0], ast.Assign) and statements[0].target.name == "B"
     assert isinstance(statements[1], ast.Assign) and statements[1].target.name == "C"
     assert [s.span.line for s in statements[:1]] == [1]
@@ -64,32 +69,75 @@ def test_a_blocks_statements_are_read_from_its_lines_again() -> None:
         statements[3]
 
 
-def test_a_blocks_last_statement_is_kept_only_when_it_jumps() -> None:
-    """An `(END)` that ends a block is read from its line again, as the others are."""
-    text = "A=1\nB=2; (END); C=3\n"
+def test_a_blocks_last_statement_is_read_from_its_line_again() -> None:
+    """The jump a block keeps may stand for another block's (graph.Block.jump): its last
+    statement, read again, is its own, where it is; an `(END)` is kept as a flag."""
+    text = "A=1\nB=2; (END); C=3\n#10\n#10\n"
     lines = LineIndex(text)
     end = parse_line(lines[1], 2)[0].statements[1]
-    statements = SourceStatements(lines, 0, 0, 3, 1, 1, end)  # from A=1 to (END)
+    places = BlockPlaces(lines)
+    places.add(0, 0, 0, 3, 1, 1)  # from A=1 to (END)
+    places.add(1, 2, 0, 1, 2, 0)  # #10 on line 3
+    places.add(2, 3, 0, 1, 3, 0)  # #10 on line 4
+    statements = SourceStatements(places, 0, True)
     assert statements.ends and statements.jump is None
     last = statements[-1]
     assert last is not end and last == end
     assert (last.span.line, last.span.column) == (2, 6)
     assert [ast.is_end(s) for s in statements] == [False, False, True]
+    shared = parse_line(lines[2], 3)[0].statements[0]
+    assert isinstance(shared, ast.Goto)
+    second = SourceStatements(places, 2, shared)
+    assert second.jump is shared and not second.ends
+    assert second[-1].span.line == 4
 
 
-# bench/memory.py's sources, at a size tracemalloc measures in seconds.
+def test_blocks_that_jump_alike_share_their_jump_and_each_reads_its_own() -> None:
+    """Undefined targets (E0203) and busy loops (W0604) are reported at the jump of each
+    block, not at the jump the blocks share."""
+    for text in ("#10\n#10\nA=1; #10\n?B=#10\n?B=#10\n",
+                 ":10 A=1\n#10\n#10\n:20 ?A=#20\n?A=#20\n#20\n"):
+        assert_same(text)
+        found = [(d.code, d.span.line) for d in diagnose(text)
+                 if d.code in ("E0203", "W0604")]
+        assert found == [(d.code, d.span.line) for d in analyze(text).diagnostics
+                         if d.code in ("E0203", "W0604")]
+        assert found
+
+
+# Lines of jumps that blocks share (graph.Block.jump), labels that define or miss their
+# targets, loops, unreachable code, and lines with fixes.
+JUMPY_LINES = ("#10", "#10", "?A=#10", "?A=#10", "?B>#20", "#1", "#123", ":10", ":20 (TIM 1)",
+               ":10 A=A+1", "A=1; #20", "(END)", "A=1 B=2", ":30 ?A<#30", "(MOV 3,3)",
+               "GOTO 10", "(mov 3,3)", "A=s", ":5 (TIM 10)", ":7", "#5", "(TRC 3)")
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.sampled_from(JUMPY_LINES), max_size=16), st.sampled_from(["\n", "\r\n"]))
+def test_blocks_that_share_jumps_give_the_diagnostics_of_the_tree(lines: list[str],
+                                                                  ending: str) -> None:
+    assert_same(ending.join(lines))
+
+
+# bench/memory.py's sources, at a size tracemalloc measures in seconds: a first line,
+# then one line repeated.
 SOURCES = {
-    "lines of 19,999 characters": ";".join(["A=1"] * 4999) + "\n",
-    "`A=1` lines": "A=1\n",
-    "lines with a syntax error": "A=1 B=2\n",
+    "lines of 19,999 characters": ("", ";".join(["A=1"] * 4999) + "\n"),
+    "`A=1` lines": ("", "A=1\n"),
+    "lines with a syntax error": ("", "A=1 B=2\n"),
     # a block of a million runs that write a reserved variable: 128 B/B when it held
     # each run's effects until it ended (effects.Combining)
-    "`t=1` lines": "t=1\n",
+    "`t=1` lines": ("", "t=1\n"),
     # a block a line: 178 B/B when each block's record was a Cut, a Block, the tree of its
     # last statement and effects of its own, and each block had a dict of triggers
-    "`(END)` lines": "(END)\n",
+    "`(END)` lines": ("", "(END)\n"),
     # a W0401 a line: 66 B/B when each was held whole (250 bytes)
-    "`A=s` lines": "A=s\n",
+    "`A=s` lines": ("", "A=s\n"),
+    # a block a line that jumps: 163 and 141 B/B when each block held its jump's tree,
+    # its statements' places as an object, a tuple of its successors, and the loop rule
+    # a set and lists of ints as large as the program
+    "`#01` lines": (":01\n", "#01\n"),
+    "`?A=#01` lines": (":01\n", "?A=#01\n"),
 }
 SOURCE_CHARACTERS = 256 * 1024
 
@@ -98,8 +146,8 @@ MEASURE = textwrap.dedent("""
     from rl1.compiler.analysis import diagnose_compactly
     from rl1.compiler.reporting.render import FileDiagnostics, exit_status, summary, write_report
     from rl1.compiler.reporting.selection import Selection
-    line, output_format = sys.argv[1:]
-    text = line * ({characters} // len(line))
+    head, line, output_format = sys.argv[1:]
+    text = head + line * ({characters} // len(line))
 
     class Nowhere(io.TextIOBase):
         def write(self, text):
@@ -123,7 +171,7 @@ def test_checking_takes_at_most_64_bytes_a_source_byte(kind: str, output_format:
     (an E0101 with its fix, 516 bytes of objects a line) before they were held compactly
     (checker/compact.py)."""
     script = MEASURE.format(characters=SOURCE_CHARACTERS)
-    measured = subprocess.run([sys.executable, "-c", script, SOURCES[kind], output_format],
+    measured = subprocess.run([sys.executable, "-c", script, *SOURCES[kind], output_format],
                               capture_output=True, text=True, check=True)
     assert float(measured.stdout) <= 64
 
