@@ -11,14 +11,17 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
+import math
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from importlib.metadata import version
+from pathlib import PurePosixPath
 from typing import Any, ClassVar
 
 from rl1.compiler.debugger import DebugError, compile_program, parse_call, parse_value
 from rl1.compiler.files import SourceError
 from rl1.compiler.frontend.source import decode
+from rl1.vm import ilc
 from rl1.vm.defaults import DEFAULT_BUDGET, DEFAULT_LEVEL
 from rl1.vm.sensor_script import Script, ScriptError, decode_script
 from rl1.vm.sim.world import World, WorldError, decode_world
@@ -110,7 +113,7 @@ class Connection:
     async def receive(self, frame: str | bytes) -> None:
         """Handle one message, answering it unless it is a notification."""
         try:
-            message = json.loads(frame)
+            message = json.loads(frame, parse_float=_finite, parse_constant=_no_constant)
         except (ValueError, RecursionError) as error:
             self._answer(None, error=RpcError(PARSE_ERROR, f"the message is no JSON ({error}): "
                                                            "send one JSON-RPC request a frame"))
@@ -210,8 +213,8 @@ class Connection:
         return {"path": path, "size": len(data), "version": version_of(data)}
 
     async def _check_world(self, params: dict[str, Any]) -> dict[str, Any]:
-        text = _string(params, "text")
-        name = _string(params, "path") if "path" in params else "world.toml"
+        text = _unicode(_string(params, "text"), "`text`")
+        name = _unicode(_string(params, "path"), "`path`") if "path" in params else "world.toml"
         if len(text) > MAX_FILE_BYTES:
             raise RpcError(FILE_UNUSABLE, f"the world is larger than {MAX_FILE_BYTES // 2**20} "
                            "MiB, the most the studio reads")
@@ -261,7 +264,7 @@ class Connection:
                  level: int | None, seed: int, stop_on_entry: bool) -> Launch:
         """The launch's files read and checked, and the program compiled (in a thread)."""
         text = self._program_text(program)
-        compiled = compile_program(text, program.name, level)
+        compiled = compile_program(text, _recorded(program.name), level)
         if isinstance(compiled, list):
             errors = [d for d in compiled if d.is_error]
             shown = "; ".join(f"{program.name}:{d.span.line}: {d.message}" for d in errors[:3])
@@ -487,9 +490,46 @@ def _source(params: dict[str, Any], key: str, default_name: str) -> Source | Non
             if len(text) > MAX_FILE_BYTES:
                 raise RpcError(FILE_UNUSABLE, f"`{key}` is larger than "
                                f"{MAX_FILE_BYTES // 2**20} MiB, the most the studio runs")
-            return Source(name, text=text)
+            if len(_unicode(name, f"`{key}.name`").encode()) > ilc.MAX_NAME_SIZE:
+                raise RpcError(INVALID_PARAMS, f"`{key}.name` is longer than "
+                               f"{ilc.MAX_NAME_SIZE} bytes, the most a program records: give "
+                               "a file's name, such as `sample.rob`")
+            return Source(name, text=_unicode(text, f"`{key}.text`"))
     raise RpcError(INVALID_PARAMS, f"`{key}` is {json.dumps(given)[:80]}: give {{\"path\": "
                    "\"a file in the folder\"} or {\"text\": \"...\", \"name\": \"...\"}")
+
+
+def _recorded(name: str) -> str:
+    """The name the program's debug section records: a path too long for it as its
+    file's name, as `rl1c build` records it (a page's own name is refused in `_source`)."""
+    return name if len(name.encode()) <= ilc.MAX_NAME_SIZE else PurePosixPath(name).name
+
+
+def _unicode(value: str, what: str) -> str:
+    """`value`, refused if it holds half of a surrogate pair: JSON can carry one (an
+    escape such as `\\ud800`), which is no character, so that no file, and no text a
+    run is given, holds it."""
+    try:
+        value.encode()
+    except UnicodeEncodeError as error:
+        raise RpcError(INVALID_PARAMS, f"{what} holds {value[error.start:error.end]!r}, half "
+                       "of a surrogate pair, which is no character: send Unicode text") from None
+    return value
+
+
+def _finite(text: str) -> float:
+    """A JSON number with a fraction or an exponent, refused when it is beyond a double
+    (`1e400`), as NaN and Infinity are (_no_constant): an answer would carry it back
+    as no JSON a page reads."""
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"{text} is beyond the numbers JSON carries")
+    return value
+
+
+def _no_constant(name: str) -> float:
+    """NaN, Infinity and -Infinity, which Python's json reads, though they are no JSON."""
+    raise ValueError(f"{name} is no JSON")
 
 
 async def _files(work: Awaitable[Any]) -> Any:

@@ -74,7 +74,7 @@ class Folder:
     def resolve(self, path: str) -> Path:
         """Where `path` (relative to the folder, or absolute inside it) leads; Refused
         when it leaves the folder or spells `..`."""
-        if not path or "\x00" in path:
+        if not path or "\x00" in path or not _nameable(path):
             raise Refused(f"`{path!r}` is no file's path: give one relative to the folder, "
                           "such as `sample.rob`")
         if path.endswith(("/", "/.")):  # `main.rob/` would name main.rob
@@ -180,6 +180,16 @@ class Folder:
                 break
         entries.sort(key=lambda entry: entry.path)
         return entries[:MAX_LISTED], truncated or len(entries) > MAX_LISTED
+
+
+def _nameable(path: str) -> bool:
+    """Whether `path` has a form in the file system's bytes: JSON can carry half of a
+    surrogate pair (`\\ud800`), which is no character, and names no file."""
+    try:
+        os.fsencode(path)
+    except UnicodeEncodeError:
+        return False
+    return True
 
 
 def _regular(path: str, status: os.stat_result) -> None:

@@ -4,22 +4,25 @@ connection goes on (Hypothesis)."""
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
 from typing import Any
 
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from served import Failed, Page, Served, page, sample_folder, serving
+from served import TIMEOUT, Failed, Page, Served, page, sample_folder, serving
 
 from rl1.lsp.studio.connection import Connection
 
 ERRORS = {-32700, -32600, -32601, -32602, -32001, -32002, -32003, -32004, -32005, -32006,
           -32007}
 JSON = st.recursive(
-    st.none() | st.booleans() | st.integers(-2**40, 2**40) | st.floats(allow_nan=False)
+    st.none() | st.booleans() | st.integers(-2**40, 2**40)
+    | st.floats(allow_nan=False, allow_infinity=False)  # JSON has neither
     | st.text(max_size=20) | st.sampled_from(["sample.rob", "sample.world.toml", "../x.rob",
-                                              "/etc/passwd", "IMG", "A<0", "a.rob"]),
+                                              "/etc/passwd", "IMG", "A<0", "a.rob",
+                                              "\ud800.rob"]),
     lambda inner: st.lists(inner, max_size=4) | st.dictionaries(
         st.sampled_from(["path", "text", "name", "program", "world", "sensors", "level",
                          "seed", "speed", "stopOnEntry", "lines", "calls", "lostLines",
@@ -64,3 +67,57 @@ def test_nothing_was_written_outside_the_folder(served: Served) -> None:
     # After the property (which sends "../x.rob" and "/etc/passwd" among the paths).
     outside = served.server.studio.folder.root.parent
     assert [path.name for path in outside.iterdir()] == ["robots"]
+
+
+SURROGATE = "\ud800"  # what JSON's "\ud800" reads as: half of a pair, no character
+
+
+@pytest.mark.parametrize("method, params, code", [
+    ("files/read", {"path": f"{SURROGATE}.rob"}, -32001),
+    ("files/save", {"path": f"{SURROGATE}.rob", "text": "(END)\n"}, -32001),
+    ("run/launch", {"program": {"path": f"{SURROGATE}.rob"}}, -32001),
+    ("world/check", {"text": f"# {SURROGATE}\n"}, -32602),
+    ("world/check", {"text": "", "path": f"{SURROGATE}.world.toml"}, -32602),
+    ("run/launch", {"program": {"text": "(END)\n"}, "world": {"text": SURROGATE}}, -32602),
+    ("run/launch", {"program": {"text": "(END)\n"}, "sensors": {"text": SURROGATE}}, -32602),
+    ("run/launch", {"program": {"text": "(END)\n", "name": SURROGATE}}, -32602),
+])
+def test_half_a_surrogate_pair_is_refused_as_no_text(client: Page, method: str,
+                                                     params: dict[str, Any],
+                                                     code: int) -> None:
+    """Found by the hostile pass: each was an internal error (UnicodeEncodeError)."""
+    with pytest.raises(Failed) as failed:
+        client.request(method, params)
+    assert failed.value.code == code, failed.value
+    assert "\\ud800" in str(failed.value)
+
+
+@pytest.mark.parametrize("constant", ["NaN", "Infinity", "-Infinity", "1e400"])
+def test_nan_and_infinity_are_no_json(client: Page, constant: str) -> None:
+    """Found by the hostile pass: Python's json reads them, and an id of NaN was
+    answered with `"id": NaN`, which no page's JSON.parse reads."""
+    client.send(f'{{"jsonrpc": "2.0", "id": {constant}, "method": "initialize"}}')
+    answer = json.loads(client.connection.recv(timeout=TIMEOUT),
+                        parse_constant=lambda name: pytest.fail(f"{name} in the answer"))
+    assert answer["id"] is None and answer["error"]["code"] == -32700
+    assert constant.lstrip("-") in answer["error"]["message"]
+
+
+def test_a_name_too_long_for_the_debug_section_is_refused(client: Page) -> None:
+    """Found by the hostile pass: an internal error (the .ilc's encoder refused it)."""
+    with pytest.raises(Failed) as failed:
+        client.request("run/launch", {"program": {"text": "(END)\n", "name": "x" * 256}})
+    assert failed.value.code == -32602
+    assert "255 bytes" in str(failed.value)
+
+
+def test_a_program_deep_in_the_folder_runs(served: Served) -> None:
+    """A path longer than the debug section holds is recorded as its file's name, as
+    `rl1c build` records it (it was an internal error)."""
+    deep = served.server.studio.folder.root / "/".join(["folder" * 10] * 5)
+    deep.mkdir(parents=True)
+    (deep / "deep.rob").write_text("(END)\n")
+    with page(served) as client:
+        path = (deep / "deep.rob").relative_to(served.server.studio.folder.root).as_posix()
+        assert len(path) > 255
+        assert client.request("run/launch", {"program": {"path": path}})["lines"] == [1]
