@@ -302,7 +302,7 @@ def test_a_jumping_block_shares_the_tail_of_the_block_that_falls_through() -> No
 
 @pytest.mark.parametrize("centre", [1, -1])
 def test_a_shared_tail_runs_as_many_instructions_on_either_way(centre: int) -> None:
-    script = {"KYO": [{"centre": centre, "right": 0, "left": 0}]}
+    script: dict[str, object] = {"KYO": [{"centre": centre, "right": 0, "left": 0}]}
     runs = [run_program(program, script) for program in (lowered(IF_ELSE),
                                                         after(merge_tails, IF_ELSE))]
     assert runs[0] == runs[1]  # the same variables, at the same count
