@@ -3,7 +3,11 @@
 - runs per second of Listing 1 on the sample world with noise on (`noise = true`:
   spec/simulator.md, "Noise"), in one process and on every core (the pool's start-up
   included: a campaign pays it once), and on local Dask clusters (compiler/executors.py)
-  of 1 worker and of 2, the fastest of a few rounds;
+  of 1 worker and of 2, the fastest of a few rounds; and the CPU time of a run counted
+  over every process (this one, the pool's or the cluster's, its scheduler included),
+  which the load of a shared machine changes less than the rate;
+- what Dask adds to a run: the CPU time of a run of a cheap program in one process and
+  on a Dask worker (a campaign sends several runs a task: compiler/campaign.py);
 - the memory of a long campaign: the resident size of a campaign in this process,
   sampled as the runs go, over `--memory-runs` runs (default 100,000) of a cheap program;
 - last, a campaign of `--runs` runs (default 1,000) of Listing 1 through the command
@@ -18,13 +22,16 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
 import shutil
 import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
+
+import psutil  # type: ignore[import-untyped]  # with `distributed`, which this bench needs
+from distributed import LocalCluster
 
 from rl1.compiler.campaign import Campaign, Tally, Task, campaign_seeds, task_for
 from rl1.compiler.cli.sim_campaign import WINDOW_PER_JOB
@@ -44,48 +51,69 @@ def noisy_world() -> bytes:
     return b"noise = true\n" + WORLD.read_bytes()
 
 
-def cpu_seconds() -> float:
-    """CPU time of this process and of its workers that have ended."""
-    own, workers = (resource.getrusage(who) for who in
-                    (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN))
-    return own.ru_utime + own.ru_stime + workers.ru_utime + workers.ru_stime
+def cpu_seconds() -> dict[int, float]:
+    """The CPU time so far of this process (a local cluster's scheduler runs in it) and
+    of each process under it (a pool's or a local cluster's workers), by process id."""
+    seconds = {}
+    me = psutil.Process()
+    for process in (me, *me.children(recursive=True)):
+        try:
+            times = process.cpu_times()
+        except psutil.NoSuchProcess:
+            continue  # ended meanwhile
+        seconds[process.pid] = times.user + times.system
+    return seconds
 
 
-def measure(task: Task, runs: int, jobs: int, scheduler: str | None = None) -> float:
-    """Runs per second of wall-clock time, on `jobs` local processes or on the cluster of
-    `scheduler`, as `rl1c sim --runs` makes them."""
-    started = time.perf_counter()
+@dataclass(frozen=True, slots=True)
+class Rate:
+    """How fast a campaign went: runs per second of wall-clock time, and milliseconds of
+    CPU time a run over every process that took part."""
+
+    runs_per_second: float
+    cpu_ms: float
+
+
+def measure(task: Task, runs: int, jobs: int, scheduler: str | None = None) -> Rate:
+    """The rate of a campaign of `runs` runs on `jobs` local processes or on the cluster
+    of `scheduler`, as `rl1c sim --runs` makes them."""
+    started, cpu = time.perf_counter(), cpu_seconds()
     with workers(jobs, scheduler) as held:
         done = sum(1 for _ in Campaign(task, campaign_seeds(0, runs), held.executor,
                                        WINDOW_PER_JOB * max(held.slots, 1), held.lost))
-    return done / (time.perf_counter() - started)
+        used = sum(now - cpu.get(pid, 0.0) for pid, now in cpu_seconds().items())
+    return Rate(done / (time.perf_counter() - started), used * 1000 / done)
 
 
-def fastest_rates(task: Task, runs: int, rounds: int, cores: int) -> dict[str, float]:
-    """The runs per second of each way of making them, the fastest of `rounds` rounds
-    that take each way in turn (so that the load of the machine, shared, falls on all
-    alike): one process, every core, and local Dask clusters of 1 and of 2 workers (a
-    process each, one thread), reached through a scheduler's address as `--scheduler`
-    reaches it."""
-    from distributed import LocalCluster
+def _cluster(count: int) -> LocalCluster:
+    """A local Dask cluster of `count` workers, a process each, one thread, reached
+    through its scheduler's address as `--scheduler` reaches it."""
+    return LocalCluster(  # type: ignore[no-untyped-call]
+        n_workers=count, threads_per_worker=1, processes=True,
+        dashboard_address=":0")  # the dashboard on any free port
 
-    def cluster(count: int) -> LocalCluster:
-        return LocalCluster(  # type: ignore[no-untyped-call]
-            n_workers=count, threads_per_worker=1, processes=True,
-            dashboard_address=":0")  # the dashboard on any free port
 
-    with cluster(1) as one, cluster(2) as two:
-        ways: dict[str, tuple[int, str | None]] = {
-            "1 process": (1, None), f"{cores} processes": (cores, None),
-            "Dask, 1 worker": (1, one.scheduler_address),
-            "Dask, 2 workers": (1, two.scheduler_address)}
-        for jobs, scheduler in ways.values():  # the workers' imports and caches
-            measure(task, 4, jobs, scheduler)
-        best: dict[str, float] = {}
-        for _ in range(rounds):
-            for name, (jobs, scheduler) in ways.items():
-                best[name] = max(best.get(name, 0.0), measure(task, runs, jobs, scheduler))
+def fastest_rates(task: Task, runs: int, rounds: int,
+                  ways: dict[str, tuple[int, str | None]]) -> dict[str, Rate]:
+    """The rate of each way of making runs (its local processes, or its cluster's
+    scheduler), the fastest of `rounds` rounds that take each way in turn (so that the
+    load of the machine, shared, falls on all alike), with the least CPU time a run of
+    those rounds."""
+    for jobs, scheduler in ways.values():  # the workers' imports and caches
+        measure(task, 4, jobs, scheduler)
+    best: dict[str, Rate] = {}
+    for _ in range(rounds):
+        for name, (jobs, scheduler) in ways.items():
+            rate = measure(task, runs, jobs, scheduler)
+            fastest = best.get(name, rate)
+            best[name] = Rate(max(fastest.runs_per_second, rate.runs_per_second),
+                              min(fastest.cpu_ms, rate.cpu_ms))
     return best
+
+
+def cheap_task() -> Task:
+    return task_for(CHEAP_PROGRAM, noisy_world(), "sample.noisy.world.toml", "vm",
+                    DEFAULT_BUDGET, "cheap.rob")
 
 
 def resident_mb() -> float:
@@ -97,8 +125,7 @@ def resident_mb() -> float:
 def memory_samples(runs: int) -> list[tuple[int, float]]:
     """The resident memory after every tenth of a campaign of `runs` runs of a cheap
     program, each run kept as the command keeps it (counted, written as a JSON line)."""
-    task = task_for(CHEAP_PROGRAM, noisy_world(), "sample.noisy.world.toml", "vm",
-                    DEFAULT_BUDGET, "cheap.rob")
+    task = cheap_task()
     tally = Tally()
     samples = [(0, resident_mb())]
     with open(os.devnull, "w", encoding="utf-8") as lines:  # written, not held
@@ -115,30 +142,45 @@ def main() -> None:
     parser.add_argument("--runs", type=int, default=1000)
     parser.add_argument("--rate-runs", type=int, default=100)
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--cheap-runs", type=int, default=2000)
     parser.add_argument("--memory-runs", type=int, default=100_000)
     options = parser.parse_args()
     cores = os.cpu_count() or 1
     task = task_for(PROGRAM.read_text(), noisy_world(), "sample.noisy.world.toml", "vm",
                     DEFAULT_BUDGET, PROGRAM.name)
     load = os.getloadavg()[0]  # other work on the machine takes cores from the pool
-    cpu = cpu_seconds()
-    measure(task, options.rate_runs, 1)
-    one_cpu = (cpu_seconds() - cpu) * 1000 / options.rate_runs
-    rates = fastest_rates(task, options.rate_runs, options.rounds, cores)
+    with _cluster(1) as one, _cluster(2) as two:
+        rates = fastest_rates(task, options.rate_runs, options.rounds, {
+            "1 process": (1, None), f"{cores} processes": (cores, None),
+            "Dask, 1 worker": (1, one.scheduler_address),
+            "Dask, 2 workers": (1, two.scheduler_address)})
+        # What Dask adds to a run, seen on a cheap one.
+        costs = fastest_rates(cheap_task(), options.cheap_runs, options.rounds, {
+            "here": (1, None), "there": (1, one.scheduler_address)})
     one, every = rates["1 process"], rates[f"{cores} processes"]
     one_worker, two_workers = rates["Dask, 1 worker"], rates["Dask, 2 workers"]
     print(f"Listing 1 on the sample world with noise on, {options.rate_runs} runs, the "
           f"fastest of {options.rounds} rounds ({cores} cores, load average {load:.1f} "
-          "before):")
-    print(f"  1 process:       {one:6.1f} runs/s ({one_cpu:.0f} ms of CPU a run)")
-    print(f"  {cores} processes:     {every:6.1f} runs/s ({every / one:.2f}x one process; "
-          "the pool's start-up included)")
-    print(f"  Dask, 1 worker:  {one_worker:6.1f} runs/s ({one_worker / one:.2f}x one "
-          "process)")
-    print(f"  Dask, 2 workers: {two_workers:6.1f} runs/s ({two_workers / one_worker:.2f}x "
-          f"1 worker)")
+          "before), and the least CPU time a run over every process:")
+    for name, rate, against in [
+            ("1 process", one, ""),
+            (f"{cores} processes", every, f"{every.runs_per_second / one.runs_per_second:.2f}x "
+             "one process; the pool's start-up included"),
+            ("Dask, 1 worker", one_worker,
+             f"{one_worker.runs_per_second / one.runs_per_second:.2f}x one process"),
+            ("Dask, 2 workers", two_workers,
+             f"{two_workers.runs_per_second / one_worker.runs_per_second:.2f}x 1 worker")]:
+        print(f"  {name + ':':<17}{rate.runs_per_second:6.1f} runs/s"
+              + (f" ({against})" if against else "") + f", {rate.cpu_ms:.1f} ms of CPU a run")
 
     cheap = "; ".join(CHEAP_PROGRAM.splitlines())
+    here, there = costs["here"], costs["there"]
+    print(f"\nwhat Dask adds to a run: {options.cheap_runs:,} runs of `{cheap}`, the fastest "
+          f"of {options.rounds} rounds, and the least CPU time a run over every process:")
+    print(f"  in one process:     {here.cpu_ms:5.2f} ms ({here.runs_per_second:.0f} runs/s)")
+    print(f"  on one Dask worker: {there.cpu_ms:5.2f} ms ({there.runs_per_second:.0f} runs/s; "
+          f"{there.cpu_ms - here.cpu_ms:+.2f} ms a run)")
+
     print(f"\nmemory of a campaign of {options.memory_runs:,} runs of `{cheap}` on the "
           "sample world with noise on (resident, this process):")
     started = time.perf_counter()
