@@ -1,6 +1,7 @@
 """Tail merging (cross-jumping): a block that jumps to T and ends with the instructions
 the block falling through to T ends with jumps to those instructions instead, so that
-they are written once.
+they are written once: split off as a block of their own, laid out where they were,
+unless they are the whole falling block, to which the jump then goes.
 
 Assumes: the IR is valid, in the layout order the code generator keeps (a block falls
 through to the next one, where its jump to that block is left out); it runs once, after
@@ -23,38 +24,45 @@ tail falls through to T), the other's the same ones.
 from __future__ import annotations
 
 from dataclasses import replace
+from itertools import count
 
 from . import flow, ir
 
 
 def merge_tails(program: ir.Program) -> ir.Program:
+    """One sweep, target by target (the merges for one target change no block of
+    another's: a tail is laid out just before its own target); for each, the longest
+    shared tail first, so that each shorter one is a tail of it in turn."""
     if flow.takes_events(program):
         return program
-    while (merge := _longest_shared_tail(program)) is not None:
-        jumping, falling, length = merge
-        _share(program, jumping, falling, length)
-    return program
-
-
-def _longest_shared_tail(program: ir.Program) -> tuple[ir.Block, ir.Block, int] | None:
-    """The jumping block, the falling block and the length of the longest tail they
-    share (the first such pair in layout order), or None when no pair shares one."""
     following = program.following()
     falling_into = {block.terminator.target: block for block in program
                     if isinstance(block.terminator, ir.Jump)
                     and following[block.id] == block.terminator.target}
-    best: tuple[ir.Block, ir.Block, int] | None = None
+    jumping_to: dict[ir.BlockId, list[ir.Block]] = {}
     for block in program:
         terminator = block.terminator
-        if not isinstance(terminator, ir.Jump) or following[block.id] == terminator.target:
-            continue
-        falling = falling_into.get(terminator.target)
-        if falling is None:
-            continue
-        length = _shared_length(block.instructions, falling.instructions)
-        if length and (best is None or length > best[2]):
-            best = (block, falling, length)
-    return best
+        if isinstance(terminator, ir.Jump) and terminator.target in falling_into \
+                and following[block.id] != terminator.target:
+            jumping_to.setdefault(terminator.target, []).append(block)
+    numbers = count(_first_free_number(program))
+    split_off: dict[ir.BlockId, list[ir.Block]] = {}  # laid out after the block, in order
+    for target, jumping in jumping_to.items():
+        first = falling = falling_into[target]
+        shared = sorted(((_shared_length(block.instructions, first.instructions), block)
+                         for block in jumping), key=lambda pair: -pair[0])
+        for length, block in shared:
+            if not length:
+                break
+            if length < len(falling.instructions):
+                falling = _split(falling, length, f"B{next(numbers)}")
+                split_off.setdefault(first.id, []).append(falling)
+            block.instructions = block.instructions[:-length]
+            block.terminator = ir.Jump(falling.id, block.terminator.line)
+    if split_off:
+        program.blocks = {each.id: each for block in program
+                          for each in (block, *split_off.get(block.id, ()))}
+    return program
 
 
 def _shared_length(first: list[ir.Instruction], second: list[ir.Instruction]) -> int:
@@ -82,26 +90,16 @@ def _starts_a_block(instructions: list[ir.Instruction]) -> bool:
     return True
 
 
-def _share(program: ir.Program, jumping: ir.Block, falling: ir.Block, length: int) -> None:
-    """The falling block's last `length` instructions split off into a block after it,
-    to which the jumping block, without its own copy, jumps."""
-    tail_id = _new_id(program)
-    tail = falling.instructions[-length:]
-    shared = ir.Block(tail_id, tail, falling.terminator)
-    falling.instructions = falling.instructions[:-length]
-    falling.terminator = ir.Jump(tail_id, tail[0].line)  # the fall-through: not written
-    jumping.instructions = jumping.instructions[:-length]
-    jumping.terminator = ir.Jump(tail_id, jumping.terminator.line)
-    blocks: dict[ir.BlockId, ir.Block] = {}
-    for block_id, block in program.blocks.items():
-        blocks[block_id] = block
-        if block is falling:
-            blocks[tail_id] = shared
-    program.blocks = blocks
+def _split(block: ir.Block, length: int, tail_id: ir.BlockId) -> ir.Block:
+    """The block's last `length` instructions as a block of their own with its
+    terminator, to which the block, without them, falls through."""
+    tail = ir.Block(tail_id, block.instructions[-length:], block.terminator)
+    block.instructions = block.instructions[:-length]
+    block.terminator = ir.Jump(tail_id, tail.instructions[0].line)  # not written
+    return tail
 
 
-def _new_id(program: ir.Program) -> ir.BlockId:
-    """A block id no block has: `Bn`, n past every one in use."""
-    numbers = [int(block_id[1:]) for block_id in program.blocks
-               if block_id.startswith("B") and block_id[1:].isdigit()]
-    return f"B{max(numbers, default=-1) + 1}"
+def _first_free_number(program: ir.Program) -> int:
+    """The first n past every `Bn` block id in use."""
+    return max((int(block_id[1:]) for block_id in program.blocks
+                if block_id.startswith("B") and block_id[1:].isdigit()), default=-1) + 1

@@ -300,6 +300,26 @@ def test_a_jumping_block_shares_the_tail_of_the_block_that_falls_through() -> No
     assert [item.line for item in program.blocks["B2"].instructions] == [3] * 4  # L20's
 
 
+def test_shorter_shared_tails_split_the_longer_one_again() -> None:
+    # L21 falls through to :30 ending `D=6; C=7`: B2 shares both, L20 only `C=7`.
+    text = ("A=(KYO); ?A>#20\n?A<#21\nD=6; C=7; #30\n:20 D=5; C=7; #30\n:21 B=2; D=6; C=7\n"
+            ":30 (MOV C,D); (END)")
+    program = after(merge_tails, text)
+    assert list(program.blocks) == ["B0", "B1", "B2", "L20", "L21", "B3", "B4", "L30"]
+    assert code(program, "B2") == ["jump B3"]
+    assert code(program, "L20") == ["load 5", "store D", "jump B4"]
+    assert code(program, "L21") == ["load 2", "store B", "jump B3"]  # falls through
+    assert code(program, "B3") == ["load 6", "store D", "jump B4"]  # falls through
+    assert code(program, "B4") == ["load 7", "store C", "jump L30"]  # falls through
+
+
+def test_a_tail_that_is_the_whole_falling_block_is_jumped_to_as_it_is() -> None:
+    text = "A=(KYO); ?A>#20\nB=1; C=7; #30\n:20 (TIM 1)\n:21 C=7\n:30 (MOV C,C); (END)"
+    program = after(merge_tails, text)
+    assert list(program.blocks) == list(lowered(text).blocks)
+    assert code(program, "B1") == ["load 1", "store B", "jump L21"]
+
+
 @pytest.mark.parametrize("centre", [1, -1])
 def test_a_shared_tail_runs_as_many_instructions_on_either_way(centre: int) -> None:
     script: dict[str, object] = {"KYO": [{"centre": centre, "right": 0, "left": 0}]}
