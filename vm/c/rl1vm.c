@@ -86,9 +86,9 @@ static bool broken_in(const rl1_vm *vm)
 #define ALWAYS_INLINE
 #endif
 
-/* The signed byte at p + k, without the implementation-defined conversion to int8_t. */
-#define S8_AT(p, k)                                                                      \
-    ((int16_t)((int16_t)RL1_BYTE((p) + (k)) - (int16_t)((RL1_BYTE((p) + (k)) & 0x80u) << 1)))
+/* The signed byte at p + k: two's complement, as every conversion to int16_t here
+ * (spec/ilc.md 13). */
+#define S8_AT(p, k) ((int16_t)(int8_t)RL1_BYTE((p) + (k)))
 
 /* A variable argument's value, from its index in *arg, into *arg: false when it is out
  * of its parameter's range, low and high at range[0] and range[1]. */
@@ -548,17 +548,18 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
             poll:
                 clear_reading(&out);
                 status = hw->poll(hw->ctx, &out);
-                if (status == RL1_BUSY && !broken_in(vm)) {
-                    vm->waiting = RL1_BYTE(ip); /* as in the code: a compact call's too */
-                    vm->acc = (int16_t)acc;
-                    vm->executed = counted(before, n - left);
-                    return RL1_WAITING;
-                }
-                vm->waiting = 0;
-                if (status != RL1_OK) {
+                if (status != RL1_OK) { /* one comparison when it is done */
+                    if (status == RL1_BUSY && !broken_in(vm)) {
+                        vm->waiting = RL1_BYTE(ip); /* as in the code: a compact call's too */
+                        vm->acc = (int16_t)acc;
+                        vm->executed = counted(before, n - left);
+                        return RL1_WAITING;
+                    }
+                    vm->waiting = 0;
                     kind = RL1_FAULT_DEVICE;
                     break;
                 }
+                vm->waiting = 0;
             } else {
                 clear_reading(&out);
                 if (hw->call(hw->ctx, op, given, &out) != RL1_OK) {
