@@ -5,11 +5,15 @@ calls counted apart from the other instructions, against the goal of issue 26: a
 For bench/corpus/ (with Listing 1) and bench/unseen/, each program on its sensor script
 at -O2, with the threaded build (what hosts build) and the switch one (RL1_THREADED=0):
 vm/c's conformance runner (`--once`, the Makefile's -O2 runner) runs the programs under
-`valgrind --tool=callgrind --dump-instr=yes`, which counts each machine instruction
-executed at each address. `addr2line -i` names, for each address of rl1_step and the
-functions it reaches in rl1vm.c, the source line of `run()` it was compiled from, through
-any inlined functions (a helper such as take_event, inlined at a call and at a jump,
-belongs to the place it was inlined into). So the split is by counting, not by a model:
+`valgrind --tool=callgrind --dump-instr=yes --collect-jumps=yes`, which counts each
+machine instruction executed at each address, and the jumps taken between addresses.
+`addr2line -i` names, for each address of rl1_step and the functions it reaches in
+rl1vm.c, the source line of `run()` it was compiled from, through any inlined functions
+(a helper such as take_event, inlined at a call and at a jump, belongs to the place it
+was inlined into). gcc merges code that several cases end with (the jump to the next
+instruction above all), which addr2line places in one of them; such code is shared out
+by control flow (call_shares): in proportion to the counts of the instructions that
+fall into it or jump to it. So the split is by counting, not by a model:
 
 - a call: the instructions of the call case of `run()` (from its first `case` to its
   `NEXT()`, threaded its own jump to the next instruction included) and the block
@@ -30,6 +34,7 @@ they share one path, and its instructions cannot tell which kind ran them
 
 from __future__ import annotations
 
+import itertools
 import json
 import re
 import shutil
@@ -74,17 +79,43 @@ class Regions:
                        range(call, first(r"^\s*ip = next;", call) + 2),
                        range(first(r"^\s*if \(vm->waiting\) \{"), head))
 
+    def kind(self, line: int | None) -> str:
+        """Whose the code of a line of `run()` is (None: outside it): the step's entry and
+        exit, the loop's head, the poll of a waiting call before the loop, the call case,
+        or the other instructions' cases."""
+        if line is None or line not in self.loop:
+            return "resume" if line is not None and line in self.resume else "steps"
+        if line in self.dispatch:
+            return "dispatch"
+        return "call" if line in self.call_case else "other"
 
-def self_costs(out: Path, source: Path) -> dict[int, int]:
-    """Instructions executed at each address of rl1_step and the static functions of
-    `source`, from a
-    callgrind file written with --dump-instr=yes (positions: address, line; each absolute,
-    relative +n/-n, or * for the last). A `calls=` line's next line is the callee's
-    inclusive cost at the calling instruction: its position counts, its cost does not."""
+
+@dataclass(frozen=True)
+class Profile:
+    """What callgrind counted in rl1_step and the static functions of rl1vm.c."""
+
+    costs: dict[int, int]              # instructions executed at each address
+    jumps: dict[tuple[int, int], int]  # (from, to): the jumps taken between two addresses
+
+
+def position(text: str, last: int) -> int:
+    """A callgrind position: absolute, relative (+n, -n) to the last, or * for the last."""
+    if text.startswith("0x"):
+        return int(text, 16)
+    return last if text == "*" else last + int(text)
+
+
+def profile(out: Path, source: Path) -> Profile:
+    """The counts of a callgrind file written with --dump-instr=yes --collect-jumps=yes
+    (positions: address, line). A `calls=` line's next line is the callee's inclusive
+    cost at the calling instruction: its position counts, its cost does not. A `jump=` or
+    `jcnd=` line (taken count, target position) comes before the position of the jump."""
     names: dict[str, str] = {}
     costs: dict[int, int] = {}
+    jumps: dict[tuple[int, int], int] = {}
     address = 0
     in_file = counted = skip_next = False
+    jump: tuple[int, int] | None = None  # a jump's target and taken count, its source next
     for line in out.read_text(encoding="utf-8").splitlines():
         # files (fl, fi, fe, cfi, cfl) share one table of compressed names, functions
         # (fn, cfn) another
@@ -100,18 +131,78 @@ def self_costs(out: Path, source: Path) -> dict[int, int]:
         if line.startswith("calls="):
             skip_next = True
             continue
+        if found := re.match(r"(?:jump=(\d+)|jcnd=(\d+)/\d+) (\S+)", line):
+            taken = int(found.group(1) or found.group(2))
+            jump = (position(found.group(3), address), taken)
+            continue
         fields = line.split()
         if not fields or not re.match(r"0x[0-9a-f]+$|[+-]\d+$|\*$", fields[0]):
             continue
-        position = fields[0]
-        if position.startswith("0x"):
-            address = int(position, 16)
-        elif position != "*":
-            address += int(position)
+        address = position(fields[0], address)
+        if jump is not None:
+            if counted and jump[1]:
+                edge = (address, jump[0])
+                jumps[edge] = jumps.get(edge, 0) + jump[1]
+            jump = None
         if counted and not skip_next and len(fields) == 3:
             costs[address] = costs.get(address, 0) + int(fields[2])
         skip_next = False
-    return costs
+    return Profile(costs, jumps)
+
+
+def instructions(binary: Path) -> dict[int, tuple[str, int]]:
+    """Each instruction of `binary`: its mnemonic and operands, and the next one's address."""
+    listing = subprocess.run(["objdump", "-d", "--no-show-raw-insn", str(binary)],
+                             check=True, capture_output=True, text=True).stdout
+    found = [(int(address, 16), text) for address, text
+             in re.findall(r"^\s*([0-9a-f]+):\s+(\S.*)$", listing, re.MULTILINE)]
+    return {address: (text, following) for (address, text), (following, _)
+            in itertools.pairwise(found)}
+
+
+def call_shares(profile: Profile, code: dict[int, tuple[str, int]],
+                kinds: dict[int, str]) -> dict[int, float]:
+    """For each address of the dispatch loop, the part of its count that calls ran.
+
+    gcc merges code that several cases end with (the jump to the next instruction, a
+    fault), which addr2line then places in one of them, so a line alone does not say
+    whose a count is. Control flow does: an instruction starts where a jump through the
+    dispatch table lands (its case's own line says which kind), and every other address
+    is run by the instructions that reach it, by falling through or by a jump, in
+    proportion to the counts of each way in (the fixed point of those equations)."""
+    costs = profile.costs
+    ways_in: dict[int, list[tuple[int, int]]] = {address: [] for address in costs}
+    jumped_from: dict[int, int] = {}
+
+    def way_in(source: int, target: int, count: int) -> None:
+        # from the loop's head or the step's entry, an instruction starts
+        if target in ways_in and kinds[source] in ("other", "call", "resume"):
+            ways_in[target].append((source, count))
+
+    for (source, target), taken in profile.jumps.items():
+        jumped_from[source] = jumped_from.get(source, 0) + taken
+        if "*" not in code[source][0]:  # a jump through the table starts an instruction
+            way_in(source, target, taken)
+    for source, count in costs.items():
+        text, following = code[source]
+        if not re.search(r"\b(jmp|ret)\b", text):
+            way_in(source, following, count - jumped_from.get(source, 0))
+    share = {address: 1.0 if kind in ("call", "resume") else 0.0
+             for address, kind in kinds.items()}
+    for _ in range(100):
+        changed = False
+        for address in costs:
+            if kinds[address] not in ("other", "call"):
+                continue
+            entered = costs[address] - sum(count for _, count in ways_in[address])
+            base = entered * (1.0 if kinds[address] == "call" else 0.0)
+            value = (base + sum(count * share[source] for source, count in ways_in[address])
+                     ) / costs[address]
+            changed |= abs(value - share[address]) > 1e-12
+            share[address] = value
+        if not changed:
+            break
+    return share
 
 
 def run_lines(binary: Path, addresses: list[int]) -> Iterator[tuple[int, int | None]]:
@@ -146,18 +237,16 @@ def programs(paths: list[Path]) -> list[dict[str, object]]:
 def measure(binary: Path, vectors_file: Path, executed: int, calls: int, folder: Path,
             regions: Regions) -> str:
     out = folder / "callgrind.out"
-    subprocess.run(["valgrind", "--tool=callgrind", "--dump-instr=yes",
+    subprocess.run(["valgrind", "--tool=callgrind", "--dump-instr=yes", "--collect-jumps=yes",
                     f"--callgrind-out-file={out}", str(binary), "--once", str(vectors_file)],
                    check=True, capture_output=True)
-    costs = self_costs(out, VM_SOURCE)
-    call_cost = dispatch = steps = 0
-    for address, line in run_lines(binary, sorted(costs)):
-        if line is not None and (line in regions.call_case or line in regions.resume):
-            call_cost += costs[address]
-        elif line is None or line not in regions.loop:
-            steps += costs[address]
-        elif line in regions.dispatch:
-            dispatch += costs[address]
+    counted = profile(out, VM_SOURCE)
+    costs = counted.costs
+    kinds = {address: regions.kind(line) for address, line in run_lines(binary, sorted(costs))}
+    shares = call_shares(counted, instructions(binary), kinds)
+    call_cost = sum(costs[address] * shares[address] for address in costs)
+    steps = sum(costs[address] for address, kind in kinds.items() if kind == "steps")
+    dispatch = sum(costs[address] for address, kind in kinds.items() if kind == "dispatch")
     total = sum(costs.values())
     expected = callgrind_cost(binary, vectors_file, folder)
     assert total == expected, f"{total:,} instructions by address, {expected:,} by function"
@@ -180,7 +269,7 @@ def main() -> int:
     regions = Regions.of(VM_SOURCE.read_text(encoding="utf-8"))
     host_cc = shutil.which("gcc") or "cc"
     print(f"host instructions per bytecode instruction, the programs at -O{LEVEL} "
-          "(callgrind, each address's count placed by addr2line -i)")
+          "(callgrind, each address's count placed by addr2line -i and its ways in)")
     with tempfile.TemporaryDirectory(prefix="rl1-c-host-cost-") as scratch:
         folder = Path(scratch)
         binaries = {}
