@@ -167,6 +167,7 @@ def test_every_level_runs_the_shaped_programs_as_the_interpreter_does(case: Run)
     assert judge(case, engines, BUDGET).problems == []
 
 
+@pytest.mark.slow  # a Hypothesis search inside, which the marker plugin cannot see
 def test_the_shaped_programs_give_the_later_passes_work() -> None:
     """So that the property above tests them: each pass changes a good share."""
     @settings(max_examples=100, deadline=None, suppress_health_check=list(HealthCheck))
