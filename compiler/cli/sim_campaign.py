@@ -47,8 +47,8 @@ from .streams import cannot_write, file_failure, read_ilc, same_file, write_file
 
 PROGRESS_EVERY = 5.0  # s between progress lines when standard error is no terminal
 REDRAW_EVERY = 0.2  # s between redraws of the progress line on a terminal
-WINDOW_PER_JOB = 8  # runs in flight per worker (a cluster: per thread): enough to keep
-# each busy, few to hold
+WINDOW_PER_JOB = 8  # tasks in flight per worker (a cluster: per thread), each of a few
+# runs (compiler/campaign.py): enough to keep each busy, few to hold
 MAX_JOBS = 1024  # processes: beyond, --scheduler (a cluster) is the way
 
 
