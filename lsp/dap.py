@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import os
+import stat
 import sys
 import threading
 from collections.abc import Callable
@@ -125,10 +126,14 @@ class Adapter:
         except (ValueError, RecursionError) as error:
             print(f"rl1-dap: a message that is no JSON was skipped: {error}", file=sys.stderr)
             return
-        if not isinstance(message, dict) or message.get("type") != "request" or not (
-                isinstance(message.get("seq"), int) and isinstance(message.get("command"), str)):
+        if not isinstance(message, dict) or message.get("type") != "request" \
+                or not _whole(message.get("seq")):
             print("rl1-dap: a message that is no DAP request (type, seq and command) was "
                   "skipped", file=sys.stderr)
+            return
+        if not isinstance(message.get("command"), str):  # answered: its client waits
+            self._refuse({"seq": message["seq"]}, "a request's `command` is a string, such "
+                                                  "as \"launch\": send one")
             return
         handler = getattr(self, "_on_" + message["command"], None)
         if handler is None:
@@ -178,7 +183,7 @@ class Adapter:
         if level is not None and not (_whole(level) and level in (0, 1, 2)):
             raise Refused(f"`level` is {level!r}: give 0, 1 or 2, as rl1c -O0..-O2")
         try:
-            if program.lower().endswith(".ilc"):
+            if _regular(program).lower().endswith(".ilc"):
                 return read_bounded(program, MAX_ILC_BYTES, "an .ilc file")
             text = read_source(program).text
         except SourceError as error:
@@ -405,16 +410,37 @@ def _device_maker(arguments: dict[str, Any]) -> Callable[[], Device]:
         if not _whole(seed):
             raise Refused(f"`seed` is {seed!r}: give a whole number")
         try:
-            the_world = decode_world(read_bounded(world, MAX_WORLD_BYTES, "a world file"),
-                                     world)
+            the_world = decode_world(read_bounded(_regular(world), MAX_WORLD_BYTES,
+                                                  "a world file"), world)
         except (SourceError, WorldError) as error:
             raise Refused(str(error)) from None
         return lambda: SimDevice(the_world, seed=seed)
     try:
-        script = load_script(sensors) if sensors is not None else None
+        script = load_script(_regular(sensors)) if sensors is not None else None
     except (SourceError, ScriptError) as error:
         raise Refused(str(error)) from None
     return lambda: ScriptedDevice(script)
+
+
+_KINDS = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def _regular(path: str) -> str:
+    """`path`, refused when it names no file (a NUL, half a surrogate pair) or a file
+    that is neither regular nor a folder (which reading refuses with why): a FIFO waits
+    for a writer, and the adapter, which reads its client's requests in the thread
+    that reads files, would stop answering; a device is no program, world or script."""
+    try:
+        mode = os.stat(path).st_mode
+    except (ValueError, UnicodeEncodeError):
+        raise Refused(f"`{path!r}` is no file's path: give the path of a file") from None
+    except OSError:  # reading says what is wrong
+        return path
+    kind = next((kind for test, kind in _KINDS if test(mode)), None)
+    if kind is not None:
+        raise Refused(f"{path}: it is {kind}, not a regular file: name one")
+    return path
 
 
 def _shown(value: object) -> str:

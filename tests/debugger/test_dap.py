@@ -5,6 +5,7 @@ compared as exact JSON where the protocol fixes them."""
 from __future__ import annotations
 
 import json
+import os
 import queue
 import subprocess
 import sys
@@ -333,3 +334,55 @@ def test_the_command_line_answers_help_and_version_without_serving() -> None:
         done = subprocess.run([sys.executable, "-m", "rl1.lsp.dap", flag], input=b"",
                               capture_output=True, timeout=60, check=False)
         assert done.returncode == 0 and said in done.stdout.decode(), done
+
+
+def _answer_in_process(request: dict[str, Any]) -> dict[str, Any]:
+    """The response of a fresh adapter to `request`, which must come within seconds."""
+    sent: list[dict[str, Any]] = []
+    adapter = Adapter(sent.append)
+    reading = threading.Thread(target=adapter.receive, args=(json.dumps(request).encode(),),
+                               daemon=True)
+    reading.start()
+    reading.join(10)
+    assert not reading.is_alive(), f"the adapter hangs on {request}"
+    (response,) = [m for m in sent if m["type"] == "response"]
+    return response
+
+
+@pytest.mark.parametrize("arguments, said", [
+    ({"program": "\ud800.rob"}, "is no file's path"),
+    ({"program": "a\x00b.rob"}, "is no file's path"),
+    ({"program": str(SAMPLE), "world": "w\ud800.world.toml"}, "is no file's path"),
+    ({"program": str(SAMPLE), "sensors": "s\x00.sensors.json"}, "is no file's path"),
+    ({"program": "/dev/null"}, "is a character device"),
+    ({"program": str(SAMPLE), "world": "/dev/zero"}, "is a character device"),
+])
+def test_a_path_that_names_no_file_is_refused_with_why(arguments: dict[str, Any],
+                                                       said: str) -> None:
+    """Found by the hostile pass: each was an internal error ("please report it")."""
+    response = _answer_in_process({"seq": 1, "type": "request", "command": "launch",
+                                   "arguments": arguments})
+    assert response["success"] is False and said in response["message"], response
+    assert "please report it" not in response["message"]
+
+
+def test_a_fifo_is_refused_not_waited_on(tmp_path: Path) -> None:
+    """Found by the hostile pass: opening a FIFO waits for a writer, and the adapter,
+    which reads its client's requests in the same thread, stopped answering."""
+    for name, key in (("program.rob", "program"), ("w.world.toml", "world"),
+                      ("s.sensors.json", "sensors")):
+        fifo = tmp_path / name
+        os.mkfifo(fifo)
+        arguments = {"program": str(SAMPLE), key: str(fifo)}
+        response = _answer_in_process({"seq": 1, "type": "request", "command": "launch",
+                                       "arguments": arguments})
+        assert response["message"] == f"{fifo}: it is a FIFO, not a regular file: name one"
+
+
+@pytest.mark.parametrize("command", [5, None, ["threads"]])
+def test_a_request_whose_command_is_no_string_is_answered(command: object) -> None:
+    """Found by the hostile pass: skipped, it left its client waiting for an answer."""
+    response = _answer_in_process({"seq": 7, "type": "request", "command": command})
+    assert (response["request_seq"], response["success"]) == (7, False)
+    assert response["message"] == ("a request's `command` is a string, such as "
+                                   "\"launch\": send one")
