@@ -1,14 +1,15 @@
 """Peak memory of `rl1c` on the largest inputs it accepts: `rl1c sim` on the worst valid
 worlds (the longest time limit, the shortest tracing interval), against the bound of
-spec/simulator.md (200 MB), and `rl1c check` and `rl1c compile` on 8 MiB sources of
-several shapes, in bytes per source byte, against the bound of spec/language.md (64).
+spec/simulator.md (200 MB), and `rl1c check`, `rl1c compile` and `rl1c check --fix` on
+8 MiB sources of several shapes, in bytes per source byte, against the bound of
+spec/language.md (64).
 
 Each figure is the peak resident set of one `rl1c` process (os.wait4's ru_maxrss), with
 the peak of `rl1c check` on an empty file printed as the reference (the interpreter and
 the modules). A run that has not ended after --seconds is stopped, and its peak so far
 is printed with "(stopped)".
 
-    .venv/bin/python bench/memory.py [--only sim|source] [--command check|compile]
+    .venv/bin/python bench/memory.py [--only sim|source] [--command check|compile|fix]
                                      [--match TEXT] [--seconds 300]
 """
 
@@ -108,6 +109,8 @@ def sources() -> list[tuple[str, bytes, bytes]]:
         # through (a loop of every line)
         ("`#01` lines after `:01`, a jump each", b":01\n", b"#01\n"),
         ("`?A=#01` lines after `:01`", b":01\n", b"?A=#01\n"),
+        # a fix a line, all made in one round (and lines with a syntax error above)
+        ("`(mov 3,3)` lines, a fix each", b"", b"(mov 3,3)\n"),
     ]
 
 
@@ -127,29 +130,32 @@ def write_filled(path: Path, head: bytes, line: bytes) -> int:
 
 
 def source_cases(folder: Path, seconds: float, match: str, commands: list[str]) -> None:
-    arguments = {"check": ["check"], "compile": ["compile", "-o", str(folder / "big.ilc")]}
+    arguments = {"check": ["check"], "compile": ["compile", "-o", str(folder / "big.ilc")],
+                 "fix": ["check", "--fix"]}
     empty = folder / "empty.rob"
     empty.write_bytes(b"")
     reference, _ = peak(["check", str(empty)], seconds)
-    print(f"rl1c check and compile on 8 MiB sources: peak resident MB, and bytes per source "
-          f"byte above `rl1c check` on an empty file ({reference:.1f} MB); bound: 64")
+    labels = {"check": "check", "compile": "compile", "fix": "check --fix"}
+    print(f"rl1c {', '.join(labels[one] for one in commands)} on 8 MiB sources: peak "
+          f"resident MB, and bytes per source byte above `rl1c check` on an empty file "
+          f"({reference:.1f} MB); bound: 64")
     for name, head, line in sources():
         if match not in name:
             continue
         path = folder / "big.rob"
-        size = write_filled(path, head, line)
-        for command in (arguments[one] for one in commands):
+        for command in commands:
+            size = write_filled(path, head, line)  # anew: --fix rewrites it
             started = time.monotonic()
-            megabytes, ending = peak([*command, str(path)], seconds)
+            megabytes, ending = peak([*arguments[command], str(path)], seconds)
             per_byte = (megabytes - reference) * MIB / size
-            print(f"  {command[0]:<8} {name:<40} {megabytes:8.1f} MB {per_byte:6.1f} B/B  "
-                  f"{ending} after {time.monotonic() - started:.0f} s")
+            print(f"  {labels[command]:<11} {name:<40} {megabytes:8.1f} MB {per_byte:6.1f} B/B"
+                  f"  {ending} after {time.monotonic() - started:.0f} s")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", choices=("sim", "source"))
-    parser.add_argument("--command", choices=("check", "compile"),
+    parser.add_argument("--command", choices=("check", "compile", "fix"),
                         help="only this command on the sources")
     parser.add_argument("--match", default="", help="only the cases whose name holds this")
     parser.add_argument("--seconds", type=float, default=300.0,

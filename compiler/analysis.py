@@ -5,14 +5,15 @@ makes the checker's fixes."""
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable, Iterable, Iterator
-from typing import NamedTuple
+from array import array
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from typing import NamedTuple, overload
 
 from .checker import apply_suppressions, check, check_text
 from .checker.compact import CompactDiagnostics
-from .frontend.ast import Program
-from .frontend.diagnostics import Diagnostic, Fix, sort_key
-from .frontend.edits import apply_edits, compatible
+from .frontend.ast import Program, Span
+from .frontend.diagnostics import Diagnostic, Edit, Fix, sort_key
+from .frontend.edits import apply_edits, compatible_one_by_one
 from .frontend.parser import parse_program
 
 
@@ -76,13 +77,20 @@ def fix(text: str, keep: Callable[[Diagnostic], bool] = lambda _: True, *,
     diagnostics = diagnose_compactly(text)
     made = 0
     for done in range(MAX_FIX_ROUNDS):
-        fixes = compatible(_fixes(diagnostics, keep, unsafe and done == 0))
+        edits = _HeldEdits()
+        fixes = 0
+        safe = True
+        for one in compatible_one_by_one(_fixes(diagnostics, keep, unsafe and done == 0)):
+            edits.extend(one.edits)
+            fixes += 1
+            safe = safe and one.safe
         if not fixes:
             break
-        text = apply_edits(text, [edit for one in fixes for edit in one.edits])
-        made += len(fixes)
+        text = apply_edits(text, edits)
+        made += fixes
+        del edits  # made: the next round's diagnostics take its place
         diagnostics = diagnose_compactly(text)
-        if not all(one.safe for one in fixes):
+        if not safe:
             break
     left = sum(1 for d in diagnostics if keep(d) and d.fixes)
     return Fixed(text, made, diagnostics, left)
@@ -95,3 +103,45 @@ def _fixes(diagnostics: Iterable[Diagnostic], keep: Callable[[Diagnostic], bool]
         if keep(diagnostic):
             yield from itertools.islice((one for one in diagnostic.fixes
                                          if one.safe or unsafe), 1)
+
+
+class _HeldEdits(Sequence[Edit]):
+    """The edits of the fixes a round of `fix` makes, in order, each held as the four
+    numbers of its span and its text (one object for equal texts), and built again
+    when read: a source with a fix on each line held 290 bytes of objects a fix (its
+    Fix, Edit, Span and row) until all were made, 36 bytes a source byte on lines of 8."""
+
+    __slots__ = ("_places", "_text_index", "_texts", "_which")
+
+    def __init__(self) -> None:
+        self._places = array("I")  # line, column, end line and end column of each edit
+        self._which = array("I")  # the index of each edit's text in _texts
+        self._texts: list[str] = []
+        self._text_index: dict[str, int] = {}
+
+    def extend(self, edits: Iterable[Edit]) -> None:
+        for edit in edits:
+            span = edit.span
+            self._places.extend((span.line, span.column, span.end_line, span.end_column))
+            which = self._text_index.get(edit.text)
+            if which is None:
+                which = self._text_index[edit.text] = len(self._texts)
+                self._texts.append(edit.text)
+            self._which.append(which)
+
+    def __len__(self) -> int:
+        return len(self._which)
+
+    @overload
+    def __getitem__(self, index: int) -> Edit: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> Sequence[Edit]: ...
+
+    def __getitem__(self, index: int | slice) -> Edit | Sequence[Edit]:
+        if isinstance(index, slice):
+            return [self[position] for position in range(len(self))[index]]
+        position = range(len(self))[index]  # IndexError as a list gives it
+        line, column, end_line, end_column = self._places[4 * position:4 * position + 4]
+        return Edit(Span(line, column, end_line, end_column),
+                    self._texts[self._which[position]])

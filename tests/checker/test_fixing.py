@@ -6,6 +6,9 @@ fix of the run wrote."""
 from __future__ import annotations
 
 import re
+import subprocess
+import sys
+import textwrap
 
 import pytest
 from hypothesis import assume, given, settings
@@ -286,3 +289,76 @@ def test_explain_says_whether_a_codes_fix_is_safe(code: str) -> None:
         return
     assert len(stated) == 1, f"`rl1c explain {code}` must say whether its fix is safe"
     assert {one.safe for one in fixes} == {stated[0] == "safe"}
+
+
+def fix_holding_every_fix(text: str, unsafe: bool = False) -> tuple[str, int, list[Diagnostic]]:
+    """`fix` as it was before it held its fixes compactly (every Fix of a round in a
+    list, on `analyze`'s diagnostics): the reference its results are held to."""
+    diagnostics = analyze(text).diagnostics
+    made = 0
+    for done in range(10):
+        fixes = compatible(next((one for one in d.fixes if one.safe or (unsafe and done == 0)),
+                                None) for d in diagnostics
+                           if any(one.safe or (unsafe and done == 0) for one in d.fixes))
+        if not fixes:
+            break
+        text = apply_edits(text, [edit for one in fixes for edit in one.edits])
+        made += len(fixes)
+        diagnostics = analyze(text).diagnostics
+        if not all(one.safe for one in fixes):
+            break
+    return text, made, diagnostics
+
+
+# Lines with fixes, repeated so that fixes meet and edits share their texts, and jumps
+# that blocks share (graph.Block.jump).
+REPEATED_LINES = ("(mov 3,3)", "(mov 3,3)", "A=1 B=2", "A=1 B=2", "#5", "#5", ":5 (TIM 10)",
+                  ":7", "?A=#5", "#10", ":10 A=1", "GOTO 10", "(TIM 1,2)", "A=40000", "(END)",
+                  "(MOV 3,3)", ":97 (MOV 0,0); (END)", "(HLB)", "(TRC 3)")
+
+
+@settings(deadline=None, max_examples=300)
+@given(programs() | fixable_programs()
+       | st.lists(st.sampled_from(REPEATED_LINES), min_size=1, max_size=16).map("\n".join),
+       st.booleans())
+def test_fix_makes_what_it_made_holding_every_fix(text: str, unsafe: bool) -> None:
+    """`fix` holds a round's edits as numbers (analysis._HeldEdits) and takes the fixes
+    one by one from the diagnostics held compactly: the text, the fixes counted and the
+    diagnostics left are those of holding every Fix of the tree's check."""
+    fixed = fix(text, unsafe=unsafe)
+    expected_text, expected_made, expected_left = fix_holding_every_fix(text, unsafe)
+    assert (fixed.text, fixed.fixes) == (expected_text, expected_made)
+    assert [repr(d) for d in fixed.diagnostics] == [repr(d) for d in expected_left]
+
+
+FIX_MEASURE = textwrap.dedent("""
+    import io, sys, tracemalloc
+    from rl1.compiler.analysis import fix
+    from rl1.compiler.reporting.render import FileDiagnostics, write_report
+    from rl1.compiler.reporting.selection import Selection
+    line = sys.argv[1]
+    text = line * (256 * 1024 // len(line))
+
+    class Nowhere(io.TextIOBase):
+        def write(self, text):
+            return len(text)
+
+    tracemalloc.start()
+    selection = Selection()
+    fixed = fix(text, keep=selection.reports)
+    files = [FileDiagnostics("big.rob", fixed.text, selection.apply_compact(fixed.diagnostics))]
+    write_report(Nowhere(), files, "human")
+    print(fixed.fixes, tracemalloc.get_traced_memory()[1] / len(text))
+""")
+
+
+@pytest.mark.parametrize("line", ["A=1 B=2\n", "(mov 3,3)\n"])
+def test_fixing_takes_at_most_64_bytes_a_source_byte(line: str) -> None:
+    """What `rl1c check --fix` does beyond reading its text, on a fix a line (bench/memory.py),
+    against spec/language.md's bound: 72 and 69 B/B when a round held every Fix (290
+    bytes a fix) until it made them."""
+    measured = subprocess.run([sys.executable, "-c", FIX_MEASURE, line], capture_output=True,
+                              text=True, check=True)
+    fixes, per_byte = measured.stdout.split()
+    assert int(fixes) >= 256 * 1024 // len(line)  # a fix a line, and an (END)
+    assert float(per_byte) <= 64
