@@ -49,6 +49,7 @@ from rl1.vm.sim.device import SimEntry
 from rl1.vm.verifier import VerifyError
 
 from .framing import CHUNK, Framer, frame
+from .json_reading import read_json
 
 THREAD = 1
 FRAME = 1
@@ -122,7 +123,7 @@ class Adapter:
     def receive(self, body: bytes) -> None:
         """Handle one message's body."""
         try:
-            message = json.loads(body)
+            message = read_json(body)
         except (ValueError, RecursionError) as error:
             print(f"rl1-dap: a message that is no JSON was skipped: {error}", file=sys.stderr)
             return

@@ -44,6 +44,7 @@ from . import (
     transports,
 )
 from .document import MAX_ANALYSED_CHARACTERS, Document
+from .json_reading import read_json
 from .positions import UTF16, Columns
 
 log = logging.getLogger(__name__)
@@ -120,7 +121,7 @@ class Rl1Protocol(LanguageServerProtocol):
     def receive(self, body: bytes) -> None:
         """Handle one message's body."""
         try:
-            data = json.loads(body)
+            data = read_json(body)
         except RecursionError:
             self._refuse(None, JsonRpcParseError(
                 "the message is nested too deeply to read: send a JSON-RPC message"))

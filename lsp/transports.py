@@ -42,6 +42,7 @@ from concurrent.futures import CancelledError
 from typing import Any, BinaryIO, Protocol
 
 from .framing import CHUNK, MAX_MESSAGE, Admission, Framer, frame
+from .json_reading import read_json
 
 log = logging.getLogger(__name__)
 
@@ -332,7 +333,7 @@ async def _read_tcp(reader: asyncio.StreamReader, writer: asyncio.StreamWriter
 def _request_id(body: bytes) -> object:
     """The id of the request in `body`, or None."""
     try:
-        data = json.loads(body)
+        data = read_json(body)
     except (ValueError, RecursionError):
         return None
     return data.get("id") if isinstance(data, dict) and "method" in data else None

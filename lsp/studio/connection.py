@@ -11,7 +11,6 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
-import math
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from importlib.metadata import version
@@ -26,6 +25,7 @@ from rl1.vm.defaults import DEFAULT_BUDGET, DEFAULT_LEVEL
 from rl1.vm.sensor_script import Script, ScriptError, decode_script
 from rl1.vm.sim.world import World, WorldError, decode_world
 
+from ..json_reading import read_json
 from . import shapes
 from .files import MAX_FILE_BYTES, Changed, Folder, Refused, Unusable, version_of
 from .run import DEFAULT_SPEED, FRAMES_PER_SECOND, MAX_SPEED, MIN_SPEED, Launch, Run
@@ -113,7 +113,7 @@ class Connection:
     async def receive(self, frame: str | bytes) -> None:
         """Handle one message, answering it unless it is a notification."""
         try:
-            message = json.loads(frame, parse_float=_finite, parse_constant=_no_constant)
+            message = read_json(frame)
         except (ValueError, RecursionError) as error:
             self._answer(None, error=RpcError(PARSE_ERROR, f"the message is no JSON ({error}): "
                                                            "send one JSON-RPC request a frame"))
@@ -515,21 +515,6 @@ def _unicode(value: str, what: str) -> str:
         raise RpcError(INVALID_PARAMS, f"{what} holds {value[error.start:error.end]!r}, half "
                        "of a surrogate pair, which is no character: send Unicode text") from None
     return value
-
-
-def _finite(text: str) -> float:
-    """A JSON number with a fraction or an exponent, refused when it is beyond a double
-    (`1e400`), as NaN and Infinity are (_no_constant): an answer would carry it back
-    as no JSON a page reads."""
-    value = float(text)
-    if not math.isfinite(value):
-        raise ValueError(f"{text} is beyond the numbers JSON carries")
-    return value
-
-
-def _no_constant(name: str) -> float:
-    """NaN, Infinity and -Infinity, which Python's json reads, though they are no JSON."""
-    raise ValueError(f"{name} is no JSON")
 
 
 async def _files(work: Awaitable[Any]) -> Any:

@@ -9,6 +9,7 @@ from urllib.parse import unquote, urlsplit
 
 from .. import server as language_server
 from .. import transports
+from ..json_reading import read_json
 from .files import Folder, Refused
 
 
@@ -35,7 +36,7 @@ class Confined:
 
     def receive(self, body: bytes) -> None:
         try:
-            message = json.loads(body)
+            message = read_json(body)
         except (ValueError, RecursionError):
             message = None  # the session answers what is no JSON
         if isinstance(message, dict) and (uri := _document_uri(message)) is not None \

@@ -96,6 +96,18 @@ def test_malformed_json_is_a_parse_error(server: RawServer, body: bytes) -> None
     answered(server, 3)
 
 
+@pytest.mark.parametrize("number", [b"NaN", b"Infinity", b"-Infinity", b"1e400"])
+def test_nan_and_infinity_are_no_json(server: RawServer, number: bytes) -> None:
+    """Found by the studio's hostile pass: Python's json reads them, and a request with
+    the id NaN was answered with `"id": NaN`, which no client's JSON reader reads."""
+    server.start()
+    server.send(frame(b'{"jsonrpc": "2.0", "id": %s, "method": "shutdown"}' % number))
+    reply = server.next()
+    assert reply["id"] is None and reply["error"]["code"] == PARSE_ERROR, reply
+    assert number.lstrip(b"-").decode() in reply["error"]["message"]
+    answered(server, 3)
+
+
 @pytest.mark.parametrize("body", [b"[]", b"42", b'"hover"', b'{"id": 2, "method": "shutdown"}'])
 def test_json_that_is_no_message_is_an_invalid_request(server: RawServer, body: bytes) -> None:
     server.start()
