@@ -162,12 +162,20 @@ class Server:
                 connection, f"rl1c studio serves {transports.MAX_SESSIONS} pages at once: "
                 "close one")
             return
+        assert isinstance(connection, self.lsp.connection_class)
         self.pages += 1
         outbox = _Outbox(connection)
         page = Connection(self.studio, outbox.send, lambda: outbox.unsent)
         try:
-            async for message in connection:
-                await page.receive(message)
+            # Its bytes in flight are bounded together with the language server's
+            # sessions' (transports.InFlight), as each of them counts its own.
+            with self.lsp.in_flight.counting(connection,
+                                             lambda: connection.received + outbox.unsent):
+                while True:
+                    message = await connection.recv(decode=False)
+                    await page.receive(message)
+                    # The library keeps the last frame it read until the next.
+                    connection.received, message = len(message), b""
         except ConnectionClosed as closed:
             log.info("a page's connection ended: %s", closed)
         finally:
@@ -212,9 +220,7 @@ class _Outbox:
 async def serve_studio(server: Server, port: int, listening: Callable[[int], None]) -> None:
     """Serve until cancelled; `listening` is told the port once the server listens."""
     async with serve(server.handle, HOST, port, process_request=server.process_request,
-                     create_connection=server.lsp.connection_class, max_size=MAX_MESSAGE,
-                     max_queue=1, logger=transports.WEBSOCKETS_LOG,
-                     server_header=None) as listener:
+                     server_header=None, **server.lsp.serving()) as listener:
         server.addresses = [socket.getsockname()[:2] for socket in listener.sockets]
         server.gate.port = server.addresses[0][1]
         listening(server.gate.port)

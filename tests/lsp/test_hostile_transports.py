@@ -170,6 +170,40 @@ def test_more_clients_than_are_served_sending_the_largest_message_stay_in_the_bo
         server.stop()
 
 
+def test_websocket_clients_sending_compressed_messages_at_once_stay_in_the_bound() -> None:
+    """Found by the studio's hostile pass: with permessage-deflate a message of 60 MiB
+    came as some 60 KiB, which is all the bound of the bytes in flight counted, and the
+    server inflated and read every client's at once. The server now takes no
+    compression: what it receives is what a message takes."""
+    from websockets.exceptions import WebSocketException
+    from websockets.sync.client import connect
+
+    server = ServedLsp("ws")
+    text = "\\u0041" * (10 * 2**20)  # 60 MiB of JSON escapes, 10 MiB of text
+    message = ('{"jsonrpc": "2.0", "id": 1, "method": "initialize", "params": '
+               f'{{"capabilities": {{}}, "rootPath": "{text}"}}}}')
+    answered: list[str] = []
+
+    def send() -> None:
+        # Refused while the others' are read: WebSocketException, or OSError.
+        with contextlib.suppress(WebSocketException, OSError), connect(
+                f"ws://127.0.0.1:{server.port}", max_size=None, open_timeout=60) as client:
+            client.send(message)
+            answered.append(str(client.recv(timeout=60)))
+
+    try:
+        clients = [threading.Thread(target=send) for _ in range(MAX_SESSIONS)]
+        for client in clients:
+            client.start()
+        for client in clients:
+            client.join()
+        peak = server.peak_mib() - server.started_mib
+        assert peak < GROWTH_BOUND_MIB, f"{peak:.0f} MiB at its peak"
+        assert answered and all('"capabilities"' in answer for answer in answered)
+    finally:
+        server.stop()
+
+
 @pytest.mark.parametrize("transport", TRANSPORTS)
 def test_a_server_keeps_no_message_of_the_clients_that_have_left(transport: str) -> None:
     """Issue 23: a session kept its last message after it ended (in a coroutine's

@@ -208,6 +208,13 @@ class StudioProcess:
                 return int(line.split()[1]) / 1024
         raise AssertionError("no VmRSS")
 
+    def peak_mib(self) -> float:
+        """The most resident memory the process has held, from /proc."""
+        for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024
+        raise AssertionError("no VmHWM")
+
     def stop(self) -> None:
         self.process.kill()
         self.process.wait(TIMEOUT)

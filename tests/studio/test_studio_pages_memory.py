@@ -1,13 +1,20 @@
-"""`rl1c studio` serving pages one after another, each closed with its run held, keeps
-what they held no longer than an ended language server session (lsp/transports.py,
-Collector)."""
+"""`rl1c studio`'s memory as pages come and go: serving pages one after another, each
+closed with its run held, it keeps what they held no longer than an ended language
+server session (lsp/transports.py, Collector); pages sending their largest messages at
+once take no more than the language server's sessions may (transports.InFlight)."""
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import pytest
-from served import StudioProcess, pages_one_after_another, sample_folder
+from served import TIMEOUT, StudioProcess, pages_one_after_another, sample_folder
+from support.hostile import GROWTH_BOUND_MIB
+from websockets.exceptions import ConnectionClosed
+from websockets.sync.client import connect
+
+from rl1.lsp.transports import MAX_SESSIONS
 
 pytestmark = pytest.mark.slow  # a studio in a process of its own, 220 pages
 
@@ -25,5 +32,38 @@ def test_pages_one_after_another_leave_nothing_behind(tmp_path: Path) -> None:
         pages_one_after_another(studio, 200)
         kept = studio.resident_mib() - before
         assert kept < KEPT_BY_200_PAGES_MIB, f"{kept:.1f} MiB kept by 200 pages"
+    finally:
+        studio.stop()
+
+
+def test_pages_sending_a_compressed_message_of_60_mib_at_once_stay_in_the_bound(
+        tmp_path: Path) -> None:
+    """Found by the hostile pass: permessage-deflate carried each message in some 60 KiB,
+    which is what the bound of the bytes in flight counted, and the server inflated the
+    eight of them at once: 1,134 MiB at its peak."""
+    studio = StudioProcess(sample_folder(tmp_path))
+    started = studio.resident_mib()
+    text = "\\u0041" * (10 * 2**20)  # 60 MiB of JSON escapes, 10 MiB of text
+    message = ('{"jsonrpc": "2.0", "id": 1, "method": "files/save", "params": '
+               f'{{"path": "large.rob", "text": "{text}"}}}}')
+    answered: list[str] = []
+
+    def send() -> None:
+        try:
+            with connect(studio.url("/studio"), max_size=None, open_timeout=TIMEOUT) as page:
+                page.send(message)
+                answered.append(str(page.recv(timeout=TIMEOUT)))
+        except (ConnectionClosed, OSError):  # refused while the others are read
+            pass
+
+    try:
+        pages = [threading.Thread(target=send) for _ in range(MAX_SESSIONS)]
+        for page in pages:
+            page.start()
+        for page in pages:
+            page.join()
+        peak = studio.peak_mib() - started
+        assert peak < GROWTH_BOUND_MIB, f"{peak:.0f} MiB at its peak"
+        assert answered and all("larger than 8 MiB" in answer for answer in answered)
     finally:
         studio.stop()
