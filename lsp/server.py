@@ -211,7 +211,8 @@ def _converter() -> cattrs.Converter:
     the event loop, so that it holds no session's state, only the functions it makes
     for each type, which the sessions then share (bench/lsp_sessions.py: one a session
     cost some 5 ms and 0.3 MiB)."""
-    return default_converter()
+    converter: cattrs.Converter = default_converter()  # type: ignore[no-untyped-call]
+    return converter
 
 
 class Rl1Server(LanguageServer):
