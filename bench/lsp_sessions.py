@@ -40,7 +40,7 @@ def measure(transport: str, clients: int) -> None:
         seconds = processor_seconds(server.process.pid) - start
         grown = server.resident_mib() - before
         print(f"rl1-lsp --{transport}: {clients} clients one after another grew the server by "
-              f"{grown:.1f} MiB, {grown / clients:.3f} MiB a client ({grown / clients / before:.2%}"
+              f"{grown:.1f} MiB, {grown / clients:.3f} MiB a client ({grown / clients / before:.3%}"
               f" of the {before:.0f} MiB it held after {WARM_UP} clients); "
               f"{seconds / clients * 1000:.1f} ms of processor time a client")
     finally:
