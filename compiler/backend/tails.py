@@ -33,8 +33,6 @@ def merge_tails(program: ir.Program) -> ir.Program:
     """One sweep, target by target (the merges for one target change no block of
     another's: a tail is laid out just before its own target); for each, the longest
     shared tail first, so that each shorter one is a tail of it in turn."""
-    if flow.takes_events(program):
-        return program
     following = program.following()
     falling_into = {block.terminator.target: block for block in program
                     if isinstance(block.terminator, ir.Jump)
@@ -45,12 +43,17 @@ def merge_tails(program: ir.Program) -> ir.Program:
         if isinstance(terminator, ir.Jump) and terminator.target in falling_into \
                 and following[block.id] != terminator.target:
             jumping_to.setdefault(terminator.target, []).append(block)
+    plans = {target: sorted(((_shared_length(block.instructions,
+                                             falling_into[target].instructions), block)
+                             for block in jumping), key=lambda pair: -pair[0])
+             for target, jumping in jumping_to.items()}
+    # The scan for events last, where a tail is shared: it costs the most.
+    if not any(plan[0][0] for plan in plans.values()) or flow.takes_events(program):
+        return program
     numbers = count(_first_free_number(program))
     split_off: dict[ir.BlockId, list[ir.Block]] = {}  # laid out after the block, in order
-    for target, jumping in jumping_to.items():
+    for target, shared in plans.items():
         first = falling = falling_into[target]
-        shared = sorted(((_shared_length(block.instructions, first.instructions), block)
-                         for block in jumping), key=lambda pair: -pair[0])
         for length, block in shared:
             if not length:
                 break
