@@ -160,6 +160,8 @@ class Adapter:
         self._respond(request, CAPABILITIES)
 
     def _on_launch(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
+        if self.session is not None:
+            self._idle()  # a program running would go on, unseen, beside the new one
         program = _text(arguments, "program")
         if program is None:
             raise Refused("launch needs `program`: the .rob or .ilc file to debug")

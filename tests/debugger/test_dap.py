@@ -386,3 +386,32 @@ def test_a_request_whose_command_is_no_string_is_answered(command: object) -> No
     assert (response["request_seq"], response["success"]) == (7, False)
     assert response["message"] == ("a request's `command` is a string, such as "
                                    "\"launch\": send one")
+
+
+def test_a_launch_while_the_program_runs_is_refused(tmp_path: Path) -> None:
+    """Found by the hostile pass: the new launch replaced the session while the old
+    program went on running in its worker, for good, and told its stops as the new
+    one's."""
+    looping = tmp_path / "loop.rob"
+    looping.write_text(":01 A=A+1; #01\n")
+    sent: list[dict[str, Any]] = []
+    adapter = Adapter(sent.append)
+
+    def request(seq: int, command: str, arguments: dict[str, Any]) -> dict[str, Any]:
+        adapter.receive(json.dumps({"seq": seq, "type": "request", "command": command,
+                                    "arguments": arguments}).encode())
+        (response,) = [m for m in sent if m.get("request_seq") == seq]
+        return response
+
+    request(1, "launch", {"program": str(looping), "budget": 10**12})
+    request(2, "configurationDone", {})
+    running = adapter._worker
+    again = request(3, "launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)})
+    assert (again["success"], again["message"]) == (False, "the program is running: pause "
+                                                           "it first")
+    request(4, "pause", {})
+    assert running is not None
+    running.join(TIMEOUT)
+    assert not running.is_alive()
+    assert request(5, "launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)}
+                   )["success"]
