@@ -109,6 +109,7 @@ def sources() -> list[tuple[str, bytes, bytes]]:
         # through (a loop of every line)
         ("`#01` lines after `:01`, a jump each", b":01\n", b"#01\n"),
         ("`?A=#01` lines after `:01`", b":01\n", b"?A=#01\n"),
+        ("`#01` lines, no `:01`: an E0203 each", b"", b"#01\n"),
         # a fix a line, all made in one round (and lines with a syntax error above)
         ("`(mov 3,3)` lines, a fix each", b"", b"(mov 3,3)\n"),
     ]

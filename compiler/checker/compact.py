@@ -11,8 +11,9 @@ starts, and their kind (code and severity): 14 bytes each. Reading them parses t
 line again (what a line gives is a function of its text and its number), keeps what
 was kept of them, and merges them into the others, which are few and held whole (the
 program-wide rules', the W0107s of suppression comments). Of the program-wide rules',
-W0401 alone may be one a line; its reads are held by line too, with their column, and
-built again from their line (reserved.unset_reads). Reading costs a second parse
+W0401 and E0203 may be one a line; they are held by line too, with the column of the
+read or the jump's target, and built again from their line (`Rebuild`:
+reserved.unset_reads, labels.undefined_targets). Reading costs a second parse
 of each line held: `rl1c check` on a source of a syntax error a line takes about 1.4
 times the processor time it took when they were held whole, and a twelfth of the memory.
 """
@@ -21,7 +22,7 @@ from __future__ import annotations
 
 import itertools
 from array import array
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from typing import overload
 
 from rl1.compiler.frontend import ast
@@ -48,17 +49,24 @@ def parsed_line(text: str, number: int) -> tuple[ast.Line, list[Diagnostic]]:
 
 
 UNSET_READ: Kind = ("W0401", Severity.WARNING)
-"""The kind of the one program-wide rule's diagnostics held by line: a read of a
-reserved variable that may be unset (reserved.py), one a line in a source of `A=s`
-lines, 250 bytes each held whole."""
+"""A read of a reserved variable that may be unset (reserved.py): held by line, one a
+line in a source of `A=s` lines, 250 bytes each held whole."""
+
+UNDEFINED_TARGET: Kind = ("E0203", Severity.ERROR)
+"""A jump to a label no line defines (labels.py): held by line, one a line in a source
+of `#01` lines without `:01`, 400 bytes each held whole."""
+
+Rebuild = Callable[[ast.Line, list[int]], list[Diagnostic]]
+"""The diagnostics of a program-wide rule held by line, built again from their line:
+those at the columns given."""
 
 
 class LineDiagnostics:
     """The diagnostics of single lines while a text is checked, each held as its line's
     number, where the line starts in the text, an index into the kinds seen (4, 8 and 2
-    bytes), and once a W0401 is held, the column of each read that W0401 reports, 0 for
-    a diagnostic the line gives alone (4 bytes): a text's lines are found again without
-    an index of them all."""
+    bytes), and once a program-wide rule's is held (`Rebuild`), the column it is built
+    again from, 0 for a diagnostic the line gives alone (4 bytes): a text's lines are
+    found again without an index of them all."""
 
     __slots__ = ("_index", "columns", "kinds", "numbers", "of_kind", "starts")
 
@@ -72,8 +80,8 @@ class LineDiagnostics:
 
     def add(self, number: int, start: int, kind: Kind, column: int = 0) -> None:
         """Hold a diagnostic of `kind` given by line `number`, which starts at `start`
-        in the text (the next lines' come after); `column` is that of the read a W0401
-        reports."""
+        in the text (the next lines' come after); `column` is the one a program-wide
+        rule's is built again from."""
         index = self._index.get(kind)
         if index is None:
             index = self._index[kind] = len(self.kinds)
@@ -89,9 +97,16 @@ class LineDiagnostics:
         self.starts.append(start)
         self.of_kind.append(index)
 
-    def columns_of(self, start: int, end: int) -> Sequence[int]:
-        """The columns of the reads held from position `start` to `end` (0: none)."""
-        return self.columns[start:end] if self.columns is not None else ()
+    def rebuilt_of(self, start: int, end: int) -> dict[Kind, list[int]]:
+        """The columns of the program-wide rules' diagnostics held from position `start`
+        to `end`, by kind."""
+        found: dict[Kind, list[int]] = {}
+        if self.columns is not None:
+            for index, column in zip(self.of_kind[start:end], self.columns[start:end],
+                                     strict=True):
+                if column:
+                    found.setdefault(self.kinds[index], []).append(column)
+        return found
 
     def _entries(self) -> Iterator[tuple[int, int, int, int]]:
         columns = self.columns
@@ -133,18 +148,21 @@ class LineDiagnostics:
 class CompactDiagnostics(Sequence[Diagnostic]):
     """Every diagnostic of a text in sort_key's order, as `analysis.diagnose` gives
     them: those of single lines held in `held` (those a line gives that `keeps` keeps,
-    built again when read), the `others` whole, in order. Reading them all parses each
-    line of `held` once; `severities` says what they are without building any."""
+    and the program-wide rules' that `rebuilt` builds again, built again when read), the
+    `others` whole, in order. Reading them all parses each line of `held` once;
+    `severities` says what they are without building any."""
 
-    __slots__ = ("_as_errors", "_held", "_keeps", "_others", "_text")
+    __slots__ = ("_as_errors", "_held", "_keeps", "_others", "_rebuilt", "_text")
 
     def __init__(self, text: str, held: LineDiagnostics, keeps: Keeps,
-                 others: list[Diagnostic], *, as_errors: bool = False) -> None:
+                 others: list[Diagnostic], *, as_errors: bool = False,
+                 rebuilt: Mapping[Kind, Rebuild] | None = None) -> None:
         self._text = text
         self._held = held
         self._keeps = keeps
         self._others = others
         self._as_errors = as_errors
+        self._rebuilt = rebuilt if rebuilt is not None else {UNSET_READ: unset_reads}
 
     def selected(self, reports: Callable[[str, Severity], bool], as_errors: bool
                  ) -> CompactDiagnostics:
@@ -158,7 +176,8 @@ class CompactDiagnostics(Sequence[Diagnostic]):
         others = [self._made_error(d) if as_errors else d for d in self._others
                   if reports(d.code, d.severity)]
         return CompactDiagnostics(self._text, self._held.kept(kept), kept, others,
-                                  as_errors=self._as_errors or as_errors)
+                                  as_errors=self._as_errors or as_errors,
+                                  rebuilt=self._rebuilt)
 
     def severities(self) -> Iterator[Severity]:
         """The severity of each diagnostic, in no particular order."""
@@ -182,7 +201,7 @@ class CompactDiagnostics(Sequence[Diagnostic]):
             while end < len(numbers) and numbers[end] == number:
                 end += 1
             built = self._built(number, self._held.starts[position],
-                                self._held.columns_of(position, end))
+                                self._held.rebuilt_of(position, end))
             if len(built) != end - position:
                 raise AssertionError(f"line {number} gave other diagnostics than it did")
             position = end
@@ -211,14 +230,16 @@ class CompactDiagnostics(Sequence[Diagnostic]):
                 return diagnostic
         raise AssertionError("fewer diagnostics were built than were held")
 
-    def _built(self, number: int, start: int, columns: Sequence[int]) -> list[Diagnostic]:
+    def _built(self, number: int, start: int, rebuilt: dict[Kind, list[int]]
+               ) -> list[Diagnostic]:
         """The diagnostics held of line `number`, which starts at `start` in the text,
-        built again, in sort_key's order; `columns` are the held ones' columns of reads."""
+        built again, in sort_key's order; `rebuilt` has the columns of the program-wide
+        rules' held, by kind."""
         end = LINE_BREAK.search(self._text, start)
         text = self._text[start:end.start() if end else len(self._text)]
         line, found = parsed_line(text, number)
-        if any(columns):
-            found += unset_reads(line, [column for column in columns if column])
+        for kind, columns in rebuilt.items():
+            found += self._rebuilt[kind](line, columns)
         built = [self._made_error(d) if self._as_errors else d for d in found
                  if d.span.line == number and self._keeps(d.code, d.severity, number)]
         built.sort(key=_place_in_line)

@@ -22,7 +22,7 @@ def solve(graph: ControlFlowGraph, start: int, transfer: Transfer) -> list[int]:
     extra edges carry their own states (lost-line handlers are entered mid-block)."""
     count = len(graph.blocks)
     states = [0] * count
-    seen = [False] * count  # a state of 0 may be a real state: track visits apart
+    seen = bytearray(count)  # a state of 0 may be a real state: track visits apart
     seen[graph.entry] = True
     states[graph.entry] = start
     queued = bytearray(count)

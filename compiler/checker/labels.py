@@ -9,6 +9,7 @@ unused labels are not reported: they are likely cascades of that error.
 from __future__ import annotations
 
 import operator
+from collections.abc import Callable, Collection
 
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Related, Severity
@@ -16,8 +17,16 @@ from rl1.vm.language import HANDLER_LABELS
 
 from .graph import ControlFlowGraph
 
+OnUndefined = Callable[[ast.LabelRef, str], None]
+"""Told of a jump target no label defines, with what E0203's help says of the labels
+defined (the same for every one)."""
 
-def check_labels(graph: ControlFlowGraph) -> list[Diagnostic]:
+
+def check_labels(graph: ControlFlowGraph, on_undefined: OnUndefined | None = None
+                 ) -> list[Diagnostic]:
+    """The label diagnostics of `graph`; with `on_undefined`, each target E0203 would
+    report is handed to it instead (the streaming check holds them compactly: a source
+    of jumps to a missing label has one a line)."""
     found: list[Diagnostic] = []
     first: dict[int, ast.LabelDef] = {}
     for index in graph.labelled:
@@ -34,11 +43,17 @@ def check_labels(graph: ControlFlowGraph) -> list[Diagnostic]:
     blind = any(not graph.blocks[index].labels for index in graph.opaque)
     missing = {number for number in targets if number is not None and number not in first}
     if missing and not blind:
-        # a block's jump may stand for others' (graph.Block.jump): its place is that of
-        # the block's last statement
-        found.extend(_undefined(_written(block.statements[-1]), first)
-                     for block in graph.blocks
-                     if block.jump is not None and block.jump.target.number in missing)
+        defined = _defined(first)
+
+        def report(ref: ast.LabelRef, defined: str) -> None:
+            found.append(_undefined(ref, defined))
+
+        undefined = report if on_undefined is None else on_undefined
+        for block in graph.blocks:
+            if block.jump is not None and block.jump.target.number in missing:
+                # a block's jump may stand for others' (graph.Block.jump): its place is
+                # that of the block's last statement
+                undefined(_written(block.statements[-1]), defined)
     if not graph.opaque:
         found.extend(_unused(graph, number, label) for number, label in first.items()
                      if number not in targets and number not in HANDLER_LABELS)
@@ -60,12 +75,26 @@ def _defined_twice(label: ast.LabelDef, earlier: ast.LabelDef) -> Diagnostic:
     )
 
 
-def _undefined(ref: ast.LabelRef, defined: dict[int, ast.LabelDef]) -> Diagnostic:
-    help_text = f"start the line to jump to with `:{ref.text[1:]}`"
-    if defined:
-        listed = ", ".join(f"`{label.text}`" for _, label in sorted(defined.items())[:12])
-        more = ", ..." if len(defined) > 12 else ""
-        help_text += f"; the labels defined are {listed}{more}"
+def undefined_targets(line: ast.Line, columns: Collection[int], defined: str
+                      ) -> list[Diagnostic]:
+    """The E0203s of the jumps in `line` whose targets are at `columns`, which
+    check_labels reported with `defined`: built again from the line (compact.py)."""
+    return [_undefined(statement.target, defined) for statement in line.statements
+            if isinstance(statement, ast.Goto | ast.CondJump)
+            and statement.target.span.column in columns]
+
+
+def _defined(first: dict[int, ast.LabelDef]) -> str:
+    """What E0203's help says of the labels `first` defines."""
+    if not first:
+        return ""
+    listed = ", ".join(f"`{label.text}`" for _, label in sorted(first.items())[:12])
+    more = ", ..." if len(first) > 12 else ""
+    return f"; the labels defined are {listed}{more}"
+
+
+def _undefined(ref: ast.LabelRef, defined: str) -> Diagnostic:
+    help_text = f"start the line to jump to with `:{ref.text[1:]}`{defined}"
     return Diagnostic("E0203", Severity.ERROR,
                       f"the jump target `{ref.text}` is not defined: no line starts with "
                       f"`:{ref.text[1:]}`", ref.span, help=help_text)

@@ -29,7 +29,7 @@ def check_loops(graph: ControlFlowGraph) -> list[Diagnostic]:
     # the blocks of the component looked at: a byte a block, where a set of a loop of
     # every block took 70 bytes a block
     members = bytearray(len(blocks))
-    for component in cycles([block.successors for block in blocks], blind):
+    for component in cycles(lambda index: blocks[index].successors, blind):
         for index in component:
             members[index] = True
         diagnostic = _busy(graph, [blocks[index] for index in sorted(component)], members)

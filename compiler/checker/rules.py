@@ -8,19 +8,20 @@ from rl1.compiler.frontend.diagnostics import Diagnostic
 
 from .graph import ControlFlowGraph
 from .handlers import check_handlers
-from .labels import check_labels
+from .labels import OnUndefined, check_labels
 from .loops import check_loops
 from .reachability import check_reachability
 from .reserved import OnRead, check_reserved
 from .safety import check_safety
 
 
-def check_graph(graph: ControlFlowGraph, program: ast.Span,
-                on_unset: OnRead | None = None) -> list[Diagnostic]:
+def check_graph(graph: ControlFlowGraph, program: ast.Span, on_unset: OnRead | None = None,
+                on_undefined: OnUndefined | None = None) -> list[Diagnostic]:
     """The diagnostics of the whole-program rules on `graph`, whose program spans
-    `program`; with `on_unset`, the reads W0401 reports are handed to it instead."""
+    `program`; with `on_unset`, the reads W0401 reports are handed to it instead, and
+    with `on_undefined` the targets E0203 reports."""
     return [
-        *check_labels(graph),
+        *check_labels(graph, on_undefined),
         *check_handlers(program, graph),
         *check_reserved(graph, on_unset),
         *check_reachability(program, graph),

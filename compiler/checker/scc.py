@@ -6,14 +6,15 @@ took 64 bytes a node for their objects alone (bench/memory.py's jumps)."""
 from __future__ import annotations
 
 from array import array
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 
-def cycles(successors: Sequence[Sequence[int]], included: Sequence[bool]
+def cycles(successors: Callable[[int], Sequence[int]], included: Sequence[bool]
            ) -> list[array[int]]:
     """The components of the subgraph of `included` nodes that hold a cycle: more than
-    one node, or one node with an edge to itself."""
-    count = len(successors)
+    one node, or one node with an edge to itself. `successors` gives a node's, looked
+    up as they are needed (a list of them all took 8 bytes a node)."""
+    count = len(included)
     order = array("i", [-1]) * count  # discovery number, -1 while undiscovered
     low = array("i", [0]) * count
     on_stack = bytearray(count)
@@ -32,7 +33,7 @@ def cycles(successors: Sequence[Sequence[int]], included: Sequence[bool]
         work, positions = array("q", [root]), array("q", [0])
         while work:
             node, position = work[-1], positions[-1]
-            following = successors[node]
+            following = successors(node)
             if position < len(following):
                 positions[-1] = position + 1
                 successor = following[position]

@@ -16,6 +16,7 @@ built again when read (compact.py).
 
 from __future__ import annotations
 
+import functools
 import itertools
 from array import array
 from collections.abc import Callable, Hashable, Iterator, Sequence
@@ -28,9 +29,19 @@ from rl1.compiler.frontend.parser import parse_line
 from rl1.compiler.frontend.source import LineIndex, iter_lines
 
 from .cfg import graph_of
-from .compact import UNSET_READ, CompactDiagnostics, LineDiagnostics, parsed_line
+from .compact import (
+    UNDEFINED_TARGET,
+    UNSET_READ,
+    CompactDiagnostics,
+    Kind,
+    LineDiagnostics,
+    Rebuild,
+    parsed_line,
+)
 from .effects import BlockEffects, Combining, Segment, line_segments
 from .graph import Block, ReadAgain
+from .labels import undefined_targets
+from .reserved import unset_reads
 from .rules import check_graph
 from .suppression import MARK, Suppressions
 
@@ -256,16 +267,28 @@ def check_text(text: str) -> CompactDiagnostics:
         blocks.append(Block(len(blocks), (), _taken(pending), False, (), (), nothing))
         graph = graph_of(blocks, summaries)
         summaries.clear()  # the blocks hold their effects
-        unset = LineDiagnostics()  # W0401's reads, in the order of their lines
+        # the program-wide rules' that may be one a line, each in the order of its lines
+        unset = LineDiagnostics()  # W0401's reads
+        undefined = LineDiagnostics()  # E0203's targets
+        defined_labels = ""  # what E0203's help says of the labels defined
 
         def unset_read(var: ast.Var) -> None:
             number = var.span.line
             unset.add(number, lines.start(number - 1), UNSET_READ, var.span.column)
 
+        def undefined_target(target: ast.LabelRef, defined: str) -> None:
+            nonlocal defined_labels
+            defined_labels = defined
+            number = target.span.line
+            undefined.add(number, lines.start(number - 1), UNDEFINED_TARGET,
+                          target.span.column)
+
         others += check_graph(graph, ast.Span(1, 1, last_span.end_line, last_span.end_column),
-                              unset_read)
-        if unset.numbers:  # a copy of the lines' own, which may be one a line
-            held = held.merged(unset)
+                              unset_read, undefined_target)
+        del graph, blocks  # 60 bytes a block: let go before the merges copy what is held
+        for program_wide in (unset, undefined):
+            if program_wide.numbers:  # a copy of the lines' own, which may be one a line
+                held = held.merged(program_wide)
     suppressions = Suppressions(directives)
     if not suppressions.empty:
         held = held.kept(suppressions.reports)
@@ -273,7 +296,10 @@ def check_text(text: str) -> CompactDiagnostics:
                   if suppressions.reports(d.code, d.severity, d.span.line)]
         others += suppressions.problems()
     sort_by_place(others)
-    return CompactDiagnostics(text, held, suppressions.reports, others)
+    rebuilt: dict[Kind, Rebuild] = {
+        UNSET_READ: unset_reads,
+        UNDEFINED_TARGET: functools.partial(undefined_targets, defined=defined_labels)}
+    return CompactDiagnostics(text, held, suppressions.reports, others, rebuilt=rebuilt)
 
 
 def _merges_into(blocks: list[Block]) -> bool:

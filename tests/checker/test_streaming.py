@@ -138,6 +138,8 @@ SOURCES = {
     # a set and lists of ints as large as the program
     "`#01` lines": (":01\n", "#01\n"),
     "`?A=#01` lines": (":01\n", "?A=#01\n"),
+    # and an E0203 a line: 172 B/B when each was held whole (400 bytes)
+    "`#01` lines without `:01`": ("", "#01\n"),
 }
 SOURCE_CHARACTERS = 256 * 1024
 
