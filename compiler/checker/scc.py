@@ -9,11 +9,12 @@ from array import array
 from collections.abc import Callable, Sequence
 
 
-def cycles(successors: Callable[[int], Sequence[int]], included: Sequence[bool]
+def cycles(successors: Callable[[int], Sequence[int]], included: Sequence[int]
            ) -> list[array[int]]:
-    """The components of the subgraph of `included` nodes that hold a cycle: more than
-    one node, or one node with an edge to itself. `successors` gives a node's, looked
-    up as they are needed (a list of them all took 8 bytes a node)."""
+    """The components of the subgraph of `included` nodes (nonzero there: a bytearray
+    does) that hold a cycle: more than one node, or one node with an edge to itself.
+    `successors` gives a node's, looked up as they are needed (a list of them all took
+    8 bytes a node)."""
     count = len(included)
     order = array("i", [-1]) * count  # discovery number, -1 while undiscovered
     low = array("i", [0]) * count

@@ -137,6 +137,30 @@ class SourceStatements(ReadAgain):
             start = 0
 
 
+class SourceBlock(Block):
+    """A block of the streaming check: a graph `Block` whose statements are read from the
+    source again (`SourceStatements`, made at each reading of `statements`) where
+    `places` says they are, and `ending` says how the last one ends the block (as
+    SourceStatements takes it). No object of statements is held: 56 bytes a block."""
+
+    __slots__ = ("ending", "places")
+
+    def __init__(self, index: int, labels: Sequence[ast.LabelDef], places: BlockPlaces,
+                 effects: BlockEffects) -> None:
+        self.places = places
+        self.ending: ast.Goto | ast.CondJump | bool = False  # until the block is closed
+        super().__init__(index, (), labels, False, (), (), effects)
+
+    @property  # over a field of Block's, which the constructor alone sets
+    def statements(self) -> Sequence[ast.Statement]:
+        return SourceStatements(self.places, self.index, self.ending)
+
+    @statements.setter
+    def statements(self, given: Sequence[ast.Statement]) -> None:
+        """Block's constructor gives none: the places say where they are."""
+        assert not given
+
+
 class _OpenBlock:
     """The block being cut, its graph block made: where its statements start, how many,
     the effects of its runs combined as they come, the last statement seen and where."""
@@ -144,7 +168,7 @@ class _OpenBlock:
     __slots__ = ("block", "effects", "first", "last", "last_line", "last_start", "length",
                  "start")
 
-    def __init__(self, block: Block, first: int, start: int) -> None:
+    def __init__(self, block: SourceBlock, first: int, start: int) -> None:
         self.block = block
         self.first = first
         self.start = start
@@ -214,10 +238,8 @@ def check_text(text: str) -> CompactDiagnostics:
             block = cutting.block
             places.add(block.index, cutting.first, cutting.start, cutting.length,
                        cutting.last_line, cutting.last_start)
-            block.statements = SourceStatements(
-                places, block.index,
-                shared_jump(last) if isinstance(last, ast.Goto | ast.CondJump)
-                else ast.is_end(last))
+            block.ending = (shared_jump(last) if isinstance(last, ast.Goto | ast.CondJump)
+                            else ast.is_end(last))
             effects = cutting.effects
             summaries.append(nothing if effects.empty else shared(effects.result()))
             cutting = None
@@ -252,7 +274,7 @@ def check_text(text: str) -> CompactDiagnostics:
             start = 0
             for run, summary, closes in segments:
                 if cutting is None:
-                    made = Block(len(blocks), (), _taken(pending), False, (), (), nothing)
+                    made = SourceBlock(len(blocks), _taken(pending), places, nothing)
                     cutting = _OpenBlock(made, index, start)
                     blocks.append(cutting.block)
                 if summary is not None:

@@ -297,8 +297,8 @@ def fix_holding_every_fix(text: str, unsafe: bool = False) -> tuple[str, int, li
     diagnostics = analyze(text).diagnostics
     made = 0
     for done in range(10):
-        fixes = compatible(next((one for one in d.fixes if one.safe or (unsafe and done == 0)),
-                                None) for d in diagnostics
+        fixes = compatible(next(one for one in d.fixes if one.safe or (unsafe and done == 0))
+                           for d in diagnostics
                            if any(one.safe or (unsafe and done == 0) for one in d.fixes))
         if not fixes:
             break

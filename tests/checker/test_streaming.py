@@ -53,6 +53,7 @@ def test_a_blocks_statements_are_read_from_its_lines_again() -> None:
     text = "A=1; B=2\n\n' comment\nC=3; #10\n"
     lines = LineIndex(text)
     last = parse_line(lines[3], 4)[0].statements[1]
+    assert isinstance(last, ast.Goto)
     places = BlockPlaces(lines)
     places.add(2, 0, 1, 3, 3, 1)  # block 2, from B=2 to #10; blocks 0 and 1 hold none
     assert list(places.length) == [0, 0, 3]
