@@ -110,6 +110,8 @@ def sources() -> list[tuple[str, bytes, bytes]]:
         ("`#01` lines after `:01`, a jump each", b":01\n", b"#01\n"),
         ("`?A=#01` lines after `:01`", b":01\n", b"?A=#01\n"),
         ("`#01` lines, no `:01`: an E0203 each", b"", b"#01\n"),
+        # a block for every three bytes (and an E0202 a line): above the bound
+        ("`#1` lines, a block each 3 bytes", b"", b"#1\n"),
         # a fix a line, all made in one round (and lines with a syntax error above)
         ("`(mov 3,3)` lines, a fix each", b"", b"(mov 3,3)\n"),
     ]

@@ -4,9 +4,10 @@ bench/memory.py).
 
 The lines are parsed one at a time, once: each line's syntax errors and per-line rules
 are taken then, and the line's statements are cut into blocks and summarized
-(effects.line_segments) as the language server's memo does. A block keeps where its
-statements are, not the statements: the few rules that read them (the spans of a
-block's first statement, the reads of reserved variables that may be unset, the
+(effects.line_segments) as the language server's memo does. A block (`SourceBlock`)
+keeps where its statements are, as numbers in arrays for all blocks (`BlockPlaces`),
+not the statements: the few rules that read them (the spans of a block's first
+statement and of its jump, the reads of reserved variables that may be unset, the
 targets written in a busy loop) have its lines parsed again as they read
 (`SourceStatements`). The diagnostics are the same as those of the tree's check
 (`analysis.analyze`, which the compiler needs for its tree), and a property test holds
@@ -51,10 +52,12 @@ Value = TypeVar("Value")
 class BlockPlaces:
     """Where the statements of each block cut are in the source, as numbers in arrays
     indexed by the block's number: from statement `start` of line `first` to the block's
-    last, statement `last_start` of line `last_line` (0-based indices), `length` in all.
-    20 bytes a block, where an object of them with a line's number took 124."""
+    last, statement `last_start` of line `last_line` (0-based indices), `length` in all,
+    and the column of the target of the jump that ends it (0: none), which E0203 reports
+    without reading the line again. 24 bytes a block, where an object of its place with
+    a line's number took 124."""
 
-    __slots__ = ("first", "last_line", "last_start", "length", "lines", "start")
+    __slots__ = ("first", "last_line", "last_start", "length", "lines", "start", "target")
 
     def __init__(self, lines: LineIndex) -> None:
         self.lines = lines
@@ -63,15 +66,17 @@ class BlockPlaces:
         self.length = array("I")
         self.last_line = array("I")
         self.last_start = array("I")
+        self.target = array("I")
 
     def add(self, block: int, first: int, start: int, length: int, last_line: int,
-            last_start: int) -> None:
+            last_start: int, target: int) -> None:
         """Hold the place of block number `block`, past those held (the blocks between,
         which hold no statements, get zeros)."""
-        columns = (self.first, self.start, self.length, self.last_line, self.last_start)
+        columns = (self.first, self.start, self.length, self.last_line, self.last_start,
+                   self.target)
         missing = block - len(self.first)
-        for column, value in zip(columns, (first, start, length, last_line, last_start),
-                                 strict=True):
+        for column, value in zip(columns, (first, start, length, last_line, last_start,
+                                           target), strict=True):
             if missing:
                 column.extend(itertools.repeat(0, missing))
             column.append(value)
@@ -236,10 +241,11 @@ def check_text(text: str) -> CompactDiagnostics:
             last = cutting.last
             assert last is not None  # a block opens with its first run
             block = cutting.block
+            jumps = isinstance(last, ast.Goto | ast.CondJump)
             places.add(block.index, cutting.first, cutting.start, cutting.length,
-                       cutting.last_line, cutting.last_start)
-            block.ending = (shared_jump(last) if isinstance(last, ast.Goto | ast.CondJump)
-                            else ast.is_end(last))
+                       cutting.last_line, cutting.last_start,
+                       last.target.span.column if jumps else 0)
+            block.ending = shared_jump(last) if jumps else ast.is_end(last)
             effects = cutting.effects
             summaries.append(nothing if effects.empty else shared(effects.result()))
             cutting = None
@@ -298,12 +304,12 @@ def check_text(text: str) -> CompactDiagnostics:
             number = var.span.line
             unset.add(number, lines.start(number - 1), UNSET_READ, var.span.column)
 
-        def undefined_target(target: ast.LabelRef, defined: str) -> None:
+        def undefined_target(block: Block, defined: str) -> None:
             nonlocal defined_labels
             defined_labels = defined
-            number = target.span.line
-            undefined.add(number, lines.start(number - 1), UNDEFINED_TARGET,
-                          target.span.column)
+            line = places.last_line[block.index]
+            undefined.add(line + 1, lines.start(line), UNDEFINED_TARGET,
+                          places.target[block.index])
 
         others += check_graph(graph, ast.Span(1, 1, last_span.end_line, last_span.end_column),
                               unset_read, undefined_target)

@@ -55,8 +55,9 @@ def test_a_blocks_statements_are_read_from_its_lines_again() -> None:
     last = parse_line(lines[3], 4)[0].statements[1]
     assert isinstance(last, ast.Goto)
     places = BlockPlaces(lines)
-    places.add(2, 0, 1, 3, 3, 1)  # block 2, from B=2 to #10; blocks 0 and 1 hold none
-    assert list(places.length) == [0, 0, 3]
+    places.add(2, 0, 1, 3, 3, 1, 6)  # block 2, from B=2 to #10; blocks 0 and 1 hold none
+    assert list(places.length) == [0, 0, 3] and list(places.target) == [0, 0, 6]
+    assert last.target.span.column == 6
     statements = SourceStatements(places, 2, last)
     assert len(statements) == 3
     assert statements.jump is last and not statements.ends
@@ -77,9 +78,9 @@ def test_a_blocks_last_statement_is_read_from_its_line_again() -> None:
     lines = LineIndex(text)
     end = parse_line(lines[1], 2)[0].statements[1]
     places = BlockPlaces(lines)
-    places.add(0, 0, 0, 3, 1, 1)  # from A=1 to (END)
-    places.add(1, 2, 0, 1, 2, 0)  # #10 on line 3
-    places.add(2, 3, 0, 1, 3, 0)  # #10 on line 4
+    places.add(0, 0, 0, 3, 1, 1, 0)  # from A=1 to (END)
+    places.add(1, 2, 0, 1, 2, 0, 1)  # #10 on line 3
+    places.add(2, 3, 0, 1, 3, 0, 1)  # #10 on line 4
     statements = SourceStatements(places, 0, True)
     assert statements.ends and statements.jump is None
     last = statements[-1]
