@@ -109,7 +109,7 @@ def _link(blocks: list[Block], changed: Iterable[int], summaries: list[BlockEffe
         block = blocks[index]
         summary = summaries[index]
         block.effects = summary
-        following = block.index + 1
+        following = index + 1
         jump, ends = _ending(block.statements)
         if block.opaque:
             block.successors = tuple(dict.fromkeys([following, *named, exit_index]))

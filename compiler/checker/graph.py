@@ -73,6 +73,8 @@ class HandlerEdge(NamedTuple):
 class Block:
     """A basic block. The graph's construction fills in its edges and effects."""
 
+    # its number; one object may stand for several blocks that never run (streaming.py),
+    # numbered as the first, so the rules go by the block's place in ControlFlowGraph.blocks
     index: int
     statements: Sequence[ast.Statement]  # read from the source again when not a list
     labels: Sequence[ast.LabelDef]  # the labels naming it
@@ -88,6 +90,11 @@ class Block:
     # where the block's own is, is its last statement. A field, not a property, so that
     # the rules gather the jumps of thousands of blocks in C (attrgetter).
     jump: ast.Goto | ast.CondJump | None = None
+
+    def statements_at(self, index: int) -> Sequence[ast.Statement]:
+        """The statements of the block at `index` in the graph: this block's own, unless
+        it stands for several blocks (streaming.py's blocks that never run)."""
+        return self.statements
 
     @property
     def ends(self) -> bool:
@@ -114,3 +121,8 @@ class ControlFlowGraph:
 
     def reachable(self, index: int) -> bool:
         return self.device_on_entry[index] != 0
+
+    def statements(self, index: int) -> Sequence[ast.Statement]:
+        """The statements of block number `index`: the rules read them by number, as a
+        block object may stand for several (streaming.py)."""
+        return self.blocks[index].statements_at(index)

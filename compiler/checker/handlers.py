@@ -35,10 +35,10 @@ def check_handlers(program: ast.Span, graph: ControlFlowGraph) -> list[Diagnosti
     if any(block.opaque and not block.labels for block in graph.blocks):
         return []  # the line with a syntax error may define the handler
     first: dict[int, ast.Statement] = {}
-    for block in graph.blocks:
+    for index, block in enumerate(graph.blocks):
         for edge in block.handlers:
             if edge.target is None and edge.label not in first:
-                first[edge.label] = block.statements[edge.statement]
+                first[edge.label] = graph.statements(index)[edge.statement]
     return [_missing(program, label, statement) for label, statement in sorted(first.items())]
 
 

@@ -15,18 +15,18 @@ from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix, Related, Severity
 from rl1.vm.language import HANDLER_LABELS
 
-from .graph import Block, ControlFlowGraph
+from .graph import ControlFlowGraph
 
-OnUndefined = Callable[[Block, str], None]
-"""Told of a block whose jump goes to a label no line defines, with what E0203's help
+OnUndefined = Callable[[int, str], None]
+"""Told of the number of a block whose jump goes to a label no line defines, with what E0203's help
 says of the labels defined (the same for every one)."""
 
 
 def check_labels(graph: ControlFlowGraph, on_undefined: OnUndefined | None = None
                  ) -> list[Diagnostic]:
-    """The label diagnostics of `graph`; with `on_undefined`, each block whose jump's
-    target E0203 would report is handed to it instead (the streaming check holds them
-    compactly: a source of jumps to a missing label has one a line)."""
+    """The label diagnostics of `graph`; with `on_undefined`, the number of each block
+    whose jump's target E0203 would report is handed to it instead (the streaming check
+    holds them compactly: a source of jumps to a missing label has one a line)."""
     found: list[Diagnostic] = []
     first: dict[int, ast.LabelDef] = {}
     for index in graph.labelled:
@@ -45,15 +45,15 @@ def check_labels(graph: ControlFlowGraph, on_undefined: OnUndefined | None = Non
     if missing and not blind:
         defined = _defined(first)
 
-        def report(block: Block, defined: str) -> None:
+        def report(index: int, defined: str) -> None:
             # a block's jump may stand for others' (graph.Block.jump): its place is that
             # of the block's last statement
-            found.append(_undefined(_written(block.statements[-1]), defined))
+            found.append(_undefined(_written(graph.statements(index)[-1]), defined))
 
         undefined = report if on_undefined is None else on_undefined
-        for block in graph.blocks:
+        for index, block in enumerate(graph.blocks):
             if block.jump is not None and block.jump.target.number in missing:
-                undefined(block, defined)
+                undefined(index, defined)
     if not graph.opaque:
         found.extend(_unused(graph, number, label) for number, label in first.items()
                      if number not in targets and number not in HANDLER_LABELS)
@@ -101,8 +101,7 @@ def _undefined(ref: ast.LabelRef, defined: str) -> Diagnostic:
 
 
 def _unused(graph: ControlFlowGraph, number: int, label: ast.LabelDef) -> Diagnostic:
-    block = graph.blocks[graph.labels[number]]
-    following = [statement.span for statement in block.statements[:1]
+    following = [statement.span for statement in graph.statements(graph.labels[number])[:1]
                  if statement.span.line == label.span.line]
     end = following[0] if following else label.span
     removal = ast.Span(label.span.line, label.span.column, end.line,

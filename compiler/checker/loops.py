@@ -14,7 +14,7 @@ from __future__ import annotations
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Related, Severity
 
-from .graph import Block, ControlFlowGraph
+from .graph import ControlFlowGraph
 from .scc import cycles
 
 HELP = ("read a sensor inside the loop (e.g. `A=(IMG)-180`, `(KYO)`, `A=(ULT A)`) or wait "
@@ -23,8 +23,8 @@ HELP = ("read a sensor inside the loop (e.g. `A=(IMG)-180`, `(KYO)`, `A=(ULT A)`
 
 def check_loops(graph: ControlFlowGraph) -> list[Diagnostic]:
     blocks = graph.blocks
-    blind = bytearray(graph.reachable(block.index) and not block.opaque and not block.handlers
-                      and not block.effects.observes for block in blocks)
+    blind = bytearray(graph.reachable(index) and not block.opaque and not block.handlers
+                      and not block.effects.observes for index, block in enumerate(blocks))
     found: list[Diagnostic] = []
     # the blocks of the component looked at: a byte a block, where a set of a loop of
     # every block took 70 bytes a block
@@ -32,7 +32,7 @@ def check_loops(graph: ControlFlowGraph) -> list[Diagnostic]:
     for component in cycles(lambda index: blocks[index].successors, blind):
         for index in component:
             members[index] = True
-        diagnostic = _busy(graph, [blocks[index] for index in sorted(component)], members)
+        diagnostic = _busy(graph, sorted(component), members)
         if diagnostic is not None:
             found.append(diagnostic)
         for index in component:
@@ -40,16 +40,17 @@ def check_loops(graph: ControlFlowGraph) -> list[Diagnostic]:
     return found
 
 
-def _busy(graph: ControlFlowGraph, loop: list[Block], members: bytearray) -> Diagnostic | None:
-    """W0604 for the cycle of `loop`'s blocks (in order), whose indices `members` marks,
-    if it is busy."""
+def _busy(graph: ControlFlowGraph, loop: list[int], members: bytearray) -> Diagnostic | None:
+    """W0604 for the cycle of the blocks numbered `loop` (in order), which `members`
+    marks, if it is busy."""
     tested: set[str] = set()
-    for block in loop:
+    for index in loop:
+        block = graph.blocks[index]
         jump = block.jump
-        if isinstance(jump, ast.CondJump) and not all(members[index]
-                                                      for index in block.successors):
+        if isinstance(jump, ast.CondJump) and not all(members[successor]
+                                                      for successor in block.successors):
             tested.add(jump.var.name)
-    written = {statement.target.name for block in loop for statement in block.statements
+    written = {statement.target.name for index in loop for statement in graph.statements(index)
                if isinstance(statement, ast.Assign | ast.IncDec)}
     if tested & written:
         return None
@@ -64,19 +65,19 @@ def _busy(graph: ControlFlowGraph, loop: list[Block], members: bytearray) -> Dia
                       related=(Related(head.span, "the loop starts here"),))
 
 
-def _backward_jump(graph: ControlFlowGraph, loop: list[Block],
+def _backward_jump(graph: ControlFlowGraph, loop: list[int],
                    members: bytearray) -> tuple[ast.Goto | ast.CondJump, ast.LabelDef]:
     """The last jump back to a label inside the loop, and that label. Every cycle has
     one: fall-through only goes forward, and handler edges never leave a blind block."""
-    for block in reversed(loop):
-        jump = block.jump
+    for index in reversed(loop):
+        jump = graph.blocks[index].jump
         number = jump.target.number if jump is not None else None
         target = graph.labels.get(number) if number is not None else None
         if jump is not None and target is not None and members[target] \
-                and target <= block.index:
+                and target <= index:
             head = next(label for label in graph.blocks[target].labels if label.number == number)
             # block.jump may stand for others' jumps (graph.Block.jump): the block's own
-            written = block.statements[-1]
+            written = graph.statements(index)[-1]
             assert isinstance(written, ast.Goto | ast.CondJump)
             return written, head
     raise AssertionError("a cycle without a backward jump")

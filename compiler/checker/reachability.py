@@ -14,23 +14,22 @@ from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity
 from rl1.vm.language import HANDLER_LABELS
 
 from .fixes import append_line
-from .graph import Block, ControlFlowGraph
+from .graph import ControlFlowGraph
 
 REMOVE_OR_LABEL = "remove it, or start its line with a label and jump there"
 
 
 def check_reachability(program: ast.Span, graph: ControlFlowGraph) -> list[Diagnostic]:
     found: list[Diagnostic] = []
-    run: list[Block] = []
+    run = 0  # where the run of blocks no path reaches starts, if one has started
     defensive = _handler_code(graph)
-    for block, entry in zip(graph.blocks, graph.device_on_entry, strict=True):
-        if not entry and block.index not in defensive:
-            run.append(block)
-        elif run:
-            found.extend(_unreachable(graph, run))
-            run = []
-    if run:
-        found.extend(_unreachable(graph, run))
+    for index, entry in enumerate(graph.device_on_entry):
+        if entry or index in defensive:
+            if run < index:
+                found.extend(_unreachable(graph, range(run, index)))
+            run = index + 1
+    if run < len(graph.blocks):
+        found.extend(_unreachable(graph, range(run, len(graph.blocks))))
     found.extend(_no_end(program, graph))
     return found
 
@@ -49,16 +48,18 @@ def _handler_code(graph: ControlFlowGraph) -> set[int]:
     return found
 
 
-def _unreachable(graph: ControlFlowGraph, run: list[Block]) -> list[Diagnostic]:
+def _unreachable(graph: ControlFlowGraph, run: range) -> list[Diagnostic]:
+    """W0601 or W0602 for the blocks numbered `run`, which no path reaches."""
     # the first and last statements only: a run may be most of the program
-    first_statement = next((block.statements[0] for block in run if block.statements), None)
-    last_statement = next((block.statements[-1] for block in reversed(run)
-                           if block.statements), None)
+    first_statement = next((statements[0] for statements in map(graph.statements, run)
+                            if statements), None)
+    last_statement = next((statements[-1] for statements in map(graph.statements, reversed(run))
+                           if statements), None)
     if first_statement is None or last_statement is None:
         return []  # only lines with syntax errors
     span = first_statement.span.cover(last_statement.span)
-    first = run[0]
-    before = graph.blocks[first.index - 1].statements[-1:]  # the entry block is reachable
+    first = graph.blocks[run[0]]
+    before = graph.statements(run[0] - 1)[-1:]  # the entry block is reachable
     if first.labels:
         label = first.labels[-1].text
         return [Diagnostic("W0601", Severity.WARNING,
@@ -99,7 +100,7 @@ def fall_off_span(graph: ControlFlowGraph) -> ast.Span | None:
     exit_block = graph.blocks[graph.exit]
     if exit_block.labels:
         return exit_block.labels[-1].span
-    for block in reversed(graph.blocks):
-        if block.statements:
-            return block.statements[-1].span
+    for index in reversed(range(len(graph.blocks))):
+        if statements := graph.statements(index):
+            return statements[-1].span
     return None

@@ -38,7 +38,7 @@ def check_reserved(graph: ControlFlowGraph, on_unset: OnRead | None = None
         if block.opaque:
             return 0, []
         writes = block.effects.writes
-        return state & _kept(writes, len(block.statements)), [
+        return state & _kept(writes, len(graph.statements(index))), [
             (edge.target, state & _kept(writes, edge.statement))
             for edge in block.handlers if edge.target is not None]
 
@@ -55,7 +55,7 @@ def check_reserved(graph: ControlFlowGraph, on_unset: OnRead | None = None
         state = states[index]
         reads = block.effects.reads
         if state & reads and graph.reachable(index):
-            for statement in block.statements:
+            for statement in graph.statements(index):
                 if not state & reads:
                     break  # the state only shrinks: no read left in the block is reported
                 state = _walk(statement, state, reported)

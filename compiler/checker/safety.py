@@ -20,13 +20,13 @@ MOVING = device.MOVING | device.RUNNING  # a MOV in effect, or an MVI in the bac
 
 def check_safety(program: ast.Span, graph: ControlFlowGraph) -> list[Diagnostic]:
     found: list[Diagnostic] = []
-    for block in graph.blocks:
-        entry = graph.device_on_entry[block.index]
+    for index, (block, entry) in enumerate(zip(graph.blocks, graph.device_on_entry,
+                                               strict=True)):
         if not (entry and block.ends):
             continue
         state = device.run(block.effects.operations, block.effects.first_event, entry)[0]
         if state & MOVING:
-            end = block.statements[-1].span
+            end = graph.statements(index)[-1].span
             found.append(Diagnostic(
                 "W0701", Severity.WARNING, f"the program can end here {_while(state)}", end,
                 help=HELP,

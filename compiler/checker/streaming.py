@@ -146,7 +146,12 @@ class SourceBlock(Block):
     """A block of the streaming check: a graph `Block` whose statements are read from the
     source again (`SourceStatements`, made at each reading of `statements`) where
     `places` says they are, and `ending` says how the last one ends the block (as
-    SourceStatements takes it). No object of statements is held: 56 bytes a block."""
+    SourceStatements takes it). No object of statements is held: 56 bytes a block.
+
+    One SourceBlock stands for all the blocks that never run and are alike but for their
+    place (`_never_runs`): a block cost 140 bytes, and a program of `#1` lines is
+    such a block every 3 bytes. Its `index` and `statements` are the first's; the
+    graph's rules read each block's by its number (`statements_at`)."""
 
     __slots__ = ("ending", "places")
 
@@ -164,6 +169,9 @@ class SourceBlock(Block):
     def statements(self, given: Sequence[ast.Statement]) -> None:
         """Block's constructor gives none: the places say where they are."""
         assert not given
+
+    def statements_at(self, index: int) -> Sequence[ast.Statement]:
+        return SourceStatements(self.places, index, self.ending)
 
 
 class _OpenBlock:
@@ -231,6 +239,7 @@ def check_text(text: str) -> CompactDiagnostics:
     nothing = BlockEffects.nothing()
     shared = _Shared(_effects_key)
     shared_jump: _Shared[ast.Goto | ast.CondJump] = _Shared(_jump_key)
+    shared_dead: _Shared[tuple[SourceBlock, BlockEffects]] = _Shared(_dead_key)
     pending: list[ast.LabelDef] = []  # labels seen since the last statement
     cutting: _OpenBlock | None = None
     last_span = ast.Span(1, 1, 1, 1)
@@ -241,13 +250,17 @@ def check_text(text: str) -> CompactDiagnostics:
             last = cutting.last
             assert last is not None  # a block opens with its first run
             block = cutting.block
-            jumps = isinstance(last, ast.Goto | ast.CondJump)
+            if isinstance(last, ast.Goto | ast.CondJump):
+                target, block.ending = last.target.span.column, shared_jump(last)
+            else:
+                target, block.ending = 0, ast.is_end(last)
             places.add(block.index, cutting.first, cutting.start, cutting.length,
-                       cutting.last_line, cutting.last_start,
-                       last.target.span.column if jumps else 0)
-            block.ending = shared_jump(last) if jumps else ast.is_end(last)
+                       cutting.last_line, cutting.last_start, target)
             effects = cutting.effects
-            summaries.append(nothing if effects.empty else shared(effects.result()))
+            summary = nothing if effects.empty else shared(effects.result())
+            summaries.append(summary)
+            if _never_runs(block, blocks):
+                blocks[-1] = shared_dead((block, summary))[0]
             cutting = None
 
     with collector_paused():
@@ -304,16 +317,17 @@ def check_text(text: str) -> CompactDiagnostics:
             number = var.span.line
             unset.add(number, lines.start(number - 1), UNSET_READ, var.span.column)
 
-        def undefined_target(block: Block, defined: str) -> None:
+        def undefined_target(index: int, defined: str) -> None:
             nonlocal defined_labels
             defined_labels = defined
-            line = places.last_line[block.index]
-            undefined.add(line + 1, lines.start(line), UNDEFINED_TARGET,
-                          places.target[block.index])
+            line = places.last_line[index]
+            undefined.add(line + 1, lines.start(line), UNDEFINED_TARGET, places.target[index])
 
         others += check_graph(graph, ast.Span(1, 1, last_span.end_line, last_span.end_column),
                               unset_read, undefined_target)
-        del graph, blocks  # 60 bytes a block: let go before the merges copy what is held
+        # the graph's blocks, up to 60 bytes each: let go before the merges copy what is held
+        blocks.clear()
+        del graph
         for program_wide in (unset, undefined):
             if program_wide.numbers:  # a copy of the lines' own, which may be one a line
                 held = held.merged(program_wide)
@@ -328,6 +342,31 @@ def check_text(text: str) -> CompactDiagnostics:
         UNSET_READ: unset_reads,
         UNDEFINED_TARGET: functools.partial(undefined_targets, defined=defined_labels)}
     return CompactDiagnostics(text, held, suppressions.reports, others, rebuilt=rebuilt)
+
+
+def _never_runs(block: SourceBlock, blocks: list[Block]) -> bool:
+    """Whether `block`, just closed and last of `blocks`, may be one object with the
+    blocks alike but for their place: no path reaches it, and its edges are the same
+    wherever it is. It has no label, follows a block that ends with `#NN` or `(END)`
+    (so nothing falls or jumps into it: an opaque block falls into the next one, and a
+    jump to no label goes to the opaque blocks), and ends so too (its successors do not
+    depend on its place). A block no path reaches has no handler edges."""
+    if block.labels or len(blocks) < 2 or not _ends_unconditionally(block):
+        return False
+    before = blocks[-2]
+    return isinstance(before, SourceBlock) and _ends_unconditionally(before)
+
+
+def _ends_unconditionally(block: SourceBlock) -> bool:
+    return block.ending is True or isinstance(block.ending, ast.Goto)
+
+
+def _dead_key(dead: tuple[SourceBlock, BlockEffects]) -> Hashable:
+    """What the graph and its rules read of a block that never runs, but its place: how
+    it ends and its effects."""
+    block, effects = dead
+    ending = block.ending
+    return (ending if isinstance(ending, bool) else _jump_key(ending), _effects_key(effects))
 
 
 def _merges_into(blocks: list[Block]) -> bool:

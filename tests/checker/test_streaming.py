@@ -44,6 +44,11 @@ def assert_same(text: str) -> None:
     # line's own diagnostics, allowed by a comment, after a call that sets one
     "A=s+t; B=s; C=99999\nA=1 B=2\n(IMG 1); C=s+u ' rl1: allow W0401\nD=v; #10\n"
     "t=w\n?x=1#20\n:10 E=(ULT 1)+u+s\n",
+    # blocks that never run and are alike, which one object stands for: each says where
+    # it is (an E0203 a line, the spans of W0601 and W0602), a label ends the run, and
+    # the last is where the program runs off its end
+    "#10\n#05\n#05; A=1\n#05\n(END)\n(END)\n:10 #1\n#1\n(TIM 1); #1\n#1\n",
+    ":20 (MOV 1,1); #30\n(END)\n(END)\n:30 ?A=1#20\n#20\n#20\n",
 ])
 def test_programs_with_each_rule_give_the_same_diagnostics(text: str) -> None:
     assert_same(text)
@@ -142,6 +147,9 @@ SOURCES = {
     "`?A=#01` lines": (":01\n", "?A=#01\n"),
     # and an E0203 a line: 172 B/B when each was held whole (400 bytes)
     "`#01` lines without `:01`": ("", "#01\n"),
+    # a block every 3 bytes that never runs (each follows a jump, and has an E0202): 74
+    # B/B when each was a SourceBlock of its own (140 bytes)
+    "`#1` lines": ("", "#1\n"),
 }
 SOURCE_CHARACTERS = 256 * 1024
 
