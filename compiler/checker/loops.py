@@ -11,6 +11,8 @@ nested blind loops are reported once, on their last backward jump.
 
 from __future__ import annotations
 
+from array import array
+
 from rl1.compiler.frontend import ast
 from rl1.compiler.frontend.diagnostics import Diagnostic, Related, Severity
 
@@ -32,7 +34,9 @@ def check_loops(graph: ControlFlowGraph) -> list[Diagnostic]:
     for component in cycles(lambda index: blocks[index].successors, blind):
         for index in component:
             members[index] = True
-        diagnostic = _busy(graph, sorted(component), members)
+        # in order, as numbers in an array: a list of a loop of every block held an int
+        # object a block while the rule ran
+        diagnostic = _busy(graph, array("q", sorted(component)), members)
         if diagnostic is not None:
             found.append(diagnostic)
         for index in component:
@@ -40,7 +44,7 @@ def check_loops(graph: ControlFlowGraph) -> list[Diagnostic]:
     return found
 
 
-def _busy(graph: ControlFlowGraph, loop: list[int], members: bytearray) -> Diagnostic | None:
+def _busy(graph: ControlFlowGraph, loop: array[int], members: bytearray) -> Diagnostic | None:
     """W0604 for the cycle of the blocks numbered `loop` (in order), which `members`
     marks, if it is busy."""
     tested: set[str] = set()
@@ -65,7 +69,7 @@ def _busy(graph: ControlFlowGraph, loop: list[int], members: bytearray) -> Diagn
                       related=(Related(head.span, "the loop starts here"),))
 
 
-def _backward_jump(graph: ControlFlowGraph, loop: list[int],
+def _backward_jump(graph: ControlFlowGraph, loop: array[int],
                    members: bytearray) -> tuple[ast.Goto | ast.CondJump, ast.LabelDef]:
     """The last jump back to a label inside the loop, and that label. Every cycle has
     one: fall-through only goes forward, and handler edges never leave a blind block."""
