@@ -9,6 +9,8 @@ statement after it, and falling off the end of the program ends it.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 from rl1.compiler.frontend import ast
 from rl1.vm.language import HANDLER_LABELS
 
@@ -20,9 +22,10 @@ class LoweringError(Exception):
     lowering runs only on programs without errors, so this is a compiler bug."""
 
 
-def lower(program: ast.Program) -> ir.Program:
-    """The IR of a program the checker accepted."""
-    lowered = _Lowerer().lower(program)
+def lower(program: ast.Program | Iterable[ast.Line]) -> ir.Program:
+    """The IR of a program the checker accepted, from its tree or its lines in order (so
+    that a caller may parse each line as it is lowered and hold no tree: driver.py)."""
+    lowered = _Lowerer().lower(program.lines if isinstance(program, ast.Program) else program)
     problems = ir.validate(lowered)
     if problems:
         raise LoweringError("the checker let through a program with errors: "
@@ -37,15 +40,20 @@ class _Lowerer:
         self.block_id: ir.BlockId | None = None  # the open block, None after a jump or end
         self.code: list[ir.Instruction] = []
         self.unlabelled = 0
+        # One object for each variable and constant (they are frozen): a long program's
+        # IR was otherwise half operands (80 of the 192 bytes of `A=1`).
+        self.variables: dict[str, ir.Var] = {}
+        self.constants: dict[int, ir.Imm] = {}
 
-    def lower(self, program: ast.Program) -> ir.Program:
-        for line in program.lines:
+    def lower(self, lines: Iterable[ast.Line]) -> ir.Program:
+        last_line = 1
+        for line in lines:
             if line.label is not None:
                 self.start_label(line.label)
             for statement in line.statements:
                 self.statement(statement, line.number)
+            last_line = line.number
         if self.block_id is not None or not self.blocks:
-            last_line = program.lines[-1].number if program.lines else 1
             self.finish(ir.End(last_line))
         return ir.Program(self.blocks, next(iter(self.blocks)), self.handlers)
 
@@ -92,9 +100,9 @@ class _Lowerer:
             self.operand(statement.first, None, line)
             for step in statement.rest:
                 self.operand(step.operand, step.op, line)
-            self.emit(ir.Store(ir.Var(statement.target.name), line))
+            self.emit(ir.Store(self.variable(statement.target), line))
         elif isinstance(statement, ast.IncDec):
-            self.emit(ir.StepVar(ir.Var(statement.target.name), statement.step, line))
+            self.emit(ir.StepVar(self.variable(statement.target), statement.step, line))
         elif isinstance(statement, ast.Goto):
             ref = statement.target
             self.finish(ir.Jump(self.target(ref.number, ref.text, line), line))
@@ -103,7 +111,7 @@ class _Lowerer:
             taken = self.target(ref.number, ref.text, line)
             self.open_block()
             fall_through = f"B{self.unlabelled}"
-            self.finish(ir.Branch(ir.Var(statement.var.name), statement.relation,
+            self.finish(ir.Branch(self.variable(statement.var), statement.relation,
                                   taken, fall_through, line))
             self.open_block()
         elif statement.call.is_end:
@@ -134,6 +142,16 @@ class _Lowerer:
             lowered.append(self.argument(arg))
         return ir.Call(call.mnemonic.upper(), selector, tuple(lowered), line)
 
-    @staticmethod
-    def argument(arg: ast.Var | ast.Const) -> ir.Argument:
-        return ir.Var(arg.name) if isinstance(arg, ast.Var) else ir.Imm(arg.value)
+    def argument(self, arg: ast.Var | ast.Const) -> ir.Argument:
+        if isinstance(arg, ast.Var):
+            return self.variable(arg)
+        constant = self.constants.get(arg.value)
+        if constant is None:
+            constant = self.constants[arg.value] = ir.Imm(arg.value)
+        return constant
+
+    def variable(self, var: ast.Var) -> ir.Var:
+        shared = self.variables.get(var.name)
+        if shared is None:
+            shared = self.variables[var.name] = ir.Var(var.name)
+        return shared

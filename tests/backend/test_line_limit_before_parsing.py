@@ -11,19 +11,19 @@ from rl1.compiler.backend.driver import compile_text
 from rl1.vm import ilc
 
 
-def _refuse_parsing(text: str) -> None:
-    raise AssertionError("the parser was called")
+def _refuse_checking(text: str) -> None:  # a compile's check parses the text
+    raise AssertionError("the text was checked")
 
 
 def test_code_past_line_65535_is_refused_before_parsing(
         monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(analysis, "parse_program", _refuse_parsing)
+    monkeypatch.setattr(analysis, "check_text", _refuse_checking)
     text = "' a long program\n" + "\n" * (ilc.MAX_LINE - 1) + "  ' more\n" + "A=1\n" * 100_000
     compilation = compile_text(text, "long.rob")
     assert compilation.output is None
     [diagnostic] = compilation.diagnostics
     assert diagnostic.code == "E0191" and diagnostic.span.line == ilc.MAX_LINE + 2
-    with pytest.raises(AssertionError, match="the parser was called"):
+    with pytest.raises(AssertionError, match="the text was checked"):
         compile_text(text, "long.rob", strip_debug=True)  # no limit on lines: parsed
 
 

@@ -10,7 +10,6 @@ from intelhex import IntelHex
 from support import SAMPLE
 from support.cli import rl1c
 
-from rl1.compiler.analysis import Analysis
 from rl1.compiler.backend import driver
 from rl1.compiler.backend.firmware import c_source
 from rl1.compiler.backend.ir import format_program
@@ -187,10 +186,10 @@ def test_warnings_are_printed_and_do_not_block(
 ) -> None:
     warning = Diagnostic("W0601", Severity.WARNING, "a warning for the test", Span(2, 1, 2, 8))
 
-    def analyze_with_warning(text: str) -> Analysis:
-        return Analysis(parse_program(text)[0], [warning])
+    def diagnose_with_warning(text: str) -> list[Diagnostic]:
+        return [warning]
 
-    monkeypatch.setattr(driver, "analyze", analyze_with_warning)
+    monkeypatch.setattr(driver, "diagnose", diagnose_with_warning)
     result = rl1c(str(sample), "--color", "never")
     assert result.exit_code == 0
     assert "warning[W0601]: a warning for the test" in result.stderr

@@ -48,6 +48,7 @@ MARKS: dict[str, tuple[str, ...]] = {
     "tests/checker/test_streaming.py::test_checking_takes_at_most_64_bytes_a_source_byte":
         ("slow",),
     "tests/checker/test_fixing.py::test_fixing_takes_at_most_64_bytes_a_source_byte": ("slow",),
+    "tests/backend/test_compile_memory.py": ("slow",),
     # Campaigns of simulated runs on pools of processes, and on a Dask cluster of a
     # scheduler and two workers started for each test.
     "tests/sim/test_campaign.py": ("slow",),
