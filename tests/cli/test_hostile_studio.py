@@ -42,14 +42,19 @@ def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[int, str,
     server = subprocess.Popen([str(RL1C), "studio", "--no-browser", "--port", "0"],
                               cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                               text=True)
-    assert server.stdout is not None
-    address = re.search(r"http://127\.0\.0\.1:(\d+)/\?token=(\S+)", server.stdout.readline())
-    assert address is not None
-    yield int(address[1]), address[2], outside
-    server.send_signal(signal.SIGINT)
-    _, said = server.communicate(timeout=60)
-    assert server.returncode == 130
-    assert "Traceback" not in said
+    try:  # the server ends with the fixture, whatever fails
+        assert server.stdout is not None
+        address = re.search(r"http://127\.0\.0\.1:(\d+)/\?token=(\S+)",
+                            server.stdout.readline())
+        assert address is not None
+        yield int(address[1]), address[2], outside
+        server.send_signal(signal.SIGINT)
+        _, said = server.communicate(timeout=60)
+        assert server.returncode == 130
+        assert "Traceback" not in said
+    finally:
+        server.kill()
+        server.wait(60)
 
 
 def status_of(port: int, path: str, headers: dict[str, str]) -> int:
