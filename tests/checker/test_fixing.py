@@ -13,6 +13,7 @@ import textwrap
 import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
+from support.checker import FIX_TEXTS, an_edit
 
 from rl1.compiler.analysis import analyze, fix
 from rl1.compiler.frontend.ast import Program, Span
@@ -181,18 +182,8 @@ def edits_made_as_before(text: str, edits: list[Edit]) -> str:
     return text
 
 
-@st.composite
-def an_edit(draw: st.DrawFn) -> Edit:
-    line = draw(st.integers(1, 6))
-    column = draw(st.integers(1, 8))
-    end_line = draw(st.integers(line, 7))
-    end_column = draw(st.integers(1 if end_line > line else column, 9))
-    new = draw(st.sampled_from(["", "Z", "\n(END)", "; "]))
-    return Edit(Span(line, column, end_line, end_column), new)
-
-
 @settings(max_examples=1000, deadline=None)
-@given(st.text(alphabet="AB=1 \r\n", max_size=30), st.lists(an_edit(), max_size=4))
+@given(st.text(alphabet="AB=1 \r\n", max_size=30), st.lists(an_edit(FIX_TEXTS), max_size=4))
 def test_apply_edits_makes_edits_as_it_did(text: str, edits: list[Edit]) -> None:
     """Any edits that do not overlap (two may insert at one place)."""
     def overlap(one: Edit, other: Edit) -> bool:

@@ -12,9 +12,9 @@ from pathlib import Path
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from lsprotocol import types
+from support.checker import FIX_TEXTS, an_edit
 from support.cli import rl1c
 
-from rl1.compiler.frontend.ast import Span
 from rl1.compiler.frontend.diagnostics import Edit, Fix
 from rl1.compiler.frontend.edits import apply_edits
 from rl1.compiler.frontend.source import LINE_BREAK
@@ -53,16 +53,6 @@ def made_by_an_editor(text: str, edit: types.WorkspaceEdit) -> str:
     return text
 
 
-@st.composite
-def an_edit(draw: st.DrawFn) -> Edit:
-    line = draw(st.integers(1, 6))
-    column = draw(st.integers(1, 8))
-    end_line = draw(st.integers(line, 7))
-    end_column = draw(st.integers(1 if end_line > line else column, 9))
-    new = draw(st.sampled_from(["", "Z", "\n(END)", "; ", "\n"]))
-    return Edit(Span(line, column, end_line, end_column), new)
-
-
 def _overlap(one: Edit, other: Edit) -> bool:
     a, b = one.span, other.span
     return (a.line, a.column) < (b.end_line, b.end_column) \
@@ -71,7 +61,7 @@ def _overlap(one: Edit, other: Edit) -> bool:
 
 @settings(max_examples=1500, deadline=None)
 @given(st.text(alphabet="AB=1 \r\n日😀", max_size=30),
-       st.lists(an_edit(), min_size=1, max_size=3))
+       st.lists(an_edit([*FIX_TEXTS, "\n"]), min_size=1, max_size=3))
 def test_a_fixs_edit_made_by_an_editor_is_what_apply_edits_makes(text: str,
                                                                  edits: list[Edit]) -> None:
     assume(not any(_overlap(one, other) for index, one in enumerate(edits)

@@ -2,9 +2,15 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
+from hypothesis import strategies as st
+
 from rl1.compiler.analysis import analyze
 from rl1.compiler.frontend.ast import Span
-from rl1.compiler.frontend.diagnostics import Diagnostic, Fix
+from rl1.compiler.frontend.diagnostics import Diagnostic, Edit, Fix
+
+FIX_TEXTS = ["", "Z", "\n(END)", "; "]  # what an edit writes: nothing, a word, a line
 
 
 def found(source: str, code: str) -> list[Diagnostic]:
@@ -42,3 +48,14 @@ def apply(source: str, fix: Fix) -> str:
         end = offset(edit.span.end_line, edit.span.end_column)
         source = source[:start] + edit.text + source[end:]
     return source
+
+
+@st.composite
+def an_edit(draw: st.DrawFn, texts: Sequence[str]) -> Edit:
+    """An edit in the first lines of a short source, writing one of `texts`; its span
+    may end past its line or the text, as a fix's may."""
+    line = draw(st.integers(1, 6))
+    column = draw(st.integers(1, 8))
+    end_line = draw(st.integers(line, 7))
+    end_column = draw(st.integers(1 if end_line > line else column, 9))
+    return Edit(Span(line, column, end_line, end_column), draw(st.sampled_from(texts)))
