@@ -13,7 +13,7 @@ from .checker import apply_suppressions, check, check_text
 from .checker.compact import CompactDiagnostics
 from .frontend.ast import Program, Span
 from .frontend.diagnostics import Diagnostic, Edit, Fix, sort_key
-from .frontend.edits import apply_edits, compatible_one_by_one
+from .frontend.edits import apply_edits, compatible
 from .frontend.parser import parse_program
 
 
@@ -80,7 +80,7 @@ def fix(text: str, keep: Callable[[Diagnostic], bool] = lambda _: True, *,
         edits = _HeldEdits()
         fixes = 0
         safe = True
-        for one in compatible_one_by_one(_fixes(diagnostics, keep, unsafe and done == 0)):
+        for one in compatible(_fixes(diagnostics, keep, unsafe and done == 0)):
             edits.extend(one.edits)
             fixes += 1
             safe = safe and one.safe

@@ -12,22 +12,17 @@ from .source import LINE_BREAK, LineIndex
 _Place = tuple[int, int]  # (line, column)
 
 
-def compatible(fixes: Iterable[Fix]) -> list[Fix]:
+def compatible(fixes: Iterable[Fix]) -> Iterator[Fix]:
     """The fixes, in order, less any with an edit that overlaps, or inserts at the same
     place as, an edit of a fix kept before it: made together, they could not each do
     what it says (two lines added at the end would come in an order neither chose).
+    Each is given as soon as it is kept, so that `rl1c check --fix` can hold them
+    compactly (analysis.fix), where a list of them held 290 bytes a fix.
 
     The kept edits meet none of the others, so each is looked for by bisection among
     them, sorted: a source with a fix on each line has hundreds of thousands. (A fix
     whose own edits meet, or end before they start, would break that order: from it
     on, every kept edit is looked at.)"""
-    return list(compatible_one_by_one(fixes))
-
-
-def compatible_one_by_one(fixes: Iterable[Fix]) -> Iterator[Fix]:
-    """The fixes `compatible` keeps, each given as soon as it is kept: `rl1c check
-    --fix` holds them compactly (analysis.fix), where a list of them held 290 bytes a
-    fix."""
     starts: list[_Place] = []  # the kept edits' spans, sorted, as their starts and ends
     ends: list[_Place] = []
     apart = True  # whether the kept edits are in order and meet none of the others
