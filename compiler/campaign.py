@@ -193,8 +193,8 @@ def noiseless(task: Task) -> bool:
 
 
 RESUBMISSIONS = 2  # of a run lost with its worker: more, and the run may be what kills them
-TASK_SECONDS = 0.5  # of runs a task makes: a task's cost on a cluster (about 20 ms on a
-# loaded machine) then weighs little, and a stopped campaign loses little of what ran
+TASK_SECONDS = 0.5  # of runs a task makes: a task's cost on a cluster (about 4.4 ms of
+# CPU, bench/campaign.py) then weighs little, and a stopped campaign loses little
 MOST_RUNS_A_TASK = 64  # so that a window of tasks holds at most 64 records a task
 
 
