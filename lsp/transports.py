@@ -19,7 +19,8 @@ the limit is told so (an error answering its first request on TCP, close code 10
 WebSocket). What the server holds for its clients is bounded: each session's open
 documents (server.MAX_OPEN_CHARACTERS), and the bytes in flight of all sessions together
 (InFlight: messages being read, answers their clients have not read yet), so that eight
-clients sending a message of framing.MAX_MESSAGE each at once do not hold eight. A
+clients sending a message of framing.MAX_MESSAGE each at once do not hold eight, and the
+first of them to need more than its free share is read whatever the others send. A
 connection that has not
 sent `initialize` within INITIALIZE_SECONDS is closed, so that a local process cannot
 hold every place by connecting and saying nothing.
@@ -53,9 +54,12 @@ FREE_IN_FLIGHT = 2**20
 messages and the answers to them are far smaller), so that no client starves another."""
 MAX_IN_FLIGHT = 2 * MAX_MESSAGE
 """Bytes in flight that a server's sessions may hold between them beyond FREE_IN_FLIGHT
-each: a message that would pass it is skipped (TCP; the client is told) or its
-connection closed (WebSocket, close code 1009), and a client that would pass it by not
-reading is disconnected."""
+each (RESERVED_IN_FLIGHT of it kept for one session's message): a message that would
+pass it is skipped (TCP; the client is told) or its connection closed (WebSocket, close
+code 1009), and a client that would pass it by not reading is disconnected."""
+RESERVED_IN_FLIGHT = MAX_MESSAGE
+"""Of MAX_IN_FLIGHT, the bytes kept for the first session to need more than its free
+share (InFlight), so that of several large messages read at once one is always read."""
 MEMORY_IN_FLIGHT = MAX_IN_FLIGHT + MAX_SESSIONS * FREE_IN_FLIGHT + 2 * MAX_MESSAGE
 """The most memory a server's messages in flight take, 264 MiB: each byte in flight once,
 and the message being decoded (one at a time: sessions share one thread) twice more, as
@@ -109,10 +113,20 @@ class Session(Protocol):
 class InFlight:
     """The bytes in flight of a server's sessions (each message being read, the answers
     written that its client has not read), each session counting its own when asked, so
-    that there is nothing to give back when a message is done or a session ends."""
+    that there is nothing to give back when a message is done or a session ends.
+
+    Beyond FREE_IN_FLIGHT each, the sessions share MAX_IN_FLIGHT, and the first session
+    to need more than its free share holds a reservation of RESERVED_IN_FLIGHT, which
+    counts against the others whether or not it has read that much yet, until it holds
+    no more than its free share again. Without it, which of several large messages read
+    at once fitted depended on how their bytes interleaved: eight clients sending 60 MiB
+    each over WebSocket all grew together, and each was refused midway, none read. With
+    it, the holder's message (up to RESERVED_IN_FLIGHT beyond its free share) is always
+    read to its end, and the others share what is left."""
 
     def __init__(self) -> None:
         self._held: dict[object, Callable[[], int]] = {}
+        self._reserved: object | None = None  # the session holding the reservation
 
     @contextlib.contextmanager
     def counting(self, session: object, held: Callable[[], int]) -> Iterator[None]:
@@ -122,22 +136,38 @@ class InFlight:
             yield
         finally:
             del self._held[session]
+            if self._reserved is session:
+                self._reserved = None
 
     def __contains__(self, session: object) -> bool:
         return session in self._held
 
     def refusal(self, session: object, more: int = 0) -> str | None:
         """None if `session` may hold `more` bytes beyond what it holds, else why not."""
-        mine = self._held[session]() + more - FREE_IN_FLIGHT
+        mine = self._beyond_free(session) + more
         if mine <= 0:
             return None
-        others = sum(max(0, held() - FREE_IN_FLIGHT)
-                     for other, held in self._held.items() if other is not session)
-        if others + mine <= MAX_IN_FLIGHT:
+        if self._reserved is not None and self._beyond_free(self._reserved) <= 0:
+            self._reserved = None  # its message is done: the next to need more takes it
+        if self._reserved is None:
+            self._reserved = session
+        others = sum(self._counted(other, self._beyond_free(other))
+                     for other in self._held if other is not session)
+        if others + self._counted(session, mine) <= MAX_IN_FLIGHT:
             return None
-        return (f"the server holds {others / 2**20:.0f} MiB of other clients' messages and "
-                f"answers, and {MAX_IN_FLIGHT // 2**20} MiB at most between them; send it "
-                "again when they are done")
+        return (f"the server holds {others / 2**20:.0f} MiB for other clients' messages "
+                f"and answers, and {MAX_IN_FLIGHT // 2**20} MiB at most between them; "
+                "send it again when they are done")
+
+    def _beyond_free(self, session: object) -> int:
+        return self._held[session]() - FREE_IN_FLIGHT
+
+    def _counted(self, session: object, beyond_free: int) -> int:
+        """What `session`, holding `beyond_free` bytes beyond its free share, takes of
+        MAX_IN_FLIGHT: at least the reservation if it holds it."""
+        if session is self._reserved:
+            return max(beyond_free, RESERVED_IN_FLIGHT)
+        return max(0, beyond_free)
 
 
 def _show_error(text: str) -> bytes:
