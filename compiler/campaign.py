@@ -224,6 +224,23 @@ def runs_a_task(runs: int, seconds: float) -> int:
 
 
 @dataclass(slots=True)
+class Timing:
+    """The runs timed so far and the seconds they took, which size the tasks that
+    follow. Campaigns of one program on near worlds (a sweep's points) share one, so that
+    each after the first starts with tasks of the right size, not of one run."""
+
+    runs: int = 0
+    seconds: float = 0.0
+
+    def add(self, batch: Batch) -> None:
+        self.runs += len(batch.records)
+        self.seconds += batch.seconds
+
+    def runs_a_task(self) -> int:
+        return runs_a_task(self.runs, self.seconds)
+
+
+@dataclass(slots=True)
 class _Part:
     """Runs submitted as one task: their seeds, the task's future, how many of its
     records the campaign has yielded, and how many times these runs have been made."""
@@ -238,22 +255,24 @@ class Campaign:
     """The runs of `task` over `seeds` on `executor` (in this process when None), as an
     iterator of their records in seed order. The runs go in tasks of several seeds each
     (`runs_a_task`: about TASK_SECONDS of runs), with at most `window` tasks submitted
-    and not yet yielded whole. A task that fails with an error of `lost` (a Dask
-    cluster's KilledWorker: its worker died) is submitted again a run a task, so that a
-    run that kills its worker is told from those beside it; each run is made at most
-    1 + RESUBMISSIONS times. `salvage` ends it early, keeping the runs already finished
-    that follow the last yielded without a gap."""
+    and not yet yielded whole. A task that fails with an error of `lost` (its worker
+    died: a Dask cluster's KilledWorker, a local pool's BrokenProcessPool) is submitted
+    again a run a task once the runs before it are yielded, so that a run that kills its
+    worker is told from those beside it; each run is made at most 1 + RESUBMISSIONS
+    times. `salvage` ends it early, keeping the runs already finished that follow the
+    last yielded without a gap. `timing` holds the runs timed before (a sweep's earlier
+    points), and takes this campaign's."""
 
     def __init__(self, task: Task, seeds: Iterable[int], executor: Executor | None,
-                 window: int, lost: tuple[type[BaseException], ...] = ()) -> None:
+                 window: int, lost: tuple[type[BaseException], ...] = (),
+                 timing: Timing | None = None) -> None:
         self._task = task
         self._seeds = iter(seeds)
         self._executor = executor
         self._window = window
         self._lost = lost
         self._pending: deque[_Part] = deque()
-        self._timed_runs = 0
-        self._timed_seconds = 0.0
+        self._timing = Timing() if timing is None else timing
 
     def __iter__(self) -> Iterator[Record]:
         if self._executor is None:
@@ -274,8 +293,7 @@ class Campaign:
 
     def _fill(self) -> None:
         while len(self._pending) < self._window:
-            seeds = tuple(islice(self._seeds, runs_a_task(self._timed_runs,
-                                                          self._timed_seconds)))
+            seeds = tuple(islice(self._seeds, self._timing.runs_a_task()))
             if not seeds:
                 return
             self._pending.append(_Part(seeds, self._submit(seeds)))
@@ -299,8 +317,7 @@ class Campaign:
                 # One assignment: a signal finds the queue before or after, whole.
                 self._pending = deque([*again, *islice(self._pending, 1, None)])
                 continue
-            self._timed_runs += len(batch.records)
-            self._timed_seconds += batch.seconds
+            self._timing.add(batch)
             return part, batch.records
 
     def salvage(self) -> list[Record]:

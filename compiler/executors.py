@@ -21,6 +21,7 @@ import time
 import weakref
 from collections.abc import Callable, Iterator
 from concurrent.futures import Executor, Future, InvalidStateError, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,6 +36,9 @@ CONNECT_TIMEOUT = 5  # s: an unreachable scheduler is said in a few seconds, and
 # one once its client has tried as long to reconnect
 WATCH_EVERY = 0.5  # s between looks at whether a cluster's client has given up
 EXTRA = "cluster"  # pyproject.toml's extra that installs `distributed`
+
+P = ParamSpec("P")
+T = TypeVar("T")
 
 
 class Unavailable(Exception):
@@ -57,8 +61,9 @@ class _OtherRl1(Exception):
 class Workers:
     """An executor (None: the work is done in this process), how many tasks it makes at
     once (a cluster: its workers' threads when it was reached, 0 while none has joined),
-    and the errors of a task lost with its worker, which can be submitted again
-    (a pool whose worker died is broken instead: concurrent.futures.BrokenExecutor)."""
+    and the errors of a task lost with its worker, which can be submitted again (a
+    pool whose worker died, unless made again, is broken instead:
+    concurrent.futures.BrokenExecutor)."""
 
     executor: Executor | None
     slots: int
@@ -74,11 +79,13 @@ def ignore_interrupts() -> None:
 
 
 @contextmanager
-def workers(jobs: int, scheduler: str | None = None) -> Iterator[Workers]:
+def workers(jobs: int, scheduler: str | None = None,
+            renewed: Callable[[], None] | None = None) -> Iterator[Workers]:
     """The workers of a campaign: the Dask cluster of `scheduler` when given, else `jobs`
-    local processes (this process alone for 1). Unavailable when `distributed` is not
-    installed or the scheduler cannot be reached. On leaving, the work not yet done is
-    cancelled."""
+    local processes (this process alone for 1). When one of those processes dies, the
+    pool is broken for good, or, given `renewed`, made again (`Renewed`), and `renewed`
+    called. Unavailable when `distributed` is not installed or the scheduler cannot be
+    reached. On leaving, the work not yet done is cancelled."""
     if scheduler is not None:
         with _cluster(scheduler) as cluster:
             yield cluster
@@ -86,11 +93,53 @@ def workers(jobs: int, scheduler: str | None = None) -> Iterator[Workers]:
     if jobs == 1:
         yield Workers(None, 1)
         return
-    pool = ProcessPoolExecutor(max_workers=jobs, initializer=ignore_interrupts)
+    pool: Executor = _pool(jobs) if renewed is None else Renewed(jobs, renewed)
     try:
-        yield Workers(pool, jobs)
+        yield Workers(pool, jobs, () if renewed is None else (BrokenProcessPool,))
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _pool(jobs: int) -> ProcessPoolExecutor:
+    return ProcessPoolExecutor(max_workers=jobs, initializer=ignore_interrupts)
+
+
+class Renewed(Executor):
+    """`jobs` local processes that outlive the death of one, as a Dask cluster outlives a
+    worker's: a ProcessPoolExecutor whose process dies is broken for good, failing every
+    task in flight with BrokenProcessPool (the one that killed it and those merely beside
+    it alike), so the first task submitted after that goes to a new pool, which then
+    takes every task (a campaign submits the lost ones again, a run a task), and
+    `renewed` is called."""
+
+    def __init__(self, jobs: int, renewed: Callable[[], None]) -> None:
+        self._jobs = jobs
+        self._renewed = renewed
+        self._pool = _pool(jobs)
+        self._futures: weakref.WeakSet[Future[Any]] = weakref.WeakSet()  # of this pool
+
+    def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
+        try:
+            future = self._pool.submit(fn, *args, **kwargs)
+        except BrokenProcessPool as broken:
+            self._renew(broken)
+            future = self._pool.submit(fn, *args, **kwargs)
+        self._futures.add(future)
+        return future
+
+    def _renew(self, broken: BrokenProcessPool) -> None:
+        old, self._pool = self._pool, _pool(self._jobs)
+        old.shutdown(wait=True)  # its thread fails its tasks and ends its processes
+        # A task submitted while the old pool was being found broken can be missed by
+        # that thread, and wait for ever: failed here, it is lost as the others were.
+        for future in list(self._futures):
+            with contextlib.suppress(InvalidStateError):  # finished, or failed already
+                future.set_exception(broken)
+        self._futures = weakref.WeakSet()
+        self._renewed()
+
+    def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
+        self._pool.shutdown(wait=wait, cancel_futures=cancel_futures)
 
 
 @contextmanager
@@ -179,10 +228,6 @@ def _unreachable(address: str, why: str) -> Unavailable:
         f"cannot reach a Dask scheduler at {address} ({why})\n"
         f"  = help: start one there (`dask scheduler`, then `dask worker {address}` on "
         "each machine), or give its address as tcp://HOST:8786")
-
-
-P = ParamSpec("P")
-T = TypeVar("T")
 
 
 class _Watched(Executor):

@@ -15,7 +15,6 @@ import signal
 import sys
 import time
 from collections.abc import Callable, Iterator
-from concurrent.futures import BrokenExecutor
 from contextlib import ExitStack, contextmanager
 from dataclasses import dataclass, field, replace
 from types import FrameType
@@ -28,6 +27,7 @@ from rl1.compiler.campaign import (
     Record,
     Tally,
     Task,
+    Timing,
     campaign_seeds,
     noiseless,
     task_for,
@@ -146,11 +146,12 @@ class Stopping:
 
 
 @contextmanager
-def _workers(setting: Setting) -> Iterator[Workers]:
-    """The campaign's workers (no more local processes than runs), or the Failure that
-    says why there are none."""
+def _workers(setting: Setting, progress: Progress) -> Iterator[Workers]:
+    """The campaign's workers (no more local processes than runs; a new pool of them when
+    one dies, said through `progress`), or the Failure that says why there are none."""
     try:
-        with workers(min(setting.jobs, setting.runs), setting.scheduler) as held:
+        with workers(min(setting.jobs, setting.runs), setting.scheduler,
+                     lambda: progress.warn(POOL_RENEWED)) as held:
             if setting.scheduler is not None and held.slots == 0:
                 print(f"rl1c: note: the scheduler at {setting.scheduler} has no workers yet; "
                       f"the runs wait for one (`dask worker {setting.scheduler}`)",
@@ -209,6 +210,16 @@ class Progress:
         if self.terminal:
             self.stream.write("\r\033[K")
             self.stream.flush()
+
+    def warn(self, warning: str) -> None:
+        """Say `warning` on a line of its own (the progress line is drawn again later)."""
+        self.finish()
+        self.stream.write(f"rl1c: warning: {warning}\n")
+        self.stream.flush()
+
+
+POOL_RENEWED = ("a worker process ended abruptly (killed, or out of memory); a new pool "
+                "of workers makes its runs and those beside it again, a run a task")
 
 
 SAME_RUNS = ("the world has no noise: every seed makes the same run, so {counted} "
@@ -323,41 +334,28 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     if pictures.wanted:
         _refuse_targets(pictures, (file, setting.world), out)
         task = replace(task, path_points=PATH_POINTS)
+    points = grid(setting.sweep)
+    progress = Progress(setting.runs * len(points), sys.stderr)
     held = ExitStack()  # the workers: a cluster is reached before --out replaces a file
-    current = held.enter_context(_workers(setting))
+    current = held.enter_context(_workers(setting, progress))
     try:
         lines = _open_out(out, (file, setting.world))
     except BaseException:
         held.close()
         raise
     report = sys.stderr if out == "-" else sys.stdout
-    points = grid(setting.sweep)
     keeper = Keeper(setting.runs, points, lines,
                     Overlay() if pictures.wanted else None)
-    progress = Progress(setting.runs * len(points), sys.stderr)
+    timing = Timing()  # carried from point to point: they run one program on near worlds
     status = 0
     lost: ClusterLost | None = None
     stopping = Stopping()
-    broken_at = None  # the point and the first seed left when the workers last broke
     try:
         with stopping.in_effect(), held:  # the workers end while a signal only stops
             while status == 0 and not keeper.done:
                 left = range(setting.seed + keeper.tally.runs, seeds.stop)
-                try:
-                    status = _make_runs(replace(task, offsets=keeper.point), left, current,
-                                        keeper, progress, stopping)
-                except BrokenExecutor:
-                    first_left = setting.seed + keeper.tally.runs
-                    if (keeper.point, first_left) == broken_at:
-                        status = EXIT_INTERNAL  # the same run broke them twice
-                        break
-                    broken_at = keeper.point, first_left
-                    progress.finish()
-                    print(f"rl1c: warning: a worker process ended abruptly (killed, or out "
-                          f"of memory); the workers start again from seed {first_left}",
-                          file=sys.stderr)
-                    held.close()
-                    current = held.enter_context(_workers(setting))
+                status = _make_runs(replace(task, offsets=keeper.point), left, current,
+                                    keeper, progress, stopping, timing)
     except Stopped as stop:  # again, while the workers end their runs
         status = stop.status
     except ClusterLost as error:
@@ -391,16 +389,15 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     return status
 
 def _make_runs(task: Task, seeds: range, held: Workers, keeper: Keeper,
-               progress: Progress, stopping: Stopping) -> int:
-    """Make the runs of `seeds` on `held`, keeping each; 0, the status of a signal that
-    stopped them, or EXIT_INTERNAL when a run was lost with its worker each time it was
-    made. BrokenExecutor when a local worker process ended abruptly, ClusterLost when
-    a cluster's scheduler was lost, after keeping the runs finished before the first
-    lost."""
+               progress: Progress, stopping: Stopping, timing: Timing) -> int:
+    """Make the runs of `seeds` on `held`, keeping each, their tasks sized by `timing`
+    (which takes their times); 0, the status of a signal that stopped them, or
+    EXIT_INTERNAL when a run was lost with its worker each time it was made.
+    ClusterLost when a cluster's scheduler was lost, after keeping the runs finished
+    before the first lost."""
     runs = Campaign(task, seeds, held.executor, WINDOW_PER_JOB * max(held.slots, 1),
-                    held.lost)
-    ending: tuple[type[BaseException], ...] = (Stopped, BrokenExecutor, ClusterLost,
-                                               *held.lost)
+                    held.lost, timing)
+    ending: tuple[type[BaseException], ...] = (Stopped, ClusterLost, *held.lost)
     try:
         for record in runs:
             with stopping.keeping():
@@ -413,7 +410,7 @@ def _make_runs(task: Task, seeds: range, held: Workers, keeper: Keeper,
         match stop:
             case Stopped():
                 return stop.status
-            case BrokenExecutor() | ClusterLost():
+            case ClusterLost():
                 raise
         return EXIT_INTERNAL
     return 0

@@ -17,26 +17,27 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
-from concurrent.futures import BrokenExecutor, Executor, Future
+from concurrent.futures import BrokenExecutor
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
-from typing import ParamSpec, TypeVar, cast
 
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from support.campaigns import DROPOUT, WALL_PROGRAM, WALL_WORLD
-from support.cli import rl1c
+from support.campaigns import DROPOUT, WALL_PROGRAM, WALL_WORLD, BrokenAfter, Instant, Lost
+from support.cli import Result, rl1c
 
+from rl1.compiler import campaign
 from rl1.compiler.campaign import (
     MOST_RUNS_A_TASK,
     RESUBMISSIONS,
     SEEDS_KEPT,
     TASK_SECONDS,
-    Batch,
     Campaign,
     Record,
     Tally,
     Task,
+    Timing,
     campaign_seeds,
     run_batch,
     run_one,
@@ -45,6 +46,7 @@ from rl1.compiler.campaign import (
     wilson,
 )
 from rl1.compiler.cli.sim_campaign import Progress
+from rl1.compiler.executors import Renewed
 from rl1.vm.defaults import DEFAULT_BUDGET
 
 RL1C = str(Path(sys.executable).with_name("rl1c"))
@@ -221,42 +223,6 @@ def test_a_workers_memory_stays_flat_over_runs_of_source() -> None:
     assert len(gc.get_objects()) - before < 20_000  # at most COLLECT_EVERY runs' garbage
 
 
-P = ParamSpec("P")
-T = TypeVar("T")
-
-
-class Lost(Exception):
-    """A task lost with its worker, as a Dask cluster's KilledWorker says it."""
-
-
-class Instant(Executor):
-    """The Executor interface, making each task at once, as if it took no time (so the
-    campaign's tasks soon reach MOST_RUNS_A_TASK runs), and noting each task's seeds;
-    those of the run of `losing` it fails, its first `losses` times, as a Dask cluster's
-    KilledWorker does when the task's worker died."""
-
-    def __init__(self, losing: int | None = None, losses: int = 0) -> None:
-        self.submitted: list[tuple[int, ...]] = []
-        self.losing = losing
-        self.losses = losses
-
-    def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
-        task, seeds = args
-        assert isinstance(task, Task) and isinstance(seeds, tuple)
-        self.submitted.append(seeds)
-        future: Future[T] = Future()
-        if self.losing in seeds and self.losses > 0:
-            self.losses -= 1
-            future.set_exception(Lost(f"the worker of seeds {seeds} died"))
-        else:
-            future.set_result(cast(T, Batch(run_batch(task, seeds).records, 0.0)))
-        return future
-
-    def made(self, seed: int) -> int:
-        """How many times the run of `seed` was submitted."""
-        return sum(seed in seeds for seeds in self.submitted)
-
-
 def test_a_campaign_holds_at_most_its_window_of_tasks_in_flight() -> None:
     instant = Instant()
     runs = iter(Campaign(wall_task(), range(400), instant, 4))
@@ -268,6 +234,17 @@ def test_a_campaign_holds_at_most_its_window_of_tasks_in_flight() -> None:
     # TASK_SECONDS, here the most a task makes.
     assert instant.submitted[:4] == [(0,), (1,), (2,), (3,)]
     assert instant.submitted[4] == tuple(range(4, 4 + MOST_RUNS_A_TASK))
+
+
+def test_a_campaign_given_the_timing_of_another_starts_with_tasks_of_its_size() -> None:
+    timing = Timing()
+    list(Campaign(compiled_wall_task(), range(10), Instant(), 2, timing=timing))
+    assert timing.runs == 10
+    instant = Instant()
+    list(Campaign(compiled_wall_task(), range(10, 200), instant, 2, timing=timing))
+    assert instant.submitted[:2] == [tuple(range(10, 10 + MOST_RUNS_A_TASK)),
+                                     tuple(range(10 + MOST_RUNS_A_TASK,
+                                                 10 + 2 * MOST_RUNS_A_TASK))]
 
 
 @given(runs=st.integers(0, 10**6), seconds=st.floats(0, 10**5, allow_nan=False))
@@ -367,6 +344,83 @@ def test_a_worker_killed_in_a_campaign_loses_no_run(wall: tuple[Path, Path],
         assert kept[seed] == run_one(compiled_wall_task(), seed).to_json()
 
 
+KILLER = 5  # the seed whose run ends its worker process
+BESIDE = 1.0  # s the run of the seed before it takes: it is under way on the other worker
+
+
+@pytest.fixture
+def ending_its_worker(monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+                      ) -> Callable[[bool], None]:
+    """Given whether every time, make the run of KILLER end the worker process that makes
+    it (os._exit, as a crash in C would), and that of KILLER - 1 take BESIDE seconds
+    more, in the pool's processes (forked from this one, they have the double)."""
+    parent, made, real = os.getpid(), tmp_path / "killed once", campaign.run_one
+
+    def install(every_time: bool) -> None:
+        def run(task: Task, seed: int) -> Record:
+            if os.getpid() != parent and seed == KILLER and (every_time or not made.exists()):
+                made.touch()
+                os._exit(1)
+            if os.getpid() != parent and seed == KILLER - 1:
+                time.sleep(BESIDE)
+            return real(task, seed)
+
+        monkeypatch.setattr(campaign, "run_one", run)
+
+    return install
+
+
+def _wall_campaign(wall: tuple[Path, Path], jobs: str, out: Path) -> tuple[Result, str]:
+    program, world = wall
+    result = rl1c("sim", program, "--world", world, "--runs", "20", "--jobs", jobs,
+                  "--out", out)
+    return result, out.read_text()
+
+
+def test_a_run_that_ends_its_worker_once_is_made_again_with_those_beside_it(
+        wall: tuple[Path, Path], tmp_path: Path,
+        ending_its_worker: Callable[[bool], None]) -> None:
+    alone, alone_lines = _wall_campaign(wall, "1", tmp_path / "alone.jsonl")
+    ending_its_worker(False)
+    result, lines = _wall_campaign(wall, "2", tmp_path / "two.jsonl")
+    assert result.exit_code == 0, result.output
+    assert "a worker process ended abruptly" in result.stderr
+    assert (result.stdout, lines) == (alone.stdout, alone_lines)  # every run, each once
+
+
+def test_a_run_that_ends_its_worker_each_time_is_named_and_those_before_it_kept(
+        wall: tuple[Path, Path], tmp_path: Path,
+        ending_its_worker: Callable[[bool], None]) -> None:
+    # The run before it, lost with it, was named: a new pool had started again from
+    # there, and the killer, made beside it, broke it again at that seed.
+    _, alone_lines = _wall_campaign(wall, "1", tmp_path / "alone.jsonl")
+    ending_its_worker(True)
+    result, lines = _wall_campaign(wall, "2", tmp_path / "two.jsonl")
+    assert result.exit_code == 3, result.output
+    assert (f"rl1c: error: the run of seed {KILLER} ended its worker each time it was "
+            f"made: replay it alone (rl1c sim ") in result.stderr
+    assert f"--runs {20 - KILLER - 1} --seed {KILLER + 1} --jobs 2" in result.stderr
+    assert lines.splitlines() == alone_lines.splitlines()[:KILLER]
+    assert f"{KILLER} runs of" in result.stdout and "Traceback" not in result.output
+
+
+def _ends_its_process() -> None:
+    os._exit(1)
+
+
+def test_a_renewed_pool_makes_the_tasks_after_a_process_died() -> None:
+    renewals: list[None] = []
+    pool = Renewed(2, lambda: renewals.append(None))
+    try:
+        with pytest.raises(BrokenProcessPool):
+            pool.submit(_ends_its_process).result(timeout=60)
+        assert renewals == []  # made again only when needed
+        assert [pool.submit(pow, 2, n).result(timeout=60) for n in range(3)] == [1, 2, 4]
+        assert len(renewals) == 1
+    finally:
+        pool.shutdown()
+
+
 def _children(pid: int) -> list[int]:
     """The processes whose parent is `pid`."""
     found = []
@@ -397,22 +451,6 @@ def test_campaign_options_out_of_place_are_usage_errors(
     result = rl1c("sim", program, "--world", world, *extra)
     assert result.exit_code == 2
     assert message in result.stderr
-
-
-class BrokenAfter(Executor):
-    """An executor that makes its first `runs` submissions at once, then refuses every
-    other as a pool whose worker died does."""
-
-    def __init__(self, runs: int) -> None:
-        self.left = runs
-
-    def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
-        if self.left == 0:
-            raise BrokenExecutor("a worker process ended abruptly")
-        self.left -= 1
-        future: Future[T] = Future()
-        future.set_result(fn(*args, **kwargs))
-        return future
 
 
 def test_a_run_finished_when_the_pool_breaks_is_kept() -> None:

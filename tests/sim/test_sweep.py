@@ -8,15 +8,20 @@ from __future__ import annotations
 import json
 import math
 import re
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from support.campaigns import Instant
 from support.cli import rl1c
 from support.hold import CAMERA_TO_MARKER, HOLD_WORLD, WAIT, WITHIN
 
 from rl1.compiler.campaign import Task, run_one, run_world
+from rl1.compiler.cli import sim_campaign
+from rl1.compiler.executors import Workers
 from rl1.compiler.sweep import Axis, check, grid, parse_axis
 from rl1.vm.sim.world import decode_world
 
@@ -146,6 +151,28 @@ def test_a_run_at_one_point_is_the_campaign_s_run(hold: tuple[Path, Path],
                   "stands.bench.x=30:30:1", "--format", "json")
     assert single.exit_code == line["exit_status"] == 20
     assert json.loads(single.stdout)["status"]["code"] == line["outcome"] == "goal-missed"
+
+
+def test_each_point_after_the_first_starts_with_tasks_sized_by_the_runs_before(
+        hold: tuple[Path, Path], monkeypatch: pytest.MonkeyPatch) -> None:
+    instant = Instant()  # its runs take no time: once timed, a task makes the most runs
+
+    @contextmanager
+    def two_workers(jobs: int, scheduler: str | None,
+                    renewed: Callable[[], None]) -> Iterator[Workers]:
+        yield Workers(instant, 2)
+
+    monkeypatch.setattr(sim_campaign, "workers", two_workers)
+    program, world = hold
+    result = rl1c("sim", program, "--world", world, "--runs", "40", "--jobs", "2",
+                  "--sweep", "stands.bench.x=0:15:2")
+    assert result.exit_code == 0, result.output
+    first = [seeds for seeds, point in zip(instant.submitted, instant.points, strict=True)
+             if point == (("stands.bench.x", 0.0),)]
+    second = [seeds for seeds, point in zip(instant.submitted, instant.points, strict=True)
+              if point == (("stands.bench.x", 15.0),)]
+    assert first[0] == (0,)  # nothing timed yet: a run a task
+    assert second == [tuple(range(40))]  # one task, where it began with 16 of a run
 
 
 @pytest.mark.parametrize(("args", "says"), [
