@@ -396,17 +396,30 @@ def test_a_fuzz_finding_of_a_planted_bug_is_reduced_with_its_engines(tmp_path: P
         encoding="utf-8") == "{}\n"
 
 
-def test_ctrl_c_keeps_the_smallest_so_far(sample: tuple[Path, Path]) -> None:
+def test_ctrl_c_keeps_the_smallest_so_far(sample: tuple[Path, Path], tmp_path: Path) -> None:
     program, _ = sample
-    slow = "grep -q '(MOV' sample.rob && sleep 0.2"
-    process = subprocess.Popen([RL1C, "reduce", str(program), "--interesting", slow],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    assert process.stderr is not None
-    first = process.stderr.readline()  # a pass made it smaller
-    assert first.startswith("rl1c reduce: lines: "), first
-    process.send_signal(signal.SIGINT)
-    stdout, _ = process.communicate(timeout=60)
-    assert process.returncode == 130
+    said, holding = tmp_path / "stderr.txt", tmp_path / "holding"
+    # Every test after the first progress line holds (until rl1c ends it), so that the
+    # signal always lands mid-reduction, whatever the machine's speed.
+    held = (f"if grep -q '^rl1c reduce: ' {shlex.quote(str(said))}; then "
+            f"touch {shlex.quote(str(holding))}; sleep 60; fi; grep -q '(MOV' sample.rob")
+    with open(said, "w") as stderr:
+        process = subprocess.Popen([RL1C, "reduce", str(program), "--interesting", held],
+                                   stdout=subprocess.PIPE, stderr=stderr, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not holding.exists():
+            assert process.poll() is None, f"it ended before a test held: {said.read_text()}"
+            assert time.monotonic() < deadline, said.read_text()
+            time.sleep(0.05)
+        first = said.read_text().splitlines()[0]  # a pass made it smaller
+        assert first.startswith("rl1c reduce: lines: "), first
+        process.send_signal(signal.SIGINT)
+        stdout, _ = process.communicate(timeout=60)
+    finally:
+        process.kill()
+        process.wait()
+    assert process.returncode == 130, said.read_text()
     assert "interrupted (Ctrl-C) with the smallest so far" in stdout
     reduced = program.with_name("sample.reduced.rob").read_text(encoding="utf-8")
     assert "(MOV" in reduced and len(reduced) < len(SAMPLE.read_text(encoding="utf-8"))
