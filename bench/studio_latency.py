@@ -31,10 +31,11 @@ from pathlib import Path
 
 from playwright.sync_api import Page, sync_playwright
 
-ROOT = Path(__file__).parents[1]
-CHROMIUM = "/usr/bin/chromium"
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--no-first-run", "--disable-sync"]
+ROOT = Path(__file__).resolve().parent.parent
+sys.path[:0] = [str(ROOT / "tests")]
+
+from support.browser import ARGS, CHROMIUM  # noqa: E402  (tests/ on the path just above)
+
 SERVING = re.compile(r"rl1c studio: serving .* at (http://127\.0\.0\.1:\d+/\?token=\S+) ")
 GOAL_MS = 100.0
 GOAL_FPS = 30.0

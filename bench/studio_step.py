@@ -6,64 +6,39 @@ second of a live run at 10x real time (goal 30), with how far the simulated time
 to ten times the wall time; and a whole run at full speed, from run/launch to run/ended,
 against a Session's continue alone.
 
-The server runs in a thread of this process, on a free port of 127.0.0.1; wall time
-(time.perf_counter), as the page sees it. The machine is shared: the figures vary.
+The server runs in a thread of this process, on a free port of 127.0.0.1 (as the tests
+serve it: tests/studio/served.py); wall time (time.perf_counter), as the page sees it.
+The machine is shared: the figures vary.
 
     .venv/bin/python bench/studio_step.py
 """
 
 from __future__ import annotations
 
-import asyncio
-import contextlib
 import json
 import statistics
-import threading
+import sys
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 from websockets.sync.client import ClientConnection, connect
 
 from rl1.compiler.debugger import Session, compile_program
-from rl1.lsp.studio.server import Gate, Server, new_token, serve_studio
-from rl1.lsp.studio.start import studio_for
 from rl1.vm.sim.device import SimDevice
 from rl1.vm.sim.world import decode_world
 
-ROOT = Path(__file__).parents[1]
-EXAMPLES = ROOT / "examples"
+ROOT = Path(__file__).resolve().parent.parent
+sys.path[:0] = [str(ROOT / "tests"), str(ROOT / "tests" / "studio")]
+
+from served import serving  # noqa: E402  (tests/ on the path just above)
+from support import EXAMPLES  # noqa: E402
+
 STEP_GOAL_MS = 20.0
 FRAMES_GOAL = 30
 LIVE_SECONDS = 4.0
 SPEED = 10
 RUNS = 3  # the fastest of these: the machine is shared
-
-
-@contextlib.contextmanager
-def studio() -> Iterator[str]:
-    """The address of /studio on a server for the examples folder."""
-    server = Server(Gate(new_token()), studio_for(EXAMPLES, None, None))
-    ready = threading.Event()
-    running: dict[str, Any] = {}
-
-    async def main() -> None:
-        running["loop"], running["task"] = asyncio.get_running_loop(), asyncio.current_task()
-        await serve_studio(server, 0, lambda port: ready.set())
-
-    def serve() -> None:
-        with contextlib.suppress(asyncio.CancelledError):
-            asyncio.run(main())
-
-    thread = threading.Thread(target=serve, daemon=True)
-    thread.start()
-    ready.wait(30)
-    try:
-        yield f"ws://127.0.0.1:{server.gate.port}/studio?token={server.gate.token}"
-    finally:
-        running["loop"].call_soon_threadsafe(running["task"].cancel)
-        thread.join(30)
 
 
 class Page:
@@ -160,7 +135,8 @@ def live(page: Page) -> tuple[int, float, float]:
 def main() -> None:
     alone = session_steps()
     reference = min(session_run() for _ in range(RUNS))
-    with studio() as address, connect(address, max_size=None) as connection:
+    with serving(EXAMPLES) as served, connect(served.url("/studio", scheme="ws"),
+                                              max_size=None) as connection:
         page = Page(connection)
         steps = server_steps(page)
         whole = min(whole_run(page) for _ in range(RUNS))

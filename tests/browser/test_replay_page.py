@@ -6,24 +6,15 @@ camera's image and the plots, with nothing on the console."""
 
 from __future__ import annotations
 
-import os
 import re
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
 
 import pytest
+from support.browser import WatchedPage, chromium, playwright_or_skip
 from support.pictures import HANDLER_LINE, draw
 
-CHROMIUM = "/usr/bin/chromium"
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--no-first-run", "--disable-sync"]
-
-if not os.access(CHROMIUM, os.X_OK):
-    pytest.skip(f"{CHROMIUM} is missing: run tests/browser/install-chromium as root",
-                allow_module_level=True)
-sync_api = pytest.importorskip(
-    "playwright.sync_api", reason="Playwright is missing: run tests/browser/install-chromium")
+sync_api = playwright_or_skip()
 
 
 @pytest.fixture(scope="module")
@@ -33,34 +24,18 @@ def replay(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def browser() -> Iterator[object]:
-    with sync_api.sync_playwright() as playwright:
-        launched = playwright.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+    with chromium(sync_api) as launched:
         yield launched
-        launched.close()
 
 
-class Page:
-    """The replay page open in a fresh offline context, with what it logged and every
-    request it made that was not for the page itself."""
+class Page(WatchedPage):
+    """The replay page open in a fresh offline context: what it asks for besides itself
+    is `elsewhere`."""
 
     def __init__(self, browser: object, path: Path) -> None:
-        self.context = browser.new_context(offline=True)  # type: ignore[attr-defined]
-        self.page = self.context.new_page()
-        self.problems: list[str] = []
-        self.requests: list[str] = []
-        self.page.on("console", self._console)
-        self.page.on("pageerror", lambda error: self.problems.append(f"error: {error}"))
-        self.page.on("request", self._request)
-        self.address = path.as_uri()
-        self.page.goto(self.address)
-
-    def _console(self, message: Any) -> None:
-        if message.type in ("error", "warning"):
-            self.problems.append(f"{message.type}: {message.text}")
-
-    def _request(self, request: Any) -> None:
-        if request.url.split("#")[0] != self.address:
-            self.requests.append(request.url)
+        address = path.as_uri()
+        super().__init__(browser, address, lambda url: url.split("#")[0] == address,
+                         offline=True)
 
     def clock(self) -> float:
         text = self.page.text_content("#clock") or ""
@@ -82,7 +57,7 @@ def page(browser: object, replay: Path) -> Iterator[Page]:
     opened = Page(browser, replay)
     yield opened
     assert opened.problems == [], "the page logged problems"
-    assert opened.requests == [], "the page asked for something besides itself"
+    assert opened.elsewhere == [], "the page asked for something besides itself"
     opened.context.close()
 
 

@@ -14,7 +14,6 @@ build/studio-screenshots/."""
 from __future__ import annotations
 
 import contextlib
-import os
 import re
 import shutil
 import subprocess
@@ -25,10 +24,8 @@ from typing import Any
 
 import pytest
 from support import EXAMPLES, ROOT
+from support.browser import WatchedPage, chromium, playwright_or_skip
 
-CHROMIUM = "/usr/bin/chromium"
-ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--no-first-run", "--disable-sync"]
 RL1C = str(Path(sys.executable).with_name("rl1c"))
 SCREENSHOTS = ROOT / "build" / "studio-screenshots"
 SERVING = re.compile(r"rl1c studio: serving .* at (http://127\.0\.0\.1:\d+/\?token=\S+) ")
@@ -36,11 +33,7 @@ WAIT = 20_000  # ms: a step of the page on two shared cores
 # The page's Content-Security-Policy allows no eval, so the tests wait for selectors
 # (Playwright's wait_for_function evaluates a string).
 
-if not os.access(CHROMIUM, os.X_OK):
-    pytest.skip(f"{CHROMIUM} is missing: run tests/browser/install-chromium as root",
-                allow_module_level=True)
-sync_api = pytest.importorskip(
-    "playwright.sync_api", reason="Playwright is missing: run tests/browser/install-chromium")
+sync_api = playwright_or_skip()
 
 
 @pytest.fixture(scope="module")
@@ -78,36 +71,20 @@ def studio(folder: Path) -> Iterator[str]:
 
 @pytest.fixture(scope="module")
 def browser() -> Iterator[Any]:
-    with sync_api.sync_playwright() as playwright:
-        launched = playwright.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+    with chromium(sync_api) as launched:
         yield launched
-        launched.close()
 
 
-class Studio:
-    """The page open in a fresh context, with what it logged and every request it made
-    somewhere other than the studio's server."""
+class Studio(WatchedPage):
+    """The page open in a fresh context `width` pixels wide, once ready: what it asks of
+    anywhere but the studio's server is `elsewhere`."""
 
     def __init__(self, browser: Any, address: str, width: int) -> None:
-        self.context = browser.new_context(viewport={"width": width, "height": 900})
-        self.page = self.context.new_page()
-        self.problems: list[str] = []
-        self.elsewhere: list[str] = []
         origin = address.split("/?", 1)[0]  # http://127.0.0.1:PORT
-        self.served = (origin, origin.replace("http", "ws", 1), "data:")
-        self.page.on("console", self._console)
-        self.page.on("pageerror", lambda error: self.problems.append(f"error: {error}"))
-        self.page.on("request", self._request)
-        self.page.goto(address)
+        served = (origin, origin.replace("http", "ws", 1), "data:")
+        super().__init__(browser, address, lambda url: url.startswith(served),
+                         viewport={"width": width, "height": 900})
         self.page.wait_for_selector("body[data-ready=true]", state="attached", timeout=WAIT)
-
-    def _console(self, message: Any) -> None:
-        if message.type in ("error", "warning"):
-            self.problems.append(f"{message.type}: {message.text}")
-
-    def _request(self, request: Any) -> None:
-        if not request.url.startswith(self.served):
-            self.elsewhere.append(request.url)
 
     def shot(self, name: str) -> None:
         SCREENSHOTS.mkdir(parents=True, exist_ok=True)

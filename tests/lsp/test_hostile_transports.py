@@ -9,11 +9,11 @@ connections that send nothing cannot hold every place."""
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import logging
 import re
 import socket
-import threading
 import time
 from collections.abc import Iterator
 
@@ -33,6 +33,7 @@ from support.hostile import (
     ws_frame,
     ws_handshake,
 )
+from support.memory import at_once, kept_mib
 
 from rl1.lsp.framing import MAX_MESSAGE
 from rl1.lsp.transports import INITIALIZE_SECONDS, MAX_SESSIONS, MEMORY_IN_FLIGHT
@@ -122,12 +123,7 @@ def test_eight_clients_sending_the_largest_message_at_once_stay_in_the_bound(
     attack = HostileConnection(chunks=_largest_message(transport))
     connections: list[socket.socket | None] = []
     try:
-        senders = [threading.Thread(target=lambda: connections.append(
-            _send_hostile(server, attack))) for _ in range(MAX_SESSIONS)]
-        for sender in senders:
-            sender.start()
-        for sender in senders:
-            sender.join()
+        at_once(MAX_SESSIONS, lambda: connections.append(_send_hostile(server, attack)))
         for connection in connections:
             if connection is not None:
                 connection.close()
@@ -152,12 +148,7 @@ def test_more_clients_than_are_served_sending_the_largest_message_stay_in_the_bo
     attack = HostileConnection(chunks=_largest_message(transport, fragments))
     connections: list[socket.socket | None] = []
     try:
-        senders = [threading.Thread(target=lambda: connections.append(
-            _send_hostile(server, attack))) for _ in range(MAX_SESSIONS + 4)]
-        for sender in senders:
-            sender.start()
-        for sender in senders:
-            sender.join()
+        at_once(MAX_SESSIONS + 4, lambda: connections.append(_send_hostile(server, attack)))
         peak = server.peak_mib() - server.started_mib
         assert peak < MEMORY_IN_FLIGHT / 2**20, f"{peak:.0f} MiB at its peak"
         for connection in connections:
@@ -193,11 +184,7 @@ def test_websocket_clients_sending_compressed_messages_at_once_stay_in_the_bound
             answered.append(str(client.recv(timeout=60)))
 
     try:
-        clients = [threading.Thread(target=send) for _ in range(MAX_SESSIONS)]
-        for client in clients:
-            client.start()
-        for client in clients:
-            client.join()
+        at_once(MAX_SESSIONS, send)
         peak = server.peak_mib() - server.started_mib
         assert peak < GROWTH_BOUND_MIB, f"{peak:.0f} MiB at its peak"
         # However their frames interleave, the first to need more than its free share
@@ -246,10 +233,8 @@ def test_clients_one_after_another_leave_nothing_behind(transport: str) -> None:
     that after about 1,000 clients the server passed the hostile harness's bound."""
     server = ServedLsp(transport)
     try:
-        serve_one_after_another(server, 20)  # imports, caches, the allocator's arenas
-        before = server.resident_mib()
-        serve_one_after_another(server, 200)
-        kept = server.resident_mib() - before
+        kept = kept_mib(functools.partial(serve_one_after_another, server),
+                        server.resident_mib, 200)
         assert kept < KEPT_BY_200_CLIENTS_MIB, f"{kept:.1f} MiB kept by 200 clients"
     finally:
         server.stop()

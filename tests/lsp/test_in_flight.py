@@ -6,6 +6,7 @@ TCP transport asks once, for the whole body, which is one piece here)."""
 from __future__ import annotations
 
 import contextlib
+import functools
 import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -38,6 +39,9 @@ class Sender:
     def read(self) -> bool:
         return self.held == self.size
 
+    def holding(self) -> int:
+        return self.held
+
     def wants(self) -> int:
         return min(self.piece, self.size - self.held)
 
@@ -62,7 +66,7 @@ def _send(senders: Sequence[Sender], turns: Sequence[int], release_refused: bool
     sent = Sent(peak=0, first_large=None)
     with contextlib.ExitStack() as stack:
         for sender in senders:
-            stack.enter_context(in_flight.counting(sender, lambda sender=sender: sender.held))
+            stack.enter_context(in_flight.counting(sender, sender.holding))
         for turn in itertools.chain(turns, itertools.count()):
             waiting = [s for s in senders if not s.read and s.refused is None]
             if not waiting:
@@ -116,7 +120,7 @@ def test_the_reservation_passes_on_when_its_message_is_done() -> None:
     in_flight = InFlight()
     with contextlib.ExitStack() as stack:
         for name in held:
-            stack.enter_context(in_flight.counting(name, lambda name=name: held[name]))
+            stack.enter_context(in_flight.counting(name, functools.partial(held.__getitem__, name)))
         assert in_flight.refusal("first", MAX_MESSAGE) is None
         held["first"] = MAX_MESSAGE
         shared = MAX_IN_FLIGHT - RESERVED_IN_FLIGHT + FREE_IN_FLIGHT

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from support import EXAMPLES
+from support.memory import status_mib
 from websockets.sync.client import ClientConnection, connect
 from websockets.typing import Origin
 
@@ -202,18 +203,11 @@ class StudioProcess:
         return f"ws://127.0.0.1:{self.port}{path}?token={self.token}"
 
     def resident_mib(self) -> float:
-        """Resident memory, from /proc."""
-        for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024
-        raise AssertionError("no VmRSS")
+        return status_mib(self.process.pid, "VmRSS")
 
     def peak_mib(self) -> float:
-        """The most resident memory the process has held, from /proc."""
-        for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
-            if line.startswith("VmHWM:"):
-                return int(line.split()[1]) / 1024
-        raise AssertionError("no VmHWM")
+        """The most resident memory the process has held."""
+        return status_mib(self.process.pid, "VmHWM")
 
     def stop(self) -> None:
         self.process.kill()

@@ -8,31 +8,13 @@ from __future__ import annotations
 
 import base64
 import json
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pytest
-from served import LISTING_1, Page, Served, page, sample_folder, serving
+from listing_1 import listing_1_folder, listing_1_page, listing_1_served  # noqa: F401  (fixtures)
+from served import LISTING_1, Page
 from support.cli import rl1c
-
-
-@pytest.fixture(scope="module")
-def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return sample_folder(tmp_path_factory.mktemp("robots"))
-
-
-@pytest.fixture(scope="module")
-def served(folder: Path) -> Iterator[Served]:
-    with serving(folder, "sample.rob") as server:
-        yield server
-
-
-@pytest.fixture
-def client(served: Served) -> Iterator[Page]:
-    with page(served) as connection:
-        yield connection
 
 
 def replay_frames(folder: Path, into: Path) -> list[dict[str, Any]]:

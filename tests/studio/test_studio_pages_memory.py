@@ -5,12 +5,13 @@ once take no more than the language server's sessions may (transports.InFlight).
 
 from __future__ import annotations
 
-import threading
+import functools
 from pathlib import Path
 
 import pytest
 from served import TIMEOUT, StudioProcess, pages_one_after_another, sample_folder
 from support.hostile import GROWTH_BOUND_MIB
+from support.memory import at_once, kept_mib
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import connect
 
@@ -27,10 +28,8 @@ collected as the sessions are: 29 MiB)."""
 def test_pages_one_after_another_leave_nothing_behind(tmp_path: Path) -> None:
     studio = StudioProcess(sample_folder(tmp_path))
     try:
-        pages_one_after_another(studio, 20)  # imports, caches, the allocator's arenas
-        before = studio.resident_mib()
-        pages_one_after_another(studio, 200)
-        kept = studio.resident_mib() - before
+        kept = kept_mib(functools.partial(pages_one_after_another, studio),
+                        studio.resident_mib, 200)
         assert kept < KEPT_BY_200_PAGES_MIB, f"{kept:.1f} MiB kept by 200 pages"
     finally:
         studio.stop()
@@ -57,11 +56,7 @@ def test_pages_sending_a_compressed_message_of_60_mib_at_once_stay_in_the_bound(
             pass
 
     try:
-        pages = [threading.Thread(target=send) for _ in range(MAX_SESSIONS)]
-        for page in pages:
-            page.start()
-        for page in pages:
-            page.join()
+        at_once(MAX_SESSIONS, send)
         peak = studio.peak_mib() - started
         assert peak < GROWTH_BOUND_MIB, f"{peak:.0f} MiB at its peak"
         assert answered and all("larger than 8 MiB" in answer for answer in answered)

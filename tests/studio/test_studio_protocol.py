@@ -9,35 +9,18 @@ import contextlib
 import itertools
 import json
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
-from served import LISTING_1, Failed, Page, Served, page, sample_folder, serving
+from listing_1 import listing_1_folder, listing_1_page, listing_1_served  # noqa: F401  (fixtures)
+from served import LISTING_1, Failed, Page, Served, page, serving
 from support.cli import rl1c
 from websockets.exceptions import ConnectionClosed
 
 from rl1.lsp.studio import connection
 from rl1.lsp.studio.run import FRAMES_PER_SECOND
 from rl1.vm.language import BUILTINS, VARIABLES
-
-
-@pytest.fixture(scope="module")
-def folder(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    return sample_folder(tmp_path_factory.mktemp("robots"))
-
-
-@pytest.fixture(scope="module")
-def served(folder: Path) -> Iterator[Served]:
-    with serving(folder, "sample.rob") as server:
-        yield server
-
-
-@pytest.fixture
-def client(served: Served) -> Iterator[Page]:
-    with page(served) as connection:
-        yield connection
 
 
 def rl1c_sim(folder: Path) -> dict[str, Any]:
