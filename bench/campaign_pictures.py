@@ -16,23 +16,13 @@ import sys
 import tempfile
 from pathlib import Path
 
+ROOT = Path(__file__).parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+from support.hold import HOLD_WORLD, TURN  # noqa: E402  (tests/ is put on the path just above)
+
 RL1C = str(Path(sys.executable).with_name("rl1c"))
-PROGRAM = "(MOV 0,-3); (TIM 1); (MOV 0,0); (TIM 1); (END)\n"
-WORLD = """\
-[floor]
-size = [1000, 1000]
-[start]
-x = 200.0
-y = 500.0
-[[stands]]
-name = "bench"
-x = 290.0
-y = 500.0
-facing = 180.0
-[goal]
-[[goal.hold]]
-stand = "bench"
-within = 60
+WORLD = HOLD_WORLD + """\
 [vary]
 stands.bench.x = { uniform = [0, 45] }
 start.y = { normal = [0, 5] }
@@ -56,7 +46,7 @@ def main() -> None:
     runs = parser.parse_args().runs
     with tempfile.TemporaryDirectory() as folder:
         program, world = Path(folder, "p.rob"), Path(folder, "w.world.toml")
-        program.write_text(PROGRAM)
+        program.write_text(TURN)
         world.write_text(WORLD)
         for count in (runs, 10 * runs):
             base = ["sim", str(program), "--world", str(world), "--runs", str(count),

@@ -24,7 +24,15 @@ from pathlib import Path
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from support.campaigns import DROPOUT, WALL_PROGRAM, WALL_WORLD, BrokenAfter, Instant, Lost
+from support.campaigns import (
+    DROPOUT,
+    WALL_PROGRAM,
+    WALL_WORLD,
+    BrokenAfter,
+    Instant,
+    Lost,
+    campaign_files,
+)
 from support.cli import Result, rl1c
 
 from rl1.compiler import campaign
@@ -54,10 +62,7 @@ RL1C = str(Path(sys.executable).with_name("rl1c"))
 
 @pytest.fixture
 def wall(tmp_path: Path) -> tuple[Path, Path]:
-    program, world = tmp_path / "wall.rob", tmp_path / "wall.world.toml"
-    program.write_text(WALL_PROGRAM)
-    world.write_text(WALL_WORLD)
-    return program, world
+    return campaign_files(tmp_path, "wall", WALL_PROGRAM, WALL_WORLD)
 
 
 def wall_task(world: str = WALL_WORLD) -> Task:
@@ -348,15 +353,37 @@ KILLER = 5  # the seed whose run ends its worker process
 BESIDE = 1.0  # s the run of the seed before it takes: it is under way on the other worker
 
 
+RUNS = 20  # of the campaigns with a killer
+
+
+@dataclasses.dataclass(frozen=True)
+class Killed:
+    """A campaign on two processes with a killer, and the same campaign in this process
+    alone: what each printed, and its JSON lines."""
+
+    two: Result
+    lines: str
+    alone: Result
+    alone_lines: str
+
+
 @pytest.fixture
-def ending_its_worker(monkeypatch: pytest.MonkeyPatch, tmp_path: Path
-                      ) -> Callable[[bool], None]:
-    """Given whether every time, make the run of KILLER end the worker process that makes
-    it (os._exit, as a crash in C would), and that of KILLER - 1 take BESIDE seconds
-    more, in the pool's processes (forked from this one, they have the double)."""
+def with_a_killer(wall: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+                  ) -> Callable[[bool], Killed]:
+    """Given whether every time, the campaign of RUNS runs on two processes where the run
+    of KILLER ends the process that makes it (os._exit, as a crash in C would), and that
+    of KILLER - 1 takes BESIDE seconds more (the pool's processes, forked from this one,
+    have the double; this one makes the runs as they are)."""
+    program, world = wall
     parent, made, real = os.getpid(), tmp_path / "killed once", campaign.run_one
 
-    def install(every_time: bool) -> None:
+    def campaign_on(jobs: str) -> tuple[Result, str]:
+        out = tmp_path / f"{jobs}.jsonl"
+        result = rl1c("sim", program, "--world", world, "--runs", str(RUNS), "--jobs", jobs,
+                      "--out", out)
+        return result, out.read_text()
+
+    def killing(every_time: bool) -> Killed:
         def run(task: Task, seed: int) -> Record:
             if os.getpid() != parent and seed == KILLER and (every_time or not made.exists()):
                 made.touch()
@@ -366,41 +393,31 @@ def ending_its_worker(monkeypatch: pytest.MonkeyPatch, tmp_path: Path
             return real(task, seed)
 
         monkeypatch.setattr(campaign, "run_one", run)
+        return Killed(*campaign_on("2"), *campaign_on("1"))
 
-    return install
-
-
-def _wall_campaign(wall: tuple[Path, Path], jobs: str, out: Path) -> tuple[Result, str]:
-    program, world = wall
-    result = rl1c("sim", program, "--world", world, "--runs", "20", "--jobs", jobs,
-                  "--out", out)
-    return result, out.read_text()
+    return killing
 
 
 def test_a_run_that_ends_its_worker_once_is_made_again_with_those_beside_it(
-        wall: tuple[Path, Path], tmp_path: Path,
-        ending_its_worker: Callable[[bool], None]) -> None:
-    alone, alone_lines = _wall_campaign(wall, "1", tmp_path / "alone.jsonl")
-    ending_its_worker(False)
-    result, lines = _wall_campaign(wall, "2", tmp_path / "two.jsonl")
-    assert result.exit_code == 0, result.output
-    assert "a worker process ended abruptly" in result.stderr
-    assert (result.stdout, lines) == (alone.stdout, alone_lines)  # every run, each once
+        with_a_killer: Callable[[bool], Killed]) -> None:
+    killed = with_a_killer(False)
+    assert killed.two.exit_code == 0, killed.two.output
+    assert "a worker process ended abruptly" in killed.two.stderr
+    # Every run, each once: the same lines and summary as the campaign alone.
+    assert (killed.lines, killed.two.stdout) == (killed.alone_lines, killed.alone.stdout)
 
 
 def test_a_run_that_ends_its_worker_each_time_is_named_and_those_before_it_kept(
-        wall: tuple[Path, Path], tmp_path: Path,
-        ending_its_worker: Callable[[bool], None]) -> None:
+        with_a_killer: Callable[[bool], Killed]) -> None:
     # The run before it, lost with it, was named: a new pool had started again from
     # there, and the killer, made beside it, broke it again at that seed.
-    _, alone_lines = _wall_campaign(wall, "1", tmp_path / "alone.jsonl")
-    ending_its_worker(True)
-    result, lines = _wall_campaign(wall, "2", tmp_path / "two.jsonl")
+    killed = with_a_killer(True)
+    result = killed.two
     assert result.exit_code == 3, result.output
     assert (f"rl1c: error: the run of seed {KILLER} ended its worker each time it was "
             f"made: replay it alone (rl1c sim ") in result.stderr
-    assert f"--runs {20 - KILLER - 1} --seed {KILLER + 1} --jobs 2" in result.stderr
-    assert lines.splitlines() == alone_lines.splitlines()[:KILLER]
+    assert f"--runs {RUNS - KILLER - 1} --seed {KILLER + 1} --jobs 2" in result.stderr
+    assert killed.lines.splitlines() == killed.alone_lines.splitlines()[:KILLER]
     assert f"{KILLER} runs of" in result.stdout and "Traceback" not in result.output
 
 

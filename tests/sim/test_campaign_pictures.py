@@ -15,8 +15,9 @@ from typing import cast
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from support.campaigns import campaign_files
 from support.cli import rl1c
-from support.hold import HOLD_WORLD
+from support.hold import HOLD_WORLD, TURN
 
 from rl1.compiler.campaign import Task, run_one, thinned
 from rl1.vm.sim.campaign_render import MAX_MARKS, MAX_PATHS, Overlay, Run
@@ -35,7 +36,6 @@ points = [[100, 445], [400, 445], [400, 450], [100, 450]]
 stands.bench.x = { uniform = [0, 45] }
 start.y = { uniform = [-40, 0] }
 """
-PROGRAM = "(MOV 0,-3); (TIM 1); (MOV 0,0); (TIM 1); (END)\n"  # a turn to the right
 RUNS = 24
 SVG = "{http://www.w3.org/2000/svg}"
 
@@ -44,9 +44,7 @@ SVG = "{http://www.w3.org/2000/svg}"
 def campaign(tmp_path_factory: pytest.TempPathFactory
              ) -> tuple[ElementTree.Element, str, list[dict[str, object]]]:
     folder = tmp_path_factory.mktemp("pictures")
-    program, world = folder / "p.rob", folder / "w.world.toml"
-    program.write_text(PROGRAM)
-    world.write_text(WORLD)
+    program, world = campaign_files(folder, "p", TURN, WORLD)
     picture, page, out = folder / "c.svg", folder / "c.html", folder / "c.jsonl"
     result = rl1c("sim", program, "--world", world, "--runs", str(RUNS), "--jobs", "1",
                   "--svg", picture, "--html", page, "--out", out)
@@ -148,9 +146,8 @@ def test_the_page_is_whole_html_with_the_picture_and_the_summary(
 
 
 def test_a_sweep_s_picture_is_its_heat_map(tmp_path: Path) -> None:
-    program, world, picture = tmp_path / "p.rob", tmp_path / "w.toml", tmp_path / "h.svg"
-    program.write_text(PROGRAM)
-    world.write_text(WORLD.split("[vary]")[0])
+    program, world = campaign_files(tmp_path, "p", TURN, WORLD.split("[vary]")[0])
+    picture = tmp_path / "h.svg"
     result = rl1c("sim", program, "--world", world, "--runs", "2", "--jobs", "1",
                   "--sweep", "stands.bench.x=0:40:2", "--sweep", "start.y=0:10:3",
                   "--svg", picture)
@@ -189,7 +186,7 @@ def test_a_campaign_stopped_at_any_point_shows_paths_spread_over_its_runs(runs: 
 
 
 def test_a_record_carries_a_thinned_path_only_when_asked() -> None:
-    task = Task(PROGRAM, WORLD.encode(), "w.toml", budget=1000)
+    task = Task(TURN, WORLD.encode(), "w.toml", budget=1000)
     assert run_one(task, 0).path == ()
     record = run_one(dataclasses.replace(task, path_points=64), 0)
     assert 2 <= len(record.path) <= 64

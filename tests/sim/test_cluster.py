@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 from support import ROOT
-from support.campaigns import WALL_PROGRAM, WALL_WORLD
+from support.campaigns import WALL_PROGRAM, WALL_WORLD, campaign_files
 from support.cli import rl1c
 
 from rl1.compiler.cli.sim_campaign import Setting
@@ -123,10 +123,7 @@ def scheduler(tmp_path: Path) -> Iterator[Cluster]:
 
 
 def _wall(folder: Path) -> tuple[Path, Path]:
-    program, world = folder / "wall.rob", folder / "wall.world.toml"
-    program.write_text(WALL_PROGRAM)
-    world.write_text(WALL_WORLD)
-    return program, world
+    return campaign_files(folder, "wall", WALL_PROGRAM, WALL_WORLD)
 
 
 def _local(program: Path, world: Path, runs: int, out: Path) -> str:

@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from support.campaigns import Instant
+from support.campaigns import Instant, campaign_files
 from support.cli import rl1c
 from support.hold import CAMERA_TO_MARKER, HOLD_WORLD, WAIT, WITHIN
 
@@ -28,10 +28,7 @@ from rl1.vm.sim.world import decode_world
 
 @pytest.fixture
 def hold(tmp_path: Path) -> tuple[Path, Path]:
-    program, world = tmp_path / "wait.rob", tmp_path / "hold.world.toml"
-    program.write_text(WAIT)
-    world.write_text(HOLD_WORLD)
-    return program, world
+    return campaign_files(tmp_path, "hold", WAIT, HOLD_WORLD)
 
 
 # The grid ------------------------------------------------------------------------------

@@ -1,11 +1,13 @@
 """A cheap campaign whose success rate has a closed form, for the tests of campaigns on
-local processes (tests/sim/test_campaign.py) and on a Dask cluster (test_cluster.py), and
-executors that make each task at once (test_sweep.py too)."""
+local processes (tests/sim/test_campaign.py) and on a Dask cluster (test_cluster.py);
+executors that make each task at once; and a campaign's two files written (these for the
+sweeps' and the pictures' tests too)."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from concurrent.futures import BrokenExecutor, Executor, Future
+from pathlib import Path
 from typing import ParamSpec, TypeVar, cast
 
 from rl1.compiler.campaign import Batch, Task, run_batch
@@ -36,6 +38,14 @@ start_deg = 0
 ultrasonic_cm = 0
 ultrasonic_dropout = {DROPOUT}
 """
+
+
+def campaign_files(folder: Path, name: str, program: str, world: str) -> tuple[Path, Path]:
+    """`name`.rob holding `program` and `name`.world.toml holding `world`, in `folder`."""
+    program_file, world_file = folder / f"{name}.rob", folder / f"{name}.world.toml"
+    program_file.write_text(program)
+    world_file.write_text(world)
+    return program_file, world_file
 
 
 P = ParamSpec("P")

@@ -1,6 +1,7 @@
 """A world whose answer is known, for sweeps (tests/sim/test_sweep.py) and a campaign's
-pictures (test_campaign_pictures.py): its goal holds the vehicle within WITHIN cm of a
-stand's marker, so a program that only waits succeeds exactly where the stand is near."""
+pictures (test_campaign_pictures.py, bench/campaign_pictures.py): its goal holds the
+vehicle within WITHIN cm of a stand's marker, so a program that only waits succeeds
+exactly where the stand is near."""
 
 from __future__ import annotations
 
@@ -26,3 +27,4 @@ seconds = 0.5
 CAMERA_TO_MARKER = 40.0
 WITHIN = 60.0
 WAIT = "(TIM 1); (END)\n"
+TURN = "(MOV 0,-3); (TIM 1); (MOV 0,0); (TIM 1); (END)\n"  # a turn to the right, a wait
