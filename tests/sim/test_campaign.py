@@ -17,9 +17,10 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
-from concurrent.futures import BrokenExecutor
+from concurrent.futures import BrokenExecutor, Executor, Future
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
+from typing import ParamSpec, TypeVar
 
 import pytest
 from hypothesis import given
@@ -35,7 +36,7 @@ from support.campaigns import (
 )
 from support.cli import Result, rl1c
 
-from rl1.compiler import campaign
+from rl1.compiler import campaign, executors
 from rl1.compiler.campaign import (
     MOST_RUNS_A_TASK,
     RESUBMISSIONS,
@@ -58,6 +59,8 @@ from rl1.compiler.executors import Renewed
 from rl1.vm.defaults import DEFAULT_BUDGET
 
 RL1C = str(Path(sys.executable).with_name("rl1c"))
+P = ParamSpec("P")
+T = TypeVar("T")
 
 
 @pytest.fixture
@@ -436,6 +439,32 @@ def test_a_renewed_pool_makes_the_tasks_after_a_process_died() -> None:
         assert len(renewals) == 1
     finally:
         pool.shutdown()
+
+
+class Forgetting(Executor):
+    """A pool found broken after it took one task, which it never finishes: the task
+    submitted while a ProcessPoolExecutor was being found broken, which its thread can
+    miss (not in its list of tasks when it failed them)."""
+
+    def __init__(self) -> None:
+        self.taken = 0
+
+    def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
+        if self.taken:
+            raise BrokenProcessPool("a process ended abruptly")
+        self.taken += 1
+        return Future()
+
+
+def test_a_task_the_broken_pool_missed_is_lost_when_the_pool_is_made_again(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    pools: list[Executor] = [Forgetting(), Instant()]
+    monkeypatch.setattr(executors, "_pool", lambda jobs: pools.pop(0))
+    pool = Renewed(2, lambda: None)
+    missed = pool.submit(run_batch, compiled_wall_task(), (0,))
+    made = pool.submit(run_batch, compiled_wall_task(), (1,))
+    assert isinstance(missed.exception(timeout=0), BrokenProcessPool)  # not waited on
+    assert made.result().records == (run_one(compiled_wall_task(), 1),)
 
 
 def _children(pid: int) -> list[int]:
