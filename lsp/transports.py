@@ -330,10 +330,9 @@ def serve_stdio(session: Session, stdin: BinaryIO, stdout: BinaryIO) -> int:
 # TCP ------------------------------------------------------------------------------------
 
 class _TcpWriter:
-    def __init__(self, stream: asyncio.StreamWriter, refusal: Callable[[], str | None]
-                 ) -> None:
+    def __init__(self, stream: asyncio.StreamWriter, refusal: Admission) -> None:
         self._stream = stream
-        self._refusal = refusal  # why the session may not hold what it holds, if so
+        self._refusal = refusal  # why the session may not hold so many bytes more, if so
 
     @property
     def unread(self) -> int:
@@ -343,11 +342,13 @@ class _TcpWriter:
     def write(self, data: bytes) -> None:
         if self._stream.is_closing():
             return
-        self._stream.write(frame(data))
-        if (refused := self._refusal()) is not None:
+        framed = frame(data)
+        if (refused := self._refusal(len(framed))) is not None:
             log.warning("a client has not read %.0f MiB the server wrote, and %s: "
                         "disconnected", self.unread / 2**20, refused)
             self._stream.transport.abort()
+            return
+        self._stream.write(framed)
 
     def close(self) -> None:
         self._stream.close()
@@ -407,7 +408,7 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
             sessions.add(session)
             admit: Admission = functools.partial(in_flight.refusal, session)
             framer = Framer(admit=admit)
-            tcp_writer = _TcpWriter(writer, functools.partial(in_flight.refusal, session))
+            tcp_writer = _TcpWriter(writer, admit)
             session.attach(tcp_writer)
             try:
                 with in_flight.counting(session, lambda: framer.reading + tcp_writer.unread):
@@ -459,20 +460,20 @@ def _hand_over(session: Session, body: bytes) -> int:
 class _WebSocketWriter:
     """Sends each message as a text frame, in order, from a task of its own."""
 
-    def __init__(self, connection: Any, refusal: Callable[[], str | None]) -> None:
+    def __init__(self, connection: Any, refusal: Admission) -> None:
         self._connection = connection
-        self._refusal = refusal  # why the session may not hold what it holds, if so
+        self._refusal = refusal  # why the session may not hold so many bytes more, if so
         self._outbox: asyncio.Queue[str] = asyncio.Queue()
         self.unsent = 0
         self._pump = asyncio.get_running_loop().create_task(self._send_all())
 
     def write(self, data: bytes) -> None:
-        self.unsent += len(data)
-        if (refused := self._refusal()) is not None:
+        if (refused := self._refusal(len(data))) is not None:
             log.warning("a client has not read %.0f MiB the server wrote, and %s: "
                         "disconnected", self.unsent / 2**20, refused)
             self._connection.transport.abort()
             return
+        self.unsent += len(data)
         self._outbox.put_nowait(data.decode())
 
     async def _send_all(self) -> None:
@@ -543,16 +544,17 @@ class WebSocketSessions:
                 if self.protocol.state is not State.OPEN or self not in in_flight:
                     super().data_received(data)
                     return
-                self.received += len(data)
-                if (refused := in_flight.refusal(self)) is None:
+                if (refused := in_flight.refusal(self, len(data))) is None:
+                    self.received += len(data)
                     super().data_received(data)
                     return
                 log.warning("closed a WebSocket connection: its message would take more "
-                            "than %.0f MiB, and %s", self.received / 2**20, refused)
-                # Failed, the library discards what comes, but holds the frames of the
-                # message read so far until the connection is lost (they stay counted
-                # until then): the connection is closed now, not when its client
-                # answers, which a hostile one never does.
+                            "than %.0f MiB, and %s", (self.received + len(data)) / 2**20,
+                            refused)
+                # Failed, the library discards what comes (`data` too, never counted),
+                # but holds the frames of the message read so far until the connection
+                # is lost (they stay counted until then): the connection is closed now,
+                # not when its client answers, which a hostile one never does.
                 self.protocol.fail(CloseCode.MESSAGE_TOO_BIG, "the server is reading "
                                    "other clients' large messages: send it again later")
                 super().data_received(data)  # writes the close frame

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import logging
 import mimetypes
 import secrets
@@ -29,7 +30,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.http11 import Request, Response
 
 from .. import transports
-from ..framing import MAX_MESSAGE
+from ..framing import Admission
 from .connection import Connection, Studio
 from .files import Folder, Refused, Unusable
 from .language import new_session
@@ -40,8 +41,6 @@ HOST = "127.0.0.1"
 STATIC = Path(__file__).with_name("static")
 TOKEN_PLACEHOLDER = "__RL1_STUDIO_TOKEN__"
 BUILD_HELP = "make studio-page"  # in the checkout: the page's packages, then esbuild
-MAX_UNSENT = 2 * MAX_MESSAGE
-"""Bytes a page may leave unread before it is disconnected."""
 _TYPES = {".html": "text/html; charset=utf-8", ".js": "text/javascript; charset=utf-8",
           ".css": "text/css; charset=utf-8", ".json": "application/json",
           ".map": "application/json", ".svg": "image/svg+xml", ".png": "image/png",
@@ -164,7 +163,7 @@ class Server:
             return
         assert isinstance(connection, self.lsp.connection_class)
         self.pages += 1
-        outbox = _Outbox(connection)
+        outbox = _Outbox(connection, functools.partial(self.lsp.in_flight.refusal, connection))
         page = Connection(self.studio, outbox.send, lambda: outbox.unsent)
         try:
             # Its bytes in flight are bounded together with the language server's
@@ -190,20 +189,27 @@ class Server:
 
 class _Outbox:
     """Sends each message as a text frame, in order, from a task of its own; a page
-    that leaves MAX_UNSENT bytes unread is disconnected."""
+    that would leave more unread than the bound of the bytes in flight allows
+    (`refusal`: transports.InFlight's) is disconnected."""
 
-    def __init__(self, connection: ServerConnection) -> None:
+    def __init__(self, connection: ServerConnection, refusal: Admission) -> None:
         self._connection = connection
+        self._refusal = refusal
         self._queue: asyncio.Queue[str] = asyncio.Queue()
         self.unsent = 0
+        self._closed = False
         self._pump = asyncio.get_running_loop().create_task(self._send_all())
 
     def send(self, text: str) -> None:
-        self.unsent += len(text)
-        if self.unsent > MAX_UNSENT:
-            log.warning("a page has not read %d MiB: disconnected", MAX_UNSENT // 2**20)
+        if self._closed:  # the page has gone, and is counted no more
+            return
+        # JSON as json.dumps writes it is ASCII: its length is its bytes'.
+        if (refused := self._refusal(len(text))) is not None:
+            log.warning("a page has not read %.0f MiB, and %s: disconnected",
+                        self.unsent / 2**20, refused)
             self._connection.transport.abort()
             return
+        self.unsent += len(text)
         self._queue.put_nowait(text)
 
     async def _send_all(self) -> None:
@@ -214,6 +220,7 @@ class _Outbox:
                 self.unsent -= len(text)
 
     def close(self) -> None:
+        self._closed = True
         self._pump.cancel()
 
 

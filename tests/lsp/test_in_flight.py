@@ -5,16 +5,19 @@ TCP transport asks once, for the whole body, which is one piece here)."""
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import functools
 import itertools
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 from hypothesis import given
 from hypothesis import strategies as st
 
+from rl1.lsp import transports
 from rl1.lsp.framing import MAX_MESSAGE
+from rl1.lsp.studio import server
 from rl1.lsp.transports import (
     FREE_IN_FLIGHT,
     MAX_IN_FLIGHT,
@@ -165,3 +168,86 @@ def test_whatever_the_interleaving_the_bound_holds_and_one_large_message_is_read
     assert sent.peak <= MAX_IN_FLIGHT
     assert all(sender.read for sender in senders if sender.size <= FREE_IN_FLIGHT)
     assert sent.first_large is None or sent.first_large.read, sent.first_large.refused
+
+
+class _Transport:
+    def __init__(self) -> None:
+        self.aborted = False
+        self.buffered = 0
+
+    def abort(self) -> None:
+        self.aborted = True
+
+    def get_write_buffer_size(self) -> int:
+        return self.buffered
+
+
+class _Stream:
+    """What _TcpWriter writes to (an asyncio.StreamWriter), and what the WebSocket
+    writers send on (a websockets ServerConnection)."""
+
+    def __init__(self) -> None:
+        self.transport = _Transport()
+        self.written: list[bytes | str] = []
+
+    def is_closing(self) -> bool:
+        return self.transport.aborted
+
+    def write(self, data: bytes) -> None:
+        self.written.append(data)
+        self.transport.buffered += len(data)
+
+    async def send(self, text: str) -> None:
+        self.written.append(text)
+
+
+@contextlib.contextmanager
+def _bound_full() -> Iterator[InFlight]:
+    """An InFlight whose bound another session holds whole (the reservation too)."""
+    in_flight = InFlight()
+    with in_flight.counting("other", lambda: FREE_IN_FLIGHT + MAX_IN_FLIGHT):
+        assert in_flight.refusal("other") is None
+        yield in_flight
+
+
+ANSWER = b" " * (2 * MiB)  # beyond a session's free share
+
+
+def test_a_tcp_answer_past_the_bound_is_not_written() -> None:
+    """The TCP writer wrote an answer, then asked whether its session might hold it."""
+    stream = _Stream()
+    with _bound_full() as in_flight:
+        writer = transports._TcpWriter(stream, functools.partial(  # type: ignore[arg-type]
+            in_flight.refusal, stream))
+        with in_flight.counting(stream, lambda: writer.unread):
+            writer.write(ANSWER)
+    assert stream.transport.aborted
+    assert stream.written == []
+
+
+def test_a_websocket_answer_past_the_bound_is_not_counted() -> None:
+    """The WebSocket writers (rl1-lsp's and the studio page's) counted an answer, then
+    asked whether their session might hold it: refused, the answer was not sent but
+    stayed counted against the others until the session ended. A studio page could
+    also leave 128 MiB unread whatever the others held, past the bound."""
+    async def answer() -> None:
+        stream = _Stream()
+        with _bound_full() as in_flight:
+            writer = transports._WebSocketWriter(
+                stream, functools.partial(in_flight.refusal, stream))
+            with in_flight.counting(stream, lambda: writer.unsent):
+                writer.write(ANSWER)
+            writer.close()
+        assert stream.transport.aborted and writer.unsent == 0
+
+        page = _Stream()
+        with _bound_full() as in_flight:
+            outbox = server._Outbox(page, functools.partial(  # type: ignore[arg-type]
+                in_flight.refusal, page))
+            with in_flight.counting(page, lambda: outbox.unsent):
+                outbox.send(ANSWER.decode())
+            outbox.close()
+            outbox.send("{}")  # closed, as when its page has gone: nothing is asked
+        assert page.transport.aborted and outbox.unsent == 0
+
+    asyncio.run(answer())
