@@ -8,13 +8,16 @@
   which the load of a shared machine changes less than the rate;
 - what Dask adds to a run: the CPU time of a run of a cheap program in one process and
   on a Dask worker (a campaign sends several runs a task: compiler/campaign.py);
+- a sweep of many points of few runs each, on 1 Dask worker: the tasks sent and the runs
+  per second with the runs' timing carried from point to point (as `rl1c sim --sweep`
+  makes it) and begun again at each point (its tasks of one run until a run is timed);
 - the memory of a long campaign: the resident size of a campaign in this process,
   sampled as the runs go, over `--memory-runs` runs (default 100,000) of a cheap program;
 - last, a campaign of `--runs` runs (default 1,000) of Listing 1 through the command
   line, its summary as printed.
 
     .venv/bin/python bench/campaign.py [--runs N] [--rate-runs N] [--rounds N]
-        [--memory-runs N]
+        [--memory-runs N] [--sweep-points N] [--sweep-runs N]
 """
 
 from __future__ import annotations
@@ -27,13 +30,16 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import dataclass
+from collections.abc import Callable
+from concurrent.futures import Executor, Future
+from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import ParamSpec, TypeVar
 
 import psutil  # type: ignore[import-untyped]  # with `distributed`, which this bench needs
 from distributed import LocalCluster
 
-from rl1.compiler.campaign import Campaign, Tally, Task, campaign_seeds, task_for
+from rl1.compiler.campaign import Campaign, Tally, Task, Timing, campaign_seeds, task_for
 from rl1.compiler.cli.sim_campaign import WINDOW_PER_JOB
 from rl1.compiler.executors import workers
 from rl1.vm.defaults import DEFAULT_BUDGET
@@ -44,6 +50,9 @@ WORLD = ROOT / "examples" / "sample.world.toml"
 RL1C = str(Path(sys.executable).with_name("rl1c"))
 CHEAP_PROGRAM = "A=(ULT A)\n(END)\n"  # one noisy reading: a run of about a millisecond
 SAMPLES = 10  # of the memory, over the long campaign
+
+P = ParamSpec("P")
+T = TypeVar("T")
 
 
 def noisy_world() -> bytes:
@@ -111,6 +120,38 @@ def fastest_rates(task: Task, runs: int, rounds: int,
     return best
 
 
+class Counting(Executor):
+    """An executor's tasks, counted as they are submitted."""
+
+    def __init__(self, executor: Executor) -> None:
+        self.executor = executor
+        self.tasks = 0
+
+    def submit(self, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> Future[T]:
+        self.tasks += 1
+        return self.executor.submit(fn, *args, **kwargs)
+
+
+def sweep_rate(task: Task, points: int, runs: int, scheduler: str, carried: bool
+               ) -> tuple[float, int]:
+    """The runs per second of a sweep of `points` points (start.x moved by 0, 1, ... cm)
+    of `runs` runs each on the cluster of `scheduler`, one campaign a point as `rl1c sim
+    --sweep` makes them, their timing `carried` from point to point or not; and the
+    tasks it sent."""
+    started = time.perf_counter()
+    timing = Timing()
+    with workers(1, scheduler) as held:
+        assert held.executor is not None  # a cluster's
+        counting = Counting(held.executor)
+        for point in range(points):
+            moved = replace(task, offsets=(("start.x", float(point)),))
+            for _ in Campaign(moved, campaign_seeds(0, runs), counting,
+                              WINDOW_PER_JOB * max(held.slots, 1), held.lost,
+                              timing if carried else Timing()):
+                pass
+    return points * runs / (time.perf_counter() - started), counting.tasks
+
+
 def cheap_task() -> Task:
     return task_for(CHEAP_PROGRAM, noisy_world(), "sample.noisy.world.toml", "vm",
                     DEFAULT_BUDGET, "cheap.rob")
@@ -144,6 +185,8 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--cheap-runs", type=int, default=2000)
     parser.add_argument("--memory-runs", type=int, default=100_000)
+    parser.add_argument("--sweep-points", type=int, default=50)
+    parser.add_argument("--sweep-runs", type=int, default=40)
     options = parser.parse_args()
     cores = os.cpu_count() or 1
     task = task_for(PROGRAM.read_text(), noisy_world(), "sample.noisy.world.toml", "vm",
@@ -157,6 +200,10 @@ def main() -> None:
         # What Dask adds to a run, seen on a cheap one.
         costs = fastest_rates(cheap_task(), options.cheap_runs, options.rounds, {
             "here": (1, None), "there": (1, one.scheduler_address)})
+        sweeps = {carried: max(sweep_rate(cheap_task(), options.sweep_points,
+                                          options.sweep_runs, one.scheduler_address,
+                                          carried) for _ in range(options.rounds))
+                  for carried in (False, True)}
     one, every = rates["1 process"], rates[f"{cores} processes"]
     one_worker, two_workers = rates["Dask, 1 worker"], rates["Dask, 2 workers"]
     print(f"Listing 1 on the sample world with noise on, {options.rate_runs} runs, the "
@@ -180,6 +227,13 @@ def main() -> None:
     print(f"  in one process:     {here.cpu_ms:5.2f} ms ({here.runs_per_second:.0f} runs/s)")
     print(f"  on one Dask worker: {there.cpu_ms:5.2f} ms ({there.runs_per_second:.0f} runs/s; "
           f"{there.cpu_ms - here.cpu_ms:+.2f} ms a run)")
+
+    print(f"\na sweep of {options.sweep_points} points of {options.sweep_runs} runs of "
+          f"`{cheap}` on one Dask worker, the fastest of {options.rounds} rounds:")
+    (fresh, fresh_tasks), (carried, carried_tasks) = sweeps[False], sweeps[True]
+    print(f"  timing begun again at each point: {fresh_tasks:5} tasks, {fresh:6.0f} runs/s")
+    print(f"  timing carried over (rl1c sim):   {carried_tasks:5} tasks, {carried:6.0f} "
+          f"runs/s ({carried / fresh:.2f}x)")
 
     print(f"\nmemory of a campaign of {options.memory_runs:,} runs of `{cheap}` on the "
           "sample world with noise on (resident, this process):")
