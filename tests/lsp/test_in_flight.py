@@ -10,7 +10,7 @@ import contextlib
 import functools
 import itertools
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from hypothesis import given
 from hypothesis import strategies as st
@@ -31,62 +31,72 @@ MiB = 2**20
 
 @dataclass(eq=False)  # a session, known by its identity
 class Sender:
-    """A session reading one message of `size` bytes, `piece` bytes at a time."""
+    """A session reading its messages of `sizes` bytes one after another, `piece` bytes
+    at a time; each message read is handled, and its bytes let go of."""
 
-    size: int
+    sizes: list[int]
     piece: int
-    held: int = 0
-    refused: str | None = None
+    held: int = 0  # of the message being read
+    read: list[int] = field(default_factory=list)  # the indexes of the messages read
+    refused: list[int] = field(default_factory=list)  # and of those refused
+    closed: bool = False  # refused, and reading no more
 
     @property
-    def read(self) -> bool:
-        return self.held == self.size
+    def reading(self) -> int | None:
+        """The index of the message being read, None once all are read or refused."""
+        done = len(self.read) + len(self.refused)
+        return None if self.closed or done == len(self.sizes) else done
 
     def holding(self) -> int:
         return self.held
 
-    def wants(self) -> int:
-        return min(self.piece, self.size - self.held)
 
-
-def _beyond_free(senders: Sequence[Sender]) -> int:
-    return sum(max(0, sender.held - FREE_IN_FLIGHT) for sender in senders)
+def _beyond_free(sender: Sender) -> int:
+    return max(0, sender.held - FREE_IN_FLIGHT)
 
 
 @dataclass
 class Sent:
-    peak: int  # the greatest sum of the bytes held beyond the free shares
-    first_large: Sender | None  # the first to ask for more than its free share
+    peak: int = 0  # the greatest sum of the bytes held beyond the free shares
+    # The messages that passed their free share while no other session held beyond its own.
+    alone: list[tuple[Sender, int]] = field(default_factory=list)
 
 
 def _send(senders: Sequence[Sender], turns: Sequence[int], release_refused: bool) -> Sent:
-    """Each turn, the sender of that index (modulo their number) asks for its next piece,
-    and holds it if admitted; a refused sender asks no more, and holds what it had read
-    (a WebSocket connection's frames until it is lost) or, with `release_refused`, lets
-    go of it (a TCP message skipped). Once `turns` is spent, the senders take turns
-    round-robin until each has read its message or been refused."""
+    """Each turn, the sender of that index (modulo their number) asks for the next piece
+    of its message, and holds it if admitted; a refused sender holds what it had read,
+    and reads no more (a WebSocket connection closed, its frames held until it is lost),
+    or, with `release_refused`, lets go of it and reads its next message (a TCP message
+    skipped). Once `turns` is spent, the senders take turns round-robin until each has
+    read or been refused all it sends."""
     in_flight = InFlight()
-    sent = Sent(peak=0, first_large=None)
+    sent = Sent()
     with contextlib.ExitStack() as stack:
         for sender in senders:
             stack.enter_context(in_flight.counting(sender, sender.holding))
         for turn in itertools.chain(turns, itertools.count()):
-            waiting = [s for s in senders if not s.read and s.refused is None]
-            if not waiting:
+            if all(sender.reading is None for sender in senders):
                 break
             sender = senders[turn % len(senders)]
-            if sender not in waiting:
+            if (message := sender.reading) is None:
                 continue
-            more = sender.wants()
-            if sent.first_large is None and sender.held + more > FREE_IN_FLIGHT:
-                sent.first_large = sender
-            if (refused := in_flight.refusal(sender, more)) is None:
+            size = sender.sizes[message]
+            more = min(sender.piece, size - sender.held)
+            if sender.held <= FREE_IN_FLIGHT < sender.held + more and not any(
+                    _beyond_free(other) for other in senders if other is not sender):
+                sent.alone.append((sender, message))
+            if in_flight.refusal(sender, more) is None:
                 sender.held += more
+                if sender.held == size:
+                    sender.read.append(message)
+                    sender.held = 0
             else:
-                sender.refused = refused
+                sender.refused.append(message)
                 if release_refused:
                     sender.held = 0
-            sent.peak = max(sent.peak, _beyond_free(senders))
+                else:
+                    sender.closed = True
+            sent.peak = max(sent.peak, sum(map(_beyond_free, senders)))
     return sent
 
 
@@ -95,13 +105,13 @@ def test_of_eight_large_messages_read_at_once_the_first_is_read_whole() -> None:
     grew together until the bound was full, and each was refused midway, none read (on
     a loaded machine, every time). The first to need more than its free share keeps
     room for its message, and the others share what is left."""
-    senders = [Sender(size=60 * MiB, piece=MiB // 4) for _ in range(MAX_SESSIONS)]
+    senders = [Sender(sizes=[60 * MiB], piece=MiB // 4) for _ in range(MAX_SESSIONS)]
     round_robin = list(range(MAX_SESSIONS)) * (60 * 4)
     sent = _send(senders, round_robin, release_refused=False)
-    assert sent.first_large is senders[0]
-    assert senders[0].read, senders[0].refused
+    assert sent.alone == [(senders[0], 0)]
+    assert senders[0].read == [0]
     assert sent.peak <= MAX_IN_FLIGHT
-    assert all(sender.refused is not None for sender in senders[2:])
+    assert all(sender.refused == [0] for sender in senders[2:])
 
 
 def test_a_refusal_says_what_the_others_hold_and_what_to_do() -> None:
@@ -149,25 +159,33 @@ def test_a_session_that_ends_gives_back_the_reservation() -> None:
 
 @st.composite
 def senders(draw: st.DrawFn) -> list[Sender]:
-    """Up to MAX_SESSIONS messages, received in pieces of one size (a transport reads
-    what has come, up to the same size each time), or each whole (TCP's admission)."""
+    """Up to MAX_SESSIONS sessions, each sending up to three messages, all received in
+    pieces of one size (a transport reads what has come, up to the same size each
+    time), or each whole (TCP's admission)."""
     piece = draw(st.sampled_from([2**16, MiB, 8 * MiB, MAX_MESSAGE]))
-    sizes = st.integers(0, MAX_MESSAGE) | st.integers(MAX_MESSAGE // 2, MAX_MESSAGE)
-    return [Sender(size=size, piece=piece)
-            for size in draw(st.lists(sizes, min_size=1, max_size=MAX_SESSIONS))]
+    size = st.integers(0, MAX_MESSAGE) | st.integers(MAX_MESSAGE // 2, MAX_MESSAGE)
+    return [Sender(sizes=sizes, piece=piece) for sizes in draw(st.lists(
+        st.lists(size, min_size=1, max_size=3), min_size=1, max_size=MAX_SESSIONS))]
 
 
 @given(senders=senders(), turns=st.lists(st.integers(0, MAX_SESSIONS - 1), max_size=200),
        release_refused=st.booleans())
-def test_whatever_the_interleaving_the_bound_holds_and_one_large_message_is_read(
+def test_whatever_the_interleaving_the_bound_holds_and_large_messages_are_read(
         senders: list[Sender], turns: list[int], release_refused: bool) -> None:
     """For every interleaving of messages of up to MAX_MESSAGE bytes: the bytes held
     beyond the free shares never pass MAX_IN_FLIGHT, a message within its free share is
-    always read, and so is the first message to need more than that."""
+    always read, and so is a message that passes its free share while no other session
+    holds beyond its own (such as the first to need more than that): the others'
+    messages, begun before or after, do not make it refused midway."""
     sent = _send(senders, turns, release_refused)
     assert sent.peak <= MAX_IN_FLIGHT
-    assert all(sender.read for sender in senders if sender.size <= FREE_IN_FLIGHT)
-    assert sent.first_large is None or sent.first_large.read, sent.first_large.refused
+    for sender in senders:
+        small = [index for index, size in enumerate(sender.sizes) if size <= FREE_IN_FLIGHT]
+        assert not set(small) & set(sender.refused)
+    for sender, message in sent.alone:
+        assert message in sender.read, (sender.sizes, sender.refused)
+    if any(size > FREE_IN_FLIGHT for sender in senders for size in sender.sizes):
+        assert sent.alone, "some message passes its free share while alone"
 
 
 class _Transport:
