@@ -15,7 +15,13 @@ simulator, an editor plug-in):
   forward, handlers `:96`-`:99` end with `(END)`, every argument is in range (a variable
   argument is set just before its call). Their expressions use every operator with
   constants chosen to hit the edges: wrap-around at both ends, shift counts below 0 and
-  of 16 or more. Use them to run two engines side by side:
+  of 16 or more. Mixed in are the shapes each optimizer pass rewrites, so that every
+  pass has work in some of them (spec/optimization.md): if-else ways that end alike (or
+  nearly), and loops whose body ends as the code before them does; equal operands
+  (`A=P-P`), steps written as additions (`A=A+1`), copies then their uses, stores
+  overwritten before they are read, and branches on a variable inside the way a branch
+  on it fell through, mostly on a sensor's reading (a value no pass knows). Use them to
+  run two engines side by side:
 
       from hypothesis import given
       from rl1.compiler.strategies import checked_programs
@@ -70,6 +76,8 @@ _FORMS: tuple[tuple[str, Form], ...] = tuple(
 )
 _VALUE_FORMS = tuple((mnemonic, form) for mnemonic, form in _FORMS if form.returns_value)
 _ORDINARY_VARIABLES = tuple(v for v in VARIABLES if v not in RESERVED_VARIABLES)
+_EQUAL_OPERAND_OPERATORS = ("-", "^", "&", "|")  # `P-P` is 0, `P&P` is P
+_NEAR_OPERANDS = ("0", "1", "2", "7", "A", "B", "P")  # what `nearly` changes an end to
 
 
 # Text -----------------------------------------------------------------------------------
@@ -316,14 +324,124 @@ class _Builder:
             self.traces = True
         return values
 
+    # The shapes the optimizer's passes look for (issue 25): each pass has work in some
+    # share of the programs, which tests/backend/test_generator_shapes.py holds.
+
+    def reading(self) -> str:
+        """A variable set to a sensor's reading (one the script has, and repeats): a
+        value no pass knows, where a constant would be folded before the passes that
+        need a variable (equal operands, steps, branches decided by signs) see it."""
+        variable = self.draw(st.sampled_from(
+            [v for v in _ORDINARY_VARIABLES if v not in self.counters]))
+        sensor, _ = self.draw(st.sampled_from(_SENSED))
+        self.emit((variable, "=", *sensor))
+        return variable
+
+    def plain(self, pool: Sequence[str]) -> list[Tokens]:
+        """A statement or two without a call, reading mostly the variables of `pool`,
+        of a shape one of the passes rewrites: equal operands (`A=P-P`, `A=P&P`); a
+        step written as an addition (`A=A+1`; `+3` is left as it is); a copy, then its
+        use (`A=P+1; B=A`, `A=A`, `D=D+A`); a store overwritten before it is read
+        (`A=P+1; A=Q`); or an assignment."""
+        draw = self.draw
+        target, other = self.writable(), self.writable()
+        source = draw(st.sampled_from(pool))
+        computed = (target, "=", source, draw(st.sampled_from(OPERATORS)), self.small())
+        kind = draw(st.sampled_from(("equal", "step", "copy", "overwritten", "assign")))
+        if kind == "equal":
+            return [(target, "=", source, draw(st.sampled_from(_EQUAL_OPERAND_OPERATORS)),
+                     source, *draw(st.sampled_from(((), ("+", self.small())))))]
+        if kind == "step":
+            return [(target, "=", target, draw(st.sampled_from("+-")),
+                     draw(st.sampled_from(("1", "2", "1", "2", "3", "0", "-1"))))]
+        if kind == "copy":
+            use = draw(st.sampled_from(((other, "=", target), (target, "=", target),
+                                        (other, "=", other, draw(st.sampled_from("+&|^")),
+                                         target))))
+            return [computed, use]
+        if kind == "overwritten":
+            return [computed, (target, "=", draw(st.sampled_from(pool)), "-", self.small())]
+        return [computed]
+
+    def small(self) -> str:
+        return _constant_text(self.draw, self.draw(st.integers(-2, 300)))
+
+    def nearly(self, statement: Tokens) -> Tokens:
+        """The statement with its last operand changed: alike but for its end, where
+        tail merging must stop."""
+        last = statement[-1]
+        other = self.draw(st.sampled_from([operand for operand in _NEAR_OPERANDS
+                                           if operand != last]))
+        return (*statement[:-1], other)
+
+    def arm(self, depth: int) -> None:
+        """What an if-else's way, or the code between branches, holds: a block (not too
+        deep), or a few statements, or none."""
+        if depth < 2 and self.draw(st.booleans()):
+            self.block(depth + 1)
+        else:
+            for _ in range(self.draw(st.integers(0, 1))):
+                self.statement()
+
+    def if_else(self, depth: int) -> None:
+        """`?V=#20; <then>; <tail>; #30; :20 <else>; <tail>; :30`: two ways that end
+        alike and join, whose tail merge_tails writes once; or, now and then, the else
+        way's tail with its first statement's last operand changed, where the merge
+        must stop."""
+        otherwise, join = self.new_label(), self.new_label()
+        assert otherwise is not None and join is not None
+        variable = self.reading() if self.draw(st.integers(0, 2)) \
+            else self.draw(st.sampled_from(VARIABLES))
+        pool = (variable, self.draw(st.sampled_from(VARIABLES)))
+        tail = self.plain(pool)
+        self.emit(("?", variable, self.draw(st.sampled_from(RELATIONS)),
+                   f"#{otherwise:02d}"))
+        self.arm(depth)
+        for statement in tail:
+            self.emit(statement)
+        self.emit((f"#{join:02d}",))
+        self.label(otherwise)
+        self.arm(depth)
+        if self.draw(st.integers(0, 3)) == 0:
+            tail[0] = self.nearly(tail[0])
+        for statement in tail:
+            self.emit(statement)
+        self.label(join)
+
+    def branches(self, depth: int) -> None:
+        """Two or three branches on one variable, each inside the way the one before
+        falls through, nothing writing the variable in between: `?V=#20; ...; ?V=#30`,
+        where the second never jumps (decide_branches); the same relation again, or
+        another (`?V<#20; ?V>#30; ?V=#40` always jumps)."""
+        variable = self.reading() if self.draw(st.integers(0, 2)) else self.draw(
+            st.sampled_from([v for v in _ORDINARY_VARIABLES if v not in self.counters]))
+        self.counters.add(variable)  # not written until the last branch's target
+        relation = self.draw(st.sampled_from(RELATIONS))
+        targets: list[int] = []
+        for _ in range(self.draw(st.integers(2, 3))):
+            if (target := self.new_label()) is None:
+                break
+            if self.draw(st.booleans()):
+                relation = self.draw(st.sampled_from(RELATIONS))
+            self.emit(("?", variable, relation, f"#{target:02d}"))
+            targets.append(target)
+            self.arm(depth)
+        self.counters.discard(variable)
+        for target in reversed(targets):
+            self.label(target)
+
     # Statements and blocks
 
     def statement(self, tracing: bool = True) -> None:
-        """One statement; with `tracing` False, no (TRC ...) (handlers must not set a
-        mode whose handlers might not exist)."""
-        kind = self.draw(st.sampled_from(("assign", "assign", "step", "call", "call")))
+        """One statement (or a few of the shapes in `plain`); with `tracing` False, no
+        (TRC ...) (handlers must not set a mode whose handlers might not exist)."""
+        kind = self.draw(st.sampled_from(("assign", "assign", "step", "call", "call",
+                                          "plain")))
         if self.wild and self.draw(st.integers(0, 199)) == 100:  # not 0: Hypothesis favours 0
             self.emit(("(", "MVI", "3", ",", "-3", ",", "10", ")"))  # a device error
+        elif kind == "plain":
+            for statement in self.plain([self.draw(st.sampled_from(VARIABLES))]):
+                self.emit(statement)
         elif kind == "assign":
             target = self.writable()
             tokens = [target, "=", *self.operand()]
@@ -338,7 +456,8 @@ class _Builder:
                 self.emit(self.call(mnemonic, form))
 
     def block(self, depth: int) -> None:
-        kinds = ("straight", "straight", "loop", "skip") + (("sensed",) if self.wild else ())
+        kinds = ("straight", "straight", "straight", "loop", "skip", "if-else", "branches") \
+            + (("sensed",) if self.wild else ())
         kind = self.draw(st.sampled_from(kinds))
         if self.wild and depth == 0 and self.free_labels and self.draw(st.booleans()):
             self.wild.top_labels.append(number := self.free_labels.pop())
@@ -349,6 +468,10 @@ class _Builder:
             self.loop(depth)
         elif kind == "skip" and depth < 3 and self.free_labels:
             self.skip(depth)
+        elif kind == "if-else" and depth < 3 and len(self.free_labels) >= 2:
+            self.if_else(depth)
+        elif kind == "branches" and depth < 3 and self.free_labels:
+            self.branches(depth)
         else:
             for _ in range(self.draw(st.integers(1, 4))):
                 self.statement()
@@ -358,15 +481,17 @@ class _Builder:
             self.block(depth + 1)
 
     def loop(self, depth: int) -> None:
-        """A counted loop in one of three shapes; `count` passes (0 for the third shape
-        means the body never runs)."""
+        """A counted loop in one of four shapes; `count` passes (0 for the third shape
+        means the body never runs). In the fourth, the code before the loop ends as its
+        body does (`C=3; A=P+1; :10 ?C=#20; C--; ...; A=P+1; #10`), which merge_tails
+        writes once."""
         counter = self.draw(st.sampled_from(
             [v for v in _ORDINARY_VARIABLES if v not in self.counters]))
         count = self.draw(st.integers(1, 4))
         top, exit_label = self.new_label(), self.new_label()
         assert top is not None and exit_label is not None
         self.counters.add(counter)
-        shape = self.draw(st.sampled_from(("down", "up", "while")))
+        shape = self.draw(st.sampled_from(("down", "up", "while", "tail")))
         if shape == "down":
             self.emit((counter, "=", str(count)))
             self.label(top)
@@ -379,14 +504,29 @@ class _Builder:
             self.body(depth)
             self.emit((counter, "++"))
             self.emit(("?", counter, "<", f"#{top:02d}"))
-        else:
+        elif shape == "while":
             self.emit((counter, "=", str(count - 1)))
             self.label(top)
             self.emit(("?", counter, "=", f"#{exit_label:02d}"))
             self.body(depth)
             self.emit((counter, "--"))
             self.emit((f"#{top:02d}",))
-        if shape == "while":
+        else:
+            self.emit((counter, "=", str(count)))
+            read = self.reading()
+            self.counters.add(read)  # its value alike in both tails
+            tail = self.plain((read, self.draw(st.sampled_from(VARIABLES))))
+            for statement in tail:
+                self.emit(statement)
+            self.label(top)
+            self.emit(("?", counter, "=", f"#{exit_label:02d}"))
+            self.emit((counter, "--"))
+            self.body(depth)
+            for statement in tail:
+                self.emit(statement)
+            self.emit((f"#{top:02d}",))
+            self.counters.discard(read)
+        if shape in ("while", "tail"):
             self.label(exit_label)
         else:
             self.free_labels.append(exit_label)
