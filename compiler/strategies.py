@@ -253,13 +253,13 @@ class _Wild:
 @dataclass
 class _Builder:
     """Builds a program that passes the checker and ends: counted loops, forward jumps,
-    arguments in range. Variables that count a loop in progress are never written by the
-    loop's body."""
+    arguments in range. The variables `held` are never written while they are held: the
+    counter of a loop in progress, and what a shape relies on keeping its value."""
 
     draw: st.DrawFn
     free_labels: list[int]
     lines: list[_Line] = field(default_factory=lambda: [_Line()])
-    counters: set[str] = field(default_factory=set)
+    held: set[str] = field(default_factory=set)
     traces: bool = False  # some (TRC 2) or (TRC 3) may run
     wild: _Wild | None = None  # runs(): sensor loops, re-entered handlers, faults
 
@@ -280,12 +280,17 @@ class _Builder:
     # Variables and values
 
     def writable(self) -> str:
-        """A variable the program may assign now: not a loop counter in use; rarely a
-        reserved one (the checker only warns)."""
-        pool = [v for v in _ORDINARY_VARIABLES if v not in self.counters]
+        """A variable the program may assign now: not one held; rarely a reserved one
+        (the checker only warns)."""
+        pool = [v for v in _ORDINARY_VARIABLES if v not in self.held]
         if self.draw(st.integers(0, 15)) == 0:
             pool += RESERVED_VARIABLES
         return self.draw(st.sampled_from(pool))
+
+    def unheld(self) -> str:
+        """An ordinary variable not held, to hold or to set to a reading."""
+        return self.draw(st.sampled_from(
+            [v for v in _ORDINARY_VARIABLES if v not in self.held]))
 
     def operand(self) -> Tokens:
         kind = self.draw(st.sampled_from(("variable", "constant", "constant", "call")))
@@ -301,7 +306,7 @@ class _Builder:
         (to distinct variables, so one setting cannot undo another)."""
         args: list[str] = []
         values = self.arguments(mnemonic, form)
-        spare = [v for v in _ORDINARY_VARIABLES if v not in self.counters]
+        spare = [v for v in _ORDINARY_VARIABLES if v not in self.held]
         for value, param in zip(values, form.params, strict=True):
             if self.draw(st.integers(0, 2)) == 0:
                 variable = self.draw(st.sampled_from(spare))
@@ -331,8 +336,7 @@ class _Builder:
         """A variable set to a sensor's reading (one the script has, and repeats): a
         value no pass knows, where a constant would be folded before the passes that
         need a variable (equal operands, steps, branches decided by signs) see it."""
-        variable = self.draw(st.sampled_from(
-            [v for v in _ORDINARY_VARIABLES if v not in self.counters]))
+        variable = self.unheld()
         sensor, _ = self.draw(st.sampled_from(_SENSED))
         self.emit((variable, "=", *sensor))
         return variable
@@ -413,9 +417,8 @@ class _Builder:
         falls through, nothing writing the variable in between: `?V=#20; ...; ?V=#30`,
         where the second never jumps (decide_branches); the same relation again, or
         another (`?V<#20; ?V>#30; ?V=#40` always jumps)."""
-        variable = self.reading() if self.draw(st.integers(0, 2)) else self.draw(
-            st.sampled_from([v for v in _ORDINARY_VARIABLES if v not in self.counters]))
-        self.counters.add(variable)  # not written until the last branch's target
+        variable = self.reading() if self.draw(st.integers(0, 2)) else self.unheld()
+        self.held.add(variable)  # not written until the last branch's target
         relation = self.draw(st.sampled_from(RELATIONS))
         targets: list[int] = []
         for _ in range(self.draw(st.integers(2, 3))):
@@ -426,7 +429,7 @@ class _Builder:
             self.emit(("?", variable, relation, f"#{target:02d}"))
             targets.append(target)
             self.arm(depth)
-        self.counters.discard(variable)
+        self.held.discard(variable)
         for target in reversed(targets):
             self.label(target)
 
@@ -485,12 +488,11 @@ class _Builder:
         means the body never runs). In the fourth, the code before the loop ends as its
         body does (`C=3; A=P+1; :10 ?C=#20; C--; ...; A=P+1; #10`), which merge_tails
         writes once."""
-        counter = self.draw(st.sampled_from(
-            [v for v in _ORDINARY_VARIABLES if v not in self.counters]))
+        counter = self.unheld()
         count = self.draw(st.integers(1, 4))
         top, exit_label = self.new_label(), self.new_label()
         assert top is not None and exit_label is not None
-        self.counters.add(counter)
+        self.held.add(counter)
         shape = self.draw(st.sampled_from(("down", "up", "while", "tail")))
         if shape == "down":
             self.emit((counter, "=", str(count)))
@@ -514,7 +516,7 @@ class _Builder:
         else:
             self.emit((counter, "=", str(count)))
             read = self.reading()
-            self.counters.add(read)  # its value alike in both tails
+            self.held.add(read)  # its value alike in both tails
             tail = self.plain((read, self.draw(st.sampled_from(VARIABLES))))
             for statement in tail:
                 self.emit(statement)
@@ -525,12 +527,12 @@ class _Builder:
             for statement in tail:
                 self.emit(statement)
             self.emit((f"#{top:02d}",))
-            self.counters.discard(read)
+            self.held.discard(read)
         if shape in ("while", "tail"):
             self.label(exit_label)
         else:
             self.free_labels.append(exit_label)
-        self.counters.discard(counter)
+        self.held.discard(counter)
 
     def sensed_loop(self) -> None:
         """A loop that waits for a sensor, as Listing 1's `:10 A=(IMG)-180; ?A<#10`: the
