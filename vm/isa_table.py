@@ -154,7 +154,7 @@ def _initializer(items: list[str]) -> list[str]:
 def render_descriptors() -> list[str]:
     """Each call's descriptor, from vm/language.py (spec/ilc.md 8.3 and 12): a byte of
     bits, and a byte that says where its parameters' ranges start in one list of (low,
-    high) pairs, or which reserved variables it writes."""
+    span) pairs, or which reserved variables it writes."""
     infos = calls()
     forms = [_form(info) for info in infos]
     results = _kinds([form.result_range for form in forms], _ANY)
@@ -182,9 +182,9 @@ def render_descriptors() -> list[str]:
         "/* Each call's descriptor (spec/ilc.md 8.3 and 12), from vm/language.py: for each",
         "   call from RL1_OP_FIRST_CALL, a byte of the bits below in RL1_CALL_DESCRIPTORS,",
         "   and one in RL1_CALL_FIRST: for a call with arguments, the index in",
-        "   RL1_PARAM_RANGES of its first parameter's (low, high) pair, the others'",
-        "   following it; for one that writes reserved variables (none takes arguments),",
-        "   the first of them, the others following it. */",
+        "   RL1_PARAM_RANGES of its first parameter's range (low, and the span to high:",
+        "   rl1_param_range), the others' following it; for one that writes reserved",
+        "   variables (none takes arguments), the first of them, the others following it. */",
         "#define RL1_CALL_ARITY 0x03u       /* how many arguments it takes, 0 to 3 */",
         "#define RL1_CALL_STARTED 0x04u     /* it takes device time: started, then polled */",
         "#define RL1_CALL_SETS_R 0x08u      /* its result goes into R */",
@@ -202,7 +202,7 @@ def render_descriptors() -> list[str]:
         *_initializer([str(index) for index in firsts]),
         f"#define RL1_PARAM_COUNT {len(ranges) // 2}",
         "#define RL1_PARAM_RANGES \\",
-        *_initializer([f"{_c_int(low)}, {_c_int(high)}"
+        *_initializer([f"{{{_c_int(low)}, {high - low}u}}"
                        for low, high in zip(ranges[::2], ranges[1::2], strict=True)]),
     ]
 

@@ -2,7 +2,8 @@
 RL1_CALL_DESCRIPTORS, RL1_CALL_FIRST and RL1_PARAM_RANGES, defined in rl1vm_load.c) say
 of each call what vm/language.py says of its form: its arity, whether it takes device
 time (started, then polled), whether its result goes into R, the reserved variables it
-writes, and each parameter's range, read from the built library as the VM reads them.
+writes, and each parameter's range (its low end, and the span to its high end), read from
+the built library as the VM reads them.
 (test_c_constants.py holds the header's block equal to what vm/isa_table.py renders;
 this holds what that block means.)"""
 
@@ -21,6 +22,11 @@ from rl1.vm.language import BUILTINS, VARIABLES, Form, Param
 
 CALLS = isa_table.calls()
 ARITY, STARTED, SETS_R, PAIRS, PAIRS_SHIFT = 0x03, 0x04, 0x08, 0x30, 4
+
+
+class Range(ctypes.Structure):
+    """rl1vm.h's rl1_param_range."""
+    _fields_ = (("low", ctypes.c_int16), ("span", ctypes.c_uint16))
 
 
 @pytest.fixture(scope="module")
@@ -79,3 +85,15 @@ def test_every_parameter_bound_and_its_neighbours(lib: ctypes.CDLL) -> None:
             if -32768 <= value <= 32767:
                 assert lib.rl1_arg_in_range(opcode, index, value) == \
                     (param.low <= value <= param.high), (name, param.name, value)
+
+
+def test_each_parameter_s_range_is_its_low_end_and_span(lib: ctypes.CDLL) -> None:
+    """The ranges' table holds, from the index of each call's first parameter, its
+    parameters' low ends and spans (high - low) in their order."""
+    ranges = (Range * len(_parameters())).in_dll(lib, "rl1_param_ranges")
+    firsts = table(lib, "rl1_call_first", ctypes.c_uint8, len(CALLS))
+    for info, first in zip(CALLS, firsts, strict=True):
+        for index, param in enumerate(_form(info).params):
+            entry = ranges[first + index]
+            assert (entry.low, entry.span) == (param.low, param.high - param.low), \
+                (info.name, param.name)

@@ -91,12 +91,12 @@ static bool broken_in(const rl1_vm *vm)
 #define S8_AT(p, k) ((int16_t)(int8_t)RL1_BYTE((p) + (k)))
 
 /* A variable argument's value, from its index in *arg, into *arg: false when it is out
- * of its parameter's range, low and high at range[0] and range[1]. */
-static ALWAYS_INLINE bool variable_argument(const int16_t *V, const int16_t *range,
+ * of its parameter's range. */
+static ALWAYS_INLINE bool variable_argument(const int16_t *V, const rl1_param_range *range,
                                             int16_t *arg)
 {
     int16_t value = V[*arg];
-    if (value < rl1_flash_i16(range) || value > rl1_flash_i16(range + 1)) {
+    if (!rl1_in_range(range, value)) {
         return false;
     }
     *arg = value;
@@ -116,7 +116,7 @@ static const uint8_t *arguments(const int16_t *V, uint8_t op, uint8_t arity,
                                 const uint8_t *at, int16_t *args)
 {
     uint8_t mask = RL1_BYTE(at);
-    const int16_t *range;
+    const rl1_param_range *range;
     if (op & RL1_COMPACT_CALL_BIT) {
         switch (arity) {
         case 3: args[2] = S8_AT(at, 3); /* fall through */
@@ -133,11 +133,10 @@ static const uint8_t *arguments(const int16_t *V, uint8_t op, uint8_t arity,
         at += 2u * arity;
     }
     if (mask) {
-        range = &rl1_param_ranges[2u * rl1_flash_byte(
-            &rl1_call_first[(op & (uint8_t)~RL1_COMPACT_CALL_BIT) - RL1_OP_FIRST_CALL])];
+        range = rl1_call_ranges((uint8_t)(op & ~RL1_COMPACT_CALL_BIT));
         if (((mask & 1u) && !variable_argument(V, range, &args[0]))
-            || ((mask & 2u) && !variable_argument(V, range + 2, &args[1]))
-            || ((mask & 4u) && !variable_argument(V, range + 4, &args[2]))) {
+            || ((mask & 2u) && !variable_argument(V, range + 1, &args[1]))
+            || ((mask & 4u) && !variable_argument(V, range + 2, &args[2]))) {
             return NULL;
         }
     }

@@ -166,9 +166,9 @@ typedef enum rl1_feature {
 /* Each call's descriptor (spec/ilc.md 8.3 and 12), from vm/language.py: for each
    call from RL1_OP_FIRST_CALL, a byte of the bits below in RL1_CALL_DESCRIPTORS,
    and one in RL1_CALL_FIRST: for a call with arguments, the index in
-   RL1_PARAM_RANGES of its first parameter's (low, high) pair, the others'
-   following it; for one that writes reserved variables (none takes arguments),
-   the first of them, the others following it. */
+   RL1_PARAM_RANGES of its first parameter's range (low, and the span to high:
+   rl1_param_range), the others' following it; for one that writes reserved
+   variables (none takes arguments), the first of them, the others following it. */
 #define RL1_CALL_ARITY 0x03u       /* how many arguments it takes, 0 to 3 */
 #define RL1_CALL_STARTED 0x04u     /* it takes device time: started, then polled */
 #define RL1_CALL_SETS_R 0x08u      /* its result goes into R */
@@ -189,9 +189,10 @@ typedef enum rl1_feature {
      14, 14, 14, 14, 15, 16, 18, 44}
 #define RL1_PARAM_COUNT 20
 #define RL1_PARAM_RANGES \
-    {-12, 12, -12, 12, -1900, 1900, -12, 12, -12, 12, 0, 180, 0, 180, -1800, 1800, \
-     -360, 360, 0, 3, 1, 100, 0, 7, 0, 180, 0, 784, 0, 1, 0, 125, 0, 125, 0, 255, \
-     INT16_MIN, INT16_MAX, INT16_MIN, INT16_MAX}
+    {{-12, 24u}, {-12, 24u}, {-1900, 3800u}, {-12, 24u}, {-12, 24u}, {0, 180u}, \
+     {0, 180u}, {-1800, 3600u}, {-360, 720u}, {0, 3u}, {1, 99u}, {0, 7u}, {0, 180u}, \
+     {0, 784u}, {0, 1u}, {0, 125u}, {0, 125u}, {0, 255u}, {INT16_MIN, 65535u}, \
+     {INT16_MIN, 65535u}}
 
 /* ---- End of the generated constants ---- */
 
@@ -319,14 +320,23 @@ static inline uint8_t rl1_flash_byte(const uint8_t *p)
     __asm__("lpm %0, Z" : "=r"(byte) : "z"(p));
     return byte;
 }
-static inline int16_t rl1_flash_i16(const int16_t *p) /* AVR is little-endian */
+static inline uint16_t rl1_flash_u16(const uint16_t *p) /* AVR is little-endian */
 {
-    const uint8_t *at = (const uint8_t *)p;
-    return (int16_t)(uint16_t)(rl1_flash_byte(at) | (unsigned)rl1_flash_byte(at + 1) << 8);
+    uint16_t word; /* the low byte, then the high one, Z moving on between them */
+    __asm__("lpm %A0, Z+\n\tlpm %B0, Z" : "=r"(word), "+z"(p));
+    return word;
+}
+static inline int16_t rl1_flash_i16(const int16_t *p)
+{
+    return (int16_t)rl1_flash_u16((const uint16_t *)p);
 }
 #else
 #define RL1_IN_FLASH
 static inline uint8_t rl1_flash_byte(const uint8_t *p)
+{
+    return *p;
+}
+static inline uint16_t rl1_flash_u16(const uint16_t *p)
 {
     return *p;
 }
@@ -335,9 +345,17 @@ static inline int16_t rl1_flash_i16(const int16_t *p)
     return *p;
 }
 #endif
+
+/* A parameter's range: low to low + span. The span, not the high end, so that a value is
+ * checked with one comparison (rl1_in_range). */
+typedef struct {
+    int16_t low;
+    uint16_t span;
+} rl1_param_range;
+
 extern const uint8_t rl1_call_descriptors[RL1_CALL_COUNT];
 extern const uint8_t rl1_call_first[RL1_CALL_COUNT];
-extern const int16_t rl1_param_ranges[2 * RL1_PARAM_COUNT];
+extern const rl1_param_range rl1_param_ranges[RL1_PARAM_COUNT];
 
 /* The descriptor of call `op` (RL1_OP_FRE..RL1_OP_FZI). */
 static inline uint8_t rl1_call_descriptor(uint8_t op)
@@ -351,11 +369,21 @@ static inline uint8_t rl1_call_arity(uint8_t op)
     return (uint8_t)(rl1_call_descriptor(op) & RL1_CALL_ARITY);
 }
 
-/* The low (0) or high (1) end of the range of the parameter at `index` in
- * RL1_PARAM_RANGES (the call's rl1_call_first, plus the argument's place). */
-static inline int16_t rl1_param_end(uint8_t index, uint8_t end)
+/* The ranges of call `op`'s parameters, from the first's, in rl1_param_ranges. */
+static inline const rl1_param_range *rl1_call_ranges(uint8_t op)
 {
-    return rl1_flash_i16(&rl1_param_ranges[2u * index + end]);
+    return &rl1_param_ranges[rl1_flash_byte(&rl1_call_first[op - RL1_OP_FIRST_CALL])];
+}
+
+/* Whether `value` lies in `range`, in one comparison: value - low, as unsigned, is at
+ * most the span exactly when low <= value <= low + span, whether int has 16 bits or
+ * more. Below low the difference wraps past every span: with an unsigned of N >= 32
+ * bits to at least 2^N - 65535; of 16 bits to 65536 + value - low, which is above the
+ * span (high - low) since value > high - 65536. */
+static inline bool rl1_in_range(const rl1_param_range *range, int16_t value)
+{
+    return (unsigned)value - (unsigned)rl1_flash_i16(&range->low)
+           <= rl1_flash_u16(&range->span);
 }
 
 /* The length of a call with `arity` arguments: the opcode alone, or the opcode, the

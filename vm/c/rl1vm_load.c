@@ -195,15 +195,13 @@ static uint8_t op_feature(uint8_t op)
  * vm/language.py): the one copy the loader and the VM share. */
 const uint8_t rl1_call_descriptors[RL1_CALL_COUNT] RL1_IN_FLASH = RL1_CALL_DESCRIPTORS;
 const uint8_t rl1_call_first[RL1_CALL_COUNT] RL1_IN_FLASH = RL1_CALL_FIRST;
-const int16_t rl1_param_ranges[2 * RL1_PARAM_COUNT] RL1_IN_FLASH = RL1_PARAM_RANGES;
+const rl1_param_range rl1_param_ranges[RL1_PARAM_COUNT] RL1_IN_FLASH = RL1_PARAM_RANGES;
 
 /* Whether `value` lies in the range of parameter `index` of call `op`
  * (spec/language.md section 8). */
 bool rl1_arg_in_range(uint8_t op, uint8_t index, int16_t value)
 {
-    uint8_t param = (uint8_t)(rl1_flash_byte(&rl1_call_first[op - RL1_OP_FIRST_CALL])
-                              + index);
-    return value >= rl1_param_end(param, 0) && value <= rl1_param_end(param, 1);
+    return rl1_in_range(rl1_call_ranges(op) + index, value);
 }
 
 /* --- the container (spec/ilc.md sections 2-7) -------------------------------------- */
@@ -429,6 +427,7 @@ static rl1_refusal check_variable(loader *ld, uint32_t index, uint32_t offset)
 static rl1_refusal check_call(loader *ld, uint8_t op, uint8_t width, uint32_t at)
 {
     uint8_t mask = BYTE(ld->file + at), arity = rl1_call_arity(op), k;
+    const rl1_param_range *range = rl1_call_ranges(op);
     rl1_refusal status = RL1_ACCEPTED;
     if (mask >> arity) {
         return fail(ld, RL1_BAD_MASK, at);
@@ -439,7 +438,7 @@ static rl1_refusal check_call(loader *ld, uint8_t op, uint8_t width, uint32_t at
                                     : i16_at(ld->file + field);
         if (((unsigned)mask >> k) & 1u) {
             status = check_variable(ld, (uint16_t)value, field);
-        } else if (!rl1_arg_in_range(op, k, value)) {
+        } else if (!rl1_in_range(range + k, value)) {
             status = fail(ld, RL1_ARGUMENT_RANGE, field);
         }
     }
