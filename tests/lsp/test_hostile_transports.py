@@ -33,7 +33,7 @@ from support.hostile import (
     ws_frame,
     ws_handshake,
 )
-from support.memory import at_once, kept_mib
+from support.memory import at_once, kept_mib, settled_mib
 
 from rl1.lsp.framing import MAX_MESSAGE
 from rl1.lsp.transports import INITIALIZE_SECONDS, MAX_SESSIONS, MEMORY_IN_FLIGHT
@@ -149,14 +149,18 @@ def test_more_clients_than_are_served_sending_the_largest_message_stay_in_the_bo
     connections: list[socket.socket | None] = []
     try:
         at_once(MAX_SESSIONS + 4, lambda: connections.append(_send_hostile(server, attack)))
-        peak = server.peak_mib() - server.started_mib
-        assert peak < MEMORY_IN_FLIGHT / 2**20, f"{peak:.0f} MiB at its peak"
         for connection in connections:
             if connection is not None:
                 connection.close()
         assert transport_attack(server, HostileConnection(chunks=(b"",), copies=0)) == []
-        kept = server.resident_mib() - server.started_mib
+        # The one message read whole (transports.InFlight's reservation) may still be
+        # read or decoded once the others are done: on a loaded machine 65 MiB were
+        # held just after the client that came next was served.
+        kept = settled_mib(lambda: server.resident_mib() - server.started_mib,
+                           MAX_MESSAGE / 2**20)
         assert kept < MAX_MESSAGE / 2**20, f"{kept:.0f} MiB kept after the clients left"
+        peak = server.peak_mib() - server.started_mib
+        assert peak < MEMORY_IN_FLIGHT / 2**20, f"{peak:.0f} MiB at its peak"
     finally:
         server.stop()
 

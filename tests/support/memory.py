@@ -1,10 +1,12 @@
 """The memory of a server process a test started, read from /proc: what it holds, what it
-has held at its peak, and what serving clients one after another leaves it holding; and
-clients sent at once, whose peak a test measures."""
+has held at its peak, what it holds once done with clients that have left, and what
+serving clients one after another leaves it holding; and clients sent at once, whose
+peak a test measures."""
 
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -20,6 +22,21 @@ def status_mib(pid: int, field: str) -> float:
         if line.startswith(f"{field}:"):
             return int(line.split()[1]) / 1024
     raise AssertionError(f"no {field} in /proc/{pid}/status")
+
+
+SETTLE_SECONDS = 60.0
+"""How long a server may take to be done with the clients that have left (a message one
+sent, still being read or decoded on a loaded machine) before what it holds is kept."""
+
+
+def settled_mib(held_mib: Callable[[], float], bound: float,
+                seconds: float = SETTLE_SECONDS) -> float:
+    """The first of `held_mib`'s readings, a tenth of a second apart, below `bound`; the
+    last if none is within `seconds`."""
+    deadline = time.monotonic() + seconds
+    while (held := held_mib()) >= bound and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return held
 
 
 def kept_mib(serve: Callable[[int], None], resident_mib: Callable[[], float],
