@@ -148,18 +148,19 @@ static const uint8_t *arguments(const int16_t *V, uint8_t op, uint8_t arity,
  * writes its reserved variables, then R (spec/ilc.md section 9, steps 5-6). */
 static bool take_reading(rl1_vm *vm, uint8_t op, uint8_t call, const rl1_reading *out)
 {
-    unsigned pairs = (call & RL1_CALL_PAIRS) >> RL1_CALL_PAIRS_SHIFT;
-    unsigned result = (call & RL1_CALL_RESULT) >> RL1_CALL_RESULT_SHIFT;
+    /* the fields where they lie in the descriptor: tested there, no shift is needed */
+    unsigned pairs = call & RL1_CALL_PAIRS, result = call & RL1_CALL_RESULT;
     const int16_t *from = out->writes;
     /* every checked range starts at 0 (isa_table.py): a negative result is above high */
-    if (result && (uint16_t)out->result > (uint16_t)RL1_RESULT_HIGH(result)) {
+    if (result && (uint16_t)out->result
+                      > (uint16_t)RL1_RESULT_HIGH(result >> RL1_CALL_RESULT_SHIFT)) {
         return false;
     }
     if (pairs) { /* one or two: rl1_reading has four writes */
         int16_t *to = &vm->V[rl1_flash_byte(&rl1_call_first[op - RL1_OP_FIRST_CALL])];
         to[0] = from[0];
         to[1] = from[1];
-        if (pairs > 1u) {
+        if (pairs > 1u << RL1_CALL_PAIRS_SHIFT) {
             to[2] = from[2];
             to[3] = from[3];
         }
