@@ -15,6 +15,7 @@ import base64
 import contextlib
 import json
 import os
+import pickle
 import re
 import selectors
 import shlex
@@ -23,12 +24,13 @@ import subprocess
 import tempfile
 import time
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal, Protocol
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
+from rl1.compiler.executors import ignore_interrupts
 from rl1.compiler.interpreter import interpret
 from rl1.compiler.strategies import Run
 from rl1.vm import isa
@@ -48,6 +50,8 @@ EXEC_OUTPUT_LIMIT = 16 * 2**20  # bytes it may print: a run's JSON, however long
 STDERR_KEPT = 4096  # the end of its standard error, for the message of a run it did not print
 BUDGET_CODE = FaultKind.BUDGET.code
 CRASH_CODE = "crash"  # the status of an engine that raised (a bug in it, not a run)
+ENDED_CODE = "ended-process"  # the status of an engine that ended the process it ran in
+ENDED = "ended its process"  # how a problem of ENDED_CODE begins, after the engine's name
 
 
 @dataclass(frozen=True)
@@ -61,14 +65,18 @@ class Observation:
     opcodes: dict[str, int] | None = None  # the instructions executed by opcode, if counted
 
     @property
-    def crashed(self) -> bool:
+    def ending_code(self) -> object:
+        """The code of its status (None for format 1's "ok")."""
         status = self.document.get("status")
-        return isinstance(status, dict) and status.get("code") == CRASH_CODE
+        return status.get("code") if isinstance(status, dict) else None
+
+    @property
+    def crashed(self) -> bool:
+        return self.ending_code == CRASH_CODE
 
     @property
     def ran_away(self) -> bool:
-        status = self.document.get("status")
-        return isinstance(status, dict) and status.get("code") == BUDGET_CODE
+        return self.ending_code == BUDGET_CODE
 
     def ending(self) -> object:
         status = self.document.get("status")
@@ -583,6 +591,8 @@ class Verdict:
     observations: dict[str, Observation]
     problems: list[str]
 
+    ended: str | None = None  # judge_apart: how an engine ended its process, if one did
+
 
 def _observed(engine: Engine, case: Run, budget: int) -> Observation:
     """The engine's run, or the status `crash` when its compiler or VM raised: a crash
@@ -658,6 +668,98 @@ def _judge_by_level(case: Run, engines: Sequence[Engine], budget: int) -> Verdic
     return Verdict(observations, _crashes(observations) + problems)
 
 
+def judge_apart(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
+    """`judge` in a process of its own (forked from this one), so that an engine that
+    ends the process it runs in (the C VM's segmentation fault, a sanitizer's abort, the
+    memory exhausted) ends that one, not this: then the Verdict has the runs of the
+    engines before it, and its one problem `NAME: ended its process (HOW)`, HOW the
+    signal or the exit status. The errors of this machine (BuildError,
+    EngineUnavailable) and of judge itself are raised here as the child raised them."""
+    reading, writing = os.pipe()
+    child = os.fork()
+    if child == 0:
+        os.close(reading)
+        _judge_in_child(writing, case, engines, budget)
+    os.close(writing)
+    observations: dict[str, Observation] = {}
+    running = ""  # the engine that started and has not finished, if any
+    told: Verdict | BaseException | None = None
+    try:
+        with open(reading, "rb") as stream:
+            while told is None:
+                try:
+                    message = pickle.load(stream)
+                except (EOFError, pickle.UnpicklingError):  # ended, perhaps mid-message
+                    break
+                match message:
+                    case ("started", str(name)):
+                        running = name
+                    case ("ran", str(name), Observation() as observation):
+                        observations[name], running = observation, ""
+                    case ("verdict", Verdict() | BaseException() as told):
+                        pass
+    finally:
+        _, status = os.waitpid(child, 0)
+    if isinstance(told, BaseException):
+        raise told
+    if told is not None:
+        return told
+    code = os.waitstatus_to_exitcode(status)
+    how = (f"signal {signal.Signals(-code).name}" if -code in signal.valid_signals()
+           else f"exit status {code}")
+    if not running:  # after the runs, as they were compared
+        return Verdict(observations, [f"{ENDED} ({how}) as the runs were compared"], how)
+    ended = Observation({"status": {"code": ENDED_CODE, "line": None, "message": how},
+                         "variables": {}, "trace": []})
+    return Verdict({**observations, running: ended}, [f"{running}: {ENDED} ({how})"], how)
+
+
+def _judge_in_child(writing: int, case: Run, engines: Sequence[Engine], budget: int
+                    ) -> None:
+    """`judge_apart`'s child: tells each engine as it starts and ends, then the verdict
+    (or what judge raised), on the pipe `writing`, and ends without returning."""
+    try:
+        ignore_interrupts()
+        with open(writing, "wb") as stream:
+            def tell(*message: object) -> None:
+                stream.write(pickle.dumps(message))  # whole, or not at all
+                stream.flush()
+
+            try:
+                tell("verdict", judge(case, [_Told(engine, tell) for engine in engines],
+                                      budget))
+            except BaseException as error:  # the parent raises it
+                try:
+                    tell("verdict", error)
+                except Exception:  # which cannot be pickled
+                    tell("verdict", RuntimeError(f"{type(error).__name__}: {error}"))
+    finally:
+        _close_batches()  # a process forked from this one ends without atexit's calls
+        os._exit(0)
+
+
+@dataclass(frozen=True)
+class _Told:
+    """An engine whose runs `tell` (started, then ran with the observation)."""
+
+    engine: Engine
+    tell: Callable[..., None]
+
+    @property
+    def name(self) -> str:
+        return self.engine.name
+
+    @property
+    def level(self) -> int | None:
+        return self.engine.level
+
+    def run(self, case: Run, budget: int) -> Observation:
+        self.tell("started", self.name)
+        observation = self.engine.run(case, budget)
+        self.tell("ran", self.name, observation)
+        return observation
+
+
 def signature(verdict: Verdict) -> str:
     """What a disagreement is, the same for two programs that show one bug: for each
     engine that disagrees, the kind of its first difference, with what varies from
@@ -685,6 +787,8 @@ def _kind(difference: str) -> str:
     """One line of `differences` (or of the budget invariant, or a crash) without what
     varies between two programs that show one bug."""
     match difference.split(": ", 1):
+        case [ended] if ended.startswith(ENDED):  # its signal or exit status kept
+            return ended
         case ["variables", _]:
             return "variables"
         case ["ending", endings]:

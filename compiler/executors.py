@@ -80,17 +80,20 @@ def ignore_interrupts() -> None:
 
 @contextmanager
 def workers(jobs: int, scheduler: str | None = None,
-            renewed: Callable[[], None] | None = None) -> Iterator[Workers]:
+            renewed: Callable[[], None] | None = None, *, isolated: bool = False
+            ) -> Iterator[Workers]:
     """The workers of a campaign: the Dask cluster of `scheduler` when given, else `jobs`
-    local processes (this process alone for 1). When one of those processes dies, the
-    pool is broken for good, or, given `renewed`, made again (`Renewed`), and `renewed`
-    called. Unavailable when `distributed` is not installed or the scheduler cannot be
-    reached. On leaving, the work not yet done is cancelled."""
+    local processes (this process alone for 1, unless `isolated`: work that may end the
+    process doing it, such as the C VM's, then has one of its own). When one of those
+    processes dies, the pool is broken for good, or, given `renewed`, made again
+    (`Renewed`), and `renewed` called. Unavailable when `distributed` is not installed
+    or the scheduler cannot be reached. On leaving, the work not yet done is
+    cancelled."""
     if scheduler is not None:
         with _cluster(scheduler) as cluster:
             yield cluster
         return
-    if jobs == 1:
+    if jobs == 1 and not isolated:
         yield Workers(None, 1)
         return
     pool: Executor = _pool(jobs) if renewed is None else Renewed(jobs, renewed)

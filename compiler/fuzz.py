@@ -6,7 +6,9 @@ disagreement, shrinks the run to the smallest it can find that still disagrees (
 disagreement may change on the way: it is the smallest run that shows one), for at most
 SHRINK_ATTEMPTS runs, a bound in runs rather than seconds, so that a seed gives the same
 reproducer on a loaded machine as on an idle one. `judge` in differential.py decides
-what disagrees (spec/optimization.md).
+what disagrees (spec/optimization.md). A program on which an engine ends the process it
+runs in (the C VM's crash) ends a worker: the searches lost with it run again with each
+program judged in a process of its own, where that program is a finding, not shrunk.
 """
 
 from __future__ import annotations
@@ -47,6 +49,7 @@ from rl1.compiler.differential import (
     compiled,
     engine_named,
     judge,
+    judge_apart,
     signature,
 )
 from rl1.compiler.files import SourceError, read_bounded, write_atomically
@@ -107,6 +110,9 @@ class Search:
     channel: str | None = None  # the campaign's Channel folder, on this machine
     corpus: tuple[Run, ...] = ()  # runs judged as they are, before any generated
     statistics: bool = False  # whether to gather what the programs did
+    # Each program judged in a process of its own (judge_apart): a search run again after
+    # its worker died, so that a program that ends its process is told from the others.
+    apart: bool = False
 
 
 @dataclass
@@ -196,6 +202,11 @@ class _Enough(BaseException):
     failure to shrink, calling the predicate again and again)."""
 
 
+class _Unshrunk(BaseException):
+    """A program ended the process that judged it: a finding, kept as it is (each run
+    shrinking tried would need a process of its own), and the Hypothesis search ends."""
+
+
 HALT = "halt"  # the Channel's file naming the first search that must stop
 TOLD_EVERY = 1.0  # seconds between a search's counts on the Channel
 
@@ -262,6 +273,7 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
     reaches a terminal's every process)."""
     searched = Searched(task.index, statistics=Statistics() if task.statistics else None)
     channel = Channel(task.channel) if task.channel is not None else None
+    judging = judge_apart if task.apart else judge
     told = time.monotonic()
     target: str | None = None  # the signature being shrunk
     shrinks = 0  # runs tried since the first disagreement
@@ -286,8 +298,10 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
             raise _Enough  # small enough: keep the smallest so far
         else:
             shrinks += 1
-        verdict = judge(case, task.engines, task.budget)
-        if target is None and searched.statistics is not None:
+        verdict = judging(case, task.engines, task.budget)
+        if verdict.ended is not None and target is not None:
+            return False  # shrinking keeps to runs whose every engine ran
+        if target is None and searched.statistics is not None and verdict.ended is None:
             searched.statistics.add(case, verdict)
         if not verdict.problems:
             return False
@@ -300,6 +314,8 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
         elif task.keep_going and found != target:
             return False
         searched.findings[target] = Finding(case, verdict)  # the smallest so far
+        if verdict.ended is not None:
+            raise _Unshrunk
         return True
 
     # Losses after an instruction count compare only between engines given one file.
@@ -310,10 +326,11 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
         with contextlib.suppress(_Enough):
             for case in task.corpus:  # shrunk by deleting lines alone
                 target = None
-                if (task.keep_going or not searched.findings) and disagrees(case) \
-                        and not stopped():
-                    _delete_lines(searched, next(reversed(searched.findings)), task,
-                                  stopped)
+                with contextlib.suppress(_Unshrunk):
+                    if (task.keep_going or not searched.findings) and disagrees(case) \
+                            and not stopped():
+                        _delete_lines(searched, next(reversed(searched.findings)), task,
+                                      stopped)
             size = task.size + len(task.corpus)
             while searched.programs < size and (task.keep_going or not searched.findings):
                 before = searched.programs
@@ -321,7 +338,8 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
                 limits = settings(max_examples=size - searched.programs, database=None,
                                   deadline=None, suppress_health_check=list(HealthCheck),
                                   phases=(Phase.generate, Phase.shrink))
-                with contextlib.suppress(NoSuchExample), contextlib.suppress(_Enough):
+                with contextlib.suppress(NoSuchExample), \
+                        contextlib.suppress(_Enough, _Unshrunk):
                     find(runs(instruction_losses=comparable), disagrees, settings=limits,
                          random=Random(seeds.getrandbits(64)))
                 if target is not None and not stopped():
@@ -383,15 +401,21 @@ def _corpus_run(file: str) -> Run:
 def _delete_lines(searched: Searched, target: str, task: Search,
                   stopped: Callable[[], bool]) -> None:
     """The finding of `target` reduced further by `_reduced` (no further once
-    `stopped()`)."""
+    `stopped()`; not at all when it ended its process)."""
+    if searched.findings[target].verdict.ended is not None:
+        return
+    judging = judge_apart if task.apart else judge
+
     def keeps(case: Run) -> bool:
         if stopped():
             return False
-        verdict = judge(case, task.engines, task.budget)
-        return bool(verdict.problems) and (not task.keep_going or signature(verdict) == target)
+        verdict = judging(case, task.engines, task.budget)
+        return bool(verdict.problems) and verdict.ended is None and (
+            not task.keep_going or signature(verdict) == target)
 
     smallest = _reduced(searched.findings[target].case, keeps)
-    searched.findings[target] = Finding(smallest, judge(smallest, task.engines, task.budget))
+    searched.findings[target] = Finding(smallest, judging(smallest, task.engines,
+                                                          task.budget))
 
 
 def searches(seed: int, count: int | None) -> Iterator[tuple[int, int]]:
@@ -508,7 +532,7 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
 
 
 POLL = 0.5  # seconds between looks at the searches under way, for progress
-LOSSES = 2  # times a search lost with its worker (a cluster's) runs again
+LOSSES = 2  # times a search lost with its worker runs again
 
 
 def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search | None],
@@ -517,7 +541,9 @@ def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search
                  ) -> None:
     """Run the searches `next_search` gives on `executor`, `jobs` at a time, keeping
     each as it ends; one lost with its worker (an error of `lost`) runs again, up to
-    LOSSES times."""
+    LOSSES times, each of its programs then judged in a process of its own (its worker
+    may have died of one of them, or beside the search that had it: either way the same
+    programs, and the one that ends its process is a finding)."""
     pending: dict[Future[Searched], Search] = {}
     losses: dict[int, int] = {}
 
@@ -533,6 +559,7 @@ def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search
             error = future.exception()
             if isinstance(error, lost) and losses.get(task.index, 0) < LOSSES:
                 losses[task.index] = losses.get(task.index, 0) + 1
+                task = replace(task, apart=True)
                 pending[executor.submit(search, task)] = task
                 continue
             keep(future.result())
@@ -568,11 +595,11 @@ class Reproducer:
 
 def write_reproducer(out: str, finding: Finding, engines: Sequence[Engine],
                      budget: int) -> Reproducer:
-    """Write the run, its compiled files, each engine's run, the engines and budget
-    (`engines.json`) and `replay.sh` (which judges the run again, and names each engine's
-    command) into a new folder under `out` (made for it, so that nothing there is
-    replaced, followed or written into: the first free `finding-N`); OSError when that
-    cannot be done."""
+    """Write the run, its compiled files, each engine's run (of those that ran, when one
+    ended its process), the engines and budget (`engines.json`) and `replay.sh` (which
+    judges the run again in a process of its own, and names each engine's command) into
+    a new folder under `out` (made for it, so that nothing there is replaced, followed or
+    written into: the first free `finding-N`); OSError when that cannot be done."""
     os.makedirs(out, exist_ok=True)
     folder = _new_folder(out)
     case = finding.case
@@ -587,14 +614,17 @@ def write_reproducer(out: str, finding: Finding, engines: Sequence[Engine],
     write(ENGINES, json.dumps({"engines": [engine.name for engine in engines],
                                "budget": budget}, indent=2) + "\n")
     commands = ["#!/bin/sh",
-                "# Runs every engine on the program again and prints what still differs: exit",
-                "# status 1 while the engines disagree, 0 once they agree. Run it from the",
-                "# folder the campaign ran in when an exec: engine names relative paths.",
+                "# Runs every engine on the program again, in a process of its own, and",
+                "# prints what still differs: exit status 1 while the engines disagree or",
+                "# one ends its process, 0 once they agree. Run it from the folder the",
+                "# campaign ran in when an exec: engine names relative paths.",
                 "#", "# Each engine alone (the files named are in this folder):"]
     for index, engine in enumerate(engines, 1):
         slug = re.sub(r"[^A-Za-z0-9]+", "-", engine.name).strip("-")[:40]
-        write(f"run-{index}-{slug}.json",
-              json.dumps(finding.verdict.observations[engine.name].document, indent=2) + "\n")
+        observation = finding.verdict.observations.get(engine.name)
+        if observation is not None:  # none for those after one that ended its process
+            write(f"run-{index}-{slug}.json",
+                  json.dumps(observation.document, indent=2) + "\n")
         commands.append("#   " + _replay(engine, case, budget, write))
     commands.append('exec rl1c fuzz --replay "$(dirname "$0")"')
     write("replay.sh", "\n".join(commands) + "\n")

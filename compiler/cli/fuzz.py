@@ -35,7 +35,7 @@ from .command import (
 
 if TYPE_CHECKING:
     from rl1.compiler.differential import Engine
-    from rl1.compiler.fuzz import Channel, Outcome, Reproducer
+    from rl1.compiler.fuzz import Channel, Finding, Outcome, Reproducer
 
 SECTION = "Testing"
 
@@ -109,8 +109,10 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     programs on any number of processes). On the first disagreement the program is
     shrunk to a small one, written with each engine's run and a replay script to --out,
     and the difference printed; --replay judges it again. Ctrl-C or SIGTERM stops the
-    campaign with its summary and its seed. Exit status: 0 all agreed, 1 a
-    disagreement, 2 a usage problem, 130 or 143 stopped by Ctrl-C or SIGTERM."""
+    campaign with its summary and its seed. A program on which an engine ends its
+    process (the C VM's crash) is a finding too, written down unshrunk. Exit status: 0
+    all agreed, 1 a disagreement or such a program, 2 a usage problem, 130 or 143
+    stopped by Ctrl-C or SIGTERM."""
     try:
         from rl1.compiler.differential import (
             DEFAULT_ENGINES,
@@ -119,8 +121,8 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
             engine_named,
         )
         from rl1.compiler.fuzz import (
+            LOSSES,
             Channel,
-            Finding,
             campaign,
             read_corpus,
             write_reproducer,
@@ -189,8 +191,11 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
             written[finding.signature] = error
 
     try:
+        # Processes even for one job: an engine that ends the process it runs in (the C
+        # VM's crash) ends a worker, whose searches run again to name the program.
         with _halted_by_signals(channel) as signalled, \
-                workers(jobs or os.cpu_count() or 1, scheduler) as held:
+                workers(jobs or os.cpu_count() or 1, scheduler,
+                        lambda: bar.warn(POOL_RENEWED), isolated=True) as held:
             outcome = campaign(engines, budget, count=limit, seconds=seconds,
                                seed=seed_value, progress=bar.update, executor=held.executor,
                                jobs=max(held.slots, 1), keep_going=keep_going,
@@ -200,9 +205,11 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     # Such as no C compiler for c-ON, or a cluster that cannot be had or was lost.
     except (BuildError, EngineUnavailable, Unavailable, ClusterLost) as error:
         raise Failure(f"error: {error}") from None
-    except BrokenExecutor:
-        raise Failure("error: a worker process ended abruptly (killed, or out of memory); "
-                      f"the campaign runs again with --seed {seed_value}", EXIT_INTERNAL
+    except BrokenExecutor:  # a search lost each time, though no program ended its process
+        raise Failure(f"error: a worker process ended abruptly {LOSSES + 1} times running "
+                      "one search, though none of its programs ended the process that ran "
+                      "it (something killed the workers, or the memory ran out); the "
+                      f"campaign runs again with --seed {seed_value}", EXIT_INTERNAL
                       ) from None
     finally:
         bar.close()
@@ -223,9 +230,8 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         _report_groups(summary, outcome, written, engines[0].name, out_dir, say)
     else:
         finding = outcome.finding
-        say(f"{summary}: the engines disagree (reference: {engines[0].name})\n\n"
-            f"the smallest program found:\n{_numbered(finding.case.source)}\n\n"
-            + "\n".join(finding.verdict.problems))
+        say(f"{summary}: {_found(finding, engines[0].name)}:\n"
+            f"{_numbered(finding.case.source)}\n\n" + "\n".join(finding.verdict.problems))
         write(finding)
         match written[finding.signature]:
             case OSError() as unwritten:
@@ -241,6 +247,19 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
                       f"({unwritten.strerror or unwritten}); the program is above, and the "
                       "campaign runs again with the same --seed", EXIT_ERRORS)
     return stopped or (EXIT_ERRORS if outcome.finding is not None else 0)
+
+
+POOL_RENEWED = ("a worker process ended abruptly (killed, out of memory, or ended by an "
+                "engine); its searches run again, each program in a process of its own, "
+                "to find the program that ended it")
+
+
+def _found(finding: Finding, reference: str) -> str:
+    """What a campaign found, before its program."""
+    if finding.verdict.ended is not None:
+        return ("an engine ended the process it ran in, on this program (not shrunk: "
+                "each smaller one tried could end its process again)")
+    return f"the engines disagree (reference: {reference})\n\nthe smallest program found"
 
 
 def _statistics(outcome: Outcome, seed: int, engines: list[Engine], budget: int,
@@ -309,8 +328,9 @@ def _numbered(source: str) -> str:
 
 
 def _replay(folder: str) -> int:
-    """Judge the reproducer in `folder` again: 1 while its engines disagree."""
-    from rl1.compiler.differential import EngineUnavailable, judge
+    """Judge the reproducer in `folder` again, in a process of its own: 1 while its
+    engines disagree or one ends its process."""
+    from rl1.compiler.differential import EngineUnavailable, judge_apart
     from rl1.compiler.files import SourceError
     from rl1.compiler.fuzz import ReproducerError, read_reproducer
     from rl1.vm.native import BuildError
@@ -326,7 +346,7 @@ def _replay(folder: str) -> int:
                            "write it as `rl1c fuzz` did, or replay another finding"
                            ) from None
     try:
-        verdict = judge(replay.case, replay.engines, replay.budget)
+        verdict = judge_apart(replay.case, replay.engines, replay.budget)
     except (BuildError, EngineUnavailable) as error:
         raise Failure(f"error: {error}") from None
     names = ", ".join(engine.name for engine in replay.engines)
@@ -335,8 +355,10 @@ def _replay(folder: str) -> int:
         click.echo(f"replay: the engines agree now (engines {names}; budget "
                    f"{replay.budget}) on:\n{program}")
         return 0
-    click.echo(f"replay: the engines still disagree (reference: {replay.engines[0].name}; "
-               f"budget {replay.budget}) on:\n{program}\n\n" + "\n".join(verdict.problems))
+    still = (f"an engine still ends the process it runs in (budget {replay.budget})"
+             if verdict.ended is not None else "the engines still disagree (reference: "
+             f"{replay.engines[0].name}; budget {replay.budget})")
+    click.echo(f"replay: {still} on:\n{program}\n\n" + "\n".join(verdict.problems))
     return EXIT_ERRORS
 
 
@@ -381,6 +403,12 @@ class _Bar:
             part = programs / self.count if self.count else elapsed / (self.seconds or 1)
             filled = int(BAR_WIDTH * min(part, 1.0))
             self.stream.write(f"\r[{'#' * filled}{'.' * (BAR_WIDTH - filled)}] {done}")
+        self.stream.flush()
+
+    def warn(self, warning: str) -> None:
+        """Say `warning` on a line of its own (a bar is drawn again after it)."""
+        erase = "\r\033[K" if self.terminal and self.shown else ""  # the bar drawn so far
+        self.stream.write(f"{erase}rl1c: warning: {warning}\n")
         self.stream.flush()
 
     def close(self) -> None:

@@ -1,0 +1,272 @@
+"""`rl1c fuzz` when an engine ends the process it runs in (the C VM's crash, an abort, the
+memory exhausted): the program that does it is a finding of its own, named and written
+down, and the programs beside it are judged as ever, on any number of processes."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+from support.cli import rl1c
+
+from rl1.compiler import differential, fuzz
+from rl1.compiler.differential import (
+    Engine,
+    EngineUnavailable,
+    Observation,
+    VmEngine,
+    judge,
+    judge_apart,
+    signature,
+)
+from rl1.compiler.executors import workers
+from rl1.compiler.strategies import Run
+from rl1.vm import native
+
+pytestmark = pytest.mark.slow  # campaigns, on pools of processes
+
+SEED = 3
+COUNT = 12
+KILLER = "ends-its-process"
+SIGSEGV = f"{KILLER}: ended its process (signal SIGSEGV)"
+
+
+@dataclass(frozen=True)
+class _EndsItsProcess:
+    """The -O0 VM, except on `program`, where it ends its process as the C VM's crash
+    would: by `signum`, or with the exit status `status` (os._exit) when it is None."""
+
+    program: str
+    signum: int | None = signal.SIGSEGV
+    status: int = 0
+    name: str = KILLER
+    level: int = 0
+
+    def run(self, case: Run, budget: int) -> Observation:
+        if case.source == self.program:
+            if self.signum is None:
+                os._exit(self.status)
+            os.kill(os.getpid(), self.signum)
+        return VmEngine(0).run(case, budget)
+
+
+@dataclass(frozen=True)
+class _Recording:
+    """The -O0 VM, writing each program it runs to `path`, from any process."""
+
+    path: str
+    name: str = "recording"
+    level: int = 0
+
+    def run(self, case: Run, budget: int) -> Observation:
+        with open(self.path, "a", encoding="utf-8") as stream:
+            stream.write(json.dumps(case.source) + "\n")
+        return VmEngine(0).run(case, budget)
+
+
+def _recorded(path: Path) -> list[str]:
+    return [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()]
+
+
+def _quiet(programs: int, elapsed: float) -> None:
+    pass
+
+
+@pytest.fixture
+def programs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """The COUNT programs of the campaign of SEED, in searches of 4, in their order."""
+    monkeypatch.setattr(fuzz, "BATCH", 4)
+    path = tmp_path / "programs"
+    outcome = fuzz.campaign([VmEngine(0), _Recording(str(path))], 20_000, count=COUNT,
+                            seconds=None, seed=SEED, progress=_quiet)
+    assert outcome.programs == COUNT and outcome.finding is None
+    return _recorded(path)
+
+
+def _on_processes(engines: list[Engine], jobs: int, keep_going: bool) -> fuzz.Outcome:
+    renewals: list[None] = []
+    with workers(jobs, renewed=lambda: renewals.append(None), isolated=True) as held:
+        outcome = fuzz.campaign(engines, 20_000, count=COUNT, seconds=None, seed=SEED,
+                                progress=_quiet, executor=held.executor, jobs=held.slots,
+                                keep_going=keep_going, lost=held.lost)
+    assert renewals, "no worker process ended: the engine did not end its process"
+    return outcome
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_the_program_that_ends_its_worker_is_the_finding_and_the_others_are_judged(
+        programs: list[str], tmp_path: Path, jobs: int) -> None:
+    killer = programs[7]  # the last of the second search of three
+    path = tmp_path / "judged"
+    outcome = _on_processes([VmEngine(0), _Recording(str(path)), _EndsItsProcess(killer)],
+                            jobs, keep_going=True)
+    assert outcome.finding is not None and outcome.finding.case.source == killer
+    assert outcome.counts == {SIGSEGV: 1} and outcome.programs == COUNT
+    # Every program judged (some twice: those of a search lost with a worker).
+    assert set(_recorded(path)) == set(programs)
+    # Its reproducer's runs are those of the engines before it.
+    assert list(outcome.finding.verdict.observations) == ["vm-O0", "recording", KILLER]
+
+
+def test_without_keep_going_the_campaign_stops_at_it_the_same_for_any_jobs(
+        programs: list[str]) -> None:
+    killer = programs[7]
+    one, two = (_on_processes([VmEngine(0), _EndsItsProcess(killer)], jobs, False)
+                for jobs in (1, 2))
+    for outcome in (one, two):
+        assert outcome.finding is not None and outcome.finding.case.source == killer
+        assert outcome.finding.signature == SIGSEGV
+    # The first two searches: the killer is the eighth program.
+    assert one.programs == 8
+
+
+def test_judged_apart_an_ordinary_run_is_judged_as_in_this_process() -> None:
+    case = Run("A=1\nB=A+2\n", {})
+    engines = [VmEngine(0), VmEngine(2)]
+    assert judge_apart(case, engines, 100) == judge(case, engines, 100)
+
+
+def test_judged_apart_an_exit_names_its_status_and_the_runs_before_it() -> None:
+    case = Run("A=1\n", {})
+    verdict = judge_apart(case, [VmEngine(0), _EndsItsProcess(case.source, None, 3),
+                                 VmEngine(1)], 100)
+    assert verdict.problems == [f"{KILLER}: ended its process (exit status 3)"]
+    assert verdict.ended == "exit status 3"
+    assert list(verdict.observations) == ["vm-O0", KILLER]
+    assert signature(verdict) == f"{KILLER}: ended its process (exit status 3)"
+
+
+@dataclass(frozen=True)
+class _Unavailable:
+    name: str = "unavailable"
+    level: int = 0
+
+    def run(self, case: Run, budget: int) -> Observation:
+        raise EngineUnavailable("this machine cannot run it")
+
+
+def test_judged_apart_an_engine_this_machine_cannot_run_is_raised_here() -> None:
+    with pytest.raises(EngineUnavailable, match="this machine cannot run it"):
+        judge_apart(Run("A=1\n", {}), [VmEngine(0), _Unavailable()], 100)
+
+
+@pytest.fixture
+def named_killer(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> str:
+    """`rl1c fuzz --engine ends-its-process` (in this process and those forked from it)
+    ends its process on the eighth program of `rl1c fuzz --seed SEED`; that program.
+    Found by rl1c itself, with an engine `recording`: Hypothesis draws constants from
+    the project's modules loaded, so that rl1c's programs are not those of a campaign
+    made before its modules were."""
+    monkeypatch.setattr(fuzz, "BATCH", 4)
+    path = tmp_path / "programs"
+    killing: list[str] = []
+    named = differential.engine_named
+
+    def engine_named(name: str) -> Engine | None:
+        if name == "recording":
+            return _Recording(str(path))
+        return _EndsItsProcess(*killing) if name == KILLER else named(name)
+
+    monkeypatch.setattr(differential, "engine_named", engine_named)
+    monkeypatch.setattr(fuzz, "engine_named", engine_named)
+    result = rl1c("fuzz", "--engine", "vm-O0", "--engine", "recording", "--count",
+                  str(COUNT), "--seed", str(SEED), "--jobs", "1", "--out", tmp_path)
+    assert result.exit_code == 0, result.output
+    killing.append(_recorded(path)[7])
+    return killing[0]
+
+
+@pytest.mark.parametrize("jobs", ["1", "2"])
+def test_rl1c_fuzz_names_the_program_writes_its_reproducer_and_replays_it(
+        named_killer: str, tmp_path: Path, jobs: str) -> None:
+    out = tmp_path / "out"
+    result = rl1c("fuzz", "--engine", "vm-O0", "--engine", KILLER, "--count", str(COUNT),
+                  "--seed", str(SEED), "--jobs", jobs, "--out", out)
+    assert result.exit_code == 1, result.output
+    assert "Traceback" not in result.output
+    assert "rl1c: warning: a worker process ended abruptly" in result.stderr
+    assert ("fuzz: 8 programs in " in result.stdout
+            and "an engine ended the process it ran in, on this program (not shrunk"
+            in result.stdout and result.stdout.rstrip().endswith(
+                f"{SIGSEGV}\n\nreproducer: {out / 'finding-1'} (program, sensor script, "
+                f"each engine's run); replay: sh {out / 'finding-1' / 'replay.sh'}"))
+    for number, line in enumerate(named_killer.splitlines(), 1):
+        assert f"{number:4} | {line}" in result.stdout
+    folder = out / "finding-1"
+    assert (folder / "program.rob").read_text(encoding="utf-8") == named_killer
+    assert json.loads((folder / "engines.json").read_text()) == {
+        "engines": ["vm-O0", KILLER], "budget": 20_000}
+    assert (folder / "program.sensors.json").exists()
+    assert sorted(path.name for path in folder.glob("run-*")) == [
+        "run-1-vm-O0.json", f"run-2-{KILLER}.json"]
+    assert json.loads((folder / f"run-2-{KILLER}.json").read_text())["status"] == {
+        "code": "ended-process", "line": None, "message": "signal SIGSEGV"}
+    assert "exec rl1c fuzz --replay" in (folder / "replay.sh").read_text()
+    replayed = rl1c("fuzz", "--replay", folder)
+    assert replayed.exit_code == 1, replayed.output
+    assert replayed.stdout.startswith("replay: an engine still ends the process it runs "
+                                      "in (budget 20000) on:\n")
+    assert replayed.stdout.rstrip().endswith(SIGSEGV)
+
+
+def test_rl1c_fuzz_keep_going_counts_it_in_its_group(named_killer: str, tmp_path: Path
+                                                     ) -> None:
+    out = tmp_path / "out"
+    result = rl1c("fuzz", "--engine", "vm-O0", "--engine", KILLER, "--count", str(COUNT),
+                  "--seed", str(SEED), "--jobs", "2", "--out", out, "--keep-going")
+    assert result.exit_code == 1, result.output
+    assert f"fuzz: {COUNT} programs in " in result.stdout
+    assert (f"1 kind of disagreement (reference: vm-O0), by the programs that showed "
+            f"each:\n      1  {SIGSEGV}\n         reproducer: {out / 'finding-1'}; "
+            in result.stdout)
+    assert (out / "finding-1" / "program.rob").read_text(encoding="utf-8") == named_killer
+
+
+# The C VM with a planted bug: a step after which A is 1234 writes through a null pointer.
+PLANTED_STEP = r"""
+#include "rl1vm.h"
+#undef rl1_step
+rl1_state rl1_step(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
+                   uint32_t n)
+{
+    rl1_state state = rl1_step_unplanted(vm, program, hw, n);
+    if (vm->V[0] == 1234)
+        *(volatile int *)0 = 0;
+    return state;
+}
+"""
+
+
+@pytest.mark.needs_cc
+def test_a_c_vm_that_crashes_is_a_finding_of_rl1c_fuzz(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    compiler = next((cc for cc in ("cc", "gcc", "clang") if shutil.which(cc)), None)
+    if compiler is None:
+        pytest.skip("no C compiler")
+    planted, library = tmp_path / "planted.c", tmp_path / "librl1vm-planted.so"
+    planted.write_text(PLANTED_STEP, encoding="ascii")
+    subprocess.run([compiler, *native.FLAGS, f"-I{native.C_FOLDER}",
+                    f"-I{native.HEADER_FOLDER}", "-Drl1_step=rl1_step_unplanted", "-o",
+                    str(library), *map(str, native.SOURCES), str(planted)], check=True)
+    # The c-ON engines load it, here and in the processes forked from here.
+    monkeypatch.setattr(differential, "library", lambda: library)
+    corpus = tmp_path / "corpus"
+    corpus.mkdir()
+    (corpus / "crash.rob").write_text("B=1\nA=1234\nC=2\n", encoding="ascii")
+    out = tmp_path / "out"
+    result = rl1c("fuzz", "--engine", "vm-O0", "--engine", "c-O1", "--corpus", corpus,
+                  "--count", "20", "--seed", "1", "--jobs", "1", "--keep-going", "--out", out)
+    assert result.exit_code == 1, result.output
+    assert "fuzz: 21 programs (the corpus of 1 first)" in result.stdout
+    assert "      1  c-O1: ended its process (signal SIGSEGV)\n" in result.stdout
+    folder = next(path.parent for path in out.glob("finding-*/program.rob")
+                  if path.read_text() == "B=1\nA=1234\nC=2\n")
+    replayed = rl1c("fuzz", "--replay", folder)
+    assert replayed.exit_code == 1, replayed.output
+    assert replayed.stdout.rstrip().endswith("c-O1: ended its process (signal SIGSEGV)")
