@@ -8,7 +8,7 @@ SHRINK_ATTEMPTS runs, a bound in runs rather than seconds, so that a seed gives 
 reproducer on a loaded machine as on an idle one. `judge` in differential.py decides
 what disagrees (spec/optimization.md). A program on which an engine ends the process it
 runs in (the C VM's crash) ends a worker: the searches lost with it run again with each
-program judged in a process of its own, where that program is a finding, not shrunk.
+program judged in a process of its own, where that program is a finding, shrunk as any.
 """
 
 from __future__ import annotations
@@ -202,11 +202,6 @@ class _Enough(BaseException):
     failure to shrink, calling the predicate again and again)."""
 
 
-class _Unshrunk(BaseException):
-    """A program ended the process that judged it: a finding, kept as it is (each run
-    shrinking tried would need a process of its own), and the Hypothesis search ends."""
-
-
 HALT = "halt"  # the Channel's file naming the first search that must stop
 TOLD_EVERY = 1.0  # seconds between a search's counts on the Channel
 
@@ -299,8 +294,7 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
         else:
             shrinks += 1
         verdict = judging(case, task.engines, task.budget)
-        if verdict.ended is not None and target is not None:
-            return False  # shrinking keeps to runs whose every engine ran
+        # What a program that ended its process did is not known.
         if target is None and searched.statistics is not None and verdict.ended is None:
             searched.statistics.add(case, verdict)
         if not verdict.problems:
@@ -314,8 +308,6 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
         elif task.keep_going and found != target:
             return False
         searched.findings[target] = Finding(case, verdict)  # the smallest so far
-        if verdict.ended is not None:
-            raise _Unshrunk
         return True
 
     # Losses after an instruction count compare only between engines given one file.
@@ -326,11 +318,10 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
         with contextlib.suppress(_Enough):
             for case in task.corpus:  # shrunk by deleting lines alone
                 target = None
-                with contextlib.suppress(_Unshrunk):
-                    if (task.keep_going or not searched.findings) and disagrees(case) \
-                            and not stopped():
-                        _delete_lines(searched, next(reversed(searched.findings)), task,
-                                      stopped)
+                if (task.keep_going or not searched.findings) and disagrees(case) \
+                        and not stopped():
+                    _delete_lines(searched, next(reversed(searched.findings)), task,
+                                  stopped)
             size = task.size + len(task.corpus)
             while searched.programs < size and (task.keep_going or not searched.findings):
                 before = searched.programs
@@ -338,8 +329,7 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
                 limits = settings(max_examples=size - searched.programs, database=None,
                                   deadline=None, suppress_health_check=list(HealthCheck),
                                   phases=(Phase.generate, Phase.shrink))
-                with contextlib.suppress(NoSuchExample), \
-                        contextlib.suppress(_Enough, _Unshrunk):
+                with contextlib.suppress(NoSuchExample), contextlib.suppress(_Enough):
                     find(runs(instruction_losses=comparable), disagrees, settings=limits,
                          random=Random(seeds.getrandbits(64)))
                 if target is not None and not stopped():
@@ -401,17 +391,15 @@ def _corpus_run(file: str) -> Run:
 def _delete_lines(searched: Searched, target: str, task: Search,
                   stopped: Callable[[], bool]) -> None:
     """The finding of `target` reduced further by `_reduced` (no further once
-    `stopped()`; not at all when it ended its process)."""
-    if searched.findings[target].verdict.ended is not None:
-        return
+    `stopped()`)."""
     judging = judge_apart if task.apart else judge
 
     def keeps(case: Run) -> bool:
         if stopped():
             return False
         verdict = judging(case, task.engines, task.budget)
-        return bool(verdict.problems) and verdict.ended is None and (
-            not task.keep_going or signature(verdict) == target)
+        return bool(verdict.problems) and (not task.keep_going
+                                           or signature(verdict) == target)
 
     smallest = _reduced(searched.findings[target].case, keeps)
     searched.findings[target] = Finding(smallest, judging(smallest, task.engines,
@@ -541,9 +529,10 @@ def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search
                  ) -> None:
     """Run the searches `next_search` gives on `executor`, `jobs` at a time, keeping
     each as it ends; one lost with its worker (an error of `lost`) runs again, up to
-    LOSSES times, each of its programs then judged in a process of its own (its worker
-    may have died of one of them, or beside the search that had it: either way the same
-    programs, and the one that ends its process is a finding)."""
+    LOSSES times, each of its programs (and each tried in shrinking) then judged in a
+    process of its own: its worker may have died of one of them, or beside the search
+    that had it; either way the same programs, and one that ends its process is a
+    finding."""
     pending: dict[Future[Searched], Search] = {}
     losses: dict[int, int] = {}
 

@@ -110,7 +110,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     shrunk to a small one, written with each engine's run and a replay script to --out,
     and the difference printed; --replay judges it again. Ctrl-C or SIGTERM stops the
     campaign with its summary and its seed. A program on which an engine ends its
-    process (the C VM's crash) is a finding too, written down unshrunk. Exit status: 0
+    process (the C VM's crash) is a finding too, shrunk as any. Exit status: 0
     all agreed, 1 a disagreement or such a program, 2 a usage problem, 130 or 143
     stopped by Ctrl-C or SIGTERM."""
     try:
@@ -257,8 +257,8 @@ POOL_RENEWED = ("a worker process ended abruptly (killed, out of memory, or ende
 def _found(finding: Finding, reference: str) -> str:
     """What a campaign found, before its program."""
     if finding.verdict.ended is not None:
-        return ("an engine ended the process it ran in, on this program (not shrunk: "
-                "each smaller one tried could end its process again)")
+        return ("an engine ended the process it ran in (each program was then judged in "
+                "a process of its own)\n\nthe smallest program found that does it")
     return f"the engines disagree (reference: {reference})\n\nthe smallest program found"
 
 
