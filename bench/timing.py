@@ -16,3 +16,13 @@ def best_time(action: Callable[[], object], repeats: int) -> float:
         action()
         times.append(time.perf_counter() - start)
     return min(times)
+
+
+def best_times(actions: list[Callable[[], object]], repeats: int) -> list[float]:
+    """The best time of each action, run in turns (one of each a round), so that a burst
+    of load elsewhere slows every action alike rather than the one it fell on."""
+    best = [float("inf")] * len(actions)
+    for _ in range(repeats):
+        for index, action in enumerate(actions):
+            best[index] = min(best[index], best_time(action, 1))
+    return best

@@ -11,7 +11,7 @@ from typing import NamedTuple, overload
 
 from .checker import apply_suppressions, check, check_text
 from .checker.compact import CompactDiagnostics
-from .frontend.ast import Program, Span
+from .frontend.ast import Line, Program, Span
 from .frontend.diagnostics import Diagnostic, Edit, Fix, sort_key
 from .frontend.edits import apply_edits, compatible
 from .frontend.parser import parse_program
@@ -39,10 +39,13 @@ def diagnose(text: str) -> list[Diagnostic]:
     return list(check_text(text))
 
 
-def diagnose_compactly(text: str) -> CompactDiagnostics:
+def diagnose_compactly(text: str, each_line: Callable[[Line], object] | None = None
+                       ) -> CompactDiagnostics:
     """`diagnose(text)`, holding those of single lines as a few bytes each until they are
-    read (checker/compact.py): for `rl1c check`, whose memory is then the text's."""
-    return check_text(text)
+    read (checker/compact.py): for `rl1c check`, whose memory is then the text's. Each
+    line is handed to `each_line` as it is parsed until a line has an error (the
+    compile lowers them so)."""
+    return check_text(text, each_line)
 
 
 MAX_FIX_ROUNDS = 10

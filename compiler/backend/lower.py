@@ -9,8 +9,6 @@ statement after it, and falling off the end of the program ends it.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-
 from rl1.compiler.frontend import ast
 from rl1.vm.language import HANDLER_LABELS
 
@@ -22,15 +20,43 @@ class LoweringError(Exception):
     lowering runs only on programs without errors, so this is a compiler bug."""
 
 
-def lower(program: ast.Program | Iterable[ast.Line]) -> ir.Program:
-    """The IR of a program the checker accepted, from its tree or its lines in order (so
-    that a caller may parse each line as it is lowered and hold no tree: driver.py)."""
-    lowered = _Lowerer().lower(program.lines if isinstance(program, ast.Program) else program)
-    problems = ir.validate(lowered)
-    if problems:
-        raise LoweringError("the checker let through a program with errors: "
-                            + "; ".join(problems))
-    return lowered
+def lower(program: ast.Program) -> ir.Program:
+    """The IR of a program the checker accepted."""
+    lowering = Lowering()
+    for line in program.lines:
+        lowering.take(line)
+    return lowering.program()
+
+
+class Lowering:
+    """The IR of a program made as its lines are handed over in order (`take`), so that
+    the compile lowers each line as the check parses it (driver.py) and no tree is held.
+    A line the lowering refuses stops it, since the program has an error the check
+    reports; `program` raises the refusal if the check let the program through."""
+
+    __slots__ = ("_lowerer", "_refused")
+
+    def __init__(self) -> None:
+        self._lowerer = _Lowerer()
+        self._refused: LoweringError | None = None
+
+    def take(self, line: ast.Line) -> None:
+        if self._refused is None:
+            try:
+                self._lowerer.line(line)
+            except LoweringError as refused:
+                self._refused = refused
+
+    def program(self) -> ir.Program:
+        """The IR of the lines taken, which the checker accepted."""
+        if self._refused is not None:
+            raise self._refused
+        lowered = self._lowerer.program()
+        problems = ir.validate(lowered)
+        if problems:
+            raise LoweringError("the checker let through a program with errors: "
+                                + "; ".join(problems))
+        return lowered
 
 
 class _Lowerer:
@@ -40,21 +66,22 @@ class _Lowerer:
         self.block_id: ir.BlockId | None = None  # the open block, None after a jump or end
         self.code: list[ir.Instruction] = []
         self.unlabelled = 0
+        self.last_line = 1
         # One object for each variable and constant (they are frozen): a long program's
         # IR was otherwise half operands (80 of the 192 bytes of `A=1`).
         self.variables: dict[str, ir.Var] = {}
         self.constants: dict[int, ir.Imm] = {}
 
-    def lower(self, lines: Iterable[ast.Line]) -> ir.Program:
-        last_line = 1
-        for line in lines:
-            if line.label is not None:
-                self.start_label(line.label)
-            for statement in line.statements:
-                self.statement(statement, line.number)
-            last_line = line.number
+    def line(self, line: ast.Line) -> None:
+        if line.label is not None:
+            self.start_label(line.label)
+        for statement in line.statements:
+            self.statement(statement, line.number)
+        self.last_line = line.number
+
+    def program(self) -> ir.Program:
         if self.block_id is not None or not self.blocks:
-            self.finish(ir.End(last_line))
+            self.finish(ir.End(self.last_line))
         return ir.Program(self.blocks, next(iter(self.blocks)), self.handlers)
 
     # Blocks -------------------------------------------------------------------------

@@ -226,9 +226,14 @@ def _jump_key(jump: ast.Goto | ast.CondJump) -> Hashable:
     return jump.target.text, jump.target.number, jump.var.name, jump.relation
 
 
-def check_text(text: str) -> CompactDiagnostics:
+def check_text(text: str, each_line: Callable[[ast.Line], object] | None = None
+               ) -> CompactDiagnostics:
     """Every diagnostic of `text`, in sort_key's order, those its comments allow left
-    out: what `check` and `apply_suppressions` give on `parse_program`'s tree."""
+    out: what `check` and `apply_suppressions` give on `parse_program`'s tree.
+
+    `each_line` is handed each line as it is parsed, in order, until a line has an
+    error (no comment allows one away, so the program has errors then): the compile
+    lowers the lines so, parsing each once (driver.py)."""
     held = LineDiagnostics()  # those of single lines
     others: list[Diagnostic] = []
     directives: list[ast.Line] = []  # the lines whose comments may be directives
@@ -273,6 +278,11 @@ def check_text(text: str) -> CompactDiagnostics:
                              (diagnostic.code, diagnostic.severity))
                 else:  # none is; built again, it would be looked for on its own line
                     others.append(diagnostic)
+            if each_line is not None:
+                if any(diagnostic.is_error for diagnostic in found):
+                    each_line = None
+                else:
+                    each_line(line)
             if line.comment is not None and MARK in line.comment.text:
                 directives.append(line)
             if line.label is not None:

@@ -10,14 +10,11 @@ from intelhex import IntelHex
 from support import SAMPLE
 from support.cli import rl1c
 
-from rl1.compiler.backend import driver
 from rl1.compiler.backend.firmware import c_source
 from rl1.compiler.backend.ir import format_program
 from rl1.compiler.backend.lower import lower
 from rl1.compiler.backend.optimize import optimize
 from rl1.compiler.files import write_atomically
-from rl1.compiler.frontend.ast import Span
-from rl1.compiler.frontend.diagnostics import Diagnostic, Severity
 from rl1.compiler.frontend.parser import parse_program
 from rl1.compiler.ils.asm import assemble
 from rl1.vm import ilc
@@ -181,20 +178,14 @@ def test_errors_refuse_to_write_and_are_printed_as_check_prints_them(tmp_path: P
     assert sorted(os.listdir(tmp_path)) == ["broken.ilc", "broken.rob"]
 
 
-def test_warnings_are_printed_and_do_not_block(
-    sample: Path, monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    warning = Diagnostic("W0601", Severity.WARNING, "a warning for the test", Span(2, 1, 2, 8))
-
-    def diagnose_with_warning(text: str) -> list[Diagnostic]:
-        return [warning]
-
-    monkeypatch.setattr(driver, "diagnose", diagnose_with_warning)
-    result = rl1c(str(sample), "--color", "never")
+def test_warnings_are_printed_and_do_not_block(tmp_path: Path) -> None:
+    source = tmp_path / "warned.rob"
+    source.write_text("A=1\nB=s\n(END)\n", encoding="utf-8")  # W0401: `s` may be unset
+    result = rl1c(str(source), "--color", "never")
     assert result.exit_code == 0
-    assert "warning[W0601]: a warning for the test" in result.stderr
-    assert "sample.rob:2:1" in result.stderr
-    verify((sample.parent / "sample.ilc").read_bytes())
+    assert "warning[W0401]: `s` is read here" in result.stderr
+    assert "warned.rob:2:3" in result.stderr
+    verify((tmp_path / "warned.ilc").read_bytes())
 
 
 def test_code_too_large_is_refused_with_e0190(tmp_path: Path) -> None:
