@@ -25,13 +25,12 @@ the budget invariant (spec/optimization.md, section 3).
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass
 
 from rl1.vm.language import VARIABLES
 from rl1.vm.machine import evaluate
 
-from . import flow, ir
+from . import forward, ir
 
 # The operand that leaves the accumulator as it is, for each operator; 0 unless listed.
 _IDENTITY = {"&": -1}
@@ -88,36 +87,18 @@ def _always_zero(program: ir.Program) -> frozenset[str]:
 def _solve(program: ir.Program, zeros: frozenset[str]) -> dict[ir.BlockId, _Folded]:
     """Each reachable block folded from what is known where it starts: the meet (the
     values all agree on) of what its predecessors know at their ends, and of the start
-    of the program or a handler's entry. A worklist in layout order, each block queued
-    once at a time. The variables in `zeros` are left out of what is known."""
-    starts: dict[ir.BlockId, list[Known]] = {block_id: [] for block_id in program.blocks}
-    starts[program.entry].append({name: 0 for name in VARIABLES if name not in zeros})
-    for block_id in program.handlers.values():
-        starts[block_id].append({})
-    # For each block, what each predecessor visited so far knows where it leads there.
-    incoming: dict[ir.BlockId, dict[ir.BlockId, Known]] = {
-        block_id: {} for block_id in program.blocks}
-    entries: dict[ir.BlockId, Known] = {}
-    folded: dict[ir.BlockId, _Folded] = {}
-    work = deque(flow.roots(program))
-    queued = set(work)
-    while work:
-        block_id = work.popleft()
-        queued.discard(block_id)
-        known = _meet([*starts[block_id], *incoming[block_id].values()])
-        if entries.get(block_id) == known:
-            continue
-        entries[block_id] = known
-        before = folded.get(block_id)
-        after = folded[block_id] = _fold(program.blocks[block_id], dict(known), zeros)
-        for target in before.terminator.targets if before else ():
-            incoming[target].pop(block_id, None)
-        for target in after.terminator.targets:
-            incoming[target][block_id] = after.known
-            if target not in queued:
-                queued.add(target)
-                work.append(target)
-    return folded
+    of the program or a handler's entry. The variables in `zeros` are left out of what
+    is known."""
+    return forward.solve(
+        program, entry={name: 0 for name in VARIABLES if name not in zeros}, handler={},
+        combine=_meet, visit=lambda block, known: _fold(block, dict(known), zeros),
+        edges=_edges)
+
+
+def _edges(block: ir.Block, folded: _Folded) -> list[tuple[ir.BlockId, Known]]:
+    """The ways the folded block goes (a branch decided goes one way), each with what
+    is known where it ends."""
+    return [(target, folded.known) for target in folded.terminator.targets]
 
 
 def _meet(states: list[Known]) -> Known:

@@ -202,8 +202,20 @@ class Jump:
         return f"jump {self.target}"
 
 
+class _TwoWay:
+    """A terminator that goes to `if_true` or to `if_false`: the branches."""
+
+    __slots__ = ()
+    if_true: BlockId
+    if_false: BlockId
+
+    @property
+    def targets(self) -> tuple[BlockId, ...]:
+        return (self.if_true, self.if_false)
+
+
 @dataclass(frozen=True, slots=True)
-class Branch:
+class Branch(_TwoWay):
     """Go to `if_true` when `var` compares with zero as `relation` says, else `if_false`."""
 
     var: Var
@@ -212,16 +224,12 @@ class Branch:
     if_false: BlockId
     line: int
 
-    @property
-    def targets(self) -> tuple[BlockId, ...]:
-        return (self.if_true, self.if_false)
-
     def __str__(self) -> str:
         return f"if {self.var}{self.relation}0 then {self.if_true} else {self.if_false}"
 
 
 @dataclass(frozen=True, slots=True)
-class StoreBranch:
+class StoreBranch(_TwoWay):
     """var = acc, then go to `if_true` when var compares with zero as `relation` says,
     else `if_false` (a superinstruction of -O2)."""
 
@@ -231,17 +239,13 @@ class StoreBranch:
     if_false: BlockId
     line: int
 
-    @property
-    def targets(self) -> tuple[BlockId, ...]:
-        return (self.if_true, self.if_false)
-
     def __str__(self) -> str:
         return (f"store {self.var}; if {self.var}{self.relation}0 then {self.if_true} "
                 f"else {self.if_false}")
 
 
 @dataclass(frozen=True, slots=True)
-class DecrementBranch:
+class DecrementBranch(_TwoWay):
     """var--, then go to `if_true` when var > 0, else `if_false` (a superinstruction of
     -O2, for counted loops)."""
 
@@ -249,10 +253,6 @@ class DecrementBranch:
     if_true: BlockId
     if_false: BlockId
     line: int
-
-    @property
-    def targets(self) -> tuple[BlockId, ...]:
-        return (self.if_true, self.if_false)
 
     def __str__(self) -> str:
         return f"dec {self.var}; if {self.var}>0 then {self.if_true} else {self.if_false}"

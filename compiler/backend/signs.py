@@ -29,13 +29,12 @@ edge all but it. Then:
 from __future__ import annotations
 
 import dataclasses
-from collections import deque
 from functools import cache
 
 from rl1.compiler.frontend.ast import Relation
 from rl1.vm.language import VARIABLES
 
-from . import flow, ir
+from . import forward, ir
 
 Signs = frozenset[str]
 """The signs a value may have: a subset of `<`, `=`, `>` (the relations with zero)."""
@@ -135,36 +134,12 @@ def _tracked(program: ir.Program) -> frozenset[str]:
 def _solve(program: ir.Program, tracked: frozenset[str]) -> dict[ir.BlockId, State]:
     """What is known where each block some path reaches ends (before its terminator),
     from what is known where it starts: the union (the signs any path allows) over its
-    predecessors' edges and the program's or a handler's start. A worklist in layout
-    order; a decided branch's other edge is not followed."""
-    starts: dict[ir.BlockId, list[State]] = {block_id: [] for block_id in program.blocks}
-    starts[program.entry].append(dict.fromkeys(
-        [name for name in VARIABLES if name in tracked], frozenset("=")))
-    for block_id in program.handlers.values():
-        starts[block_id].append({})
-    incoming: dict[ir.BlockId, dict[ir.BlockId, State]] = {
-        block_id: {} for block_id in program.blocks}
-    entries: dict[ir.BlockId, State] = {}
-    exits: dict[ir.BlockId, State] = {}
-    work = deque(flow.roots(program))
-    queued = set(work)
-    while work:
-        block_id = work.popleft()
-        queued.discard(block_id)
-        state = _join([*starts[block_id], *incoming[block_id].values()])
-        if entries.get(block_id) == state:
-            continue
-        entries[block_id] = state
-        block = program.blocks[block_id]
-        for target in block.terminator.targets:
-            incoming[target].pop(block_id, None)
-        exits[block_id] = _exit_state(block, state, tracked)
-        for target, leaving in _edges(block, exits[block_id]):
-            incoming[target][block_id] = leaving
-            if target not in queued:
-                queued.add(target)
-                work.append(target)
-    return exits
+    predecessors' edges and the program's or a handler's start. A decided branch's
+    other edge is not followed."""
+    entry = dict.fromkeys([name for name in VARIABLES if name in tracked], frozenset("="))
+    return forward.solve(program, entry=entry, handler={}, combine=_join,
+                         visit=lambda block, state: _exit_state(block, state, tracked),
+                         edges=_edges)
 
 
 def _join(states: list[State]) -> State:
