@@ -284,3 +284,37 @@ def test_a_c_vm_that_crashes_is_a_finding_of_rl1c_fuzz(
     replayed = rl1c("fuzz", "--replay", folder)
     assert replayed.exit_code == 1, replayed.output
     assert replayed.stdout.rstrip().endswith("c-O1: ended its process (signal SIGSEGV)")
+
+
+@dataclass(frozen=True)
+class _EndsItsWorker:
+    """An engine that ends the worker process of a campaign on every program, whether
+    it runs there or in a process the worker forked to judge the program apart (as the
+    kernel's out-of-memory killer may choose the worker): no program is to blame."""
+
+    campaign: int  # the process id of the campaign, whose children are its workers
+    name: str = "ends-its-worker"
+    level: int = 0
+
+    def run(self, case: Run, budget: int) -> Observation:
+        os.kill(os.getpid() if os.getppid() == self.campaign else os.getppid(),
+                signal.SIGKILL)
+        return VmEngine(0).run(case, budget)
+
+
+def test_a_worker_killed_each_time_whatever_program_it_judges_is_said_as_such(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    named = differential.engine_named
+
+    def engine_named(name: str) -> Engine | None:
+        return _EndsItsWorker(os.getpid()) if name == "ends-its-worker" else named(name)
+
+    monkeypatch.setattr(differential, "engine_named", engine_named)
+    result = rl1c("fuzz", "--engine", "vm-O0", "--engine", "ends-its-worker", "--count",
+                  "4", "--seed", "3", "--jobs", "1")
+    assert result.exit_code == 3, result.output
+    assert result.stderr.endswith(
+        "\nerror: a worker process ended abruptly 3 times running one search, though "
+        "none of its programs ended the process that ran it (something killed the "
+        "workers, or the memory ran out); the campaign runs again with --seed 3\n")
+    assert "Traceback" not in result.output
