@@ -238,7 +238,10 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
                 pass
             case reproducer:
                 say(f"\nreproducer: {reproducer.folder} (program, sensor script, each "
-                    f"engine's run); replay: {reproducer.replay}")
+                    f"engine's run); replay: {reproducer.replay}"
+                    + ("\n  = help: replay.sh names each engine's own command, to run the "
+                       "one that ends its process under a debugger"
+                       if finding.verdict.ended is not None else ""))
     if fuzz_format == "json":
         click.echo(json.dumps(_statistics(outcome, seed_value, engines, budget, len(corpus),
                                           written), indent=2))
@@ -257,8 +260,7 @@ POOL_RENEWED = ("a worker process ended abruptly (killed, out of memory, or ende
 def _found(finding: Finding, reference: str) -> str:
     """What a campaign found, before its program."""
     if finding.verdict.ended is not None:
-        return ("an engine ended the process it ran in (each program was then judged in "
-                "a process of its own)\n\nthe smallest program found that does it")
+        return "an engine ends the process it runs in\n\nthe smallest program found that does it"
     return f"the engines disagree (reference: {reference})\n\nthe smallest program found"
 
 

@@ -204,11 +204,12 @@ def test_rl1c_fuzz_names_the_program_writes_its_reproducer_and_replays_it(
     # The killer is the eighth program; on 2 processes the third search may run a while.
     programs = int(result.stdout.split()[1])
     assert programs == 8 if jobs == "1" else 8 <= programs <= COUNT
-    assert ("an engine ended the process it ran in (each program was then judged in a "
-            "process of its own)\n\nthe smallest program found that does it:\n"
-            in result.stdout and result.stdout.rstrip().endswith(
+    assert ("an engine ends the process it runs in\n\nthe smallest program found that "
+            "does it:\n" in result.stdout and result.stdout.rstrip().endswith(
                 f"{SIGSEGV}\n\nreproducer: {out / 'finding-1'} (program, sensor script, "
-                f"each engine's run); replay: sh {out / 'finding-1' / 'replay.sh'}"))
+                f"each engine's run); replay: sh {out / 'finding-1' / 'replay.sh'}\n"
+                "  = help: replay.sh names each engine's own command, to run the one that "
+                "ends its process under a debugger"))
     for number, line in enumerate(named_killer.splitlines(), 1):
         assert f"{number:4} | {line}" in result.stdout
     folder = out / "finding-1"
