@@ -153,14 +153,13 @@ def _initializer(items: list[str]) -> list[str]:
 
 def render_descriptors() -> list[str]:
     """Each call's descriptor, from vm/language.py (spec/ilc.md 8.3 and 12): a byte of
-    bits, and a byte that says where its parameters' ranges start in one list of (low,
-    span) pairs, or which reserved variables it writes."""
+    bits, and above it a byte that says where its parameters' ranges start in one list
+    of ranges, or which reserved variables it writes: one load of a u16 gives both."""
     infos = calls()
     forms = [_form(info) for info in infos]
     results = _kinds([form.result_range for form in forms], _ANY)
     assert all(low == 0 for low, _high in results), "a result's check is one unsigned compare"
     descriptors: list[int] = []
-    firsts: list[int] = []
     ranges: list[int] = []
     for info, form in zip(infos, forms, strict=True):
         written = [VARIABLES.index(name) for name in form.writes]
@@ -168,20 +167,22 @@ def render_descriptors() -> list[str]:
             assert written == list(range(written[0], written[0] + len(written)))
         assert len(written) % 2 == 0 and len(written) <= 4, "rl1_reading holds 4 writes"
         assert not (written and form.params), "one byte says the first of either"
+        first = written[0] if written else len(ranges) // 2
+        assert first < 256, "the descriptor's high byte holds it"
         descriptors.append(
             info.arity
             | (0x04 if BUILTINS[form_mnemonic(info)].waits else 0)
             | (0x08 if form.returns_value else 0)
             | (len(written) // 2) << 4
             | ((results.index(form.result_range) + 1 if form.result_range != _ANY else 0)
-               << 6))
-        firsts.append(written[0] if written else len(ranges) // 2)
+               << 6)
+            | first << 8)
         for param in form.params:
             ranges += [param.low, param.high]
     return [
         "/* Each call's descriptor (spec/ilc.md 8.3 and 12), from vm/language.py: for each",
-        "   call from RL1_OP_FIRST_CALL, a byte of the bits below in RL1_CALL_DESCRIPTORS,",
-        "   and one in RL1_CALL_FIRST: for a call with arguments, the index in",
+        "   call from RL1_OP_FIRST_CALL, a u16 in RL1_CALL_DESCRIPTORS of the bits below and,",
+        "   in its high byte (RL1_CALL_FIRST_SHIFT), for a call with arguments the index in",
         "   RL1_PARAM_RANGES of its first parameter's range (low, and the span to high:",
         "   rl1_param_range), the others' following it; for one that writes reserved",
         "   variables (none takes arguments), the first of them, the others following it. */",
@@ -194,12 +195,11 @@ def render_descriptors() -> list[str]:
         "#define RL1_CALL_RESULT 0xC0u      /* its result's range: 0 for any, else",
         "                                      0 .. RL1_RESULT_HIGH of it */",
         "#define RL1_CALL_RESULT_SHIFT 6u",
+        "#define RL1_CALL_FIRST_SHIFT 8u   /* the high byte: where its ranges or writes start */",
         f"#define RL1_RESULT_HIGH(kind) {_select([high for _low, high in results], 'kind')}",
         f"#define RL1_CALL_COUNT {len(infos)}",
         "#define RL1_CALL_DESCRIPTORS \\",
-        *_initializer([f"0x{byte:02X}" for byte in descriptors]),
-        "#define RL1_CALL_FIRST \\",
-        *_initializer([str(index) for index in firsts]),
+        *_initializer([f"0x{word:04X}u" for word in descriptors]),
         f"#define RL1_PARAM_COUNT {len(ranges) // 2}",
         "#define RL1_PARAM_RANGES \\",
         *_initializer([f"{{{_c_int(low)}, {high - low}u}}"

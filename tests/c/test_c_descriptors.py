@@ -1,5 +1,5 @@
 """The calls' descriptors the C VM and loader read (vm/c/rl1vm.h's generated
-RL1_CALL_DESCRIPTORS, RL1_CALL_FIRST and RL1_PARAM_RANGES, defined in rl1vm_load.c) say
+RL1_CALL_DESCRIPTORS and RL1_PARAM_RANGES, defined in rl1vm_load.c) say
 of each call what vm/language.py says of its form: its arity, whether it takes device
 time (started, then polled), whether its result goes into R, the reserved variables it
 writes, and each parameter's range (its low end, and the span to its high end), read from
@@ -21,7 +21,7 @@ from rl1.vm import isa, isa_table, native
 from rl1.vm.language import BUILTINS, VARIABLES, Form, Param
 
 CALLS = isa_table.calls()
-ARITY, STARTED, SETS_R, PAIRS, PAIRS_SHIFT = 0x03, 0x04, 0x08, 0x30, 4
+ARITY, STARTED, SETS_R, PAIRS, PAIRS_SHIFT, FIRST_SHIFT = 0x03, 0x04, 0x08, 0x30, 4, 8
 
 
 class Range(ctypes.Structure):
@@ -41,17 +41,17 @@ def lib(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
     return library
 
 
-def table(lib: ctypes.CDLL, name: str, kind: type[ctypes.c_uint8] | type[ctypes.c_int16],
-          size: int) -> list[int]:
-    return list((kind * size).in_dll(lib, name))
+def descriptors(lib: ctypes.CDLL) -> list[int]:
+    """Each call's u16 descriptor: its bits, and in its high byte where its parameters'
+    ranges or its written variables start."""
+    return list((ctypes.c_uint16 * len(CALLS)).in_dll(lib, "rl1_call_descriptors"))
 
 
 def test_each_descriptor_says_what_the_language_says_of_its_call(lib: ctypes.CDLL) -> None:
-    descriptors = table(lib, "rl1_call_descriptors", ctypes.c_uint8, len(CALLS))
-    firsts = table(lib, "rl1_call_first", ctypes.c_uint8, len(CALLS))
-    for info, descriptor, first in zip(CALLS, descriptors, firsts, strict=True):
+    for info, descriptor in zip(CALLS, descriptors(lib), strict=True):
         form = _form(info)
         assert info.builtin is not None
+        first = descriptor >> FIRST_SHIFT
         pairs = (descriptor & PAIRS) >> PAIRS_SHIFT
         written = [VARIABLES[first + k] for k in range(2 * pairs)]
         assert (descriptor & ARITY, bool(descriptor & STARTED), bool(descriptor & SETS_R),
@@ -88,12 +88,12 @@ def test_every_parameter_bound_and_its_neighbours(lib: ctypes.CDLL) -> None:
 
 
 def test_each_parameter_s_range_is_its_low_end_and_span(lib: ctypes.CDLL) -> None:
-    """The ranges' table holds, from the index of each call's first parameter, its
-    parameters' low ends and spans (high - low) in their order."""
+    """The ranges' table holds, from the index of each call's first parameter (its
+    descriptor's high byte), its parameters' low ends and spans (high - low) in their
+    order."""
     ranges = (Range * len(_parameters())).in_dll(lib, "rl1_param_ranges")
-    firsts = table(lib, "rl1_call_first", ctypes.c_uint8, len(CALLS))
-    for info, first in zip(CALLS, firsts, strict=True):
+    for info, descriptor in zip(CALLS, descriptors(lib), strict=True):
         for index, param in enumerate(_form(info).params):
-            entry = ranges[first + index]
+            entry = ranges[(descriptor >> FIRST_SHIFT) + index]
             assert (entry.low, entry.span) == (param.low, param.high - param.low), \
                 (info.name, param.name)

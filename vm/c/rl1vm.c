@@ -103,17 +103,17 @@ static ALWAYS_INLINE bool variable_argument(const int16_t *V, const rl1_param_ra
     return true;
 }
 
-/* The `arity` (1 to 3) arguments of call `op` from its operands at `at` (the mask, then
- * the arguments: 2 bytes each, a byte in a compact call) into `args`, left to right:
- * the end of the call's operands, or NULL when a variable is out of its parameter's
- * range (section 9, step 2; which one does not matter, the fault is the call's).
- * First each argument's field, a constant's value or a variable's index: an index is 0
- * to 52, which reads the same as a signed byte and as a full call's i16 (its high byte
- * is 0: the verifier checked it), so that the fields need no look at the mask. Then,
- * when there are variables, their values (the mask has no bit at or above the arity:
- * checked too). Unrolled, the last argument first, each at fixed offsets. */
-static const uint8_t *arguments(const int16_t *V, uint8_t op, uint8_t arity,
-                                const uint8_t *at, int16_t *args)
+/* The `arity` (1 to 3) arguments of call `op` (descriptor `call`) from its operands at
+ * `at` (the mask, then the arguments: 2 bytes each, a byte in a compact call) into
+ * `args`, left to right: the end of the call's operands, or NULL when a variable is out
+ * of its parameter's range (section 9, step 2; which one does not matter, the fault is
+ * the call's). First each argument's field, a constant's value or a variable's index:
+ * an index is 0 to 52, which reads the same as a signed byte and as a full call's i16
+ * (its high byte is 0: the verifier checked it), so that the fields need no look at the
+ * mask. Then, when there are variables, their values (the mask has no bit at or above
+ * the arity: checked too). Unrolled, the last argument first, each at fixed offsets. */
+static const uint8_t *arguments(const int16_t *V, uint8_t op, rl1_descriptor call,
+                                uint8_t arity, const uint8_t *at, int16_t *args)
 {
     uint8_t mask = RL1_BYTE(at);
     const rl1_param_range *range;
@@ -133,7 +133,7 @@ static const uint8_t *arguments(const int16_t *V, uint8_t op, uint8_t arity,
         at += 2u * arity;
     }
     if (mask) {
-        range = rl1_call_ranges((uint8_t)(op & ~RL1_COMPACT_CALL_BIT));
+        range = rl1_call_ranges((uint8_t)(op & ~RL1_COMPACT_CALL_BIT), call);
         if (((mask & 1u) && !variable_argument(V, range, &args[0]))
             || ((mask & 2u) && !variable_argument(V, range + 1, &args[1]))
             || ((mask & 4u) && !variable_argument(V, range + 2, &args[2]))) {
@@ -146,7 +146,8 @@ static const uint8_t *arguments(const int16_t *V, uint8_t op, uint8_t arity,
 /* Takes what call `op` (descriptor `call`, READS), finished, read: false, writing
  * nothing, when its result is outside its documented range (12.5), a device error; else
  * writes its reserved variables, then R (spec/ilc.md section 9, steps 5-6). */
-static bool take_reading(rl1_vm *vm, uint8_t op, uint8_t call, const rl1_reading *out)
+static bool take_reading(rl1_vm *vm, uint8_t op, rl1_descriptor call,
+                         const rl1_reading *out)
 {
     /* the fields where they lie in the descriptor: tested there, no shift is needed */
     unsigned pairs = call & RL1_CALL_PAIRS, result = call & RL1_CALL_RESULT;
@@ -157,7 +158,7 @@ static bool take_reading(rl1_vm *vm, uint8_t op, uint8_t call, const rl1_reading
         return false;
     }
     if (pairs) { /* one or two: rl1_reading has four writes */
-        int16_t *to = &vm->V[rl1_flash_byte(&rl1_call_first[op - RL1_OP_FIRST_CALL])];
+        int16_t *to = &vm->V[rl1_call_first(op, call)];
         to[0] = from[0];
         to[1] = from[1];
         if (pairs > 1u << RL1_CALL_PAIRS_SHIFT) {
@@ -430,7 +431,8 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
     const int16_t *given; /* args, or NULL for a call without arguments */
     rl1_reading out;
     rl1_status status;
-    uint8_t op, call, arity;
+    rl1_descriptor call;
+    uint8_t op, arity;
 #ifdef RL1_COMPACT
     uint16_t operand;
 #endif
@@ -523,7 +525,7 @@ static rl1_state run(rl1_vm *vm, const rl1_program *program, const rl1_hardware 
             next = ip + 1;
             given = NULL;
             if (arity) {
-                next = arguments(V, op, arity, next, args);
+                next = arguments(V, op, call, arity, next, args);
                 if (next == NULL) {
                     kind = RL1_FAULT_ARGUMENT_RANGE;
                     break;

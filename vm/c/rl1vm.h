@@ -164,8 +164,8 @@ typedef enum rl1_feature {
 } rl1_feature;
 
 /* Each call's descriptor (spec/ilc.md 8.3 and 12), from vm/language.py: for each
-   call from RL1_OP_FIRST_CALL, a byte of the bits below in RL1_CALL_DESCRIPTORS,
-   and one in RL1_CALL_FIRST: for a call with arguments, the index in
+   call from RL1_OP_FIRST_CALL, a u16 in RL1_CALL_DESCRIPTORS of the bits below and,
+   in its high byte (RL1_CALL_FIRST_SHIFT), for a call with arguments the index in
    RL1_PARAM_RANGES of its first parameter's range (low, and the span to high:
    rl1_param_range), the others' following it; for one that writes reserved
    variables (none takes arguments), the first of them, the others following it. */
@@ -178,15 +178,14 @@ typedef enum rl1_feature {
 #define RL1_CALL_RESULT 0xC0u      /* its result's range: 0 for any, else
                                       0 .. RL1_RESULT_HIGH of it */
 #define RL1_CALL_RESULT_SHIFT 6u
+#define RL1_CALL_FIRST_SHIFT 8u   /* the high byte: where its ranges or writes start */
 #define RL1_RESULT_HIGH(kind) ((kind) == 1u ? 784 : 255)
 #define RL1_CALL_COUNT 30
 #define RL1_CALL_DESCRIPTORS \
-    {0x00, 0x00, 0x04, 0x07, 0x02, 0x05, 0x05, 0x05, 0x05, 0x01, 0x05, 0x00, 0x18, \
-     0x01, 0x2C, 0x04, 0x04, 0x04, 0x05, 0x05, 0x4C, 0x0C, 0x0C, 0x0C, 0x0C, 0x01, \
-     0x89, 0x02, 0x02, 0x10}
-#define RL1_CALL_FIRST \
-    {0, 0, 0, 0, 3, 5, 6, 7, 8, 9, 10, 11, 46, 11, 48, 12, 12, 12, 12, 13, 14, 14, \
-     14, 14, 14, 14, 15, 16, 18, 44}
+    {0x0000u, 0x0000u, 0x0004u, 0x0007u, 0x0302u, 0x0505u, 0x0605u, 0x0705u, \
+     0x0805u, 0x0901u, 0x0A05u, 0x0B00u, 0x2E18u, 0x0B01u, 0x302Cu, 0x0C04u, \
+     0x0C04u, 0x0C04u, 0x0C05u, 0x0D05u, 0x0E4Cu, 0x0E0Cu, 0x0E0Cu, 0x0E0Cu, \
+     0x0E0Cu, 0x0E01u, 0x0F89u, 0x1002u, 0x1202u, 0x2C10u}
 #define RL1_PARAM_COUNT 20
 #define RL1_PARAM_RANGES \
     {{-12, 24u}, {-12, 24u}, {-1900, 3800u}, {-12, 24u}, {-12, 24u}, {0, 180u}, \
@@ -308,8 +307,8 @@ void rl1_vm_init(rl1_vm *vm, uint32_t budget);
  * operands' shape; 0 for an opcode unknown in that version. */
 uint8_t rl1_op_length(uint8_t op, uint8_t minor, uint8_t *shape);
 
-/* The calls' descriptors and their parameters' ranges (the generated RL1_CALL_DESCRIPTORS,
- * RL1_CALL_FIRST and RL1_PARAM_RANGES), defined once in rl1vm_load.c. Constant
+/* The calls' descriptors and their parameters' ranges (the generated RL1_CALL_DESCRIPTORS
+ * and RL1_PARAM_RANGES), defined once in rl1vm_load.c. Constant
  * data: in flash on every target, on AVR in program memory (a table there would
  * otherwise be copied to RAM at start-up), so read only through the functions below. */
 #if defined(__AVR__)
@@ -353,15 +352,38 @@ typedef struct {
     uint16_t span;
 } rl1_param_range;
 
-extern const uint8_t rl1_call_descriptors[RL1_CALL_COUNT];
-extern const uint8_t rl1_call_first[RL1_CALL_COUNT];
+extern const uint16_t rl1_call_descriptors[RL1_CALL_COUNT];
 extern const rl1_param_range rl1_param_ranges[RL1_PARAM_COUNT];
 
-/* The descriptor of call `op` (RL1_OP_FRE..RL1_OP_FZI). */
-static inline uint8_t rl1_call_descriptor(uint8_t op)
+/* A call's descriptor as the VM holds it while the call runs, and where its parameters'
+ * ranges or its written variables start (its high byte, RL1_CALL_FIRST_SHIFT), from the
+ * call's opcode `op` (RL1_OP_FRE..RL1_OP_FZI) and that descriptor. A 32-bit target holds
+ * the whole u16, one load for both; AVR holds the low byte alone, and reads the high
+ * one from flash when it needs it (a u16 held across the callbacks costs it more:
+ * vm/c/README.md, "What a call costs"). */
+#if defined(__AVR__)
+typedef uint8_t rl1_descriptor;
+static inline rl1_descriptor rl1_call_descriptor(uint8_t op)
 {
-    return rl1_flash_byte(&rl1_call_descriptors[op - RL1_OP_FIRST_CALL]);
+    return rl1_flash_byte((const uint8_t *)&rl1_call_descriptors[op - RL1_OP_FIRST_CALL]);
 }
+static inline uint8_t rl1_call_first(uint8_t op, rl1_descriptor call)
+{
+    (void)call; /* AVR is little-endian: the high byte is the second */
+    return rl1_flash_byte((const uint8_t *)&rl1_call_descriptors[op - RL1_OP_FIRST_CALL] + 1);
+}
+#else
+typedef uint16_t rl1_descriptor;
+static inline rl1_descriptor rl1_call_descriptor(uint8_t op)
+{
+    return rl1_flash_u16(&rl1_call_descriptors[op - RL1_OP_FIRST_CALL]);
+}
+static inline uint8_t rl1_call_first(uint8_t op, rl1_descriptor call)
+{
+    (void)op;
+    return (uint8_t)(call >> RL1_CALL_FIRST_SHIFT);
+}
+#endif
 
 /* How many arguments call `op` takes, 0 to 3. */
 static inline uint8_t rl1_call_arity(uint8_t op)
@@ -369,10 +391,10 @@ static inline uint8_t rl1_call_arity(uint8_t op)
     return (uint8_t)(rl1_call_descriptor(op) & RL1_CALL_ARITY);
 }
 
-/* The ranges of call `op`'s parameters, from the first's, in rl1_param_ranges. */
-static inline const rl1_param_range *rl1_call_ranges(uint8_t op)
+/* The ranges of call `op`'s parameters (descriptor `call`), from the first's. */
+static inline const rl1_param_range *rl1_call_ranges(uint8_t op, rl1_descriptor call)
 {
-    return &rl1_param_ranges[rl1_flash_byte(&rl1_call_first[op - RL1_OP_FIRST_CALL])];
+    return &rl1_param_ranges[rl1_call_first(op, call)];
 }
 
 /* Whether `value` lies in `range`, in one comparison: value - low, as unsigned, is at

@@ -193,15 +193,14 @@ static uint8_t op_feature(uint8_t op)
 
 /* Each call's descriptor and its parameters' ranges (rl1vm.h, generated from
  * vm/language.py): the one copy the loader and the VM share. */
-const uint8_t rl1_call_descriptors[RL1_CALL_COUNT] RL1_IN_FLASH = RL1_CALL_DESCRIPTORS;
-const uint8_t rl1_call_first[RL1_CALL_COUNT] RL1_IN_FLASH = RL1_CALL_FIRST;
+const uint16_t rl1_call_descriptors[RL1_CALL_COUNT] RL1_IN_FLASH = RL1_CALL_DESCRIPTORS;
 const rl1_param_range rl1_param_ranges[RL1_PARAM_COUNT] RL1_IN_FLASH = RL1_PARAM_RANGES;
 
 /* Whether `value` lies in the range of parameter `index` of call `op`
  * (spec/language.md section 8). */
 bool rl1_arg_in_range(uint8_t op, uint8_t index, int16_t value)
 {
-    return rl1_in_range(rl1_call_ranges(op) + index, value);
+    return rl1_in_range(rl1_call_ranges(op, rl1_call_descriptor(op)) + index, value);
 }
 
 /* --- the container (spec/ilc.md sections 2-7) -------------------------------------- */
@@ -426,8 +425,9 @@ static rl1_refusal check_variable(loader *ld, uint32_t index, uint32_t offset)
 /* A call's mask and arguments, `width` bytes each; `at` is the mask's file offset. */
 static rl1_refusal check_call(loader *ld, uint8_t op, uint8_t width, uint32_t at)
 {
-    uint8_t mask = BYTE(ld->file + at), arity = rl1_call_arity(op), k;
-    const rl1_param_range *range = rl1_call_ranges(op);
+    rl1_descriptor call = rl1_call_descriptor(op);
+    uint8_t mask = BYTE(ld->file + at), arity = call & RL1_CALL_ARITY, k;
+    const rl1_param_range *range = rl1_call_ranges(op, call);
     rl1_refusal status = RL1_ACCEPTED;
     if (mask >> arity) {
         return fail(ld, RL1_BAD_MASK, at);
