@@ -139,7 +139,10 @@ class Statistics:
         for name, observation in observations.items():
             if observation.opcodes is not None:
                 self.opcodes.setdefault(name, Counter()).update(observation.opcodes)
-        self.passes.update(passes_fired(case.source))
+        fired: set[str] = set()
+        optimize(lower(analyze(case.source).program), max(OPTIMIZATION_LEVELS),
+                 fired=fired.add)
+        self.passes.update(fired)
 
     def merge(self, other: Statistics) -> None:
         self.endings.update(other.endings)
@@ -158,14 +161,6 @@ class Statistics:
                            if isa.BY_NAME[opcode].minor >= isa.FUSED_MINOR}
                     for name, opcodes in self.opcodes.items()},
                 "passes": dict(sorted(self.passes.items()))}
-
-
-def passes_fired(source: str) -> set[str]:
-    """The passes of the optimizer's highest level that change `source` (a program the
-    checker accepts): what the statistics count in `passes`."""
-    fired: set[str] = set()
-    optimize(lower(analyze(source).program), max(OPTIMIZATION_LEVELS), fired=fired.add)
-    return fired
 
 
 LOST = "LINE LOST"  # a trace entry's call when the device lost the guidance line

@@ -438,8 +438,7 @@ class _Builder:
     def statement(self, tracing: bool = True) -> None:
         """One statement (or a few of the shapes in `plain`); with `tracing` False, no
         (TRC ...) (handlers must not set a mode whose handlers might not exist)."""
-        kind = self.draw(st.sampled_from(("assign", "assign", "step", "call", "call",
-                                          "plain")))
+        kind = self.draw(st.sampled_from(("assign", "plain", "step", "call", "call")))
         if self.wild and self.draw(st.integers(0, 199)) == 100:  # not 0: Hypothesis favours 0
             self.emit(("(", "MVI", "3", ",", "-3", ",", "10", ")"))  # a device error
         elif kind == "plain":
@@ -459,8 +458,8 @@ class _Builder:
                 self.emit(self.call(mnemonic, form))
 
     def block(self, depth: int) -> None:
-        kinds = ("straight", "straight", "straight", "loop", "skip", "if-else", "branches") \
-            + (("sensed",) if self.wild else ())
+        kinds = ("straight", "straight", "straight", "loop", "skip", "if-else", "if-else",
+                 "branches", *(("sensed",) if self.wild else ()))
         kind = self.draw(st.sampled_from(kinds))
         if self.wild and depth == 0 and self.free_labels and self.draw(st.booleans()):
             self.wild.top_labels.append(number := self.free_labels.pop())
