@@ -65,18 +65,14 @@ class Observation:
     opcodes: dict[str, int] | None = None  # the instructions executed by opcode, if counted
 
     @property
-    def ending_code(self) -> object:
-        """The code of its status (None for format 1's "ok")."""
-        status = self.document.get("status")
-        return status.get("code") if isinstance(status, dict) else None
-
-    @property
     def crashed(self) -> bool:
-        return self.ending_code == CRASH_CODE
+        status = self.document.get("status")
+        return isinstance(status, dict) and status.get("code") == CRASH_CODE
 
     @property
     def ran_away(self) -> bool:
-        return self.ending_code == BUDGET_CODE
+        status = self.document.get("status")
+        return isinstance(status, dict) and status.get("code") == BUDGET_CODE
 
     def ending(self) -> object:
         status = self.document.get("status")
@@ -590,7 +586,6 @@ class Verdict:
 
     observations: dict[str, Observation]
     problems: list[str]
-
     ended: str | None = None  # judge_apart: how an engine ended its process, if one did
 
 

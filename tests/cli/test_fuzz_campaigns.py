@@ -21,6 +21,7 @@ import pytest
 from support import ROOT
 from support.cli import rl1c
 from support.planted import BROKEN_VM
+from support.recording import Recording
 
 from rl1.compiler import fuzz
 from rl1.compiler.cli import fuzz as fuzz_cli
@@ -33,21 +34,6 @@ pytestmark = pytest.mark.slow  # campaigns, on pools of processes
 T = TypeVar("T")
 
 RL1C = [str(Path(sys.executable).with_name("rl1c"))]
-
-
-class _Recording:
-    """The -O0 VM, writing each program it runs to a file, from any process."""
-
-    name = "recording"
-    level = 0
-
-    def __init__(self, path: Path) -> None:
-        self.path = path
-
-    def run(self, case: Run, budget: int) -> Observation:
-        with open(self.path, "a", encoding="utf-8") as stream:
-            stream.write(json.dumps(case.source) + "\n")
-        return VmEngine(0).run(case, budget)
 
 
 class _TwoBugs:
@@ -89,7 +75,7 @@ def test_a_seed_gives_the_same_programs_on_any_number_of_processes(
     seen = []
     for jobs in (1, 2, 3):
         path = tmp_path / f"jobs-{jobs}"
-        outcome = _campaign([VmEngine(0), _Recording(path)], jobs, 12)
+        outcome = _campaign([VmEngine(0), Recording(path)], jobs, 12)
         assert outcome.programs == 12 and outcome.finding is None
         seen.append(sorted(path.read_text(encoding="utf-8").splitlines()))
     assert seen[0] == seen[1] == seen[2] and len(seen[0]) == 12

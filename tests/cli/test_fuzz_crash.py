@@ -15,6 +15,7 @@ from pathlib import Path
 
 import pytest
 from support.cli import rl1c
+from support.recording import Recording, recorded
 
 from rl1.compiler import differential, fuzz
 from rl1.compiler.differential import (
@@ -57,24 +58,6 @@ class _EndsItsProcess:
         return VmEngine(0).run(case, budget)
 
 
-@dataclass(frozen=True)
-class _Recording:
-    """The -O0 VM, writing each program it runs to `path`, from any process."""
-
-    path: str
-    name: str = "recording"
-    level: int = 0
-
-    def run(self, case: Run, budget: int) -> Observation:
-        with open(self.path, "a", encoding="utf-8") as stream:
-            stream.write(json.dumps(case.source) + "\n")
-        return VmEngine(0).run(case, budget)
-
-
-def _recorded(path: Path) -> list[str]:
-    return [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()]
-
-
 def _quiet(programs: int, elapsed: float) -> None:
     pass
 
@@ -92,10 +75,10 @@ def programs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> list[str]:
     """The COUNT programs of the campaign of SEED, in searches of 4, in their order."""
     _small_searches(monkeypatch)
     path = tmp_path / "programs"
-    outcome = fuzz.campaign([VmEngine(0), _Recording(str(path))], 20_000, count=COUNT,
+    outcome = fuzz.campaign([VmEngine(0), Recording(path)], 20_000, count=COUNT,
                             seconds=None, seed=SEED, progress=_quiet)
     assert outcome.programs == COUNT and outcome.finding is None
-    return _recorded(path)
+    return recorded(path)
 
 
 def _on_processes(engines: list[Engine], jobs: int, keep_going: bool) -> fuzz.Outcome:
@@ -113,13 +96,13 @@ def test_the_program_that_ends_its_worker_is_the_finding_and_the_others_are_judg
         programs: list[str], tmp_path: Path, jobs: int) -> None:
     killer = programs[7]  # the last of the second search of three
     path = tmp_path / "judged"
-    outcome = _on_processes([VmEngine(0), _Recording(str(path)), _EndsItsProcess(killer)],
+    outcome = _on_processes([VmEngine(0), Recording(path), _EndsItsProcess(killer)],
                             jobs, keep_going=True)
     assert outcome.finding is not None and outcome.finding.case.source == killer
     assert outcome.counts == {SIGSEGV: 1} and outcome.programs == COUNT
     # Every program judged (some twice: those of a search lost with a worker; and the
     # programs shrinking tried).
-    assert set(programs) <= set(_recorded(path))
+    assert set(programs) <= set(recorded(path))
     # Its reproducer's runs are those of the engines before it.
     assert list(outcome.finding.verdict.observations) == ["vm-O0", "recording", KILLER]
 
@@ -180,7 +163,7 @@ def named_killer(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> str:
 
     def engine_named(name: str) -> Engine | None:
         if name == "recording":
-            return _Recording(str(path))
+            return Recording(path)
         return _EndsItsProcess(killing[0]) if name == KILLER else named(name)
 
     monkeypatch.setattr(differential, "engine_named", engine_named)
@@ -188,7 +171,7 @@ def named_killer(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> str:
     result = rl1c("fuzz", "--engine", "vm-O0", "--engine", "recording", "--count",
                   str(COUNT), "--seed", str(SEED), "--jobs", "1", "--out", tmp_path)
     assert result.exit_code == 0, result.output
-    killing.append(_recorded(path)[7])
+    killing.append(recorded(path)[7])
     return killing[0]
 
 
