@@ -30,8 +30,9 @@ OPTIMIZATION_LEVELS = tuple(LEVELS)
 
 TREE_CHARACTERS = 16 * 1024
 """A source of up to this many characters is checked and lowered on its whole tree, which
-is faster than the streaming check (Listing 1 at -O0 in 0.85 of the time): its tree is
-at most about 2.5 MB (some 155 bytes a character), a tenth of what rl1c takes to start."""
+is faster than the streaming check (Listing 1 at -O0 in 0.8 of the time): its tree and
+diagnostics hold at most about 3 MB (16 KiB of `A=s` lines), a fifth of the 16.6 MB
+rl1c takes to start."""
 
 
 @dataclass(frozen=True, slots=True)
