@@ -195,7 +195,7 @@ def render_descriptors() -> list[str]:
         "#define RL1_CALL_RESULT 0xC0u      /* its result's range: 0 for any, else",
         "                                      0 .. RL1_RESULT_HIGH of it */",
         "#define RL1_CALL_RESULT_SHIFT 6u",
-        "#define RL1_CALL_FIRST_SHIFT 8u   /* the high byte: where its ranges or writes start */",
+        "#define RL1_CALL_FIRST_SHIFT 8u    /* the high byte: where its ranges or writes start */",
         f"#define RL1_RESULT_HIGH(kind) {_select([high for _low, high in results], 'kind')}",
         f"#define RL1_CALL_COUNT {len(infos)}",
         "#define RL1_CALL_DESCRIPTORS \\",

@@ -178,7 +178,7 @@ typedef enum rl1_feature {
 #define RL1_CALL_RESULT 0xC0u      /* its result's range: 0 for any, else
                                       0 .. RL1_RESULT_HIGH of it */
 #define RL1_CALL_RESULT_SHIFT 6u
-#define RL1_CALL_FIRST_SHIFT 8u   /* the high byte: where its ranges or writes start */
+#define RL1_CALL_FIRST_SHIFT 8u    /* the high byte: where its ranges or writes start */
 #define RL1_RESULT_HIGH(kind) ((kind) == 1u ? 784 : 255)
 #define RL1_CALL_COUNT 30
 #define RL1_CALL_DESCRIPTORS \
