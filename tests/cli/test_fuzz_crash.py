@@ -5,6 +5,7 @@ processes."""
 
 from __future__ import annotations
 
+import faulthandler
 import json
 import os
 import shutil
@@ -54,6 +55,7 @@ class _EndsItsProcess:
         if case.source == self.program:
             if self.signum is None:
                 os._exit(self.status)
+            faulthandler.disable()  # pytest's, which would print this process's stacks
             os.kill(os.getpid(), self.signum)
         return VmEngine(0).run(case, budget)
 
