@@ -289,8 +289,7 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
         else:
             shrinks += 1
         verdict = judging(case, task.engines, task.budget)
-        # What a program that ended its process did is not known.
-        if target is None and searched.statistics is not None and verdict.ended is None:
+        if target is None and searched.statistics is not None:
             searched.statistics.add(case, verdict)
         if not verdict.problems:
             return False

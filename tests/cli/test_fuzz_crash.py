@@ -227,6 +227,22 @@ def test_rl1c_fuzz_keep_going_counts_it_in_its_group(named_killer: str, tmp_path
     assert (out / "finding-1" / "program.rob").read_bytes().decode() == named_killer
 
 
+
+def test_json_statistics_count_it_among_the_endings_and_the_findings(
+        named_killer: str, tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = rl1c("fuzz", "--engine", KILLER, "--engine", "vm-O0", "--count", str(COUNT),
+                  "--seed", str(SEED), "--jobs", "2", "--out", out, "--keep-going",
+                  "--format", "json")
+    assert result.exit_code == 1, result.output
+    document = json.loads(result.stdout)
+    # How the first engine, the one that ends its process, ended each program.
+    endings = document["endings"]
+    assert document["programs"] == sum(endings.values()) == COUNT
+    assert endings["ended-process"] == 1
+    assert document["findings"] == [{"signature": SIGSEGV, "programs": 1,
+                                     "reproducer": str(out / "finding-1")}]
+
 # The C VM with a planted bug: a step after which A is 1234 writes through a null pointer.
 PLANTED_STEP = r"""
 #include "rl1vm.h"
