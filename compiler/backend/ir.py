@@ -27,6 +27,7 @@ BlockId = str
 """`Lnn` for the block a source label `:nn` starts, `Bn` for the others."""
 
 
+@cache  # one string a label, however many jumps name it
 def label_block(number: int) -> BlockId:
     return f"L{number:02d}"
 

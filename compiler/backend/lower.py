@@ -86,12 +86,13 @@ class _Lowerer:
 
     # Blocks -------------------------------------------------------------------------
 
-    def open_block(self) -> None:
+    def open_block(self, named: ir.BlockId | None = None) -> None:
         """Open an unlabelled block unless one is open: at the start of the program,
-        for the fall-through of a conditional jump, or for code after a jump or
-        `(END)` (which only a label could reach, so nothing does)."""
+        for the fall-through of a conditional jump (`named` as its branch names it, one
+        string for both), or for code after a jump or `(END)` (which only a label could
+        reach, so nothing does)."""
         if self.block_id is None:
-            self.block_id = f"B{self.unlabelled}"
+            self.block_id = named or f"B{self.unlabelled}"
             self.unlabelled += 1
 
     def finish(self, terminator: ir.Terminator) -> None:
@@ -140,7 +141,7 @@ class _Lowerer:
             fall_through = f"B{self.unlabelled}"
             self.finish(ir.Branch(self.variable(statement.var), statement.relation,
                                   taken, fall_through, line))
-            self.open_block()
+            self.open_block(fall_through)
         elif statement.call.is_end:
             if statement.call.args:
                 raise LoweringError(f"line {line}: `(END)` takes no arguments")
