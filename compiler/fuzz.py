@@ -33,6 +33,8 @@ from typing import Any
 
 from hypothesis import HealthCheck, Phase, find, settings
 from hypothesis.errors import NoSuchExample
+from hypothesis.internal.conjecture import providers
+from hypothesis.internal.constants_ast import Constants
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS
@@ -197,6 +199,29 @@ class _Enough(BaseException):
     failure to shrink, calling the predicate again and again)."""
 
 
+@contextlib.contextmanager
+def only_hypothesis_constants() -> Iterator[None]:
+    """While inside, Hypothesis draws none of the literals it finds in the source of the
+    modules a process has loaded. Since 6.131 it does (a twentieth of its draws pick a
+    constant, half of them local), so one seed gave other programs in a process that had
+    loaded other modules: a Dask worker, a wheel's rl1 (site-packages, not local) rather
+    than an editable one, a command that imports more. Its own constants, the same in
+    every process, are still drawn. Hypothesis has no setting for it: its private
+    function is replaced, and tests/cli/test_fuzz_seeds.py holds the programs the same
+    with other modules loaded, so that a Hypothesis that moves it is noticed."""
+    collect = getattr(providers, "_get_local_constants", None)
+    if collect is None:  # a Hypothesis before 6.131, or one that collects elsewhere
+        yield
+        return
+    providers._get_local_constants = Constants
+    providers.CONSTANTS_CACHE.cache.clear()  # what was drawn from before, locals and all
+    try:
+        yield
+    finally:
+        providers._get_local_constants = collect
+        providers.CONSTANTS_CACHE.cache.clear()
+
+
 HALT = "halt"  # the Channel's file naming the first search that must stop
 TOLD_EVERY = 1.0  # seconds between a search's counts on the Channel
 
@@ -323,7 +348,8 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
                 limits = settings(max_examples=size - searched.programs, database=None,
                                   deadline=None, suppress_health_check=list(HealthCheck),
                                   phases=(Phase.generate, Phase.shrink))
-                with contextlib.suppress(NoSuchExample), contextlib.suppress(_Enough):
+                with contextlib.suppress(NoSuchExample), contextlib.suppress(_Enough), \
+                        only_hypothesis_constants():
                     find(runs(instruction_losses=comparable), disagrees, settings=limits,
                          random=Random(seeds.getrandbits(64)))
                 if target is not None and not stopped():
