@@ -12,8 +12,11 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
 from support import ROOT
 from support.recording import recorded
+
+pytestmark = pytest.mark.slow  # two campaigns, each in an interpreter of its own
 
 CAMPAIGN = """
 import sys
