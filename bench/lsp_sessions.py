@@ -20,8 +20,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 
 from support.hostile import ServedLsp, serve_one_after_another  # noqa: E402  (tests/ is put on the path just above)
-
-WARM_UP = 20  # clients served before measuring: imports, caches, the allocator's first arenas
+from support.memory import WARM_UP  # noqa: E402
 
 
 def processor_seconds(pid: int) -> float:

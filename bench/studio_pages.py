@@ -20,8 +20,7 @@ sys.path[:0] = [str(ROOT / "tests"), str(ROOT / "tests" / "studio")]
 
 from lsp_sessions import processor_seconds  # noqa: E402  (bench/ is this script's folder)
 from served import StudioProcess, pages_one_after_another, sample_folder  # noqa: E402  (tests/ on the path just above)
-
-WARM_UP = 20  # pages served before measuring: imports, caches, the allocator's first arenas
+from support.memory import WARM_UP  # noqa: E402
 
 
 def main() -> None:

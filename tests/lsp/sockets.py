@@ -9,11 +9,11 @@ import socket
 import subprocess
 import time
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 from conftest import SERVER, TIMEOUT
 from raw import Message
+from support.memory import status_mib
 
 
 def free_port() -> int:
@@ -41,10 +41,7 @@ class Listening:
             time.sleep(0.1)
 
     def resident_mib(self) -> float:
-        for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) / 1024
-        raise AssertionError("no VmRSS")
+        return status_mib(self.process.pid, "VmRSS")
 
     def stderr(self) -> str:
         """Standard error so far (ends the server if it still runs)."""

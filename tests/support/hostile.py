@@ -57,6 +57,7 @@ from rl1.vm.sim.world import WorldError, decode_world
 from . import EXAMPLES, ROOT, SAMPLE, SAMPLE_SENSORS
 from .cli import Result, rl1c
 from .ilc import with_crc
+from .memory import status_mib
 
 # The exit statuses each command documents (docs/commands.md).
 STATUSES = {
@@ -355,17 +356,12 @@ class ServedLsp:
     def resident_mib(self) -> float:
         """Resident memory, from /proc (0 once the process has ended)."""
         with contextlib.suppress(OSError):
-            for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
-                if line.startswith("VmRSS:"):
-                    return int(line.split()[1]) / 1024
+            return status_mib(self.process.pid, "VmRSS")
         return 0.0
 
     def peak_mib(self) -> float:
         """The most resident memory the process has held, from /proc."""
-        for line in Path(f"/proc/{self.process.pid}/status").read_text().splitlines():
-            if line.startswith("VmHWM:"):
-                return int(line.split()[1]) / 1024
-        raise AssertionError("no VmHWM")
+        return status_mib(self.process.pid, "VmHWM")
 
     def _read_stderr(self, stream: IO[bytes]) -> None:
         with stream:
