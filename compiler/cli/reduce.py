@@ -83,9 +83,11 @@ def reduce(file: str, sensors: str | None, command: str | None,
     Lines, statements, terms and operands are deleted or made smaller (constants towards
     0), and the script's readings, losses and numbers too, while the case stays
     interesting: CMD exits 0 on it (--interesting), or the engines disagree on it as on
-    the original (--engine). Each candidate is tested once, and only if it is as
-    well-formed as the original (a program the checker accepts stays so); the result is
-    in the formatter's layout when it stays interesting so. The same input and command
+    the original (--engine; an engine that ends the process it runs in, as a crashing C
+    VM does, is such a difference: with a C engine, each candidate is judged in a
+    process of its own). Each candidate is tested once, and only if it is as well-formed
+    as the original (a program the checker accepts stays so); the result is in the
+    formatter's layout when it stays interesting so. The same input and command
     give the same result. The original is never changed unless --out names it. Exit
     status: 0 reduced; 1 the original is not interesting (CMD must exit 0 on it, or the
     engines disagree on it); 2 a usage problem or a file that cannot be read; 130
@@ -155,6 +157,8 @@ def reduce(file: str, sensors: str | None, command: str | None,
     if script is not None and case.script is not None:
         lines.append(f"sensor script {sensors}: {_figures(script)} -> "
                      f"{_figures(case.script)}")
+    if isinstance(interesting, _EnginesTest):  # the one bug the reduction kept to
+        lines.append(f"difference kept: {interesting.signature}")
     lines.append(f"{tested} tests{ending}")
     lines.append("written: " + ", ".join(written) if written else
                  "nothing smaller is interesting: nothing written")
@@ -382,20 +386,30 @@ def _script_data(text: str | None) -> dict[str, Any]:
 
 class _EnginesTest:
     """Interesting while the engines disagree as on the first case tested (the
-    original): the same signature, so that the reduction keeps to one bug."""
+    original): the same signature, so that the reduction keeps to one bug. An engine
+    that ends the process it runs in (the C VM's crash) is such a difference, its
+    signal or exit status in the signature: when one could, each case is judged in a
+    process forked for it, so that rl1c reduce outlives it."""
 
     def __init__(self, engines: list[Engine], budget: int) -> None:
         self.engines, self.budget = engines, budget
+        self.apart = any(map(_may_end_its_process, engines))
         self.signature: str | None = None
 
     def __call__(self, case: Case) -> bool:
-        from rl1.compiler.differential import EngineUnavailable, judge, signature
+        from rl1.compiler.differential import (
+            EngineUnavailable,
+            judge,
+            judge_apart,
+            signature,
+        )
         from rl1.compiler.strategies import Run
         from rl1.vm.native import BuildError
 
+        judging = judge_apart if self.apart else judge
         try:
-            verdict = judge(Run(case.source, _script_data(case.script)), self.engines,
-                            self.budget)
+            verdict = judging(Run(case.source, _script_data(case.script)), self.engines,
+                              self.budget)
         except (BuildError, EngineUnavailable) as error:  # such as no C compiler
             raise Failure(f"rl1c reduce: error: {error}") from None
         if not verdict.problems:
@@ -404,6 +418,16 @@ class _EnginesTest:
         if self.signature is None:
             self.signature = found
         return found == self.signature
+
+
+def _may_end_its_process(engine: Engine) -> bool:
+    """Whether a run of `engine` could end the process it runs in: the C VM's, in it
+    through ctypes, can (a crash, a sanitizer's abort), and so may any engine not known
+    here; Python's engines raise instead, and the exec engines run in processes of their
+    own (a batch engine's would start again for each case judged apart)."""
+    from rl1.compiler.differential import AstEngine, BatchEngine, ExecEngine, VmEngine
+
+    return not isinstance(engine, AstEngine | VmEngine | ExecEngine | BatchEngine)
 
 
 COMMANDS = (reduce,)
