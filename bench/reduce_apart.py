@@ -1,0 +1,68 @@
+"""What judging each case in a process of its own costs `rl1c reduce --engine`, as it
+does with an engine that could end the process it runs in (a c-ON engine): in one run,
+the cases a reduction of FILE tries (with a predicate of no cost: a `(MOV` in the
+program), each judged by the engines in this process (`judge`, the reference) and apart
+(`judge_apart`, a fork a case), apart first with nothing of the engines' loaded here, as
+in `rl1c reduce`, then again once this process has loaded it (the C VM's library);
+each judged N times over; cases per second of wall time, and their ratios.
+
+    .venv/bin/python bench/reduce_apart.py [FILE.rob] [--engine NAME]... [--rounds N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from rl1.compiler.differential import Engine, Verdict, engine_named, judge, judge_apart
+from rl1.compiler.reduce import Case, reduce
+from rl1.compiler.strategies import Run
+
+SAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sample.rob"
+Judging = Callable[[Run, Sequence[Engine], int], Verdict]
+
+
+def tried(source: str) -> list[Case]:
+    """The cases that reducing `source` while it holds a `(MOV` tries, in order."""
+    cases: list[Case] = []
+
+    def moves(case: Case) -> bool:
+        cases.append(case)
+        return "(MOV" in case.source
+
+    reduce(Case(source), moves, max_tests=2000)
+    return cases
+
+
+def rate(judging: Judging, cases: list[Case], engines: Sequence[Engine]) -> float:
+    """Cases per second that `judging` judges, in wall time."""
+    started = time.perf_counter()
+    for case in cases:
+        judging(Run(case.source, {}), engines, 20_000)
+    return len(cases) / (time.perf_counter() - started)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("file", nargs="?", default=str(SAMPLE), metavar="FILE.rob")
+    parser.add_argument("--engine", action="append", metavar="NAME",
+                        help="an engine (default: vm-O0 and c-O1)")
+    parser.add_argument("--rounds", type=int, default=10, metavar="N",
+                        help="how many times each case is judged (default 10)")
+    arguments = parser.parse_args()
+    engines = [engine for name in arguments.engine or ("vm-O0", "c-O1")
+               if (engine := engine_named(name)) is not None]
+    cases = tried(Path(arguments.file).read_text(encoding="utf-8")) * arguments.rounds
+    cold = rate(judge_apart, cases, engines)
+    here = rate(judge, cases, engines)
+    warm = rate(judge_apart, cases, engines)
+    print(f"{len(cases)} cases of reducing {arguments.file} on "
+          f"{', '.join(engine.name for engine in engines)}: judged in this process "
+          f"{here:.1f}/s, each apart {cold:.1f}/s ({cold / here:.2f}x), apart with the "
+          f"engines loaded here {warm:.1f}/s ({warm / here:.2f}x)")
+
+
+if __name__ == "__main__":
+    main()
