@@ -2,9 +2,11 @@
 does with an engine that could end the process it runs in (a c-ON engine): in one run,
 the cases a reduction of FILE tries (with a predicate of no cost: a `(MOV` in the
 program), each judged by the engines in this process (`judge`, the reference) and apart
-(`judge_apart`, a fork a case), apart first with nothing of the engines' loaded here, as
-in `rl1c reduce`, then again once this process has loaded it (the C VM's library);
-each judged N times over; cases per second of wall time, and their ratios.
+(`judge_apart`, a fork a case): apart with nothing of the engines' loaded here, then with
+the C VM's library loaded here (as `rl1c reduce` loads it, for each case to inherit),
+then in this process, then apart again once this process has judged every case
+(everything the engines use loaded and warm); each case N times over; cases per second
+of wall time, and their ratios to judging in this process.
 
     .venv/bin/python bench/reduce_apart.py [FILE.rob] [--engine NAME]... [--rounds N]
 """
@@ -16,9 +18,11 @@ import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from rl1.compiler import differential
 from rl1.compiler.differential import Engine, Verdict, engine_named, judge, judge_apart
 from rl1.compiler.reduce import Case, reduce
 from rl1.compiler.strategies import Run
+from rl1.vm.native import library, load
 
 SAMPLE = Path(__file__).resolve().parents[1] / "examples" / "sample.rob"
 Judging = Callable[[Run, Sequence[Engine], int], Verdict]
@@ -56,12 +60,16 @@ def main() -> None:
                if (engine := engine_named(name)) is not None]
     cases = tried(Path(arguments.file).read_text(encoding="utf-8")) * arguments.rounds
     cold = rate(judge_apart, cases, engines)
+    if any(isinstance(engine, differential.CEngine) for engine in engines):
+        load(library())
+    loaded = rate(judge_apart, cases, engines)
     here = rate(judge, cases, engines)
     warm = rate(judge_apart, cases, engines)
     print(f"{len(cases)} cases of reducing {arguments.file} on "
           f"{', '.join(engine.name for engine in engines)}: judged in this process "
-          f"{here:.1f}/s, each apart {cold:.1f}/s ({cold / here:.2f}x), apart with the "
-          f"engines loaded here {warm:.1f}/s ({warm / here:.2f}x)")
+          f"{here:.1f}/s; each apart {cold:.1f}/s ({cold / here:.2f}x), with the C VM's "
+          f"library loaded here {loaded:.1f}/s ({loaded / here:.2f}x), with everything "
+          f"warm here {warm:.1f}/s ({warm / here:.2f}x)")
 
 
 if __name__ == "__main__":

@@ -110,6 +110,17 @@ def test_cases_are_judged_apart_only_with_an_engine_that_could_end_this_process(
     assert _may_end_its_process(engine) is apart
 
 
+def test_no_c_compiler_for_a_c_engine_is_a_message_and_status_2(program: Path,
+                                                                 tmp_path: Path) -> None:
+    ran = ending_rl1c("reduce", program, "--engine", "vm-O0", "--engine", "c-O1",
+                      env={"CC": "/nonexistent/cc", "XDG_CACHE_HOME": str(tmp_path)})
+    assert ran.returncode == 2, ran.stderr
+    assert ran.stderr == ("rl1c reduce: error: CC='/nonexistent/cc' names "
+                          "'/nonexistent/cc', which is no command here; set CC to a C "
+                          "compiler, or unset it to use cc, gcc or clang\n")
+    assert not program.with_name("crash.reduced.rob").exists()
+
+
 # The C VM with a planted bug: a step after which A is 1234 writes through a null
 # pointer (as tests/cli/test_fuzz_crash.py plants it for rl1c fuzz).
 PLANTED_STEP = r"""

@@ -7,8 +7,8 @@ first creates that file and holds for HOLD_SECONDS (a test sends Ctrl-C meanwhil
     python ending_rl1c.py [--c-library PATH] ARGS...
 
 runs `rl1c ARGS...` in a process of its own, so that a test whose rl1c does not outlive
-the engine fails rather than ending pytest; with --c-library, the c-ON engines load the
-C VM's library at PATH (one with a planted bug) instead of building it."""
+the engine fails rather than ending pytest; with --c-library, the C VM's library is the
+one at PATH (one with a planted bug) instead of one built."""
 
 from __future__ import annotations
 
@@ -20,10 +20,13 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import pytest
+
 from rl1.compiler import differential
 from rl1.compiler.cli.main import rl1c
 from rl1.compiler.differential import Engine, Observation, VmEngine
 from rl1.compiler.strategies import Run
+from rl1.vm import native
 
 PREFIX = "ends-on:"
 HOLD = "RL1_TEST_HOLD"
@@ -62,7 +65,10 @@ def main(arguments: list[str]) -> None:
     differential.engine_named = engine_named
     if arguments[:1] == ["--c-library"]:
         planted = Path(arguments[1])
-        differential.library = lambda: planted  # type: ignore[assignment]
+        patch = pytest.MonkeyPatch()  # for this process's life
+        # Where the c-ON engines find it, and where rl1c reduce loads it first.
+        for module in (differential, native):
+            patch.setattr(module, "library", lambda: planted)
         arguments = arguments[2:]
     rl1c.main(arguments, prog_name="rl1c")
 
