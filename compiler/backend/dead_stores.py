@@ -15,6 +15,8 @@ among them stays).
 
 from __future__ import annotations
 
+from array import array
+
 from rl1.vm.language import VARIABLES
 
 from . import flow, ir
@@ -28,38 +30,75 @@ def remove_dead_stores(program: ir.Program) -> ir.Program:
     return program
 
 
-def _live_out(block: ir.Block, live_in: dict[ir.BlockId, frozenset[str]],
-              events: bool) -> frozenset[str]:
+def _live_out(block: ir.Block, live_in: list[frozenset[str] | None],
+              position: dict[ir.BlockId, int], events: bool) -> frozenset[str]:
     terminator = block.terminator
     if isinstance(terminator, ir.End) or events:
         return ALL  # the final variables; or a handler (or a fault) after a jump
-    live = frozenset().union(*(live_in.get(target, frozenset())
+    live = frozenset().union(*(live_in[position[target]] or frozenset()
                                for target in terminator.targets))
     return live | {terminator.var.name} if isinstance(terminator, ir.Branch) else live
 
 
 def _solve(program: ir.Program, events: bool) -> dict[ir.BlockId, list[ir.Instruction]]:
-    """Each block's instructions without its dead ones, from what is live where each
-    block starts: a worklist, each block swept again when what is live after it grows
-    (its last sweep is the one with the final liveness)."""
-    preds = program.predecessors()
-    live_in: dict[ir.BlockId, frozenset[str]] = {}
+    """The instructions without their dead ones of each block that has some, from what
+    is live where each block starts: a worklist, each block swept again when what is
+    live after it grows (its last sweep is the one with the final liveness).
+
+    Blocks go by their place in the layout, and what the flow holds of each is in lists
+    and arrays by place (a block a line of `?A=#01` held 300 bytes of dictionaries and
+    lists of the flow a block, 42 bytes a source byte)."""
+    blocks = list(program)
+    position = {block.id: place for place, block in enumerate(blocks)}
+    first_pred, preds = _predecessors(blocks, position)
+    live_in: list[frozenset[str] | None] = [None] * len(blocks)
     # One object for equal sets: most blocks of a long program see every variable live
     # (a set of 53 names is 2 KB; 8 MiB of `?A=#01` lines held 370 bytes a source byte).
     shared: dict[frozenset[str], frozenset[str]] = {}
-    kept: dict[ir.BlockId, list[ir.Instruction]] = {}
-    work = list(program.blocks)  # popped from the end: the last block first
-    queued = set(work)
+    kept: dict[int, list[ir.Instruction]] = {}  # of the blocks that lose instructions
+    work = array("I", range(len(blocks)))  # popped from the end: the last block first
+    queued = bytearray(b"\x01") * len(blocks)
     while work:
-        block_id = work.pop()
-        queued.discard(block_id)
-        block = program.blocks[block_id]
-        kept[block_id], live = _sweep(block, _live_out(block, live_in, events))
-        if live_in.get(block_id) != live:
-            live_in[block_id] = shared.setdefault(live, live)
-            work.extend(pred for pred in preds[block_id] if pred not in queued)
-            queued.update(preds[block_id])
-    return kept
+        place = work.pop()
+        queued[place] = 0
+        block = blocks[place]
+        swept, live = _sweep(block, _live_out(block, live_in, position, events))
+        if len(swept) < len(block.instructions):
+            kept[place] = swept
+        else:
+            kept.pop(place, None)
+        if live_in[place] != live:
+            live_in[place] = shared.setdefault(live, live)
+            for pred in preds[first_pred[place]:first_pred[place + 1]]:
+                if not queued[pred]:
+                    queued[pred] = 1
+                    work.append(pred)
+    return {blocks[place].id: instructions for place, instructions in kept.items()}
+
+
+def _predecessors(blocks: list[ir.Block], position: dict[ir.BlockId, int]
+                  ) -> tuple[array[int], array[int]]:
+    """The places of the predecessors of each block, by place: those of block `i` are
+    `preds[first[i]:first[i + 1]]` (a block that jumps to itself is its own)."""
+    first = array("I", bytes(4 * (len(blocks) + 1)))  # first counts, then starts
+    for block in blocks:
+        for target in _distinct(block.successors):
+            first[position[target] + 1] += 1
+    for place in range(len(blocks)):
+        first[place + 1] += first[place]
+    preds = array("I", bytes(4 * first[-1]))
+    filled = array("I", first)
+    for place, block in enumerate(blocks):
+        for target in _distinct(block.successors):
+            at = position[target]
+            preds[filled[at]] = place
+            filled[at] += 1
+    return first, preds
+
+
+def _distinct(targets: tuple[ir.BlockId, ...]) -> tuple[ir.BlockId, ...]:
+    """A terminator's targets, each once (a branch may go to one block both ways)."""
+    return targets[:1] if len(targets) == 2 and targets[0] == targets[1] else targets
 
 
 def _sweep(block: ir.Block, live_out: frozenset[str]
