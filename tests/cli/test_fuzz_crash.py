@@ -8,14 +8,13 @@ from __future__ import annotations
 import faulthandler
 import json
 import os
-import shutil
 import signal
-import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 from support.cli import rl1c
+from support.planted import crashing_c_vm
 from support.recording import Recording, recorded
 
 from rl1.compiler import differential, fuzz
@@ -30,7 +29,6 @@ from rl1.compiler.differential import (
 )
 from rl1.compiler.executors import workers
 from rl1.compiler.strategies import Run
-from rl1.vm import native
 
 pytestmark = pytest.mark.slow  # campaigns, on pools of processes
 
@@ -243,32 +241,11 @@ def test_json_statistics_count_it_among_the_endings_and_the_findings(
     assert document["findings"] == [{"signature": SIGSEGV, "programs": 1,
                                      "reproducer": str(out / "finding-1")}]
 
-# The C VM with a planted bug: a step after which A is 1234 writes through a null pointer.
-PLANTED_STEP = r"""
-#include "rl1vm.h"
-#undef rl1_step
-rl1_state rl1_step(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
-                   uint32_t n)
-{
-    rl1_state state = rl1_step_unplanted(vm, program, hw, n);
-    if (vm->V[0] == 1234)
-        *(volatile int *)0 = 0;
-    return state;
-}
-"""
-
 
 @pytest.mark.needs_cc
 def test_a_c_vm_that_crashes_is_a_finding_of_rl1c_fuzz(
         tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    compiler = next((cc for cc in ("cc", "gcc", "clang") if shutil.which(cc)), None)
-    if compiler is None:
-        pytest.skip("no C compiler")
-    planted, library = tmp_path / "planted.c", tmp_path / "librl1vm-planted.so"
-    planted.write_text(PLANTED_STEP, encoding="ascii")
-    subprocess.run([compiler, *native.FLAGS, f"-I{native.C_FOLDER}",
-                    f"-I{native.HEADER_FOLDER}", "-Drl1_step=rl1_step_unplanted", "-o",
-                    str(library), *map(str, native.SOURCES), str(planted)], check=True)
+    library = crashing_c_vm(tmp_path)
     # The c-ON engines load it, here and in the processes forked from here.
     monkeypatch.setattr(differential, "library", lambda: library)
     corpus = tmp_path / "corpus"

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import signal
 import subprocess
 import sys
@@ -17,10 +16,10 @@ from pathlib import Path
 
 import pytest
 from support import ROOT
+from support.planted import crashing_c_vm
 
 from rl1.compiler.cli.reduce import _may_end_its_process
 from rl1.compiler.differential import engine_named
-from rl1.vm import native
 
 pytestmark = pytest.mark.slow  # a process of rl1c for each test, forking one a case
 
@@ -121,33 +120,10 @@ def test_no_c_compiler_for_a_c_engine_is_a_message_and_status_2(program: Path,
     assert not program.with_name("crash.reduced.rob").exists()
 
 
-# The C VM with a planted bug: a step after which A is 1234 writes through a null
-# pointer (as tests/cli/test_fuzz_crash.py plants it for rl1c fuzz).
-PLANTED_STEP = r"""
-#include "rl1vm.h"
-#undef rl1_step
-rl1_state rl1_step(rl1_vm *vm, const rl1_program *program, const rl1_hardware *hw,
-                   uint32_t n)
-{
-    rl1_state state = rl1_step_unplanted(vm, program, hw, n);
-    if (vm->V[0] == 1234)
-        *(volatile int *)0 = 0;
-    return state;
-}
-"""
-
-
 @pytest.mark.needs_cc
 def test_a_crashing_c_vm_is_reduced_to_the_line_that_crashes_it(program: Path,
                                                                 tmp_path: Path) -> None:
-    compiler = next((cc for cc in ("cc", "gcc", "clang") if shutil.which(cc)), None)
-    if compiler is None:
-        pytest.skip("no C compiler")
-    planted, library = tmp_path / "planted.c", tmp_path / "librl1vm-planted.so"
-    planted.write_text(PLANTED_STEP, encoding="ascii")
-    subprocess.run([compiler, *native.FLAGS, f"-I{native.C_FOLDER}",
-                    f"-I{native.HEADER_FOLDER}", "-Drl1_step=rl1_step_unplanted", "-o",
-                    str(library), *map(str, native.SOURCES), str(planted)], check=True)
+    library = crashing_c_vm(tmp_path)
     ran = ending_rl1c("--c-library", library, "reduce", program, "--engine", "vm-O0",
                       "--engine", "c-O1")
     assert ran.returncode == 0, ran.stderr
