@@ -58,20 +58,6 @@ __attribute__((noinline)) void callcost_end(void)
 #ifdef __AVR__
 #include <avr/io.h>
 
-static char *decimal(char *at, uint32_t value)
-{
-    char digits[11];
-    uint8_t n = 0;
-    do {
-        digits[n++] = (char)('0' + value % 10u);
-        value /= 10u;
-    } while (value);
-    while (n) {
-        *at++ = digits[--n];
-    }
-    return at;
-}
-
 /* The cycles Timer1 counts from its start to its read: the timer's own cost. */
 #define TIMED(total, statement)                                                          \
     do {                                                                                 \
@@ -108,9 +94,9 @@ uint16_t target_run(void)
         TIMED(empty, (void)0);
         TIMED(run, state = rl1_step(&vm, &program, &hw, 1000000u));
         TIMED(callback, (void)device->call(device->ctx, RL1_OP_KYC, args, &reading));
-        at = decimal(at, (uint32_t)(run - empty));
+        at = target_decimal(at, (uint32_t)(run - empty));
         *at++ = ' ';
-        at = decimal(at, (uint32_t)(callback - empty));
+        at = target_decimal(at, (uint32_t)(callback - empty));
         *at++ = '\n';
         *at = 0;
         target_print("callcost: ");

@@ -5,20 +5,6 @@
  * <wrong>". */
 #include "target.h"
 
-static char *decimal(char *at, uint32_t value)
-{
-    char digits[11];
-    uint8_t n = 0;
-    do {
-        digits[n++] = (char)('0' + value % 10u);
-        value /= 10u;
-    } while (value);
-    while (n) {
-        *at++ = digits[--n];
-    }
-    return at;
-}
-
 uint16_t target_run(void)
 {
     uint32_t checked = 0, wrong = 0;
@@ -37,9 +23,9 @@ uint16_t target_run(void)
             }
         }
     }
-    at = decimal(at, checked);
+    at = target_decimal(at, checked);
     *at++ = ' ';
-    at = decimal(at, wrong);
+    at = target_decimal(at, wrong);
     *at++ = '\n';
     *at = 0;
     target_print("range: ");

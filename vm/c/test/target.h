@@ -30,4 +30,19 @@ uint32_t target_stack_depth(void);  /* how much of it has been written since */
  * vectors'); returns the number that differ from the host. */
 uint16_t target_run(void);
 
+/* Writes `value` in decimal at `at` (no C library on a target); returns the end. */
+static inline char *target_decimal(char *at, uint32_t value)
+{
+    char digits[11];
+    uint8_t n = 0;
+    do {
+        digits[n++] = (char)('0' + value % 10u);
+        value /= 10u;
+    } while (value);
+    while (n) {
+        *at++ = digits[--n];
+    }
+    return at;
+}
+
 #endif
