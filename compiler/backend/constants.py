@@ -91,7 +91,7 @@ def _solve(program: ir.Program, zeros: frozenset[str]) -> dict[ir.BlockId, _Fold
     is known."""
     return forward.solve(
         program, entry={name: 0 for name in VARIABLES if name not in zeros}, handler={},
-        combine=_meet, visit=lambda block, known: _fold(block, dict(known), zeros),
+        combine=_meet, visit=lambda block, known: _fold(block, known, zeros),
         edges=_edges)
 
 
@@ -122,11 +122,24 @@ def _value(operand: ir.Operand, known: Known) -> int | None:
     return None  # R: the device's answer
 
 
-def _fold(block: ir.Block, known: Known, zeros: frozenset[str]) -> _Folded:
+def _fold(block: ir.Block, entry: Known, zeros: frozenset[str]) -> _Folded:
+    """The block folded from what is known where it starts (`entry`, which it leaves as
+    it is), and what is known where it ends: `entry` itself when the block changes
+    nothing of it (one object for the blocks alike: a copy a block of a branch a line
+    was 26 bytes a source byte)."""
+    known = entry
+    copied = False
     out: list[ir.Instruction] = []
     acc: int | None = None  # the accumulator's value, when known
     pending = False  # whether that known value has yet to be loaded into the accumulator
     loaded_from: ir.Var | None = None  # the variable the expression's first load named
+
+    def writable() -> Known:
+        """`known`, a copy of `entry` once it changes."""
+        nonlocal known, copied
+        if not copied:
+            known, copied = dict(known), True
+        return known
 
     def materialize(line: int) -> None:
         """Load the pending value: from the variable the source loaded when it holds
@@ -169,23 +182,26 @@ def _fold(block: ir.Block, known: Known, zeros: frozenset[str]) -> _Folded:
                 continue  # the variable holds this value already
             materialize(instruction.line)
             out.append(instruction)
-            _set(known, name, acc)
+            _set(writable(), name, acc)
         elif isinstance(instruction, ir.StepVar):
             out.append(instruction)
             name = instruction.target.name
             value = known.get(name)
-            _set(known, name, None if value is None
+            _set(writable(), name, None if value is None
                  else evaluate("+" if instruction.step == "++" else "-", value, 1))
         elif isinstance(instruction, ir.Move):
             out.append(instruction)
-            _set(known, instruction.target.name, _value(instruction.source, known))
+            _set(writable(), instruction.target.name, _value(instruction.source, known))
         elif isinstance(instruction, ir.Compute):
             out.append(instruction)  # -O2's, after this pass: left as it is
             acc, pending = None, False
         else:
             out.append(_call(instruction, known))
             for name in instruction.form.writes:
-                known.pop(name, None)
+                if name in known:
+                    writable().pop(name)
+    if out == block.instructions:  # one list for the block's instructions, as it was
+        out = block.instructions
     return _Folded(out, _terminator(block.terminator, known), known)
 
 

@@ -48,9 +48,8 @@ def _solve(program: ir.Program, events: bool) -> dict[ir.BlockId, list[ir.Instru
     Blocks go by their place in the layout, and what the flow holds of each is in lists
     and arrays by place (a block a line of `?A=#01` held 300 bytes of dictionaries and
     lists of the flow a block, 42 bytes a source byte)."""
-    blocks = list(program)
-    position = {block.id: place for place, block in enumerate(blocks)}
-    first_pred, preds = _predecessors(blocks, position)
+    places = flow.Places(program)
+    blocks, position = places.blocks, places.place
     live_in: list[frozenset[str] | None] = [None] * len(blocks)
     # One object for equal sets: most blocks of a long program see every variable live
     # (a set of 53 names is 2 KB; 8 MiB of `?A=#01` lines held 370 bytes a source byte).
@@ -69,36 +68,11 @@ def _solve(program: ir.Program, events: bool) -> dict[ir.BlockId, list[ir.Instru
             kept.pop(place, None)
         if live_in[place] != live:
             live_in[place] = shared.setdefault(live, live)
-            for pred in preds[first_pred[place]:first_pred[place + 1]]:
+            for pred in places.predecessors(place):
                 if not queued[pred]:
                     queued[pred] = 1
                     work.append(pred)
     return {blocks[place].id: instructions for place, instructions in kept.items()}
-
-
-def _predecessors(blocks: list[ir.Block], position: dict[ir.BlockId, int]
-                  ) -> tuple[array[int], array[int]]:
-    """The places of the predecessors of each block, by place: those of block `i` are
-    `preds[first[i]:first[i + 1]]` (a block that jumps to itself is its own)."""
-    first = array("I", bytes(4 * (len(blocks) + 1)))  # first counts, then starts
-    for block in blocks:
-        for target in _distinct(block.successors):
-            first[position[target] + 1] += 1
-    for place in range(len(blocks)):
-        first[place + 1] += first[place]
-    preds = array("I", bytes(4 * first[-1]))
-    filled = array("I", first)
-    for place, block in enumerate(blocks):
-        for target in _distinct(block.successors):
-            at = position[target]
-            preds[filled[at]] = place
-            filled[at] += 1
-    return first, preds
-
-
-def _distinct(targets: tuple[ir.BlockId, ...]) -> tuple[ir.BlockId, ...]:
-    """A terminator's targets, each once (a branch may go to one block both ways)."""
-    return targets[:1] if len(targets) == 2 and targets[0] == targets[1] else targets
 
 
 def _sweep(block: ir.Block, live_out: frozenset[str]
