@@ -18,6 +18,7 @@ when that block's own jump is a real one, not a fall-through).
 from __future__ import annotations
 
 import dataclasses
+from array import array
 
 from . import flow, ir
 
@@ -27,6 +28,7 @@ def simplify_control(program: ir.Program) -> ir.Program:
     following = program.following()
     for block in program:
         block.terminator = _threaded(program, following, block.terminator)
+    del following  # of the blocks before some go
     _remove_unreachable(program)
     _merge(program)
     return program
@@ -49,11 +51,15 @@ def _threaded(program: ir.Program, following: dict[ir.BlockId, ir.BlockId | None
         if_true, if_false = final(terminator.if_true), final(terminator.if_false)
         if if_true == if_false:
             return ir.Jump(if_true, terminator.line)
+        if (if_true, if_false) == (terminator.if_true, terminator.if_false):
+            return terminator  # as it was: a block's terminator is not made again
         return dataclasses.replace(terminator, if_true=if_true, if_false=if_false)
     if isinstance(terminator, ir.Jump):
         target = program.blocks[final(terminator.target)]
         if not target.instructions and isinstance(target.terminator, ir.End):
             return ir.End(terminator.line)
+        if target.id == terminator.target:
+            return terminator
         return ir.Jump(target.id, terminator.line)
     return terminator
 
@@ -65,20 +71,26 @@ def _remove_unreachable(program: ir.Program) -> None:
 
 
 def _merge(program: ir.Program) -> None:
+    """Each block entered only by a jump from the block before it joined to that block.
+    Its predecessors are the places of its predecessors' blocks (flow.Places), each
+    mapped to the block it has joined (`joined`): a list of them a block was 15 bytes a
+    source byte of a branch a line."""
     entries = set(flow.roots(program))
-    preds = program.predecessors()
-    kept: dict[ir.BlockId, ir.Block] = {}
-    previous: ir.Block | None = None
-    for block in program:
-        if (previous is not None and isinstance(previous.terminator, ir.Jump)
-                and previous.terminator.target == block.id and block.id not in entries
-                and preds[block.id] == [previous.id]):
-            previous.instructions = [*previous.instructions, *block.instructions]
-            previous.terminator = block.terminator
-            for target in dict.fromkeys(block.successors):
-                preds[target] = [previous.id if pred == block.id else pred
-                                 for pred in preds[target]]
-            continue
-        kept[block.id] = block
-        previous = block
-    program.blocks = kept
+    places = flow.Places(program)
+    joined = array("I", range(len(places.blocks)))  # the place of the block each is in
+    merged: list[ir.BlockId] = []
+    previous: int | None = None
+    for place, block in enumerate(places.blocks):
+        if previous is not None and block.id not in entries:
+            into = places.blocks[previous]
+            preds = places.predecessors(place)
+            if (isinstance(into.terminator, ir.Jump) and into.terminator.target == block.id
+                    and len(preds) == 1 and joined[preds[0]] == previous):
+                into.instructions = [*into.instructions, *block.instructions]
+                into.terminator = block.terminator
+                joined[place] = previous
+                merged.append(block.id)
+                continue
+        previous = place
+    for block_id in merged:
+        del program.blocks[block_id]
