@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 from typing import Literal
 
 from rl1.compiler.analysis import analyze, diagnose_compactly
+from rl1.compiler.frontend.ast import Line
 from rl1.compiler.frontend.diagnostics import Diagnostic, Severity, sort_key
 from rl1.compiler.frontend.source import first_code_line_after
 from rl1.vm import ilc
@@ -20,7 +21,7 @@ from rl1.vm.defaults import DEFAULT_LEVEL
 from .codegen import CodegenError, generate, line_too_far
 from .ir import Program as IrProgram
 from .ir import format_program
-from .lower import Lowering, lower
+from .lower import Lowering, lower, lower_text
 from .optimize import LEVELS, optimize
 
 Emit = Literal["ilc", "ir"]
@@ -33,6 +34,12 @@ TREE_CHARACTERS = 16 * 1024
 is faster than the streaming check (Listing 1 at -O0 in 0.8 of the time): its tree and
 diagnostics hold at most about 3 MB (16 KiB of `A=s` lines), a fifth of the 16.6 MB
 rl1c takes to start."""
+
+
+BYTES_A_BLOCK = 32
+"""A source past TREE_CHARACTERS with more blocks than one for this many characters is
+lowered after its check, each line parsed again (lower.lower_text), not as the check
+parses it: vehicles' programs have a block for 38 to 45 bytes (examples/)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,9 +86,22 @@ def _checked_and_lowered(text: str) -> tuple[list[Diagnostic], IrProgram | None]
     # parses it: the tree is never held whole beside the IR (8 MiB of `A=1;...` lines
     # peaked at 155 bytes a source byte with the tree, 95 of them its own), and no line
     # is parsed twice.
-    lowering = Lowering()
-    checked = diagnose_compactly(text, lowering.take)
+    # A source of many blocks is lowered after the check instead, its lines parsed
+    # again, so that the check's graph and the IR (each some 300 bytes a block) are
+    # not held together: 7 bytes a block (`?A=#01` lines) peaked at 90 bytes a
+    # source byte so. Its lowering is let go once it has made more blocks than that.
+    most_blocks = len(text) // BYTES_A_BLOCK
+    lowering: Lowering | None = Lowering()
+
+    def take(line: Line) -> None:
+        nonlocal lowering
+        if lowering is not None:
+            lowering.take(line)
+            if lowering.blocks > most_blocks:
+                lowering = None
+
+    checked = diagnose_compactly(text, take)
     if any(severity is Severity.ERROR for severity in checked.severities()):
-        del lowering  # of no use: let its IR go before the diagnostics are built
+        lowering = None  # of no use: let its IR go before the diagnostics are built
         return list(checked), None
-    return list(checked), lowering.program()
+    return list(checked), lower_text(text) if lowering is None else lowering.program()

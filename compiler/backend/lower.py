@@ -10,6 +10,9 @@ statement after it, and falling off the end of the program ends it.
 from __future__ import annotations
 
 from rl1.compiler.frontend import ast
+from rl1.compiler.frontend.collector import collector_paused
+from rl1.compiler.frontend.parser import parse_line
+from rl1.compiler.frontend.source import iter_lines
 from rl1.vm.language import HANDLER_LABELS
 
 from . import ir
@@ -25,6 +28,16 @@ def lower(program: ast.Program) -> ir.Program:
     lowering = Lowering()
     for line in program.lines:
         lowering.take(line)
+    return lowering.program()
+
+
+def lower_text(text: str) -> ir.Program:
+    """The IR of a program the checker accepted, from its text: each line parsed and
+    lowered in turn, so that no tree is held."""
+    lowering = Lowering()
+    with collector_paused():
+        for index, line_text in enumerate(iter_lines(text)):
+            lowering.take(parse_line(line_text, index + 1)[0])
     return lowering.program()
 
 
@@ -46,6 +59,11 @@ class Lowering:
                 self._lowerer.line(line)
             except LoweringError as refused:
                 self._refused = refused
+
+    @property
+    def blocks(self) -> int:
+        """How many blocks the lines taken have ended."""
+        return len(self._lowerer.blocks)
 
     def program(self) -> ir.Program:
         """The IR of the lines taken, which the checker accepted."""
