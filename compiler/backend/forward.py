@@ -31,9 +31,9 @@ def solve(program: ir.Program, *, entry: State, handler: State,
     the visits of its predecessors lead into it with.
 
     What the flow holds of each block is in lists by its place in the layout, and what
-    leads into a block is found from its predecessors' last visits, not held for it: a
-    block a line of `?A<#01` held 400 bytes of the flow's dictionaries and lists, 57
-    bytes a source byte."""
+    leads into a block is found again from its predecessors' last visits (`edges`), not
+    held: a block a line of `?A<#01` held 400 bytes of the flow's dictionaries and
+    lists, 57 bytes a source byte."""
     places = flow.Places(program)
     blocks, place_of = places.blocks, places.place
     starts: dict[int, list[State]] = {}  # the roots' own states
@@ -42,8 +42,6 @@ def solve(program: ir.Program, *, entry: State, handler: State,
         starts.setdefault(place_of[block_id], []).append(handler)
     entries: list[State | None] = [None] * len(blocks)  # what its last visit started from
     visited: list[Visited | None] = [None] * len(blocks)
-    # Where each block's last visit leads, and with what.
-    leads: list[tuple[tuple[int, State], ...]] = [()] * len(blocks)
     work = deque(place_of[block_id] for block_id in flow.roots(program))
     queued = bytearray(len(blocks))
     for place in work:
@@ -51,27 +49,31 @@ def solve(program: ir.Program, *, entry: State, handler: State,
     while work:
         place = work.popleft()
         queued[place] = 0
-        known = combine([*starts.get(place, ()), *_incoming(place, places, leads)])
+        known = combine([*starts.get(place, ()), *_incoming(place, places, visited, edges)])
         if entries[place] == known:
             continue
         entries[place] = known
         block = blocks[place]
         visited[place] = after = visit(block, known)
-        leads[place] = tuple((place_of[target], leaving)
-                             for target, leaving in edges(block, after))
-        for target, _ in leads[place]:
+        for target_id, _ in edges(block, after):
+            target = place_of[target_id]
             if not queued[target]:
                 queued[target] = 1
                 work.append(target)
-    del entries, leads
+    del entries
     return {blocks[place].id: result for place, result in enumerate(visited)
             if result is not None}
 
 
-def _incoming(place: int, places: flow.Places,
-              leads: list[tuple[tuple[int, State], ...]]) -> Iterator[State]:
-    """The states the last visits of the block's predecessors lead into it with."""
+def _incoming(place: int, places: flow.Places, visited: list[Visited | None],
+              edges: Callable[[ir.Block, Visited], Iterable[tuple[ir.BlockId, State]]]
+              ) -> Iterator[State]:
+    """The states the last visits of the block's predecessors lead into it with: their
+    edges again (held, they were 56 bytes a block)."""
+    block_id = places.blocks[place].id
     for pred in places.predecessors(place):
-        for target, leaving in leads[pred]:
-            if target == place:
-                yield leaving
+        last = visited[pred]
+        if last is not None:
+            for target, leaving in edges(places.blocks[pred], last):
+                if target == block_id:
+                    yield leaving
