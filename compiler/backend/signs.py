@@ -29,6 +29,7 @@ edge all but it. Then:
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from functools import cache
 
 from rl1.compiler.frontend.ast import Relation
@@ -52,17 +53,21 @@ _STEPPED: dict[str, dict[str, Signs]] = {
 
 
 def decide_branches(program: ir.Program) -> ir.Program:
-    following = program.following()
+    # the blocks that only branch, as they are before any is rewritten
     branches = {block.id: block.terminator for block in program
                 if not block.instructions and isinstance(block.terminator, ir.Branch)}
     exits = _solve(program, _tracked(program))
-    for block_id, state in exits.items():
-        block = program.blocks[block_id]
+    # Each block with the one laid out after it, where it falls through (no dictionary
+    # of them: 7 bytes a source byte of a branch a line).
+    laid_out_next = itertools.chain(itertools.islice(program, 1, None), [None])
+    for block, after in zip(program, laid_out_next, strict=True):
+        state = exits.get(block.id)
+        if state is None:
+            continue  # no path reaches it: control.py's to remove
+        following = after.id if after is not None else None
         if isinstance(block.terminator, ir.Branch):
-            block.terminator = _rewritten(block.terminator, state, following[block_id])
-    for block_id, state in exits.items():
-        block = program.blocks[block_id]
-        block.terminator = _threaded(block.terminator, state, branches, following[block_id])
+            block.terminator = _rewritten(block.terminator, state, following)
+        block.terminator = _threaded(block.terminator, state, branches, following)
     return program
 
 

@@ -8,6 +8,8 @@ import subprocess
 import sys
 import textwrap
 
+import pytest
+
 # bench/memory.py's source with lines of 1,999 characters instead of 19,999, at a size
 # tracemalloc measures in seconds (the tokens of one long line, 10 MB while it is parsed,
 # would be 38 B/B of 256 KiB but are 1.2 of bench/memory.py's 8 MiB).
@@ -38,25 +40,72 @@ def test_compiling_takes_at_most_64_bytes_a_source_byte() -> None:
     assert float(measured.stdout) <= 64
 
 
-BRANCHES = textwrap.dedent("""
+# Sources of many blocks, the costliest IR a byte (a block's IR is some 300 bytes), at
+# 64 KiB (past driver.TREE_CHARACTERS, so streamed; their figures are those of 256 KiB
+# within a byte a byte): each an expression that makes the text from `characters`.
+BLOCK_SOURCES = {
+    # a conditional jump a line, each a block of its own (7 bytes)
+    "?A=#01": '":01\\n" + "?A=#01\\n" * (characters // 7)',
+    "?A<#01": '":01\\n" + "?A<#01\\n" * (characters // 7)',
+    "?A>#01": '":01\\n" + "?A>#01\\n" * (characters // 7)',
+    # a jump a line: a block every 4 bytes, which no path reaches
+    "#01": '":01\\n" + "#01\\n" * (characters // 4)',
+    # a label on each of 96 lines, and jumps between them on all the others
+    "labels": '"".join(f":{n:02d} ?A=#{(n * 37 + 11) % 96:02d}\\n" for n in range(96))'
+              ' + "".join(f"?A=#{(n * 37 + 5) % 96:02d}\\n" for n in range(96))'
+              ' * (characters // 672)',
+    # a handler's lines, each ending the program (a block each)
+    "(END)": '":96\\n" + "(END)\\n" * (characters // 6)',
+}
+BLOCK_CHARACTERS = 64 * 1024
+
+MEASURE_BLOCKS = textwrap.dedent("""
     import tracemalloc
     from rl1.compiler.backend.driver import compile_text
-    text = ":01\\n" + "?A=#01\\n" * ({characters} // 7)
+    characters = {characters}
+    text = {source}
     tracemalloc.start()
-    compilation = compile_text(text, "branches.rob", strip_debug=True)
-    assert compilation.output is not None, compilation.diagnostics
-    print(tracemalloc.get_traced_memory()[1] / len(text))
+    for strip_debug in (True, False):
+        tracemalloc.reset_peak()
+        compilation = compile_text(text, "blocks.rob", strip_debug=strip_debug)
+        assert compilation.output is not None, compilation.diagnostics
+        del compilation
+        print(tracemalloc.get_traced_memory()[1] / len(text))
 """)
 
+# The shapes still above spec/language.md's 64, and what they are held to meanwhile:
+# ?A<#01 and ?A>#01 peak at 77 to 78 in constant folding (the IR, 42, and every branch
+# decided: a new jump and the fold's result a block); #01 at 81 as its IR is made (a
+# block every 4 bytes, 276 bytes each). Their test of 64 is expected to fail, strictly:
+# one that comes within 64 fails it until it leaves this table.
+ABOVE_THE_BOUND = {"?A<#01": 80, "?A>#01": 80, "#01": 84}
 
-def test_a_block_a_line_takes_at_most_128_bytes_a_source_byte() -> None:
-    """The costliest IR a byte: a conditional jump a line, each a block of its own (7
-    bytes). The dead-store pass held a set of the live variables a block (2 KB, all 53
-    live): 445 B/B at its peak; 103 once equal sets are one object and a block's id and
-    each label's are one string (the IR 58 -> 42 B/B), the peak now where the check's
-    graph is held beside the IR. Above spec/language.md's 64, which sources of long
-    lines keep."""
-    script = BRANCHES.format(characters=SOURCE_CHARACTERS)
+
+@pytest.mark.parametrize("shape", [
+    pytest.param(shape, marks=pytest.mark.xfail(strict=True, reason="above 64 B/B still"))
+    if shape in ABOVE_THE_BOUND else shape for shape in BLOCK_SOURCES])
+def test_a_block_a_line_takes_at_most_64_bytes_a_source_byte(shape: str) -> None:
+    """The peak of the allocations of a compile beyond its text, with --strip-debug and
+    without, of a source of a block every few bytes. ?A=#01 peaked at 445 B/B (a set of
+    the live variables a block, 2 KB), at 103 with equal sets one object; then 90 while
+    the check's graph (48) was held beside the IR (42), which a source of more than a
+    block for driver.BYTES_A_BLOCK bytes now lowers after its check; 62 once the
+    optimizer's flows held their state by a block's place (flow.Places), not a
+    dictionary and list or two a block."""
+    for measured in _peaks(shape):
+        assert measured <= 64
+
+
+@pytest.mark.parametrize("shape", ABOVE_THE_BOUND)
+def test_the_shapes_above_64_keep_their_figures(shape: str) -> None:
+    for measured in _peaks(shape):
+        assert measured <= ABOVE_THE_BOUND[shape]
+
+
+def _peaks(shape: str) -> list[float]:
+    """The peak, in bytes a source byte, of compiling the shape with --strip-debug and
+    without, in a process of its own (so that no other test's caches count)."""
+    script = MEASURE_BLOCKS.format(characters=BLOCK_CHARACTERS, source=BLOCK_SOURCES[shape])
     measured = subprocess.run([sys.executable, "-c", script], capture_output=True,
                               text=True, check=True)
-    assert float(measured.stdout) <= 128
+    return [float(line) for line in measured.stdout.split()]
