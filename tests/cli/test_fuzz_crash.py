@@ -153,10 +153,9 @@ def test_judged_apart_an_engine_this_machine_cannot_run_is_raised_here() -> None
 @pytest.fixture
 def named_killer(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> str:
     """`rl1c fuzz --engine ends-its-process` (in this process and those forked from it)
-    ends its process on the eighth program of `rl1c fuzz --seed SEED`; that program.
-    Found by rl1c itself, with an engine `recording`: Hypothesis draws constants from
-    the project's modules loaded, so that rl1c's programs are not those of a campaign
-    made before its modules were."""
+    ends its process on the eighth program of `rl1c fuzz --seed SEED`; that program,
+    found by rl1c itself with an engine `recording`, so that the test follows the
+    generator as it changes."""
     _small_searches(monkeypatch)
     path = tmp_path / "programs"
     killing: list[str] = []
