@@ -34,6 +34,8 @@ MARKS: dict[str, tuple[str, ...]] = {
     "tests/cli/test_reduce.py::test_rl1c_reduce_gives_the_same_bytes_every_time": ("slow",),
     "tests/cli/test_reduce.py::test_rl1c_fuzz_reduces_its_finding_with_these_passes": ("slow",),
     "tests/frontend/test_strategies.py": ("slow",),
+    # A seeded search of 1,000 generated programs on two engines, and its statistics.
+    "tests/backend/test_generator_shapes.py": ("slow",),
     # A language server process of its own for each test (its command line, its raw
     # protocol over standard input and output).
     "tests/lsp/test_command.py": ("slow",),
