@@ -12,40 +12,23 @@ messages in flight may take (transports.MEMORY_IN_FLIGHT) as the reference.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import logging
 import sys
 from pathlib import Path
-
-from websockets.exceptions import WebSocketException
-from websockets.sync.client import connect
 
 from rl1.lsp.transports import MAX_SESSIONS, MEMORY_IN_FLIGHT
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT / "tests")]
 
-from support.hostile import ServedLsp  # noqa: E402  (tests/ on the path just above)
-from support.memory import at_once  # noqa: E402
-
-TEXT = "\\u0041" * (10 * 2**20)  # 60 MiB of JSON escapes, 10 MiB of text
-MESSAGE = ('{"jsonrpc": "2.0", "id": 1, "method": "initialize", "params": '
-           f'{{"capabilities": {{}}, "rootPath": "{TEXT}"}}}}')
+from support.hostile import ServedLsp, large_messages_at_once  # noqa: E402  (tests/ on the path just above)
 
 
 def one_round() -> tuple[int, float]:
     """The clients answered, and the server's growth at its peak in MiB."""
     server = ServedLsp("ws")
-    answered: list[str] = []
-
-    def send() -> None:
-        with contextlib.suppress(WebSocketException, OSError), connect(
-                f"ws://127.0.0.1:{server.port}", max_size=None, open_timeout=60) as client:
-            client.send(MESSAGE)
-            answered.append(str(client.recv(timeout=60)))
-
     try:
-        at_once(MAX_SESSIONS, send)
+        answered = large_messages_at_once(server)
         return len(answered), server.peak_mib() - server.started_mib
     finally:
         server.stop()

@@ -28,6 +28,7 @@ from support.hostile import (
     _frame,
     _send_hostile,
     hostile_connections,
+    large_messages_at_once,
     serve_one_after_another,
     transport_attack,
     ws_frame,
@@ -171,24 +172,9 @@ def test_websocket_clients_sending_compressed_messages_at_once_stay_in_the_bound
     server inflated and read every client's at once. The server now takes no
     compression: what it receives is what a message takes. And one of the eight is
     always read and answered, whatever the others send meanwhile."""
-    from websockets.exceptions import WebSocketException
-    from websockets.sync.client import connect
-
     server = ServedLsp("ws")
-    text = "\\u0041" * (10 * 2**20)  # 60 MiB of JSON escapes, 10 MiB of text
-    message = ('{"jsonrpc": "2.0", "id": 1, "method": "initialize", "params": '
-               f'{{"capabilities": {{}}, "rootPath": "{text}"}}}}')
-    answered: list[str] = []
-
-    def send() -> None:
-        # Refused while the others' are read: WebSocketException, or OSError.
-        with contextlib.suppress(WebSocketException, OSError), connect(
-                f"ws://127.0.0.1:{server.port}", max_size=None, open_timeout=60) as client:
-            client.send(message)
-            answered.append(str(client.recv(timeout=60)))
-
     try:
-        at_once(MAX_SESSIONS, send)
+        answered = large_messages_at_once(server)
         peak = server.peak_mib() - server.started_mib
         assert peak < GROWTH_BOUND_MIB, f"{peak:.0f} MiB at its peak"
         # However their frames interleave, the first to need more than its free share

@@ -57,7 +57,7 @@ from rl1.vm.sim.world import WorldError, decode_world
 from . import EXAMPLES, ROOT, SAMPLE, SAMPLE_SENSORS
 from .cli import Result, rl1c
 from .ilc import with_crc
-from .memory import status_mib
+from .memory import at_once, status_mib
 
 # The exit statuses each command documents (docs/commands.md).
 STATUSES = {
@@ -655,6 +655,30 @@ def serve_one_after_another(server: ServedLsp, clients: int) -> None:
     for _ in range(clients):
         if (said := _Probe(server).run()) is not None:
             raise AssertionError(f"{server.transport}: {said[:300]}")
+
+
+LARGE_INITIALIZE = ('{"jsonrpc": "2.0", "id": 1, "method": "initialize", "params": '
+                    '{"capabilities": {}, "rootPath": "' + "\\u0041" * (10 * 2**20) + '"}}')
+"""An initialize of 60 MiB: JSON escapes of 10 MiB of text."""
+
+
+def large_messages_at_once(server: ServedLsp, clients: int = MAX_SESSIONS) -> list[str]:
+    """`clients` WebSocket clients sending LARGE_INITIALIZE to `server` at once: the
+    answers they were given (a client refused while the others' are read, by a
+    WebSocketException or an OSError, has none)."""
+    from websockets.exceptions import WebSocketException
+    from websockets.sync.client import connect
+
+    answered: list[str] = []
+
+    def send() -> None:
+        with contextlib.suppress(WebSocketException, OSError), connect(
+                f"ws://127.0.0.1:{server.port}", max_size=None, open_timeout=60) as client:
+            client.send(LARGE_INITIALIZE)
+            answered.append(str(client.recv(timeout=60)))
+
+    at_once(clients, send)
+    return answered
 
 
 def transport_attack(server: ServedLsp, attack: HostileConnection) -> list[str]:
