@@ -669,12 +669,21 @@ def judge_apart(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
     memory exhausted) ends that one, not this: then the Verdict has the runs of the
     engines before it, and its one problem `NAME: ended its process (HOW)`, HOW the
     signal or the exit status. The errors of this machine (BuildError,
-    EngineUnavailable) and of judge itself are raised here as the child raised them."""
+    EngineUnavailable) and of judge itself are raised here as the child raised them.
+
+    The engines that run programs in processes of their own (`runs_elsewhere`) cannot
+    end this one: they run here, before the fork, and the child is given their runs, so
+    that a batch engine's process, started here once, answers every case judged apart
+    rather than being started and ended in each child."""
+    ran_here = {engine.name: _observed(engine, case, budget) for engine in engines
+                if runs_elsewhere(engine)}
     reading, writing = os.pipe()
     child = os.fork()
     if child == 0:
         os.close(reading)
-        _judge_in_child(writing, case, engines, budget)
+        _judge_in_child(writing, case, [_RanBefore(engine, ran_here[engine.name])
+                                        if engine.name in ran_here else engine
+                                        for engine in engines], budget)
     os.close(writing)
     observations: dict[str, Observation] = {}
     running = ""  # the engine that started and has not finished, if any
@@ -753,6 +762,31 @@ class _Told:
         observation = self.engine.run(case, budget)
         self.tell("ran", self.name, observation)
         return observation
+
+
+@dataclass(frozen=True)
+class _RanBefore:
+    """An engine whose run of the case judged was made before the fork."""
+
+    engine: Engine
+    observation: Observation
+
+    @property
+    def name(self) -> str:
+        return self.engine.name
+
+    @property
+    def level(self) -> int | None:
+        return self.engine.level
+
+    def run(self, case: Run, budget: int) -> Observation:
+        return self.observation
+
+
+def runs_elsewhere(engine: Engine) -> bool:
+    """Whether `engine` runs programs in processes of its own (the exec and batch
+    engines), so that nothing a run does can end the process that asks for it."""
+    return isinstance(engine, ExecEngine | BatchEngine)
 
 
 def signature(verdict: Verdict) -> str:

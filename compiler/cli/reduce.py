@@ -433,11 +433,11 @@ class _EnginesTest:
 def _may_end_its_process(engine: Engine) -> bool:
     """Whether a run of `engine` could end the process it runs in: the C VM's, in it
     through ctypes, can (a crash, a sanitizer's abort), and so may any engine not known
-    here; Python's engines raise instead, and the exec engines run in processes of their
-    own (a batch engine's would start again for each case judged apart)."""
-    from rl1.compiler.differential import AstEngine, BatchEngine, ExecEngine, VmEngine
+    here; Python's engines raise instead, and the exec and batch engines run in
+    processes of their own (which judge_apart drives from this one)."""
+    from rl1.compiler.differential import AstEngine, VmEngine, runs_elsewhere
 
-    return not isinstance(engine, AstEngine | VmEngine | ExecEngine | BatchEngine)
+    return not (isinstance(engine, AstEngine | VmEngine) or runs_elsewhere(engine))
 
 
 COMMANDS = (reduce,)
