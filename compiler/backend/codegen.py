@@ -40,8 +40,8 @@ class _MachineOp:
 def generate(program: ir.Program, source_name: str, *, debug: bool = True) -> ilc.Image:
     """The image of a valid IR program, with its line map unless `debug` is False;
     CodegenError when the code passes 65535 bytes or the map a line it cannot record."""
-    layout = [(block_id, _select(program.blocks[block_id], following))
-              for block_id, following in program.following().items()]
+    layout = [(block.id, _select(block, following))
+              for block, following in program.laid_out()]
     block_offsets: dict[ir.BlockId, int] = {}
     offset = 0
     for block_id, ops in layout:

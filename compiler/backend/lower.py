@@ -116,8 +116,13 @@ class _Lowerer:
     def finish(self, terminator: ir.Terminator) -> None:
         self.open_block()
         assert self.block_id is not None
-        self.blocks[self.block_id] = ir.Block(self.block_id, self.code, terminator)
-        self.block_id, self.code = None, []
+        if self.code:
+            self.blocks[self.block_id] = ir.Block(self.block_id, self.code, terminator)
+            self.code = []
+        else:  # the list stays open for the next block's code
+            self.blocks[self.block_id] = ir.Block(self.block_id, ir.NO_INSTRUCTIONS,
+                                                  terminator)
+        self.block_id = None
 
     def start_label(self, label: ast.LabelDef) -> None:
         block_id = self.target(label.number, label.text, label.span.line)
