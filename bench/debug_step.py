@@ -2,7 +2,11 @@
 (examples/sample.world.toml) run to its end by `runner.run` (the reference) and by a
 session's continue with a breakpoint that never holds, as a ratio; and the time a line
 step takes, stepping the whole run line by line (median and slowest), against issue 28's
-goal of 20 ms a step.
+goal of 20 ms a step. Then breakpoints at scale: an rl1-dap `setBreakpoints` request
+(lsp/dap.py's Adapter, in this process) of 10,000 conditional breakpoints, one a line of
+a program of 10,000 lines, against compiling that program; the same request again with
+one condition changed (as a client sends the whole list at each edit); and a continue
+over that program with the 10,000 breakpoints set, never met, against one with none.
 
 CPU time (time.process_time), the fastest of RUNS runs: the machine is shared.
 
@@ -11,12 +15,17 @@ CPU time (time.process_time), the fastest of RUNS runs: the machine is shared.
 
 from __future__ import annotations
 
+import json
 import statistics
+import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 from rl1.compiler.debugger import Session, compile_program
 from rl1.compiler.runner import run
+from rl1.lsp.dap import Adapter
+from rl1.vm.scripted import ScriptedDevice
 from rl1.vm.sim.device import SimDevice
 from rl1.vm.sim.world import decode_world
 
@@ -25,6 +34,10 @@ SAMPLE = (ROOT / "examples" / "sample.rob").read_text()
 WORLD = decode_world((ROOT / "examples" / "sample.world.toml").read_bytes(), "sample.world.toml")
 RUNS = 5
 GOAL_MS = 20.0
+BREAKPOINTS = 10_000
+LONG = "A=B\n" * BREAKPOINTS  # code on each line at -O0, in the 64 KiB of a program
+NEVER_MET = [{"line": line, "condition": f"B-A-{line}>0"}  # B=A=0 throughout
+             for line in range(1, BREAKPOINTS + 1)]
 
 
 def _session() -> Session:
@@ -58,6 +71,59 @@ def line_steps() -> list[float]:
     return steps
 
 
+class Client:
+    """rl1-dap's Adapter in this process, each message it sends encoded as its `serve`
+    encodes it, and the last response kept."""
+
+    def __init__(self) -> None:
+        self.adapter = Adapter(self._sent)
+        self.response: dict[str, Any] = {}
+
+    def _sent(self, message: dict[str, Any]) -> None:
+        json.dumps(message, separators=(",", ":")).encode("utf-8")
+        if message["type"] == "response":
+            self.response = message
+
+    def request(self, command: str, arguments: dict[str, Any]) -> float:
+        """The CPU time of one request, which must succeed."""
+        body = json.dumps({"seq": 1, "type": "request", "command": command,
+                           "arguments": arguments}).encode()
+        started = time.process_time()
+        self.adapter.receive(body)
+        elapsed = time.process_time() - started
+        assert self.response["success"], self.response
+        return elapsed
+
+
+def set_breakpoints() -> tuple[float, float, float]:
+    """rl1-dap's setBreakpoints of BREAKPOINTS conditions, then the same with one
+    changed, and compiling the program they are set in (the reference)."""
+    with tempfile.TemporaryDirectory(prefix="rl1-bench-") as folder:
+        program = Path(folder) / "long.rob"
+        program.write_text(LONG, encoding="utf-8")
+        client = Client()
+        client.request("launch", {"program": str(program), "level": 0})
+        source = {"path": str(program)}
+        first = client.request("setBreakpoints", {"source": source, "breakpoints": NEVER_MET})
+        edited = [*NEVER_MET[:-1], {"line": BREAKPOINTS, "condition": "B-A>0"}]
+        again = client.request("setBreakpoints", {"source": source, "breakpoints": edited})
+    started = time.process_time()
+    compile_program(LONG, "long.rob", 0)
+    return first, again, time.process_time() - started
+
+
+def continued_over_long(breakpoints: int) -> float:
+    """A continue over LONG to its end, with the first `breakpoints` of NEVER_MET set."""
+    image = compile_program(LONG, "long.rob", 0)
+    assert isinstance(image, bytes)
+    session = Session(image, lambda: ScriptedDevice(None))
+    session.set_line_breakpoints((wanted["line"], wanted["condition"])
+                                 for wanted in NEVER_MET[:breakpoints])
+    started = time.process_time()
+    assert session.continue_().reason == "end"
+    return time.process_time() - started
+
+
 def main() -> None:
     reference = min(whole_run() for _ in range(RUNS))
     debugged = min(continued() for _ in range(RUNS))
@@ -67,6 +133,16 @@ def main() -> None:
     median, slowest = statistics.median(steps) * 1000, max(steps) * 1000
     print(f"line steps: {len(steps)}, median {median:.3f} ms, slowest {slowest:.3f} ms "
           f"(goal {GOAL_MS:g} ms: {'met' if slowest <= GOAL_MS else 'missed'})")
+    first, again, compiling = min((set_breakpoints() for _ in range(RUNS)), key=sum)
+    print(f"rl1-dap setBreakpoints of {BREAKPOINTS:,} conditions, one a line of "
+          f"{BREAKPOINTS:,}: {first * 1000:.1f} ms ({first / compiling:.2f}x compiling the "
+          f"program, {compiling * 1000:.1f} ms); again with one changed "
+          f"{again * 1000:.1f} ms ({again / compiling:.2f}x)")
+    bare = min(continued_over_long(0) for _ in range(RUNS))
+    watched = min(continued_over_long(BREAKPOINTS) for _ in range(RUNS))
+    print(f"a continue over those {BREAKPOINTS:,} lines: {bare * 1000:.1f} ms without "
+          f"breakpoints, {watched * 1000:.1f} ms with the {BREAKPOINTS:,} never met "
+          f"({watched / bare:.2f}x)")
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ tests/debugger/ holds this with Hypothesis.
 
 from __future__ import annotations
 
+import bisect
 import math
 import re
 from collections.abc import Callable, Iterable, Sequence
@@ -65,29 +66,31 @@ _CONDITION_HELP = ("write a value of the language compared with 0, as a conditio
 _VALUE_HELP = "write variables and constants joined by operators, as `U-L` or `a<3+c`"
 
 
+Read = tuple[bool, int]
+"""An operand of a value as read: (True, a variable's index) or (False, a constant)."""
+
+
 @dataclass(frozen=True, slots=True)
 class Value:
     """A value as the language writes one: the right side of an assignment, without
-    calls (`U-L`, `a<3+c`), read left to right."""
+    calls (`U-L`, `a<3+c`), read left to right. Its operands are kept as plain numbers,
+    not the parser's nodes and spans, which a breakpoint's condition would hold by the
+    thousand for the collector to go over."""
 
     text: str
-    assign: ast.Assign
+    first: Read
+    rest: tuple[tuple[ast.BinaryOperator, Read], ...]
 
     def of(self, variables: Sequence[int]) -> int:
-        value = self._operand(self.assign.first, variables)
-        for step in self.assign.rest:
-            value = apply(step.op, value, self._operand(step.operand, variables))
+        value = _read(self.first, variables)
+        for op, operand in self.rest:
+            value = apply(op, value, _read(operand, variables))
         return value
 
-    @staticmethod
-    def _operand(operand: ast.Operand, variables: Sequence[int]) -> int:
-        match operand:
-            case ast.Var(name=name):
-                return variables[VARIABLE_INDEX[name]]
-            case ast.Const():
-                return constant(operand)
-            case _:  # parse_value refused calls
-                raise AssertionError(operand)
+
+def _read(operand: Read, variables: Sequence[int]) -> int:
+    variable, number = operand
+    return variables[number] if variable else number
 
 
 @dataclass(frozen=True, slots=True)
@@ -123,7 +126,18 @@ def parse_value(text: str, help: str = _VALUE_HELP) -> Value:
             case ast.Const(hex=False, value=number) if not -32768 <= number <= 32767:
                 raise DebugError(f"the constant {number} in `{text.strip()}` is outside "
                                  "-32768..32767, the values a variable holds")
-    return Value(text.strip(), assign)
+    return Value(text.strip(), _as_read(assign.first),
+                 tuple((step.op, _as_read(step.operand)) for step in assign.rest))
+
+
+def _as_read(operand: ast.Operand) -> Read:
+    match operand:
+        case ast.Var(name=name):
+            return (True, VARIABLE_INDEX[name])
+        case ast.Const():
+            return (False, constant(operand))
+        case _:  # parse_value refused calls
+            raise AssertionError(operand)
 
 
 def parse_condition(text: str) -> Condition:
@@ -218,7 +232,11 @@ class Session:
         self.make_device = make_device
         self.budget = budget
         self.lines = _instruction_lines(self.program)
-        self.line_breakpoints: dict[int, Binding] = {}
+        self._with_code = sorted({line for line in self.lines if line is not None})
+        # The bindings on each line (each condition once; one without a condition,
+        # which always stops, alone): a step looks up only the line it enters.
+        self.line_breakpoints: dict[int, tuple[Binding, ...]] = {}
+        self._conditions: dict[str, Condition | DebugError] = {}  # the last set's, parsed
         self.call_breakpoints: set[FormKey] = set()
         self.stop_on_lost_line = False
         self._pause_requested = False
@@ -307,26 +325,31 @@ class Session:
     def set_line_breakpoints(self, wanted: Iterable[tuple[int, str | None]]
                              ) -> list[Binding]:
         """Replace the line breakpoints: each (line, condition or None), bound to the
-        first line at or after it that has code."""
-        with_code = sorted({line for line in self.lines if line is not None})
+        first line at or after it that has code. A condition is parsed once, here; one
+        the last call parsed is not parsed again (a client sends every breakpoint of a
+        file each time one changes)."""
+        with_code = self._with_code
+        parsed: dict[str, Condition | DebugError] = {}
         bindings = []
         for requested, text in wanted:
-            line = next((candidate for candidate in with_code if candidate >= requested),
-                        None)
-            if line is None:
+            at = bisect.bisect_left(with_code, requested)
+            if at == len(with_code):
                 bindings.append(Binding(requested, None, message=(
                     "no code runs on this line or after it" if with_code else
                     "the program has no line map (compiled without debug information): "
                     "compile it again without stripping")))
                 continue
-            try:
-                condition = parse_condition(text) if text else None
-            except DebugError as error:
-                bindings.append(Binding(requested, None, message=str(error)))
+            condition = None
+            if text:
+                if text not in parsed:
+                    parsed[text] = self._conditions.get(text) or _parsed_condition(text)
+                condition = parsed[text]
+            if isinstance(condition, DebugError):
+                bindings.append(Binding(requested, None, message=str(condition)))
                 continue
-            bindings.append(Binding(requested, line, condition))
-        self.line_breakpoints = {binding.line: binding for binding in bindings
-                                 if binding.line is not None}
+            bindings.append(Binding(requested, with_code[at], condition))
+        self._conditions = parsed
+        self.line_breakpoints = _by_line(bindings)
         return bindings
 
     def set_call_breakpoints(self, names: Iterable[str]) -> None:
@@ -408,11 +431,12 @@ class Session:
 
     def _breakpoint(self, entered: bool) -> Stop | None:
         line = self.line
-        binding = self.line_breakpoints.get(line) if entered and line is not None else None
-        if binding is not None and (binding.condition is None or binding.condition.met(
-                self.machine.variables)):
-            text = "" if binding.condition is None else binding.condition.text
-            return Stop("breakpoint", line, text)
+        if entered and line is not None:
+            for binding in self.line_breakpoints.get(line, ()):
+                if binding.condition is None:
+                    return Stop("breakpoint", line)
+                if binding.condition.met(self.machine.variables):
+                    return Stop("breakpoint", line, binding.condition.text)
         pc = self.machine.pc
         if pc < len(self.program.instructions):
             form = self.program.instructions[pc].info.builtin
@@ -434,6 +458,25 @@ class Session:
         if fault is None:
             return Stop("end", None, "the program ended")
         return Stop("fault", fault.line, f"{fault.kind.diagnostic_code}: {fault.message}")
+
+
+def _parsed_condition(text: str) -> Condition | DebugError:
+    try:
+        return parse_condition(text)
+    except DebugError as error:
+        return error
+
+
+def _by_line(bindings: list[Binding]) -> dict[int, tuple[Binding, ...]]:
+    """The verified bindings by the line they stop on: each condition once, in the order
+    given, or the first without one alone (it stops whatever the others say)."""
+    by_line: dict[int, dict[str | None, Binding]] = {}
+    for binding in bindings:
+        if binding.line is not None:
+            text = None if binding.condition is None else binding.condition.text
+            by_line.setdefault(binding.line, {}).setdefault(text, binding)
+    return {line: (found[None],) if None in found else tuple(found.values())
+            for line, found in by_line.items()}
 
 
 def _instruction_lines(program: VerifiedProgram) -> list[int | None]:

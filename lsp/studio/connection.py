@@ -46,8 +46,8 @@ CHANGED = -32007
 
 LEVELS = (0, 1, 2)
 MAX_BREAKPOINTS = 10_000
-"""Line breakpoints, and call breakpoints, a page may set: binding them costs a pass over
-the program's lines each, on the event loop."""
+"""Line breakpoints, and call breakpoints, a page may set: binding them costs, on the
+event loop, a search of the program's lines and a condition parsed (once) each."""
 MAX_EXPRESSION = 1000
 """Characters of a condition or an evaluated value."""
 MAX_SEED = 2**32 - 1
