@@ -1,10 +1,11 @@
 """`rl1c`: compile RL/I (`rl1c FILE.rob -o FILE.ilc`) and the commands beside it.
 
 The commands live by what they work on: source.py (check, fmt, explain), build.py
-(compile, run, dis, asm), sim.py (sim), testing.py (test), new.py (new) and fuzz.py
-(fuzz); command.py has what they share. A command's module is imported only when the
-command runs (or help lists them all), as click's documentation shows for lazy groups:
-`rl1c check` pays for no other command.
+(compile, run, dis, asm), sim.py (sim), testing.py (test), new.py (new), fuzz.py
+(fuzz), reduce.py (reduce) and docs.py (docs); command.py has what they share. Other
+packages add commands through entry points (plugins.py): rl1.lsp adds `rl1c studio`.
+A command's module is imported only when the command runs (or help lists them all), as
+click's documentation shows for lazy groups: `rl1c check` pays for no other command.
 
 This module makes them one click group with what the toolchain adds to click: a first
 word that names a file means `compile`, a mistyped command gets a suggestion, and usage
@@ -29,6 +30,7 @@ import click
 
 from rl1.compiler.reporting.render import EXIT_USAGE
 
+from . import plugins
 from .command import (
     CONTEXT_SETTINGS,
     Context,
@@ -44,7 +46,6 @@ MODULES: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("source", ("check", "fmt", "explain")),
     ("build", ("compile", "run", "dis", "asm")),
     ("sim", ("sim",)),
-    ("studio", ("studio",)),
     ("testing", ("test",)),
     ("new", ("new",)),
     ("fuzz", ("fuzz",)),
@@ -52,6 +53,17 @@ MODULES: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("docs", ("docs",)),
 )
 COMMAND_NAMES = tuple(name for _, names in MODULES for name in names)
+
+
+def plugin_names() -> tuple[str, ...]:
+    """The commands of the plugins installed (plugins.py), but for any named as one of
+    rl1c's own, which a plugin cannot replace."""
+    return tuple(name for name in plugins.installed() if name not in COMMAND_NAMES)
+
+
+def command_names() -> tuple[str, ...]:
+    """Every command: rl1c's own, then the plugins'."""
+    return (*COMMAND_NAMES, *plugin_names())
 
 
 def command_module(name: str) -> ModuleType:
@@ -68,26 +80,34 @@ class Toolchain(click.Group):
         write_usage(self, ctx, formatter)
 
     def list_commands(self, ctx: click.Context) -> list[str]:
-        return sorted(COMMAND_NAMES)  # as click's own groups list them
+        return sorted(command_names())  # as click's own groups list them
 
     def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
         for module, names in MODULES:
             if cmd_name in names:
                 commands: Sequence[click.Command] = command_module(module).COMMANDS
                 return next(command for command in commands if command.name == cmd_name)
+        if cmd_name in plugin_names():
+            return plugins.load(cmd_name).command
         return None
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        sections: dict[str, list[click.Command]] = {}  # in the order of MODULES, then plugins'
+        for name, _ in MODULES:
+            module = command_module(name)
+            sections.setdefault(module.SECTION, []).extend(module.COMMANDS)
+        for name in plugin_names():
+            plugin = plugins.load(name)
+            sections.setdefault(plugin.section, []).append(plugin.command)
         with formatter.section("Commands"):
-            for index, (name, _) in enumerate(MODULES):
-                module = command_module(name)
+            for index, (section, commands) in enumerate(sections.items()):
                 if index:
                     formatter.write_paragraph()
-                formatter.write_heading(module.SECTION)
+                formatter.write_heading(section)
                 with formatter.indentation():
                     # The whole first sentence: write_dl wraps it to the terminal's width.
                     formatter.write_dl([(command.name or "", command.get_short_help_str(1000))
-                                        for command in module.COMMANDS])
+                                        for command in commands])
 
     def parse_args(self, ctx: click.Context, args: list[str]) -> list[str]:
         if not args and not ctx.resilient_parsing:
@@ -101,18 +121,19 @@ class Toolchain(click.Group):
     def resolve_command(self, ctx: click.Context, args: list[str]
                         ) -> tuple[str | None, click.Command | None, list[str]]:
         name = args[0]
-        if name not in COMMAND_NAMES and not name.startswith("-") \
-                and not ctx.resilient_parsing:
+        if not name.startswith("-") and not ctx.resilient_parsing \
+                and name not in COMMAND_NAMES and name not in plugin_names():
             raise click.UsageError(self._no_such_command(name), ctx)
         return super().resolve_command(ctx, args)
 
     def _no_such_command(self, name: str) -> str:
         import difflib  # for this message only
 
-        close = difflib.get_close_matches(name, COMMAND_NAMES, n=1)
+        names = command_names()
+        close = difflib.get_close_matches(name, names, n=1)
         if close:
             return f"No such command {name!r}. Did you mean {close[0]!r}?"
-        return (f"No such command {name!r}. The commands are {', '.join(COMMAND_NAMES)}; "
+        return (f"No such command {name!r}. The commands are {', '.join(names)}; "
                 "to compile a file, give its path (such as `rl1c prog.rob`)")
 
     def shell_complete(self, ctx: click.Context, incomplete: str) -> list[Any]:
@@ -150,11 +171,12 @@ class Toolchain(click.Group):
 def names_a_file(word: str) -> bool:
     """Whether `word`, first on the command line and no command, is a file to compile
     rather than a mistyped command: `-` (standard input), a path with a directory or an
-    extension, or an existing file."""
+    extension, or an existing file that no plugin's command is named as (the plugins are
+    looked for only then, not for `rl1c prog.rob`)."""
     if word.startswith("-"):
         return word == "-"
     return (os.sep in word or "/" in word or os.path.splitext(word)[1] != ""
-            or os.path.exists(word))
+            or (os.path.exists(word) and word not in plugin_names()))
 
 
 def show_usage_error(error: click.UsageError) -> int:

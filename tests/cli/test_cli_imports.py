@@ -86,6 +86,15 @@ def test_check_loads_nothing_costly(loaded_by_check: set[str]) -> None:
     assert loaded_by_check & COSTLY == set()
 
 
+def test_rl1cs_own_commands_read_no_entry_points(loaded_by_check: set[str],
+                                                 tmp_path: Path) -> None:
+    # importlib.metadata, which finds the plugins' commands (cli/plugins.py), takes
+    # tens of milliseconds to load: check, and compile without a command, do without.
+    assert "importlib.metadata" not in loaded_by_check
+    status, loaded = modules_loaded_by([str(SAMPLE), "-o", str(tmp_path / "sample.ilc")])
+    assert status == 0 and "importlib.metadata" not in loaded
+
+
 def test_json_is_loaded_for_the_json_format_only() -> None:
     status, loaded = modules_loaded_by(["check", "--format", "json", str(SAMPLE)])
     assert status == 0 and "json" in loaded

@@ -20,7 +20,7 @@ import pytest
 from support import ROOT, SAMPLE, SAMPLE_SENSORS
 from support.documents import DOCUMENT_NAME
 
-from rl1.compiler.cli.main import COMMAND_NAMES
+from rl1.compiler.cli.main import command_names
 
 pytestmark = [pytest.mark.slow, pytest.mark.needs_cc]
 
@@ -76,6 +76,21 @@ def test_rl1_comes_from_the_wheel(installed: Installed) -> None:
     assert Path(shown.stdout.strip()).is_relative_to(installed.folder / "venv")
 
 
+def test_the_wheel_adds_rl1c_studio_through_its_entry_point(installed: Installed) -> None:
+    shown = installed.run("python", "-c", "from importlib.metadata import distribution\n"
+                          "rl1 = distribution('rl1')\n"
+                          "print(rl1.locate_file(''))\n"
+                          "for entry in rl1.entry_points.select(group='rl1.commands'):\n"
+                          "    print(entry.name, '=', entry.value)")
+    assert shown.returncode == 0, shown.stderr
+    where, *entries = shown.stdout.splitlines()
+    assert Path(where).is_relative_to(installed.folder / "venv")  # the wheel's metadata
+    assert entries == ["studio = rl1.lsp.studio.command"]
+    helped = installed.run("rl1c", "studio", "--help")
+    assert helped.returncode == 0, helped.stderr
+    assert helped.stdout.startswith("usage: rl1c studio ")
+
+
 def test_the_c_engine_runs_a_program_as_the_reference_vm_does(installed: Installed) -> None:
     runs = {engine: installed.run("rl1c", "run", SAMPLE, "--sensors", SAMPLE_SENSORS,
                                   "--engine", engine, "--format", "json")
@@ -87,7 +102,7 @@ def test_the_c_engine_runs_a_program_as_the_reference_vm_does(installed: Install
 
 def _named_documents(installed: Installed) -> set[str]:
     said = [installed.run("rl1c", "--help"),
-            *(installed.run("rl1c", name, "--help") for name in COMMAND_NAMES),
+            *(installed.run("rl1c", name, "--help") for name in command_names()),
             installed.run("rl1c", "run", SAMPLE)]  # no sensor script: its help names one
     return {name for shown in said
             for name in DOCUMENT_NAME.findall(" ".join((shown.stdout + shown.stderr).split()))}

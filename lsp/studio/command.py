@@ -1,5 +1,9 @@
 """`rl1c studio`: the studio's page for the current folder (spec/studio.md), served by
-rl1.lsp.studio, which needs the `websockets` package (the `ws` extra)."""
+rl1.lsp.studio, which needs the `websockets` package (the `ws` extra).
+
+rl1c finds it through the entry point `studio` of the group `rl1.commands`
+(pyproject.toml; compiler/cli/plugins.py), since rl1.compiler imports nothing of
+rl1.lsp; like rl1c's own commands, it is an `rl1.compiler.cli.command.Command`."""
 
 from __future__ import annotations
 
@@ -7,7 +11,7 @@ import os
 
 import click
 
-from .command import PATH, Command, Failure
+from rl1.compiler.cli.command import PATH, Command, Failure
 
 SECTION = "Studio"
 
@@ -33,7 +37,7 @@ def studio(file: str | None, world: str | None, port: int, no_browser: bool) -> 
     except ImportError:
         raise Failure("rl1c studio: error: the studio needs the websockets package: "
                       "pip install 'rl1[ws]'") from None
-    from rl1.lsp.studio.start import CannotStart, serve, studio_for
+    from .start import CannotStart, serve, studio_for
 
     try:
         serve(studio_for(os.getcwd(), file, world), port, open_browser=not no_browser)
