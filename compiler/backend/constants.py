@@ -45,15 +45,30 @@ def fold_constants(program: ir.Program) -> ir.Program:
     zeros = _always_zero(program)
     for block_id, folded in _solve(program, zeros).items():
         block = program.blocks[block_id]  # a block no path reaches is control.py's to remove
-        block.instructions, block.terminator = folded.instructions, folded.terminator
+        if isinstance(folded, _Folded):
+            block.instructions = folded.instructions
+        block.terminator = _terminator(block.terminator, _known_at_end(folded))
     return program
 
 
 @dataclass(slots=True)
 class _Folded:
+    """A block whose instructions folding changed: them, and what is known where it
+    ends."""
+
     instructions: list[ir.Instruction]
-    terminator: ir.Terminator
-    known: Known  # where the block ends
+    known: Known
+
+
+Visited = _Folded | Known
+"""A block folded: what is known where it ends alone when its instructions stay as they
+are (no object a block: a block a line of `?A<#01` held 104 bytes, 15 a source byte, of
+a `_Folded` and the jump its decided branch became, which is made once the flow is
+done)."""
+
+
+def _known_at_end(folded: Visited) -> Known:
+    return folded.known if isinstance(folded, _Folded) else folded
 
 
 def _always_zero(program: ir.Program) -> frozenset[str]:
@@ -84,7 +99,7 @@ def _always_zero(program: ir.Program) -> frozenset[str]:
     return frozenset(VARIABLES) - named
 
 
-def _solve(program: ir.Program, zeros: frozenset[str]) -> dict[ir.BlockId, _Folded]:
+def _solve(program: ir.Program, zeros: frozenset[str]) -> dict[ir.BlockId, Visited]:
     """Each reachable block folded from what is known where it starts: the meet (the
     values all agree on) of what its predecessors know at their ends, and of the start
     of the program or a handler's entry. The variables in `zeros` are left out of what
@@ -95,10 +110,13 @@ def _solve(program: ir.Program, zeros: frozenset[str]) -> dict[ir.BlockId, _Fold
         edges=_edges)
 
 
-def _edges(block: ir.Block, folded: _Folded) -> list[tuple[ir.BlockId, Known]]:
+def _edges(block: ir.Block, folded: Visited) -> list[tuple[ir.BlockId, Known]]:
     """The ways the folded block goes (a branch decided goes one way), each with what
     is known where it ends."""
-    return [(target, folded.known) for target in folded.terminator.targets]
+    known = _known_at_end(folded)
+    taken = _taken(block.terminator, known)
+    targets = block.terminator.targets if taken is None else (taken,)
+    return [(target, known) for target in targets]
 
 
 def _meet(states: list[Known]) -> Known:
@@ -122,11 +140,11 @@ def _value(operand: ir.Operand, known: Known) -> int | None:
     return None  # R: the device's answer
 
 
-def _fold(block: ir.Block, entry: Known, zeros: frozenset[str]) -> _Folded:
+def _fold(block: ir.Block, entry: Known, zeros: frozenset[str]) -> Visited:
     """The block folded from what is known where it starts (`entry`, which it leaves as
     it is), and what is known where it ends: `entry` itself when the block changes
     nothing of it (one object for the blocks alike: a copy a block of a branch a line
-    was 26 bytes a source byte)."""
+    was 26 bytes a source byte). Its terminator is decided from that (`_terminator`)."""
     known = entry
     copied = False
     out: list[ir.Instruction] = []
@@ -200,9 +218,9 @@ def _fold(block: ir.Block, entry: Known, zeros: frozenset[str]) -> _Folded:
             for name in instruction.form.writes:
                 if name in known:
                     writable().pop(name)
-    if out == block.instructions:  # one list for the block's instructions, as it was
-        out = block.instructions
-    return _Folded(out, _terminator(block.terminator, known), known)
+    if out == block.instructions:  # the block's instructions as they were: no _Folded
+        return known
+    return _Folded(out, known)
 
 
 def _holding(known: Known, zeros: frozenset[str], value: int) -> ir.Var | None:
@@ -233,10 +251,23 @@ def _call(call: ir.Call, known: Known) -> ir.Call:
 
 
 def _terminator(terminator: ir.Terminator, known: Known) -> ir.Terminator:
+    """The terminator, a branch on a known variable decided: a jump."""
+    taken = _taken(terminator, known)
+    return terminator if taken is None else ir.Jump(taken, terminator.line)
+
+
+def _taken(terminator: ir.Terminator, known: Known) -> ir.BlockId | None:
+    """Where a branch on a known variable goes; None for any other terminator."""
     if not isinstance(terminator, ir.Branch):
-        return terminator
+        return None
     value = known.get(terminator.var.name)
     if value is None:
-        return terminator
-    holds = {"=": value == 0, ">": value > 0, "<": value < 0}[terminator.relation]
-    return ir.Jump(terminator.if_true if holds else terminator.if_false, terminator.line)
+        return None
+    match terminator.relation:
+        case "=":
+            holds = value == 0
+        case ">":
+            holds = value > 0
+        case "<":
+            holds = value < 0
+    return terminator.if_true if holds else terminator.if_false
