@@ -2,16 +2,23 @@
 (signs.py) both run: what is known where each block starts, from what its predecessors
 know where their edges leave them, until nothing changes.
 
-A worklist in layout order from the roots (flow.roots), each block queued once at a
-time; a block is visited again only when what is known where it starts changed. A
-visit may decide that an edge is not taken (a branch on a known value): only the edges
-the last visit gave count, so code behind a way never taken learns nothing from it.
+A worklist of the blocks whose start changed, the first in the layout first (most
+edges go forward, so a block is seldom visited before a predecessor that comes before
+it), from the roots (flow.roots). A visit may decide that an edge is not taken (a
+branch on a known value): code behind a way never taken learns nothing from it.
+
+What is known where a block starts is combined as each edge into it is followed, not
+gathered again from its predecessors: the flow is monotone (a visit from less knowledge
+knows less where it ends, and takes every edge a visit from more took), so what an
+edge leads in with only ever loses knowledge, and combining it with what was known
+before is combining what the predecessors' last visits lead in with. The result is the
+flow's one greatest fixed point, whatever the order of the visits.
 """
 
 from __future__ import annotations
 
-from collections import deque
-from collections.abc import Callable, Iterable, Iterator
+import heapq
+from collections.abc import Callable, Iterable
 from typing import TypeVar
 
 from . import flow, ir
@@ -30,50 +37,42 @@ def solve(program: ir.Program, *, entry: State, handler: State,
     start, where an event arrives from anywhere) say and of the states the `edges` of
     the visits of its predecessors lead into it with.
 
-    What the flow holds of each block is in lists by its place in the layout, and what
-    leads into a block is found again from its predecessors' last visits (`edges`), not
-    held: a block a line of `?A<#01` held 400 bytes of the flow's dictionaries and
-    lists, 57 bytes a source byte."""
+    What the flow holds of each block is in lists by its place in the layout (a block a
+    line of `?A<#01` held 400 bytes of the flow's dictionaries and lists, 57 bytes a
+    source byte): what is known where it starts, and its last visit."""
     places = flow.Places(program)
     blocks, place_of = places.blocks, places.place
     starts: dict[int, list[State]] = {}  # the roots' own states
     starts.setdefault(place_of[program.entry], []).append(entry)
     for block_id in program.handlers.values():
         starts.setdefault(place_of[block_id], []).append(handler)
-    entries: list[State | None] = [None] * len(blocks)  # what its last visit started from
+    known: list[State | None] = [None] * len(blocks)  # where each block starts
+    for place, states in starts.items():
+        known[place] = combine(states)
     visited: list[Visited | None] = [None] * len(blocks)
-    work = deque(place_of[block_id] for block_id in flow.roots(program))
+    work = sorted(starts)
     queued = bytearray(len(blocks))
     for place in work:
         queued[place] = 1
     while work:
-        place = work.popleft()
+        place = heapq.heappop(work)
         queued[place] = 0
-        known = combine([*starts.get(place, ()), *_incoming(place, places, visited, edges)])
-        if entries[place] == known:
-            continue
-        entries[place] = known
-        block = blocks[place]
-        visited[place] = after = visit(block, known)
-        for target_id, _ in edges(block, after):
+        block, start = blocks[place], known[place]
+        assert start is not None  # queued once something led into it
+        visited[place] = after = visit(block, start)
+        for target_id, leaving in edges(block, after):
             target = place_of[target_id]
+            before = known[target]
+            if before is None:
+                known[target] = leaving
+            else:
+                combined = combine([before, leaving])
+                if combined is before or combined == before:
+                    continue
+                known[target] = combined
             if not queued[target]:
                 queued[target] = 1
-                work.append(target)
-    del entries
+                heapq.heappush(work, target)
+    del known
     return {blocks[place].id: result for place, result in enumerate(visited)
             if result is not None}
-
-
-def _incoming(place: int, places: flow.Places, visited: list[Visited | None],
-              edges: Callable[[ir.Block, Visited], Iterable[tuple[ir.BlockId, State]]]
-              ) -> Iterator[State]:
-    """The states the last visits of the block's predecessors lead into it with: their
-    edges again (held, they were 56 bytes a block)."""
-    block_id = places.blocks[place].id
-    for pred in places.predecessors(place):
-        last = visited[pred]
-        if last is not None:
-            for target, leaving in edges(places.blocks[pred], last):
-                if target == block_id:
-                    yield leaving
