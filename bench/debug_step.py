@@ -36,8 +36,8 @@ RUNS = 5
 GOAL_MS = 20.0
 BREAKPOINTS = 10_000
 LONG = "A=B\n" * BREAKPOINTS  # code on each line at -O0, in the 64 KiB of a program
-NEVER_MET = [{"line": line, "condition": f"B-A-{line}>0"}  # B=A=0 throughout
-             for line in range(1, BREAKPOINTS + 1)]
+NEVER_MET: list[dict[str, Any]] = [{"line": line, "condition": f"B-A-{line}>0"}
+                                   for line in range(1, BREAKPOINTS + 1)]  # B=A=0 throughout
 
 
 def _session() -> Session:

@@ -18,7 +18,14 @@ from support import ROOT
 from support.ending_rl1c import EndsOnLine
 
 from rl1.compiler import differential, fuzz
-from rl1.compiler.differential import BatchEngine, VmEngine, engine_named, judge, judge_apart
+from rl1.compiler.differential import (
+    BatchEngine,
+    Engine,
+    VmEngine,
+    engine_named,
+    judge,
+    judge_apart,
+)
 from rl1.compiler.strategies import Run, runs
 
 pytestmark = pytest.mark.slow  # a batch engine's process, a fork a case
@@ -56,7 +63,7 @@ def batch(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Starts]:
 
 
 def test_judged_apart_a_batch_engine_is_started_once_for_every_case(batch: Starts) -> None:
-    engines = [VmEngine(0), EndsOnLine(CRASHING), batch.engine]
+    engines: list[Engine] = [VmEngine(0), EndsOnLine(CRASHING), batch.engine]
     ordinary = [Run(f"A={number}\nB=A+{number}\n", {}) for number in range(6)]
     for case in ordinary:
         assert judge_apart(case, engines, 100) == judge(case, engines, 100)
@@ -73,7 +80,7 @@ def test_judged_apart_with_a_batch_engine_every_run_is_judged_as_here(
         tmp_path_factory: pytest.TempPathFactory, case: Run) -> None:
     starts = Starts(tmp_path_factory.mktemp("batch"))
     try:
-        engines = [VmEngine(0), starts.engine, VmEngine(2)]
+        engines: list[Engine] = [VmEngine(0), starts.engine, VmEngine(2)]
         assert judge_apart(case, engines, 20_000) == judge(case, engines, 20_000)
         assert judge_apart(case, engines, 20_000) == judge(case, engines, 20_000)
         assert starts.count == 1

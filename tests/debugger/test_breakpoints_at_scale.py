@@ -69,10 +69,10 @@ def test_a_continue_stops_at_each_entry_where_a_breakpoint_bound_there_holds(
         bound.setdefault(line, []).append(text)
     expected = []
     for line, variables in ENTRIES:
-        met = [text for text in bound.get(line, [])
+        met = [text or "" for text in bound.get(line, [])
                if text is None or parse_condition(text).met(variables)]
         if met:  # one without a condition says nothing; else the first condition met
-            expected.append(Stop("breakpoint", line, "" if None in met else met[0]))
+            expected.append(Stop("breakpoint", line, "" if "" in met else met[0]))
     stops = []
     while (stop := session.continue_()).reason == "breakpoint":
         stops.append(stop)
