@@ -16,6 +16,7 @@ import pytest
 from hypothesis import given, settings
 from support import ROOT
 from support.ending_rl1c import EndsOnLine
+from support.planted import crashing_c_vm
 
 from rl1.compiler import differential, fuzz
 from rl1.compiler.differential import (
@@ -109,3 +110,19 @@ def test_rl1c_reduce_with_a_batch_engine_beside_one_that_ends_its_process(
     assert f"difference kept: {KILLER}: ended its process (signal SIGSEGV)\n" in ran.stdout
     tests = int(ran.stdout.split(" tests", 1)[0].rsplit("\n", 1)[-1])
     assert tests > 5 and batch.count == 1
+
+
+@pytest.mark.needs_cc
+def test_rl1c_reduce_with_a_batch_engine_beside_a_crashing_c_vm(batch: Starts,
+                                                                 tmp_path: Path) -> None:
+    program = tmp_path / "crash.rob"
+    program.write_text(f"B=1\n{CRASHING}\nC=2\nD=B+C ' the sum\n", encoding="utf-8")
+    ran = subprocess.run(
+        [sys.executable, ENDING_RL1C, "--c-library", str(crashing_c_vm(tmp_path)), "reduce",
+         str(program), "--engine", "vm-O0", "--engine", "c-O1", "--engine", batch.name],
+        capture_output=True, text=True, timeout=300)
+    assert ran.returncode == 0, ran.stderr
+    assert program.with_name("crash.reduced.rob").read_text(encoding="utf-8") == \
+        f"{CRASHING}\n"
+    assert "difference kept: c-O1: ended its process (signal SIGSEGV)\n" in ran.stdout
+    assert batch.count == 1
