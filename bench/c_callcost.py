@@ -20,9 +20,12 @@ done at once) into a firmware image built at -Os as firmware is, and run:
 
 A call's cost is (run with N calls - run without) / N: dispatch, decoding, the
 arguments' range checks, the callbacks' invocation, writing the results, and the event
-point after it.
+point after it. With --by-line, each Cortex-M3 kind's count is also placed by line of
+vm/c (each address's (count with N calls - without) / N, named by addr2line in the image,
+which is built with -g: the same code), the source line beside it, so that what a call
+spends is read where it is written.
 
-    .venv/bin/python bench/c_callcost.py [--calls N] [--build FOLDER]
+    .venv/bin/python bench/c_callcost.py [--calls N] [--build FOLDER] [--by-line]
 
 Needs arm-none-eabi-gcc, qemu-system-arm, avr-gcc and simavr (vm/c/install-tools); a
 target without its tools is skipped, and says so.
@@ -31,6 +34,7 @@ target without its tools is skipped, and says so.
 from __future__ import annotations
 
 import argparse
+import collections
 import re
 import shutil
 import subprocess
@@ -105,7 +109,7 @@ def build(compiler: list[str], build_dir: Path, name: str, data: bytes) -> Path:
     return elf
 
 
-ARM = ["arm-none-eabi-gcc", "-mcpu=cortex-m3", "-mthumb", "-Os", "-ffreestanding",
+ARM = ["arm-none-eabi-gcc", "-mcpu=cortex-m3", "-mthumb", "-Os", "-g", "-ffreestanding",
        "-nostdlib", "-T", "test/arm.ld", "test/arm_start.c"]
 AVR = ["avr-gcc", "-mmcu=atmega328p", "-Os", "-DRL1_READ_BYTE(p)=pgm_read_byte(p)",
        "-include", "avr/pgmspace.h", "-fno-tree-switch-conversion",
@@ -122,8 +126,9 @@ def one_instruction_a_block() -> str:
     return "-one-insn-per-tb" if "-one-insn-per-tb" in usage else "-singlestep"
 
 
-def m3_instructions(elf: Path) -> int:
-    """The instructions the Cortex-M3 runs in rl1_step, the callbacks' left out."""
+def m3_instructions(elf: Path) -> collections.Counter[int]:
+    """The instructions the Cortex-M3 runs in rl1_step, the callbacks' left out: how many
+    times each address ran."""
     log = elf.with_suffix(".log")
     run = subprocess.run(["qemu-system-arm", "-M", "lm3s6965evb", "-nographic",
                           "-semihosting-config", "enable=on,target=native",
@@ -133,7 +138,7 @@ def m3_instructions(elf: Path) -> int:
                          timeout=300, check=False)
     if run.returncode != 0:
         raise RuntimeError(f"{elf.name} failed under qemu: {run.stdout}{run.stderr}")
-    counting, count = False, 0
+    counting, count = False, collections.Counter[int]()
     with log.open(encoding="utf-8", errors="replace") as lines:
         for line in lines:
             match = TRACE.match(line)
@@ -145,8 +150,28 @@ def m3_instructions(elf: Path) -> int:
             if function == "callcost_begin":
                 counting = True
             elif counting and not function.startswith("callcost_hw_"):
-                count += 1
+                count[int(match.group(1), 16)] += 1
     raise RuntimeError(f"{log}: no callcost_end in qemu's log")
+
+
+def by_line(elf: Path, per_call: dict[int, float]) -> list[str]:
+    """Each line of vm/c whose instructions a call ran, in the order of the files: how many
+    a call, the line's place and its text. addr2line names an inlined helper's own line
+    (rl1vm.h's rl1_flash_u16 for the descriptor's load), not the line it is used at."""
+    addresses = sorted(per_call)
+    named = subprocess.run(["arm-none-eabi-addr2line", "-e", str(elf),
+                            *(hex(address) for address in addresses)],
+                           check=True, capture_output=True, text=True).stdout.splitlines()
+    lines: collections.defaultdict[tuple[str, int], float] = collections.defaultdict(float)
+    for address, place in zip(addresses, named, strict=True):
+        file, _, number = place.rpartition(":")
+        lines[Path(file).name, int(number.split()[0]) if number[:1].isdigit() else 0] += (
+            per_call[address])
+    texts = {name: (VM_C / name).read_text(encoding="utf-8").splitlines()
+             for name in ("rl1vm.c", "rl1vm.h") if any(file == name for file, _ in lines)}
+    return [f"    {count:5.1f}  {file}:{number:<5} "
+            f"{texts[file][number - 1].strip()[:60] if file in texts and number else ''}"
+            for (file, number), count in sorted(lines.items()) if round(count, 1)]
 
 
 def avr_cycles(elf: Path, callbacks: int) -> int:
@@ -164,6 +189,8 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--calls", type=int, default=10, help="calls in a program (10)")
     parser.add_argument("--build", type=Path, default=VM_C / "build" / "callcost")
+    parser.add_argument("--by-line", action="store_true",
+                        help="place each Cortex-M3 count by line of vm/c")
     options = parser.parse_args()
     options.build.mkdir(parents=True, exist_ok=True)
     build_dir = options.build.resolve()
@@ -179,12 +206,17 @@ def main() -> int:
         m3_over = avr_over = False
         callbacks = 2 if kind.started else 1
         name = kind.mnemonic.lower() + ("-variables" if kind.variables else "")
+        lines: list[str] = []
         if have_arm:
-            with_calls, without = (m3_instructions(build(ARM, build_dir, f"{name}-{n}-m3",
-                                                         program(kind, n)))
-                                   for n in (options.calls, 0))
-            cost = (with_calls - without) / options.calls
+            images = {n: build(ARM, build_dir, f"{name}-{n}-m3", program(kind, n))
+                      for n in (options.calls, 0)}
+            ran, ran_without = (m3_instructions(images[n]) for n in (options.calls, 0))
+            cost = (ran.total() - ran_without.total()) / options.calls
             m3, m3_over = f"{cost:.1f}", cost > kind.m3_goal
+            if options.by_line:
+                per_call = {address: (ran[address] - ran_without[address]) / options.calls
+                            for address in ran.keys() | ran_without.keys()}
+                lines = by_line(images[options.calls], per_call)
         if have_avr:
             with_calls, without = (avr_cycles(build(AVR, build_dir, f"{name}-{n}-avr",
                                                     program(kind, n)), callbacks * n)
@@ -194,6 +226,8 @@ def main() -> int:
         avr_goal = str(GOAL_AVR_KYC) if kind.mnemonic == "KYC" else "-"
         print(f"{kind.label:<32} {m3:>22} {kind.m3_goal:>5}{' over' if m3_over else '     '}"
               f" {avr:>17} {avr_goal:>5}{' over' if avr_over else ''}")
+        for line in lines:
+            print(line)
         status |= m3_over or avr_over
     if not have_arm:
         print("Cortex-M3 skipped: no arm-none-eabi-gcc or qemu-system-arm (vm/c/install-tools)")
