@@ -743,11 +743,10 @@ def _judge_in_child(writing: int, case: Run, engines: Sequence[Engine], budget: 
 
 
 @dataclass(frozen=True)
-class _Told:
-    """An engine whose runs `tell` (started, then ran with the observation)."""
+class _StandingFor:
+    """An engine in the place of `engine`, under its name and level."""
 
     engine: Engine
-    tell: Callable[..., None]
 
     @property
     def name(self) -> str:
@@ -756,6 +755,13 @@ class _Told:
     @property
     def level(self) -> int | None:
         return self.engine.level
+
+
+@dataclass(frozen=True)
+class _Told(_StandingFor):
+    """An engine whose runs `tell` (started, then ran with the observation)."""
+
+    tell: Callable[..., None]
 
     def run(self, case: Run, budget: int) -> Observation:
         self.tell("started", self.name)
@@ -765,19 +771,10 @@ class _Told:
 
 
 @dataclass(frozen=True)
-class _RanBefore:
+class _RanBefore(_StandingFor):
     """An engine whose run of the case judged was made before the fork."""
 
-    engine: Engine
     observation: Observation
-
-    @property
-    def name(self) -> str:
-        return self.engine.name
-
-    @property
-    def level(self) -> int | None:
-        return self.engine.level
 
     def run(self, case: Run, budget: int) -> Observation:
         return self.observation
