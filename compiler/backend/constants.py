@@ -119,17 +119,12 @@ def _edges(block: ir.Block, folded: Visited) -> list[tuple[ir.BlockId, Known]]:
     return [(target, known) for target in targets]
 
 
-def _meet(states: list[Known]) -> Known:
-    """What every state knows alike, in the first state's order (a set of items would
-    order it by hash, and the variable _holding picks with it: PYTHONHASHSEED would
-    change the bytes)."""
-    if len(states) <= 1:  # a block with one way in: most of them (_fold copies it)
-        return states[0] if states else {}
-    first, *rest = states
-    shared = first.items() & rest[0].items()  # the set only tests: the order is first's
-    for state in rest[1:]:
-        shared &= state.items()
-    return {name: value for name, value in first.items() if (name, value) in shared}
+def _meet(known: Known, other: Known) -> Known:
+    """What both know alike, in the first's order (deterministic, whatever
+    PYTHONHASHSEED): `known` itself when the other knows all it knows."""
+    if known.items() <= other.items():
+        return known
+    return {name: value for name, value in known.items() if other.get(name) == value}
 
 
 def _value(operand: ir.Operand, known: Known) -> int | None:
@@ -226,6 +221,8 @@ def _fold(block: ir.Block, entry: Known, zeros: frozenset[str]) -> Visited:
 def _holding(known: Known, zeros: frozenset[str], value: int) -> ir.Var | None:
     """The first variable, in the language's order, that holds the value (those of
     `zeros` hold 0): one rule, so that the same source gives the same bytes."""
+    if value not in known.values() and not (value == 0 and zeros):
+        return None  # most often: a walk of the 53 found none
     return next((ir.Var(name) for name in VARIABLES
                  if known.get(name, 0 if name in zeros else None) == value), None)
 

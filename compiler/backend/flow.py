@@ -36,14 +36,26 @@ class Places:
     block's predecessors (each once; a block that jumps to itself is its own), in
     arrays: a pass's flow over a long program holds a few bytes a block where a
     dictionary or list a block held a hundred or more (a block a line of `?A=#01` is
-    7 source bytes)."""
+    7 source bytes). The predecessors are found when first asked for: the forward
+    flows need only the places."""
 
     __slots__ = ("_first", "_preds", "blocks", "place")
 
     def __init__(self, program: ir.Program) -> None:
         self.blocks = list(program)
         self.place = {block.id: place for place, block in enumerate(self.blocks)}
-        # counted first, then where each block's predecessors start in _preds
+        self._first: array[int] | None = None
+        self._preds: array[int] | None = None
+
+    def predecessors(self, place: int) -> array[int]:
+        """The places of the predecessors of the block at `place`, in layout order."""
+        if self._first is None or self._preds is None:
+            self._first, self._preds = self._predecessors()
+        return self._preds[self._first[place]:self._first[place + 1]]
+
+    def _predecessors(self) -> tuple[array[int], array[int]]:
+        """Where each block's predecessors start in the second array (counted first),
+        and that array."""
         first = array("I", bytes(4 * (len(self.blocks) + 1)))
         for block in self.blocks:
             for target in _distinct(block.successors):
@@ -57,11 +69,7 @@ class Places:
                 at = self.place[target]
                 preds[filled[at]] = place
                 filled[at] += 1
-        self._first, self._preds = first, preds
-
-    def predecessors(self, place: int) -> array[int]:
-        """The places of the predecessors of the block at `place`, in layout order."""
-        return self._preds[self._first[place]:self._first[place + 1]]
+        return first, preds
 
 
 def _distinct(targets: tuple[ir.BlockId, ...]) -> tuple[ir.BlockId, ...]:

@@ -28,7 +28,7 @@ Visited = TypeVar("Visited")
 
 
 def solve(program: ir.Program, *, entry: State, handler: State,
-          combine: Callable[[list[State]], State],
+          combine: Callable[[State, State], State],
           visit: Callable[[ir.Block, State], Visited],
           edges: Callable[[ir.Block, Visited], Iterable[tuple[ir.BlockId, State]]]
           ) -> dict[ir.BlockId, Visited]:
@@ -42,15 +42,14 @@ def solve(program: ir.Program, *, entry: State, handler: State,
     source byte): what is known where it starts, and its last visit."""
     places = flow.Places(program)
     blocks, place_of = places.blocks, places.place
-    starts: dict[int, list[State]] = {}  # the roots' own states
-    starts.setdefault(place_of[program.entry], []).append(entry)
-    for block_id in program.handlers.values():
-        starts.setdefault(place_of[block_id], []).append(handler)
     known: list[State | None] = [None] * len(blocks)  # where each block starts
-    for place, states in starts.items():
-        known[place] = combine(states)
+    known[place_of[program.entry]] = entry
+    for block_id in program.handlers.values():
+        place = place_of[block_id]
+        before = known[place]
+        known[place] = handler if before is None else combine(before, handler)
     visited: list[Visited | None] = [None] * len(blocks)
-    work = sorted(starts)
+    work = sorted(place_of[block_id] for block_id in flow.roots(program))
     queued = bytearray(len(blocks))
     for place in work:
         queued[place] = 1
@@ -66,7 +65,9 @@ def solve(program: ir.Program, *, entry: State, handler: State,
             if before is None:
                 known[target] = leaving
             else:
-                combined = combine([before, leaving])
+                if leaving is before:
+                    continue
+                combined = combine(before, leaving)
                 if combined is before or combined == before:
                     continue
                 known[target] = combined

@@ -147,19 +147,17 @@ def _solve(program: ir.Program, tracked: frozenset[str]) -> dict[ir.BlockId, Sta
                          edges=_edges)
 
 
-def _join(states: list[State]) -> State:
-    """The signs any of the states allows, in the first state's order (deterministic)."""
-    if len(states) <= 1:  # a block with one way in: most of them (_exit_state copies it)
-        return states[0] if states else {}
-    first, *rest = states
-    shared = set(first).intersection(*rest)
+def _join(state: State, other: State) -> State:
+    """The signs either state allows, in the first's order (deterministic): `state`
+    itself when the other allows no sign it does not."""
     joined: State = {}
-    for name, signs in first.items():
-        if name in shared:
-            union = signs.union(*(state[name] for state in rest))
+    for name, signs in state.items():
+        others = other.get(name)
+        if others is not None:
+            union = signs | others
             if union != ANY:
                 joined[name] = union
-    return joined
+    return state if joined == state else joined
 
 
 def _edges(block: ir.Block, state: State) -> list[tuple[ir.BlockId, State]]:

@@ -7,6 +7,7 @@ predecessors' last visits."""
 from __future__ import annotations
 
 import copy
+import functools
 from collections.abc import Callable, Iterable
 from typing import Any
 
@@ -23,7 +24,7 @@ from rl1.compiler.strategies import runs
 
 
 def reference_solve(program: ir.Program, *, entry: Any, handler: Any,
-                    combine: Callable[[list[Any]], Any],
+                    combine: Callable[[Any, Any], Any],
                     visit: Callable[[ir.Block, Any], Any],
                     edges: Callable[[ir.Block, Any], Iterable[tuple[ir.BlockId, Any]]]
                     ) -> dict[ir.BlockId, Any]:
@@ -44,7 +45,7 @@ def reference_solve(program: ir.Program, *, entry: Any, handler: Any,
                        if target == block.id]
             if not states:
                 continue
-            result = visit(block, combine(states))
+            result = visit(block, functools.reduce(combine, states))
             if block.id not in visited or visited[block.id] != result:
                 visited[block.id] = result
                 changed = True
