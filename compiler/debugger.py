@@ -250,10 +250,12 @@ class Session:
         self.machine = Machine(self.program, self.hardware, self.budget)
         self.result: RunResult | None = None  # once the run is over
         self._losses: list[int] = []
+        # Found once: an isinstance of a Protocol at each instruction was half a step's cost.
+        self._clocked = self.device if isinstance(self.device, Clocked) else None
         if isinstance(self.device, ScriptedDevice):
             self._losses = list(self.device.script.instruction_losses)
-        elif isinstance(self.device, Clocked):
-            self.device.count_instructions(lambda: self.machine.executed)
+        elif self._clocked is not None:
+            self._clocked.count_instructions(lambda: self.machine.executed)
         self._before = list(self.machine.variables)  # at the last stop
         self._reported = False  # whether a stop was reported here already
         self._lose_lines_due()
@@ -412,8 +414,8 @@ class Session:
             self.result = machine.result
             return
         self._lose_lines_due()
-        device = self.device
-        if isinstance(device, Clocked) and machine.executed % device.slice == 0:
+        device = self._clocked
+        if device is not None and machine.executed % device.slice == 0:
             try:
                 device.catch_up()
             except DeviceError as error:  # a safety stop between calls, as drive_clocked
