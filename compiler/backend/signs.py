@@ -179,11 +179,11 @@ def _edges(block: ir.Block, state: State) -> list[tuple[ir.BlockId, State]]:
 
 def _exit_state(block: ir.Block, entry: State, tracked: frozenset[str]) -> State:
     """What is known where the block ends, from `entry`, which it leaves as it is: `entry`
-    itself when no instruction writes a variable (one object for the blocks alike: a
-    copy a block of a branch a line was 9 bytes a source byte)."""
-    writes = any(isinstance(instruction, ir.Store | ir.StepVar | ir.Move | ir.Call)
-                 for instruction in block.instructions)
-    state = dict(entry) if writes else entry
+    itself when no instruction writes a variable the flow follows (one object for the
+    blocks alike: a copy a block of a branch a line was 9 bytes a source byte)."""
+    if not any(_writes(instruction, tracked) for instruction in block.instructions):
+        return entry
+    state = dict(entry)
     acc: Signs = ANY
     result: Signs = ANY  # R's signs, from the last call's result range
     for instruction in block.instructions:
@@ -208,10 +208,22 @@ def _exit_state(block: ir.Block, entry: State, tracked: frozenset[str]) -> State
             case ir.Compute():
                 acc = ANY
             case ir.Call():
-                for name in instruction.form.writes:
+                form = instruction.form
+                for name in form.writes:
                     state.pop(name, None)
-                result = _result_signs(instruction.form.result_range)
+                result = _result_signs(form.result_range)
     return state
+
+
+def _writes(instruction: ir.Instruction, tracked: frozenset[str]) -> bool:
+    """Whether the instruction writes a variable the flow follows."""
+    match instruction:
+        case ir.Store(target=target) | ir.StepVar(target=target) | ir.Move(target=target):
+            return target.name in tracked
+        case ir.Call():
+            return not tracked.isdisjoint(instruction.form.writes)
+        case _:
+            return False
 
 
 @cache
