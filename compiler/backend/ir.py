@@ -330,16 +330,6 @@ class Program:
             yield block, None if after is None else after.id
             block = after
 
-    def predecessors(self) -> dict[BlockId, list[BlockId]]:
-        """Each block's predecessors in layout order (a block that jumps to itself is
-        its own predecessor; the handler table is not an edge)."""
-        preds: dict[BlockId, list[BlockId]] = {block_id: [] for block_id in self.blocks}
-        for block in self:
-            for target in dict.fromkeys(block.successors):
-                if target in preds:
-                    preds[target].append(block.id)
-        return preds
-
 
 # Invariants -------------------------------------------------------------------------
 
@@ -464,13 +454,17 @@ def _call_problems(call: Call) -> Iterator[str]:
 
 def format_program(program: Program) -> str:
     """The IR as stable text: a header, then each block in layout order with its
-    predecessors and one instruction a line, prefixed by its source line."""
+    predecessors (flow.Places's, in layout order; the handler table is not an edge) and
+    one instruction a line, prefixed by its source line."""
+    from .flow import Places  # which builds on this module
+
     out = [f"entry {program.entry}"]
     out += [f"handler :{label} {program.handlers[label]}" for label in sorted(program.handlers)]
-    preds = program.predecessors()
-    for block in program:
+    places = Places(program)
+    for place, block in enumerate(places.blocks):
+        preds = [places.blocks[pred].id for pred in places.predecessors(place)]
         out.append("")
-        comment = f"  ; from {', '.join(preds[block.id])}" if preds[block.id] else ""
+        comment = f"  ; from {', '.join(preds)}" if preds else ""
         out.append(f"{block.id}:{comment}")
         for item in [*block.instructions, block.terminator]:
             out.append(f"{item.line:6}  {item}")
