@@ -26,10 +26,14 @@ from . import flow, ir
 def simplify_control(program: ir.Program) -> ir.Program:
     _remove_unreachable(program)
     following = program.following()
+    threaded = False  # whether a terminator changed, and with it what is reachable
     for block in program:
-        block.terminator = _threaded(program, following, block.terminator)
+        terminator = _threaded(program, following, block.terminator)
+        if terminator is not block.terminator:
+            block.terminator, threaded = terminator, True
     del following  # of the blocks before some go
-    _remove_unreachable(program)
+    if threaded:
+        _remove_unreachable(program)
     _merge(program)
     return program
 
