@@ -83,19 +83,21 @@ def _threaded(terminator: ir.Terminator, state: State,
         if branch is None or target == following:
             return target
         decided = _decided(branch, leaving.get(branch.var.name, ANY))
-        return target if decided is None else decided.target
+        return target if decided is None else decided
 
     match terminator:
         case ir.Jump(target=target) if target in branches:
-            return dataclasses.replace(terminator, target=past(target, state))
+            onward = past(target, state)
+            if onward != target:
+                return dataclasses.replace(terminator, target=onward)
         case ir.Branch(var=var, relation=relation, if_true=if_true, if_false=if_false) \
                 if if_true in branches or if_false in branches:
             signs = state.get(var.name, ANY)
-            return dataclasses.replace(
-                terminator, if_true=past(if_true, {**state, var.name: frozenset(relation)}),
-                if_false=past(if_false, {**state, var.name: signs - {relation}}))
-        case _:
-            return terminator  # no way into a block that only branches
+            ways = (past(if_true, {**state, var.name: frozenset(relation)}),
+                    past(if_false, {**state, var.name: signs - {relation}}))
+            if ways != (if_true, if_false):
+                return dataclasses.replace(terminator, if_true=ways[0], if_false=ways[1])
+    return terminator  # as it was: no way into a block that only branches is decided
 
 
 def _rewritten(branch: ir.Branch, state: State, following: ir.BlockId | None
@@ -104,7 +106,7 @@ def _rewritten(branch: ir.Branch, state: State, following: ir.BlockId | None
     signs = state.get(branch.var.name, ANY)
     decided = _decided(branch, signs)
     if decided is not None:
-        return decided
+        return ir.Jump(decided, branch.line)
     others = signs - {branch.relation}
     if branch.if_true == following and branch.if_false != following and len(others) == 1:
         # `JLT N :20; JMP :10` with :20 next: one conditional jump to :10 does it.
@@ -113,11 +115,12 @@ def _rewritten(branch: ir.Branch, state: State, following: ir.BlockId | None
     return branch
 
 
-def _decided(branch: ir.Branch, signs: Signs) -> ir.Jump | None:
+def _decided(branch: ir.Branch, signs: Signs) -> ir.BlockId | None:
+    """Where the branch goes when a variable of these signs decides it."""
     if signs <= {branch.relation}:
-        return ir.Jump(branch.if_true, branch.line)
+        return branch.if_true
     if branch.relation not in signs:
-        return ir.Jump(branch.if_false, branch.line)
+        return branch.if_false
     return None
 
 
@@ -172,7 +175,7 @@ def _edges(block: ir.Block, state: State) -> list[tuple[ir.BlockId, State]]:
     signs = state.get(name, ANY)
     decided = _decided(terminator, signs)
     if decided is not None:
-        return [(decided.target, state)]
+        return [(decided, state)]
     return [(terminator.if_true, {**state, name: frozenset(terminator.relation)}),
             (terminator.if_false, {**state, name: signs - {terminator.relation}})]
 
