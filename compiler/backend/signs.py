@@ -41,6 +41,7 @@ Signs = frozenset[str]
 """The signs a value may have: a subset of `<`, `=`, `>` (the relations with zero)."""
 
 ANY: Signs = frozenset("<=>")
+_ONLY: dict[str, Signs] = {relation: frozenset(relation) for relation in ANY}
 NOT_NEGATIVE: Signs = frozenset("=>")
 State = dict[str, Signs]
 """Each variable whose sign is known to be limited; a variable not in it may have any."""
@@ -133,9 +134,9 @@ def _tracked(program: ir.Program) -> frozenset[str]:
         if isinstance(block.terminator, ir.Branch):
             names.add(block.terminator.var.name)
         for instruction in block.instructions:
-            if isinstance(instruction, ir.Load | ir.Move) \
-                    and isinstance(instruction.source, ir.Var):
-                names.add(instruction.source.name)
+            match instruction:
+                case ir.Load(source=ir.Var(name=name)) | ir.Move(source=ir.Var(name=name)):
+                    names.add(name)
     return frozenset(names)
 
 
@@ -176,17 +177,29 @@ def _edges(block: ir.Block, state: State) -> list[tuple[ir.BlockId, State]]:
     decided = _decided(terminator, signs)
     if decided is not None:
         return [(decided, state)]
-    return [(terminator.if_true, {**state, name: frozenset(terminator.relation)}),
-            (terminator.if_false, {**state, name: signs - {terminator.relation}})]
+    return [(terminator.if_true, {**state, name: _ONLY[terminator.relation]}),
+            (terminator.if_false, {**state, name: signs - _ONLY[terminator.relation]})]
 
 
 def _exit_state(block: ir.Block, entry: State, tracked: frozenset[str]) -> State:
     """What is known where the block ends, from `entry`, which it leaves as it is: `entry`
     itself when no instruction writes a variable the flow follows (one object for the
     blocks alike: a copy a block of a branch a line was 9 bytes a source byte)."""
-    if not any(_writes(instruction, tracked) for instruction in block.instructions):
-        return entry
-    state = dict(entry)
+    state = entry
+    copied = False
+
+    def write(name: str, signs: Signs) -> None:
+        """The variable's signs set, in a copy of `entry` once one changes."""
+        nonlocal state, copied
+        if name not in tracked:
+            return
+        if not copied:
+            state, copied = dict(state), True
+        if signs == ANY:
+            state.pop(name, None)
+        else:
+            state[name] = signs
+
     acc: Signs = ANY
     result: Signs = ANY  # R's signs, from the last call's result range
     for instruction in block.instructions:
@@ -201,32 +214,20 @@ def _exit_state(block: ir.Block, entry: State, tracked: frozenset[str]) -> State
             case ir.Operate():
                 acc = ANY
             case ir.Store(target=target):
-                _set(state, target.name, acc, tracked)
+                write(target.name, acc)
             case ir.StepVar(target=target, step=step):
                 before = state.get(target.name, ANY)
-                _set(state, target.name, frozenset().union(
-                    *(_STEPPED[step][sign] for sign in before)), tracked)
+                write(target.name, frozenset().union(*(_STEPPED[step][sign] for sign in before)))
             case ir.Move(target=target, source=source):
-                _set(state, target.name, _operand(source, state, result), tracked)
+                write(target.name, _operand(source, state, result))
             case ir.Compute():
                 acc = ANY
             case ir.Call():
                 form = instruction.form
                 for name in form.writes:
-                    state.pop(name, None)
+                    write(name, ANY)
                 result = _result_signs(form.result_range)
     return state
-
-
-def _writes(instruction: ir.Instruction, tracked: frozenset[str]) -> bool:
-    """Whether the instruction writes a variable the flow follows."""
-    match instruction:
-        case ir.Store(target=target) | ir.StepVar(target=target) | ir.Move(target=target):
-            return target.name in tracked
-        case ir.Call():
-            return not tracked.isdisjoint(instruction.form.writes)
-        case _:
-            return False
 
 
 @cache
@@ -247,10 +248,3 @@ def _operand(operand: ir.Operand, state: State, result: Signs) -> Signs:
             return state.get(name, ANY)
         case _:
             return result
-
-
-def _set(state: State, name: str, signs: Signs, tracked: frozenset[str]) -> None:
-    if signs == ANY or name not in tracked:
-        state.pop(name, None)
-    else:
-        state[name] = signs
