@@ -66,7 +66,7 @@ def _solve(program: ir.Program, events: bool) -> dict[ir.BlockId, list[ir.Instru
             kept[place] = swept
         else:
             kept.pop(place, None)
-        if live_in[place] != live:
+        if live_in[place] != live and not events:  # with events, all is live after each
             live_in[place] = shared.setdefault(live, live)
             for pred in places.predecessors(place):
                 if not queued[pred]:
