@@ -15,6 +15,8 @@ import contextlib
 import functools
 import hashlib
 import logging
+import multiprocessing
+import os
 import signal
 import threading
 import time
@@ -25,6 +27,7 @@ from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from types import FrameType
 from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 
 from rl1 import vm
@@ -35,6 +38,8 @@ if TYPE_CHECKING:
 CONNECT_TIMEOUT = 5  # s: an unreachable scheduler is said in a few seconds, and a lost
 # one once its client has tried as long to reconnect
 WATCH_EVERY = 0.5  # s between looks at whether a cluster's client has given up
+PARENT_WATCH_EVERY = 0.5  # s between a local worker's looks at whether its parent
+# has ended, once it was sent SIGINT or SIGTERM
 EXTRA = "cluster"  # pyproject.toml's extra that installs `distributed`
 
 P = ParamSpec("P")
@@ -71,11 +76,46 @@ class Workers:
 
 
 def ignore_interrupts() -> None:
-    """A local worker's start: Ctrl-C reaches the whole process group, and the parent
-    stops its workers itself; a worker forked while the parent has its own SIGTERM
-    handler must not take it, since a pool ends its workers with SIGTERM when one dies."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    """A local worker's start: SIGINT and SIGTERM reach the whole process group (Ctrl-C,
+    a CI job's timeout) or every process of a command line (`pkill -f`), and the parent,
+    which takes them, stops its workers itself, keeping their work: a worker ended by
+    one would be a worker lost (a pool ends its workers with SIGKILL instead: `_Worker`).
+    Once sent one, a worker ends when its parent does, as a parent that does not take
+    them (a test, a script) would have it."""
+    parent = os.getppid()
+    watching = False
+
+    def heard(signum: int, frame: FrameType | None) -> None:
+        nonlocal watching
+        if not watching:
+            watching = True
+            threading.Thread(target=_end_with, args=(parent, signum), daemon=True).start()
+
+    signal.signal(signal.SIGINT, heard)
+    signal.signal(signal.SIGTERM, heard)
+
+
+def _end_with(parent: int, signum: int) -> None:
+    """Ends this process, as the signal `signum` would have, once `parent` has ended
+    (and this process is another's child)."""
+    while os.getppid() == parent:
+        time.sleep(PARENT_WATCH_EVERY)
+    os._exit(128 + signum)
+
+
+class _Worker(multiprocessing.Process):
+    """A pool's process, of the platform's start method: a pool ends its workers with
+    SIGTERM when one dies (the queues may be in a dirty state), which they ignore, so
+    they are ended with SIGKILL."""
+
+    def terminate(self) -> None:
+        self.kill()
+
+
+class _Workers(multiprocessing.context.DefaultContext):
+    """The platform's multiprocessing context, making `_Worker`s."""
+
+    Process = _Worker
 
 
 @contextmanager
@@ -104,7 +144,8 @@ def workers(jobs: int, scheduler: str | None = None,
 
 
 def _pool(jobs: int) -> ProcessPoolExecutor:
-    return ProcessPoolExecutor(max_workers=jobs, initializer=ignore_interrupts)
+    return ProcessPoolExecutor(max_workers=jobs, initializer=ignore_interrupts,
+                               mp_context=_Workers(multiprocessing.get_context()))
 
 
 class Renewed(Executor):
