@@ -68,7 +68,12 @@ def optimize(program: ir.Program, level: int, *, check: bool = False,
         return program
     program = _to_fixpoint(passes, program, check, fired)
     for run in FINAL_PASSES[level]:
-        program, _ = _run_one(run, program, _shape(program), check, fired)
+        before = _shape(program) if fired is not None else None  # else no one asks
+        program = run(program)
+        if check:
+            _validate(program, run.__name__)
+        if fired is not None and _shape(program) != before:
+            fired(run.__name__)
     _validate(program, "the optimizer")
     return program
 
