@@ -5,7 +5,8 @@ COMMANDS as the modules of main.MODULES do. rl1.lsp adds `rl1c studio` so
 
 Entry points are read only when a command is not one of rl1c's own, and for help and
 completion: `rl1c check` pays nothing for them. A plugin that cannot be loaded is still
-listed, as a command that says why and what to do (exit status 2), never a traceback.
+listed, as a command that says why and what to do (exit status 2), never a traceback; a
+package whose entry points cannot be read is left out, with a warning.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import click
 from .command import Command, Failure
 
 if TYPE_CHECKING:  # importlib.metadata takes tens of milliseconds to load: when asked
-    from importlib.metadata import EntryPoint
+    from importlib.metadata import Distribution, EntryPoint
 
 GROUP = "rl1.commands"
 UNLOADED = "Commands that cannot be loaded"  # the help's section of broken plugins
@@ -37,13 +38,32 @@ class Plugin:
 @functools.cache
 def installed() -> dict[str, EntryPoint]:
     """The plugins installed, by command name (the first of each name found on the
-    path, as Python finds the first of two modules)."""
-    from importlib.metadata import entry_points
+    path, as Python finds the first of two modules). A package whose metadata cannot be
+    read is left out, with a warning."""
+    from importlib.metadata import distributions
 
     found: dict[str, EntryPoint] = {}
-    for entry in entry_points(group=GROUP):
-        found.setdefault(entry.name, entry)
+    for distribution in distributions():
+        try:
+            entries = distribution.entry_points.select(group=GROUP)
+        except Exception as error:  # a file of its metadata that is no entry point list
+            click.echo(f"rl1c: warning: cannot read the entry points (entry_points.txt) "
+                       f"of {_named(distribution)} ({type(error).__name__}: {error}), "
+                       "which may add commands to rl1c; they are left out: install that "
+                       "package again", err=True)
+            continue
+        for entry in entries:
+            found.setdefault(entry.name, entry)
     return found
+
+
+def _named(distribution: Distribution) -> str:
+    """The package `distribution` as a message names it: its name, and where it is."""
+    where = distribution.locate_file("")
+    try:
+        return f"the package `{distribution.metadata['Name']}` in {where}"
+    except Exception:  # its metadata unreadable too
+        return f"a package in {where}"
 
 
 @functools.cache

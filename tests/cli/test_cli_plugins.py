@@ -175,3 +175,24 @@ def test_a_mistyped_command_is_matched_against_the_plugins_too(tmp_path: Path) -
     assert ran.returncode == 2
     assert ran.stderr.endswith("rl1c: error: No such command 'helo'. Did you mean "
                                "'hello'?\n")
+
+
+@pytest.mark.parametrize("broken", [b"[rl1.commands]\nno equals sign\n",
+                                    b"\xff\xfe[rl1.commands]\n"])
+def test_a_package_whose_entry_points_cannot_be_read_is_left_out_with_a_warning(
+        tmp_path: Path, broken: bytes) -> None:
+    folder = distribution(tmp_path, {"hello": "hello_plugin"}, {"hello_plugin": HELLO})
+    other = tmp_path / "other-1.0.dist-info"
+    other.mkdir()
+    (other / "METADATA").write_text("Metadata-Version: 2.1\nName: other\nVersion: 1.0\n")
+    (other / "entry_points.txt").write_bytes(broken)
+    warning = (f"rl1c: warning: cannot read the entry points (entry_points.txt) of the "
+               f"package `other` in {tmp_path} (")
+    for args, shown in ((["hello", "world"], "hello, world\n"), (["--help"], "Greetings:")):
+        ran = run(folder, *args)
+        assert ran.returncode == 0, ran.stderr
+        assert shown in ran.stdout
+        assert ran.stderr.startswith(warning) and ran.stderr.endswith(
+            "which may add commands to rl1c; they are left out: install that package "
+            "again\n")
+        assert ran.stderr.count("\n") == 1
