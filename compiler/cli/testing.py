@@ -4,16 +4,14 @@ them, compiler/program_tests.py runs them, test_report.py reports them)."""
 from __future__ import annotations
 
 import os
-import signal
 import sys
 import time
-from collections.abc import Iterator, Sequence
-from concurrent.futures import Executor, ProcessPoolExecutor
-from contextlib import contextmanager
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import click
 
+from rl1.compiler.executors import workers
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.reporting.render import EXIT_ERRORS, EXIT_USAGE, ColorChoice, use_color
 
@@ -58,18 +56,18 @@ def test(paths: tuple[str, ...], jobs: int | None, junit_file: str | None, force
     cases = [Case(file, test) for file, tests in _load(paths or (".",)) for test in tests]
     if junit_file is not None:
         _refuse_junit_target(junit_file, cases)
-    workers = jobs or os.cpu_count() or 1
+    jobs = jobs or os.cpu_count() or 1
     color_on = use_color(color, sys.stdout)
     started = time.perf_counter()
     results: list[Result] = []
     campaigns = any(isinstance(case.test.expect.success, Success) for case in cases)
-    with _executor(workers if campaigns else 1) as executor:
+    with workers(jobs if campaigns else 1) as pool:
         file = None
         for case in cases:
             if case.file != file:
                 sys.stdout.write(("\n" if file is not None else "") + f"{case.file} ")
                 file = case.file
-            results.append(finished(case, run_test(case, executor, workers), workers,
+            results.append(finished(case, run_test(case, pool.executor, jobs), jobs,
                                     color=color_on))
             sys.stdout.write(MARKS[results[-1].outcome.status])
             sys.stdout.flush()
@@ -159,24 +157,6 @@ def _test_files(paths: Sequence[str]) -> list[str]:
                           "or start a project with one: `rl1c new DIR`", EXIT_USAGE)
         files += found
     return files
-
-
-def _ignore_interrupts() -> None:
-    # Ctrl-C reaches the whole process group: the command ends its workers itself.
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
-@contextmanager
-def _executor(jobs: int) -> Iterator[Executor | None]:
-    """Worker processes for the success rates' runs; None (this process) for one job."""
-    if jobs == 1:
-        yield None
-        return
-    pool = ProcessPoolExecutor(max_workers=jobs, initializer=_ignore_interrupts)
-    try:
-        yield pool
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
 
 
 COMMANDS = (test,)
