@@ -20,7 +20,7 @@ from rl1.vm.defaults import DEFAULT_LEVEL
 
 from .codegen import CodegenError, generate, line_too_far
 from .ir import Program as IrProgram
-from .ir import format_program
+from .ir_text import format_program
 from .lower import Lowering, lower, lower_text
 from .optimize import LEVELS, optimize
 

@@ -448,24 +448,3 @@ def _call_problems(call: Call) -> Iterator[str]:
         if call.compact and isinstance(arg, Imm) and not -0x80 <= arg.value <= 0x7F:
             yield f"line {call.line}: `{call}`: {param.name} does not fit a byte"
 
-
-# Printing ---------------------------------------------------------------------------
-
-
-def format_program(program: Program) -> str:
-    """The IR as stable text: a header, then each block in layout order with its
-    predecessors (flow.Places's, in layout order; the handler table is not an edge) and
-    one instruction a line, prefixed by its source line."""
-    from .flow import Places  # which builds on this module
-
-    out = [f"entry {program.entry}"]
-    out += [f"handler :{label} {program.handlers[label]}" for label in sorted(program.handlers)]
-    places = Places(program)
-    for place, block in enumerate(places.blocks):
-        preds = [places.blocks[pred].id for pred in places.predecessors(place)]
-        out.append("")
-        comment = f"  ; from {', '.join(preds)}" if preds else ""
-        out.append(f"{block.id}:{comment}")
-        for item in [*block.instructions, block.terminator]:
-            out.append(f"{item.line:6}  {item}")
-    return "\n".join(out) + "\n"

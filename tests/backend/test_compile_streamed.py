@@ -18,7 +18,7 @@ from rl1.compiler import analysis
 from rl1.compiler.backend import driver
 from rl1.compiler.backend.codegen import CodegenError, generate
 from rl1.compiler.backend.driver import EMITS, OPTIMIZATION_LEVELS, Compilation, Emit
-from rl1.compiler.backend.ir import format_program
+from rl1.compiler.backend.ir_text import format_program
 from rl1.compiler.backend.lower import lower
 from rl1.compiler.backend.optimize import optimize
 from rl1.compiler.frontend import ast

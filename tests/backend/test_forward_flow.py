@@ -15,7 +15,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 
 from rl1.compiler.analysis import analyze
-from rl1.compiler.backend import forward, ir
+from rl1.compiler.backend import forward, ir, ir_text
 from rl1.compiler.backend.constants import fold_constants
 from rl1.compiler.backend.control import simplify_control
 from rl1.compiler.backend.lower import lower
@@ -66,7 +66,7 @@ def test_the_worklist_finds_what_the_plain_sweeps_find(
         run_pass: Callable[[ir.Program], ir.Program], case: Any) -> None:
     program = simplify_control(lower(analyze(case.source).program))
     expected = solved_plainly(run_pass, copy.deepcopy(program))
-    assert ir.format_program(run_pass(program)) == ir.format_program(expected)
+    assert ir_text.format_program(run_pass(program)) == ir_text.format_program(expected)
 
 
 def test_a_loop_is_solved_as_the_plain_sweeps_solve_it() -> None:
@@ -74,8 +74,8 @@ def test_a_loop_is_solved_as_the_plain_sweeps_solve_it() -> None:
     with less known: the fold keeps only what both ways agree on."""
     source = "A=1;B=2\n:10 A=A+1;C=B+3\n?A>#10\n(ROT C)\n"
     program = simplify_control(lower(analyze(source).program))
-    expected = ir.format_program(solved_plainly(fold_constants, copy.deepcopy(program)))
-    folded = ir.format_program(fold_constants(program))
+    expected = ir_text.format_program(solved_plainly(fold_constants, copy.deepcopy(program)))
+    folded = ir_text.format_program(fold_constants(program))
     assert folded == expected
     assert "if A>0 then L10" in folded  # A differs on the two ways into :10
     assert "call ROT 5" in folded  # C=B+3 folded: B is 2 on both

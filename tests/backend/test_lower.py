@@ -5,7 +5,7 @@ IR's invariants and its printed form."""
 import pytest
 from support import SAMPLE
 
-from rl1.compiler.backend import flow, ir
+from rl1.compiler.backend import flow, ir, ir_text
 from rl1.compiler.backend.ir import (
     Branch,
     Call,
@@ -200,7 +200,7 @@ def test_r_is_not_set_by_a_call_without_a_result() -> None:
 
 
 def test_printer_shows_header_blocks_predecessors_and_lines() -> None:
-    text = ir.format_program(lower_text("A=(IMG)-1\n:96 ?A>#96\n(MOV 1,-2); B--"))
+    text = ir_text.format_program(lower_text("A=(IMG)-1\n:96 ?A>#96\n(MOV 1,-2); B--"))
     assert text == (
         "entry B0\n"
         "handler :96 L96\n"

@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rl1.compiler.analysis import analyze
-from rl1.compiler.backend import ir, optimize
+from rl1.compiler.backend import ir, ir_text, optimize
 from rl1.compiler.backend.codegen import generate
 from rl1.compiler.backend.constants import fold_constants
 from rl1.compiler.backend.control import simplify_control
@@ -174,8 +174,8 @@ def test_the_shaped_programs_give_the_later_passes_work() -> None:
     @given(case=shaped_runs())
     def tally(case: Run) -> None:
         for run_pass in SHAPED_PASSES:
-            before = ir.format_program(lowered(case.source))
-            changed[run_pass] += ir.format_program(run_pass(lowered(case.source))) != before
+            before = ir_text.format_program(lowered(case.source))
+            changed[run_pass] += ir_text.format_program(run_pass(lowered(case.source))) != before
 
     changed = dict.fromkeys(SHAPED_PASSES, 0)
     tally()
@@ -187,8 +187,8 @@ def test_the_shaped_programs_give_the_later_passes_work() -> None:
 @given(case=runs(max_blocks=3))
 def test_a_second_run_of_the_pass_changes_nothing(run_pass: optimize.Pass, case: Run
                                                   ) -> None:
-    once = ir.format_program(run_pass(lowered(case.source)))
-    twice = ir.format_program(run_pass(run_pass(lowered(case.source))))
+    once = ir_text.format_program(run_pass(lowered(case.source)))
+    twice = ir_text.format_program(run_pass(run_pass(lowered(case.source))))
     assert twice == once
 
 
@@ -199,17 +199,17 @@ def test_a_second_run_of_the_pass_changes_nothing(run_pass: optimize.Pass, case:
 def test_a_pass_gives_no_work_to_those_the_optimizer_says(
         giver: optimize.Pass, receiver: optimize.Pass, case: Run) -> None:
     program = giver(settle(receiver, lowered(case.source)))
-    before = ir.format_program(program)  # the receiver edits the program in place
-    assert ir.format_program(receiver(program)) == before
+    before = ir_text.format_program(program)  # the receiver edits the program in place
+    assert ir_text.format_program(receiver(program)) == before
 
 
 def settle(run_pass: optimize.Pass, program: ir.Program) -> ir.Program:
     """The program after the pass, run until it changes nothing (decide_branches can
     find more on a second run)."""
     for _ in range(optimize.MAX_ROUNDS):
-        before = ir.format_program(program)
+        before = ir_text.format_program(program)
         program = run_pass(program)
-        if ir.format_program(program) == before:
+        if ir_text.format_program(program) == before:
             return program
     raise AssertionError(f"{run_pass.__name__} did not settle")
 
@@ -218,4 +218,4 @@ def settle(run_pass: optimize.Pass, program: ir.Program) -> ir.Program:
 @given(case=runs(max_blocks=3))
 def test_an_optimized_program_optimizes_to_itself(case: Run) -> None:
     once = optimize.optimize(lowered(case.source), 1)
-    assert ir.format_program(optimize.optimize(once, 1)) == ir.format_program(once)
+    assert ir_text.format_program(optimize.optimize(once, 1)) == ir_text.format_program(once)

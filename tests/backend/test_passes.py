@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from support.semantics import operate
 
-from rl1.compiler.backend import ir, optimize
+from rl1.compiler.backend import ir, ir_text, optimize
 from rl1.compiler.backend.codegen import generate
 from rl1.compiler.backend.constants import fold_constants
 from rl1.compiler.backend.control import simplify_control
@@ -348,8 +348,8 @@ def run_program(program: Program, script: dict[str, object]) -> tuple[list[int],
 ])
 def test_tails_stay_apart_where_merging_would_change_a_line_a_value_or_a_path(text: str
                                                                               ) -> None:
-    before = ir.format_program(lowered(text))
-    assert ir.format_program(after(merge_tails, text)) == before
+    before = ir_text.format_program(lowered(text))
+    assert ir_text.format_program(after(merge_tails, text)) == before
 
 
 def test_the_final_end_is_left_out_after_an_instruction_of_the_last_block() -> None:
@@ -390,8 +390,8 @@ def test_a_pass_that_breaks_the_ir_is_caught_where_it_runs(monkeypatch: pytest.M
 
 def test_level_0_changes_nothing_and_level_1_runs_until_nothing_changes() -> None:
     text = "A=1\n#10\n:10 B=A+1; A=B-2; (MOV A,B)"
-    assert ir.format_program(optimize.optimize(lowered(text), 0)) == \
-        ir.format_program(lowered(text))
+    assert ir_text.format_program(optimize.optimize(lowered(text), 0)) == \
+        ir_text.format_program(lowered(text))
     # A=1 is dead (A=B-2 follows before any call); then A=B-2 stores 0, which A holds.
     assert code(optimize.optimize(lowered(text), 1)) == [
         "load 2", "store B", "call MOV 0, 2", "end"]

@@ -11,7 +11,7 @@ from support import SAMPLE
 from support.cli import rl1c
 
 from rl1.compiler.backend.firmware import c_source
-from rl1.compiler.backend.ir import format_program
+from rl1.compiler.backend.ir_text import format_program
 from rl1.compiler.backend.lower import lower
 from rl1.compiler.backend.optimize import optimize
 from rl1.compiler.files import write_atomically
