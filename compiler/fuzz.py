@@ -443,17 +443,18 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
              executor: Executor | None = None, jobs: int = 1, keep_going: bool = False,
              found: Callable[[Finding], None] | None = None,
              channel: Channel | None = None, corpus: Sequence[Run] = (),
-             statistics: bool = False, lost: tuple[type[BaseException], ...] = ()
-             ) -> Outcome:
+             statistics: bool = False, lost: tuple[type[BaseException], ...] = (),
+             worker_lost: Callable[[], None] | None = None) -> Outcome:
     """Run the `corpus`, then generated programs, on `engines` until `count` generated
     programs or `seconds` have passed, or until they disagree (with `keep_going`, until
     then whatever they find); `progress(programs, elapsed)` as programs run,
     `found(finding)` on each new signature's smallest run. The searches run in this
     process, or `jobs` at a time on `executor` (a search lost with its worker, an error
-    of `lost`, runs again); a disagreement stops the searches after the one that found
-    it, and is the one of the first search in order that finds one, as in one process.
-    `channel.halt()` (from a signal handler) stops every search, keeping their counts and
-    findings. With `statistics`, the Outcome says what the programs did."""
+    of `lost`, runs again, after `worker_lost()`; SearchLost when it is lost each
+    time); a disagreement stops the searches after the one that found it, and is the one
+    of the first search in order that finds one, as in one process. `channel.halt()`
+    (from a signal handler) stops every search, keeping their counts and findings. With
+    `statistics`, the Outcome says what the programs did."""
     start = time.monotonic()
     deadline = None if seconds is None else time.time() + seconds
     if statistics:
@@ -520,7 +521,8 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
                 keep(search(task, told))
         else:
             _on_executor(executor, jobs, next_search, keep, channel,
-                         lambda told: progress(done() + told, time.monotonic() - start), lost)
+                         lambda told: progress(done() + told, time.monotonic() - start), lost,
+                         worker_lost)
     finally:
         if own_channel:
             channel.close()
@@ -543,16 +545,23 @@ POLL = 0.5  # seconds between looks at the searches under way, for progress
 LOSSES = 2  # times a search lost with its worker runs again
 
 
+class SearchLost(Exception):
+    """A search lost with its worker each of the LOSSES + 1 times it ran, the last ones
+    with each program judged in a process of its own: what ends its workers is no
+    program (something kills them, or the memory runs out). Raised from the last loss's
+    error (a local pool's BrokenExecutor, a cluster's KilledWorker)."""
+
+
 def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search | None],
                  keep: Callable[[Searched], None], channel: Channel,
-                 progress: Callable[[int], None], lost: tuple[type[BaseException], ...]
-                 ) -> None:
+                 progress: Callable[[int], None], lost: tuple[type[BaseException], ...],
+                 worker_lost: Callable[[], None] | None) -> None:
     """Run the searches `next_search` gives on `executor`, `jobs` at a time, keeping
-    each as it ends; one lost with its worker (an error of `lost`) runs again, up to
-    LOSSES times, each of its programs (and each tried in shrinking) then judged in a
-    process of its own: its worker may have died of one of them, or beside the search
-    that had it; either way the same programs, and one that ends its process is a
-    finding."""
+    each as it ends; one lost with its worker (an error of `lost`: `worker_lost()` is
+    called) runs again, up to LOSSES times (then SearchLost), each of its programs (and
+    each tried in shrinking) then judged in a process of its own: its worker may have
+    died of one of them, or beside the search that had it; either way the same
+    programs, and one that ends its process is a finding."""
     pending: dict[Future[Searched], Search] = {}
     losses: dict[int, int] = {}
 
@@ -566,8 +575,13 @@ def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search
         for future in finished:
             task = pending.pop(future)
             error = future.exception()
-            if isinstance(error, lost) and losses.get(task.index, 0) < LOSSES:
+            if isinstance(error, lost):
+                if losses.get(task.index, 0) >= LOSSES:
+                    raise SearchLost(f"search {task.index} lost {LOSSES + 1} times"
+                                     ) from error
                 losses[task.index] = losses.get(task.index, 0) + 1
+                if worker_lost is not None:
+                    worker_lost()
                 task = replace(task, apart=True)
                 pending[executor.submit(search, task)] = task
                 continue

@@ -13,7 +13,6 @@ import random
 import signal
 import sys
 from collections.abc import Callable, Iterator
-from concurrent.futures import BrokenExecutor
 from contextlib import contextmanager
 from functools import partial
 from types import FrameType
@@ -123,6 +122,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         from rl1.compiler.fuzz import (
             LOSSES,
             Channel,
+            SearchLost,
             campaign,
             read_corpus,
             write_reproducer,
@@ -190,22 +190,32 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         except OSError as error:
             written[finding.signature] = error
 
+    warned = False
+
+    def worker_lost() -> None:  # said once: each search lost runs again alike
+        nonlocal warned
+        if not warned:
+            warned = True
+            bar.warn(WORKER_LOST)
+
     try:
         # Processes even for one job: an engine that ends the process it runs in (the C
-        # VM's crash) ends a worker, whose searches run again to name the program.
+        # VM's crash) ends a worker, whose searches run again to name the program. A
+        # local pool is made again when one dies; the campaign says so, as for a
+        # cluster's worker (whose nanny starts it again).
         with _halted_by_signals(channel) as signalled, \
-                workers(jobs or os.cpu_count() or 1, scheduler,
-                        lambda: bar.warn(POOL_RENEWED), isolated=True) as held:
+                workers(jobs or os.cpu_count() or 1, scheduler, lambda: None,
+                        isolated=True) as held:
             outcome = campaign(engines, budget, count=limit, seconds=seconds,
                                seed=seed_value, progress=bar.update, executor=held.executor,
                                jobs=max(held.slots, 1), keep_going=keep_going,
                                found=write if keep_going else None, channel=channel,
                                corpus=corpus, statistics=fuzz_format == "json",
-                               lost=held.lost)
+                               lost=held.lost, worker_lost=worker_lost)
     # Such as no C compiler for c-ON, or a cluster that cannot be had or was lost.
     except (BuildError, EngineUnavailable, Unavailable, ClusterLost) as error:
         raise Failure(f"error: {error}") from None
-    except BrokenExecutor:  # a search lost each time, though no program ended its process
+    except SearchLost:  # though no program ended its process
         raise Failure(f"error: a worker process ended abruptly {LOSSES + 1} times running "
                       "one search, though none of its programs ended the process that ran "
                       "it (something killed the workers, or the memory ran out); the "
@@ -252,9 +262,9 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     return stopped or (EXIT_ERRORS if outcome.finding is not None else 0)
 
 
-POOL_RENEWED = ("a worker process ended abruptly (killed, out of memory, or ended by an "
-                "engine); its searches run again, each program in a process of its own, "
-                "to find the program that ended it")
+WORKER_LOST = ("a worker process ended abruptly (killed, out of memory, or ended by an "
+               "engine); its searches run again, each program in a process of its own, "
+               "to find the program that ended it")
 
 
 def _found(finding: Finding, reference: str) -> str:

@@ -22,10 +22,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
-from support import ROOT
+from support import ROOT, cluster_worker
 from support.campaigns import WALL_PROGRAM, WALL_WORLD, campaign_files
 from support.cli import rl1c
+from support.planted import crashing_c_vm
 
+from rl1.compiler import differential
+from rl1.compiler.cli.fuzz import WORKER_LOST
 from rl1.compiler.cli.sim_campaign import Setting
 from rl1.compiler.executors import Unavailable, _threads
 
@@ -41,6 +44,10 @@ class Cluster:
     logs: Path
     processes: list[subprocess.Popen[bytes]] = field(default_factory=list)
     address: str = ""
+    # Tries of a task on workers that die running it before the scheduler fails it with
+    # KilledWorker (Dask's default is 3); None: Dask's default.
+    allowed_failures: int | None = 0
+    python_path: Path | None = None  # the PYTHONPATH of every process, unless told another
 
     @property
     def workers(self) -> list[subprocess.Popen[bytes]]:
@@ -57,10 +64,15 @@ class Cluster:
             time.sleep(0.1)
         self.address = json.loads(address_file.read_text())["address"]
 
-    def start_worker(self, python_path: Path | None = None) -> None:
+    def start_worker(self, python_path: Path | None = None, *, nanny: bool = False,
+                     preload: str | None = None) -> None:
+        """A worker of one thread; with `nanny`, as `dask worker` starts one by default,
+        under a nanny that starts it again when it dies; `preload` (a module) is loaded
+        in it first."""
         self._start("worker", self.address, "--host", "127.0.0.1", "--nthreads", "1",
-                    "--no-nanny", "--name", f"worker-{len(self.workers)}",
-                    python_path=python_path)
+                    *(() if nanny else ("--no-nanny",)),
+                    *(("--preload", preload) if preload else ()),
+                    "--name", f"worker-{len(self.workers)}", python_path=python_path)
 
     def wait_for_workers(self, count: int) -> None:
         from distributed import Client
@@ -74,8 +86,10 @@ class Cluster:
         # A worker killed while it makes a run fails that run at once (allowed-failures
         # 0, where Dask would try it on up to three workers first), so that the
         # campaign's own resubmission is tested.
-        env = {**os.environ, "DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0",
-               **({"PYTHONPATH": str(python_path)} if python_path else {})}
+        python_path = python_path or self.python_path
+        env = {**os.environ, **({"PYTHONPATH": str(python_path)} if python_path else {})}
+        if self.allowed_failures is not None:
+            env["DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES"] = str(self.allowed_failures)
         with open(self.logs / f"{role}-{len(self.processes)}.log", "wb") as log:
             process = subprocess.Popen([str(BIN / "dask"), role, *options, "--no-dashboard"],
                                        stdin=subprocess.DEVNULL, stdout=log,
@@ -90,11 +104,12 @@ class Cluster:
 
 
 @contextmanager
-def _cluster(folder: Path, workers: int) -> Iterator[Cluster]:
+def _cluster(folder: Path, workers: int, allowed_failures: int | None = 0,
+             python_path: Path | None = None) -> Iterator[Cluster]:
     """A scheduler and `workers` workers, killed at the end whatever happens."""
     logs = folder / "cluster"
     logs.mkdir()
-    cluster = Cluster(logs)
+    cluster = Cluster(logs, allowed_failures=allowed_failures, python_path=python_path)
     try:
         cluster.start_scheduler()
         if workers:
@@ -424,3 +439,102 @@ def test_fuzzing_on_a_cluster_whose_scheduler_is_lost_says_so(cluster: Cluster,
     assert f"error: the connection to the Dask scheduler at {cluster.address} was lost" \
         in stderr
     assert "Traceback" not in stderr
+
+
+# Campaigns whose engines end their workers ------------------------------------------------
+
+CRASH = "c-O1: ended its process (signal SIGSEGV)"
+ENDED_WITHIN = 300  # s for a campaign of 21 programs whose workers die, on a loaded machine
+
+
+@contextmanager
+def _ending(folder: Path, allowed_failures: int | None) -> Iterator[Cluster]:
+    """Two workers, each under a nanny (which starts it again when it dies), as `dask
+    worker` starts them by default, that preload support.cluster_worker: its engine
+    ends-its-worker, and the planted crashing C VM when $PLANTED_C_VM names it. The
+    scheduler finds it too: it unpickles the tasks, and their engines."""
+    with _cluster(folder, 0, allowed_failures, ROOT / "tests") as cluster:
+        for _ in range(2):
+            cluster.start_worker(nanny=True, preload="support.cluster_worker")
+        cluster.wait_for_workers(2)
+        yield cluster
+
+
+@pytest.fixture
+def crashing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Cluster]:
+    """A cluster whose workers' C VM, and this process's, is the planted crashing one: a
+    step after which A is 1234 ends the process with SIGSEGV. Dask's scheduler as it
+    comes, which tries a task on 4 workers that die running it before it fails it with
+    KilledWorker."""
+    library = crashing_c_vm(tmp_path)
+    monkeypatch.setattr(differential, "library", lambda: library)  # for --replay here
+    monkeypatch.setenv(cluster_worker.PLANTED, str(library))
+    with _ending(tmp_path, None) as cluster:
+        yield cluster
+
+
+def _fuzz_crashing(cluster: Cluster, folder: Path, *options: str
+                   ) -> subprocess.CompletedProcess[str]:
+    """`rl1c fuzz` of vm-O0 and c-O1 on `cluster`, a program that crashes the C VM first
+    (its corpus), then 20 generated."""
+    corpus = folder / "corpus"
+    corpus.mkdir()
+    (corpus / "crash.rob").write_text("B=1\nA=1234\nC=2\n", encoding="ascii")
+    return subprocess.run([str(BIN / "rl1c"), "fuzz", "--engine", "vm-O0", "--engine", "c-O1",
+                           "--corpus", str(corpus), "--count", "20", "--seed", "1",
+                           "--scheduler", cluster.address, "--out", str(folder / "out"),
+                           *options], capture_output=True, text=True, timeout=ENDED_WITHIN,
+                          check=False)
+
+
+def _the_crash(out: Path) -> Path:
+    """The reproducer under `out` of the crash shrunk to its line, which still crashes."""
+    folder = next(path.parent for path in out.glob("finding-*/program.rob")
+                  if path.read_text() == "A=1234\n")
+    replayed = rl1c("fuzz", "--replay", folder)
+    assert replayed.exit_code == 1, replayed.output
+    assert replayed.stdout.rstrip().endswith(CRASH)
+    return folder
+
+
+@pytest.mark.needs_cc
+def test_a_program_that_crashes_a_workers_c_vm_is_the_finding(
+        crashing: Cluster, tmp_path: Path) -> None:
+    result = _fuzz_crashing(crashing, tmp_path)
+    assert result.returncode == 1, result.stderr + crashing.log()
+    assert "Traceback" not in result.stdout + result.stderr
+    assert result.stderr == f"rl1c: warning: {WORKER_LOST}\n"
+    assert ("an engine ends the process it runs in\n\nthe smallest program found that "
+            "does it:\n   1 | A=1234\n\n" + CRASH) in result.stdout
+    folder = _the_crash(tmp_path / "out")
+    assert f"reproducer: {folder} (program, sensor script, each engine's run)" \
+        in result.stdout
+
+
+@pytest.mark.needs_cc
+def test_keep_going_on_a_cluster_goes_past_a_crash_and_counts_it(
+        crashing: Cluster, tmp_path: Path) -> None:
+    result = _fuzz_crashing(crashing, tmp_path, "--keep-going")
+    assert result.returncode == 1, result.stderr + crashing.log()
+    assert "Traceback" not in result.stdout + result.stderr
+    assert "fuzz: 21 programs (the corpus of 1 first)" in result.stdout
+    assert f"      1  {CRASH}\n" in result.stdout
+    _the_crash(tmp_path / "out")
+
+
+def test_a_worker_killed_each_time_on_a_cluster_is_said_as_such(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # The cluster's KilledWorker went through as an internal error with its traceback,
+    # where a local pool's loss said what happened.
+    named = differential.engine_named
+    monkeypatch.setattr(differential, "engine_named", lambda name: (
+        cluster_worker.EndsItsWorker() if name == "ends-its-worker" else named(name)))
+    with _ending(tmp_path, 0) as cluster:  # each death a KilledWorker: 3, not 12
+        result = rl1c("fuzz", "--engine", "vm-O0", "--engine", "ends-its-worker",
+                      "--count", "4", "--seed", "3", "--scheduler", cluster.address)
+    assert result.exit_code == 3, result.output + cluster.log()
+    assert result.stderr == (
+        f"rl1c: warning: {WORKER_LOST}\n"
+        "error: a worker process ended abruptly 3 times running one search, though "
+        "none of its programs ended the process that ran it (something killed the "
+        "workers, or the memory ran out); the campaign runs again with --seed 3\n")

@@ -1,0 +1,42 @@
+"""What the Dask workers of tests/sim/test_cluster.py's campaigns that end their workers
+load first (`dask worker --preload support.cluster_worker`, with tests/ on PYTHONPATH):
+the C VM of $PLANTED_C_VM (support.planted.crashing_c_vm's library) when it is set, and
+`EndsItsWorker`, an engine that ends the worker whatever program it judges, there or in
+a process the worker forked to judge it apart."""
+
+from __future__ import annotations
+
+import os
+import signal
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from rl1.compiler import differential
+from rl1.compiler.differential import Observation, VmEngine
+from rl1.compiler.strategies import Run
+
+PLANTED = "PLANTED_C_VM"  # the environment variable naming the library
+_worker: int | None = None  # the process id of the worker this was loaded in
+
+if os.environ.get(PLANTED):
+    library = Path(os.environ[PLANTED])
+    differential.library = lambda: library
+
+
+def dask_setup(worker: Any) -> None:
+    """Dask's call when the worker starts, in its process."""
+    global _worker
+    _worker = os.getpid()
+
+
+@dataclass(frozen=True)
+class EndsItsWorker:
+    name: str = "ends-its-worker"
+    level: int = 0
+
+    def run(self, case: Run, budget: int) -> Observation:
+        if _worker is None:
+            raise RuntimeError("EndsItsWorker runs only on a worker that preloaded it")
+        os.kill(_worker, signal.SIGKILL)
+        return VmEngine(0).run(case, budget)
