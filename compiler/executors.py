@@ -229,8 +229,24 @@ def sources_digest() -> str:
 
 
 def _same_rl1(client: Client, address: str) -> None:
-    """Unavailable when a worker of the cluster now runs another rl1 (a worker joining
-    later is checked by each task it is given: `_checked`)."""
+    """Unavailable when the scheduler, or a worker of the cluster now, runs another rl1
+    or none (a worker joining later is checked by each task it is given: `_checked`).
+    The scheduler unpickles each task, and so needs the classes it holds: without them,
+    Dask fails every task with a RuntimeError that names no cause."""
+    try:
+        scheduler = client.run_on_scheduler(sources_digest)  # type: ignore[no-untyped-call]
+    except OSError as error:  # the scheduler gone since it was reached
+        raise _connection_lost(address, error) from None
+    except Exception as error:  # such as a scheduler without rl1, which cannot unpickle it
+        raise Unavailable(f"the Dask scheduler at {address} cannot read rl1's tasks "
+                          f"({type(error).__name__}: {error})\n  = help: install this rl1 "
+                          "on the scheduler's machine too (it unpickles each task), and "
+                          "restart the scheduler") from None
+    if scheduler != sources_digest():
+        raise Unavailable(
+            f"the Dask scheduler at {address} runs another rl1 than this one (its sources "
+            "differ), which may read rl1's tasks otherwise\n  = help: install the same rl1 "
+            "there, and restart the scheduler")
     try:
         theirs: dict[str, str] = client.run(sources_digest)
     except OSError as error:  # the scheduler gone since it was reached

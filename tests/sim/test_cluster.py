@@ -16,7 +16,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -305,6 +305,36 @@ def test_a_worker_running_another_rl1_is_refused_before_any_run(
     assert re.search(r"error: the Dask workers tcp://127\.0\.0\.1:\d+ of the scheduler at "
                      + re.escape(scheduler.address) + " run another rl1", result.stderr)
     assert "install the same rl1 there" in result.stderr and not out.exists()
+
+
+def _no_rl1(folder: Path) -> Path:
+    """The PYTHONPATH of a Dask process on a machine without rl1."""
+    none = folder / "none" / "rl1"
+    none.mkdir(parents=True)
+    (none / "__init__.py").write_text('raise ImportError("no rl1 here")\n', encoding="utf-8")
+    return none.parent
+
+
+@pytest.mark.parametrize(("python_path", "said"), [
+    (_no_rl1, "cannot read rl1's tasks (ImportError: no rl1 here)"),
+    (_other_rl1, "runs another rl1 than this one (its sources differ)"),
+])
+def test_a_scheduler_without_this_rl1_is_refused_before_any_run(
+        tmp_path: Path, python_path: Callable[[Path], Path], said: str) -> None:
+    # It unpickles each task: without rl1, every run failed with a RuntimeError of
+    # Dask's, an internal error of rl1c's.
+    program, world = _wall(tmp_path)
+    out = tmp_path / "runs.jsonl"
+    with _cluster(tmp_path, 0, python_path=python_path(tmp_path)) as scheduler:
+        scheduler.start_worker(tmp_path)  # this rl1 (the folder holds no other)
+        scheduler.wait_for_workers(1)
+        result = rl1c("sim", program, "--world", world, "--runs", "5", "--scheduler",
+                      scheduler.address, "--out", out)
+    assert result.exit_code == 2, result.output + scheduler.log()
+    assert result.stderr.startswith(f"error: the Dask scheduler at {scheduler.address} "
+                                    + said), result.stderr
+    assert "restart the scheduler" in result.stderr and not out.exists()
+    assert "Traceback" not in result.output
 
 
 def test_a_worker_running_another_rl1_that_joins_later_stops_the_campaign(
