@@ -4,8 +4,9 @@ or on a Dask cluster (`--scheduler tcp://HOST:8786`), each a `concurrent.futures
 for all three.
 
 Dask's `distributed` is an optional extra (`pip install 'rl1[cluster]'`), imported only
-when a scheduler is given. Its workers need rl1 installed and nothing else: what they
-run carries its inputs (compiler/campaign.py's Task holds the program and the world).
+when a scheduler is given. Its workers and its scheduler (which unpickles each task) need
+this rl1 installed and nothing else: what they run carries its inputs
+(compiler/campaign.py's Task holds the program and the world).
 """
 
 from __future__ import annotations
