@@ -20,10 +20,10 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass, field
-from functools import cache
+from functools import cache, lru_cache
 
 from rl1.compiler.frontend.ast import BinaryOperator, Relation, Step
-from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLES, Form
+from rl1.vm.language import BUILTINS, HANDLER_LABELS, VARIABLE_INDEX, Form
 
 BlockId = str
 """`Lnn` for the block a source label `:nn` starts, `Bn` for the others."""
@@ -154,10 +154,12 @@ class Call:
         return text + (" " + ", ".join(map(str, self.args)) if self.args else "")
 
 
-@cache
+@lru_cache(maxsize=256)  # bounded: a malformed IR may name any number of built-ins
 def _call_form(mnemonic: str, selector: str | None) -> Form | None:
-    """BUILTINS' form lookup, which the passes make for every call they pass."""
-    return BUILTINS[mnemonic].form(selector)
+    """BUILTINS' form lookup, which the passes and `validate` make for every call they
+    pass: None when the name or the selector names no form."""
+    builtin = BUILTINS.get(mnemonic)
+    return builtin.form(selector) if builtin else None
 
 
 @dataclass(frozen=True, slots=True)
@@ -343,20 +345,22 @@ def validate(program: Program) -> list[str]:
                         "changed a block's list in place, where it must replace it")
     if next(iter(program.blocks), None) != program.entry:
         problems.append(f"the entry block {program.entry} is not the first block")
-    for block_id, block in program.blocks.items():
+    blocks = program.blocks
+    for block_id, block in blocks.items():
         if block.id != block_id:
             problems.append(f"block {block.id} is filed under the id {block_id}")
-        problems.extend(f"{block_id}: {problem}" for problem in _block_problems(block))
-        problems.extend(
-            f"{block_id}: jumps to {target}, which is not a block"
-            for target in block.successors if target not in program.blocks
-        )
+        for problem in _block_problems(block):
+            problems.append(f"{block_id}: {problem}")
+        if isinstance(block.terminator, Terminator):
+            for target in block.terminator.targets:
+                if target not in blocks:
+                    problems.append(f"{block_id}: jumps to {target}, which is not a block")
     problems.extend(_decreasing_lines(program))
     problems.extend(_ends_not_written(program))
     for label, block_id in program.handlers.items():
         if label not in HANDLER_LABELS:
             problems.append(f"handler :{label} is not one of :96-:99")
-        if block_id not in program.blocks:
+        if block_id not in blocks:
             problems.append(f"handler :{label} names {block_id}, which is not a block")
     return problems
 
@@ -380,63 +384,67 @@ def _decreasing_lines(program: Program) -> Iterator[str]:
     previous = 0
     for block, following in program.laid_out():
         terminator = block.terminator
-        emitted: list[Instruction | Terminator] = [*block.instructions]
-        if not (isinstance(terminator, Jump) and terminator.target == following):
-            emitted.append(terminator)
-        for item in emitted:
+        left_out = isinstance(terminator, Jump) and terminator.target == following
+        for item in block.instructions if left_out else (*block.instructions, terminator):
             if item.line < previous:
                 yield f"{block.id}: line {item.line} comes after line {previous}"
-            previous = max(previous, item.line)
+            else:
+                previous = item.line
 
 
 def _block_problems(block: Block) -> Iterator[str]:
-    if not isinstance(block.terminator, Jump | Branch | StoreBranch | DecrementBranch | End):
-        yield f"ends with {block.terminator!r}, which is not a terminator"
+    terminator = block.terminator
+    if not isinstance(terminator, Terminator):
+        yield f"ends with {terminator!r}, which is not a terminator"
     result_set = False  # whether R holds a value here (only a call within the block sets it)
     loaded = False  # whether acc holds a value here: it is dead where a block starts
     for instruction in block.instructions:
-        if not isinstance(instruction, Load | Operate | Store | StepVar | Call | Move | Compute):
+        if not isinstance(instruction, Instruction):
             yield f"holds {instruction!r}, which is not an instruction"
             continue
         for operand in operands(instruction):
-            if isinstance(operand, Var) and operand.name not in VARIABLES:
-                yield f"line {instruction.line}: `{operand.name}` is not a variable"
-            elif isinstance(operand, Imm) and not -0x8000 <= operand.value <= 0x7FFF:
-                yield f"line {instruction.line}: {operand.value} does not fit 16 bits"
-            elif isinstance(operand, Result) and not result_set:
-                yield f"line {instruction.line}: `{instruction}` reads R before a call sets it"
-        if isinstance(instruction, Operate | Store) and not loaded:
-            yield f"line {instruction.line}: `{instruction}` reads acc before a load sets it"
-        loaded = loaded or isinstance(instruction, Load | Compute)
-        if isinstance(instruction, Call):
-            yield from _call_problems(instruction)
-            result_set = instruction.mnemonic in BUILTINS and instruction.returns_value
-    terminator = block.terminator
+            match operand:
+                case Var(name=name) if name not in VARIABLE_INDEX:
+                    yield f"line {instruction.line}: `{name}` is not a variable"
+                case Imm(value=value) if not -0x8000 <= value <= 0x7FFF:
+                    yield f"line {instruction.line}: {value} does not fit 16 bits"
+                case Result() if not result_set:
+                    yield f"line {instruction.line}: `{instruction}` reads R before a call sets it"
+        match instruction:
+            case Load() | Compute():
+                loaded = True
+            case Operate() | Store() if not loaded:
+                yield f"line {instruction.line}: `{instruction}` reads acc before a load sets it"
+            case Call():
+                form = _call_form(instruction.mnemonic, instruction.selector)
+                yield from _call_problems(instruction, form)
+                result_set = form is not None and form.returns_value
     if isinstance(terminator, StoreBranch) and not loaded:
         yield f"line {terminator.line}: `{terminator}` reads acc before a load sets it"
     if isinstance(terminator, Branch | StoreBranch | DecrementBranch) \
-            and terminator.var.name not in VARIABLES:
+            and terminator.var.name not in VARIABLE_INDEX:
         yield f"branches on `{terminator.var.name}`, which is not a variable"
 
 
 def operands(instruction: Instruction) -> tuple[Operand, ...]:
     """What an instruction names: the variables it reads or writes, constants and R (a
     call's reserved variables left out)."""
-    if isinstance(instruction, Load | Operate):
-        return (instruction.source,)
-    if isinstance(instruction, Store | StepVar):
-        return (instruction.target,)
-    if isinstance(instruction, Move):
-        return (instruction.target, instruction.source)
-    if isinstance(instruction, Compute):
-        return (instruction.first, instruction.second)
-    return instruction.args
+    match instruction:
+        case Load(source=source) | Operate(source=source):
+            return (source,)
+        case Store(target=target) | StepVar(target=target):
+            return (target,)
+        case Move():
+            return (instruction.target, instruction.source)
+        case Compute():
+            return (instruction.first, instruction.second)
+        case Call():
+            return instruction.args
 
 
-def _call_problems(call: Call) -> Iterator[str]:
-    builtin = BUILTINS.get(call.mnemonic)
-    form = builtin.form(call.selector) if builtin else None
-    if builtin is None or form is None or call.mnemonic == "END":
+def _call_problems(call: Call, form: Form | None) -> Iterator[str]:
+    """What is wrong with a call of `form` (None when its name and selector name none)."""
+    if form is None or call.mnemonic == "END":
         yield f"line {call.line}: `{call}` is not a built-in form (END is a terminator)"
         return
     if len(call.args) != len(form.params):
@@ -447,4 +455,3 @@ def _call_problems(call: Call) -> Iterator[str]:
             yield f"line {call.line}: `{call}`: {param.name} must lie in {param.low}..{param.high}"
         if call.compact and isinstance(arg, Imm) and not -0x80 <= arg.value <= 0x7F:
             yield f"line {call.line}: `{call}`: {param.name} does not fit a byte"
-
