@@ -81,8 +81,7 @@ def test_a_store_and_branch_before_a_load_is_refused() -> None:
     DecrementBranch(Var(""), "B0", "B0", 1),
 ], ids=["branch", "store-branch", "decrement-branch"])
 def test_a_branch_on_what_is_no_variable_is_refused(terminator: Terminator) -> None:
-    loads = [Load(Imm(1), 1)]
-    assert problems(loads, terminator) == [
+    assert problems([Load(Imm(1), 1)], terminator) == [
         f"B0: branches on `{terminator.var.name}`, which is not a variable"]  # type: ignore[union-attr]
 
 
