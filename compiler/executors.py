@@ -39,6 +39,9 @@ if TYPE_CHECKING:
 CONNECT_TIMEOUT = 5  # s: an unreachable scheduler is said in a few seconds, and a lost
 # one once its client has tried as long to reconnect
 WATCH_EVERY = 0.5  # s between looks at whether a cluster's client has given up
+MANNED_EVERY = 2.0  # s between asks whether a cluster with work waiting has workers
+UNMANNED_AFTER = 10.0  # s without one before it is said: a nanny restarts its worker in
+# a few seconds
 PARENT_WATCH_EVERY = 0.5  # s between a local worker's looks at whether its parent
 # has ended, once it was sent SIGINT or SIGTERM
 EXTRA = "cluster"  # pyproject.toml's extra that installs `distributed`
@@ -121,17 +124,19 @@ class _Workers(multiprocessing.context.DefaultContext):
 
 @contextmanager
 def workers(jobs: int, scheduler: str | None = None,
-            renewed: Callable[[], None] | None = None, *, isolated: bool = False
-            ) -> Iterator[Workers]:
+            renewed: Callable[[], None] | None = None, *, isolated: bool = False,
+            unmanned: Callable[[], None] | None = None) -> Iterator[Workers]:
     """The workers of a campaign: the Dask cluster of `scheduler` when given, else `jobs`
     local processes (this process alone for 1, unless `isolated`: work that may end the
     process doing it, such as the C VM's, then has one of its own). When one of those
     processes dies, the pool is broken for good, or, given `renewed`, made again
-    (`Renewed`), and `renewed` called. Unavailable when `distributed` is not installed
-    or the scheduler cannot be reached. On leaving, the work not yet done is
-    cancelled."""
+    (`Renewed`), and `renewed` called. A cluster whose workers have all gone while work
+    waits (killed, or ended by what they ran, without a nanny to start them again) waits
+    for one, calling `unmanned` each time it is left without. Unavailable when
+    `distributed` is not installed or the scheduler cannot be reached. On leaving, the
+    work not yet done is cancelled."""
     if scheduler is not None:
-        with _cluster(scheduler) as cluster:
+        with _cluster(scheduler, unmanned) as cluster:
             yield cluster
         return
     if jobs == 1 and not isolated:
@@ -188,7 +193,7 @@ class Renewed(Executor):
 
 
 @contextmanager
-def _cluster(address: str) -> Iterator[Workers]:
+def _cluster(address: str, unmanned: Callable[[], None] | None) -> Iterator[Workers]:
     try:
         from distributed import Client
         from distributed.scheduler import KilledWorker
@@ -210,7 +215,7 @@ def _cluster(address: str) -> Iterator[Workers]:
         client.close()  # type: ignore[no-untyped-call]
         raise
     try:
-        yield Workers(_Watched(client, address), slots, (KilledWorker,))
+        yield Workers(_Watched(client, address, unmanned), slots, (KilledWorker,))
     finally:
         # The scheduler forgets the client's tasks left, and cancels them.
         client.close()  # type: ignore[no-untyped-call]
@@ -294,15 +299,19 @@ def _unreachable(address: str, why: str) -> Unavailable:
 class _Watched(Executor):
     """The executor of a Dask client, whose work not yet finished fails with
     ClusterLost once the client gives up reconnecting to its scheduler: Dask's own
-    futures are then cancelled, or wait for ever."""
+    futures are then cancelled, or wait for ever. While work waits, it asks every
+    MANNED_EVERY seconds whether the cluster has workers, and calls `unmanned` when it
+    has had none for UNMANNED_AFTER seconds (again only once some have joined since)."""
 
-    def __init__(self, client: Client, address: str) -> None:
+    def __init__(self, client: Client, address: str,
+                 unmanned: Callable[[], None] | None = None) -> None:
         self._client = client
         # Not pure: a task submitted again after its worker died is a new one, not the
         # failed one remembered under the same key.
         self._executor: Executor = client.get_executor(  # type: ignore[no-untyped-call]
             pure=False)
         self._address = address
+        self._unmanned = unmanned
         self._futures: weakref.WeakSet[Future[Any]] = weakref.WeakSet()
         threading.Thread(target=self._watch, daemon=True).start()
 
@@ -310,10 +319,29 @@ class _Watched(Executor):
         return self._client.status in ("closing", "closed")
 
     def _watch(self) -> None:
+        asked = time.monotonic()
+        manned = asked  # when the cluster last had workers, or no work waited
+        said = False  # that it has none
         while not self._lost():
             time.sleep(WATCH_EVERY)
+            if self._unmanned is not None and time.monotonic() - asked >= MANNED_EVERY:
+                asked = time.monotonic()
+                if self._manned():
+                    manned, said = asked, False
+                elif not said and asked - manned >= UNMANNED_AFTER:
+                    said = True
+                    self._unmanned()
         for future in list(self._futures):
             self._fail(future)
+
+    def _manned(self) -> bool:
+        """Whether the cluster has workers, or no work waits for one."""
+        if all(future.done() for future in list(self._futures)):
+            return True
+        try:
+            return bool(self._client.nthreads())  # type: ignore[no-untyped-call]
+        except Exception:  # such as the connection lost, which _lost tells
+            return True
 
     def _fail(self, future: Future[Any]) -> None:
         with contextlib.suppress(InvalidStateError):  # finished, or cancelled

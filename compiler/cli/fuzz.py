@@ -205,7 +205,8 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         # cluster's worker (whose nanny starts it again).
         with _halted_by_signals(channel) as signalled, \
                 workers(jobs or os.cpu_count() or 1, scheduler, lambda: None,
-                        isolated=True) as held:
+                        isolated=True, unmanned=lambda: bar.warn(
+                            _no_workers_left(scheduler or ""))) as held:
             outcome = campaign(engines, budget, count=limit, seconds=seconds,
                                seed=seed_value, progress=bar.update, executor=held.executor,
                                jobs=max(held.slots, 1), keep_going=keep_going,
@@ -265,6 +266,12 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
 WORKER_LOST = ("a worker process ended abruptly (killed, out of memory, or ended by an "
                "engine); its searches run again, each program in a process of its own, "
                "to find the program that ended it")
+
+
+def _no_workers_left(scheduler: str) -> str:
+    return (f"the Dask scheduler at {scheduler} has no workers left (one that an engine "
+            "ends is started again only under a nanny: `dask worker` without --no-nanny); "
+            f"the searches wait for one (`dask worker {scheduler}`)")
 
 
 def _found(finding: Finding, reference: str) -> str:

@@ -20,6 +20,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import IO
 
 import pytest
 from support import ROOT, cluster_worker
@@ -503,18 +504,38 @@ def crashing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Cluste
         yield cluster
 
 
-def _fuzz_crashing(cluster: Cluster, folder: Path, *options: str
-                   ) -> subprocess.CompletedProcess[str]:
+@contextmanager
+def _crashing_campaign(cluster: Cluster, folder: Path, stderr: IO[str] | int,
+                       *options: str) -> Iterator[subprocess.Popen[str]]:
     """`rl1c fuzz` of vm-O0 and c-O1 on `cluster`, a program that crashes the C VM first
-    (its corpus), then 20 generated."""
+    (its corpus), then 20 generated, its standard error to `stderr`; killed on leaving
+    if it has not ended (a test that timed out)."""
     corpus = folder / "corpus"
     corpus.mkdir()
     (corpus / "crash.rob").write_text("B=1\nA=1234\nC=2\n", encoding="ascii")
-    return subprocess.run([str(BIN / "rl1c"), "fuzz", "--engine", "vm-O0", "--engine", "c-O1",
-                           "--corpus", str(corpus), "--count", "20", "--seed", "1",
+    with subprocess.Popen([str(BIN / "rl1c"), "fuzz", "--engine", "vm-O0", "--engine",
+                           "c-O1", "--corpus", str(corpus), "--count", "20", "--seed", "1",
                            "--scheduler", cluster.address, "--out", str(folder / "out"),
-                           *options], capture_output=True, text=True, timeout=ENDED_WITHIN,
-                          check=False)
+                           *options], stdout=subprocess.PIPE, stderr=stderr, text=True
+                          ) as process:
+        try:
+            yield process
+        finally:
+            if process.poll() is None:
+                process.kill()
+
+
+def _fuzz_crashing(cluster: Cluster, folder: Path, *options: str
+                   ) -> subprocess.CompletedProcess[str]:
+    """_crashing_campaign to its end."""
+    with _crashing_campaign(cluster, folder, subprocess.PIPE, *options) as process:
+        stdout, stderr = process.communicate(timeout=ENDED_WITHIN)
+    return subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
+
+
+def _warnings(stderr: str) -> list[str]:
+    """The lines of `stderr` but the progress lines (every 10 s)."""
+    return [line for line in stderr.splitlines() if not line.startswith("fuzz: ")]
 
 
 def _the_crash(out: Path) -> Path:
@@ -533,9 +554,9 @@ def test_a_program_that_crashes_a_workers_c_vm_is_the_finding(
     result = _fuzz_crashing(crashing, tmp_path)
     assert result.returncode == 1, result.stderr + crashing.log()
     assert "Traceback" not in result.stdout + result.stderr
-    assert result.stderr == f"rl1c: warning: {WORKER_LOST}\n"
+    assert _warnings(result.stderr) == [f"rl1c: warning: {WORKER_LOST}"]
     assert ("an engine ends the process it runs in\n\nthe smallest program found that "
-            "does it:\n   1 | A=1234\n\n" + CRASH) in result.stdout
+            f"does it:\n   1 | A=1234\n\n{CRASH}\n\nreproducer: ") in result.stdout
     folder = _the_crash(tmp_path / "out")
     assert f"reproducer: {folder} (program, sensor script, each engine's run)" \
         in result.stdout
@@ -568,3 +589,36 @@ def test_a_worker_killed_each_time_on_a_cluster_is_said_as_such(
         "error: a worker process ended abruptly 3 times running one search, though "
         "none of its programs ended the process that ran it (something killed the "
         "workers, or the memory ran out); the campaign runs again with --seed 3\n")
+
+
+@pytest.mark.needs_cc
+def test_workers_a_crash_ended_without_a_nanny_are_said_and_waited_for(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # Dask tries the search on both workers, each ended for good, and fails it (allowed
+    # failures 1): the campaign, whose search waits to run again apart, waited in silence
+    # for ever.
+    library = crashing_c_vm(tmp_path)
+    monkeypatch.setattr(differential, "library", lambda: library)
+    monkeypatch.setenv(cluster_worker.PLANTED, str(library))
+    with _cluster(tmp_path, 0, 1, ROOT / "tests") as cluster:
+        for _ in range(2):
+            cluster.start_worker(preload="support.cluster_worker")
+        cluster.wait_for_workers(2)
+        said = tmp_path / "stderr.txt"
+        with open(said, "w") as stderr, _crashing_campaign(cluster, tmp_path, stderr
+                                                          ) as process:
+            deadline = time.monotonic() + ENDED_WITHIN
+            while "has no workers left" not in said.read_text():
+                assert process.poll() is None and time.monotonic() < deadline, (
+                    said.read_text() + cluster.log())
+                time.sleep(0.1)
+            cluster.start_worker(preload="support.cluster_worker")
+            stdout, _ = process.communicate(timeout=ENDED_WITHIN)
+    assert process.returncode == 1, said.read_text() + cluster.log()
+    assert _warnings(said.read_text()) == [
+        f"rl1c: warning: {WORKER_LOST}",
+        f"rl1c: warning: the Dask scheduler at {cluster.address} has no workers left (one "
+        "that an engine ends is started again only under a nanny: `dask worker` without "
+        f"--no-nanny); the searches wait for one (`dask worker {cluster.address}`)"]
+    assert f"that does it:\n   1 | A=1234\n\n{CRASH}\n\nreproducer: " in stdout
+    _the_crash(tmp_path / "out")
