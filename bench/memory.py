@@ -24,6 +24,10 @@ import tempfile
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).parents[1] / "tests"))
+
+from support.block_shapes import BLOCK_SHAPES  # tests/ is put on the path just above
+
 RL1C = [sys.executable, "-c", "import sys; from rl1.compiler.cli.main import rl1c; "
         "sys.argv[0] = 'rl1c'; sys.exit(rl1c())"]
 MIB = 2**20
@@ -105,10 +109,11 @@ def sources() -> list[tuple[str, bytes, bytes]]:
         ("`t=1` lines, reserved writes", b"", b"t=1\n"),
         # a diagnostic of a program-wide rule a line (W0401: `s` may be unset)
         ("`A=s` lines, unset reads", b"", b"A=s\n"),
-        # a block a line that jumps back to the first line, and one that also falls
-        # through (a loop of every line)
-        ("`#01` lines after `:01`, a jump each", b":01\n", b"#01\n"),
-        ("`?A=#01` lines after `:01`", b":01\n", b"?A=#01\n"),
+        # a block every few bytes, each shape tests/backend/test_compile_memory.py holds
+        # to the bound: conditional jumps, jumps back to the first line, labels, a
+        # handler's ends
+        *((shape.name, shape.head.encode(), shape.unit.encode())
+          for shape in BLOCK_SHAPES.values()),
         ("`#01` lines, no `:01`: an E0203 each", b"", b"#01\n"),
         # a block for every three bytes (and an E0202 a line): above the bound
         ("`#1` lines, a block each 3 bytes", b"", b"#1\n"),

@@ -9,6 +9,7 @@ import sys
 import textwrap
 
 import pytest
+from support.block_shapes import BLOCK_SHAPES
 
 # bench/memory.py's source with lines of 1,999 characters instead of 19,999, at a size
 # tracemalloc measures in seconds (the tokens of one long line, 10 MB while it is parsed,
@@ -40,30 +41,16 @@ def test_compiling_takes_at_most_64_bytes_a_source_byte() -> None:
     assert float(measured.stdout) <= 64
 
 
-# Sources of many blocks, the costliest IR a byte (a block's IR is some 300 bytes), at
-# 64 KiB (past driver.TREE_CHARACTERS, so streamed; their figures are those of 256 KiB
-# within a byte a byte): each an expression that makes the text from `characters`.
-BLOCK_SOURCES = {
-    # a conditional jump a line, each a block of its own (7 bytes)
-    "?A=#01": '":01\\n" + "?A=#01\\n" * (characters // 7)',
-    "?A<#01": '":01\\n" + "?A<#01\\n" * (characters // 7)',
-    "?A>#01": '":01\\n" + "?A>#01\\n" * (characters // 7)',
-    # a jump a line: a block every 4 bytes, which no path reaches
-    "#01": '":01\\n" + "#01\\n" * (characters // 4)',
-    # a label on each of 96 lines, and jumps between them on all the others
-    "labels": '"".join(f":{n:02d} ?A=#{(n * 37 + 11) % 96:02d}\\n" for n in range(96))'
-              ' + "".join(f"?A=#{(n * 37 + 5) % 96:02d}\\n" for n in range(96))'
-              ' * (characters // 672)',
-    # a handler's lines, each ending the program (a block each)
-    "(END)": '":96\\n" + "(END)\\n" * (characters // 6)',
-}
+# The sources of many blocks (support.block_shapes) at 64 KiB (past
+# driver.TREE_CHARACTERS, so streamed; their figures are those of 256 KiB within a byte a
+# byte).
 BLOCK_CHARACTERS = 64 * 1024
 
 MEASURE_BLOCKS = textwrap.dedent("""
-    import tracemalloc
+    import sys, tracemalloc
     from rl1.compiler.backend.driver import compile_text
-    characters = {characters}
-    text = {source}
+    head, unit = sys.argv[1:]
+    text = head + unit * ({characters} // len(unit))
     tracemalloc.start()
     for strip_debug in (True, False):
         tracemalloc.reset_peak()
@@ -73,7 +60,7 @@ MEASURE_BLOCKS = textwrap.dedent("""
         print(tracemalloc.get_traced_memory()[1] / len(text))
 """)
 
-@pytest.mark.parametrize("shape", BLOCK_SOURCES)
+@pytest.mark.parametrize("shape", BLOCK_SHAPES)
 def test_a_block_a_line_takes_at_most_64_bytes_a_source_byte(shape: str) -> None:
     """The peak of the allocations of a compile beyond its text, with --strip-debug and
     without, of a source of a block every few bytes. ?A=#01 peaked at 445 B/B (a set of
@@ -94,7 +81,8 @@ def test_a_block_a_line_takes_at_most_64_bytes_a_source_byte(shape: str) -> None
 def _peaks(shape: str) -> list[float]:
     """The peak, in bytes a source byte, of compiling the shape with --strip-debug and
     without, in a process of its own (so that no other test's caches count)."""
-    script = MEASURE_BLOCKS.format(characters=BLOCK_CHARACTERS, source=BLOCK_SOURCES[shape])
-    measured = subprocess.run([sys.executable, "-c", script], capture_output=True,
-                              text=True, check=True)
+    head, unit, _ = BLOCK_SHAPES[shape]
+    script = MEASURE_BLOCKS.format(characters=BLOCK_CHARACTERS)
+    measured = subprocess.run([sys.executable, "-c", script, head, unit],
+                              capture_output=True, text=True, check=True)
     return [float(line) for line in measured.stdout.split()]
