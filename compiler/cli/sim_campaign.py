@@ -151,7 +151,9 @@ def _workers(setting: Setting, progress: Progress) -> Iterator[Workers]:
     one dies, said through `progress`), or the Failure that says why there are none."""
     try:
         with workers(min(setting.jobs, setting.runs), setting.scheduler,
-                     lambda: progress.warn(POOL_RENEWED)) as held:
+                     lambda: progress.warn(POOL_RENEWED),
+                     unmanned=lambda: progress.warn(no_workers_left(setting.scheduler or ""))
+                     ) as held:
             if setting.scheduler is not None and held.slots == 0:
                 print(f"rl1c: note: the scheduler at {setting.scheduler} has no workers yet; "
                       f"the runs wait for one (`dask worker {setting.scheduler}`)",
@@ -220,6 +222,11 @@ class Progress:
 
 POOL_RENEWED = ("a worker process ended abruptly (killed, or out of memory); a new pool "
                 "of workers makes its runs and those beside it again, a run a task")
+
+
+def no_workers_left(scheduler: str) -> str:
+    return (f"the Dask scheduler at {scheduler} has no workers left; the runs wait for "
+            f"one (`dask worker {scheduler}`)")
 
 
 SAME_RUNS = ("the world has no noise: every seed makes the same run, so {counted} "

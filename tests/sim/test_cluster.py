@@ -30,7 +30,7 @@ from support.planted import crashing_c_vm
 
 from rl1.compiler import differential
 from rl1.compiler.cli.fuzz import WORKER_LOST
-from rl1.compiler.cli.sim_campaign import Setting
+from rl1.compiler.cli.sim_campaign import Setting, no_workers_left
 from rl1.compiler.executors import Unavailable, _threads
 
 BIN = Path(sys.executable).parent
@@ -196,6 +196,35 @@ def test_a_worker_killed_in_a_campaign_on_a_cluster_loses_no_run(
     local = _local(program, world, runs, tmp_path / "local.jsonl")
     assert stdout == local  # every run counted once: the summary is exact
     assert out.read_bytes() == (tmp_path / "local.jsonl").read_bytes()
+
+
+def test_a_campaign_whose_workers_are_all_lost_says_so_and_waits_for_one(
+        tmp_path: Path) -> None:
+    # Its one worker killed, as `dask worker --no-nanny` is not started again: the runs
+    # waited in silence for ever.
+    program, world = _wall(tmp_path)
+    runs = 1000
+    out, said = tmp_path / "cluster.jsonl", tmp_path / "stderr.txt"
+    with _cluster(tmp_path, 1) as cluster, open(said, "w") as stderr, subprocess.Popen(
+            [str(BIN / "rl1c"), "sim", str(program), "--world", str(world), "--runs",
+             str(runs), "--budget", "10000", "--scheduler", cluster.address, "--out",
+             str(out)], stdout=subprocess.PIPE, stderr=stderr, text=True) as process:
+        deadline = time.monotonic() + STARTED_WITHIN
+        while not out.exists() or out.read_text().count("\n") < 100:
+            assert process.poll() is None and time.monotonic() < deadline, said.read_text()
+            time.sleep(0.05)
+        cluster.workers[0].send_signal(signal.SIGKILL)
+        cluster.workers[0].wait()
+        while "has no workers left" not in said.read_text():
+            assert process.poll() is None and time.monotonic() < deadline, (
+                said.read_text() + cluster.log())
+            time.sleep(0.1)
+        cluster.start_worker()
+        stdout, _ = process.communicate(timeout=STARTED_WITHIN)
+    assert process.returncode == 0, said.read_text() + cluster.log()
+    assert f"rl1c: warning: {no_workers_left(cluster.address)}\n" in said.read_text()
+    assert "Traceback" not in said.read_text()
+    assert stdout == _local(program, world, runs, tmp_path / "local.jsonl")
 
 
 @contextmanager
