@@ -152,13 +152,14 @@ def test_rl1c_sim_runs_stops_with_its_summary_when_its_group_is_sent_sigterm(
 
 # Workers that nap, on a pool of rl1's, in a parent that does not take SIGTERM.
 NAPPING = """
+import os
 import time
 
 from rl1.compiler.executors import workers
 
 
 def nap() -> None:
-    print("napping", flush=True)
+    os.write(1, b"napping\\n")  # one write: the two workers' lines never interleave
     time.sleep(600)
 
 
