@@ -156,7 +156,8 @@ def test_each_point_after_the_first_starts_with_tasks_sized_by_the_runs_before(
 
     @contextmanager
     def two_workers(jobs: int, scheduler: str | None,
-                    renewed: Callable[[], None]) -> Iterator[Workers]:
+                    renewed: Callable[[], None], *,
+                    unmanned: Callable[[], None] | None = None) -> Iterator[Workers]:
         yield Workers(instant, 2)
 
     monkeypatch.setattr(sim_campaign, "workers", two_workers)
