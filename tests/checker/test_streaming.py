@@ -12,6 +12,7 @@ import textwrap
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support.block_shapes import BLOCK_SHAPES
 
 from rl1.compiler.analysis import analyze, diagnose
 from rl1.compiler.checker.streaming import BlockPlaces, SourceStatements
@@ -126,8 +127,9 @@ def test_blocks_that_share_jumps_give_the_diagnostics_of_the_tree(lines: list[st
     assert_same(ending.join(lines))
 
 
-# bench/memory.py's sources, at a size tracemalloc measures in seconds: a first line,
-# then one line repeated.
+# Sources with a diagnostic a line, at a size tracemalloc measures in seconds: a first
+# line, then one line repeated; measured with each output format, which writes each
+# diagnostic its own way.
 SOURCES = {
     "lines of 19,999 characters": ("", ";".join(["A=1"] * 4999) + "\n"),
     "`A=1` lines": ("", "A=1\n"),
@@ -135,22 +137,26 @@ SOURCES = {
     # a block of a million runs that write a reserved variable: 128 B/B when it held
     # each run's effects until it ended (effects.Combining)
     "`t=1` lines": ("", "t=1\n"),
-    # a block a line: 178 B/B when each block's record was a Cut, a Block, the tree of its
-    # last statement and effects of its own, and each block had a dict of triggers
-    "`(END)` lines": ("", "(END)\n"),
     # a W0401 a line: 66 B/B when each was held whole (250 bytes)
     "`A=s` lines": ("", "A=s\n"),
-    # a block a line that jumps: 163 and 141 B/B when each block held its jump's tree,
-    # its statements' places as an object, a tuple of its successors, and the loop rule
-    # a set and lists of ints as large as the program
-    "`#01` lines": (":01\n", "#01\n"),
-    "`?A=#01` lines": (":01\n", "?A=#01\n"),
     # and an E0203 a line: 172 B/B when each was held whole (400 bytes)
     "`#01` lines without `:01`": ("", "#01\n"),
     # a block every 3 bytes that never runs (each follows a jump, and has an E0202): 74
     # B/B when each was a SourceBlock of its own (140 bytes)
     "`#1` lines": ("", "#1\n"),
 }
+# And the project's shapes of a block every few bytes (support.block_shapes, which
+# bench/memory.py measures), whose diagnostics are one or two whatever their size, so
+# that one output format measures them: a block a line, 178 B/B when each block's record
+# was a Cut, a Block, the tree of its last statement and effects of its own, and each
+# block had a dict of triggers (`(END)` lines); a block a line that jumps, 163 and 141
+# B/B when each block held its jump's tree, its statements' places as an object, a tuple
+# of its successors, and the loop rule a set and lists of ints as large as the program
+# (`#01` and `?A=#01` lines).
+SHAPES = {f"block shape {name}": (shape.head, shape.unit)
+          for name, shape in BLOCK_SHAPES.items()}
+MEASURED = [*((kind, output_format) for kind in SOURCES for output_format in ("human", "sarif")),
+            *((kind, "human") for kind in SHAPES)]
 SOURCE_CHARACTERS = 256 * 1024
 
 MEASURE = textwrap.dedent("""
@@ -174,8 +180,7 @@ MEASURE = textwrap.dedent("""
 """)
 
 
-@pytest.mark.parametrize("output_format", ["human", "sarif"])
-@pytest.mark.parametrize("kind", SOURCES)
+@pytest.mark.parametrize(("kind", "output_format"), MEASURED)
 def test_checking_takes_at_most_64_bytes_a_source_byte(kind: str, output_format: str) -> None:
     """The peak of the allocations of what `rl1c check` does beyond reading its text (in
     a process of its own, so that no other test's caches count), against
@@ -183,7 +188,8 @@ def test_checking_takes_at_most_64_bytes_a_source_byte(kind: str, output_format:
     (an E0101 with its fix, 516 bytes of objects a line) before they were held compactly
     (checker/compact.py)."""
     script = MEASURE.format(characters=SOURCE_CHARACTERS)
-    measured = subprocess.run([sys.executable, "-c", script, *SOURCES[kind], output_format],
+    measured = subprocess.run([sys.executable, "-c", script, *{**SOURCES, **SHAPES}[kind],
+                               output_format],
                               capture_output=True, text=True, check=True)
     assert float(measured.stdout) <= 64
 

@@ -1,8 +1,8 @@
 """Sources of a block every few bytes, the costliest IR a source byte (a block's IR is
 some 300 bytes), each a first line and a unit repeated after it: the one list of them
-for tests/backend/test_compile_memory.py, which holds a compile of each to
-spec/language.md's bound under tracemalloc, and bench/memory.py, which measures
-`rl1c compile -s` of 8 MiB of each."""
+for tests/backend/test_compile_memory.py and tests/checker/test_streaming.py, which hold
+a compile and a check of each to spec/language.md's bounds under tracemalloc, and
+bench/memory.py, which measures `rl1c compile -s` of 8 MiB of each."""
 
 from __future__ import annotations
 
