@@ -49,7 +49,7 @@ def rate(engines: list[Engine], count: int, jobs: int = 1) -> float:
     started = time.perf_counter()
     with workers(jobs) as held:
         outcome = fuzz.campaign(engines, BUDGET, count=count, seconds=None, seed=SEED,
-                                progress=lambda programs, elapsed: None,
+                                progress=lambda *_: None,
                                 executor=held.executor, jobs=max(held.slots, 1))
     assert outcome.finding is None, outcome.finding
     return outcome.programs / (time.perf_counter() - started)

@@ -229,8 +229,9 @@ TOLD_EVERY = 1.0  # seconds between a search's counts on the Channel
 class Channel:
     """A campaign's folder on this machine, through which its searches hear when to stop
     and tell how far they are: a search reads the file `halt` (the index of the first
-    search that must stop) before each program, and writes its count to `told-INDEX`
-    every TOLD_EVERY seconds. Files rather than shared memory, so that it works with any
+    search that must stop) before each program, and writes its count, and whether it is
+    shrinking a finding, to `told-INDEX` every TOLD_EVERY seconds and as it starts or
+    ends shrinking one. Files rather than shared memory, so that it works with any
     executor whose workers share this machine; a worker elsewhere finds no file, and its
     search runs to its end."""
 
@@ -242,7 +243,7 @@ class Channel:
         """Stop the searches from index `first` on (every one by default: safe in a
         signal handler, which may run in the middle of a halt after a finding)."""
         self.everything = self.everything or first == 0
-        self._put(HALT, 0 if self.everything else min(first, self.halted_from()))
+        self._put(HALT, str(0 if self.everything else min(first, self.halted_from())))
 
     def halted_from(self) -> float:
         if self.everything:
@@ -253,66 +254,76 @@ class Channel:
         except (OSError, ValueError):  # not halted, or a folder elsewhere
             return math.inf
 
-    def tell(self, index: int, programs: int) -> None:
-        self._put(f"told-{index}", programs)
+    def tell(self, index: int, programs: int, shrinking: bool = False) -> None:
+        self._put(f"told-{index}", f"{programs} {int(shrinking)}")
 
-    def _put(self, name: str, number: float) -> None:
-        """Replace the file `name` with `number`, whole (a reader sees the old number or
-        the new); a file system that refuses it leaves the old (a search halted later,
+    def _put(self, name: str, text: str) -> None:
+        """Replace the file `name` with `text`, whole (a reader sees the old text or the
+        new); a file system that refuses it leaves the old (a search halted later,
         a progress line behind), not the campaign failed."""
         path = os.path.join(self.folder, name)
         with contextlib.suppress(OSError):
             with open(f"{path}.{os.getpid()}", "w", encoding="ascii") as stream:
-                stream.write(str(number))
+                stream.write(text)
             os.replace(f"{path}.{os.getpid()}", path)
 
-    def told(self, indexes: Iterable[int]) -> int:
-        """The programs the searches `indexes` last told."""
-        total = 0
+    def told(self, indexes: Iterable[int]) -> tuple[int, int]:
+        """The programs the searches `indexes` last told, and how many of them said they
+        were shrinking a finding."""
+        programs = shrinking = 0
         for index in indexes:
             with contextlib.suppress(OSError, ValueError), \
                     open(os.path.join(self.folder, f"told-{index}"), "rb") as stream:
-                total += int(stream.read())
-        return total
+                ran, shrinks = map(int, stream.read().split())
+                programs, shrinking = programs + ran, shrinking + shrinks
+        return programs, shrinking
 
     def close(self) -> None:
         shutil.rmtree(self.folder, ignore_errors=True)
 
 
-def search(task: Search, progress: Callable[[int], None] | None = None) -> Searched:
+def search(task: Search, progress: Callable[[int, bool], None] | None = None) -> Searched:
     """Run the search `task`: Hypothesis searches of its programs, each shrinking the
     first run that disagrees; without `keep_going` the search ends there, with it a run
     of a signature found already counts and the search goes on (a new one is shrunk
-    keeping its signature). `progress(programs)` after each program. It ends early,
+    keeping its signature). `progress(programs, shrinking)` after each program, and
+    after each run tried in shrinking a finding (`shrinking` True). It ends early,
     with what it found, when halted, past its deadline, or on KeyboardInterrupt (Ctrl-C
     reaches a terminal's every process)."""
     searched = Searched(task.index, statistics=Statistics() if task.statistics else None)
     channel = Channel(task.channel) if task.channel is not None else None
     judging = judge_apart if task.apart else judge
     told = time.monotonic()
+    telling = False  # that it is shrinking, as the channel last heard
     target: str | None = None  # the signature being shrunk
     shrinks = 0  # runs tried since the first disagreement
 
     def stopped() -> bool:
         return channel is not None and channel.halted_from() <= task.index
 
+    def tell(shrinking: bool) -> None:
+        nonlocal told, telling
+        if progress is not None:
+            progress(searched.programs, shrinking)
+        if channel is not None and (shrinking != telling
+                                    or time.monotonic() - told >= TOLD_EVERY):
+            told, telling = time.monotonic(), shrinking
+            channel.tell(task.index, searched.programs, shrinking)
+
     def disagrees(case: Run) -> bool:
-        nonlocal told, target, shrinks
+        nonlocal target, shrinks
         if stopped():
             raise _Enough
         if target is None:
             if task.deadline is not None and time.time() >= task.deadline:
                 raise _Enough
             searched.programs += 1
-            if progress is not None:
-                progress(searched.programs)
-            if channel is not None and time.monotonic() - told >= TOLD_EVERY:
-                told = time.monotonic()
-                channel.tell(task.index, searched.programs)
+            tell(False)
         elif shrinks >= SHRINK_ATTEMPTS:
             raise _Enough  # small enough: keep the smallest so far
         else:
             shrinks += 1
+            tell(True)
         verdict = judging(case, task.engines, task.budget)
         if target is None and searched.statistics is not None:
             searched.statistics.add(case, verdict)
@@ -340,7 +351,7 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
                 if (task.keep_going or not searched.findings) and disagrees(case) \
                         and not stopped():
                     _delete_lines(searched, next(reversed(searched.findings)), task,
-                                  stopped)
+                                  stopped, tell)
             size = task.size + len(task.corpus)
             while searched.programs < size and (task.keep_going or not searched.findings):
                 before = searched.programs
@@ -353,7 +364,7 @@ def search(task: Search, progress: Callable[[int], None] | None = None) -> Searc
                     find(runs(instruction_losses=comparable), disagrees, settings=limits,
                          random=Random(seeds.getrandbits(64)))
                 if target is not None and not stopped():
-                    _delete_lines(searched, target, task, stopped)
+                    _delete_lines(searched, target, task, stopped, tell)
                 if searched.programs == before:  # Hypothesis generated nothing more
                     break
     except KeyboardInterrupt:  # in a worker: the campaign halts it too
@@ -409,14 +420,15 @@ def _corpus_run(file: str) -> Run:
 
 
 def _delete_lines(searched: Searched, target: str, task: Search,
-                  stopped: Callable[[], bool]) -> None:
+                  stopped: Callable[[], bool], tell: Callable[[bool], None]) -> None:
     """The finding of `target` reduced further by `_reduced` (no further once
-    `stopped()`)."""
+    `stopped()`), `tell(True)` before each run tried."""
     judging = judge_apart if task.apart else judge
 
     def keeps(case: Run) -> bool:
         if stopped():
             return False
+        tell(True)
         verdict = judging(case, task.engines, task.budget)
         return bool(verdict.problems) and (not task.keep_going
                                            or signature(verdict) == target)
@@ -439,7 +451,7 @@ def searches(seed: int, count: int | None) -> Iterator[tuple[int, int]]:
 
 
 def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
-             seconds: float | None, seed: int, progress: Callable[[int, float], None],
+             seconds: float | None, seed: int, progress: Callable[[int, float, int], None],
              executor: Executor | None = None, jobs: int = 1, keep_going: bool = False,
              found: Callable[[Finding], None] | None = None,
              channel: Channel | None = None, corpus: Sequence[Run] = (),
@@ -447,7 +459,8 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
              worker_lost: Callable[[], None] | None = None) -> Outcome:
     """Run the `corpus`, then generated programs, on `engines` until `count` generated
     programs or `seconds` have passed, or until they disagree (with `keep_going`, until
-    then whatever they find); `progress(programs, elapsed)` as programs run,
+    then whatever they find); `progress(programs, elapsed, shrinking)` as programs run
+    and findings are shrunk (`shrinking`: the searches shrinking one now),
     `found(finding)` on each new signature's smallest run. The searches run in this
     process, or `jobs` at a time on `executor` (a search lost with its worker, an error
     of `lost`, runs again, after `worker_lost()`; SearchLost when it is lost each
@@ -513,15 +526,16 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
         if executor is None:
             before = 0  # the programs of the searches before this one
 
-            def told(programs: int) -> None:
-                progress(before + programs, time.monotonic() - start)
+            def told(programs: int, shrinking: bool) -> None:
+                progress(before + programs, time.monotonic() - start, int(shrinking))
 
             while (task := next_search()) is not None:
                 before = done()
                 keep(search(task, told))
         else:
             _on_executor(executor, jobs, next_search, keep, channel,
-                         lambda told: progress(done() + told, time.monotonic() - start), lost,
+                         lambda programs, shrinking: progress(
+                             done() + programs, time.monotonic() - start, shrinking), lost,
                          worker_lost)
     finally:
         if own_channel:
@@ -554,7 +568,7 @@ class SearchLost(Exception):
 
 def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search | None],
                  keep: Callable[[Searched], None], channel: Channel,
-                 progress: Callable[[int], None], lost: tuple[type[BaseException], ...],
+                 progress: Callable[[int, int], None], lost: tuple[type[BaseException], ...],
                  worker_lost: Callable[[], None] | None) -> None:
     """Run the searches `next_search` gives on `executor`, `jobs` at a time, keeping
     each as it ends; one lost with its worker (an error of `lost`: `worker_lost()` is
@@ -587,7 +601,7 @@ def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search
                 continue
             keep(future.result())
         submit()
-        progress(channel.told(task.index for task in pending.values()))
+        progress(*channel.told(task.index for task in pending.values()))
 
 
 def _reduced(case: Run, disagrees: Callable[[Run], bool]) -> Run:

@@ -398,7 +398,8 @@ def _unwritable(folder: str) -> str | None:
 class _Bar:
     """Progress on standard error: on a terminal a bar redrawn in place every
     REDRAW_EVERY seconds; elsewhere (CI, a log file) a plain line every PROGRESS_EVERY
-    seconds, which a log keeps readable."""
+    seconds, which a log keeps readable. Each says how many findings are being shrunk,
+    which can take a while after the last program has run."""
 
     def __init__(self, count: int | None, seconds: int | None, stream: TextIO | None = None
                  ) -> None:
@@ -407,7 +408,7 @@ class _Bar:
         self.terminal = self.stream.isatty()
         self.shown = 0.0  # the elapsed time of the last line
 
-    def update(self, programs: int, elapsed: float) -> None:
+    def update(self, programs: int, elapsed: float, shrinking: int = 0) -> None:
         if elapsed - self.shown < (REDRAW_EVERY if self.terminal else PROGRESS_EVERY):
             return
         self.shown = elapsed
@@ -416,12 +417,16 @@ class _Bar:
         of_time = f" of {self.seconds}" if self.seconds else ""
         done = (f"{programs}{of_count} programs, {rate:.1f} per second, "
                 f"{elapsed:.0f}{of_time} s")
+        if shrinking:
+            done += f"; shrinking {shrinking} finding{'s' if shrinking != 1 else ''}"
         if not self.terminal:
             self.stream.write(f"fuzz: {done}\n")
         else:
             part = programs / self.count if self.count else elapsed / (self.seconds or 1)
             filled = int(BAR_WIDTH * min(part, 1.0))
-            self.stream.write(f"\r[{'#' * filled}{'.' * (BAR_WIDTH - filled)}] {done}")
+            # Erased past its end: a line shorter than the last (its rate a digit
+            # shorter, the shrinking said no more) leaves nothing of that one.
+            self.stream.write(f"\r[{'#' * filled}{'.' * (BAR_WIDTH - filled)}] {done}\033[K")
         self.stream.flush()
 
     def warn(self, warning: str) -> None:

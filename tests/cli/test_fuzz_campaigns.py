@@ -3,6 +3,7 @@ going on past findings (--keep-going), seeded from a corpus, and their statistic
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
 import os
@@ -57,7 +58,7 @@ class _TwoBugs:
 
 def _campaign(engines: list[Engine], jobs: int, count: int, **options: object
               ) -> fuzz.Outcome:
-    def quiet(programs: int, elapsed: float) -> None:
+    def quiet(programs: int, elapsed: float, shrinking: int) -> None:
         pass
 
     if jobs == 1:
@@ -192,7 +193,7 @@ def test_keep_going_finds_the_same_reproducers_whatever_order_the_searches_end_i
     monkeypatch.setattr(fuzz, "BATCH", 10)
     engines: list[Engine] = [VmEngine(0), _TwoBugs()]
 
-    def quiet(programs: int, elapsed: float) -> None:
+    def quiet(programs: int, elapsed: float, shrinking: int) -> None:
         pass
 
     told: dict[str, list[fuzz.Finding]] = {"in order": [], "last first": []}
@@ -330,8 +331,49 @@ def test_progress_on_a_terminal_is_a_bar_redrawn_in_place() -> None:
     bar.update(20, 30.0)
     bar.close()
     assert stream.getvalue() == (
-        f"\r[{'.' * 30}] 10 programs, 10.0 per second, 1 of 60 s"
-        f"\r[{'#' * 15}{'.' * 15}] 20 programs, 0.7 per second, 30 of 60 s\n")
+        f"\r[{'.' * 30}] 10 programs, 10.0 per second, 1 of 60 s\033[K"
+        f"\r[{'#' * 15}{'.' * 15}] 20 programs, 0.7 per second, 30 of 60 s\033[K\n")
+
+
+def test_progress_says_the_findings_being_shrunk_after_the_last_program() -> None:
+    # "20 of 20 programs" while two searches went on shrinking their findings, for as
+    # long again, looked like a campaign that hung.
+    stream = io.StringIO()
+    bar = fuzz_cli._Bar(20, None, stream)
+    every = fuzz_cli.PROGRESS_EVERY
+    bar.update(20, every, 2)
+    bar.update(20, 2 * every, 1)
+    bar.close()
+    assert stream.getvalue() == (
+        f"fuzz: 20 of 20 programs, {20 / every:.1f} per second, {every:.0f} s; shrinking "
+        "2 findings\n"
+        f"fuzz: 20 of 20 programs, {10 / every:.1f} per second, {2 * every:.0f} s; "
+        "shrinking 1 finding\n")
+    terminal = _Terminal()
+    bar = fuzz_cli._Bar(20, None, terminal)
+    bar.update(20, 1.0, 1)
+    bar.update(20, 2.0)
+    assert terminal.getvalue() == (
+        f"\r[{'#' * 30}] 20 of 20 programs, 20.0 per second, 1 s; shrinking 1 finding\033[K"
+        f"\r[{'#' * 30}] 20 of 20 programs, 10.0 per second, 2 s\033[K")
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_campaign_tells_the_findings_it_shrinks(monkeypatch: pytest.MonkeyPatch,
+                                                  jobs: int) -> None:
+    monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 30)
+    monkeypatch.setattr(fuzz, "POLL", 0.01)  # a look at the searches between any two
+    monkeypatch.setattr(fuzz, "TOLD_EVERY", 3600.0)  # told only as they start shrinking
+    told: list[tuple[int, int]] = []
+
+    def progress(programs: int, elapsed: float, shrinking: int) -> None:
+        told.append((programs, shrinking))
+
+    with ProcessPoolExecutor(jobs) if jobs > 1 else contextlib.nullcontext() as pool:
+        outcome = fuzz.campaign([VmEngine(0), _TwoBugs()], 20_000, count=100, seconds=None,
+                                seed=11, progress=progress, executor=pool, jobs=jobs)
+    assert outcome.finding is not None
+    assert any(shrinking == 1 for _, shrinking in told), told
 
 
 def test_a_campaign_in_ci_prints_progress_lines_on_standard_error(
@@ -443,7 +485,7 @@ def test_a_search_lost_with_its_worker_runs_again_and_the_count_is_exact(
 
     def on(executor: Executor, lost: tuple[type[BaseException], ...]) -> fuzz.Outcome:
         return fuzz.campaign([VmEngine(0), VmEngine(1)], 20_000, count=12, seconds=None,
-                             seed=11, progress=lambda programs, elapsed: None,
+                             seed=11, progress=lambda *_: None,
                              executor=executor, jobs=2, lost=lost)
 
     assert on(executor, (_Lost,)).programs == 12

@@ -64,7 +64,7 @@ def test_a_long_campaign_is_many_searches_with_the_same_programs_for_a_seed(
 
         monkeypatch.setattr(fuzz, "judge", judged)
         outcome = fuzz.campaign([e for e in engines if e is not None], 20_000, count=10,
-                                seconds=None, seed=7, progress=lambda programs, elapsed: None)
+                                seconds=None, seed=7, progress=lambda *_: None)
         assert outcome.programs == 10 and outcome.finding is None
     assert len(searches) == 2 * 3  # 4 + 4 + 2 programs, twice
     assert sources[0] == sources[1] and len(sources[0]) == 10
@@ -90,7 +90,7 @@ def test_an_engine_that_crashes_is_a_finding_shrunk_like_a_disagreement(
     reference = engine_named("ast")
     assert reference is not None
     outcome = fuzz.campaign([reference, _CrashesOnLess()], 20_000, count=300,
-                            seconds=None, seed=3, progress=lambda programs, elapsed: None)
+                            seconds=None, seed=3, progress=lambda *_: None)
     assert outcome.finding is not None
     assert "crashes: crashed: ValueError: line entry (10, 5): lines must not decrease" \
         in outcome.finding.verdict.problems
@@ -118,7 +118,7 @@ def test_a_seed_gives_the_same_reproducer_however_long_the_runs_take(
     for clock in (time, _Clock()):
         monkeypatch.setattr(fuzz, "time", clock)
         outcome = fuzz.campaign(engines, 20_000, count=300, seconds=None, seed=1,
-                                progress=lambda programs, elapsed: None)
+                                progress=lambda *_: None)
         assert outcome.finding is not None
         out = tmp_path / type(clock).__name__
         folders.append(Path(fuzz.write_reproducer(str(out), outcome.finding, engines,

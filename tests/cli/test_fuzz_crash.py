@@ -59,7 +59,7 @@ class _EndsItsProcess:
         return VmEngine(0).run(case, budget)
 
 
-def _quiet(programs: int, elapsed: float) -> None:
+def _quiet(programs: int, elapsed: float, shrinking: int) -> None:
     pass
 
 

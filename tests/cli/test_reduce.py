@@ -373,7 +373,7 @@ def test_rl1c_fuzz_reduces_its_finding_with_these_passes(monkeypatch: pytest.Mon
     monkeypatch.setattr(fuzz, "SHRINK_ATTEMPTS", 40)
     engines: list[Engine] = [VmEngine(0), BrokenShift()]
     outcome = fuzz.campaign(engines, 20_000, count=300, seconds=None, seed=1,
-                            progress=lambda programs, elapsed: None)
+                            progress=lambda *_: None)
     assert outcome.finding is not None
     assert re.fullmatch(r"[A-Za-z@]=1<-1(\r\n|\r|\n)", outcome.finding.case.source)
     assert outcome.finding.case.script == {}
