@@ -1,12 +1,15 @@
-"""docs/tutorial.md shows what really happens: its files (each code block after a
-`<!-- file: NAME -->` comment) are written to an empty folder, and each of its sessions
-(a code block of `$ rl1c ...` lines, each followed by what it printed) is run there; a
-line `...` in a printed output stands for any lines."""
+"""docs/tutorial.md shows what really happens: in an empty folder, in the order a reader
+meets them, its files are written (each code block after a `<!-- file: NAME -->`
+comment; after `<!-- append: NAME -->`, added to the end of that file) and its sessions
+run (a code block of `$ rl1c ...` lines, each followed by what it printed); a line `...`
+in a printed output stands for any lines, and a campaign's progress lines, which depend
+on its speed, are left out."""
 
 from __future__ import annotations
 
 import re
 import shlex
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -14,28 +17,52 @@ from support import ROOT
 from support.cli import rl1c
 
 TUTORIAL = ROOT / "docs" / "tutorial.md"
-BLOCK = re.compile(r"^(?:<!-- file: (?P<file>\S+) -->\n)?```\w*\n(?P<body>.*?)^```",
-                   re.MULTILINE | re.DOTALL)
+BLOCK = re.compile(r"^(?:<!-- (?P<how>file|append): (?P<file>\S+) -->\n)?```\w*\n"
+                   r"(?P<body>.*?)^```", re.MULTILINE | re.DOTALL)
+# What `rl1c sim --runs` prints on standard error every few seconds when not on a terminal.
+PROGRESS = re.compile(r"^\d+/\d+ runs, \d+ succeeded \(.*\), [\d.]+ runs/s$")
 
 
-def _blocks() -> list[re.Match[str]]:
-    return list(BLOCK.finditer(TUTORIAL.read_text(encoding="utf-8")))
+@dataclass(frozen=True)
+class Write:
+    """A file of the tutorial: written whole, or (`append`) added to its end."""
+
+    name: str
+    text: str
+    append: bool
 
 
-def files() -> dict[str, str]:
-    return {block["file"]: block["body"] for block in _blocks() if block["file"]}
+@dataclass(frozen=True)
+class Session:
+    """A `$ ` command of the tutorial with the lines it printed."""
+
+    command: str
+    printed: list[str]
 
 
-def sessions() -> list[tuple[str, list[str]]]:
-    """Each `$ ` command of the tutorial with the lines it printed."""
-    found: list[tuple[str, list[str]]] = []
-    for block in _blocks():
-        if not block["body"].startswith("$ "):
-            continue
-        for part in re.split(r"^\$ ", block["body"], flags=re.MULTILINE)[1:]:
-            command, *printed = part.rstrip("\n").split("\n")
-            found.append((command, printed))
+def steps(markdown: str) -> list[Write | Session]:
+    """The files and the commands of `markdown`, in the order they come."""
+    found: list[Write | Session] = []
+    for block in BLOCK.finditer(markdown):
+        if block["file"]:
+            found.append(Write(block["file"], block["body"], block["how"] == "append"))
+        elif block["body"].startswith("$ "):
+            for part in re.split(r"^\$ ", block["body"], flags=re.MULTILINE)[1:]:
+                command, *printed = part.rstrip("\n").split("\n")
+                found.append(Session(command, printed))
     return found
+
+
+def tutorial_steps() -> list[Write | Session]:
+    return steps(TUTORIAL.read_text(encoding="utf-8"))
+
+
+def files() -> set[str]:
+    return {step.name for step in tutorial_steps() if isinstance(step, Write)}
+
+
+def sessions() -> list[Session]:
+    return [step for step in tutorial_steps() if isinstance(step, Session)]
 
 
 def matches(printed: list[str], expected: list[str]) -> bool:
@@ -54,23 +81,39 @@ def test_dots_stand_for_any_lines() -> None:
     assert not matches(["a", "x"], ["a", "b"])
 
 
+def test_files_and_sessions_come_in_the_order_written() -> None:
+    markdown = ("<!-- file: a.toml -->\n```toml\nx = 1\n```\n"
+                "```\n$ rl1c run a\nran\n$ rl1c sim a\n```\n"
+                "<!-- append: a.toml -->\n```toml\ny = 2\n```\n"
+                "```sh\nrl1c studio  # not a session: no `$ `\n```\n")
+    assert steps(markdown) == [Write("a.toml", "x = 1\n", False),
+                               Session("rl1c run a", ["ran"]), Session("rl1c sim a", []),
+                               Write("a.toml", "y = 2\n", True)]
+
+
 def test_the_tutorial_has_its_files_and_its_sessions() -> None:
-    assert {"first.rob", "first.sensors.toml", "first.world.toml", "oops.rob"} <= set(files())
-    commands = [command for command, _ in sessions()]
+    assert {"first.rob", "first.sensors.toml", "first.world.toml", "oops.rob"} <= files()
+    commands = [session.command for session in sessions()]
     for command in ("check", "run", "sim"):
         assert any(line.startswith(f"rl1c {command} first.rob") for line in commands), command
+    assert any("--runs" in line for line in commands), "the tutorial asks how often"
 
 
 def test_each_command_prints_what_the_tutorial_shows(tmp_path: Path,
                                                     monkeypatch: pytest.MonkeyPatch) -> None:
-    """In order, in one folder, as a reader would: `rl1c dis` reads what `rl1c` wrote."""
-    for name, text in files().items():
-        (tmp_path / name).write_text(text, encoding="utf-8")
+    """In order, in one folder, as a reader would: `rl1c dis` reads what `rl1c` wrote,
+    and the sessions after an appended block see the file with it."""
     monkeypatch.chdir(tmp_path)
-    for command, expected in sessions():
-        program, *args = shlex.split(command)
-        assert program == "rl1c", command
-        printed = rl1c(*args).output.splitlines()
-        assert matches(printed, expected), (
-            f"docs/tutorial.md shows for `{command}`:\n" + "\n".join(expected)
+    for step in tutorial_steps():
+        if isinstance(step, Write):
+            with (tmp_path / step.name).open("a" if step.append else "w",
+                                             encoding="utf-8") as file:
+                file.write(step.text)
+            continue
+        program, *args = shlex.split(step.command)
+        assert program == "rl1c", step.command
+        printed = [line for line in rl1c(*args).output.splitlines()
+                   if not PROGRESS.match(line)]
+        assert matches(printed, step.printed), (
+            f"docs/tutorial.md shows for `{step.command}`:\n" + "\n".join(step.printed)
             + "\n\nbut it prints:\n" + "\n".join(printed))
