@@ -155,3 +155,14 @@ def test_an_unknown_document_is_a_usage_error_with_a_suggestion() -> None:
     assert shown.stdout == ""
     assert "`spec/sensor.md` is no document of rl1c" in shown.stderr
     assert "did you mean `rl1c docs sensors`?" in shown.stderr
+
+
+def test_the_development_guide_runs_every_benchmark() -> None:
+    """Each script of bench/ (a module with a `__main__`, not a shared helper) has its
+    command line in docs/development.md, where a newcomer looks for the benchmarks."""
+    guide = (DOCS / "development.md").read_text(encoding="utf-8")
+    scripts = [path for path in sorted((ROOT / "bench").glob("*.py"))
+               if 'if __name__ == "__main__":' in path.read_text(encoding="utf-8")]
+    assert len(scripts) > 20, "bench/ has scripts to run"
+    missing = [path.name for path in scripts if f"bench/{path.name}" not in guide]
+    assert not missing, f"docs/development.md does not say how to run {missing}"
