@@ -6,14 +6,17 @@ pose track and the events, for tools."""
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from typing import Any
 
 from rl1.compiler.simulation import run_status
 from rl1.vm.defaults import TraceChoice
 from rl1.vm.faults import FaultKind, RunResult
+from rl1.vm.scripted import LOST
 from rl1.vm.sim.device import RunOn, SimDevice, SimEntry
 from rl1.vm.sim.goal import Verdict
 from rl1.vm.sim.motion import Pose, heading_degrees
+from rl1.vm.sim.simulator import Event
 
 from .run_report import (
     TRACE_HEADING,
@@ -82,10 +85,37 @@ def _goal_lines(verdict: Verdict) -> list[str]:
                                   f", {outcome.text}" for outcome in verdict.outcomes)]
 
 
-def _entry_line(entry: SimEntry) -> str:
-    pose = entry.pose
-    return (entry_start(_ms(entry.time), entry.line)
-            + f"{call_text(entry.call, entry.args, entry.result):<40} "
+LINE_EVENTS = ("lost", "handler", "found")
+"""The simulator's events that the trace shows among the calls."""
+
+
+@dataclass(frozen=True, slots=True)
+class _LineEvent:
+    """A lost or found line, or a handler taken, as a row of the trace: its `call` is
+    the scripted device's lost line, so that `--trace calls` leaves it out as `rl1c run`
+    leaves out its lost lines, and `--trace short` counts it as an entry."""
+
+    event: Event
+    call: str = LOST
+
+
+def _time(row: SimEntry | _LineEvent) -> float:
+    return row.event.time if isinstance(row, _LineEvent) else row.time
+
+
+def _rows(device: SimDevice) -> list[SimEntry | _LineEvent]:
+    """The calls and the line events in the order of their time (a call first when both
+    have the same: a loss happens during the call under way)."""
+    events = [_LineEvent(event) for event in device.sim.events if event.kind in LINE_EVENTS]
+    return sorted([*device.trace, *events], key=_time)  # stable: the calls first
+
+
+def _entry_line(row: SimEntry | _LineEvent) -> str:
+    if isinstance(row, _LineEvent):
+        return f"{entry_start(_ms(row.event.time), None)}[{row.event.text}]"
+    pose = row.pose
+    return (entry_start(_ms(row.time), row.line)
+            + f"{call_text(row.call, row.args, row.result):<40} "
             f"({pose.x:7.1f}, {pose.y:7.1f}) {heading_degrees(pose.heading, 1):6.1f}")
 
 
@@ -96,13 +126,10 @@ def render_text(ran: Ran, device: SimDevice, program: str, ended_at: float,
     time `ended_at` (s), with the calls `trace` chooses (as `rl1c run --trace`), and
     the goal's `verdict` when the world has a goal."""
     lines = []
-    shown = select_trace(device.trace, trace)
+    shown = select_trace(_rows(device), trace)
     if shown.head:
         lines.append(f"{TRACE_HEADING:<58} pose after it: x, y (cm), heading (degrees)")
         lines += shown.lines(_entry_line)
-    for event in device.sim.events:
-        if event.kind in ("lost", "handler", "found"):
-            lines.append(f"{entry_start(_ms(event.time), None)}[{event.text}]")
     lines.append(_ending(ran, device, run_on, program, color))
     if verdict is not None:
         lines += _goal_lines(verdict)

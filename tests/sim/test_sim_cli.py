@@ -4,6 +4,7 @@ traceback) for a bad world file."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -255,3 +256,24 @@ def test_json_trace_entries_carry_the_source_lines_the_text_shows(engine: str) -
     rows = [line.split() for line in text.splitlines()[1:len(report["trace"]) + 1]]
     assert [entry["line"] for entry in report["trace"]] == [int(row[1]) for row in rows]
     assert all(isinstance(entry["line"], int) for entry in report["trace"])
+
+
+def test_line_events_are_trace_entries_in_time_order_chosen_by_trace(tmp_path: Path) -> None:
+    """A line lost while the program waits shows among the calls at its time, as `rl1c
+    run` shows a lost line; `--trace calls` and `none` leave it out (they printed it after
+    the last call, out of time order, even with `--trace none`)."""
+    program, world = tmp_path / "p.rob", tmp_path / "w.toml"
+    program.write_text("(CAM D); (TRC 1); (MOV 4,4)\n:10 (TIM 5); A=(ULT A)-40; ?A>#10\n"
+                       "(MOV 0,0); (HLD); (END)\n")
+    # Put down 13 degrees off its line, the vehicle loses it within a few centimetres.
+    world.write_text("[floor]\nsize = [600, 300]\n[start]\nx = 60\ny = 150\nheading = -13\n"
+                     "[[lines]]\npoints = [[0, 150], [600, 150]]\n")
+    every = rl1c("sim", program, "--world", world, "--trace", "all").stdout.splitlines()
+    rows = [line for line in every[1:] if re.match(r" +\d+ +(\d+|-) ", line)]
+    lost = [index for index, line in enumerate(rows) if "[line lost during MOV in mode 1]" in line]
+    assert len(lost) == 1 and 0 < lost[0] < len(rows) - 1, every
+    times = [int(line.split()[0]) for line in rows]
+    assert times == sorted(times), every
+    for choice in ("calls", "none"):
+        shown = rl1c("sim", program, "--world", world, "--trace", choice).stdout
+        assert "[line lost" not in shown, (choice, shown)
