@@ -99,6 +99,7 @@ def test_the_tutorial_has_its_files_and_its_sessions() -> None:
     assert any("--runs" in line for line in commands), "the tutorial asks how often"
 
 
+@pytest.mark.slow  # a campaign of 100 runs among them: some 3 s, most of it the pool's
 def test_each_command_prints_what_the_tutorial_shows(tmp_path: Path,
                                                     monkeypatch: pytest.MonkeyPatch) -> None:
     """In order, in one folder, as a reader would: `rl1c dis` reads what `rl1c` wrote,
