@@ -22,6 +22,7 @@ import shlex
 import signal
 import subprocess
 import tempfile
+import threading
 import time
 from collections import Counter
 from collections.abc import Callable, Sequence
@@ -30,7 +31,7 @@ from typing import Any, Literal, Protocol
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
-from rl1.compiler.executors import ignore_interrupts
+from rl1.compiler.executors import exit_how, ignore_interrupts, spawn
 from rl1.compiler.interpreter import interpret
 from rl1.compiler.strategies import Run
 from rl1.vm import isa
@@ -664,7 +665,8 @@ def _judge_by_level(case: Run, engines: Sequence[Engine], budget: int) -> Verdic
 
 
 def judge_apart(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
-    """`judge` in a process of its own (forked from this one), so that an engine that
+    """`judge` in a process of its own (forked from this one when it runs one thread,
+    else spawned: `forks_safely`), so that an engine that
     ends the process it runs in (the C VM's segmentation fault, a sanitizer's abort, the
     memory exhausted) ends that one, not this: then the Verdict has the runs of the
     engines before it, and its one problem `NAME: ended its process (HOW)`, HOW the
@@ -677,14 +679,25 @@ def judge_apart(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
     rather than being started and ended in each child."""
     ran_here = {engine.name: _observed(engine, case, budget) for engine in engines
                 if runs_elsewhere(engine)}
+    judged = [_RanBefore(engine, ran_here[engine.name]) if engine.name in ran_here
+              else engine for engine in engines]
     reading, writing = os.pipe()
-    child = os.fork()
-    if child == 0:
-        os.close(reading)
-        _judge_in_child(writing, case, [_RanBefore(engine, ran_here[engine.name])
-                                        if engine.name in ran_here else engine
-                                        for engine in engines], budget)
-    os.close(writing)
+    waited: Callable[[], int]  # waits for the child, and gives its exit code
+    if forks_safely():
+        child = os.fork()
+        if child == 0:
+            os.close(reading)
+            _judge_in_child(writing, case, judged, budget)
+        os.close(writing)
+
+        def waited() -> int:
+            return os.waitstatus_to_exitcode(os.waitpid(child, 0)[1])
+    else:
+        try:
+            waited = spawn(_judge_in_child, writing, case, judged, budget,
+                          keep=(writing,)).wait
+        finally:
+            os.close(writing)
     observations: dict[str, Observation] = {}
     running = ""  # the engine that started and has not finished, if any
     told: Verdict | BaseException | None = None
@@ -703,14 +716,12 @@ def judge_apart(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
                     case ("verdict", Verdict() | BaseException() as told):
                         pass
     finally:
-        _, status = os.waitpid(child, 0)
+        code = waited()
     if isinstance(told, BaseException):
         raise told
     if told is not None:
         return told
-    code = os.waitstatus_to_exitcode(status)
-    how = (f"signal {signal.Signals(-code).name}" if -code in signal.valid_signals()
-           else f"exit status {code}")
+    how = exit_how(code)
     if not running:  # after the runs, as they were compared
         return Verdict(observations, [f"{ENDED} ({how}) as the runs were compared"], how)
     ended = Observation({"status": {"code": ENDED_CODE, "line": None, "message": how},
@@ -718,10 +729,23 @@ def judge_apart(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
     return Verdict({**observations, running: ended}, [f"{running}: {ENDED} ({how})"], how)
 
 
+def forks_safely() -> bool:
+    """Whether judge_apart may fork this process: it runs one thread. A fork copies the
+    thread that makes it alone, and the locks the others held then (the allocator's,
+    logging's, an event loop's) stay held in the child for ever, so that it may
+    deadlock; Python 3.12 warns of it. A Dask worker runs its tasks in threads beside
+    its event loop's. A spawned process costs a case about 0.5 s more than a fork
+    (bench/judge_apart_start.py: judged apart, 16.4 cases a second forked, 1.9
+    spawned), so the fork is kept where it is safe: rl1c's own process, a local pool's
+    worker, the process a cluster's task has of its own (executors.in_own_process)."""
+    return threading.active_count() == 1
+
+
 def _judge_in_child(writing: int, case: Run, engines: Sequence[Engine], budget: int
                     ) -> None:
-    """`judge_apart`'s child: tells each engine as it starts and ends, then the verdict
-    (or what judge raised), on the pipe `writing`, and ends without returning."""
+    """`judge_apart`'s child, forked or spawned: tells each engine as it starts and ends,
+    then the verdict (or what judge raised), on the pipe `writing`, and ends without
+    returning."""
     try:
         ignore_interrupts()
         with open(writing, "wb") as stream:

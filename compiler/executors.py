@@ -18,7 +18,10 @@ import hashlib
 import logging
 import multiprocessing
 import os
+import pickle
 import signal
+import subprocess
+import sys
 import threading
 import time
 import weakref
@@ -59,6 +62,12 @@ class ClusterLost(Exception):
     """The work a cluster had not finished when it could no longer do it: the connection
     to its scheduler lost for good, or a worker that joined later runs another rl1 (its
     message says which)."""
+
+
+class TaskProcessEnded(Exception):
+    """A task given a process of its own on a cluster's worker (`isolated`), which ended
+    before it answered (by a signal, or an exit): what it ran ended it, as a local pool's
+    worker would have been ended, and the cluster's worker goes on."""
 
 
 class _OtherRl1(Exception):
@@ -123,28 +132,31 @@ class _Workers(multiprocessing.context.DefaultContext):
 
 
 @contextmanager
-def workers(jobs: int, scheduler: str | None = None,
-            renewed: Callable[[], None] | None = None, *, isolated: bool = False,
+def workers(jobs: int, scheduler: str | None = None, *,
+            lost: Callable[[], None] | None = None, isolated: bool = False,
             unmanned: Callable[[], None] | None = None) -> Iterator[Workers]:
     """The workers of a campaign: the Dask cluster of `scheduler` when given, else `jobs`
     local processes (this process alone for 1, unless `isolated`: work that may end the
-    process doing it, such as the C VM's, then has one of its own). When one of those
-    processes dies, the pool is broken for good, or, given `renewed`, made again
-    (`Renewed`), and `renewed` called. A cluster whose workers have all gone while work
-    waits (killed, or ended by what they ran, without a nanny to start them again) waits
-    for one, calling `unmanned` each time it is left without. Unavailable when
-    `distributed` is not installed or the scheduler cannot be reached. On leaving, the
-    work not yet done is cancelled."""
+    process doing it, such as the C VM's, then has one of its own, and on a cluster each
+    task has a process of its own on its worker, `TaskProcessEnded` when it ends, so
+    that the worker lives on). Given `lost`, a local pool one of whose processes dies is
+    made again (`Renewed`), else it is broken for good; `lost()` is called each time a
+    worker is lost with its work: a local pool's process, a cluster's (a task failed
+    with KilledWorker), or an isolated task's process. A cluster whose workers have all
+    gone while work waits (killed, without a nanny to start them again) waits for one,
+    calling `unmanned` each time it is left without. Unavailable when `distributed` is
+    not installed or the scheduler cannot be reached. On leaving, the work not yet done
+    is cancelled."""
     if scheduler is not None:
-        with _cluster(scheduler, unmanned) as cluster:
+        with _cluster(scheduler, unmanned, lost, isolated) as cluster:
             yield cluster
         return
     if jobs == 1 and not isolated:
         yield Workers(None, 1)
         return
-    pool: Executor = _pool(jobs) if renewed is None else Renewed(jobs, renewed)
+    pool: Executor = _pool(jobs) if lost is None else Renewed(jobs, lost)
     try:
-        yield Workers(pool, jobs, () if renewed is None else (BrokenProcessPool,))
+        yield Workers(pool, jobs, () if lost is None else (BrokenProcessPool,))
     finally:
         pool.shutdown(wait=True, cancel_futures=True)
 
@@ -193,7 +205,8 @@ class Renewed(Executor):
 
 
 @contextmanager
-def _cluster(address: str, unmanned: Callable[[], None] | None) -> Iterator[Workers]:
+def _cluster(address: str, unmanned: Callable[[], None] | None,
+             lost: Callable[[], None] | None, isolated: bool) -> Iterator[Workers]:
     try:
         from distributed import Client
         from distributed.scheduler import KilledWorker
@@ -215,7 +228,9 @@ def _cluster(address: str, unmanned: Callable[[], None] | None) -> Iterator[Work
         client.close()  # type: ignore[no-untyped-call]
         raise
     try:
-        yield Workers(_Watched(client, address, unmanned), slots, (KilledWorker,))
+        losses = (KilledWorker, TaskProcessEnded) if isolated else (KilledWorker,)
+        yield Workers(_Watched(client, address, unmanned, lost, isolated, losses), slots,
+                      losses)
     finally:
         # The scheduler forgets the client's tasks left, and cancels them.
         client.close()  # type: ignore[no-untyped-call]
@@ -301,10 +316,14 @@ class _Watched(Executor):
     ClusterLost once the client gives up reconnecting to its scheduler: Dask's own
     futures are then cancelled, or wait for ever. While work waits, it asks every
     MANNED_EVERY seconds whether the cluster has workers, and calls `unmanned` when it
-    has had none for UNMANNED_AFTER seconds (again only once some have joined since)."""
+    has had none for UNMANNED_AFTER seconds (again only once some have joined since).
+    `isolated`: each task runs in a process of its own on its worker (`in_own_process`).
+    `lost()` is called when a task fails with an error of `losses`."""
 
     def __init__(self, client: Client, address: str,
-                 unmanned: Callable[[], None] | None = None) -> None:
+                 unmanned: Callable[[], None] | None = None,
+                 lost: Callable[[], None] | None = None, isolated: bool = False,
+                 losses: tuple[type[BaseException], ...] = ()) -> None:
         self._client = client
         # Not pure: a task submitted again after its worker died is a new one, not the
         # failed one remembered under the same key.
@@ -312,6 +331,9 @@ class _Watched(Executor):
             pure=False)
         self._address = address
         self._unmanned = unmanned
+        self._lost_one = lost
+        self._isolated = isolated
+        self._losses = losses
         self._futures: weakref.WeakSet[Future[Any]] = weakref.WeakSet()
         threading.Thread(target=self._watch, daemon=True).start()
 
@@ -354,7 +376,8 @@ class _Watched(Executor):
         if self._lost():  # given up: Dask's future would wait for ever
             self._fail(future)
             return future
-        dask = self._executor.submit(_checked, sources_digest(), fn, *args, **kwargs)
+        dask = self._executor.submit(_checked, sources_digest(), self._isolated, fn, *args,
+                                     **kwargs)
         future.add_done_callback(lambda done: done.cancelled() and dask.cancel())
         dask.add_done_callback(lambda done: self._pass(done, future))
         if self._lost():  # given up since, perhaps after the watcher's last look
@@ -376,22 +399,103 @@ class _Watched(Executor):
                     "sources differ; install the same rl1 there, and restart that worker)")
             if error is None:
                 future.set_result(dask.result())
-            else:
-                future.set_exception(error)
+                return
+            if isinstance(error, self._losses) and self._lost_one is not None:
+                self._lost_one()
+            future.set_exception(error)
 
     def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
         self._executor.shutdown(wait=False)  # the client's close cancels what is left
 
 
-def _checked(digest: str, fn: Callable[P, T], /, *args: P.args, **kwargs: P.kwargs) -> T:
-    """`fn(*args, **kwargs)` on a cluster's worker, once it is known to run the client's
-    rl1 (whose sources have `digest`): the workers were checked when the campaign began,
-    but one may join later."""
-    if sources_digest() != digest:
-        from distributed import get_worker
+def _checked(digest: str, isolated: bool, fn: Callable[P, T], /, *args: P.args,
+             **kwargs: P.kwargs) -> T:
+    """`fn(*args, **kwargs)` on a cluster's worker (in a process of its own when
+    `isolated`, which first imports the modules the worker preloaded, as they may set up
+    what the task runs), once it is known to run the client's rl1 (whose sources have
+    `digest`): the workers were checked when the campaign began, but one may join
+    later."""
+    from distributed import get_worker
 
+    if sources_digest() != digest:
         raise _OtherRl1(get_worker().address)
-    return fn(*args, **kwargs)
+    if not isolated:
+        return fn(*args, **kwargs)
+    # Those given as modules (not files), which a process finds on the worker's path.
+    preloaded = tuple(preload.name for preload in get_worker().preloads
+                      if getattr(getattr(preload, "module", None), "__name__", None)
+                      == preload.name)
+    return in_own_process(preloaded, fn, *args, **kwargs)
+
+
+# A spawned process's start: this process's sys.path (so that it imports what this one
+# would, test modules and all), then the call, each pickled on its standard input.
+_SPAWNED = ("import pickle, sys; sys.path[:] = pickle.load(sys.stdin.buffer); "
+            "target, args = pickle.load(sys.stdin.buffer); target(*args)")
+
+
+def spawn(target: Callable[..., object], *args: object, keep: tuple[int, ...] = ()
+          ) -> subprocess.Popen[bytes]:
+    """A new Python process calling `target(*args)` (pickled) and ending: started afresh
+    with this process's sys.path, never forked from this one, so that it can be made
+    from any thread of a process of many (a Dask worker's), where a fork copies locks
+    that other threads hold and Python 3.12 warns of it. `keep`: the file descriptors
+    it inherits. Its start costs about 0.5 s of imports, where a fork costs
+    milliseconds (bench/judge_apart_start.py)."""
+    process = subprocess.Popen([sys.executable, "-c", _SPAWNED], stdin=subprocess.PIPE,
+                               pass_fds=keep)
+    assert process.stdin is not None
+    with contextlib.suppress(BrokenPipeError), process.stdin:  # ended already: its
+        # status says how
+        process.stdin.write(pickle.dumps(sys.path) + pickle.dumps((target, args)))
+    return process
+
+
+def exit_how(code: int) -> str:
+    """How a child process ended, from its exit code as subprocess gives it (minus the
+    signal that ended it): `signal SIGSEGV`, or `exit status 3`."""
+    return (f"signal {signal.Signals(-code).name}" if -code in signal.valid_signals()
+            else f"exit status {code}")
+
+
+def in_own_process(preloaded: tuple[str, ...], fn: Callable[P, T], /, *args: P.args,
+                   **kwargs: P.kwargs) -> T:
+    """`fn(*args, **kwargs)` in a process spawned for it, which imports the modules
+    `preloaded` first; TaskProcessEnded when that process ends before it answers."""
+    reading, writing = os.pipe()
+    try:
+        process = spawn(_answer, writing, preloaded, fn, args, kwargs, keep=(writing,))
+    finally:
+        os.close(writing)
+    with open(reading, "rb") as stream:
+        answer = stream.read()
+    code = process.wait()
+    if not answer:
+        raise TaskProcessEnded(f"the task's process ended ({exit_how(code)})")
+    answered, result = pickle.loads(answer)
+    if not answered:
+        raise result
+    return result  # type: ignore[no-any-return]
+
+
+def _answer(writing: int, preloaded: tuple[str, ...], fn: Callable[..., object],
+            args: tuple[object, ...], kwargs: dict[str, object]) -> None:
+    """`in_own_process`'s child: the result of the call, or what it raised, pickled on
+    the pipe `writing` (nothing when it ends first)."""
+    import importlib
+
+    for module in preloaded:
+        importlib.import_module(module)
+    try:
+        answer = (True, fn(*args, **kwargs))
+    except Exception as error:  # raised again where the task was called
+        answer = (False, error)
+    try:
+        data = pickle.dumps(answer)
+    except Exception as error:  # such as an error that cannot be pickled
+        data = pickle.dumps((False, RuntimeError(f"{type(error).__name__}: {error}")))
+    with open(writing, "wb") as stream:
+        stream.write(data)
 
 
 def _threads(client: Client, address: str) -> int:

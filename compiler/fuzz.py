@@ -455,17 +455,17 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
              executor: Executor | None = None, jobs: int = 1, keep_going: bool = False,
              found: Callable[[Finding], None] | None = None,
              channel: Channel | None = None, corpus: Sequence[Run] = (),
-             statistics: bool = False, lost: tuple[type[BaseException], ...] = (),
-             worker_lost: Callable[[], None] | None = None) -> Outcome:
+             statistics: bool = False, lost: tuple[type[BaseException], ...] = ()
+             ) -> Outcome:
     """Run the `corpus`, then generated programs, on `engines` until `count` generated
     programs or `seconds` have passed, or until they disagree (with `keep_going`, until
     then whatever they find); `progress(programs, elapsed, shrinking)` as programs run
     and findings are shrunk (`shrinking`: the searches shrinking one now),
     `found(finding)` on each new signature's smallest run. The searches run in this
     process, or `jobs` at a time on `executor` (a search lost with its worker, an error
-    of `lost`, runs again, after `worker_lost()`; SearchLost when it is lost each
-    time); a disagreement stops the searches after the one that found it, and is the one
-    of the first search in order that finds one, as in one process. `channel.halt()`
+    of `lost`, runs again; SearchLost when it is lost each time); a disagreement stops
+    the searches after the one that found it, and is the one of the first search in
+    order that finds one, as in one process. `channel.halt()`
     (from a signal handler) stops every search, keeping their counts and findings. With
     `statistics`, the Outcome says what the programs did."""
     start = time.monotonic()
@@ -535,8 +535,7 @@ def campaign(engines: Sequence[Engine], budget: int, *, count: int | None,
         else:
             _on_executor(executor, jobs, next_search, keep, channel,
                          lambda programs, shrinking: progress(
-                             done() + programs, time.monotonic() - start, shrinking), lost,
-                         worker_lost)
+                             done() + programs, time.monotonic() - start, shrinking), lost)
     finally:
         if own_channel:
             channel.close()
@@ -568,14 +567,14 @@ class SearchLost(Exception):
 
 def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search | None],
                  keep: Callable[[Searched], None], channel: Channel,
-                 progress: Callable[[int, int], None], lost: tuple[type[BaseException], ...],
-                 worker_lost: Callable[[], None] | None) -> None:
+                 progress: Callable[[int, int], None], lost: tuple[type[BaseException], ...]
+                 ) -> None:
     """Run the searches `next_search` gives on `executor`, `jobs` at a time, keeping
-    each as it ends; one lost with its worker (an error of `lost`: `worker_lost()` is
-    called) runs again, up to LOSSES times (then SearchLost), each of its programs (and
-    each tried in shrinking) then judged in a process of its own: its worker may have
-    died of one of them, or beside the search that had it; either way the same
-    programs, and one that ends its process is a finding."""
+    each as it ends; one lost with its worker (an error of `lost`) runs again, up to
+    LOSSES times (then SearchLost), each of its programs (and each tried in shrinking)
+    then judged in a process of its own: its worker may have died of one of them, or
+    beside the search that had it; either way the same programs, and one that ends its
+    process is a finding."""
     pending: dict[Future[Searched], Search] = {}
     losses: dict[int, int] = {}
 
@@ -594,8 +593,6 @@ def _on_executor(executor: Executor, jobs: int, next_search: Callable[[], Search
                     raise SearchLost(f"search {task.index} lost {LOSSES + 1} times"
                                      ) from error
                 losses[task.index] = losses.get(task.index, 0) + 1
-                if worker_lost is not None:
-                    worker_lost()
                 task = replace(task, apart=True)
                 pending[executor.submit(search, task)] = task
                 continue

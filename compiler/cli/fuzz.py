@@ -190,29 +190,22 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         except OSError as error:
             written[finding.signature] = error
 
-    warned = False
-
-    def worker_lost() -> None:  # said once: each search lost runs again alike
-        nonlocal warned
-        if not warned:
-            warned = True
-            bar.warn(WORKER_LOST)
-
     try:
-        # Processes even for one job: an engine that ends the process it runs in (the C
-        # VM's crash) ends a worker, whose searches run again to name the program. A
-        # local pool is made again when one dies; the campaign says so, as for a
-        # cluster's worker (whose nanny starts it again).
+        # Processes even for one job, and on a cluster a process a search: an engine
+        # that ends the process it runs in (the C VM's crash) ends that one, whose
+        # searches run again to name the program; a local pool is made again, and a
+        # cluster's worker lives on. Each time, the campaign says so.
         with _halted_by_signals(channel) as signalled, \
-                workers(jobs or os.cpu_count() or 1, scheduler, lambda: None,
-                        isolated=True, unmanned=lambda: bar.warn(
-                            _no_workers_left(scheduler or ""))) as held:
+                workers(jobs or os.cpu_count() or 1, scheduler,
+                        lost=lambda: bar.warn(WORKER_LOST), isolated=True,
+                        unmanned=lambda: bar.warn(_no_workers_left(scheduler or ""))
+                        ) as held:
             outcome = campaign(engines, budget, count=limit, seconds=seconds,
                                seed=seed_value, progress=bar.update, executor=held.executor,
                                jobs=max(held.slots, 1), keep_going=keep_going,
                                found=write if keep_going else None, channel=channel,
                                corpus=corpus, statistics=fuzz_format == "json",
-                               lost=held.lost, worker_lost=worker_lost)
+                               lost=held.lost)
     # Such as no C compiler for c-ON, or a cluster that cannot be had or was lost.
     except (BuildError, EngineUnavailable, Unavailable, ClusterLost) as error:
         raise Failure(f"error: {error}") from None
@@ -269,9 +262,9 @@ WORKER_LOST = ("a worker process ended abruptly (killed, out of memory, or ended
 
 
 def _no_workers_left(scheduler: str) -> str:
-    return (f"the Dask scheduler at {scheduler} has no workers left (one that an engine "
-            "ends is started again only under a nanny: `dask worker` without --no-nanny); "
-            f"the searches wait for one (`dask worker {scheduler}`)")
+    return (f"the Dask scheduler at {scheduler} has no workers left (killed, or out of "
+            "memory: one is started again only under a nanny, `dask worker` without "
+            f"--no-nanny); the searches wait for one (`dask worker {scheduler}`)")
 
 
 def _found(finding: Finding, reference: str) -> str:

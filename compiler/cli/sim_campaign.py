@@ -148,10 +148,11 @@ class Stopping:
 @contextmanager
 def _workers(setting: Setting, progress: Progress) -> Iterator[Workers]:
     """The campaign's workers (no more local processes than runs; a new pool of them when
-    one dies, said through `progress`), or the Failure that says why there are none."""
+    one dies; each worker lost said through `progress`), or the Failure that says why
+    there are none."""
     try:
         with workers(min(setting.jobs, setting.runs), setting.scheduler,
-                     lambda: progress.warn(POOL_RENEWED),
+                     lost=lambda: progress.warn(WORKER_LOST),
                      unmanned=lambda: progress.warn(no_workers_left(setting.scheduler or ""))
                      ) as held:
             if setting.scheduler is not None and held.slots == 0:
@@ -220,8 +221,8 @@ class Progress:
         self.stream.flush()
 
 
-POOL_RENEWED = ("a worker process ended abruptly (killed, or out of memory); a new pool "
-                "of workers makes its runs and those beside it again, a run a task")
+WORKER_LOST = ("a worker process ended abruptly (killed, or out of memory); its runs and "
+               "those beside it are made again, a run a task")
 
 
 def no_workers_left(scheduler: str) -> str:

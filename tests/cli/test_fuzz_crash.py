@@ -9,6 +9,7 @@ import faulthandler
 import json
 import os
 import signal
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from support.planted import crashing_c_vm
 from support.recording import Recording, recorded
 
 from rl1.compiler import differential, fuzz
+from rl1.compiler.cli.fuzz import WORKER_LOST
 from rl1.compiler.differential import (
     Engine,
     EngineUnavailable,
@@ -27,7 +29,7 @@ from rl1.compiler.differential import (
     judge_apart,
     signature,
 )
-from rl1.compiler.executors import workers
+from rl1.compiler.executors import TaskProcessEnded, in_own_process, workers
 from rl1.compiler.frontend.source import split_lines
 from rl1.compiler.strategies import Run
 
@@ -41,17 +43,19 @@ SIGSEGV = f"{KILLER}: ended its process (signal SIGSEGV)"
 
 @dataclass(frozen=True)
 class _EndsItsProcess:
-    """The -O0 VM, except on `program`, where it ends its process as the C VM's crash
-    would: by `signum`, or with the exit status `status` (os._exit) when it is None."""
+    """The -O0 VM, except on `program` (and `others`), where it ends its process as the C
+    VM's crash would: by `signum`, or with the exit status `status` (os._exit) when it
+    is None."""
 
     program: str
     signum: int | None = signal.SIGSEGV
     status: int = 0
     name: str = KILLER
     level: int = 0
+    others: tuple[str, ...] = ()
 
     def run(self, case: Run, budget: int) -> Observation:
-        if case.source == self.program:
+        if case.source == self.program or case.source in self.others:
             if self.signum is None:
                 os._exit(self.status)
             faulthandler.disable()  # pytest's, which would print this process's stacks
@@ -84,7 +88,7 @@ def programs(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> list[str]:
 
 def _on_processes(engines: list[Engine], jobs: int, keep_going: bool) -> fuzz.Outcome:
     renewals: list[None] = []
-    with workers(jobs, renewed=lambda: renewals.append(None), isolated=True) as held:
+    with workers(jobs, lost=lambda: renewals.append(None), isolated=True) as held:
         outcome = fuzz.campaign(engines, 20_000, count=COUNT, seconds=None, seed=SEED,
                                 progress=_quiet, executor=held.executor, jobs=held.slots,
                                 keep_going=keep_going, lost=held.lost)
@@ -136,6 +140,42 @@ def test_judged_apart_an_exit_names_its_status_and_the_runs_before_it() -> None:
     assert signature(verdict) == f"{KILLER}: ended its process (exit status 3)"
 
 
+def test_judged_apart_in_a_thread_its_process_is_spawned_not_forked(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # As a Dask worker judges, in a thread beside its event loop's: a fork there copies
+    # the locks other threads hold, never released in the child (Python 3.12 warns).
+    def fork() -> int:
+        raise AssertionError("forked in a process of several threads")
+
+    monkeypatch.setattr(os, "fork", fork)
+    ordinary, ending = Run("A=1\nB=A+2\n", {}), Run("A=1\n", {})
+    verdicts: list[differential.Verdict] = []
+
+    def judging() -> None:
+        verdicts.append(judge_apart(ordinary, [VmEngine(0), VmEngine(2)], 100))
+        verdicts.append(judge_apart(ending, [VmEngine(0), _EndsItsProcess(ending.source),
+                                             VmEngine(1)], 100))
+
+    thread = threading.Thread(target=judging)
+    thread.start()
+    thread.join(timeout=120)
+    assert verdicts[0] == judge(ordinary, [VmEngine(0), VmEngine(2)], 100)
+    assert verdicts[1].problems == [SIGSEGV] and verdicts[1].ended == "signal SIGSEGV"
+    assert list(verdicts[1].observations) == ["vm-O0", KILLER]
+
+
+def test_a_task_in_a_process_of_its_own_answers_raises_or_is_said_to_have_ended() -> None:
+    # How a cluster's worker runs a search (rl1c fuzz --scheduler), so that an engine
+    # that ends its process ends that one, not the worker.
+    assert in_own_process((), pow, 2, 10) == 1024
+    with pytest.raises(ZeroDivisionError):
+        in_own_process((), divmod, 1, 0)
+    with pytest.raises(TaskProcessEnded, match=r"^the task's process ended \(exit status 3\)$"):
+        in_own_process((), os._exit, 3)
+    with pytest.raises(TaskProcessEnded, match=r"\(signal SIGSEGV\)$"):
+        in_own_process((), _EndsItsProcess("A=1\n").run, Run("A=1\n", {}), 100)
+
+
 @dataclass(frozen=True)
 class _Unavailable:
     name: str = "unavailable"
@@ -153,9 +193,16 @@ def test_judged_apart_an_engine_this_machine_cannot_run_is_raised_here() -> None
 @pytest.fixture
 def named_killer(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> str:
     """`rl1c fuzz --engine ends-its-process` (in this process and those forked from it)
-    ends its process on the eighth program of `rl1c fuzz --seed SEED`; that program,
-    found by rl1c itself with an engine `recording`, so that the test follows the
-    generator as it changes."""
+    ends its process on the eighth program of `rl1c fuzz --seed SEED`; that program."""
+    return _named_killers(tmp_path, monkeypatch, [7])[0]
+
+
+def _named_killers(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, indexes: list[int]
+                   ) -> list[str]:
+    """`rl1c fuzz --engine ends-its-process` (in this process and those forked from it)
+    ends its process on the programs of `rl1c fuzz --seed SEED` at `indexes`; those
+    programs, found by rl1c itself with an engine `recording`, so that the test follows
+    the generator as it changes."""
     _small_searches(monkeypatch)
     path = tmp_path / "programs"
     killing: list[str] = []
@@ -164,15 +211,29 @@ def named_killer(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> str:
     def engine_named(name: str) -> Engine | None:
         if name == "recording":
             return Recording(path)
-        return _EndsItsProcess(killing[0]) if name == KILLER else named(name)
+        return _EndsItsProcess(killing[0], others=tuple(killing[1:])) if name == KILLER \
+            else named(name)
 
     monkeypatch.setattr(differential, "engine_named", engine_named)
     monkeypatch.setattr(fuzz, "engine_named", engine_named)
     result = rl1c("fuzz", "--engine", "vm-O0", "--engine", "recording", "--count",
                   str(COUNT), "--seed", str(SEED), "--jobs", "1", "--out", tmp_path)
     assert result.exit_code == 0, result.output
-    killing.append(recorded(path)[7])
-    return killing[0]
+    killing.extend(recorded(path)[index] for index in indexes)
+    return killing
+
+
+def test_rl1c_fuzz_says_each_worker_an_engine_ends(tmp_path: Path,
+                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+    # It said the first alone: the campaign warned of its first search lost, and gave
+    # the pool a renewal that did nothing.
+    _named_killers(tmp_path, monkeypatch, [2, 6])  # in the first search, and the second
+    result = rl1c("fuzz", "--engine", "vm-O0", "--engine", KILLER, "--count", str(COUNT),
+                  "--seed", str(SEED), "--jobs", "1", "--keep-going", "--out",
+                  tmp_path / "out")
+    assert result.exit_code == 1, result.output
+    assert f"      2  {SIGSEGV}\n" in result.stdout
+    assert result.stderr == f"rl1c: warning: {WORKER_LOST}\n" * 2
 
 
 @pytest.mark.parametrize("jobs", ["1", "2"])

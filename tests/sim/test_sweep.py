@@ -155,8 +155,8 @@ def test_each_point_after_the_first_starts_with_tasks_sized_by_the_runs_before(
     instant = Instant()  # its runs take no time: once timed, a task makes the most runs
 
     @contextmanager
-    def two_workers(jobs: int, scheduler: str | None,
-                    renewed: Callable[[], None], *,
+    def two_workers(jobs: int, scheduler: str | None, *,
+                    lost: Callable[[], None] | None = None,
                     unmanned: Callable[[], None] | None = None) -> Iterator[Workers]:
         yield Workers(instant, 2)
 

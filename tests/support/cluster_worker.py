@@ -2,7 +2,8 @@
 load first (`dask worker --preload support.cluster_worker`, with tests/ on PYTHONPATH):
 the C VM of $PLANTED_C_VM (support.planted.crashing_c_vm's library) when it is set, and
 `EndsItsWorker`, an engine that ends the worker whatever program it judges, there or in
-a process the worker forked to judge it apart."""
+a process the worker made to run a task or judge a program apart (which rl1 starts
+importing this module, as the worker preloaded it)."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ from rl1.compiler.differential import Observation, VmEngine
 from rl1.compiler.strategies import Run
 
 PLANTED = "PLANTED_C_VM"  # the environment variable naming the library
-_worker: int | None = None  # the process id of the worker this was loaded in
+WORKER = "RL1_TEST_DASK_WORKER"  # the worker's process id, for the processes it starts
 
 
 def _planted(*args: object, **kwargs: object) -> Path:
@@ -30,8 +31,7 @@ if os.environ.get(PLANTED):  # as the tests' monkeypatch does in their own proce
 
 def dask_setup(worker: Any) -> None:
     """Dask's call when the worker starts, in its process."""
-    global _worker
-    _worker = os.getpid()
+    os.environ[WORKER] = str(os.getpid())
 
 
 @dataclass(frozen=True)
@@ -40,7 +40,7 @@ class EndsItsWorker:
     level: int = 0
 
     def run(self, case: Run, budget: int) -> Observation:
-        if _worker is None:
+        if WORKER not in os.environ:
             raise RuntimeError("EndsItsWorker runs only on a worker that preloaded it")
-        os.kill(_worker, signal.SIGKILL)
+        os.kill(int(os.environ[WORKER]), signal.SIGKILL)
         return VmEngine(0).run(case, budget)
