@@ -222,6 +222,15 @@ def _encode_handlers(handlers: dict[int, int], code_size: int) -> bytes:
     return b"".join(struct.pack("<H", handlers.get(label, ABSENT)) for label in HANDLER_LABELS)
 
 
+def debug_source_name(name: str) -> str:
+    """The file name `name` as the debug section holds it: UTF-8, each surrogate (a byte
+    of a name that is not UTF-8, as Python holds it) as U+FFFD, and within MAX_NAME_SIZE
+    bytes (its end kept, where the file's own name is)."""
+    encoded = "".join("\ufffd" if "\ud800" <= character <= "\udfff" else character
+                      for character in name).encode("utf-8")
+    return encoded[-MAX_NAME_SIZE:].decode("utf-8", "ignore")
+
+
 def _encode_debug(debug: DebugInfo) -> bytes:
     name = debug.source_name.encode("utf-8")
     if len(name) > MAX_NAME_SIZE:

@@ -38,7 +38,8 @@ class _MachineOp:
 
 
 def generate(program: ir.Program, source_name: str, *, debug: bool = True) -> ilc.Image:
-    """The image of a valid IR program, with its line map unless `debug` is False;
+    """The image of a valid IR program, with its line map unless `debug` is False (the
+    source's name in it as `ilc.debug_source_name` writes it);
     CodegenError when the code passes 65535 bytes or the map a line it cannot record."""
     layout = [(block.id, _select(block, following))
               for block, following in program.laid_out()]
@@ -67,7 +68,7 @@ def generate(program: ir.Program, source_name: str, *, debug: bool = True) -> il
         bytes(code),
         {label: block_offsets[block_id] for label, block_id in program.handlers.items()},
         frozenset(feature for feature in features if feature is not None),
-        ilc.DebugInfo(source_name, tuple(lines)) if debug else None,
+        ilc.DebugInfo(ilc.debug_source_name(source_name), tuple(lines)) if debug else None,
     )
 
 

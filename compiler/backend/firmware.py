@@ -6,6 +6,7 @@ Both carry the .ilc file byte for byte; nothing here knows what the bytes mean.
 
 from __future__ import annotations
 
+import os
 import re
 from typing import Literal
 
@@ -60,7 +61,9 @@ def c_source(data: bytes, name: str, source_name: str, progmem: bool = False) ->
     assert c_name_problem(name) is None, name
     rows = [", ".join(f"0x{byte:02x}" for byte in data[start:start + _BYTES_PER_C_LINE])
             for start in range(0, len(data), _BYTES_PER_C_LINE)]
-    comment = source_name.replace("*/", "* /")  # a file name cannot end the comment early
+    # A file name cannot end the comment early, and its bytes past ASCII (ロボ.rob, or a
+    # name that is not UTF-8) are escaped, so that the file is ASCII for any compiler.
+    comment = os.fsencode(source_name).decode("ascii", "backslashreplace").replace("*/", "* /")
     command = "rl1c --emit c --progmem" if progmem else "rl1c --emit c"
     placement = ("#ifdef __AVR__\n"
                  "#include <avr/pgmspace.h> /* PROGMEM: in flash, read with pgm_read_byte */\n"

@@ -43,6 +43,7 @@ from .command import (
     format_option,
 )
 from .streams import (
+    PATH_ESCAPES,
     emit,
     file_failure,
     invalid_file,
@@ -197,7 +198,7 @@ def _ilc_form(emit_kind: str, data: bytes, source: Source, c_name: str, progmem:
         except ValueError as error:
             raise click.UsageError(f"argument --base-address: {error}") from None
     name = with_suffix(os.path.basename(source.name), ".ilc")
-    return disassemble(data, name, source.lines).encode("utf-8")
+    return disassemble(data, name, source.lines).encode("utf-8", PATH_ESCAPES)
 
 
 def _default_output(source: str, emit_kind: str) -> str:

@@ -11,6 +11,7 @@ status) or `click.UsageError` (shown with the command's usage, status 2).
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import sys
 from collections.abc import Callable, Sequence
@@ -93,16 +94,20 @@ class Command(click.Command):
 
 def output_failed(error: OSError) -> int:
     """Standard output could not be written. A closed pipe (`rl1c dis x.ilc | head`) ends
-    quietly with status 1; anything else (a full disk) is said in one line, status 2.
-    What is left in the buffer goes to /dev/null, or Python would fail again flushing it
-    at exit."""
+    quietly with status 1; anything else (a full disk, a closed descriptor) is said in
+    one line, status 2. What is left in the buffer goes to /dev/null, or Python would
+    fail again flushing it at exit."""
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, sys.stdout.fileno())
     if isinstance(error, BrokenPipeError):
         return EXIT_ERRORS
+    if error.errno == errno.EBADF:  # main.py holds a closed standard output so
+        problem = ("standard output is closed; send it to a file, a pipe or /dev/null "
+                   "(`> FILE`, not `>&-`)")
+    else:
+        problem = f"{error.strerror or error}; free some space or write elsewhere"
     with contextlib.suppress(OSError):  # standard error may be just as full
-        print(f"rl1c: error: cannot write the output: {error.strerror or error}; "
-              "free some space or write elsewhere", file=sys.stderr)
+        print(f"rl1c: error: cannot write the output: {problem}", file=sys.stderr)
     return EXIT_USAGE
 
 

@@ -147,6 +147,7 @@ class Toolchain(click.Group):
              **extra: Any) -> Any:
         """Runs the command line `args` (default: the process's arguments); returns the
         exit status, or exits with it in standalone mode (the default)."""
+        _hold_closed_standard_streams()
         _escape_unprintable_output()
         try:
             # The name is rl1c however Python was started (not "-c" or "__main__.py").
@@ -199,6 +200,22 @@ def describe(error: click.UsageError) -> str:
         close = f" (did you mean {error.possibilities[0]}?)" if error.possibilities else ""
         return f"unrecognized arguments: {error.option_name}{close}"
     return error.format_message()
+
+
+def _hold_closed_standard_streams() -> None:
+    # A standard stream the shell closed (`rl1c dis x.ilc >&-`), which Python leaves as
+    # None, gets /dev/null's descriptor, so that no file rl1c opens takes its number (an
+    # output file would receive the report). Standard output's is read-only: writing it
+    # fails (EBADF) as writing a closed descriptor does, and the command says so.
+    for number, name, access in ((0, "stdin", os.O_RDONLY), (1, "stdout", os.O_RDONLY),
+                                 (2, "stderr", os.O_WRONLY)):
+        if getattr(sys, name) is None:
+            descriptor = os.open(os.devnull, access)  # the lowest free number: this one
+            if descriptor != number:
+                os.dup2(descriptor, number)
+                os.close(descriptor)
+            stream = open(number, "r" if number == 0 else "w", closefd=False)  # noqa: SIM115
+            setattr(sys, name, stream)  # open for the process's life, as Python's own
 
 
 def _escape_unprintable_output() -> None:

@@ -22,7 +22,7 @@ from .command import (
     color_option,
     force_option,
 )
-from .streams import invalid_file, read_failure, write_file
+from .streams import PATH_ESCAPES, invalid_file, read_failure, same_file, write_file
 
 if TYPE_CHECKING:
     from rl1.compiler.sweep import Axis
@@ -126,6 +126,10 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
         if target == "-":
             raise click.UsageError(f"{option} writes a file, and standard output carries "
                                    f"the report: give {option} FILE")
+        for role, name in (("program", file), ("world file", world)):
+            if target is not None and same_file(name, target):
+                raise click.UsageError(f"{option} `{target}` is the {role} itself: give "
+                                       "another path for the picture")
     if runs is None:
         for option, given in (("--jobs", jobs), ("--scheduler", scheduler),
                               ("--out", out_file)):
@@ -169,14 +173,15 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
     title = f"{os.path.basename(file)} on {os.path.basename(world)}" + (
         "" if verdict is None else f": {verdict.headline()}")
     if svg_file is not None:
-        write_file(svg_file, svg(the_world, device.sim.track, device.sim.events, title,
-                                 device.trace, device.sightings, verdict).encode(),
-                   force=force, role="SVG file")
+        picture = svg(the_world, device.sim.track, device.sim.events, title, device.trace,
+                      device.sightings, verdict)
+        write_file(svg_file, picture.encode("utf-8", PATH_ESCAPES), force=force,
+                   role="SVG file")
     if html_file is not None:
         write_file(html_file, html(
             the_world, device.sim.track, device.sim.events, device.trace, title,
             device.sightings, lambda entry: call_text(entry.call, entry.args, entry.result),
-            verdict).encode(), force=force, role="HTML file")
+            verdict).encode("utf-8", PATH_ESCAPES), force=force, role="HTML file")
     if sim_format == "json":
         sys.stdout.write(render_json(result, device, ran.finished.instructions, ended_at,
                                      run_on, trace_choice or "all", verdict))

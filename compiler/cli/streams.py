@@ -40,6 +40,9 @@ if TYPE_CHECKING:  # the .ilc module loads only when an .ilc file is read
 STDIN_NAME = "<stdin>"
 SOURCE_SUFFIX = ".rob"  # in any case: DOS wrote SAMPLE.ROB
 MAX_ILC_BYTES = 16 * 1024 * 1024  # far more than any .ilc file holds
+# How a text file rl1c writes (.ils, a picture) holds a path that is not UTF-8: each byte
+# escaped as standard output and error show it (`\udcff`), where encoding it failed.
+PATH_ESCAPES = "backslashreplace"
 
 
 def read_input(name: str, role: str = "source file") -> Source | FileDiagnostics:
@@ -230,8 +233,8 @@ def with_suffix(path: str, suffix: str) -> str:
 
 def same_file(first: str, second: str) -> bool:
     """Whether two paths (`-` is a standard stream) name one existing file."""
-    return "-" not in (first, second) and os.path.exists(second) \
-        and os.path.samefile(first, second)
+    return "-" not in (first, second) and os.path.exists(first) \
+        and os.path.exists(second) and os.path.samefile(first, second)
 
 
 def encode_like(source: Source, text: str, *, bom: bool) -> bytes:

@@ -38,7 +38,7 @@ def recorded_name(source: str, output: str | None) -> str:
     except ValueError:  # on another drive
         return base
     name = PurePosixPath(*PurePath(relative).parts).as_posix()
-    return name if len(name.encode("utf-8")) <= ilc.MAX_NAME_SIZE else base
+    return name if len(os.fsencode(name)) <= ilc.MAX_NAME_SIZE else base
 
 
 @dataclass(frozen=True)

@@ -541,11 +541,12 @@ def _sarif_region(span: Span) -> dict[str, int]:
 
 def artifact_uri(name: str) -> str:
     """The SARIF URI of a file named on the command line: the relative path as given,
-    percent-encoded where a URI needs it; an absolute path becomes a file: URI."""
+    percent-encoded where a URI needs it; an absolute path becomes a file: URI. The
+    path's bytes are encoded, so that a name that is not UTF-8 keeps its bytes."""
     from pathlib import Path  # only for SARIF: with urllib, 3 ms of every start
     from urllib.parse import quote
 
     path = Path(name)
     if path.is_absolute():
         return path.as_uri()
-    return quote(path.as_posix())
+    return quote(os.fsencode(path.as_posix()))
