@@ -734,9 +734,9 @@ def forks_safely() -> bool:
     thread that makes it alone, and the locks the others held then (the allocator's,
     logging's, an event loop's) stay held in the child for ever, so that it may
     deadlock; Python 3.12 warns of it. A Dask worker runs its tasks in threads beside
-    its event loop's. A spawned process costs a case about 0.5 s more than a fork
-    (bench/judge_apart_start.py: judged apart, 16.4 cases a second forked, 1.9
-    spawned), so the fork is kept where it is safe: rl1c's own process, a local pool's
+    its event loop's. A spawned process costs a case some 0.2 to 0.5 s more than a fork
+    (bench/own_process.py: cases judged apart a second, forked 16 to 42, spawned 2 to
+    4), so the fork is kept where it is safe: rl1c's own process, a local pool's
     worker, the process a cluster's task has of its own (executors.in_own_process)."""
     return threading.active_count() == 1
 

@@ -32,7 +32,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from types import FrameType
-from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
+from typing import IO, TYPE_CHECKING, Any, ParamSpec, TypeVar
 
 from rl1 import vm
 
@@ -440,8 +440,8 @@ def spawn(target: Callable[..., object], *args: object, keep: tuple[int, ...] = 
     with this process's sys.path, never forked from this one, so that it can be made
     from any thread of a process of many (a Dask worker's), where a fork copies locks
     that other threads hold and Python 3.12 warns of it. `keep`: the file descriptors
-    it inherits. Its start costs about 0.5 s of imports, where a fork costs
-    milliseconds (bench/judge_apart_start.py)."""
+    it inherits. Its start costs some 0.2 to 0.5 s of imports, where a fork costs
+    milliseconds (bench/own_process.py)."""
     process = subprocess.Popen([sys.executable, "-c", _SPAWNED], stdin=subprocess.PIPE,
                                pass_fds=keep)
     assert process.stdin is not None
@@ -458,44 +458,87 @@ def exit_how(code: int) -> str:
             else f"exit status {code}")
 
 
+@dataclass(frozen=True, slots=True)
+class _OwnProcess:
+    """A process that makes a thread's tasks one after the other (`_serve`), the modules
+    `preloaded` imported; the ends of its pipes of tasks and answers."""
+
+    process: subprocess.Popen[bytes]
+    preloaded: tuple[str, ...]
+    tasks: IO[bytes]
+    answers: IO[bytes]
+
+    def close(self) -> None:
+        with contextlib.suppress(OSError):  # a task left unsent to a process that ended
+            self.tasks.close()  # which ends it, when it lives
+        self.answers.close()
+        self.process.wait()
+
+
+_own = threading.local()  # each thread's _OwnProcess
+
+
 def in_own_process(preloaded: tuple[str, ...], fn: Callable[P, T], /, *args: P.args,
                    **kwargs: P.kwargs) -> T:
-    """`fn(*args, **kwargs)` in a process spawned for it, which imports the modules
-    `preloaded` first; TaskProcessEnded when that process ends before it answers."""
-    reading, writing = os.pipe()
+    """`fn(*args, **kwargs)` in a process of this thread's own, spawned when it first
+    needs one (importing the modules `preloaded` first) and kept for its next tasks, so
+    that a cluster's search costs no start (some 0.5 s, bench/own_process.py);
+    TaskProcessEnded when that process ends before it answers (the next task has a new
+    one). The process ends when this one does: its pipe of tasks then closes."""
+    own: _OwnProcess | None = getattr(_own, "process", None)
+    if own is None or own.preloaded != preloaded:
+        if own is not None:
+            own.close()
+        own = _own.process = _start_own(preloaded)
     try:
-        process = spawn(_answer, writing, preloaded, fn, args, kwargs, keep=(writing,))
-    finally:
-        os.close(writing)
-    with open(reading, "rb") as stream:
-        answer = stream.read()
-    code = process.wait()
-    if not answer:
-        raise TaskProcessEnded(f"the task's process ended ({exit_how(code)})")
-    answered, result = pickle.loads(answer)
+        pickle.dump((fn, args, kwargs), own.tasks)
+        own.tasks.flush()
+        answered, result = pickle.load(own.answers)
+    except (OSError, EOFError, pickle.UnpicklingError):  # it ended, perhaps mid-answer
+        _own.process = None
+        own.close()
+        raise TaskProcessEnded(
+            f"the task's process ended ({exit_how(own.process.returncode)})") from None
     if not answered:
         raise result
     return result  # type: ignore[no-any-return]
 
 
-def _answer(writing: int, preloaded: tuple[str, ...], fn: Callable[..., object],
-            args: tuple[object, ...], kwargs: dict[str, object]) -> None:
-    """`in_own_process`'s child: the result of the call, or what it raised, pickled on
-    the pipe `writing` (nothing when it ends first)."""
+def _start_own(preloaded: tuple[str, ...]) -> _OwnProcess:
+    tasks_read, tasks = os.pipe()
+    answers, answers_written = os.pipe()
+    try:
+        process = spawn(_serve, tasks_read, answers_written, preloaded,
+                        keep=(tasks_read, answers_written))
+    finally:
+        os.close(tasks_read)
+        os.close(answers_written)
+    return _OwnProcess(process, preloaded, open(tasks, "wb"), open(answers, "rb"))
+
+
+def _serve(tasks: int, answers: int, preloaded: tuple[str, ...]) -> None:
+    """`in_own_process`'s child: for each call read from the pipe `tasks`, its result
+    or what it raised, pickled on the pipe `answers`, until `tasks` ends."""
     import importlib
 
     for module in preloaded:
         importlib.import_module(module)
-    try:
-        answer = (True, fn(*args, **kwargs))
-    except Exception as error:  # raised again where the task was called
-        answer = (False, error)
-    try:
-        data = pickle.dumps(answer)
-    except Exception as error:  # such as an error that cannot be pickled
-        data = pickle.dumps((False, RuntimeError(f"{type(error).__name__}: {error}")))
-    with open(writing, "wb") as stream:
-        stream.write(data)
+    with open(tasks, "rb") as calls, open(answers, "wb") as replies:
+        while True:
+            try:
+                fn, args, kwargs = pickle.load(calls)
+            except EOFError:  # the parent ended, or has no more tasks
+                return
+            try:
+                answer = (True, fn(*args, **kwargs))
+            except Exception as error:  # raised again where the task was called
+                answer = (False, error)
+            try:
+                data = pickle.dumps(answer)
+            except Exception as error:  # such as an error that cannot be pickled
+                data = pickle.dumps((False, RuntimeError(f"{type(error).__name__}: {error}")))
+            replies.write(data)
+            replies.flush()
 
 
 def _threads(client: Client, address: str) -> int:

@@ -172,8 +172,11 @@ def test_a_task_in_a_process_of_its_own_answers_raises_or_is_said_to_have_ended(
         in_own_process((), divmod, 1, 0)
     with pytest.raises(TaskProcessEnded, match=r"^the task's process ended \(exit status 3\)$"):
         in_own_process((), os._exit, 3)
+    assert in_own_process((), pow, 2, 11) == 2048  # in a new process
     with pytest.raises(TaskProcessEnded, match=r"\(signal SIGSEGV\)$"):
         in_own_process((), _EndsItsProcess("A=1\n").run, Run("A=1\n", {}), 100)
+    first = in_own_process((), os.getpid)
+    assert in_own_process((), os.getpid) == first != os.getpid()  # kept for the next
 
 
 @dataclass(frozen=True)
