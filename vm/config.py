@@ -111,7 +111,10 @@ def read_document(data: bytes, name: str, syntax: Syntax) -> tuple[Any, str]:
             if _holds_a_huge_int(document):  # 0x, 0o and 0b integers are read unbounded
                 raise ValueError("an integer too long")
             return document, text
-        return json.loads(text, parse_int=_bounded_int, parse_constant=_refuse_constant), text
+        document = json.loads(text, parse_int=_bounded_int, parse_constant=_refuse_constant)
+        if _holds_a_surrogate(document):
+            raise _surrogate_error(name, text)
+        return document, text
     except tomllib.TOMLDecodeError as error:
         # tomllib (before Python 3.14) gives the place only in its message.
         place = _TOML_PLACE.search(str(error))
@@ -153,6 +156,51 @@ def _holds_a_huge_int(value: object) -> bool:
             return any(_holds_a_huge_int(item) for item in value.values())
         case list():
             return any(_holds_a_huge_int(item) for item in value)
+    return False
+
+
+# JSON's reader takes a `\uD800` without its other half, a surrogate, which no UTF-8
+# (nor the schemas' reader) can hold. Its escape is looked for only once the data is
+# known to hold one, for its line.
+_SURROGATE = re.compile("[\ud800-\udfff]")
+_ESCAPE = re.compile(r"\\(?:u([0-9a-fA-F]{4})|.)", re.DOTALL)  # `\\` is one escape
+
+
+def _surrogate_error(name: str, text: str) -> ConfigError:
+    escape = _lone_half(text)
+    line = None if escape is None else text.count("\n", 0, escape.start()) + 1
+    quoted = "" if escape is None else f" (`{escape.group()}`)"
+    return ConfigError(name, line, "", f"invalid JSON: a string holds half of a UTF-16 "
+                       f"pair{quoted}, which is no character; write the character itself, "
+                       "or both halves of its pair")
+
+
+def _lone_half(text: str) -> re.Match[str] | None:
+    """The first escape in JSON `text` of half a UTF-16 pair without its other half."""
+    high: re.Match[str] | None = None
+    for escape in _ESCAPE.finditer(text):
+        code = int(escape[1], 16) if escape[1] else -1
+        if high is not None:
+            if 0xDC00 <= code <= 0xDFFF and escape.start() == high.end():
+                high = None  # a whole pair
+                continue
+            return high
+        if 0xD800 <= code <= 0xDBFF:
+            high = escape
+        elif 0xDC00 <= code <= 0xDFFF:
+            return escape
+    return high
+
+
+def _holds_a_surrogate(value: object) -> bool:
+    match value:
+        case str():
+            return _SURROGATE.search(value) is not None
+        case dict():
+            return any(_holds_a_surrogate(key) or _holds_a_surrogate(item)
+                       for key, item in value.items())
+        case list():
+            return any(_holds_a_surrogate(item) for item in value)
     return False
 
 

@@ -156,6 +156,23 @@ def test_json_has_no_nan() -> None:
         read_document(b'{"a": NaN}', "f", "json")
 
 
+@pytest.mark.parametrize(("text", "line", "escape"), [
+    ('{"\\ud800": 1}', 1, "\\ud800"),  # a key: msgspec failed on it with UnicodeEncodeError
+    ('{\n"a": ["\\ud83d\\ude00", "\\\\ud800 is text", "x\\udc00"]}', 2, "\\udc00"),
+])
+def test_a_json_string_with_half_a_utf16_pair_is_an_error_at_its_line(
+        text: str, line: int, escape: str) -> None:
+    with pytest.raises(ConfigError, match="half of a UTF-16 pair") as refused:
+        read_document(text.encode(), "f", "json")
+    assert refused.value.line == line
+    assert f"(`{escape}`)" in str(refused.value)
+
+
+def test_a_json_string_with_a_whole_utf16_pair_is_its_character() -> None:
+    document, _ = read_document(b'{"a": "\\ud83d\\ude00 \\\\ud800"}', "f", "json")
+    assert document == {"a": "\U0001f600 \\ud800"}
+
+
 # Messages quote excerpts, and a huge key costs time linear in it ---------------------
 
 
