@@ -490,8 +490,9 @@ def in_own_process(preloaded: tuple[str, ...], fn: Callable[P, T], /, *args: P.a
         if own is not None:
             own.close()
         own = _own.process = _start_own(preloaded)
+    task = pickle.dumps((fn, args, kwargs))  # whole before any of it is sent
     try:
-        pickle.dump((fn, args, kwargs), own.tasks)
+        own.tasks.write(task)
         own.tasks.flush()
         answered, result = pickle.load(own.answers)
     except (OSError, EOFError, pickle.UnpicklingError):  # it ended, perhaps mid-answer
@@ -523,7 +524,10 @@ def _serve(tasks: int, answers: int, preloaded: tuple[str, ...]) -> None:
 
     for module in preloaded:
         importlib.import_module(module)
-    with open(tasks, "rb") as calls, open(answers, "wb") as replies:
+    # A pipe broken: the parent ended while a task ran (its answer unwritten, this one
+    # ends as the parent did).
+    with contextlib.suppress(BrokenPipeError), open(tasks, "rb") as calls, \
+            open(answers, "wb") as replies:
         while True:
             try:
                 fn, args, kwargs = pickle.load(calls)
