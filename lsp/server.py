@@ -86,7 +86,24 @@ class _ParamsAnsweredInOneLine(logging.Filter):
         return record.msg != "Unable to deserialize message\n%s"
 
 
+class _RefusalsWithoutTraceback(logging.Filter):
+    """pygls logs an error with a traceback for each request a handler refuses on
+    purpose (a JsonRpcException: a rename off a label, an unknown command), which the
+    client is answered with; the log says it in one line, at level info."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        refused = record.exc_info[1] if record.exc_info else None
+        if record.msg != 'Exception occurred for message "%s"' or not isinstance(
+                refused, JsonRpcException):
+            return True
+        record.msg, record.args = "refused request %s: %s", (*record.args, refused)
+        record.exc_info, record.exc_text = None, None
+        record.levelno, record.levelname = logging.INFO, "INFO"
+        return logging.getLogger(record.name).isEnabledFor(logging.INFO)
+
+
 logging.getLogger("pygls.protocol.json_rpc").addFilter(_ParamsAnsweredInOneLine())
+logging.getLogger("pygls.protocol.json_rpc").addFilter(_RefusalsWithoutTraceback())
 
 
 class Rl1Protocol(LanguageServerProtocol):

@@ -133,6 +133,22 @@ def test_params_that_do_not_fit_are_answered_with_where_and_no_traceback(
     assert "dropped a message that does not fit LSP: textDocument/didChange" in stderr
 
 
+def test_a_request_refused_on_purpose_is_answered_with_no_traceback(server: RawServer) -> None:
+    server.start()
+    uri = "file:///a.rob"
+    server.send(frame(notification("textDocument/didOpen", {"textDocument": {
+        "uri": uri, "languageId": "rl1", "version": 1, "text": "A=1\n"}})))
+    server.send(frame(request(2, "textDocument/rename", {
+        "textDocument": {"uri": uri}, "position": {"line": 0, "character": 0},
+        "newName": "12"})))
+    assert "only labels can be renamed" in server.reply(2)["error"]["message"]
+    server.send(frame(request(3, "workspace/executeCommand", {"command": "rl1.nothing"})))
+    assert server.error_code(3) == INVALID_PARAMS
+    server.send(frame(request(4, "shutdown")) + frame(notification("exit")))
+    status, stderr = server.finish()
+    assert status == 0 and "Traceback" not in stderr, stderr
+
+
 # The session: initialize first, shutdown, exit --------------------------------------------
 
 def test_a_request_before_initialize_is_refused(server: RawServer) -> None:
