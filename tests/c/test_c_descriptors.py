@@ -21,7 +21,7 @@ from rl1.vm import isa, isa_table, native
 from rl1.vm.language import BUILTINS, VARIABLES, Form, Param
 
 CALLS = isa_table.calls()
-ARITY, STARTED, SETS_R, PAIRS, PAIRS_SHIFT, FIRST_SHIFT = 0x03, 0x04, 0x08, 0x30, 4, 8
+ARITY, STARTED, SETS_R, PAIRS, PAIRS_SHIFT, RESULT, FIRST_SHIFT = 0x03, 0x04, 0x08, 0x30, 4, 0xC0, 8
 
 
 class Range(ctypes.Structure):
@@ -97,3 +97,16 @@ def test_each_parameter_s_range_is_its_low_end_and_span(lib: ctypes.CDLL) -> Non
             entry = ranges[(descriptor >> FIRST_SHIFT) + index]
             assert (entry.low, entry.span) == (param.low, param.high - param.low), \
                 (info.name, param.name)
+
+
+def test_a_reading_of_two_pairs_also_sets_r_and_has_no_range(lib: ctypes.CDLL) -> None:
+    """rl1vm.c's take_reading takes a reading of two pairs (IMG's) on a path of its own that
+    writes the four variables and R and checks no range: so every call whose reading has
+    two pairs must set R and leave its result unchecked, and one call at least has such a
+    reading (else the path is dead)."""
+    two_pairs = [(info.name, descriptor) for info, descriptor
+                 in zip(CALLS, descriptors(lib), strict=True)
+                 if (descriptor & PAIRS) >> PAIRS_SHIFT == 2]
+    assert two_pairs
+    for name, descriptor in two_pairs:
+        assert descriptor & SETS_R and not descriptor & RESULT, name
