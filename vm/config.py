@@ -111,10 +111,7 @@ def read_document(data: bytes, name: str, syntax: Syntax) -> tuple[Any, str]:
             if _holds_a_huge_int(document):  # 0x, 0o and 0b integers are read unbounded
                 raise ValueError("an integer too long")
             return document, text
-        document = json.loads(text, parse_int=_bounded_int, parse_constant=_refuse_constant)
-        if _holds_a_surrogate(document):
-            raise _surrogate_error(name, text)
-        return document, text
+        return json.loads(text, parse_int=_bounded_int, parse_constant=_refuse_constant), text
     except tomllib.TOMLDecodeError as error:
         # tomllib (before Python 3.14) gives the place only in its message.
         place = _TOML_PLACE.search(str(error))
@@ -156,51 +153,6 @@ def _holds_a_huge_int(value: object) -> bool:
             return any(_holds_a_huge_int(item) for item in value.values())
         case list():
             return any(_holds_a_huge_int(item) for item in value)
-    return False
-
-
-# JSON's reader takes a `\uD800` without its other half, a surrogate, which no UTF-8
-# (nor the schemas' reader) can hold. Its escape is looked for only once the data is
-# known to hold one, for its line.
-_SURROGATE = re.compile("[\ud800-\udfff]")
-_ESCAPE = re.compile(r"\\(?:u([0-9a-fA-F]{4})|.)", re.DOTALL)  # `\\` is one escape
-
-
-def _surrogate_error(name: str, text: str) -> ConfigError:
-    escape = _lone_half(text)
-    line = None if escape is None else text.count("\n", 0, escape.start()) + 1
-    quoted = "" if escape is None else f" (`{escape.group()}`)"
-    return ConfigError(name, line, "", f"invalid JSON: a string holds half of a UTF-16 "
-                       f"pair{quoted}, which is no character; write the character itself, "
-                       "or both halves of its pair")
-
-
-def _lone_half(text: str) -> re.Match[str] | None:
-    """The first escape in JSON `text` of half a UTF-16 pair without its other half."""
-    high: re.Match[str] | None = None
-    for escape in _ESCAPE.finditer(text):
-        code = int(escape[1], 16) if escape[1] else -1
-        if high is not None:
-            if 0xDC00 <= code <= 0xDFFF and escape.start() == high.end():
-                high = None  # a whole pair
-                continue
-            return high
-        if 0xD800 <= code <= 0xDBFF:
-            high = escape
-        elif 0xDC00 <= code <= 0xDFFF:
-            return escape
-    return high
-
-
-def _holds_a_surrogate(value: object) -> bool:
-    match value:
-        case str():
-            return _SURROGATE.search(value) is not None
-        case dict():
-            return any(_holds_a_surrogate(key) or _holds_a_surrogate(item)
-                       for key, item in value.items())
-        case list():
-            return any(_holds_a_surrogate(item) for item in value)
     return False
 
 
@@ -267,6 +219,11 @@ def convert(document: object, schema: type[T], name: str, text: str,
         return msgspec.convert(document, schema)
     except msgspec.ValidationError as error:
         message = str(error)
+    except UnicodeEncodeError:  # JSON's reader takes "\ud800", half a UTF-16 pair
+        raise error_at(name, text, _surrogate_at(document) or (), "a string holds half of a "
+                       "UTF-16 pair (an escape \\uD800 to \\uDFFF without its other half), "
+                       "which is no character; write the character itself, or both halves "
+                       "of its pair", syntax) from None
     at = _AT.search(message)
     path, kind = _path(at.group(2) if at else "$", document, schema)
     what = message[:at.start()] if at else message
@@ -287,6 +244,28 @@ def convert(document: object, schema: type[T], name: str, text: str,
     else:
         detail = _mismatch(kind, value, syntax)
     raise error_at(name, text, path, detail, syntax)
+
+
+def _surrogate_at(value: object, path: KeyPath = ()) -> KeyPath | None:
+    """The path of the first key or string in `value` that holds a surrogate; None when
+    none does."""
+    match value:
+        case str():
+            return path if _SURROGATE.search(value) else None
+        case dict():
+            for key, item in value.items():
+                if isinstance(key, str) and _SURROGATE.search(key):
+                    return (*path, key)
+                if (found := _surrogate_at(item, (*path, key))) is not None:
+                    return found
+        case list():
+            for index, item in enumerate(value):
+                if (found := _surrogate_at(item, (*path, index))) is not None:
+                    return found
+    return None
+
+
+_SURROGATE = re.compile("[\ud800-\udfff]")
 
 
 def _path(text: str, document: object, schema: Any) -> tuple[KeyPath, Any]:

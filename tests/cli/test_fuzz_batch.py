@@ -65,6 +65,7 @@ def test_rl1c_run_batch_answers_each_job_as_rl1c_run_does(tmp_path: Path) -> Non
     ('{"ilc": "AA==", "sensors": {}, "budget": true}', "with N from 1 to"),
     ('{"ilc": "!!", "sensors": {}, "budget": 5}', "the job's ilc is not base64"),
     ('{"ilc": "AA==", "sensors": {"XYZ": 1}, "budget": 5}', "the job's sensors"),
+    ('{"ilc": "AA==", "sensors": {"\\ud800": 1}, "budget": 5}', "half of a UTF-16 pair"),
     ('{"ilc": "AAAA", "sensors": {}, "budget": 5}', "not valid intermediate code"),
 ])
 def test_rl1c_run_batch_answers_a_job_it_cannot_run_and_goes_on(job: str, said: str) -> None:
