@@ -269,14 +269,18 @@ def _same_rl1(client: Client, address: str) -> None:
             "differ), which may read rl1's tasks otherwise\n  = help: install the same rl1 "
             "there, and restart the scheduler")
     try:
-        theirs: dict[str, str] = client.run(sources_digest)
+        theirs: dict[str, str | BaseException] = client.run(sources_digest, on_error="return")
     except OSError as error:  # the scheduler gone since it was reached
         raise _connection_lost(address, error) from None
-    except Exception as error:  # such as a worker without rl1, which cannot run it
-        raise Unavailable(f"the workers of the Dask scheduler at {address} cannot run "
-                          f"rl1 ({type(error).__name__}: {error})\n  = help: install "
-                          "this rl1 on each worker's machine") from None
-    others = sorted(worker for worker, digest in theirs.items() if digest != sources_digest())
+    for answer in theirs.values():
+        # An OSError is a worker gone since (killed, or ended): it runs nothing.
+        if isinstance(answer, BaseException) and not isinstance(answer, OSError):
+            # such as a worker without rl1, which cannot run it
+            raise Unavailable(f"the workers of the Dask scheduler at {address} cannot run "
+                              f"rl1 ({type(answer).__name__}: {answer})\n  = help: install "
+                              "this rl1 on each worker's machine")
+    others = sorted(worker for worker, digest in theirs.items()
+                    if isinstance(digest, str) and digest != sources_digest())
     if others:
         raise Unavailable(
             f"the Dask workers {', '.join(others)} of the scheduler at {address} run "

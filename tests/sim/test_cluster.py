@@ -31,7 +31,7 @@ from support.planted import crashing_c_vm
 from rl1.compiler import differential
 from rl1.compiler.cli.fuzz import WORKER_LOST
 from rl1.compiler.cli.sim_campaign import Setting, no_workers_left
-from rl1.compiler.executors import Unavailable, _threads
+from rl1.compiler.executors import Unavailable, _same_rl1, _threads, sources_digest
 
 BIN = Path(sys.executable).parent
 STARTED_WITHIN = 120  # s for the scheduler and the workers to start on a loaded machine
@@ -431,6 +431,38 @@ def test_a_scheduler_lost_while_its_workers_are_counted_is_said_so() -> None:
         _threads(Reset(), "tcp://127.0.0.1:8786")  # type: ignore[arg-type]
 
 
+class _Checked:
+    """A client of a scheduler running this rl1 whose workers answer `answers` (a digest,
+    or the error a worker gave), as Dask's client.run gives them."""
+
+    def __init__(self, answers: dict[str, str | Exception]) -> None:
+        self.answers = answers
+
+    def run_on_scheduler(self, function: Callable[[], str]) -> str:
+        return function()
+
+    def run(self, function: Callable[[], str], on_error: str = "raise"
+            ) -> dict[str, str | Exception]:
+        for answer in self.answers.values():
+            if isinstance(answer, Exception) and on_error == "raise":
+                raise answer
+        return self.answers
+
+
+def test_a_worker_gone_while_the_workers_are_checked_is_left_out() -> None:
+    # Killed as the campaign began: its closed connection went through as the
+    # scheduler's, "the connection to the Dask scheduler was lost (Address removed.)".
+    from distributed.comm.core import CommClosedError
+
+    client = _Checked({"tcp://127.0.0.1:1": CommClosedError("Address removed."),
+                       "tcp://127.0.0.1:2": sources_digest()})
+    _same_rl1(client, "tcp://127.0.0.1:8786")  # type: ignore[arg-type]
+    client.answers["tcp://127.0.0.1:3"] = ModuleNotFoundError("No module named 'rl1'")
+    with pytest.raises(Unavailable, match=r"^the workers of the Dask scheduler at "
+                       r"tcp://127\.0\.0\.1:8786 cannot run rl1 \(ModuleNotFoundError: "):
+        _same_rl1(client, "tcp://127.0.0.1:8786")  # type: ignore[arg-type]
+
+
 # rl1c fuzz --scheduler -------------------------------------------------------------------
 
 
@@ -499,6 +531,44 @@ def test_fuzzing_on_a_cluster_whose_scheduler_is_lost_says_so(cluster: Cluster,
     assert f"error: the connection to the Dask scheduler at {cluster.address} was lost" \
         in stderr
     assert "Traceback" not in stderr
+
+
+def test_fuzzing_on_a_cluster_whose_workers_are_all_lost_says_so_and_waits_for_one(
+        tmp_path: Path) -> None:
+    said = tmp_path / "stderr.txt"
+    with _cluster(tmp_path, 1) as cluster:
+        connections = cluster.log().count("Receive client connection")  # the fixture's
+        with open(said, "w") as stderr, subprocess.Popen(
+                [str(BIN / "rl1c"), "fuzz", "--count", "20", "--seed", "1", "--scheduler",
+                 cluster.address, "--out", str(tmp_path / "out")], stdout=subprocess.PIPE,
+                stderr=stderr, text=True) as process:
+            stdout = _lose_the_workers(cluster, process, connections, said)
+    assert process.returncode == 0, said.read_text() + cluster.log()
+    assert (f"rl1c: warning: the Dask scheduler at {cluster.address} has no workers left "
+            "(killed, or out of memory: one is started again only under a nanny, `dask "
+            "worker` without --no-nanny); the searches wait for one (`dask worker "
+            f"{cluster.address}`)\n") in said.read_text()
+    assert "fuzz: 20 programs in " in stdout and "all agreed" in stdout
+
+
+def _lose_the_workers(cluster: Cluster, process: subprocess.Popen[str], connections: int,
+                      said: Path) -> str:
+    """Kill the one worker of `cluster` once `rl1c fuzz` (`process`) has connected,
+    start another once it has said (in `said`) that none is left, and give its standard
+    output at its end."""
+    deadline = time.monotonic() + STARTED_WITHIN
+    while cluster.log().count("Receive client connection") == connections:
+        assert process.poll() is None and time.monotonic() < deadline, said.read_text()
+        time.sleep(0.1)
+    cluster.workers[0].send_signal(signal.SIGKILL)  # without a nanny: gone for good
+    cluster.workers[0].wait()
+    while "has no workers left" not in said.read_text():
+        assert process.poll() is None and time.monotonic() < deadline, (
+            said.read_text() + cluster.log())
+        time.sleep(0.1)
+    cluster.start_worker()
+    stdout, _ = process.communicate(timeout=STARTED_WITHIN)
+    return stdout
 
 
 # Campaigns whose engines end their workers ------------------------------------------------
