@@ -12,7 +12,7 @@ import click
 
 from .command import PATH, Command, Failure
 from .project_template import FILES, PROGRAM
-from .streams import cannot, file_problem, os_reason, problem_text
+from .streams import cannot, file_problem, os_reason, problem_text, write_help
 
 SECTION = "Projects"
 
@@ -112,7 +112,8 @@ def _refuse_unless_empty(folder: str, target: str) -> None:
 def _cannot_create(folder: str, error: OSError) -> Failure:
     return Failure(problem_text(file_problem(folder, cannot(
         "create", "project folder", folder, os_reason(error)),
-        "check that its parent folder exists and is writable, or create it elsewhere")))
+        write_help(error, "check that its parent folder exists and is writable, or create "
+                          "it elsewhere"))))
 
 
 def _umask() -> int:

@@ -4,6 +4,7 @@ atomically, and source files written back in their own encoding or shown as a di
 
 from __future__ import annotations
 
+import errno
 import os
 import sys
 from collections.abc import Sequence
@@ -172,8 +173,20 @@ def cannot_write(target: str, role: str, error: OSError, purpose: str = "") -> F
     (`purpose`: what for, as "to make its fixes")."""
     reason = os_reason(error)
     help = ("" if "--force" in reason else
-            "check that its folder exists and is writable, or write elsewhere")
+            write_help(error, "check that its folder exists and is writable, or write "
+                              "elsewhere"))
     return file_problem(target, cannot("write", role, target, reason, purpose), help)
+
+
+def write_help(error: OSError, usual: str) -> str:
+    """What to do when `error` kept a file from being written: `usual`, unless the disk
+    is full or read-only, which no folder's permissions change."""
+    match error.errno:
+        case errno.ENOSPC | errno.EDQUOT:
+            return "free some space on its disk, or write elsewhere"
+        case errno.EROFS:
+            return "its file system is read-only: write elsewhere"
+    return usual
 
 
 ILC_ROLE = "intermediate code file"

@@ -2,6 +2,7 @@
 are not UTF-8 or not ASCII in every output that names them, and pictures of `rl1c sim`
 that would replace its own inputs."""
 
+import errno
 import json
 import os
 import subprocess
@@ -137,3 +138,22 @@ def test_any_file_name_is_recorded_as_utf8_within_the_limit(name: str) -> None:
         assert name.endswith(recorded)
         whole = len(name.encode("utf-8"))
         assert len(encoded) == whole or len(encoded) > ilc.MAX_NAME_SIZE - 4
+
+
+@pytest.mark.parametrize(("number", "help"), [
+    (errno.ENOSPC, "free some space on its disk, or write elsewhere"),
+    (errno.EROFS, "its file system is read-only: write elsewhere"),
+])
+def test_a_full_or_read_only_disk_is_said_with_what_to_do_about_it(
+        number: int, help: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # Checking the folder's permissions, as the help said, would change nothing.
+    def failing_replace(source: str, destination: object) -> None:
+        raise OSError(number, os.strerror(number))
+
+    target = tmp_path / "sample.ilc"
+    target.write_bytes(b"earlier")
+    monkeypatch.setattr(os, "replace", failing_replace)
+    done = rl1c(SAMPLE, "-o", target)
+    assert done.exit_code == 2
+    assert f"= help: {help}" in done.stderr
+    assert target.read_bytes() == b"earlier"
