@@ -130,6 +130,11 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
             if target is not None and same_file(name, target):
                 raise click.UsageError(f"{option} `{target}` is the {role} itself: give "
                                        "another path for the picture")
+    if svg_file is not None and html_file is not None and (
+            os.path.realpath(svg_file) == os.path.realpath(html_file)) and (
+            os.path.isfile(svg_file) or not os.path.exists(svg_file)):  # /dev/null takes both
+        raise click.UsageError(f"--svg and --html both name `{svg_file}`: give each its "
+                               "own file")
     if runs is None:
         for option, given in (("--jobs", jobs), ("--scheduler", scheduler),
                               ("--out", out_file)):

@@ -129,6 +129,18 @@ def test_a_byte_of_a_name_that_is_not_utf8_is_recorded_as_u_fffd() -> None:
     assert ilc.debug_source_name(os.fsdecode(b"d\xff/p\xfe.rob")) == "d\ufffd/p\ufffd.rob"
 
 
+def test_the_two_pictures_of_a_run_are_never_one_file(tmp_path: Path) -> None:
+    # The page replaced the top view without a word; a campaign refused it already.
+    picture = tmp_path / "run.svg"
+    done = rl1c("sim", SAMPLE, "--world", SAMPLE_WORLD, "--svg", picture, "--html", picture)
+    assert done.exit_code == 2
+    assert f"--svg and --html both name `{picture}`: give each its own file" in done.stderr
+    assert not picture.exists()
+    both = rl1c("sim", SAMPLE, "--world", SAMPLE_WORLD, "--svg", os.devnull, "--html",
+                os.devnull)
+    assert both.exit_code == 0, both.output
+
+
 @given(st.text(st.characters(blacklist_categories=())))
 def test_any_file_name_is_recorded_as_utf8_within_the_limit(name: str) -> None:
     recorded = ilc.debug_source_name(name)
