@@ -322,7 +322,8 @@ class _Watched(Executor):
     MANNED_EVERY seconds whether the cluster has workers, and calls `unmanned` when it
     has had none for UNMANNED_AFTER seconds (again only once some have joined since).
     `isolated`: each task runs in a process of its own on its worker (`in_own_process`).
-    `lost()` is called when a task fails with an error of `losses`."""
+    `lost()` is called when a task fails with an error of `losses`, once a worker (the
+    tasks it had fail together)."""
 
     def __init__(self, client: Client, address: str,
                  unmanned: Callable[[], None] | None = None,
@@ -336,6 +337,7 @@ class _Watched(Executor):
         self._address = address
         self._unmanned = unmanned
         self._lost_one = lost
+        self._workers_lost: set[str] = set()  # the addresses of those said
         self._isolated = isolated
         self._losses = losses
         self._futures: weakref.WeakSet[Future[Any]] = weakref.WeakSet()
@@ -404,9 +406,20 @@ class _Watched(Executor):
             if error is None:
                 future.set_result(dask.result())
                 return
-            if isinstance(error, self._losses) and self._lost_one is not None:
-                self._lost_one()
+            if isinstance(error, self._losses):
+                self._say_lost(error)
             future.set_exception(error)
+
+    def _say_lost(self, error: BaseException) -> None:
+        """`lost()` for the worker of `error`, unless said already (KilledWorker names the
+        worker that died last; each TaskProcessEnded is a process of its own)."""
+        worker = getattr(getattr(error, "last_worker", None), "address", None)
+        if worker is not None:
+            if worker in self._workers_lost:
+                return
+            self._workers_lost.add(worker)
+        if self._lost_one is not None:
+            self._lost_one()
 
     def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
         self._executor.shutdown(wait=False)  # the client's close cancels what is left

@@ -30,6 +30,7 @@ from support.planted import crashing_c_vm
 
 from rl1.compiler import differential
 from rl1.compiler.cli.fuzz import WORKER_LOST
+from rl1.compiler.cli.sim_campaign import WORKER_LOST as SIM_WORKER_LOST
 from rl1.compiler.cli.sim_campaign import Setting, no_workers_left
 from rl1.compiler.executors import Unavailable, _same_rl1, _threads, sources_digest
 
@@ -193,6 +194,9 @@ def test_a_worker_killed_in_a_campaign_on_a_cluster_loses_no_run(
         stdout, stderr = process.communicate(timeout=STARTED_WITHIN)
     assert process.returncode == 0, stderr + cluster.log()
     assert "Traceback" not in stderr
+    # Said once, though each of the tasks it had failed (KilledWorker, allowed failures 0).
+    assert stderr.count("rl1c: warning: ") == 1  # beside the progress lines
+    assert f"rl1c: warning: {SIM_WORKER_LOST}\n" in stderr
     local = _local(program, world, runs, tmp_path / "local.jsonl")
     assert stdout == local  # every run counted once: the summary is exact
     assert out.read_bytes() == (tmp_path / "local.jsonl").read_bytes()
