@@ -48,7 +48,7 @@ from rl1.vm.sensor_script import ScriptError
 from rl1.vm.sim.device import SimEntry
 from rl1.vm.verifier import VerifyError
 
-from .framing import CHUNK, Framer, frame
+from .framing import CHUNK, Framer, frame, standard_streams
 from .json_reading import read_json
 
 THREAD = 1
@@ -494,7 +494,7 @@ def command() -> None:
     0 to 2) or an .ilc file with `sensors` (a sensor script) or `world` (a world file);
     breakpoints on lines (with conditions such as A<0), on calls (IMG) and on lost lines
     and faults; stepping by line or instruction; the variables and the device."""
-    serve(sys.stdin.buffer, sys.stdout.buffer)
+    serve(*standard_streams())
 
 
 def main(argv: list[str] | None = None) -> None:

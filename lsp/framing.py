@@ -13,7 +13,11 @@ accepts LF as well as CRLF line ends, and after broken framing skips to the next
 from __future__ import annotations
 
 import re
+import sys
 from collections.abc import Callable
+from typing import BinaryIO
+
+import click
 
 MAX_MESSAGE = 64 * 2**20
 """The largest body accepted, in bytes: 6 times the largest document analysed, which
@@ -25,6 +29,17 @@ _MARKER = b"content-length:"
 _HEADER = re.compile(re.escape(_MARKER), re.IGNORECASE)
 _LENGTH = re.compile(rb"content-length:[ \t]*(\d+)[ \t]*", re.IGNORECASE)
 _FIELD = re.compile(rb"[!-9;-~]+:.*")  # any other header, such as Content-Type
+
+
+def standard_streams() -> tuple[BinaryIO, BinaryIO]:
+    """Standard input and output, the byte streams a client started the server on; a
+    usage error (status 2) when either is closed (`<&-`, `>&-`), which Python leaves as
+    None."""
+    if sys.stdin is None or sys.stdout is None:
+        closed = "input" if sys.stdin is None else "output"
+        raise click.UsageError(f"standard {closed} is closed: a client starts this server "
+                               "with its standard input and output as pipes")
+    return sys.stdin.buffer, sys.stdout.buffer
 
 
 Admission = Callable[[int], str | None]

@@ -44,6 +44,7 @@ from . import (
     transports,
 )
 from .document import MAX_ANALYSED_CHARACTERS, Document
+from .framing import standard_streams
 from .json_reading import read_json
 from .positions import UTF16, Columns
 
@@ -483,7 +484,7 @@ def command(stdio: bool, tcp: tuple[str, int] | None, ws: tuple[str, int] | None
                                "--stdio, --tcp and --ws")
     logging.basicConfig(level=log_level.upper(), format="rl1-lsp %(levelname)s: %(message)s")
     if tcp is None and ws is None:
-        sys.exit(transports.serve_stdio(create_server(), sys.stdin.buffer, sys.stdout.buffer))
+        sys.exit(transports.serve_stdio(create_server(), *standard_streams()))
     if ws is not None:
         try:
             import websockets  # noqa: F401

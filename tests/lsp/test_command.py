@@ -1,9 +1,11 @@
-"""The `rl1-lsp` command: --version, --help, bad options, and serving over TCP."""
+"""The `rl1-lsp` command: --version, --help, bad options, closed standard streams (and
+`rl1-dap`'s), and serving over TCP."""
 
 from __future__ import annotations
 
 import asyncio
 import json
+import os
 import socket
 import subprocess
 import sys
@@ -28,6 +30,20 @@ def test_version_and_help() -> None:
     assert helped.returncode == 0
     assert "--tcp HOST:PORT" in helped.stdout and "--stdio" in helped.stdout
     assert "--ws HOST:PORT" in helped.stdout
+
+
+@pytest.mark.parametrize(("module", "closed", "stream"), [
+    ("rl1.lsp", 1, "output"), ("rl1.lsp", 0, "input"), ("rl1.lsp.dap", 1, "output"),
+])
+def test_a_closed_standard_stream_is_a_usage_error(module: str, closed: int,
+                                                    stream: str) -> None:
+    # Python leaves a stream the shell closed (`>&-`) as None: an AttributeError before.
+    failed = subprocess.run([sys.executable, "-m", module], stdin=subprocess.DEVNULL,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            timeout=60, check=False, preexec_fn=lambda: os.close(closed))
+    assert failed.returncode == 2, failed.stderr
+    assert failed.stderr.endswith(f"Error: standard {stream} is closed: a client starts this "
+                                  "server with its standard input and output as pipes\n")
 
 
 @pytest.mark.parametrize("option", ["--tcp", "--ws"])
