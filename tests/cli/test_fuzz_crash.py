@@ -9,7 +9,10 @@ import faulthandler
 import json
 import os
 import signal
+import subprocess
+import sys
 import threading
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -177,6 +180,28 @@ def test_a_task_in_a_process_of_its_own_answers_raises_or_is_said_to_have_ended(
         in_own_process((), _EndsItsProcess("A=1\n").run, Run("A=1\n", {}), 100)
     first = in_own_process((), os.getpid)
     assert in_own_process((), os.getpid) == first != os.getpid()  # kept for the next
+
+
+def test_a_process_of_its_own_ends_when_its_parent_does() -> None:
+    # As a cluster's worker killed: its process must not wait for tasks for ever.
+    parent = subprocess.run(
+        [sys.executable, "-c", "import os; from rl1.compiler.executors import "
+         "in_own_process; print(in_own_process((), os.getpid), flush=True); os._exit(0)"],
+        capture_output=True, text=True, timeout=120, check=True)
+    child = int(parent.stdout)
+    deadline = time.monotonic() + 60
+    while _alive(child):
+        assert time.monotonic() < deadline, f"process {child} outlived its parent"
+        time.sleep(0.05)
+
+
+def _alive(pid: int) -> bool:
+    """Whether the process `pid` runs (not ended, nor a zombie no one waits for)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
 
 
 @dataclass(frozen=True)
