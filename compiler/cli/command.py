@@ -197,7 +197,8 @@ format_option = choice_option(
          "warning[CODE]: message (for problem matchers and grep); json or sarif: for tools")
 color_option = choice_option(
     "--color", choices=COLOR_CHOICES, default="auto",
-    help="colour the human format; auto: only on a terminal, and not if NO_COLOR is set")
+    help="colour the human format; auto: only on a terminal, and not if NO_COLOR is set "
+         "or TERM is dumb")
 
 
 force_option = click.option(

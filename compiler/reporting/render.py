@@ -159,9 +159,12 @@ def exit_status(files: Sequence[FileDiagnostics]) -> int:
 
 
 def use_color(choice: ColorChoice, stream: IO[Any]) -> bool:
-    """`auto` colours only a terminal, and never when NO_COLOR is set (no-color.org)."""
+    """`auto` colours only a terminal, and never when NO_COLOR is set (no-color.org) or
+    the terminal is a dumb one (TERM=dumb: an editor's output pane, which shows escapes
+    as text)."""
     if choice == "auto":
-        return stream.isatty() and not os.environ.get("NO_COLOR")
+        return (stream.isatty() and not os.environ.get("NO_COLOR")
+                and os.environ.get("TERM") != "dumb")
     return choice == "always"
 
 

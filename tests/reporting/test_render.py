@@ -399,6 +399,10 @@ class _Stream(io.StringIO):
 
 def test_colour_auto_means_a_terminal_without_no_color(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.delenv("NO_COLOR", raising=False)
+    monkeypatch.setenv("TERM", "dumb")  # an editor's pane, which shows escapes as text
+    assert not use_color("auto", _Stream(tty=True))
+    assert use_color("always", _Stream(tty=True))
+    monkeypatch.setenv("TERM", "xterm-256color")
     assert use_color("auto", _Stream(tty=True))
     assert not use_color("auto", _Stream(tty=False))
     assert use_color("always", _Stream(tty=False))
