@@ -34,6 +34,7 @@ they share one path, and its instructions cannot tell which kind ran them
 
 from __future__ import annotations
 
+import argparse
 import itertools
 import json
 import re
@@ -260,6 +261,7 @@ def measure(binary: Path, vectors_file: Path, executed: int, calls: int, folder:
 
 
 def main() -> int:
+    argparse.ArgumentParser(description=__doc__.split("\n\n")[0]).parse_args()
     missing = [tool for tool in ("valgrind", "addr2line", "callgrind_annotate", "make")
                if shutil.which(tool) is None]
     if missing:

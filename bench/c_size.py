@@ -30,6 +30,7 @@ NEEDS, or on Cortex-M3 more flash, struct or stack than the goals allow).
 
 from __future__ import annotations
 
+import argparse
 import shutil
 import subprocess
 import sys
@@ -114,9 +115,11 @@ def undefined_symbols(prefix: str, paths: list[Path], linked: Path) -> frozenset
 
 def main() -> int:
     vm_c = Path(__file__).parent.parent / "vm" / "c"
-    if len(sys.argv) > 1:
-        build = Path(sys.argv[1])
-    else:  # the default folder is brought up to date first: its objects may be stale
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("build", type=Path, nargs="?",
+                        help="a folder of cross-built objects (default: vm/c/build, made first)")
+    build = parser.parse_args().build
+    if build is None:  # the default folder is brought up to date first: its objects may be stale
         build = vm_c / "build"
         subprocess.run(["make", "-s", "-C", str(vm_c), "cross"], check=False)
     print("-Os          flash: VM + verifier = total   static RAM   rl1_vm   "

@@ -15,6 +15,7 @@ CPU time (time.process_time), the fastest of RUNS runs: the machine is shared.
 
 from __future__ import annotations
 
+import argparse
 import json
 import statistics
 import tempfile
@@ -125,6 +126,7 @@ def continued_over_long(breakpoints: int) -> float:
 
 
 def main() -> None:
+    argparse.ArgumentParser(description=__doc__.split("\n\n")[0]).parse_args()
     reference = min(whole_run() for _ in range(RUNS))
     debugged = min(continued() for _ in range(RUNS))
     print(f"Listing 1 on the sample world, to its end: runner.run {reference * 1000:.1f} ms, "

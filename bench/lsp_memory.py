@@ -14,6 +14,7 @@ Prints the growth in MiB, per document and per character (the reference: the tex
 
 from __future__ import annotations
 
+import argparse
 import asyncio
 import json
 import subprocess
@@ -95,8 +96,10 @@ async def measure(case: str) -> dict[str, Any]:
 
 
 def main() -> None:
-    if len(sys.argv) == 3 and sys.argv[1] == "--case":
-        print(json.dumps(asyncio.run(measure(sys.argv[2]))))
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--case", help="measure this case alone (run by the others)")
+    if (case := parser.parse_args().case) is not None:
+        print(json.dumps(asyncio.run(measure(case))))
         return
     print(f"a session holds {MAX_OPEN_DOCUMENTS:,} documents, {MAX_OPEN_CHARACTERS:,} "
           f"characters, {MAX_OPEN_LINES:,} lines, {MAX_ANALYSED_IN_ALL:,} characters "

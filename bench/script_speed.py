@@ -9,6 +9,7 @@ waits, reads the odometer and counts, so losses fall both into waits and between
 
 from __future__ import annotations
 
+import argparse
 import functools
 import json
 
@@ -38,6 +39,7 @@ def run(data: bytes) -> None:
 
 
 def main() -> None:
+    argparse.ArgumentParser(description=__doc__.split("\n\n")[0]).parse_args()
     previous = None
     for losses in (2_500, 5_000, 10_000, 20_000):
         data = script_of(losses)

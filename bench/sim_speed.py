@@ -15,6 +15,7 @@ programs are compiled before the clock starts: it times the simulated run alone.
 
 from __future__ import annotations
 
+import argparse
 import gc
 import sys
 import time
@@ -85,6 +86,7 @@ def image_cost(window: tuple[int, int, int, int]) -> float:
 
 
 def main() -> None:
+    argparse.ArgumentParser(description=__doc__.split("\n\n")[0]).parse_args()
     for name, text, world in (("Listing 1, Fig. 4", SAMPLE, WORLD),
                               ("fig4.rob, its scene", FIG4, FIG4_WORLD),
                               ("ten-minute patrol", PATROL, round_track())):

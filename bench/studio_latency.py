@@ -19,6 +19,7 @@ count. Wall time on a shared machine: the median of N.
 
 from __future__ import annotations
 
+import argparse
 import json
 import re
 import shutil
@@ -181,7 +182,9 @@ def summary(name: str, times: list[float], goal: float, past: float = 0.0) -> No
 
 
 def main() -> None:
-    runs = int(sys.argv[1]) if len(sys.argv) > 1 else 20
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("runs", type=int, nargs="?", default=20, help="edits measured")
+    runs = parser.parse_args().runs
     with tempfile.TemporaryDirectory() as temporary:
         folder = Path(temporary) / "examples"
         shutil.copytree(ROOT / "examples", folder)

@@ -15,6 +15,7 @@ The machine is shared: the figures vary.
 
 from __future__ import annotations
 
+import argparse
 import json
 import statistics
 import sys
@@ -133,6 +134,7 @@ def live(page: Page) -> tuple[int, float, float]:
 
 
 def main() -> None:
+    argparse.ArgumentParser(description=__doc__.split("\n\n")[0]).parse_args()
     alone = session_steps()
     reference = min(session_run() for _ in range(RUNS))
     with serving(EXAMPLES) as served, connect(served.url("/studio", scheme="ws"),

@@ -46,6 +46,8 @@ MARKS: dict[str, tuple[str, ...]] = {
     "tests/studio/test_studio_command.py::test_it_prints_its_address_serves_there_and_stops_on_ctrl_c":
         ("slow",),
     "tests/backend/test_reproducible.py": ("slow",),
+    # Each benchmark script in a process of its own, asked for --help.
+    "tests/project/test_bench_help.py": ("slow",),
     # rl1c check's memory per source byte, under tracemalloc in a process of its own.
     "tests/checker/test_streaming.py::test_checking_takes_at_most_64_bytes_a_source_byte":
         ("slow",),
