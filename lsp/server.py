@@ -97,7 +97,8 @@ class _RefusalsWithoutTraceback(logging.Filter):
         if record.msg != 'Exception occurred for message "%s"' or not isinstance(
                 refused, JsonRpcException):
             return True
-        record.msg, record.args = "refused request %s: %s", (*record.args, refused)
+        msg_id = record.args[0] if isinstance(record.args, tuple) and record.args else "?"
+        record.msg, record.args = "refused request %s: %s", (msg_id, refused)
         record.exc_info, record.exc_text = None, None
         record.levelno, record.levelname = logging.INFO, "INFO"
         return logging.getLogger(record.name).isEnabledFor(logging.INFO)
