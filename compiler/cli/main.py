@@ -205,9 +205,10 @@ def describe(error: click.UsageError) -> str:
 def _hold_closed_standard_streams() -> None:
     # A standard stream the shell closed (`rl1c dis x.ilc >&-`), which Python leaves as
     # None, gets /dev/null's descriptor, so that no file rl1c opens takes its number (an
-    # output file would receive the report). Standard output's is read-only: writing it
-    # fails (EBADF) as writing a closed descriptor does, and the command says so.
-    for number, name, access in ((0, "stdin", os.O_RDONLY), (1, "stdout", os.O_RDONLY),
+    # output file would receive the report). Standard input's is write-only and standard
+    # output's read-only: using them fails (EBADF) as using a closed descriptor does,
+    # and the command says so.
+    for number, name, access in ((0, "stdin", os.O_WRONLY), (1, "stdout", os.O_RDONLY),
                                  (2, "stderr", os.O_WRONLY)):
         if getattr(sys, name) is None:
             descriptor = os.open(os.devnull, access)  # the lowest free number: this one

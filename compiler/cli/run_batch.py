@@ -19,7 +19,8 @@ from rl1.vm.faults import MAX_BUDGET
 from rl1.vm.scripted import ScriptedDevice, ScriptError, parse_script, run_document
 from rl1.vm.verifier import VerifyError
 
-from .streams import MAX_ILC_BYTES
+from .command import Failure
+from .streams import MAX_ILC_BYTES, stdin_problem
 
 # A job's line: the .ilc file in base64 (4 bytes for 3) and the script, with room to spare.
 MAX_JOB_BYTES = MAX_ILC_BYTES * 4 // 3 + MAX_SCRIPT_BYTES + 4096
@@ -28,16 +29,24 @@ JOB_SHAPE = '{"ilc": BASE64, "sensors": {...}, "budget": N}'
 
 def serve(jobs: IO[bytes], answers: IO[str], engine: Engine, time_limit: int) -> int:
     """Answer each job line of `jobs` on `answers` until the end of `jobs`; exit status 0."""
-    while line := jobs.readline(MAX_JOB_BYTES + 1):
+    while line := _read_line(jobs, MAX_JOB_BYTES + 1):
         if len(line) > MAX_JOB_BYTES:
             while line and not line.endswith(b"\n"):  # the rest of the line, unread
-                line = jobs.readline(1 << 20)
+                line = _read_line(jobs, 1 << 20)
             answer = _refused("bad-job", f"the job is longer than {MAX_JOB_BYTES} bytes")
         else:
             answer = _answer(line, engine, time_limit)
         answers.write(json.dumps(answer, separators=(",", ":")) + "\n")
         answers.flush()
     return 0
+
+
+def _read_line(jobs: IO[bytes], limit: int) -> bytes:
+    try:
+        return jobs.readline(limit)
+    except OSError as error:
+        raise Failure(f"rl1c run: error: cannot read the jobs: {stdin_problem(error)}; "
+                      "send them through a pipe") from None
 
 
 def _answer(line: bytes, engine: Engine, time_limit: int) -> dict[str, Any]:

@@ -52,13 +52,29 @@ def read_input(name: str, role: str = "source file") -> Source | FileDiagnostics
     try:
         if name != "-":
             return read_source(name)
-        data = sys.stdin.buffer.read(MAX_SOURCE_BYTES + 1)
+        data = read_stdin(MAX_SOURCE_BYTES)
         if len(data) > MAX_SOURCE_BYTES:
             raise SourceError(STDIN_NAME, f"it holds more than {MAX_SOURCE_BYTES} bytes",
                               "RL/I sources are limited to that size")
         return decode(data, STDIN_NAME)
     except SourceError as error:
         return unreadable(STDIN_NAME if name == "-" else name, error, role)
+
+
+def read_stdin(limit: int) -> bytes:
+    """Standard input, up to `limit` bytes and one more (to tell a larger input); a
+    SourceError when it cannot be read."""
+    try:
+        return sys.stdin.buffer.read(limit + 1)
+    except OSError as error:
+        raise SourceError(STDIN_NAME, stdin_problem(error), "give a file's name, or send "
+                          "the input through a pipe or `< FILE`") from None
+
+
+def stdin_problem(error: OSError) -> str:
+    """Why standard input could not be read, as a clause: main.py holds a closed one
+    (`<&-`) as a descriptor that cannot be read."""
+    return "standard input is closed" if error.errno == errno.EBADF else os_reason(error)
 
 
 def source_files(names: Sequence[str], command: str) -> list[str | FileDiagnostics]:
@@ -200,7 +216,7 @@ def read_ilc(file: str) -> bytes:
     data: bytes | None
     try:
         if file == "-":
-            data = sys.stdin.buffer.read(MAX_ILC_BYTES + 1)
+            data = read_stdin(MAX_ILC_BYTES)
         else:
             data = read_bounded(file, MAX_ILC_BYTES, "an .ilc file")
     except TooLargeError:

@@ -29,6 +29,23 @@ def _with_standard_output_closed(*args: str | Path) -> subprocess.CompletedProce
                           preexec_fn=lambda: os.close(1))
 
 
+@pytest.mark.parametrize(("command", "said"), [
+    (["check", "-"], "error[E0100]: cannot read the source file `<stdin>`: standard input is "
+                     "closed"),
+    (["dis", "-"], "error[E0100]: cannot read the intermediate code file `<stdin>`: standard "
+                   "input is closed"),
+    (["run", "--batch"], "rl1c run: error: cannot read the jobs: standard input is closed; "
+                         "send them through a pipe"),
+])
+def test_a_closed_standard_input_is_said_with_status_2_not_read_as_empty(
+        command: list[str], said: str) -> None:
+    done = subprocess.run([RL1C, *command], capture_output=True, text=True, check=False,
+                          preexec_fn=lambda: os.close(0))
+    assert done.returncode == 2, done.stderr
+    said_all = done.stdout + done.stderr  # check reports on standard output
+    assert said in said_all and "internal error" not in said_all
+
+
 @pytest.mark.parametrize("command", [["check", str(SAMPLE)], ["dis", "{ilc}"], ["--help"]])
 def test_a_closed_standard_output_is_said_in_one_line_with_status_2(
         command: list[str], tmp_path: Path) -> None:
