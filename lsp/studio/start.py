@@ -42,19 +42,33 @@ def _inside(root: Folder, folder: str | Path, path: str | None) -> str | None:
 
 def serve(studio: Studio, port: int, open_browser: bool, out: TextIO = sys.stdout) -> None:
     """Serve `studio` on 127.0.0.1:`port` (0: a free one) until interrupted; CannotStart
-    when the port cannot be had."""
+    when the port cannot be had, and the OSError of `out` when the address, which only
+    it shows, cannot be written there (a closed or full standard output)."""
     token = new_token()
     server = Server(Gate(token), studio)
 
     def listening(port: int) -> None:
         address = f"http://{HOST}:{port}/?token={token}"
-        print(f"rl1c studio: serving {studio.folder.root} at {address} (Ctrl-C stops it)",
-              file=out, flush=True)
+        try:
+            print(f"rl1c studio: serving {studio.folder.root} at {address} (Ctrl-C stops "
+                  "it)", file=out, flush=True)
+        except OSError as error:
+            raise _Unshown(error) from None
         if open_browser:
             webbrowser.open(address)
 
     try:
         asyncio.run(serve_studio(server, port, listening))
+    except _Unshown as unshown:
+        raise unshown.error from None  # rl1c's Command says it, as any output's failure
     except OSError as error:
         raise CannotStart(f"cannot listen on {HOST}:{port}: {error.strerror or error}; "
                           "choose another port with --port, or 0 for any free one") from None
+
+
+class _Unshown(Exception):
+    """The address could not be written: `error`, kept apart from the listening's."""
+
+    def __init__(self, error: OSError) -> None:
+        super().__init__(str(error))
+        self.error = error

@@ -5,6 +5,7 @@ outside the folder, of another kind, or a port in use refused with status 2."""
 from __future__ import annotations
 
 import json
+import os
 import signal
 import socket
 import subprocess
@@ -83,6 +84,18 @@ def test_a_port_in_use_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatc
     assert "cannot listen on 127.0.0.1:" in ran.stderr
     assert "choose another port" in ran.stderr
     assert "Traceback" not in ran.stderr
+
+
+def test_an_address_it_cannot_print_is_said_as_any_output_is_not_as_the_port(
+        tmp_path: Path) -> None:
+    # The address, with its token, is the only way in: a studio nobody can reach ends.
+    ended = subprocess.run([*RL1C, "studio", "--no-browser"], cwd=sample_folder(tmp_path),
+                           capture_output=True, text=True, timeout=60, check=False,
+                           preexec_fn=lambda: os.close(1))
+    assert ended.returncode == 2
+    assert ended.stderr == ("rl1c: error: cannot write the output: standard output is "
+                            "closed; send it to a file, a pipe or /dev/null (`> FILE`, not "
+                            "`>&-`)\n")
 
 
 def test_without_the_websockets_package_it_says_which_extra_to_install(
