@@ -12,6 +12,7 @@ import contextlib
 import os
 import stat
 from pathlib import Path
+from typing import BinaryIO
 
 
 class SourceError(Exception):
@@ -34,6 +35,10 @@ def read_bounded(path: str | os.PathLike[str], limit: int, what: str) -> bytes:
     be read or holds more than `limit` bytes (found without reading a huge file whole)."""
     try:
         with open(path, "rb") as stream:
+            if _standard_output_too(stream):
+                raise SourceError(path, "it is where standard output goes too (the shell "
+                                  "empties it for `> FILE` before rl1c runs)",
+                                  "send the output to another file")
             data = stream.read(limit + 1)
     except FileNotFoundError:
         raise SourceError(path, "no such file", "check the name, and the folder rl1c runs "
@@ -50,6 +55,17 @@ def read_bounded(path: str | os.PathLike[str], limit: int, what: str) -> bytes:
         raise TooLargeError(path, f"it is larger than {limit // 2**20} MiB, the limit for "
                           f"{what}", f"check that this is {what}")
     return data
+
+
+def _standard_output_too(stream: BinaryIO) -> bool:
+    """Whether `stream` reads the regular file standard output writes (`rl1c dis x.ilc >
+    x.ilc`), as cat refuses to."""
+    try:
+        read, written = os.fstat(stream.fileno()), os.fstat(1)
+    except OSError:  # standard output closed
+        return False
+    return stat.S_ISREG(written.st_mode) and (read.st_dev, read.st_ino) == (
+        written.st_dev, written.st_ino)
 
 
 class NotReplaceable(OSError):

@@ -68,6 +68,22 @@ def test_a_closed_standard_output_leaves_a_compile_to_a_file_as_it_would_be(
     assert target.read_bytes() == expected
 
 
+@pytest.mark.parametrize("mode", ["wb", "ab"])  # `> x.ilc` empties it, `>> x.ilc` not
+def test_an_input_that_standard_output_writes_is_refused_as_cat_refuses_it(
+        mode: str, tmp_path: Path) -> None:
+    compiled = tmp_path / "sample.ilc"
+    compiled.write_bytes(rl1c(SAMPLE, "-o", "-").stdout_bytes)
+    before = compiled.read_bytes() if mode == "ab" else b""
+    with compiled.open(mode) as output:
+        done = subprocess.run([RL1C, "dis", compiled], stdout=output, stderr=subprocess.PIPE,
+                              text=True, check=False)
+    assert done.returncode == 2
+    assert (f"cannot read the intermediate code file `{compiled}`: it is where standard "
+            "output goes too (the shell empties it for `> FILE` before rl1c runs)"
+            ) in done.stderr
+    assert compiled.read_bytes() == before  # no listing appended to the code
+
+
 @pytest.fixture
 def not_utf8(tmp_path: Path) -> Path:
     """A folder named with a byte that is not UTF-8, holding the sample program as
