@@ -35,6 +35,8 @@ def interpret(program: ast.Program, device: Device, budget: int = DEFAULT_BUDGET
 
 
 # The arithmetic of the spec: 16-bit two's complement, wrapping, shifts by signed counts.
+# Written apart from the VM's (vm/machine.py) on purpose: the differential tests hold
+# each to the other, which a shared function would make a comparison with itself.
 
 
 def wrap(value: int) -> int:

@@ -59,7 +59,9 @@ class _Faulted(Exception):
         self.message = message
 
 
-# The arithmetic of spec/language.md, sections 6.1 and 7.2.
+# The arithmetic of spec/language.md, sections 6.1 and 7.2. Written apart from the AST
+# interpreter's (compiler/interpreter.py) on purpose: the differential tests hold each
+# to the other, which a shared function would make a comparison with itself.
 
 def _wrap(value: int) -> int:
     """`value` as a 16-bit two's complement integer."""
