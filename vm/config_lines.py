@@ -15,7 +15,7 @@ from __future__ import annotations
 import json
 import re
 import tomllib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Literal
 
 KeyPath = tuple[str | int, ...]
@@ -191,19 +191,8 @@ class _Scanner:
         self.skip_space(newlines=False)
         char = self.peek()
         if char == "[":
-            yield path, line, ""
-            self.at += 1
-            index = 0
-            while True:
-                self.skip_space(newlines=True)
-                if self.peek() in ("]", ""):
-                    self.at += 1
-                    return
-                yield from self.toml_value((*path, index), self.line)
-                index += 1
-                self.skip_space(newlines=True)
-                if self.peek() == ",":
-                    self.at += 1
+            yield from self.array(path, line, lambda item: self.toml_value(item, self.line),
+                                  lambda: self.skip_space(newlines=True))
         elif char == "{":
             yield path, line, ""
             self.at += 1
@@ -226,6 +215,24 @@ class _Scanner:
         else:
             yield path, line, self._scalar()
 
+    def array(self, path: KeyPath, line: int, item: Callable[[KeyPath], Iterator[Entry]],
+              skip: Callable[[], None]) -> Iterator[Entry]:
+        """An array at its `[`, in either syntax: its own entry, then each item's, read by
+        `item` at the item's path; `skip` passes what the syntax allows between them."""
+        yield path, line, ""
+        self.at += 1
+        index = 0
+        while True:
+            skip()
+            if self.peek() in ("]", ""):
+                self.at += 1
+                return
+            yield from item((*path, index))
+            index += 1
+            skip()
+            if self.peek() == ",":
+                self.at += 1
+
     def _scalar(self) -> str:
         """A number, boolean or date: up to the next separator."""
         scalar = _SCALAR.match(self.text, self.at)
@@ -239,19 +246,7 @@ class _Scanner:
         self.skip_json_space()
         line, char = self.line, self.peek()
         if char == "[":
-            yield path, line, ""
-            self.at += 1
-            index = 0
-            while True:
-                self.skip_json_space()
-                if self.peek() in ("]", ""):
-                    self.at += 1
-                    return
-                yield from self.json_value((*path, index))
-                index += 1
-                self.skip_json_space()
-                if self.peek() == ",":
-                    self.at += 1
+            yield from self.array(path, line, self.json_value, self.skip_json_space)
         elif char == "{":
             yield path, line, ""
             self.at += 1
