@@ -186,9 +186,27 @@ def a_budget(ctx: click.Context, param: click.Parameter, value: str) -> int:
     return number
 
 
+def completable(word: str) -> bool:
+    """Whether the shell's word `word` can be completed: click writes completions as
+    UTF-8, which a word holding bytes that are not UTF-8 (a Latin-1 file name, held as
+    surrogate escapes) has no form in, and it failed writing it back."""
+    try:
+        word.encode("utf-8")
+    except UnicodeEncodeError:
+        return False
+    return True
+
+
+class _Path(click.Path):
+    def shell_complete(self, ctx: click.Context, param: click.Parameter,
+                       incomplete: str) -> list[CompletionItem]:
+        return super().shell_complete(ctx, param, incomplete) if completable(incomplete) \
+            else []
+
+
 # A path as given: the stages read it and report what is wrong in their own terms (E0100
 # for a source file), so click checks nothing; it completes file names in the shell.
-PATH = click.Path(readable=False, allow_dash=True)
+PATH = _Path(readable=False, allow_dash=True)
 
 # Shared by the commands that report diagnostics.
 format_option = choice_option(

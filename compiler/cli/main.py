@@ -34,6 +34,7 @@ from . import plugins
 from .command import (
     CONTEXT_SETTINGS,
     Context,
+    completable,
     internal_error,
     interrupted,
     output_failed,
@@ -140,7 +141,8 @@ class Toolchain(click.Group):
         from click.shell_completion import CompletionItem
 
         # The commands, and the files `rl1c FILE.rob` compiles.
-        return [*super().shell_complete(ctx, incomplete), CompletionItem(incomplete, type="file")]
+        files = [CompletionItem(incomplete, type="file")] if completable(incomplete) else []
+        return [*super().shell_complete(ctx, incomplete), *files]
 
     def main(self, args: Sequence[str] | None = None, prog_name: str | None = None,
              complete_var: str | None = None, standalone_mode: bool = True,

@@ -3,7 +3,10 @@ or a mistyped command, and shell completion of commands, options, files and code
 
 from __future__ import annotations
 
+import os
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -97,6 +100,18 @@ def test_explain_completes_the_diagnostic_codes(typed: str) -> None:
     expected = [code for code in CODES if code.startswith(typed.upper())]
     assert expected
     assert completions(["explain"], typed) == [(code, "plain") for code in expected]
+
+
+@pytest.mark.parametrize("words", ["rl1c \udcff", "rl1c check a\udcff",
+                                   "rl1c run x.rob --sensors \udcff"])
+def test_a_word_that_is_not_utf8_completes_to_nothing_not_an_internal_error(
+        words: str) -> None:
+    # Bytes of a Latin-1 file name, which click failed to write back as UTF-8.
+    completing = subprocess.run(
+        [str(Path(sys.executable).with_name("rl1c"))], capture_output=True, check=False,
+        env={**os.environ, "_RL1C_COMPLETE": "bash_complete", "COMP_WORDS": words,
+             "COMP_CWORD": str(len(words.split(" ")) - 1)})
+    assert (completing.returncode, completing.stdout, completing.stderr) == (0, b"\n", b"")
 
 
 def test_completion_through_the_environment_the_shell_sets() -> None:
