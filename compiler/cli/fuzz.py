@@ -46,6 +46,21 @@ REDRAW_EVERY = 0.2  # seconds between redraws of the bar on a terminal
 PROGRESS_EVERY = 10.0  # seconds between progress lines elsewhere
 
 
+@contextmanager
+def needing_hypothesis(purpose: str, otherwise: str) -> Iterator[None]:
+    """Imports that need Hypothesis, the optional part `fuzz` of rl1 (rl1c fuzz's, and
+    rl1c reduce --engine's): without it, a usage error saying that `purpose` needs it
+    and how to install it, or `otherwise`."""
+    try:
+        yield
+    except ModuleNotFoundError as error:
+        if (error.name or "").partition(".")[0] != "hypothesis":
+            raise
+        raise Failure(f"error: {purpose} with Hypothesis, an optional part of rl1 that is "
+                      f"not installed here; install it with `pip install 'rl1[fuzz]'`"
+                      f"{otherwise}") from None
+
+
 @click.command(cls=Command)
 @click.option("--engine", "engine_names", multiple=True, metavar="NAME",
               help="an engine to compare, repeatable: ast, vm-O0, vm-O1, vm-O2, the C VM "
@@ -112,7 +127,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     process (the C VM's crash) is a finding too, shrunk as any. Exit status: 0
     all agreed, 1 a disagreement or such a program, 2 a usage problem, 130 or 143
     stopped by Ctrl-C or SIGTERM."""
-    try:
+    with needing_hypothesis("rl1c fuzz generates programs", " (or `pip install hypothesis`)"):
         from rl1.compiler.differential import (
             DEFAULT_ENGINES,
             ENGINE_NAMES,
@@ -127,12 +142,6 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
             read_corpus,
             write_reproducer,
         )
-    except ModuleNotFoundError as error:
-        if (error.name or "").partition(".")[0] != "hypothesis":
-            raise
-        raise Failure("error: rl1c fuzz generates programs with Hypothesis, an optional "
-                      "part of rl1 that is not installed here; install it with "
-                      "`pip install 'rl1[fuzz]'` (or `pip install hypothesis`)") from None
     from rl1.compiler.executors import ClusterLost, Unavailable, workers
     from rl1.vm.native import BuildError
 

@@ -338,20 +338,14 @@ def _run(command: str, folder: str, timeout: int) -> _Ran:
 def _engines_test(names: tuple[str, ...], budget: int | None, original: Case, file: str,
                   sensors: str | None) -> _EnginesTest:
     """The oracle of --engine: the engines named, judged as rl1c fuzz judges them."""
-    try:
+    from .fuzz import DEFAULT_BUDGET, needing_hypothesis
+
+    with needing_hypothesis("rl1c reduce --engine compares engines as rl1c fuzz does,",
+                            ", or use --interesting"):
         from rl1.compiler.differential import ENGINE_NAMES, engine_named
-    except ModuleNotFoundError as error:
-        if (error.name or "").partition(".")[0] != "hypothesis":
-            raise
-        raise Failure("error: rl1c reduce --engine compares engines as rl1c fuzz does, "
-                      "with Hypothesis, an optional part of rl1 that is not installed here; "
-                      "install it with `pip install 'rl1[fuzz]'`, or use --interesting"
-                      ) from None
     from rl1.compiler.analysis import analyze
     from rl1.vm.scripted import parse_script
     from rl1.vm.sensor_script import ScriptError
-
-    from .fuzz import DEFAULT_BUDGET
 
     engines = []
     for name in names:
