@@ -195,8 +195,7 @@ class ExecEngine:
     name: str = field(init=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "name", f"exec{f'-O{self.level}' if self.level else ''}:"
-                                         f"{self.command}")
+        object.__setattr__(self, "name", _exec_name("exec", self.level, self.command))
 
     def command_line(self, ilc_path: str, sensors_path: str, budget: int) -> str:
         return (self.command.replace("{ilc}", shlex.quote(ilc_path))
@@ -241,8 +240,7 @@ class BatchEngine:
     name: str = field(init=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "name", f"exec-batch{f'-O{self.level}' if self.level else ''}"
-                                         f":{self.command}")
+        object.__setattr__(self, "name", _exec_name("exec-batch", self.level, self.command))
 
     def job(self, case: Run, budget: int) -> bytes:
         """The job line of `case` (without its line end)."""
@@ -486,6 +484,11 @@ ENGINE_NAMES = (*DEFAULT_ENGINES, *(f"c-O{level}" for level in OPTIMIZATION_LEVE
 EXEC_ENGINE = re.compile(r"exec(-batch)?(?:-O([0-9]+))?:(.*\S.*)", re.DOTALL)
 """`exec:COMMAND` (given the -O0 file) or `exec-ON:COMMAND` (the file at -ON), and the
 same with `exec-batch`."""
+
+
+def _exec_name(kind: str, level: int, command: str) -> str:
+    """The name of an `exec` or `exec-batch` engine, as EXEC_ENGINE reads it back."""
+    return f"{kind}{f'-O{level}' if level else ''}:{command}"
 
 
 def engine_named(name: str) -> Engine | None:
