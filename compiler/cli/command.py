@@ -162,27 +162,27 @@ def choice_option(*names: str, choices: Sequence[str], help: str,
 
 def at_least_one(ctx: click.Context, param: click.Parameter, value: str) -> int:
     """An option's callback: a whole number, at least 1."""
-    try:
-        number = int(value)
-    except ValueError:
-        number = 0
-    if number < 1:
-        raise click.BadParameter(f"expected a whole number of at least 1, got {value!r}",
-                                 ctx, param)
-    return number
+    return _whole_number(ctx, param, value, "of at least 1")
 
 
 def a_budget(ctx: click.Context, param: click.Parameter, value: str) -> int:
     """An option's callback: a watchdog budget, a whole number in 1..MAX_BUDGET."""
     from rl1.vm.faults import MAX_BUDGET  # the VM's modules load only for commands that run
 
+    return _whole_number(ctx, param, value, f"from 1 to {MAX_BUDGET}", most=MAX_BUDGET)
+
+
+def _whole_number(ctx: click.Context, param: click.Parameter, value: str, expected: str,
+                  most: int | None = None) -> int:
+    """`value` as a whole number from 1 to `most` (no bound when None), or the option's
+    usage error saying it expected a whole number `expected`."""
     try:
         number = int(value)
     except ValueError:
         number = 0
-    if not 1 <= number <= MAX_BUDGET:
-        raise click.BadParameter(f"expected a whole number from 1 to {MAX_BUDGET}, "
-                                 f"got {value!r}", ctx, param)
+    if number < 1 or (most is not None and number > most):
+        raise click.BadParameter(f"expected a whole number {expected}, got {value!r}",
+                                 ctx, param)
     return number
 
 
