@@ -186,6 +186,20 @@ def _whole_number(ctx: click.Context, param: click.Parameter, value: str, expect
     return number
 
 
+OptionCallback = Callable[[click.Context, click.Parameter, str], int]
+
+
+def or_none(callback: OptionCallback
+            ) -> Callable[[click.Context, click.Parameter, str | None], int | None]:
+    """`callback` for an option that may be left out: left out (None), it stays None."""
+
+    def left_out_or(ctx: click.Context, param: click.Parameter, value: str | None
+                    ) -> int | None:
+        return None if value is None else callback(ctx, param, value)
+
+    return left_out_or
+
+
 def completable(word: str) -> bool:
     """Whether the shell's word `word` can be completed: click writes completions as
     UTF-8, which a word holding bytes that are not UTF-8 (a Latin-1 file name, held as

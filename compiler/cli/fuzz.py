@@ -30,6 +30,7 @@ from .command import (
     a_budget,
     at_least_one,
     choice_option,
+    or_none,
 )
 
 if TYPE_CHECKING:
@@ -71,12 +72,12 @@ def needing_hypothesis(purpose: str, otherwise: str) -> Iterator[None]:
                    "(and -O1, -O2) started once, reading a job a line and answering each "
                    "(spec/optimization.md, section 5; `rl1c run --batch` is one). Default: "
                    "ast, vm-O0, vm-O1, vm-O2; the first is the reference")
-@click.option("--count", type=str, default=None, callback=lambda c, p, v: None if v is None
-              else at_least_one(c, p, v), metavar="N",
+@click.option("--count", type=str, default=None, callback=or_none(at_least_one),
+              metavar="N",
               help=f"programs to generate and run, after any --corpus (default "
                    f"{DEFAULT_COUNT})")
 @click.option("--time", "seconds", type=str, default=None, metavar="SECONDS",
-              callback=lambda c, p, v: None if v is None else at_least_one(c, p, v),
+              callback=or_none(at_least_one),
               help="run for this long instead of a count")
 @click.option("--seed", type=str, default=None, metavar="N",
               help="the seed of the generator, to repeat a campaign (default: random)")
@@ -86,7 +87,7 @@ def needing_hypothesis(purpose: str, otherwise: str) -> Iterator[None]:
 @click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget,
               metavar="N", show_default=True, help="the budget of every run")
 @click.option("--jobs", type=str, default=None, metavar="J",
-              callback=lambda c, p, v: None if v is None else at_least_one(c, p, v),
+              callback=or_none(at_least_one),
               help="processes that run the searches (default: one per core); the "
                    "programs are the same for any J")
 @click.option("--scheduler", metavar="ADDRESS",

@@ -25,7 +25,15 @@ import click
 from rl1.compiler.files import SourceError, read_bounded, refuses_writing
 from rl1.compiler.reporting.render import EXIT_ERRORS
 
-from .command import EXIT_INTERRUPTED, PATH, Command, Failure, a_budget, at_least_one
+from .command import (
+    EXIT_INTERRUPTED,
+    PATH,
+    Command,
+    Failure,
+    a_budget,
+    at_least_one,
+    or_none,
+)
 from .streams import (
     encode_like,
     invalid_file,
@@ -60,8 +68,7 @@ SCRIPT_ROLE = "sensor script"
               help="instead of --interesting: engines as `rl1c fuzz --engine` names them, "
                    "repeatable; a candidate is interesting while they disagree as they do "
                    "on the original")
-@click.option("--budget", type=str, default=None, callback=lambda c, p, v: None
-              if v is None else a_budget(c, p, v), metavar="N",
+@click.option("--budget", type=str, default=None, callback=or_none(a_budget), metavar="N",
               help="with --engine, the budget of every run (default: rl1c fuzz's)")
 @click.option("--out", "out", metavar="FILE", type=PATH, default=None,
               help="where the reduced program goes (default: FILE.reduced.rob beside it)")
@@ -69,7 +76,7 @@ SCRIPT_ROLE = "sensor script"
               help="where the reduced sensor script goes (default: beside it, "
                    "S.reduced.json)")
 @click.option("--max-tests", "max_tests", type=str, default=None, metavar="N",
-              callback=lambda c, p, v: None if v is None else at_least_one(c, p, v),
+              callback=or_none(at_least_one),
               help="stop after testing so many candidates, with the smallest so far "
                    f"(default {DEFAULT_MAX_TESTS})")
 @click.option("--timeout", type=str, default=str(DEFAULT_TIMEOUT), metavar="SECONDS",

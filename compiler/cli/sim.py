@@ -21,6 +21,7 @@ from .command import (
     choice_option,
     color_option,
     force_option,
+    or_none,
 )
 from .streams import PATH_ESCAPES, invalid_file, read_failure, same_file, write_file
 
@@ -32,12 +33,6 @@ SECTION = "Simulation"
 MAX_WORLD_BYTES = 4 * 2**20
 WORLD_ROLE = "world file"
 EXAMPLE_WORLD = "examples/sample.world.toml"
-
-
-def at_least_one_or_none(ctx: click.Context, param: click.Parameter,
-                         value: str | None) -> int | None:
-    """An option's callback: left out, or a whole number of at least 1."""
-    return None if value is None else at_least_one(ctx, param, value)
 
 
 @click.command(cls=Command)
@@ -66,11 +61,11 @@ def at_least_one_or_none(ctx: click.Context, param: click.Parameter,
                help="which calls to show, as `rl1c run --trace`: short: the first 40 and "
                     "the last 20 of a longer trace, with how many were left out; all; calls; "
                     "none. Default: short with --format text, all with json")
-@click.option("--runs", type=str, default=None, callback=at_least_one_or_none, metavar="N",
+@click.option("--runs", type=str, default=None, callback=or_none(at_least_one), metavar="N",
               help="a campaign: run N times, with the seeds --seed, --seed + 1, ...; print "
                    "the success rate (95% Wilson interval) and the failures grouped by "
                    "kind and source line, each with the command that replays one")
-@click.option("--jobs", type=str, default=None, callback=at_least_one_or_none, metavar="J",
+@click.option("--jobs", type=str, default=None, callback=or_none(at_least_one), metavar="J",
               help="with --runs: the processes that make the runs (default: every core); "
                    "the results are the same for any J")
 @click.option("--scheduler", metavar="ADDRESS",

@@ -15,8 +15,15 @@ from rl1.compiler.executors import workers
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.reporting.render import EXIT_ERRORS, EXIT_USAGE, ColorChoice, use_color
 
-from .command import PATH, Command, Failure, color_option, force_option
-from .sim import at_least_one_or_none
+from .command import (
+    PATH,
+    Command,
+    Failure,
+    at_least_one,
+    color_option,
+    force_option,
+    or_none,
+)
 from .streams import cannot, file_problem, problem_text, same_file, unreadable, write_file
 
 if TYPE_CHECKING:  # the test file's schema loads when the command runs
@@ -30,7 +37,7 @@ TEST_FILE_ROLE = "test file"
 
 @click.command(cls=Command)
 @click.argument("paths", nargs=-1, metavar="[PATH]...", type=PATH)
-@click.option("--jobs", type=str, default=None, callback=at_least_one_or_none, metavar="J",
+@click.option("--jobs", type=str, default=None, callback=or_none(at_least_one), metavar="J",
               help="the processes that make a success rate's runs (default: every core); "
                    "the results are the same for any J")
 @click.option("--junit", "junit_file", metavar="FILE", type=PATH,
