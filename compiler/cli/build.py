@@ -23,7 +23,6 @@ from rl1.compiler.reporting.render import (
     use_color,
 )
 from rl1.vm.defaults import (
-    DEFAULT_BUDGET,
     DEFAULT_LEVEL,
     DEFAULT_TIME_LIMIT_MS,
     ENGINES,
@@ -36,7 +35,7 @@ from .command import (
     PATH,
     Command,
     Failure,
-    a_budget,
+    budget_option,
     choice_option,
     color_option,
     force_option,
@@ -240,10 +239,7 @@ def _time_limit(ctx: click.Context, param: click.Parameter, value: str) -> int:
                     "the last 20 of a longer trace, with how many were left out; all: every "
                     "one; calls: the program's calls only (no lost line, no stop); none. "
                     "Default: short with --format text, all with json")
-@click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget,
-              metavar="N", show_default=True,
-              help="instructions (statements with --engine ast) before the watchdog stops "
-                   "a runaway program")
+@budget_option
 @click.option("--time-limit", type=str, default=f"{DEFAULT_TIME_LIMIT_MS / 1000:g}",
               callback=_time_limit,
               metavar="SECONDS", show_default=True,

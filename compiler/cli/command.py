@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import click
 
 from rl1.compiler.reporting.render import COLOR_CHOICES, EXIT_ERRORS, EXIT_USAGE, FORMATS
+from rl1.vm.defaults import DEFAULT_BUDGET
 
 if TYPE_CHECKING:  # click's completion module loads only when a shell asks
     from click.shell_completion import CompletionItem
@@ -237,3 +238,10 @@ force_option = click.option(
     "--force", is_flag=True,
     help="replace an output file even when it is read-only (a device or a FIFO is "
          "written to, never replaced)")
+
+# Shared by the commands that run a program (rl1c run, rl1c sim).
+budget_option = click.option(
+    "--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget, metavar="N",
+    show_default=True,
+    help="instructions (statements with --engine ast) before the watchdog stops a runaway "
+         "program")

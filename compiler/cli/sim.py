@@ -11,13 +11,13 @@ import click
 
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.reporting.render import ColorChoice, use_color
-from rl1.vm.defaults import DEFAULT_BUDGET, ENGINES, TRACE_CHOICES, Engine, TraceChoice
+from rl1.vm.defaults import ENGINES, TRACE_CHOICES, Engine, TraceChoice
 
 from .command import (
     PATH,
     Command,
-    a_budget,
     at_least_one,
+    budget_option,
     choice_option,
     color_option,
     force_option,
@@ -53,10 +53,7 @@ EXAMPLE_WORLD = "examples/sample.world.toml"
 @choice_option("--engine", choices=ENGINES, default="vm",
                help="vm: compile, then run on the reference VM; ast: interpret the source; "
                     "c: run on the C VM of the firmware (vm/c, built on first use)")
-@click.option("--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget,
-              metavar="N", show_default=True,
-              help="instructions (statements with --engine ast) before the watchdog stops "
-                   "a runaway program")
+@budget_option
 @choice_option("--trace", "trace_choice", choices=TRACE_CHOICES, default=None,
                help="which calls to show, as `rl1c run --trace`: short: the first 40 and "
                     "the last 20 of a longer trace, with how many were left out; all; calls; "
