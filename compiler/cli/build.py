@@ -25,7 +25,6 @@ from rl1.compiler.reporting.render import (
 from rl1.vm.defaults import (
     DEFAULT_LEVEL,
     DEFAULT_TIME_LIMIT_MS,
-    ENGINES,
     TRACE_CHOICES,
     Engine,
     TraceChoice,
@@ -38,6 +37,7 @@ from .command import (
     budget_option,
     choice_option,
     color_option,
+    engine_option,
     force_option,
     format_option,
 )
@@ -245,9 +245,7 @@ def _time_limit(ctx: click.Context, param: click.Parameter, value: str) -> int:
               metavar="SECONDS", show_default=True,
               help="device time before the run is stopped (a device error): a program "
                    "waiting in a loop for a reading that never comes")
-@choice_option("--engine", choices=ENGINES, default="vm",
-               help="vm: compile, then run on the reference VM; ast: interpret the source; "
-                    "c: run on the C VM of the firmware (vm/c, built on first use)")
+@engine_option
 @click.option("--batch", is_flag=True,
               help="instead of FILE, run one .ilc file after another as `rl1c fuzz`'s "
                    "exec-batch: engines do: a JSON job a line on standard input, the run "

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 import click
 
 from rl1.compiler.reporting.render import COLOR_CHOICES, EXIT_ERRORS, EXIT_USAGE, FORMATS
-from rl1.vm.defaults import DEFAULT_BUDGET
+from rl1.vm.defaults import DEFAULT_BUDGET, ENGINES
 
 if TYPE_CHECKING:  # click's completion module loads only when a shell asks
     from click.shell_completion import CompletionItem
@@ -240,6 +240,10 @@ force_option = click.option(
          "written to, never replaced)")
 
 # Shared by the commands that run a program (rl1c run, rl1c sim).
+engine_option = choice_option(
+    "--engine", choices=ENGINES, default="vm",
+    help="vm: compile, then run on the reference VM; ast: interpret the source; c: run on "
+         "the C VM of the firmware (vm/c, built on first use)")
 budget_option = click.option(
     "--budget", type=str, default=str(DEFAULT_BUDGET), callback=a_budget, metavar="N",
     show_default=True,

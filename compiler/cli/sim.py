@@ -11,7 +11,7 @@ import click
 
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.reporting.render import ColorChoice, use_color
-from rl1.vm.defaults import ENGINES, TRACE_CHOICES, Engine, TraceChoice
+from rl1.vm.defaults import TRACE_CHOICES, Engine, TraceChoice
 
 from .command import (
     PATH,
@@ -20,6 +20,7 @@ from .command import (
     budget_option,
     choice_option,
     color_option,
+    engine_option,
     force_option,
     or_none,
 )
@@ -50,9 +51,7 @@ EXAMPLE_WORLD = "examples/sample.world.toml"
               help="the seed of the sensor noise (the world sets the noise; off by default) "
                    "and of the world's [vary] draws (default 0; a run without --seed draws "
                    "nothing: the world as written)")
-@choice_option("--engine", choices=ENGINES, default="vm",
-               help="vm: compile, then run on the reference VM; ast: interpret the source; "
-                    "c: run on the C VM of the firmware (vm/c, built on first use)")
+@engine_option
 @budget_option
 @choice_option("--trace", "trace_choice", choices=TRACE_CHOICES, default=None,
                help="which calls to show, as `rl1c run --trace`: short: the first 40 and "
