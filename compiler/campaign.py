@@ -14,7 +14,6 @@ group, never the records.
 
 from __future__ import annotations
 
-import gc
 import math
 import time
 from collections import deque
@@ -26,6 +25,7 @@ from itertools import islice
 from typing import Any
 
 from rl1.compiler.backend.driver import compile_text
+from rl1.compiler.frontend.collector import FullCollections
 from rl1.compiler.runner import Finished, run
 from rl1.compiler.simulation import Simulation, run_status
 from rl1.vm.defaults import Engine
@@ -116,7 +116,9 @@ class Record:
 
 
 COLLECT_EVERY = 64  # runs between full collections of a worker's garbage
-_runs_since_collection = 0
+# A worker compiles or interprets source each run: without a full collection now and
+# then (frontend/collector.py says why) it would grow without end.
+_collections = FullCollections(COLLECT_EVERY)
 
 
 @lru_cache(maxsize=4)
@@ -132,15 +134,7 @@ def world_of(task: Task) -> World:
 def run_one(task: Task, seed: int) -> Record:
     """The run of `task` with `seed`, as `rl1c sim --seed SEED` makes it. The program
     must compile (a campaign checks it once before its runs)."""
-    global _runs_since_collection
-    _runs_since_collection += 1
-    if _runs_since_collection == COLLECT_EVERY:
-        # The front end pauses the collector while it parses (frontend/collector.py) and
-        # then moves every object, this process's earlier runs' garbage cycles included,
-        # to the oldest generation, which only a full collection frees: source compiled
-        # or interpreted each run would grow a worker without end.
-        _runs_since_collection = 0
-        gc.collect()
+    _collections.count()
     world, varied = run_world(world_of(task), task.offsets, seed)
     simulation = Simulation(world, seed)
     device = simulation.device

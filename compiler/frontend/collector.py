@@ -13,7 +13,8 @@ say, put all tracked objects in the oldest generation without walking them. Garb
 moved there waits for the next full collection, which CPython starts only once enough
 objects have reached that generation the usual way: in a short command that is never,
 and nothing is lost; a long-lived process must collect now and then itself (the
-language server does when a session ends: lsp/transports.py).
+language server does when a session ends: lsp/transports.py; a campaign's worker and
+`rl1c test` every so many runs: `FullCollections`).
 """
 
 from __future__ import annotations
@@ -35,3 +36,19 @@ def collector_paused() -> Iterator[None]:
             gc.freeze()
             gc.unfreeze()
             gc.enable()
+
+
+class FullCollections:
+    """A full collection every `every` calls of `count`: for a process that runs the
+    front end over and over, whose garbage the pauses move where only a full collection
+    frees it."""
+
+    def __init__(self, every: int) -> None:
+        self.every = every
+        self._since = 0
+
+    def count(self) -> None:
+        self._since += 1
+        if self._since == self.every:
+            self._since = 0
+            gc.collect()
