@@ -356,17 +356,20 @@ class Judge:
 
     # The outcomes
 
-    def _late(self, time: float) -> bool:
-        return self.goal.deadline is not None and time > self.goal.deadline
+    def _lateness(self, time: float) -> str:
+        """What an outcome at `time` adds when it is past the goal's deadline (and so is
+        not met): ", after the deadline of D s"; empty when it is in time."""
+        if self.goal.deadline is None or time <= self.goal.deadline:
+            return ""
+        return f", after the deadline of {self.goal.deadline:g} s"
 
     def _reached(self, reaching: _Reaching) -> Outcome:
         region = reaching.region
         if reaching.reached is not None:
             time, pose = reaching.reached
-            late = self._late(time)
-            return Outcome("reach", region.name, not late, f"reached at {_at(time, pose)}"
-                           + (f", after the deadline of {self.goal.deadline:g} s"
-                              if late else ""), time, pose)
+            lateness = self._lateness(time)
+            return Outcome("reach", region.name, not lateness,
+                           f"reached at {_at(time, pose)}{lateness}", time, pose)
         if reaching.entered is not None:
             time, pose = reaching.entered
             assert region.heading is not None  # entered, so the heading was never right
@@ -385,11 +388,9 @@ class Judge:
         what = f"{hold.seconds:g} s with the camera within {hold.within:g} cm of its marker"
         if holding.held is not None:
             time, pose = holding.held
-            late = self._late(time)
-            return Outcome("hold", hold.stand, not late, f"stood still {what} by "
-                           f"{_at(time, pose)}" + (
-                               f", after the deadline of {self.goal.deadline:g} s"
-                               if late else ""), time, pose)
+            lateness = self._lateness(time)
+            return Outcome("hold", hold.stand, not lateness,
+                           f"stood still {what} by {_at(time, pose)}{lateness}", time, pose)
         assert holding.nearest is not None  # the rest after the run is long enough
         distance, time, pose = holding.nearest
         return Outcome("hold", hold.stand, False, f"never stood still {what}: the nearest "
