@@ -457,24 +457,35 @@ def _hand_over(session: Session, body: bytes) -> int:
     return len(body)
 
 
-class _WebSocketWriter:
-    """Sends each message as a text frame, in order, from a task of its own."""
+class WebSocketOutbox:
+    """Sends each message as a text frame, in order, from a task of its own; a peer that
+    would leave more unread than the bound of the bytes in flight allows (`refusal`:
+    InFlight's) is disconnected. An rl1-lsp session writes through it (a Writer), and
+    so does a studio page (studio/server.py), `peer` in the log."""
 
-    def __init__(self, connection: Any, refusal: Admission) -> None:
+    def __init__(self, connection: Any, refusal: Admission, peer: str = "a client") -> None:
         self._connection = connection
         self._refusal = refusal  # why the session may not hold so many bytes more, if so
+        self._peer = peer
         self._outbox: asyncio.Queue[str] = asyncio.Queue()
         self.unsent = 0
+        self._closed = False
         self._pump = asyncio.get_running_loop().create_task(self._send_all())
 
     def write(self, data: bytes) -> None:
-        if (refused := self._refusal(len(data))) is not None:
-            log.warning("a client has not read %.0f MiB the server wrote, and %s: "
-                        "disconnected", self.unsent / 2**20, refused)
+        self.send(data.decode())
+
+    def send(self, text: str) -> None:
+        if self._closed:  # the peer has gone, and is counted no more
+            return
+        # JSON as pygls and json.dumps write it is ASCII: its length is its bytes'.
+        if (refused := self._refusal(len(text))) is not None:
+            log.warning("%s has not read %.0f MiB the server wrote, and %s: disconnected",
+                        self._peer, self.unsent / 2**20, refused)
             self._connection.transport.abort()
             return
-        self.unsent += len(data)
-        self._outbox.put_nowait(data.decode())
+        self.unsent += len(text)
+        self._outbox.put_nowait(text)
 
     async def _send_all(self) -> None:
         from websockets.exceptions import ConnectionClosed
@@ -482,7 +493,7 @@ class _WebSocketWriter:
             while True:
                 text = await self._outbox.get()
                 await self._connection.send(text)
-                self.unsent -= len(text)  # JSON as pygls writes it is ASCII
+                self.unsent -= len(text)
                 self._outbox.task_done()
 
     async def finish(self) -> None:
@@ -493,6 +504,7 @@ class _WebSocketWriter:
         self.close()
 
     def close(self) -> None:
+        self._closed = True
         self._pump.cancel()
 
 
@@ -584,7 +596,7 @@ class WebSocketSessions:
             return
         session = new_session()
         sessions.add(session)
-        writer = _WebSocketWriter(connection, functools.partial(in_flight.refusal, connection))
+        writer = WebSocketOutbox(connection, functools.partial(in_flight.refusal, connection))
         session.attach(writer)
         try:
             with in_flight.counting(connection, lambda: connection.received + writer.unsent):

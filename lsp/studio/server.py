@@ -12,8 +12,6 @@ the command's output.
 
 from __future__ import annotations
 
-import asyncio
-import contextlib
 import functools
 import logging
 import mimetypes
@@ -30,7 +28,6 @@ from websockets.exceptions import ConnectionClosed
 from websockets.http11 import Request, Response
 
 from .. import transports
-from ..framing import Admission
 from .connection import Connection, Studio
 from .files import Folder, Refused, Unusable
 from .language import new_session
@@ -163,7 +160,8 @@ class Server:
             return
         assert isinstance(connection, self.lsp.connection_class)
         self.pages += 1
-        outbox = _Outbox(connection, functools.partial(self.lsp.in_flight.refusal, connection))
+        outbox = transports.WebSocketOutbox(
+            connection, functools.partial(self.lsp.in_flight.refusal, connection), "a page")
         page = Connection(self.studio, outbox.send, lambda: outbox.unsent)
         try:
             # Its bytes in flight are bounded together with the language server's
@@ -185,43 +183,6 @@ class Server:
             # generators) is left in reference cycles, which only a collection frees:
             # some 0.15 MiB a page, kept for good (bench/studio_pages.py).
             self.lsp.collector.ended()
-
-
-class _Outbox:
-    """Sends each message as a text frame, in order, from a task of its own; a page
-    that would leave more unread than the bound of the bytes in flight allows
-    (`refusal`: transports.InFlight's) is disconnected."""
-
-    def __init__(self, connection: ServerConnection, refusal: Admission) -> None:
-        self._connection = connection
-        self._refusal = refusal
-        self._queue: asyncio.Queue[str] = asyncio.Queue()
-        self.unsent = 0
-        self._closed = False
-        self._pump = asyncio.get_running_loop().create_task(self._send_all())
-
-    def send(self, text: str) -> None:
-        if self._closed:  # the page has gone, and is counted no more
-            return
-        # JSON as json.dumps writes it is ASCII: its length is its bytes'.
-        if (refused := self._refusal(len(text))) is not None:
-            log.warning("a page has not read %.0f MiB, and %s: disconnected",
-                        self.unsent / 2**20, refused)
-            self._connection.transport.abort()
-            return
-        self.unsent += len(text)
-        self._queue.put_nowait(text)
-
-    async def _send_all(self) -> None:
-        with contextlib.suppress(ConnectionClosed):
-            while True:
-                text = await self._queue.get()
-                await self._connection.send(text)
-                self.unsent -= len(text)
-
-    def close(self) -> None:
-        self._closed = True
-        self._pump.cancel()
 
 
 async def serve_studio(server: Server, port: int, listening: Callable[[int], None]) -> None:

@@ -17,7 +17,6 @@ from hypothesis import strategies as st
 
 from rl1.lsp import transports
 from rl1.lsp.framing import MAX_MESSAGE
-from rl1.lsp.studio import server
 from rl1.lsp.transports import (
     FREE_IN_FLIGHT,
     MAX_IN_FLIGHT,
@@ -244,14 +243,14 @@ def test_a_tcp_answer_past_the_bound_is_not_written() -> None:
 
 
 def test_a_websocket_answer_past_the_bound_is_not_counted() -> None:
-    """The WebSocket writers (rl1-lsp's and the studio page's) counted an answer, then
-    asked whether their session might hold it: refused, the answer was not sent but
-    stayed counted against the others until the session ended. A studio page could
-    also leave 128 MiB unread whatever the others held, past the bound."""
+    """The WebSocket outbox (rl1-lsp's sessions' and the studio pages') counted an
+    answer, then asked whether its session might hold it: refused, the answer was not
+    sent but stayed counted against the others until the session ended. A studio page
+    could also leave 128 MiB unread whatever the others held, past the bound."""
     async def answer() -> None:
         stream = _Stream()
         with _bound_full() as in_flight:
-            writer = transports._WebSocketWriter(
+            writer = transports.WebSocketOutbox(
                 stream, functools.partial(in_flight.refusal, stream))
             with in_flight.counting(stream, lambda: writer.unsent):
                 writer.write(ANSWER)
@@ -260,8 +259,8 @@ def test_a_websocket_answer_past_the_bound_is_not_counted() -> None:
 
         page = _Stream()
         with _bound_full() as in_flight:
-            outbox = server._Outbox(page, functools.partial(  # type: ignore[arg-type]
-                in_flight.refusal, page))
+            outbox = transports.WebSocketOutbox(page, functools.partial(
+                in_flight.refusal, page), "a page")
             with in_flight.counting(page, lambda: outbox.unsent):
                 outbox.send(ANSWER.decode())
             outbox.close()
