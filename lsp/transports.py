@@ -42,6 +42,8 @@ from collections.abc import AsyncIterator, Callable, Iterator
 from concurrent.futures import CancelledError
 from typing import Any, BinaryIO, Protocol
 
+from rl1.compiler.frontend.collector import FullCollections
+
 from .framing import CHUNK, MAX_MESSAGE, Admission, Framer, frame
 from .json_reading import read_json
 
@@ -239,30 +241,24 @@ def return_large_buffers() -> None:
         ctypes.CDLL(None).mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD)
 
 
-class Collector:
-    """Collects the garbage of ended sessions (and the studio's ended pages), once
-    every MAX_SESSIONS of them. What a session leaves after its end (server.Rl1Server.
-    end lets go of its documents) is a web of reference cycles, pygls' server and
-    protocol and the handlers that close over the server, freed only by a collection
-    of the oldest generation; and the front end's pauses of the collector (compiler/
-    frontend/collector.py) move every object there at once, where CPython starts a
-    collection only when enough objects have reached it through the younger
-    generations, which none then do. So ended sessions were never freed, and after
+class Collector(FullCollections):
+    """Collects the garbage of ended sessions (and the studio's ended pages): `count`
+    each as it ends. What a session leaves after its end (server.Rl1Server.end lets go
+    of its documents) is a web of reference cycles, pygls' server and protocol and the
+    handlers that close over the server, freed only by a collection of the oldest
+    generation, where the front end's pauses of the collector move every object
+    (compiler/frontend/collector.py). So ended sessions were never freed, and after
     about 1,000 clients the hostile harness's bound was passed (issue 23). A collection
     walks every object of the server, a few times what starting a session costs
     (bench/lsp_sessions.py): hence one for several sessions, at most MAX_SESSIONS of
     them left to it."""
 
     def __init__(self) -> None:
-        self._ended = 0
+        super().__init__(MAX_SESSIONS)
 
-    def ended(self) -> None:
-        """A session has ended: collect, once the task serving it has let go of it, if
-        it is the MAX_SESSIONS-th since the last collection."""
-        self._ended += 1
-        if self._ended >= MAX_SESSIONS:
-            self._ended = 0
-            asyncio.get_running_loop().call_soon(gc.collect)
+    def collect(self) -> None:
+        """Once the task serving the session that ended has let go of it."""
+        asyncio.get_running_loop().call_soon(gc.collect)
 
 
 # Standard input and output ----------------------------------------------------------------
@@ -418,7 +414,7 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
             finally:
                 sessions.discard(session)
                 session.end()
-                collector.ended()
+                collector.count()
                 # The frames of a connection reset live on, in a reference cycle through
                 # the exception, until the garbage collector runs (it rarely does, as
                 # a buffer of 64 MiB counts as one object): let go of the message now.
@@ -617,7 +613,7 @@ class WebSocketSessions:
             # frees, rarely on a quiet server: let go of them now.
             if (ended := connection.protocol.parser_exc) is not None:
                 ended.__traceback__ = None
-            self.collector.ended()
+            self.collector.count()
 
 
 async def serve_websocket(new_session: Callable[[], Session], host: str, port: int) -> None:

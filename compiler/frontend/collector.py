@@ -13,8 +13,8 @@ say, put all tracked objects in the oldest generation without walking them. Garb
 moved there waits for the next full collection, which CPython starts only once enough
 objects have reached that generation the usual way: in a short command that is never,
 and nothing is lost; a long-lived process must collect now and then itself (the
-language server does when a session ends: lsp/transports.py; a campaign's worker and
-`rl1c test` every so many runs: `FullCollections`).
+language server every so many sessions, a campaign's worker and `rl1c test` every so
+many runs: `FullCollections`).
 """
 
 from __future__ import annotations
@@ -39,9 +39,9 @@ def collector_paused() -> Iterator[None]:
 
 
 class FullCollections:
-    """A full collection every `every` calls of `count`: for a process that runs the
-    front end over and over, whose garbage the pauses move where only a full collection
-    frees it."""
+    """A full collection (`collect`) every `every` calls of `count`: for a process that
+    runs the front end over and over, whose garbage the pauses move where only a full
+    collection frees it."""
 
     def __init__(self, every: int) -> None:
         self.every = every
@@ -51,4 +51,7 @@ class FullCollections:
         self._since += 1
         if self._since == self.every:
             self._since = 0
-            gc.collect()
+            self.collect()
+
+    def collect(self) -> None:
+        gc.collect()

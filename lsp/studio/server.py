@@ -182,7 +182,7 @@ class Server:
             # What its run held (the program's instructions, the world, the simulator's
             # generators) is left in reference cycles, which only a collection frees:
             # some 0.15 MiB a page, kept for good (bench/studio_pages.py).
-            self.lsp.collector.ended()
+            self.lsp.collector.count()
 
 
 async def serve_studio(server: Server, port: int, listening: Callable[[int], None]) -> None:
