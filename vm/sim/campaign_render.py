@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from html import escape
 
 from .geometry import Point
-from .render import _TEXT, MARGIN, TOP, _Plane, _scale, _scene, goal_marks
+from .render import _TEXT, MARGIN, TOP, _Plane, _scale, _scene
 from .world import World
 
 MAX_PATHS = 500
@@ -77,9 +77,7 @@ def svg(world: World, overlay: Overlay, title: str, moved: Sequence[str] = ()) -
     or a sweep: their keys) each run moves; the paths show where."""
     width, depth = world.floor
     plane = _Plane(world)
-    body = _scene(world, plane)
-    if world.goal is not None:
-        body += goal_marks(world.goal, None, plane)
+    body = _scene(world, plane, None)
     for run in overlay.paths:
         colour = SUCCESS if run.kind is None else overlay.colour(run.kind)
         body.append(f'<polyline class="run" data-seed="{run.seed}" points="'

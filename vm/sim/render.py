@@ -80,8 +80,9 @@ def _centroid(points: Sequence[Point]) -> Point:
     return sum(p[0] for p in points) / len(points), sum(p[1] for p in points) / len(points)
 
 
-def _scene(world: World, plane: _Plane) -> list[str]:
-    """The floor and its features, each labelled with its name."""
+def _scene(world: World, plane: _Plane, verdict: Verdict | None) -> list[str]:
+    """The floor and its features, each labelled with its name, and the world's goal
+    (as `verdict` judged it, when given)."""
     width, depth = world.floor
     x0, y0 = plane.at(0, depth)
     parts = [f'<rect x="{x0:g}" y="{y0:g}" width="{width:g}" height="{depth:g}" '
@@ -111,7 +112,8 @@ def _scene(world: World, plane: _Plane) -> list[str]:
                      f'<circle cx="{mx:.1f}" cy="{my:.1f}" r="3" fill="#f33">'
                      f'<title>marker of {escape(stand.name)}</title></circle>')
         labels.append(plane.label(*_centroid(stand.corners()), stand.name))
-    return parts + labels
+    goal = goal_marks(world.goal, verdict, plane) if world.goal is not None else []
+    return parts + labels + goal
 
 
 def _outline(world: World, plane: _Plane, pose: Pose, style: str) -> str:
@@ -345,9 +347,7 @@ def _svg(world: World, track: Sequence[tuple[float, Pose]], events: Sequence[Eve
          vehicle_mark: bool, verdict: Verdict | None = None) -> str:
     width, depth = world.floor
     plane = _Plane(world)
-    body = _scene(world, plane)
-    if world.goal is not None:
-        body += goal_marks(world.goal, verdict, plane)
+    body = _scene(world, plane, verdict)
     notes: dict[str, str] = {}
     views = _distinct(sightings)
     views = views[::_every(views)]
