@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from html import escape
 
 from .geometry import Point
-from .render import _TEXT, MARGIN, TOP, _Plane, _scale, _scene
+from .render import _TEXT, MARGIN, TOP, _Plane, _scale, _scene, _svg_start
 from .world import World
 
 MAX_PATHS = 500
@@ -97,9 +97,8 @@ def svg(world: World, overlay: Overlay, title: str, moved: Sequence[str] = ()) -
     legend, height = _legend(overlay, MARGIN, below + 24, moved)
     total_width = max(width + 2 * MARGIN, 560)
     total_height = below + 34 + height
-    return (f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {total_width:g} '
-            f'{total_height:g}" width="{total_width:g}" height="{total_height:g}">'
-            f'<text x="{MARGIN}" y="18" font-size="14" {_TEXT}>{escape(title)}</text>'
+    return (_svg_start(total_width, total_height)
+            + f'<text x="{MARGIN}" y="18" font-size="14" {_TEXT}>{escape(title)}</text>'
             + "".join(body) + _scale(MARGIN, below + 6, width) + legend + "</svg>\n")
 
 
@@ -172,8 +171,7 @@ def heat_map_svg(title: str, rows: tuple[str, Sequence[float]],
                          + f": {successes} of {runs}</title></g>")
     total_width = max(left + CELL * len(column_offsets) + MARGIN, 8.0 * len(title))
     total_height = top + CELL * len(row_offsets) + MARGIN
-    return (f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {total_width:g} '
-            f'{total_height:g}" width="{total_width:g}" height="{total_height:g}">'
+    return (_svg_start(total_width, total_height)
             + "".join(parts) + "</svg>\n")
 
 

@@ -281,6 +281,12 @@ def _legend(x: float, y: float, notes: dict[str, str]) -> tuple[str, float]:
     return "".join(parts), row_height * math.ceil(len(swatches) / columns)
 
 
+def _svg_start(width: float, height: float) -> str:
+    """The opening tag of a picture `width` by `height` pixels."""
+    return (f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {width:g} {height:g}" '
+            f'width="{width:g}" height="{height:g}">')
+
+
 def _scale(x: float, y: float, width: float) -> str:
     """A scale bar of a round length, about a quarter of the floor's width."""
     length = max((n for n in (10, 20, 50, 100, 200, 500, 1000, 2000) if n <= width / 4),
@@ -401,9 +407,8 @@ def _svg(world: World, track: Sequence[tuple[float, Pose]], events: Sequence[Eve
               for i, event in enumerate(events[:12])]
     total_width = max(width + 2 * MARGIN, LEGEND_COLUMNS * LEGEND_WIDTH + MARGIN)
     total_height = below + 30 + legend_height + 16 * len(listed)
-    return (f'<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {total_width:g} '
-            f'{total_height:g}" width="{total_width:g}" height="{total_height:g}">'
-            '<defs><marker id="arrow" viewBox="0 0 10 10" refX="8" refY="5" markerWidth="6" '
+    return (_svg_start(total_width, total_height)
+            + '<defs><marker id="arrow" viewBox="0 0 10 10" refX="8" refY="5" markerWidth="6" '
             'markerHeight="6" orient="auto-start-reverse"><path d="M0,0 L10,5 L0,10 z" '
             'fill="context-stroke"/></marker></defs>'
             f'<text x="{MARGIN}" y="18" font-size="14" {_TEXT}>{escape(title)}</text>'
