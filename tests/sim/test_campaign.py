@@ -7,6 +7,7 @@ its runs and its summary."""
 from __future__ import annotations
 
 import dataclasses
+import errno
 import gc
 import io
 import json
@@ -20,7 +21,7 @@ from collections.abc import Callable
 from concurrent.futures import BrokenExecutor, Executor, Future
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
-from typing import ParamSpec, TypeVar
+from typing import Any, ParamSpec, TypeVar
 
 import pytest
 from hypothesis import given
@@ -36,7 +37,7 @@ from support.campaigns import (
 )
 from support.cli import Result, rl1c
 
-from rl1.compiler import campaign, executors
+from rl1.compiler import campaign, executors, files
 from rl1.compiler.campaign import (
     MOST_RUNS_A_TASK,
     RESUBMISSIONS,
@@ -54,6 +55,7 @@ from rl1.compiler.campaign import (
     task_for,
     wilson,
 )
+from rl1.compiler.cli import sim_campaign
 from rl1.compiler.cli.sim_campaign import Progress
 from rl1.compiler.executors import Renewed
 from rl1.vm.defaults import DEFAULT_BUDGET
@@ -313,6 +315,51 @@ def test_out_never_replaces_an_input_and_an_unwritable_out_is_said(
                   tmp_path / "no such folder" / "runs.jsonl")
     assert result.exit_code == 2
     assert "cannot write" in result.stderr and "Traceback" not in result.output
+
+
+class _FullDisk(io.StringIO):
+    """A stream on a disk that is full: every write fails (the real one it stands for is
+    closed with it)."""
+
+    def __init__(self, real: io.TextIOBase) -> None:
+        super().__init__()
+        self.real = real
+
+    def write(self, text: str) -> int:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    def close(self) -> None:
+        self.real.close()
+        super().close()
+
+
+@pytest.mark.parametrize("where", ["a line", "the end"])
+def test_a_full_disk_leaves_an_earlier_out_as_it_was_and_names_it(
+        where: str, wall: tuple[Path, Path], tmp_path: Path,
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """--out was opened with "w": a disk that filled left the earlier runs' file cut to
+    what fitted of the new lines, and the message did not say which file."""
+    program, world = wall
+    out = tmp_path / "runs.jsonl"
+    out.write_text("the runs of yesterday\n")
+    if where == "a line":
+        class Filling(files.Replacement):
+            def __init__(self, *args: Any, **kwargs: Any) -> None:
+                super().__init__(*args, **kwargs)
+                self.stream = _FullDisk(self.stream)
+
+        monkeypatch.setattr(sim_campaign, "Replacement", Filling)
+    else:
+        def full_replace(source: object, destination: object) -> None:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+        monkeypatch.setattr(os, "replace", full_replace)
+    result = rl1c("sim", program, "--world", world, "--runs", "2", "--out", out)
+    assert result.exit_code == 2, result.output
+    assert f"cannot write the campaign file `{out}`" in result.stderr, result.stderr
+    assert "free some space" in result.stderr and "Traceback" not in result.output
+    assert out.read_text() == "the runs of yesterday\n"
+    assert not list(tmp_path.glob(".runs.jsonl.*"))  # no temporary file left
 
 
 def test_progress_is_a_line_every_few_seconds_when_standard_error_is_no_terminal() -> None:
