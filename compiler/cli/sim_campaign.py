@@ -11,7 +11,6 @@ from __future__ import annotations
 import json
 import os
 import shlex
-import signal
 import sys
 import time
 from collections.abc import Callable, Iterator
@@ -42,9 +41,16 @@ from rl1.vm.defaults import DEFAULT_BUDGET, Engine
 from rl1.vm.sim.campaign_render import Overlay, Run, heat_map_svg, html, svg
 from rl1.vm.sim.world import World
 
-from .command import EXIT_INTERNAL, Failure
+from .command import EXIT_INTERNAL, Failure, stop_signals_handled
 from .running import run_file
-from .streams import cannot_write, file_failure, read_ilc, same_file, write_file
+from .streams import (
+    PATH_ESCAPES,
+    cannot_write,
+    file_failure,
+    read_ilc,
+    same_file,
+    write_file,
+)
 
 PROGRESS_EVERY = 5.0  # s between progress lines when standard error is no terminal
 REDRAW_EVERY = 0.2  # s between redraws of the progress line on a terminal
@@ -114,8 +120,6 @@ class Stopping:
     never while a run is being kept (`keeping`): then after it, so that the JSON lines
     and the summary always count the same runs."""
 
-    SIGNALS = (signal.SIGINT, signal.SIGTERM)
-
     def __init__(self) -> None:
         self._keeping = False
         self._pending: int | None = None
@@ -128,12 +132,8 @@ class Stopping:
 
     @contextmanager
     def in_effect(self) -> Iterator[None]:
-        previous = {signum: signal.signal(signum, self._handle) for signum in self.SIGNALS}
-        try:
+        with stop_signals_handled(self._handle):
             yield
-        finally:
-            for signum, handler in previous.items():
-                signal.signal(signum, handler)
 
     @contextmanager
     def keeping(self) -> Iterator[None]:
@@ -498,10 +498,11 @@ def _draw(pictures: Pictures, overlay: Overlay, tallies: list[Tally], setting: S
             (columns[0].key, columns[0].offsets()) if columns else ("", [0.0]),
             [(tally.successes, tally.runs) for tally in tallies]))
     if pictures.svg is not None:
-        write_file(pictures.svg, drawn[0].encode(), force=pictures.force, role="SVG file")
+        write_file(pictures.svg, drawn[0].encode("utf-8", PATH_ESCAPES), force=pictures.force,
+                   role="SVG file")
     if pictures.html is not None:
-        write_file(pictures.html, html(title, drawn, said).encode(), force=pictures.force,
-                   role="HTML file")
+        write_file(pictures.html, html(title, drawn, said).encode("utf-8", PATH_ESCAPES),
+                   force=pictures.force, role="HTML file")
 
 
 def sweep_summary(setting: Setting, keeper: Keeper, task: Task, stopped: bool) -> str:

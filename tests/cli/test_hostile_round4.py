@@ -120,6 +120,19 @@ def test_a_simulation_of_a_program_whose_name_is_not_utf8_draws_its_pictures(
     assert "p\\udcfe.rob on sample.world.toml" in page.read_text(encoding="utf-8")
 
 
+def test_a_campaign_of_a_program_whose_name_is_not_utf8_draws_its_pictures(
+        not_utf8: Path) -> None:
+    """The single run's pictures escaped the name; a campaign's ended its runs in an
+    internal error (UnicodeEncodeError) when it drew them."""
+    program = not_utf8 / os.fsdecode(b"p\xfe.rob")
+    svg, page = not_utf8 / "c.svg", not_utf8 / "c.html"
+    done = rl1c("sim", program, "--world", SAMPLE_WORLD, "--runs", "2", "--svg", svg,
+                "--html", page)
+    assert done.exit_code == 0, done.output
+    assert "p\\udcfe.rob on sample.world.toml: 2 runs" in svg.read_text(encoding="utf-8")
+    assert "p\\udcfe.rob on sample.world.toml: 2 runs" in page.read_text(encoding="utf-8")
+
+
 def test_sarif_gives_a_name_that_is_not_utf8_by_its_bytes(not_utf8: Path,
                                                          monkeypatch: pytest.MonkeyPatch
                                                          ) -> None:
