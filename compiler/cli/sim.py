@@ -76,8 +76,8 @@ EXAMPLE_WORLD = "examples/sample.world.toml"
                    "one run at that point")
 @click.option("--out", "out_file", metavar="FILE", type=PATH,
               help="with --runs: write each run as a JSON line to FILE (- for standard "
-                   "output, the summary then on standard error), in seed order, as the "
-                   "runs finish")
+                   "output, the summary then on standard error), in seed order; FILE is "
+                   "replaced when the campaign ends or is stopped")
 @force_option
 @color_option
 def sim(file: str, world: str | None, svg_file: str | None, html_file: str | None,
@@ -113,19 +113,7 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
     if world is None:
         raise click.UsageError("a simulation needs a world to run in: give --world FILE, a "
                                f"world file (TOML, spec/simulator.md) such as {EXAMPLE_WORLD}")
-    for option, target in (("--svg", svg_file), ("--html", html_file)):
-        if target == "-":
-            raise click.UsageError(f"{option} writes a file, and standard output carries "
-                                   f"the report: give {option} FILE")
-        for role, name in (("program", file), ("world file", world)):
-            if target is not None and same_file(name, target):
-                raise click.UsageError(f"{option} `{target}` is the {role} itself: give "
-                                       "another path for the picture")
-    if svg_file is not None and html_file is not None and (
-            os.path.realpath(svg_file) == os.path.realpath(html_file)) and (
-            os.path.isfile(svg_file) or not os.path.exists(svg_file)):  # /dev/null takes both
-        raise click.UsageError(f"--svg and --html both name `{svg_file}`: give each its "
-                               "own file")
+    refuse_picture_targets(svg_file, html_file, (file, world), out_file, runs is not None)
     if runs is None:
         for option, given in (("--jobs", jobs), ("--scheduler", scheduler),
                               ("--out", out_file)):
@@ -202,6 +190,41 @@ def sweep_axes(sweeps: tuple[str, ...], world: World, campaign: bool) -> tuple[A
         raise click.UsageError("--sweep of more than one point is for a campaign: give "
                                "--runs N, or KEY=A:A:1 for one run at that point")
     return axes
+
+
+def refuse_picture_targets(svg_file: str | None, html_file: str | None,
+                           inputs: tuple[str, str], out: str | None, campaign: bool) -> None:
+    """A usage error, before any run, for a picture that would replace the program or the
+    world, the other picture or a campaign's JSON lines (`out`), or, for a `campaign`,
+    that could not be written (its runs would be made for nothing; a single run's picture
+    is refused as any output file is, after it). A device such as /dev/null may take
+    every output."""
+    others: dict[str, str | None] = {"--out": out}
+    for option, target in (("--svg", svg_file), ("--html", html_file)):
+        if target is None:
+            continue
+        if target == "-":
+            raise click.UsageError(f"{option} writes a file, and standard output carries "
+                                   f"the report: give {option} FILE")
+        for role, name in zip(("program", "world file"), inputs, strict=True):
+            if os.path.exists(name) and same_file(name, target):
+                raise click.UsageError(f"{option} `{target}` is the {role} itself: give "
+                                       "another path for the picture")
+        stream = os.path.exists(target) and not os.path.isfile(target)  # /dev/null
+        for other, taken in others.items():
+            if not stream and taken is not None and (
+                    os.path.realpath(taken) == os.path.realpath(target)):
+                raise click.UsageError(f"{option} and {other} both name `{target}`: give "
+                                       "each its own file")
+        others[option] = target
+        if not campaign:
+            continue
+        if os.path.isdir(target or "."):
+            raise click.UsageError(f"{option} `{target}` is a folder: give the path of a "
+                                   "file for the picture")
+        if not os.path.isdir(os.path.dirname(os.path.abspath(target))):
+            raise click.UsageError(f"{option} `{target}`: its folder does not exist; "
+                                   "create it, or write the picture elsewhere")
 
 
 def single_run_world(world: World, axes: tuple[Axis, ...], seed: int | None) -> World:

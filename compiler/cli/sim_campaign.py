@@ -281,33 +281,6 @@ NO_PICTURES = Pictures(None, None, False)
 PATH_POINTS = 64  # of each run's path that a record carries for the pictures
 
 
-def _refuse_targets(pictures: Pictures, inputs: tuple[str, str], out: str | None) -> None:
-    """A usage error, before any run, for a picture that would replace an input, the
-    other picture or the runs' JSON lines, or that could not be written (the runs
-    would be made for nothing)."""
-    others: dict[str, str | None] = {"--out": out}
-    for option, target in (("--svg", pictures.svg), ("--html", pictures.html)):
-        if target is None:
-            continue
-        for role, name in zip(("program", "world file"), inputs, strict=True):
-            if os.path.exists(name) and same_file(name, target):
-                raise click.UsageError(f"{option} `{target}` is the {role} itself: give "
-                                       "another path for the picture")
-        stream = os.path.exists(target) and not os.path.isfile(target)  # /dev/null
-        for other, taken in others.items():
-            if not stream and taken is not None and (
-                    os.path.realpath(taken) == os.path.realpath(target)):
-                raise click.UsageError(f"{option} and {other} both name `{target}`: give "
-                                       "each its own file")
-        others[option] = target
-        if os.path.isdir(target or "."):
-            raise click.UsageError(f"{option} `{target}` is a folder: give the path of a "
-                                   "file for the picture")
-        if not os.path.isdir(os.path.dirname(os.path.abspath(target))):
-            raise click.UsageError(f"{option} `{target}`: its folder does not exist; "
-                                   "create it, or write the picture elsewhere")
-
-
 def _open_out(out: str | None, inputs: tuple[str, str]) -> Replacement | None:
     """The file of the JSON lines (not standard output's), never an input: replaced all
     at once when the campaign ends or is stopped, and left as it was when it fails (a
@@ -344,8 +317,7 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     task = task_of(file, world, world_name, setting, color)
     if isinstance(task, int):
         return task
-    if pictures.wanted:
-        _refuse_targets(pictures, (file, setting.world), out)
+    if pictures.wanted:  # their targets checked by sim.refuse_picture_targets
         task = replace(task, path_points=PATH_POINTS)
     points = grid(setting.sweep)
     progress = Progress(setting.runs * len(points), sys.stderr)

@@ -180,7 +180,7 @@ def test_the_two_pictures_of_a_run_are_never_one_file(tmp_path: Path) -> None:
     picture = tmp_path / "run.svg"
     done = rl1c("sim", SAMPLE, "--world", SAMPLE_WORLD, "--svg", picture, "--html", picture)
     assert done.exit_code == 2
-    assert f"--svg and --html both name `{picture}`: give each its own file" in done.stderr
+    assert f"--html and --svg both name `{picture}`: give each its own file" in done.stderr
     assert not picture.exists()
     both = rl1c("sim", SAMPLE, "--world", SAMPLE_WORLD, "--svg", os.devnull, "--html",
                 os.devnull)
