@@ -13,8 +13,10 @@ from __future__ import annotations
 import contextlib
 import errno
 import os
+import signal
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from types import FrameType
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import click
@@ -115,6 +117,24 @@ def output_failed(error: OSError) -> int:
 def interrupted() -> int:
     print("rl1c: interrupted", file=sys.stderr)
     return EXIT_INTERRUPTED
+
+
+# What stops a campaign (rl1c fuzz, rl1c sim --runs), which then keeps its summary:
+# Ctrl-C, and the SIGTERM of a CI job's timeout or of kill.
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextlib.contextmanager
+def stop_signals_handled(handler: Callable[[int, FrameType | None], None]
+                         ) -> Iterator[None]:
+    """While inside, SIGINT and SIGTERM call `handler` instead of ending rl1c; the
+    handlers before are back after."""
+    previous = {signum: signal.signal(signum, handler) for signum in STOP_SIGNALS}
+    try:
+        yield
+    finally:
+        for signum, earlier in previous.items():
+            signal.signal(signum, earlier)
 
 
 def internal_error(error: Exception) -> int:

@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import os
 import random
-import signal
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -31,6 +30,7 @@ from .command import (
     at_least_one,
     choice_option,
     or_none,
+    stop_signals_handled,
 )
 
 if TYPE_CHECKING:
@@ -39,7 +39,6 @@ if TYPE_CHECKING:
 
 SECTION = "Testing"
 
-SIGNALS = (signal.SIGINT, signal.SIGTERM)  # what stops a campaign, keeping its summary
 DEFAULT_COUNT = 1000
 DEFAULT_BUDGET = 20_000  # generated programs are short; a runaway is found quickly
 BAR_WIDTH = 30
@@ -334,12 +333,8 @@ def _halted_by_signals(channel: Channel) -> Iterator[list[int]]:
         caught.append(signum)
         channel.halt()
 
-    previous = {signum: signal.signal(signum, halt) for signum in SIGNALS}
-    try:
+    with stop_signals_handled(halt):
         yield caught
-    finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
 
 
 def _numbered(source: str) -> str:
