@@ -145,7 +145,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
     from rl1.compiler.executors import ClusterLost, Unavailable, workers
     from rl1.vm.native import BuildError
 
-    from .sim_campaign import MAX_JOBS
+    from .sim_campaign import MAX_JOBS, no_workers_left
 
     if replay_dir is not None:
         if engine_names or count is not None or seconds is not None or seed is not None \
@@ -207,7 +207,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         with _halted_by_signals(channel) as signalled, \
                 workers(jobs or os.cpu_count() or 1, scheduler,
                         lost=lambda: bar.warn(WORKER_LOST), isolated=True,
-                        unmanned=lambda: bar.warn(_no_workers_left(scheduler or ""))
+                        unmanned=lambda: bar.warn(no_workers_left(scheduler or "", "the searches"))
                         ) as held:
             outcome = campaign(engines, budget, count=limit, seconds=seconds,
                                seed=seed_value, progress=bar.update, executor=held.executor,
@@ -268,12 +268,6 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
 WORKER_LOST = ("a worker process ended abruptly (killed, out of memory, or ended by an "
                "engine); its searches run again, each program in a process of its own, "
                "to find the program that ended it")
-
-
-def _no_workers_left(scheduler: str) -> str:
-    return (f"the Dask scheduler at {scheduler} has no workers left (killed, or out of "
-            "memory: one is started again only under a nanny, `dask worker` without "
-            f"--no-nanny); the searches wait for one (`dask worker {scheduler}`)")
 
 
 def _found(finding: Finding, reference: str) -> str:

@@ -226,9 +226,12 @@ WORKER_LOST = ("a worker process ended abruptly (killed, or out of memory); its 
                "those beside it are made again, a run a task")
 
 
-def no_workers_left(scheduler: str) -> str:
-    return (f"the Dask scheduler at {scheduler} has no workers left; the runs wait for "
-            f"one (`dask worker {scheduler}`)")
+def no_workers_left(scheduler: str, waiting: str = "the runs") -> str:
+    """What a campaign says when the cluster's last worker is gone: `waiting` (rl1c
+    fuzz's searches) wait for one."""
+    return (f"the Dask scheduler at {scheduler} has no workers left (killed, or out of "
+            "memory: one is started again only under a nanny, `dask worker` without "
+            f"--no-nanny); {waiting} wait for one (`dask worker {scheduler}`)")
 
 
 SAME_RUNS = ("the world has no noise: every seed makes the same run, so {counted} "
