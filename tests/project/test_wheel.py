@@ -9,23 +9,19 @@ install's own .pth files there are not run, so `rl1` comes from the wheel alone)
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 import sys
 import sysconfig
-import tomllib
 from pathlib import Path
 
 import pytest
 from support import ROOT, SAMPLE, SAMPLE_SENSORS
 from support.documents import DOCUMENT_NAME
+from support.wheel import built_wheel
 
 from rl1.compiler.cli.main import command_names
 
 pytestmark = [pytest.mark.slow, pytest.mark.needs_cc]
-
-SETUPTOOLS = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))[
-    "tool"]["setuptools"]
 
 
 class Installed:
@@ -47,25 +43,16 @@ class Installed:
 
 @pytest.fixture(scope="module")
 def installed(tmp_path_factory: pytest.TempPathFactory) -> Installed:
+    built = built_wheel(tmp_path_factory)
+    assert built.wheel is not None, built.said
     folder = tmp_path_factory.mktemp("wheel")
-    source = folder / "source"
-    source.mkdir()
-    for name in ("pyproject.toml", "README.md", "LICENSE"):
-        shutil.copy(ROOT / name, source / name)
-    for top in SETUPTOOLS["package-dir"].values():
-        shutil.copytree(ROOT / top, source / top,
-                        ignore=shutil.ignore_patterns("__pycache__", "*.pyc", "build"))
-    subprocess.run([sys.executable, "-m", "pip", "wheel", ".", "--no-deps", "--quiet",
-                    "-w", str(folder / "dist")], cwd=source, check=True,
-                   capture_output=True)
-    (wheel,) = (folder / "dist").glob("rl1-*.whl")
     venv = folder / "venv"
     subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True)
     ours = Path(sysconfig.get_path("purelib"))
     site = venv / ours.relative_to(sys.prefix)  # the same Python: the same layout
     (site / "dependencies.pth").write_text(f"{ours}\n", encoding="utf-8")
     subprocess.run([sys.executable, "-m", "pip", "--python", str(venv / "bin" / "python"),
-                    "install", "--no-deps", "--no-index", "--quiet", str(wheel)],
+                    "install", "--no-deps", "--no-index", "--quiet", str(built.wheel)],
                    check=True, capture_output=True)
     return Installed(folder)
 
