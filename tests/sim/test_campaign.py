@@ -21,7 +21,7 @@ from collections.abc import Callable
 from concurrent.futures import BrokenExecutor, Executor, Future
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
-from typing import Any, ParamSpec, TypeVar
+from typing import IO, Any, ParamSpec, TypeVar
 
 import pytest
 from hypothesis import given
@@ -321,7 +321,7 @@ class _FullDisk(io.StringIO):
     """A stream on a disk that is full: every write fails (the real one it stands for is
     closed with it)."""
 
-    def __init__(self, real: io.TextIOBase) -> None:
+    def __init__(self, real: IO[Any]) -> None:
         super().__init__()
         self.real = real
 
