@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import ctypes
 import re
-import shutil
 import struct
 import sys
 from pathlib import Path
@@ -21,9 +20,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from support import ROOT
+from support.c_vm import sanitized_library
 from support.ilc import CALLS_WITH_ARGUMENTS, damaged, images, with_crc
 
-from rl1.vm import ilc, isa, native
+from rl1.vm import ilc, isa
 from rl1.vm.language import BUILTINS, Feature
 from rl1.vm.verifier import VerifyError, verify
 
@@ -61,10 +61,7 @@ class Loader:
 
 @pytest.fixture(scope="session")
 def c_loader(tmp_path_factory: pytest.TempPathFactory) -> Loader:
-    if not any(shutil.which(cc) for cc in ("gcc", "cc", "clang")):
-        pytest.skip("no C compiler (gcc, cc or clang) on this machine: vm/c/install-tools "
-                    "installs one on Debian")
-    return Loader(native.library(tmp_path_factory.mktemp("c-build"), sanitize=True))
+    return Loader(sanitized_library(tmp_path_factory))
 
 
 def python_verdict(data: bytes) -> tuple[int, int]:

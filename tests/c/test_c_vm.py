@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import ctypes
 import json
-import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,6 +17,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from support import ROOT
+from support.c_vm import sanitized_library
 from support.cli import rl1c
 from support.hardware import Relay
 from support.ilc import CALLS_WITH_ARGUMENTS
@@ -38,10 +38,7 @@ from rl1.vm.verifier import verify
 
 @pytest.fixture(scope="session")
 def c_vm(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
-    if not any(shutil.which(cc) for cc in ("gcc", "cc", "clang")):
-        pytest.skip("no C compiler (gcc, cc or clang) on this machine: vm/c/install-tools "
-                    "installs one on Debian")
-    return native.load(native.library(tmp_path_factory.mktemp("c-vm"), sanitize=True))
+    return native.load(sanitized_library(tmp_path_factory))
 
 
 def vectors() -> list[dict[str, object]]:

@@ -8,12 +8,12 @@ run-control`."""
 from __future__ import annotations
 
 import ctypes
-import shutil
 from dataclasses import dataclass, field
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support.c_vm import sanitized_library
 from support.hardware import Relay
 from support.scripts import MOVING_STARTS, scripts
 
@@ -32,10 +32,7 @@ GOING = (State.RUNNING, State.WAITING)
 
 @pytest.fixture(scope="session")
 def c_vm(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
-    if not any(shutil.which(cc) for cc in ("gcc", "cc", "clang")):
-        pytest.skip("no C compiler (gcc, cc or clang) on this machine: vm/c/install-tools "
-                    "installs one on Debian")
-    return native.load(native.library(tmp_path_factory.mktemp("c-vm"), sanitize=True))
+    return native.load(sanitized_library(tmp_path_factory))
 
 
 def _compiled(text: str, level: int = 0) -> bytes:
