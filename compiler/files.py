@@ -12,7 +12,7 @@ import contextlib
 import os
 import stat
 from pathlib import Path
-from typing import IO, Any, BinaryIO
+from typing import BinaryIO
 
 
 class SourceError(Exception):
@@ -82,72 +82,38 @@ def write_atomically(path: str | Path, data: bytes, *, force: bool = False) -> N
     or a character device (`/dev/stdout`, `/dev/null`) is written as a stream, never
     replaced. A read-only file is refused unless `force`: a rename ignores the file's
     own mode, and so does root."""
-    output = Replacement(path, force=force)
+    # Imported here: tempfile (with shutil and the compression modules it loads) costs
+    # rl1c check, which reads files but writes none, 3 ms of every start.
+    import tempfile
+
+    path = Path(os.path.realpath(path))
     try:
-        output.stream.write(data)
-    except BaseException:
-        output.discard()
-        raise
-    output.keep()
-
-
-class Replacement:
-    """An output written as a stream and put at `path` all at once by `keep()`, as
-    write_atomically puts its data (which it is made of): for what is too large to hold
-    and written as it comes, such as a campaign's JSON lines. Until `keep()`, and after
-    `discard()` (what wrote it failed), the file at `path` is as it was; a process killed
-    meanwhile leaves the stream's temporary file beside it. `encoding` given, the stream
-    takes text. OSError (NotReplaceable among them) when it cannot be begun."""
-
-    def __init__(self, path: str | Path, *, force: bool = False,
-                 encoding: str | None = None) -> None:
-        # Imported here: tempfile (with shutil and the compression modules it loads)
-        # costs rl1c check, which reads files but writes none, 3 ms of every start.
-        import tempfile
-
-        self.path = Path(os.path.realpath(path))
-        self._temporary: str | None = None
-        try:
-            status: os.stat_result | None = self.path.stat()
-        except FileNotFoundError:
-            status = None
-        if status is not None and not stat.S_ISREG(status.st_mode):
-            if not (stat.S_ISFIFO(status.st_mode) or stat.S_ISCHR(status.st_mode)):
-                kind = "a directory" if stat.S_ISDIR(status.st_mode) else "not a regular file"
-                raise NotReplaceable(f"it is {kind}")
-            # Closed by keep() or discard(), as the temporary file's stream is.
-            self.stream: IO[Any] = open(self.path, "wb" if encoding is None else "w",  # noqa: SIM115
-                                        encoding=encoding)
+        status: os.stat_result | None = path.stat()
+    except FileNotFoundError:
+        status = None
+    if status is not None and not stat.S_ISREG(status.st_mode):
+        if stat.S_ISFIFO(status.st_mode) or stat.S_ISCHR(status.st_mode):
+            with open(path, "wb") as stream:
+                stream.write(data)
             return
-        if status is not None and not force and _read_only(self.path, status):
-            raise NotReplaceable("it is read-only; give --force to replace it anyway")
-        self._mode = stat.S_IMODE(status.st_mode) if status is not None else _new_file_mode()
-        descriptor, self._temporary = tempfile.mkstemp(
-            dir=self.path.parent, prefix=f".{self.path.name}.", suffix=".tmp")
-        self.stream = os.fdopen(descriptor, "wb" if encoding is None else "w",
-                                encoding=encoding)
-
-    def keep(self) -> None:
-        """Put what the stream holds at `path` (a failure discards it)."""
-        try:
-            self.stream.flush()
-            if self._temporary is not None:
-                os.fsync(self.stream.fileno())
-            self.stream.close()
-            if self._temporary is not None:
-                os.chmod(self._temporary, self._mode)
-                os.replace(self._temporary, self.path)
-        except BaseException:
-            self.discard()
-            raise
-
-    def discard(self) -> None:
-        """Leave `path` as it was, and the stream's temporary file gone."""
-        with contextlib.suppress(OSError):  # a full disk fails the close's flush too
-            self.stream.close()
-        if self._temporary is not None:
-            with contextlib.suppress(OSError):
-                os.unlink(self._temporary)
+        kind = "a directory" if stat.S_ISDIR(status.st_mode) else "not a regular file"
+        raise NotReplaceable(f"it is {kind}")
+    if status is not None and not force and _read_only(path, status):
+        raise NotReplaceable("it is read-only; give --force to replace it anyway")
+    mode = stat.S_IMODE(status.st_mode) if status is not None else _new_file_mode()
+    descriptor, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.",
+                                             suffix=".tmp")
+    try:
+        with os.fdopen(descriptor, "wb") as out:
+            out.write(data)
+            out.flush()
+            os.fsync(out.fileno())
+        os.chmod(temporary, mode)
+        os.replace(temporary, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(temporary)
+        raise
 
 
 def refuses_writing(path: str | Path) -> bool:

@@ -76,8 +76,8 @@ EXAMPLE_WORLD = "examples/sample.world.toml"
                    "one run at that point")
 @click.option("--out", "out_file", metavar="FILE", type=PATH,
               help="with --runs: write each run as a JSON line to FILE (- for standard "
-                   "output, the summary then on standard error), in seed order; FILE is "
-                   "replaced when the campaign ends or is stopped")
+                   "output, the summary then on standard error), in seed order, as the "
+                   "runs finish")
 @force_option
 @color_option
 def sim(file: str, world: str | None, svg_file: str | None, html_file: str | None,

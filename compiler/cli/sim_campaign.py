@@ -8,6 +8,7 @@ up."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shlex
@@ -34,7 +35,6 @@ from rl1.compiler.campaign import (
     world_of,
 )
 from rl1.compiler.executors import ClusterLost, Unavailable, Workers, workers
-from rl1.compiler.files import Replacement
 from rl1.compiler.reporting.render import EXIT_USAGE, ColorChoice
 from rl1.compiler.sweep import Axis, Point, grid, heat_map, table
 from rl1.vm.defaults import DEFAULT_BUDGET, Engine
@@ -284,24 +284,34 @@ NO_PICTURES = Pictures(None, None, False)
 PATH_POINTS = 64  # of each run's path that a record carries for the pictures
 
 
-def _open_out(out: str | None, inputs: tuple[str, str]) -> Replacement | None:
-    """The file of the JSON lines (not standard output's), never an input: replaced all
-    at once when the campaign ends or is stopped, and left as it was when it fails (a
-    full disk), as `rl1c`'s outputs are; a read-only one too, as `open` would."""
-    if out is None or out == "-":
+def _open_out(out: str | None, inputs: tuple[str, str]) -> IO[str] | None:
+    """The file of the JSON lines, never an input, written as the runs finish (so that it
+    can be followed while the campaign runs)."""
+    if out is None:
         return None
+    if out == "-":
+        return sys.stdout
     for role, name in zip(("program", "world file"), inputs, strict=True):
         if os.path.exists(name) and same_file(name, out):
             raise click.UsageError(f"--out `{out}` is the {role} itself: give another "
                                    "path for the runs' JSON lines")
     try:
-        return Replacement(out, force=True, encoding="utf-8")
+        return open(out, "w", encoding="utf-8")  # closed by run_campaign
     except OSError as error:
         raise _unwritten(out, error) from None
 
 
 def _unwritten(out: str, error: OSError) -> Failure:
     return file_failure(cannot_write(out, "campaign file", error))
+
+
+class _LineUnwritten(Exception):
+    """A run's JSON line that could not be written (a full disk): the file holds the whole
+    lines before it, its first `whole` bytes."""
+
+    def __init__(self, error: OSError, whole: int) -> None:
+        super().__init__(error)
+        self.error, self.whole = error, whole
 
 
 def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out: str | None,
@@ -327,14 +337,12 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     held = ExitStack()  # the workers: a cluster is reached before --out replaces a file
     current = held.enter_context(_workers(setting, progress))
     try:
-        output = _open_out(out, (file, setting.world))
+        lines = _open_out(out, (file, setting.world))
     except BaseException:
         held.close()
         raise
     report = sys.stderr if out == "-" else sys.stdout
-    keeper = Keeper(setting.runs, points,
-                    sys.stdout if out == "-" else None if output is None else output.stream,
-                    Overlay() if pictures.wanted else None)
+    keeper = Keeper(setting.runs, points, lines, Overlay() if pictures.wanted else None)
     timing = Timing()  # carried from point to point: they run one program on near worlds
     status = 0
     lost: ClusterLost | None = None
@@ -349,19 +357,17 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
         status = stop.status
     except ClusterLost as error:
         status, lost = EXIT_USAGE, error
-    except BaseException as error:
-        if output is not None:
-            output.discard()
-        if isinstance(error, OSError) and output is not None and keeper.writing:
-            raise _unwritten(str(out), error) from None
-        raise
+    except _LineUnwritten as unwritten:
+        if lines is not None and lines is not sys.stdout:
+            with contextlib.suppress(OSError):  # its flush fails again
+                lines.close()
+            with contextlib.suppress(OSError):  # shrinking a file needs no room
+                os.truncate(str(out), unwritten.whole)  # no half line left at its end
+        raise _unwritten(str(out), unwritten.error) from None
     finally:
         progress.finish()
-    if output is not None:  # the runs finished, also those of a campaign stopped
-        try:
-            output.keep()
-        except OSError as error:
-            raise _unwritten(str(out), error) from None
+        if lines is not None and lines is not sys.stdout:
+            lines.close()
     tally = keeper.tally
     said = (sweep_summary(setting, keeper, task, stopped=status != 0) if setting.sweep else
             summary(setting, tally, task, stopped=status != 0))
@@ -426,7 +432,7 @@ class Keeper:
     overlay: Overlay | None
     tallies: list[Tally] = field(default_factory=lambda: [Tally()])
     total: Tally = field(default_factory=Tally)
-    writing: bool = False  # a line, when an error ended the campaign
+    whole: int = 0  # bytes of the JSON lines written whole, in a file
 
     @property
     def tally(self) -> Tally:
@@ -444,10 +450,13 @@ class Keeper:
         self.tally.add(record)
         self.total.add(record)
         if self.lines is not None:
-            self.writing = True  # an OSError now is the JSON lines' file's
-            self.lines.write(json.dumps(record.to_json(), separators=(",", ":")) + "\n")
-            self.lines.flush()  # a line is whole on disk when the campaign is stopped
-            self.writing = False
+            try:
+                self.lines.write(json.dumps(record.to_json(), separators=(",", ":")) + "\n")
+                self.lines.flush()  # a line is whole on disk when the campaign is stopped
+            except OSError as error:
+                raise _LineUnwritten(error, self.whole) from None
+            if self.lines is not sys.stdout:
+                self.whole = self.lines.tell()
         if self.overlay is not None:
             self.overlay.add(Run(record.seed, record.path, record.pose[:2],
                                  None if record.success else record.safety or record.outcome,

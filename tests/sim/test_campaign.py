@@ -37,7 +37,7 @@ from support.campaigns import (
 )
 from support.cli import Result, rl1c
 
-from rl1.compiler import campaign, executors, files
+from rl1.compiler import campaign, executors
 from rl1.compiler.campaign import (
     MOST_RUNS_A_TASK,
     RESUBMISSIONS,
@@ -317,49 +317,40 @@ def test_out_never_replaces_an_input_and_an_unwritable_out_is_said(
     assert "cannot write" in result.stderr and "Traceback" not in result.output
 
 
-class _FullDisk(io.StringIO):
-    """A stream on a disk that is full: every write fails (the real one it stands for is
-    closed with it)."""
+class _FillingDisk(io.FileIO):
+    """A file on a disk with room for `room` bytes: a write past it writes what fits,
+    then fails as a full disk does."""
 
-    def __init__(self, real: IO[Any]) -> None:
-        super().__init__()
-        self.real = real
+    room = 0
 
-    def write(self, text: str) -> int:
+    def write(self, data: Any) -> int:
+        fits = max(0, self.room - self.tell())
+        if len(data) <= fits:
+            return super().write(data)
+        super().write(bytes(data)[:fits])
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
 
-    def close(self) -> None:
-        self.real.close()
-        super().close()
 
-
-@pytest.mark.parametrize("where", ["a line", "the end"])
-def test_a_full_disk_leaves_an_earlier_out_as_it_was_and_names_it(
-        where: str, wall: tuple[Path, Path], tmp_path: Path,
-        monkeypatch: pytest.MonkeyPatch) -> None:
-    """--out was opened with "w": a disk that filled left the earlier runs' file cut to
-    what fitted of the new lines, and the message did not say which file."""
+def test_a_full_disk_leaves_the_whole_lines_of_the_runs_before_and_names_the_file(
+        wall: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """--out on a disk that filled was left with half a line at its end, and the message
+    did not say which file."""
     program, world = wall
     out = tmp_path / "runs.jsonl"
-    out.write_text("the runs of yesterday\n")
-    if where == "a line":
-        class Filling(files.Replacement):
-            def __init__(self, *args: Any, **kwargs: Any) -> None:
-                super().__init__(*args, **kwargs)
-                self.stream = _FullDisk(self.stream)
+    assert rl1c("sim", program, "--world", world, "--runs", "3", "--out", out).exit_code == 0
+    first, second, _ = out.read_text().splitlines(keepends=True)
+    _FillingDisk.room = len(first) + len(second) // 2
 
-        monkeypatch.setattr(sim_campaign, "Replacement", Filling)
-    else:
-        def full_replace(source: object, destination: object) -> None:
-            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    def on_a_filling_disk(path: str, mode: str, encoding: str) -> IO[str]:
+        return io.TextIOWrapper(io.BufferedWriter(_FillingDisk(path, mode)),
+                                encoding=encoding)
 
-        monkeypatch.setattr(os, "replace", full_replace)
-    result = rl1c("sim", program, "--world", world, "--runs", "2", "--out", out)
+    monkeypatch.setattr(sim_campaign, "open", on_a_filling_disk, raising=False)
+    result = rl1c("sim", program, "--world", world, "--runs", "3", "--out", out)
     assert result.exit_code == 2, result.output
     assert f"cannot write the campaign file `{out}`" in result.stderr, result.stderr
     assert "free some space" in result.stderr and "Traceback" not in result.output
-    assert out.read_text() == "the runs of yesterday\n"
-    assert not list(tmp_path.glob(".runs.jsonl.*"))  # no temporary file left
+    assert out.read_text() == first  # the runs before, each line whole
 
 
 def test_progress_is_a_line_every_few_seconds_when_standard_error_is_no_terminal() -> None:
