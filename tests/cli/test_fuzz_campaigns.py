@@ -101,13 +101,35 @@ def test_the_summary_counts_every_process_programs() -> None:
     assert "; seed 5: all agreed" in result.stdout
 
 
-def _stopped(tmp_path: Path, signum: int, *args: str) -> tuple[int, str]:
-    """`rl1c fuzz ARGS` given `signum` once it has run programs: its status and output."""
+STARTED_WITHIN = 120  # s for a campaign to run its first programs on a loaded machine
+
+
+def _programs_told(temporary: Path) -> bool:
+    """Whether a search of the campaign whose temporary folder is `temporary` has told
+    that it has run programs (in its fuzz.Channel: the count that starts `told-INDEX`)."""
+    for told in temporary.glob("rl1-fuzz-*/told-*"):
+        with contextlib.suppress(OSError, ValueError):  # gone, or not written whole
+            if told.suffix == "" and int(told.read_text().split(" ")[0]) > 0:
+                return True
+    return False
+
+
+def _stopped(tmp_path: Path, signum: int, *args: str,
+             ready: Callable[[Path], bool] = _programs_told) -> tuple[int, str]:
+    """`rl1c fuzz ARGS` given `signum` once `ready(its temporary folder)` (by default,
+    once it has run programs): its status and output."""
+    temporary = tmp_path / "tmp"
+    temporary.mkdir()
     process = subprocess.Popen([*RL1C, "fuzz", "--time", "300", "--out", str(tmp_path),
                                 *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True, cwd=tmp_path)
+                               text=True, cwd=tmp_path,
+                               env={**os.environ, "TMPDIR": str(temporary)})
     try:
-        time.sleep(8)  # started, and some programs run even on a loaded machine
+        deadline = time.monotonic() + STARTED_WITHIN
+        while not ready(temporary):
+            assert process.poll() is None, process.communicate()
+            assert time.monotonic() < deadline, f"not ready in {STARTED_WITHIN} s"
+            time.sleep(0.1)
         process.send_signal(signum)
         out, err = process.communicate(timeout=60)
     finally:
@@ -243,7 +265,8 @@ def test_keep_going_lists_each_signature_with_its_count_and_folder(tmp_path: Pat
 
 def test_a_signal_keeps_the_reproducers_of_a_campaign_that_goes_on(tmp_path: Path) -> None:
     status, output = _stopped(tmp_path, signal.SIGTERM, "--jobs", "2", "--keep-going",
-                              "--engine", "ast", "--engine", "exec:echo not json")
+                              "--engine", "ast", "--engine", "exec:echo not json",
+                              ready=lambda _: any(tmp_path.glob("finding-*/replay.sh")))
     assert status == 143, output
     assert re.search(r"fuzz: [0-9]+ programs in .*; seed [0-9]+, stopped by a signal "
                      r"before its end: [0-9]+ kinds? of disagreement", output), output
