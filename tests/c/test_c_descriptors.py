@@ -10,14 +10,13 @@ this holds what that block means.)"""
 from __future__ import annotations
 
 import ctypes
-import shutil
-from pathlib import Path
 
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from support.c_vm import sanitized_library
 
-from rl1.vm import isa, isa_table, native
+from rl1.vm import isa, isa_table
 from rl1.vm.language import BUILTINS, VARIABLES, Form, Param
 
 CALLS = isa_table.calls()
@@ -31,11 +30,7 @@ class Range(ctypes.Structure):
 
 @pytest.fixture(scope="module")
 def lib(tmp_path_factory: pytest.TempPathFactory) -> ctypes.CDLL:
-    if not any(shutil.which(cc) for cc in ("gcc", "cc", "clang")):
-        pytest.skip("no C compiler (gcc, cc or clang) on this machine: vm/c/install-tools "
-                    "installs one on Debian")
-    path: Path = native.library(tmp_path_factory.mktemp("c-build"), sanitize=True)
-    library = ctypes.CDLL(str(path))
+    library = ctypes.CDLL(str(sanitized_library(tmp_path_factory)))
     library.rl1_arg_in_range.argtypes = [ctypes.c_uint8, ctypes.c_uint8, ctypes.c_int16]
     library.rl1_arg_in_range.restype = ctypes.c_bool
     return library
