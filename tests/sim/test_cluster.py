@@ -213,18 +213,8 @@ def test_a_campaign_whose_workers_are_all_lost_says_so_and_waits_for_one(
             [str(BIN / "rl1c"), "sim", str(program), "--world", str(world), "--runs",
              str(runs), "--budget", "10000", "--scheduler", cluster.address, "--out",
              str(out)], stdout=subprocess.PIPE, stderr=stderr, text=True) as process:
-        deadline = time.monotonic() + STARTED_WITHIN
-        while not out.exists() or out.read_text().count("\n") < 100:
-            assert process.poll() is None and time.monotonic() < deadline, said.read_text()
-            time.sleep(0.05)
-        cluster.workers[0].send_signal(signal.SIGKILL)
-        cluster.workers[0].wait()
-        while "has no workers left" not in said.read_text():
-            assert process.poll() is None and time.monotonic() < deadline, (
-                said.read_text() + cluster.log())
-            time.sleep(0.1)
-        cluster.start_worker()
-        stdout, _ = process.communicate(timeout=STARTED_WITHIN)
+        stdout = _lose_the_workers(
+            cluster, process, said, lambda: out.exists() and out.read_text().count("\n") >= 100)
     assert process.returncode == 0, said.read_text() + cluster.log()
     assert f"rl1c: warning: {no_workers_left(cluster.address)}\n" in said.read_text()
     assert "Traceback" not in said.read_text()
@@ -546,7 +536,9 @@ def test_fuzzing_on_a_cluster_whose_workers_are_all_lost_says_so_and_waits_for_o
                 [str(BIN / "rl1c"), "fuzz", "--count", "20", "--seed", "1", "--scheduler",
                  cluster.address, "--out", str(tmp_path / "out")], stdout=subprocess.PIPE,
                 stderr=stderr, text=True) as process:
-            stdout = _lose_the_workers(cluster, process, connections, said)
+            stdout = _lose_the_workers(
+                cluster, process, said,
+                lambda: cluster.log().count("Receive client connection") > connections)
     assert process.returncode == 0, said.read_text() + cluster.log()
     assert (f"rl1c: warning: the Dask scheduler at {cluster.address} has no workers left "
             "(killed, or out of memory: one is started again only under a nanny, `dask "
@@ -555,15 +547,15 @@ def test_fuzzing_on_a_cluster_whose_workers_are_all_lost_says_so_and_waits_for_o
     assert "fuzz: 20 programs in " in stdout and "all agreed" in stdout
 
 
-def _lose_the_workers(cluster: Cluster, process: subprocess.Popen[str], connections: int,
-                      said: Path) -> str:
-    """Kill the one worker of `cluster` once `rl1c fuzz` (`process`) has connected,
-    start another once it has said (in `said`) that none is left, and give its standard
-    output at its end."""
+def _lose_the_workers(cluster: Cluster, process: subprocess.Popen[str], said: Path,
+                      started: Callable[[], bool]) -> str:
+    """Kill the one worker of `cluster` once the campaign `process` has `started`, start
+    another once it has said (in `said`) that none is left, and give its standard output
+    at its end."""
     deadline = time.monotonic() + STARTED_WITHIN
-    while cluster.log().count("Receive client connection") == connections:
+    while not started():
         assert process.poll() is None and time.monotonic() < deadline, said.read_text()
-        time.sleep(0.1)
+        time.sleep(0.05)
     cluster.workers[0].send_signal(signal.SIGKILL)  # without a nanny: gone for good
     cluster.workers[0].wait()
     while "has no workers left" not in said.read_text():
