@@ -459,12 +459,15 @@ def spawn(target: Callable[..., object], *args: object, keep: tuple[int, ...] = 
     that other threads hold and Python 3.12 warns of it. `keep`: the file descriptors
     it inherits. Its start costs some 0.2 to 0.5 s of imports, where a fork costs
     milliseconds (bench/own_process.py)."""
+    # Pickled before the process starts: a call that cannot be pickled is raised here,
+    # not left to a process that would end on a half-read input and never be waited for.
+    start = pickle.dumps(sys.path) + pickle.dumps((target, args))
     process = subprocess.Popen([sys.executable, "-c", _SPAWNED], stdin=subprocess.PIPE,
                                pass_fds=keep)
     assert process.stdin is not None
     with contextlib.suppress(BrokenPipeError), process.stdin:  # ended already: its
         # status says how
-        process.stdin.write(pickle.dumps(sys.path) + pickle.dumps((target, args)))
+        process.stdin.write(start)
     return process
 
 

@@ -21,7 +21,7 @@ from support.cli import rl1c
 from support.planted import crashing_c_vm
 from support.recording import Recording, recorded
 
-from rl1.compiler import differential, fuzz
+from rl1.compiler import differential, executors, fuzz
 from rl1.compiler.cli.fuzz import WORKER_LOST
 from rl1.compiler.differential import (
     Engine,
@@ -180,6 +180,17 @@ def test_a_task_in_a_process_of_its_own_answers_raises_or_is_said_to_have_ended(
         in_own_process((), _EndsItsProcess("A=1\n").run, Run("A=1\n", {}), 100)
     first = in_own_process((), os.getpid)
     assert in_own_process((), os.getpid) == first != os.getpid()  # kept for the next
+
+
+def test_spawn_raises_a_call_it_cannot_pickle_before_it_starts_a_process(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    # Started first, the process would end on a half-read input, never waited for.
+    def popen(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a process started for a call that cannot be pickled")
+
+    monkeypatch.setattr(executors.subprocess, "Popen", popen)
+    with pytest.raises(TypeError, match=r"cannot pickle '_thread\.lock' object"):
+        executors.spawn(print, threading.Lock())
 
 
 def test_a_process_of_its_own_ends_when_its_parent_does() -> None:
