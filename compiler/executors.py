@@ -520,6 +520,12 @@ def in_own_process(preloaded: tuple[str, ...], fn: Callable[P, T], /, *args: P.a
         own.close()
         raise TaskProcessEnded(
             f"the task's process ended ({exit_how(own.process.returncode)})") from None
+    except BaseException:  # interrupted (Ctrl-C) before the answer: the next task
+        # would read this one's, so the process goes with the task
+        _own.process = None
+        own.process.kill()
+        own.close()
+        raise
     if not answered:
         raise result
     return result  # type: ignore[no-any-return]

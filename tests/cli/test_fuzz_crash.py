@@ -182,6 +182,29 @@ def test_a_task_in_a_process_of_its_own_answers_raises_or_is_said_to_have_ended(
     assert in_own_process((), os.getpid) == first != os.getpid()  # kept for the next
 
 
+class _Interrupted(Exception):
+    pass
+
+
+def test_a_task_interrupted_in_its_own_process_leaves_no_answer_to_the_next() -> None:
+    # Ctrl-C while the answer is awaited: the next task must get its own answer, not
+    # the interrupted one's when it comes.
+    in_own_process((), os.getpid)  # the process started, so the alarm finds the task
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise _Interrupted
+
+    previous = signal.signal(signal.SIGALRM, interrupt)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, 0.2)
+        with pytest.raises(_Interrupted):
+            in_own_process((), time.sleep, 2)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+    assert in_own_process((), pow, 2, 10) == 1024
+
+
 def test_spawn_raises_a_call_it_cannot_pickle_before_it_starts_a_process(
         monkeypatch: pytest.MonkeyPatch) -> None:
     # Started first, the process would end on a half-read input, never waited for.
