@@ -450,13 +450,15 @@ class Keeper:
         self.tally.add(record)
         self.total.add(record)
         if self.lines is not None:
+            # ASCII (json.dumps escapes the rest): its length is its bytes, counted, not
+            # asked of the file, which may be a pipe (--out FIFO) that cannot tell
+            line = json.dumps(record.to_json(), separators=(",", ":")) + "\n"
             try:
-                self.lines.write(json.dumps(record.to_json(), separators=(",", ":")) + "\n")
+                self.lines.write(line)
                 self.lines.flush()  # a line is whole on disk when the campaign is stopped
             except OSError as error:
                 raise _LineUnwritten(error, self.whole) from None
-            if self.lines is not sys.stdout:
-                self.whole = self.lines.tell()
+            self.whole += len(line)
         if self.overlay is not None:
             self.overlay.add(Run(record.seed, record.path, record.pose[:2],
                                  None if record.success else record.safety or record.outcome,

@@ -16,6 +16,7 @@ import shlex
 import signal
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import BrokenExecutor, Executor, Future
@@ -351,6 +352,25 @@ def test_a_full_disk_leaves_the_whole_lines_of_the_runs_before_and_names_the_fil
     assert f"cannot write the campaign file `{out}`" in result.stderr, result.stderr
     assert "free some space" in result.stderr and "Traceback" not in result.output
     assert out.read_text() == first  # the runs before, each line whole
+
+
+def test_out_streams_to_a_fifo(wall: tuple[Path, Path], tmp_path: Path) -> None:
+    """A pipe cannot say its position: the count of the whole lines' bytes asked it
+    (tell) after the first line, and the campaign ended with status 2, `cannot write the
+    output: underlying stream is not seekable; free some space`."""
+    program, world = wall
+    fifo = tmp_path / "runs.fifo"
+    os.mkfifo(fifo)
+    received: list[str] = []
+    reader = threading.Thread(target=lambda: received.append(fifo.read_text()))
+    reader.start()
+    result = rl1c("sim", program, "--world", world, "--runs", "3", "--jobs", "1",
+                  "--out", fifo)
+    # A writer of its own ends the reader's wait, should rl1c not have opened the FIFO.
+    os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+    reader.join()
+    assert result.exit_code == 0, result.stderr
+    assert [json.loads(line)["seed"] for line in received[0].splitlines()] == [0, 1, 2]
 
 
 def test_progress_is_a_line_every_few_seconds_when_standard_error_is_no_terminal() -> None:
