@@ -699,6 +699,9 @@ def judge_apart(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
         try:
             waited = spawn(_judge_in_child, writing, case, judged, budget,
                           keep=(writing,)).wait
+        except BaseException:  # such as an engine that cannot be pickled
+            os.close(reading)
+            raise
         finally:
             os.close(writing)
     observations: dict[str, Observation] = {}

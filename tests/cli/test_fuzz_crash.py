@@ -13,7 +13,7 @@ import subprocess
 import sys
 import threading
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
@@ -236,6 +236,34 @@ def _alive(pid: int) -> bool:
             return stat.read().rsplit(")", 1)[1].split()[0] != "Z"
     except FileNotFoundError:
         return False
+
+
+@dataclass(frozen=True)
+class _Unpicklable:
+    name: str = "unpicklable"
+    level: int = 0
+    held: threading.Lock = field(default_factory=threading.Lock)
+
+    def run(self, case: Run, budget: int) -> Observation:
+        raise AssertionError("never run: it cannot be sent to a process")
+
+
+def test_judged_apart_in_a_thread_an_engine_that_cannot_be_pickled_leaks_no_pipe() -> None:
+    # In a thread judge_apart spawns its process, which is given the engines pickled.
+    open_before = len(os.listdir("/proc/self/fd"))
+    raised: list[BaseException] = []
+
+    def judging() -> None:
+        try:
+            judge_apart(Run("A=1\n", {}), [VmEngine(0), _Unpicklable()], 100)
+        except TypeError as error:
+            raised.append(error)
+
+    thread = threading.Thread(target=judging)
+    thread.start()
+    thread.join()
+    assert "cannot pickle '_thread.lock' object" in str(raised[0])
+    assert len(os.listdir("/proc/self/fd")) == open_before
 
 
 @dataclass(frozen=True)
