@@ -537,6 +537,10 @@ def _start_own(preloaded: tuple[str, ...]) -> _OwnProcess:
     try:
         process = spawn(_serve, tasks_read, answers_written, preloaded,
                         keep=(tasks_read, answers_written))
+    except BaseException:  # such as no process to be had (EAGAIN, ENOMEM)
+        os.close(tasks)
+        os.close(answers)
+        raise
     finally:
         os.close(tasks_read)
         os.close(answers_written)

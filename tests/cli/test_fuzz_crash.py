@@ -5,6 +5,7 @@ processes."""
 
 from __future__ import annotations
 
+import errno
 import faulthandler
 import json
 import os
@@ -214,6 +215,28 @@ def test_spawn_raises_a_call_it_cannot_pickle_before_it_starts_a_process(
     monkeypatch.setattr(executors.subprocess, "Popen", popen)
     with pytest.raises(TypeError, match=r"cannot pickle '_thread\.lock' object"):
         executors.spawn(print, threading.Lock())
+
+
+def test_a_process_of_its_own_that_cannot_be_started_leaks_no_pipe(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    def no_process(*args: object, **kwargs: object) -> None:
+        raise BlockingIOError(errno.EAGAIN, os.strerror(errno.EAGAIN))
+
+    monkeypatch.setattr(executors, "spawn", no_process)
+    open_before = len(os.listdir("/proc/self/fd"))
+    raised: list[BaseException] = []
+
+    def starting() -> None:  # in a thread of its own: none of its own process yet
+        try:
+            in_own_process((), os.getpid)
+        except BlockingIOError as error:
+            raised.append(error)
+
+    thread = threading.Thread(target=starting)
+    thread.start()
+    thread.join()
+    assert isinstance(raised[0], BlockingIOError)
+    assert len(os.listdir("/proc/self/fd")) == open_before
 
 
 def test_a_process_of_its_own_ends_when_its_parent_does() -> None:
