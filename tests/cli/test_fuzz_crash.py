@@ -212,7 +212,7 @@ def test_spawn_raises_a_call_it_cannot_pickle_before_it_starts_a_process(
     def popen(*args: object, **kwargs: object) -> None:
         raise AssertionError("a process started for a call that cannot be pickled")
 
-    monkeypatch.setattr(executors.subprocess, "Popen", popen)
+    monkeypatch.setattr(subprocess, "Popen", popen)
     with pytest.raises(TypeError, match=r"cannot pickle '_thread\.lock' object"):
         executors.spawn(print, threading.Lock())
 
