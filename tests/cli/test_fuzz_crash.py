@@ -163,6 +163,8 @@ def test_judged_apart_in_a_thread_its_process_is_spawned_not_forked(
     thread = threading.Thread(target=judging)
     thread.start()
     thread.join(timeout=120)
+    assert not thread.is_alive(), "judge_apart in a thread did not end within 120 s"
+    assert len(verdicts) == 2, "judge_apart in a thread failed: see its exception above"
     assert verdicts[0] == judge(ordinary, [VmEngine(0), VmEngine(2)], 100)
     assert verdicts[1].problems == [SIGSEGV] and verdicts[1].ended == "signal SIGSEGV"
     assert list(verdicts[1].observations) == ["vm-O0", KILLER]
