@@ -358,11 +358,12 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     except ClusterLost as error:
         status, lost = EXIT_USAGE, error
     except _LineUnwritten as unwritten:
-        if lines is not None and lines is not sys.stdout:
-            with contextlib.suppress(OSError):  # its flush fails again
-                lines.close()
-            with contextlib.suppress(OSError):  # shrinking a file needs no room
-                os.truncate(str(out), unwritten.whole)  # no half line left at its end
+        if lines is None or lines is sys.stdout:  # said as any output's failure: a pipe
+            raise unwritten.error from None  # closed by `| head` ends quietly
+        with contextlib.suppress(OSError):  # its flush fails again
+            lines.close()
+        with contextlib.suppress(OSError):  # shrinking a file needs no room
+            os.truncate(str(out), unwritten.whole)  # no half line left at its end
         raise _unwritten(str(out), unwritten.error) from None
     finally:
         progress.finish()

@@ -373,6 +373,22 @@ def test_out_streams_to_a_fifo(wall: tuple[Path, Path], tmp_path: Path) -> None:
     assert [json.loads(line)["seed"] for line in received[0].splitlines()] == [0, 1, 2]
 
 
+def test_out_to_standard_output_closed_by_head_ends_quietly(wall: tuple[Path, Path]) -> None:
+    """`--out - | head -1`: the pipe closed early ends the campaign as it ends any command
+    (status 1, nothing said), where 29c77a3 said it could not write the campaign file `-`."""
+    program, world = wall
+    with subprocess.Popen([RL1C, "sim", str(program), "--world", str(world), "--runs", "2000",
+                           "--jobs", "1", "--out", "-"], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE) as process:
+        assert process.stdout is not None and process.stderr is not None
+        assert process.stdout.readline().startswith(b'{"seed":0,')
+        process.stdout.close()  # as head does after its first line
+        said = process.stderr.read().decode()
+        process.wait(timeout=120)
+    assert process.returncode == 1, said
+    assert "error" not in said and "Traceback" not in said
+
+
 def test_progress_is_a_line_every_few_seconds_when_standard_error_is_no_terminal() -> None:
     clock = iter([0.0, 1.0, 5.5, 7.0, 11.0])
     stream = io.StringIO()
