@@ -366,8 +366,12 @@ def test_out_streams_to_a_fifo(wall: tuple[Path, Path], tmp_path: Path) -> None:
     reader.start()
     result = rl1c("sim", program, "--world", world, "--runs", "3", "--jobs", "1",
                   "--out", fifo)
-    # A writer of its own ends the reader's wait, should rl1c not have opened the FIFO.
-    os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+    # A writer of its own ends the reader's wait, should rl1c not have opened the FIFO;
+    # there is no reader left to open it for (ENXIO) when the reader has read it all.
+    try:
+        os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+    except OSError as error:
+        assert error.errno == errno.ENXIO, error
     reader.join()
     assert result.exit_code == 0, result.stderr
     assert [json.loads(line)["seed"] for line in received[0].splitlines()] == [0, 1, 2]
