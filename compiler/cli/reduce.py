@@ -200,7 +200,7 @@ def _check_targets(file: str, sensors: str | None, out: str | None,
         for other, name in others:
             if problem is None and other is not None and (
                     os.path.abspath(other) == os.path.abspath(target)
-                    or (os.path.exists(other) and same_file(other, target))):
+                    or same_file(other, target)):
                 problem = f"it is {name}: give each its own file"
         if problem is not None:
             raise click.UsageError(f"argument {role}: {target}: {problem}")

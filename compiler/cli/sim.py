@@ -207,7 +207,7 @@ def refuse_picture_targets(svg_file: str | None, html_file: str | None,
             raise click.UsageError(f"{option} writes a file, and standard output carries "
                                    f"the report: give {option} FILE")
         for role, name in zip(("program", "world file"), inputs, strict=True):
-            if os.path.exists(name) and same_file(name, target):
+            if same_file(name, target):
                 raise click.UsageError(f"{option} `{target}` is the {role} itself: give "
                                        "another path for the picture")
         stream = os.path.exists(target) and not os.path.isfile(target)  # /dev/null

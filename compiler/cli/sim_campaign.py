@@ -292,7 +292,7 @@ def _open_out(out: str | None, inputs: tuple[str, str]) -> IO[str] | None:
     if out == "-":
         return sys.stdout
     for role, name in zip(("program", "world file"), inputs, strict=True):
-        if os.path.exists(name) and same_file(name, out):
+        if same_file(name, out):
             raise click.UsageError(f"--out `{out}` is the {role} itself: give another "
                                    "path for the runs' JSON lines")
     try:

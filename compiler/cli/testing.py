@@ -130,7 +130,7 @@ def _refuse_junit_target(target: str, cases: Sequence[Case]) -> None:
                                                  (case.sensors, "sensor script"))
                    if name is not None}
     for name, role in inputs.items():
-        if os.path.exists(name) and same_file(name, target):
+        if same_file(name, target):
             raise click.UsageError(f"--junit `{target}` is the {role} `{name}` itself: "
                                    "give another path for the JUnit XML")
 
