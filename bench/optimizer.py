@@ -48,7 +48,8 @@ def geometric_mean(ratios: list[float]) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--level", type=int, default=2, help="the level set against -O0")
+    parser.add_argument("--level", type=int, choices=(1, 2), default=2,
+                        help="the level set against -O0: 1 or 2 (default 2)")
     parser.add_argument("--repeat", type=int, default=5, help="compiles of each; the best counts")
     parser.add_argument("--set", choices=sorted(SETS), action="append",
                         help="the set measured (repeatable; both when left out)")
