@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import argparse
 import itertools
-import json
 import re
 import shutil
 import subprocess
@@ -46,7 +45,14 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
-from c_speed import C_FOLDER, CORPUS, NOT_CALLS, callgrind_cost, compiled, vector, write_vectors
+from c_speed import (
+    C_FOLDER,
+    CORPUS,
+    callgrind_cost,
+    device_calls,
+    program_vectors,
+    write_vectors,
+)
 
 ROOT = Path(__file__).resolve().parent.parent
 VM_SOURCE = C_FOLDER / "rl1vm.c"
@@ -224,17 +230,6 @@ def run_lines(binary: Path, addresses: list[int]) -> Iterator[tuple[int, int | N
         yield address, run_line
 
 
-def programs(paths: list[Path]) -> list[dict[str, object]]:
-    vectors = []
-    for path in paths:
-        sensors_path = path.with_suffix(".sensors.json")
-        sensors = (json.loads(sensors_path.read_text(encoding="utf-8"))
-                   if sensors_path.exists() else {})
-        vectors.append(vector(path.stem, compiled(path.read_text(encoding="utf-8"),
-                                                  path.name, LEVEL), sensors))
-    return vectors
-
-
 def measure(binary: Path, vectors_file: Path, executed: int, calls: int, folder: Path,
             regions: Regions) -> str:
     out = folder / "callgrind.out"
@@ -285,11 +280,10 @@ def main() -> int:
         for name, paths in SETS.items():
             if not paths:
                 continue
-            vectors = programs(paths)
+            vectors = program_vectors(paths, LEVEL)
             vectors_file = folder / f"{name}.txt"
             executed = write_vectors(vectors_file, vectors)
-            calls = sum(1 for v in vectors if isinstance(trace := v["trace"], list)
-                        for entry in trace if entry["call"] not in NOT_CALLS)
+            calls = device_calls(vectors)
             for build, binary in binaries.items():
                 figures = measure(binary, vectors_file, executed, calls, folder, regions)
                 print(f"   {name} ({len(vectors)} programs), {build:8} {figures}")

@@ -97,6 +97,26 @@ def vector(name: str, data: bytes, sensors: dict[str, object]) -> dict[str, obje
                        "result": list(entry.result or ())} for entry in device.trace]}
 
 
+def program_vectors(paths: Sequence[Path], level: int) -> list[dict[str, object]]:
+    """A run vector of each program compiled at -O`level`, on its sensor script beside
+    it (NAME.sensors.json), or on none."""
+    vectors = []
+    for path in paths:
+        sensors_path = path.with_suffix(".sensors.json")
+        sensors = (json.loads(sensors_path.read_text(encoding="utf-8"))
+                   if sensors_path.exists() else {})
+        vectors.append(vector(path.stem, compiled(path.read_text(encoding="utf-8"),
+                                                  path.name, level), sensors))
+    return vectors
+
+
+def device_calls(vectors: list[dict[str, object]]) -> int:
+    """The call instructions the vectors' runs executed: their traces' entries, less
+    those no call made."""
+    return sum(1 for v in vectors if isinstance(trace := v["trace"], list)
+               for entry in trace if entry["call"] not in NOT_CALLS)
+
+
 def compiled(source: str, name: str, level: int = 0) -> bytes:
     output = compile_text(source, name, level=level).output
     assert output is not None, f"{name} does not compile"
@@ -180,17 +200,10 @@ def instructions(runner: Path, folder: Path) -> None:
         print(f"   the computation at -O{level}       {cost / executed:6.2f}  "
               f"({cost:,} / {executed:,})")
     for level in (0, 2):
-        vectors = []
-        for path in CORPUS:
-            sensors_path = path.with_suffix(".sensors.json")
-            sensors = (json.loads(sensors_path.read_text(encoding="utf-8"))
-                       if sensors_path.exists() else {})
-            vectors.append(vector(path.stem, compiled(path.read_text(encoding="utf-8"),
-                                                      path.name, level), sensors))
+        vectors = program_vectors(CORPUS, level)
         corpus = folder / f"corpus-O{level}.txt"
         executed = write_vectors(corpus, vectors)
-        calls = sum(1 for v in vectors if isinstance(trace := v["trace"], list)
-                    for entry in trace if entry["call"] not in NOT_CALLS)
+        calls = device_calls(vectors)
         cost = callgrind_cost(runner, corpus, folder)
         print(f"   the corpus at -O{level} ({len(vectors)} programs) {cost / executed:6.2f}  "
               f"({cost:,} / {executed:,}, {calls:,} of them device calls)   "
