@@ -12,36 +12,21 @@ time the server spends on a client (collecting an ended session's garbage among 
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 
+from server_growth import growth  # noqa: E402  (bench/ is this script's folder)
 from support.hostile import ServedLsp, serve_one_after_another  # noqa: E402  (tests/ is put on the path just above)
-from support.memory import WARM_UP  # noqa: E402
-
-
-def processor_seconds(pid: int) -> float:
-    """User and system time of process `pid` so far."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def measure(transport: str, clients: int) -> None:
     server = ServedLsp(transport)
     try:
-        serve_one_after_another(server, WARM_UP)
-        before = server.resident_mib()
-        start = processor_seconds(server.process.pid)
-        serve_one_after_another(server, clients)
-        seconds = processor_seconds(server.process.pid) - start
-        grown = server.resident_mib() - before
-        print(f"rl1-lsp --{transport}: {clients} clients one after another grew the server by "
-              f"{grown:.1f} MiB, {grown / clients:.3f} MiB a client ({grown / clients / before:.3%}"
-              f" of the {before:.0f} MiB it held after {WARM_UP} clients); "
-              f"{seconds / clients * 1000:.1f} ms of processor time a client")
+        print(growth(server, serve_one_after_another, clients, f"rl1-lsp --{transport}",
+                     "client"))
     finally:
         server.stop()
 

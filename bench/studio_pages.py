@@ -18,9 +18,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT / "tests"), str(ROOT / "tests" / "studio")]
 
-from lsp_sessions import processor_seconds  # noqa: E402  (bench/ is this script's folder)
 from served import StudioProcess, pages_one_after_another, sample_folder  # noqa: E402  (tests/ on the path just above)
-from support.memory import WARM_UP  # noqa: E402
+from server_growth import growth  # noqa: E402  (bench/ is this script's folder)
 
 
 def main() -> None:
@@ -30,18 +29,9 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         studio = StudioProcess(sample_folder(Path(folder)))
         try:
-            pages_one_after_another(studio, WARM_UP)
-            before = studio.resident_mib()
-            start = processor_seconds(studio.process.pid)
-            pages_one_after_another(studio, pages)
-            seconds = processor_seconds(studio.process.pid) - start
-            grown = studio.resident_mib() - before
+            print(growth(studio, pages_one_after_another, pages, "rl1c studio", "page"))
         finally:
             studio.stop()
-    print(f"rl1c studio: {pages} pages one after another grew the server by {grown:.1f} MiB, "
-          f"{grown / pages:.3f} MiB a page ({grown / pages / before:.3%} of the {before:.0f} "
-          f"MiB it held after {WARM_UP} pages); {seconds / pages * 1000:.1f} ms of processor "
-          "time a page")
 
 
 if __name__ == "__main__":
