@@ -25,13 +25,10 @@ from typing import Any
 
 from websockets.sync.client import ClientConnection, connect
 
-from rl1.compiler.debugger import Session, compile_program
-from rl1.vm.sim.device import SimDevice
-from rl1.vm.sim.world import decode_world
-
 ROOT = Path(__file__).resolve().parent.parent
 sys.path[:0] = [str(ROOT / "tests"), str(ROOT / "tests" / "studio")]
 
+from debug_step import line_steps, listing_1_session  # noqa: E402  (bench/ is this script's folder)
 from served import serving  # noqa: E402  (tests/ on the path just above)
 from support import EXAMPLES  # noqa: E402
 
@@ -80,24 +77,6 @@ def server_steps(page: Page) -> list[float]:
             return steps
 
 
-def _session() -> Session:
-    image = compile_program((EXAMPLES / "sample.rob").read_text(), "sample.rob")
-    assert isinstance(image, bytes)
-    world = decode_world((EXAMPLES / "sample.world.toml").read_bytes(), "sample.world.toml")
-    return Session(image, lambda: SimDevice(world))
-
-
-def session_steps() -> list[float]:
-    """The same steps of a Session alone."""
-    session = _session()
-    steps = []
-    while not session.over:
-        started = time.perf_counter()
-        session.step_line()
-        steps.append(time.perf_counter() - started)
-    return steps
-
-
 def whole_run(page: Page) -> float:
     """From run/launch at full speed to run/ended: the run, its frames and its trace."""
     started = time.perf_counter()
@@ -108,7 +87,7 @@ def whole_run(page: Page) -> float:
 
 def session_run() -> float:
     """The same run by a Session's continue alone."""
-    session = _session()
+    session = listing_1_session()
     started = time.perf_counter()
     while not session.over:
         session.continue_()
@@ -135,7 +114,7 @@ def live(page: Page) -> tuple[int, float, float]:
 
 def main() -> None:
     argparse.ArgumentParser(description=__doc__.split("\n\n")[0]).parse_args()
-    alone = session_steps()
+    alone = line_steps(time.perf_counter)  # the same steps of a Session alone
     reference = min(session_run() for _ in range(RUNS))
     with serving(EXAMPLES) as served, connect(served.url("/studio", scheme="ws"),
                                               max_size=None) as connection:
