@@ -34,6 +34,14 @@ def test_the_page_names_its_files_with_the_token() -> None:
                              "/static/studio.js?token=__RL1_STUDIO_TOKEN__"]
 
 
+def test_the_committed_page_is_its_source_copied() -> None:
+    # build.mjs copies index.html as it is: held equal without Node.js too, which the
+    # rebuild below needs (the wheel ships lsp/studio/static/ and never builds it).
+    assert (STUDIO / "src" / "index.html").read_bytes() == (STATIC / "index.html").read_bytes(), (
+        "lsp/studio/static/index.html is not editors/studio/src/index.html: "
+        "cd editors/studio && npm run build (or copy the file), and commit it")
+
+
 @pytest.mark.slow  # esbuild bundles CodeMirror
 @pytest.mark.needs_node
 def test_the_committed_page_is_the_build_of_its_sources(tmp_path: Path) -> None:
