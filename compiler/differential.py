@@ -31,7 +31,13 @@ from typing import Any, Literal, Protocol
 
 from rl1.compiler.analysis import analyze
 from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
-from rl1.compiler.executors import exit_how, ignore_interrupts, spawn
+from rl1.compiler.executors import (
+    exit_how,
+    ignore_interrupts,
+    pickled_error,
+    spawn,
+    unpickled_error,
+)
 from rl1.compiler.interpreter import interpret
 from rl1.compiler.strategies import Run
 from rl1.vm import isa
@@ -719,8 +725,10 @@ def judge_apart(case: Run, engines: Sequence[Engine], budget: int) -> Verdict:
                         running = name
                     case ("ran", str(name), Observation() as observation):
                         observations[name], running = observation, ""
-                    case ("verdict", Verdict() | BaseException() as told):
+                    case ("verdict", Verdict() as told):
                         pass
+                    case ("raised", bytes(data), str(text)):
+                        told = unpickled_error(data, text)
     finally:
         code = waited()
     if isinstance(told, BaseException):
@@ -763,10 +771,7 @@ def _judge_in_child(writing: int, case: Run, engines: Sequence[Engine], budget: 
                 tell("verdict", judge(case, [_Told(engine, tell) for engine in engines],
                                       budget))
             except BaseException as error:  # the parent raises it
-                try:
-                    tell("verdict", error)
-                except Exception:  # which cannot be pickled
-                    tell("verdict", RuntimeError(f"{type(error).__name__}: {error}"))
+                tell("raised", *pickled_error(error))
     finally:
         _close_batches()  # a process forked from this one ends without atexit's calls
         os._exit(0)

@@ -20,6 +20,7 @@ import multiprocessing
 import os
 import pickle
 import signal
+import struct
 import subprocess
 import sys
 import threading
@@ -68,6 +69,11 @@ class TaskProcessEnded(Exception):
     """A task given a process of its own on a cluster's worker (`isolated`), which ended
     before it answered (by a signal, or an exit): what it ran ended it, as a local pool's
     worker would have been ended, and the cluster's worker goes on."""
+
+
+class TaskUnreadable(Unavailable):
+    """A task that its process of its own could not read (unpickle): the code it names
+    cannot be imported there as it is here. The installation's doing, not the task's."""
 
 
 class _OtherRl1(Exception):
@@ -442,7 +448,10 @@ def _checked(digest: str, isolated: bool, fn: Callable[P, T], /, *args: P.args,
     preloaded = tuple(preload.name for preload in get_worker().preloads
                       if getattr(getattr(preload, "module", None), "__name__", None)
                       == preload.name)
-    return in_own_process(preloaded, fn, *args, **kwargs)
+    try:
+        return in_own_process(preloaded, fn, *args, **kwargs)
+    except TaskUnreadable as error:
+        raise TaskUnreadable(f"on the Dask worker {get_worker().address}, {error}") from None
 
 
 # A spawned process's start: this process's sys.path (so that it imports what this one
@@ -478,21 +487,78 @@ def exit_how(code: int) -> str:
             else f"exit status {code}")
 
 
+def pickled_error(error: BaseException) -> tuple[bytes, str]:
+    """What a child process sends back of an error raised in it: the error pickled
+    (empty when it cannot be), and its type and message as text, for a parent that
+    cannot rebuild it (`unpickled_error`)."""
+    text = f"{type(error).__name__}: {error}"
+    try:
+        return pickle.dumps(error), text
+    except Exception:  # such as an error holding a lock
+        return b"", text
+
+
+def unpickled_error(data: bytes, text: str) -> BaseException:
+    """The error a child process sent (`pickled_error`), or a RuntimeError naming its
+    type and message where it cannot be rebuilt here (a class this process cannot
+    import, an `__init__` that takes other arguments than the error keeps)."""
+    if not data:
+        return RuntimeError(text)
+    try:
+        error: BaseException = pickle.loads(data)
+    except Exception as why:
+        return RuntimeError(f"{text} (raised in a child process, and not rebuilt here: "
+                            f"{type(why).__name__}: {why})")
+    return error
+
+
+# A message on the pipes of `in_own_process`: its length, then its bytes, read whole
+# before they are unpickled, so that what cannot be unpickled leaves the next in place.
+_LENGTH = struct.Struct("<Q")
+
+
+def _send(stream: IO[bytes], message: bytes) -> None:
+    stream.write(_LENGTH.pack(len(message)) + message)
+    stream.flush()
+
+
+def _received(stream: IO[bytes]) -> bytes | None:
+    """The next message on `stream`; None at its end. EOFError when it ends mid-message."""
+    head = stream.read(_LENGTH.size)
+    if not head:
+        return None
+    if len(head) < _LENGTH.size:
+        raise EOFError
+    message = stream.read(_LENGTH.unpack(head)[0])
+    if len(message) < _LENGTH.unpack(head)[0]:
+        raise EOFError
+    return message
+
+
+# What `in_own_process`'s child answers of a task: how it ended, the result or the error
+# pickled, and the error's type and message (`pickled_error`).
+_RETURNED, _RAISED, _UNREADABLE = "returned", "raised", "unreadable"
+_Answer = tuple[str, bytes, str]
+
+
 @dataclass(frozen=True, slots=True)
 class _OwnProcess:
     """A process that makes a thread's tasks one after the other (`_serve`), the modules
-    `preloaded` imported; the ends of its pipes of tasks and answers."""
+    `preloaded` imported; the ends of its pipes of tasks and answers, and of the pipe
+    whose end, closed, tells it that this process ended (`_end_with_parent`)."""
 
     process: subprocess.Popen[bytes]
     preloaded: tuple[str, ...]
     tasks: IO[bytes]
     answers: IO[bytes]
+    alive: IO[bytes]
 
     def close(self) -> None:
         with contextlib.suppress(OSError):  # a task left unsent to a process that ended
             self.tasks.close()  # which ends it, when it lives
         self.answers.close()
         self.process.wait()
+        self.alive.close()
 
 
 _own = threading.local()  # each thread's _OwnProcess
@@ -504,7 +570,9 @@ def in_own_process(preloaded: tuple[str, ...], fn: Callable[P, T], /, *args: P.a
     needs one (importing the modules `preloaded` first) and kept for its next tasks, so
     that a cluster's search costs no start (some 0.5 s, bench/own_process.py);
     TaskProcessEnded when that process ends before it answers (the next task has a new
-    one). The process ends when this one does: its pipe of tasks then closes."""
+    one); TaskUnreadable when it cannot unpickle the task (it imports other code than
+    this process); what the task raised, or a RuntimeError naming it where this process
+    cannot rebuild it. The process ends when this one does, even amid a task."""
     own: _OwnProcess | None = getattr(_own, "process", None)
     if own is None or own.preloaded != preloaded:
         if own is not None:
@@ -512,10 +580,11 @@ def in_own_process(preloaded: tuple[str, ...], fn: Callable[P, T], /, *args: P.a
         own = _own.process = _start_own(preloaded)
     task = pickle.dumps((fn, args, kwargs))  # whole before any of it is sent
     try:
-        own.tasks.write(task)
-        own.tasks.flush()
-        answered, result = pickle.load(own.answers)
-    except (OSError, EOFError, pickle.UnpicklingError):  # it ended, perhaps mid-answer
+        _send(own.tasks, task)
+        answer = _received(own.answers)
+        if answer is None:
+            raise EOFError
+    except (OSError, EOFError):  # it ended, perhaps mid-answer
         _own.process = None
         own.close()
         raise TaskProcessEnded(
@@ -526,53 +595,83 @@ def in_own_process(preloaded: tuple[str, ...], fn: Callable[P, T], /, *args: P.a
         own.process.kill()
         own.close()
         raise
-    if not answered:
-        raise result
-    return result  # type: ignore[no-any-return]
+    how, data, text = pickle.loads(answer)
+    if how == _UNREADABLE:
+        raise TaskUnreadable(
+            f"the process spawned for a task could not read it ({text})\n  = help: the "
+            "task's code must import there as it does here: install the same rl1, and "
+            "any module the task comes from, on every worker's machine, and name a "
+            "module to `dask worker --preload` rather than a file")
+    if how == _RAISED:
+        raise unpickled_error(data, text)
+    try:
+        result: T = pickle.loads(data)
+    except Exception as error:
+        raise RuntimeError(f"the task's result cannot be rebuilt here ({type(error).__name__}: "
+                           f"{error})") from None
+    return result
 
 
 def _start_own(preloaded: tuple[str, ...]) -> _OwnProcess:
     tasks_read, tasks = os.pipe()
     answers, answers_written = os.pipe()
+    alive_read, alive = os.pipe()
     try:
-        process = spawn(_serve, tasks_read, answers_written, preloaded,
-                        keep=(tasks_read, answers_written))
+        process = spawn(_serve, tasks_read, answers_written, alive_read, preloaded,
+                        keep=(tasks_read, answers_written, alive_read))
     except BaseException:  # such as no process to be had (EAGAIN, ENOMEM)
         os.close(tasks)
         os.close(answers)
+        os.close(alive)
         raise
     finally:
         os.close(tasks_read)
         os.close(answers_written)
-    return _OwnProcess(process, preloaded, open(tasks, "wb"), open(answers, "rb"))
+        os.close(alive_read)
+    return _OwnProcess(process, preloaded, open(tasks, "wb"), open(answers, "rb"),
+                       open(alive, "wb"))
 
 
-def _serve(tasks: int, answers: int, preloaded: tuple[str, ...]) -> None:
-    """`in_own_process`'s child: for each call read from the pipe `tasks`, its result
-    or what it raised, pickled on the pipe `answers`, until `tasks` ends."""
+def _serve(tasks: int, answers: int, alive: int, preloaded: tuple[str, ...]) -> None:
+    """`in_own_process`'s child: for each task read from the pipe `tasks`, its answer
+    (`_answer`) on the pipe `answers`, until `tasks` ends; it ends amid a task when the
+    pipe `alive` ends."""
     import importlib
 
+    threading.Thread(target=_end_with_parent, args=(alive,), daemon=True).start()
     for module in preloaded:
         importlib.import_module(module)
     # A pipe broken: the parent ended while a task ran (its answer unwritten, this one
     # ends as the parent did).
     with contextlib.suppress(BrokenPipeError), open(tasks, "rb") as calls, \
             open(answers, "wb") as replies:
-        while True:
-            try:
-                fn, args, kwargs = pickle.load(calls)
-            except EOFError:  # the parent ended, or has no more tasks
-                return
-            try:
-                answer = (True, fn(*args, **kwargs))
-            except Exception as error:  # raised again where the task was called
-                answer = (False, error)
-            try:
-                data = pickle.dumps(answer)
-            except Exception as error:  # such as an error that cannot be pickled
-                data = pickle.dumps((False, RuntimeError(f"{type(error).__name__}: {error}")))
-            replies.write(data)
-            replies.flush()
+        while (task := _received(calls)) is not None:
+            _send(replies, pickle.dumps(_answer(task)))
+
+
+def _answer(task: bytes) -> _Answer:
+    """The pickled call `task` made: its result, or what it raised, pickled; or, when
+    it cannot be unpickled here, why (a module this process does not have)."""
+    try:
+        fn, args, kwargs = pickle.loads(task)
+    except Exception as error:
+        return _UNREADABLE, b"", f"{type(error).__name__}: {error}"
+    try:
+        result = fn(*args, **kwargs)
+    except Exception as error:  # raised again where the task was called
+        return _RAISED, *pickled_error(error)
+    try:
+        return _RETURNED, pickle.dumps(result), ""
+    except Exception as error:  # such as a result holding a lock
+        return _RAISED, *pickled_error(error)
+
+
+def _end_with_parent(alive: int) -> None:
+    """Ends this process once the pipe `alive` ends: its one writer, the parent, has
+    ended (a Dask worker killed amid a task), and the task's result has no reader."""
+    while os.read(alive, 1):  # nothing is written: it returns at the end
+        pass
+    os._exit(128 + signal.SIGHUP)
 
 
 def _threads(client: Client, address: str) -> int:

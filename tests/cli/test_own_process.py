@@ -1,0 +1,95 @@
+"""executors.in_own_process, how a Dask worker runs each search of `rl1c fuzz`, and
+judge_apart: what cannot cross between the processes (a task the child cannot read, an
+error the parent cannot rebuild) is said as such, and the child does not outlive its
+parent."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from support.processes import ends_within
+
+from rl1.compiler.differential import EngineUnavailable, Observation, VmEngine, judge_apart
+from rl1.compiler.executors import TaskUnreadable, in_own_process
+from rl1.compiler.strategies import Run
+
+
+class _Refused(EngineUnavailable):
+    """An error whose `__init__` takes other arguments than it keeps (`args`): it
+    pickles, and unpickling it calls `_Refused("refused at 3")`, a TypeError."""
+
+    def __init__(self, what: str, where: int) -> None:
+        super().__init__(f"{what} at {where}")
+
+
+def _refuses() -> None:
+    raise _Refused("refused", 3)
+
+
+def test_a_task_its_process_cannot_read_is_said_so_and_the_process_lives_on(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    # A function of a module this process loaded from a file that is not on the path
+    # (as Dask loads a preload file): it pickles here, and the child cannot import it.
+    (tmp_path / "rl1_loaded_here.py").write_text("def answer() -> int:\n    return 42\n")
+    spec = importlib.util.spec_from_file_location("rl1_loaded_here",
+                                                  tmp_path / "rl1_loaded_here.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    monkeypatch.setitem(sys.modules, "rl1_loaded_here", module)
+    child = in_own_process((), os.getpid)
+    with pytest.raises(TaskUnreadable) as raised:
+        in_own_process((), module.answer)
+    assert str(raised.value).startswith(
+        "the process spawned for a task could not read it (ModuleNotFoundError: No module "
+        "named 'rl1_loaded_here')\n  = help: the task's code must import there as it does "
+        "here: install the same rl1")
+    assert in_own_process((), os.getpid) == child  # the next task, in the same process
+
+
+def test_an_error_the_parent_cannot_rebuild_is_named_with_its_message() -> None:
+    with pytest.raises(RuntimeError) as raised:
+        in_own_process((), _refuses)
+    assert str(raised.value).startswith("_Refused: refused at 3 (raised in a child process, "
+                                        "and not rebuilt here: TypeError: ")
+    assert in_own_process((), pow, 2, 10) == 1024
+
+
+class _RefusingEngine:
+    name = "refusing"
+    level = 0
+
+    def run(self, case: Run, budget: int) -> Observation:
+        _refuses()
+        raise AssertionError("unreachable")
+
+
+def test_judged_apart_an_error_the_parent_cannot_rebuild_is_named_with_its_message() -> None:
+    with pytest.raises(RuntimeError, match=r"^_Refused: refused at 3 \(raised in a child "
+                       r"process, and not rebuilt here: TypeError: "):
+        judge_apart(Run("A=1\n", {}), [VmEngine(0), _RefusingEngine()], 100)
+
+
+def test_a_process_of_its_own_ends_amid_a_task_when_its_parent_is_killed() -> None:
+    # As a Dask worker killed amid a search: the search's process must not finish it, an
+    # orphan holding a core.
+    task = "import os, time; print(os.getpid(), flush=True); time.sleep(600)"
+    with subprocess.Popen(
+            [sys.executable, "-c", "from rl1.compiler.executors import in_own_process; "
+             f"in_own_process((), exec, {task!r})"],
+            stdout=subprocess.PIPE, text=True) as parent:
+        assert parent.stdout is not None
+        child = int(parent.stdout.readline())
+        parent.kill()
+        parent.wait()
+        try:
+            assert ends_within(child, 30), f"process {child} outlived its parent"
+        finally:
+            if not ends_within(child, 0):
+                os.kill(child, signal.SIGKILL)
