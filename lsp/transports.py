@@ -544,11 +544,25 @@ class WebSocketSessions:
         class Counted(ServerConnection):
             """A connection that counts the bytes received since its last message was
             handled, and is closed when they would pass what InFlight allows: the library
-            reads a whole message before handing it over."""
+            reads a whole message before handing it over. It reads nothing while its
+            client has not read what was written to it (the library's answers to pings
+            too, which nothing else bounds)."""
 
             received = 0
 
             def data_received(self, data: bytes) -> None:
+                self._count_and_receive(data)
+                # The library answers a ping as it reads it, whatever is still unread:
+                # from a client that never reads, nothing more is read until it does.
+                if self.paused:
+                    self.transport.pause_reading()
+
+            def resume_writing(self) -> None:
+                super().resume_writing()
+                if not self.recv_messages.paused:  # the library's own pause stands
+                    self.transport.resume_reading()
+
+            def _count_and_receive(self, data: bytes) -> None:
                 if self.protocol.state is not State.OPEN or self not in in_flight:
                     super().data_received(data)
                     return

@@ -315,3 +315,29 @@ def test_an_error_the_websocket_library_logs_is_one_line(
     said = capsys.readouterr().err
     assert "Traceback" not in said
     assert "unexpected internal error (AssertionError: send_eof)" in said
+
+
+def test_a_websocket_client_that_pings_and_never_reads_holds_no_more_memory() -> None:
+    """Found by the hostile pass: the websockets library answers each ping as it reads it,
+    into the connection's buffer, whatever is still unread there, so a client that sent
+    pings and never read grew the server without bound (with a message now and then,
+    which keeps its count of the bytes received low: 320 MiB of pings, 285 MiB more
+    held). Now the server reads no more from a client while what it wrote is unread."""
+    server = ServedLsp("ws")
+    flood = ws_frame(9, b"p" * 125) * 2000 + ws_frame(1, json.dumps(
+        {"jsonrpc": "2.0", "method": "$/cancelRequest", "params": {"id": 1}}).encode())
+    try:
+        with socket.socket() as client:
+            client.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)  # reads nothing
+            client.connect(("127.0.0.1", server.port))
+            client.sendall(ws_handshake(server.port, None))
+            client.sendall(ws_frame(1, json.dumps(INITIALIZE).encode()))
+            client.settimeout(2)  # the server reads no more: the flood stops here
+            with contextlib.suppress(TimeoutError):
+                for _ in range(64 * 2**20 // len(flood)):
+                    client.sendall(flood)
+            grown = server.peak_mib() - server.started_mib
+        assert grown < 24, f"the server grew by {grown:.0f} MiB"
+        assert transport_attack(server, HostileConnection(chunks=(b"",), copies=0)) == []
+    finally:
+        server.stop()
