@@ -278,6 +278,9 @@ class _Batch:
                                             stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                             start_new_session=True)
             self.stderr.clear()
+        elif self._printed_since_answering():
+            return self._failed("no-run", "it printed a line after its answer to the job "
+                                "before (two lines for one job)")
         process = self.process
         assert process.stdin is not None and process.stdout is not None \
             and process.stderr is not None
@@ -298,13 +301,13 @@ class _Batch:
                         try:
                             unsent = unsent[os.write(key.fd, unsent):]
                         except BrokenPipeError:
-                            return self._failed("no-run", self._ended("reading the job"))
+                            return self._failed("no-run", self._gone("input", "reading the job"))
                         if not unsent:
                             selector.unregister(process.stdin)
                         continue
                     chunk = os.read(key.fd, 1 << 16)
                     if not chunk and key.fileobj is process.stdout:
-                        return self._failed("no-run", self._ended("answering"))
+                        return self._failed("no-run", self._gone("output", "answering"))
                     if not chunk:
                         selector.unregister(key.fileobj)
                     key.data.extend(chunk)
@@ -318,9 +321,19 @@ class _Batch:
                                 else "it answered before it had read the whole job")
         return Observation(printed_run(bytes(line), bytes(self.stderr)))
 
-    def _ended(self, doing: str) -> str:
-        """What the engine, which ended, did: its exit status, its standard error's end
-        read (for at most a second, when another process holds it open)."""
+    def _printed_since_answering(self) -> bool:
+        """Whether the engine wrote on its standard output after its last answer, which
+        would be taken for its answer to the next job (its end is found by the job)."""
+        assert self.process is not None and self.process.stdout is not None
+        with selectors.DefaultSelector() as selector:
+            selector.register(self.process.stdout, selectors.EVENT_READ)
+            return bool(selector.select(0)) and bool(os.read(self.process.stdout.fileno(),
+                                                             1 << 16))
+
+    def _gone(self, stream: str, doing: str) -> str:
+        """What the engine did, which closed its standard `stream` (input or output):
+        ended, with its exit status, or closed it alive; its standard error's end read
+        (for at most a second, when another process holds it open)."""
         assert self.process is not None and self.process.stderr is not None
         with contextlib.suppress(subprocess.TimeoutExpired):
             self.process.wait(1)
@@ -334,8 +347,9 @@ class _Batch:
                 self.stderr.extend(chunk)
                 del self.stderr[:-STDERR_KEPT]
         status = self.process.poll()
-        return (f"it ended before {doing}" + (f" (exit status {status})"
-                                              if status is not None else ""))
+        if status is None:
+            return f"it closed its standard {stream} before {doing}"
+        return f"it ended before {doing} (exit status {status})"
 
     def _failed(self, code: str, message: str) -> Observation:
         """The status of a job the engine did not answer; it is stopped, to start again

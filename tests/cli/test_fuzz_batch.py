@@ -114,6 +114,10 @@ def quick_timeout(monkeypatch: pytest.MonkeyPatch) -> None:
     ("exit 3", "no-run", "(exit status 3)"),  # before reading the job, or answering
     ("echo oops >&2; exit 1", "no-run", "its standard error ends: oops"),
     ("cat > /dev/null", "timeout", "it answered no job in 1 seconds"),
+    # Alive, they were said to have ended.
+    ("exec 0<&-; sleep 30", "no-run", "it closed its standard input before reading the job"),
+    ("read job; exec >&-; sleep 30", "no-run", "it closed its standard output before "
+                                               "answering"),
     ("yes", "no-run", "it printed more than one line for one job"),
     ("read job; echo '{\"status\": 1}'; cat > /dev/null", "no-run",
      "its object has no variables nor trace"),
@@ -141,6 +145,20 @@ def test_an_engine_that_dies_is_started_again_at_the_next_job() -> None:
     answers = [engine.run(Run(f"A={number}\n", {}), 100) for number in range(3)]
     assert [answer.ending()["code"] for answer in answers] == ["ok", "no-run", "ok"]  # type: ignore[index]
     assert answers[2].document["variables"]["A"] == 2
+
+
+def test_a_second_answer_that_comes_late_is_no_answer_to_the_next_job() -> None:
+    """Found by the hostile pass: an engine that answered a job twice, the second line
+    after a while, had that line taken for its answer to the next job (A=99 for a
+    program setting A=1), unseen."""
+    run = '{"status":"ok","variables":{"A":%s},"trace":[]}'
+    twice = (f"while read job; do echo '{run % 0}'; sleep 0.5; echo '{run % 99}'; done")
+    engine = _batch(twice)
+    assert engine.run(Run("A=0\n", {}), 100).ending()["code"] == "ok"  # type: ignore[index]
+    time.sleep(1)  # the second line is written
+    late = engine.run(Run("A=1\n", {}), 100).document
+    assert late["status"] == {"code": "no-run", "line": None, "message": (
+        "it printed a line after its answer to the job before (two lines for one job)")}
 
 
 def test_an_engine_past_its_output_cap_is_stopped(monkeypatch: pytest.MonkeyPatch) -> None:
