@@ -29,6 +29,7 @@ from typing import Any, BinaryIO
 
 import click
 
+from rl1.compiler.campaign import MAX_SEED
 from rl1.compiler.debugger import (
     DebugError,
     Session,
@@ -145,6 +146,7 @@ class Adapter:
         try:
             if not isinstance(arguments, dict):
                 raise Refused("the request's arguments are not an object")
+            _refuse_unknown_ids(arguments)
             handler(message, arguments)
         except Refused as refused:
             self._refuse(message, str(refused))
@@ -209,6 +211,10 @@ class Adapter:
         wanted = _listed(arguments, "breakpoints")
         if not all(isinstance(b, dict) and _whole(b.get("line")) for b in wanted):
             raise Refused("`breakpoints` is a list of objects, each with a `line`")
+        if (elsewhere := self._elsewhere(arguments.get("source"))) is not None:
+            self._respond(request, {"breakpoints": [
+                {"verified": False, "line": b["line"], "message": elsewhere} for b in wanted]})
+            return
         bindings = session.set_line_breakpoints(
             (b["line"], b.get("condition") if isinstance(b.get("condition"), str) else None)
             for b in wanted)
@@ -216,6 +222,25 @@ class Adapter:
             {"verified": True, "line": binding.line} if binding.verified else
             {"verified": False, "line": binding.requested, "message": binding.message}
             for binding in bindings]})
+
+    def _elsewhere(self, source: object) -> str | None:
+        """Why breakpoints in `source` (a DAP Source) are not the program's, or None when
+        they are (a source without a path, as the tests send, is the program): a client
+        sends every file's breakpoints, and they must not replace the program's."""
+        match source:
+            case None | {"path": None}:
+                return None
+            case {"path": str(path)}:
+                try:
+                    if os.path.realpath(path) == self.program_path:
+                        return None
+                except ValueError:  # a NUL, half a surrogate pair: no file's path
+                    pass
+                return (f"{path} is not the program being debugged, {self.program_path}: "
+                        "rl1-dap debugs one program")
+            case dict() if "path" not in source:
+                return None
+        raise Refused(f"`source` is {source!r}: give an object with the file's `path`")
 
     def _on_setFunctionBreakpoints(self, request: dict[str, Any], arguments: dict[str, Any]
                                    ) -> None:
@@ -386,6 +411,17 @@ def _whole(value: object) -> bool:
     return isinstance(value, int) and not isinstance(value, bool)
 
 
+_IDS = {"threadId": ("thread", f"the program's is {THREAD}", THREAD),
+        "frameId": ("frame", f"the program's line is frame {FRAME}", FRAME)}
+
+
+def _refuse_unknown_ids(arguments: dict[str, Any]) -> None:
+    """Refuse a thread or a frame the adapter never gave out, in any request."""
+    for key, (what, ours, given) in _IDS.items():
+        if key in arguments and not (_whole(arguments[key]) and arguments[key] == given):
+            raise Refused(f"no {what} has the id {arguments[key]!r}: {ours}")
+
+
 def _listed(arguments: dict[str, Any], key: str) -> list[Any]:
     value = arguments.get(key, [])
     if not isinstance(value, list):
@@ -410,8 +446,9 @@ def _device_maker(arguments: dict[str, Any]) -> Callable[[], Device]:
         from rl1.vm.sim.world import WorldError, decode_world
 
         seed = arguments.get("seed", 0)
-        if not _whole(seed):
-            raise Refused(f"`seed` is {seed!r}: give a whole number")
+        if not (_whole(seed) and 0 <= seed <= MAX_SEED):
+            raise Refused(f"`seed` is {seed!r}: give a whole number from 0 to {MAX_SEED}, "
+                          "as rl1c sim --seed")
         try:
             the_world = decode_world(read_bounded(_regular(world), MAX_WORLD_BYTES,
                                                   "a world file"), world)

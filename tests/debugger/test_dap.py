@@ -336,6 +336,35 @@ def test_the_command_line_answers_help_and_version_without_serving() -> None:
         assert done.returncode == 0 and said in done.stdout.decode(), done
 
 
+class InProcess:
+    """An adapter in this process, driven request by request; every message it sends
+    kept."""
+
+    def __init__(self) -> None:
+        self.sent: list[dict[str, Any]] = []
+        self.adapter = Adapter(self.sent.append)
+        self.seq = 0
+
+    def request(self, command: str, arguments: dict[str, Any] | None = None
+                ) -> dict[str, Any]:
+        """The response to the request, which the adapter sends before it returns."""
+        self.seq += 1
+        self.adapter.receive(json.dumps({"seq": self.seq, "type": "request",
+                                         "command": command,
+                                         "arguments": arguments or {}}).encode())
+        (response,) = [m for m in self.sent
+                       if m["type"] == "response" and m["request_seq"] == self.seq]
+        return response
+
+    def stopped_on(self) -> tuple[str, int]:
+        """Why the run started by the last request stopped, and on which line."""
+        if (running := self.adapter._worker) is not None:
+            running.join(TIMEOUT)
+        (stop,) = [m for m in self.sent if m.get("event") == "stopped"][-1:]
+        return stop["body"]["reason"], self.request("stackTrace")["body"]["stackFrames"][0][
+            "line"]
+
+
 def _answer_in_process(request: dict[str, Any]) -> dict[str, Any]:
     """The response of a fresh adapter to `request`, which must come within seconds."""
     sent: list[dict[str, Any]] = []
@@ -394,24 +423,81 @@ def test_a_launch_while_the_program_runs_is_refused(tmp_path: Path) -> None:
     one's."""
     looping = tmp_path / "loop.rob"
     looping.write_text(":01 A=A+1; #01\n")
-    sent: list[dict[str, Any]] = []
-    adapter = Adapter(sent.append)
-
-    def request(seq: int, command: str, arguments: dict[str, Any]) -> dict[str, Any]:
-        adapter.receive(json.dumps({"seq": seq, "type": "request", "command": command,
-                                    "arguments": arguments}).encode())
-        (response,) = [m for m in sent if m.get("request_seq") == seq]
-        return response
-
-    request(1, "launch", {"program": str(looping), "budget": 10**12})
-    request(2, "configurationDone", {})
-    running = adapter._worker
-    again = request(3, "launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)})
+    client = InProcess()
+    client.request("launch", {"program": str(looping), "budget": 10**12})
+    client.request("configurationDone")
+    running = client.adapter._worker
+    again = client.request("launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)})
     assert (again["success"], again["message"]) == (False, "the program is running: pause "
                                                            "it first")
-    request(4, "pause", {})
+    client.request("pause")
     assert running is not None
     running.join(TIMEOUT)
     assert not running.is_alive()
-    assert request(5, "launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)}
-                   )["success"]
+    assert client.request("launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)}
+                          )["success"]
+
+
+@pytest.mark.parametrize("seed", [-1, 2**32, 2**70])
+def test_a_seed_outside_rl1c_sims_range_is_refused(seed: int) -> None:
+    """Found by the hostile pass: a negative seed was an internal error ("please report
+    it"), which the world's random generators raised."""
+    response = _answer_in_process({"seq": 1, "type": "request", "command": "launch",
+                                   "arguments": {"program": str(SAMPLE), "world": str(WORLD),
+                                                 "seed": seed}})
+    assert (response["success"], response["message"]) == (
+        False, f"`seed` is {seed}: give a whole number from 0 to 4294967295, as rl1c sim "
+               "--seed")
+
+
+@pytest.mark.parametrize("elsewhere", ["other.rob", "missing.rob", "folder"])
+def test_breakpoints_of_another_file_leave_the_programs_alone(tmp_path: Path,
+                                                              elsewhere: str) -> None:
+    """Found by the hostile pass: the adapter took every file's breakpoints for the
+    program's, so that a client with breakpoints in two files (VS Code sends them file
+    by file) had the second file's replace the program's, and stop on their lines."""
+    (tmp_path / "other.rob").write_text("A=1\n")
+    (tmp_path / "folder").mkdir()
+    client = InProcess()
+    client.request("launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)})
+    ours = client.request("setBreakpoints", {"source": {"path": str(SAMPLE)},
+                                             "breakpoints": [{"line": 20}]})
+    assert ours["body"]["breakpoints"] == [{"verified": True, "line": 20}]
+    other = client.request("setBreakpoints", {"source": {"path": str(tmp_path / elsewhere)},
+                                              "breakpoints": [{"line": 1}, {"line": 3}]})
+    said = (f"{tmp_path / elsewhere} is not the program being debugged, {SAMPLE.resolve()}: "
+            "rl1-dap debugs one program")
+    assert other["body"]["breakpoints"] == [{"verified": False, "line": line, "message": said}
+                                            for line in (1, 3)]
+    client.request("configurationDone")
+    assert client.stopped_on() == ("breakpoint", 20)
+
+
+@pytest.mark.parametrize("source", [3, "sample.rob", {"path": 5}])
+def test_breakpoints_of_no_file_are_refused(source: object) -> None:
+    client = InProcess()
+    client.request("launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)})
+    response = client.request("setBreakpoints", {"source": source, "breakpoints": []})
+    assert (response["success"], response["message"]) == (
+        False, f"`source` is {source!r}: give an object with the file's `path`")
+
+
+@pytest.mark.parametrize(("command", "arguments", "said"), [
+    ("stackTrace", {"threadId": 2}, "no thread has the id 2: the program's is 1"),
+    ("continue", {"threadId": 0}, "no thread has the id 0: the program's is 1"),
+    ("next", {"threadId": "1"}, "no thread has the id '1': the program's is 1"),
+    ("pause", {"threadId": None}, "no thread has the id None: the program's is 1"),
+    ("scopes", {"frameId": 7}, "no frame has the id 7: the program's line is frame 1"),
+    ("evaluate", {"expression": "A", "frameId": 2},
+     "no frame has the id 2: the program's line is frame 1"),
+])
+def test_a_thread_or_frame_never_given_out_is_refused(command: str, arguments: dict[str, Any],
+                                                      said: str) -> None:
+    """Found by the hostile pass: each was answered as if the id were the program's."""
+    client = InProcess()
+    client.request("launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS),
+                              "stopOnEntry": True})
+    client.request("configurationDone")
+    response = client.request(command, arguments)
+    assert (response["success"], response["message"]) == (False, said)
+    assert client.request(command, {**arguments, "threadId": 1, "frameId": 1})["success"]
