@@ -34,6 +34,7 @@ from rl1.compiler.backend.driver import OPTIMIZATION_LEVELS, compile_text
 from rl1.compiler.executors import (
     exit_how,
     ignore_interrupts,
+    orphans_ended,
     pickled_error,
     spawn,
     unpickled_error,
@@ -224,7 +225,8 @@ class ExecEngine:
                 stream.write(compiled(case.source, self.level))
             with open(sensors_path, "w", encoding="utf-8") as stream:
                 json.dump(case.script, stream)
-            ran = _run_shell(self.command_line(ilc_path, sensors_path, budget))
+            with orphans_ended():  # what it started in a session of its own, too
+                ran = _run_shell(self.command_line(ilc_path, sensors_path, budget))
         match ran:
             case _Ran(ending="timeout"):
                 return _no_run("timeout", f"it ran longer than {EXEC_TIMEOUT:.0f} seconds")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import ctypes
 import functools
 import hashlib
 import logging
@@ -478,6 +479,66 @@ def spawn(target: Callable[..., object], *args: object, keep: tuple[int, ...] = 
         # status says how
         process.stdin.write(start)
     return process
+
+
+PR_SET_CHILD_SUBREAPER = 36  # Linux's prctl option (linux/prctl.h)
+
+
+@contextmanager
+def orphans_ended() -> Iterator[None]:
+    """While inside, this process adopts the orphans among its descendants, where init
+    would (Linux's child subreaper); on leaving, it kills and reaps every child it has
+    that it did not have on entering, and those that these leave in turn: so a command
+    run inside, whose process group is killed at its end, leaves no process it started
+    in a session of its own (setsid), outside that group. Nothing is adopted where that
+    cannot be (not Linux, no /proc listing the children). Only for a thread whose
+    process starts no other processes meanwhile: those would be taken for orphans."""
+    adopting = _adopt_orphans(True)
+    before = _children() if adopting else set()
+    try:
+        yield
+    finally:
+        if adopting:
+            _end_adopted(before)
+            _adopt_orphans(False)
+
+
+def _adopt_orphans(adopt: bool) -> bool:
+    """Whether this process now adopts (or no longer adopts) its descendants' orphans."""
+    if not sys.platform.startswith("linux") or not os.path.exists(
+            f"/proc/self/task/{threading.get_native_id()}/children"):
+        return False
+    libc = ctypes.CDLL(None, use_errno=True)
+    return libc.prctl(ctypes.c_int(PR_SET_CHILD_SUBREAPER), ctypes.c_ulong(adopt),
+                      ctypes.c_ulong(0), ctypes.c_ulong(0), ctypes.c_ulong(0)) == 0
+
+
+def _children() -> set[int]:
+    """This process's children now, those of each of its threads."""
+    children: set[int] = set()
+    for thread in os.listdir("/proc/self/task"):
+        with contextlib.suppress(OSError), \
+                open(f"/proc/self/task/{thread}/children", encoding="ascii") as listed:
+            # (suppressed: a thread that ended since)
+            children.update(int(pid) for pid in listed.read().split())
+    return children
+
+
+def _end_adopted(before: set[int]) -> None:
+    """Kill and reap the children this process has beyond `before` (and, as each ends,
+    the orphans it leaves in turn)."""
+    spared = set(before)
+    while adopted := _children() - spared:
+        for pid in adopted:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except PermissionError:  # another user's (setuid): it cannot be ended
+                spared.add(pid)
+            except ProcessLookupError:  # reaped already (waitpid finds none)
+                pass
+        for pid in adopted - spared:
+            with contextlib.suppress(ChildProcessError):
+                os.waitpid(pid, 0)
 
 
 def exit_how(code: int) -> str:

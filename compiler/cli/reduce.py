@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
+from rl1.compiler.executors import orphans_ended
 from rl1.compiler.files import SourceError, read_bounded, refuses_writing
 from rl1.compiler.reporting.render import EXIT_ERRORS
 
@@ -282,7 +283,8 @@ class _ShellTest:
     """`command` run through the shell on each candidate, in a new temporary folder
     holding its files: interesting when it exits 0 within `timeout` seconds. Its output
     is read as it comes and only its end kept; when it ends, or is stopped, every process
-    left in its process group is killed."""
+    left in its process group is killed, and on Linux every process it started in a
+    session of its own too (`executors.orphans_ended`)."""
 
     def __init__(self, command: str, files: _Files, timeout: int) -> None:
         self.command, self.files, self.timeout = command, files, timeout
@@ -312,33 +314,33 @@ class _ShellTest:
 
 
 def _run(command: str, folder: str, timeout: int) -> _Ran:
-    process = subprocess.Popen(command, shell=True, cwd=folder, stdin=subprocess.DEVNULL,
-                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                               start_new_session=True)
-    assert process.stdout is not None
     kept = bytearray()
-    pipe = process.stdout.fileno()
 
-    def read() -> None:
+    def read(pipe: int) -> None:
         with contextlib.suppress(OSError):
             while chunk := os.read(pipe, 1 << 16):
                 kept.extend(chunk)
                 del kept[:-OUTPUT_KEPT]
 
-    reader = threading.Thread(target=read, daemon=True)
-    reader.start()
-    try:
-        status: int | None = process.wait(timeout)
-    except subprocess.TimeoutExpired:
-        status = None
-    finally:
-        # What it started is killed with it (gone already, or another user's: let be).
-        with contextlib.suppress(ProcessLookupError, PermissionError):
-            os.killpg(process.pid, signal.SIGKILL)
-        process.wait()
-        reader.join(1.0)  # a process that left the group may hold the pipe: not waited for
-        if not reader.is_alive():
-            process.stdout.close()
+    with orphans_ended():
+        process = subprocess.Popen(command, shell=True, cwd=folder,
+                                   stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                                   stderr=subprocess.STDOUT, start_new_session=True)
+        assert process.stdout is not None
+        reader = threading.Thread(target=read, args=(process.stdout.fileno(),), daemon=True)
+        reader.start()
+        try:
+            status: int | None = process.wait(timeout)
+        except subprocess.TimeoutExpired:
+            status = None
+        finally:
+            # What it started is killed with it (gone already, or another user's: let be).
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+    reader.join(1.0)  # a process that escaped may hold the pipe: not waited for
+    if not reader.is_alive():
+        process.stdout.close()
     return _Ran(status, bytes(kept))
 
 

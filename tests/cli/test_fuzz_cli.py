@@ -3,9 +3,12 @@ spec/optimization.md section 5, and a planted bug is found, shrunk and written d
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shlex
+import shutil
+import signal
 import stat
 import subprocess
 import sys
@@ -298,6 +301,22 @@ def test_a_timed_out_engine_leaves_no_process_behind(tmp_path: Path,
     finally:
         if Path(f"/proc/{pid}").exists():
             os.kill(pid, 9)
+
+
+@pytest.mark.skipif(shutil.which("setsid") is None, reason="the test starts setsid")
+@pytest.mark.parametrize("ending", ["sleep 300", "exit 0"])
+def test_an_engines_process_in_a_session_of_its_own_is_killed_too(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, ending: str) -> None:
+    # Outside the process group that is killed: one left a program, for a campaign.
+    monkeypatch.setattr(differential, "EXEC_TIMEOUT", 1.0)
+    pid_file = tmp_path / "pid"
+    exec_run(f"setsid sleep 300 > /dev/null 2>&1 & echo $! > {pid_file}; {ending}")
+    pid = int(pid_file.read_text(encoding="ascii"))
+    try:
+        assert ends_within(pid, seconds=10.0), f"process {pid} outlived the engine"
+    finally:
+        with contextlib.suppress(ProcessLookupError):  # as it should be
+            os.kill(pid, signal.SIGKILL)
 
 
 def test_a_quoted_placeholder_never_runs_the_folder_name(tmp_path: Path) -> None:

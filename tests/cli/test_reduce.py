@@ -4,11 +4,13 @@ never touched, and hostile commands and files end with a message and a status.""
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
 import re
 import shlex
+import shutil
 import signal
 import subprocess
 import sys
@@ -21,6 +23,7 @@ from hypothesis import strategies as st
 from support import SAMPLE, SAMPLE_SENSORS
 from support.cli import rl1c
 from support.planted import BROKEN_VM, BrokenShift
+from support.processes import ends_within
 
 from rl1.compiler import fuzz
 from rl1.compiler.analysis import analyze
@@ -265,6 +268,27 @@ def test_a_command_that_hangs_is_stopped_at_the_timeout(sample: tuple[Path, Path
     assert time.monotonic() - started < 30
     assert result.exit_code == 1
     assert "`sleep 60 & sleep 60` ran longer than 1 s (--timeout)" in result.stderr
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux") or shutil.which("setsid") is None,
+                    reason="a child subreaper is Linux's, and the test starts setsid")
+@pytest.mark.parametrize("ending", ["sleep 60", "exit 1"])
+def test_a_process_the_command_started_in_a_session_of_its_own_is_killed_too(
+        sample: tuple[Path, Path], tmp_path: Path, ending: str) -> None:
+    # Outside the process group, which the timeout kills; as each test runs the command
+    # again, such processes would pile up for the whole reduction.
+    program, _ = sample
+    pid_file = tmp_path / "pid"
+    command = f"setsid sleep 300 & echo $! > {shlex.quote(str(pid_file))}; {ending}"
+    result = rl1c("reduce", program, "--interesting", command, "--timeout", "1")
+    assert result.exit_code == 1
+    orphan = int(pid_file.read_text())
+    try:
+        assert ends_within(orphan, 10), f"process {orphan}, in a session of its own, outlived" \
+            " the command"
+    finally:
+        with contextlib.suppress(ProcessLookupError):  # as it should be
+            os.kill(orphan, signal.SIGKILL)
 
 
 def test_a_command_that_prints_megabytes_keeps_only_the_end(
