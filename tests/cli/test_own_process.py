@@ -5,6 +5,7 @@ parent."""
 
 from __future__ import annotations
 
+import contextlib
 import importlib.util
 import os
 import signal
@@ -91,5 +92,5 @@ def test_a_process_of_its_own_ends_amid_a_task_when_its_parent_is_killed() -> No
         try:
             assert ends_within(child, 30), f"process {child} outlived its parent"
         finally:
-            if not ends_within(child, 0):
+            with contextlib.suppress(ProcessLookupError):  # as it should be
                 os.kill(child, signal.SIGKILL)
