@@ -11,11 +11,14 @@ import os
 import signal
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from support.cli import rl1c
 from support.processes import ends_within
 
+from rl1.compiler import fuzz
 from rl1.compiler.differential import EngineUnavailable, Observation, VmEngine, judge_apart
 from rl1.compiler.executors import TaskUnreadable, in_own_process
 from rl1.compiler.strategies import Run
@@ -33,10 +36,10 @@ def _refuses() -> None:
     raise _Refused("refused", 3)
 
 
-def test_a_task_its_process_cannot_read_is_said_so_and_the_process_lives_on(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    # A function of a module this process loaded from a file that is not on the path
-    # (as Dask loads a preload file): it pickles here, and the child cannot import it.
+@pytest.fixture
+def loaded_here(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Callable[[], int]:
+    """A function of a module this process loaded from a file that is not on the path
+    (as Dask loads a preload file): it pickles here, and a child cannot import it."""
     (tmp_path / "rl1_loaded_here.py").write_text("def answer() -> int:\n    return 42\n")
     spec = importlib.util.spec_from_file_location("rl1_loaded_here",
                                                   tmp_path / "rl1_loaded_here.py")
@@ -44,14 +47,36 @@ def test_a_task_its_process_cannot_read_is_said_so_and_the_process_lives_on(
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     monkeypatch.setitem(sys.modules, "rl1_loaded_here", module)
+    answer: Callable[[], int] = module.answer
+    return answer
+
+
+UNREADABLE = ("the process spawned for a task could not read it (ModuleNotFoundError: No "
+              "module named 'rl1_loaded_here')\n  = help: the task's code must import there "
+              "as it does here: install the same rl1")
+
+
+def test_a_task_its_process_cannot_read_is_said_so_and_the_process_lives_on(
+        loaded_here: Callable[[], int]) -> None:
     child = in_own_process((), os.getpid)
     with pytest.raises(TaskUnreadable) as raised:
-        in_own_process((), module.answer)
-    assert str(raised.value).startswith(
-        "the process spawned for a task could not read it (ModuleNotFoundError: No module "
-        "named 'rl1_loaded_here')\n  = help: the task's code must import there as it does "
-        "here: install the same rl1")
+        in_own_process((), loaded_here)
+    assert str(raised.value).startswith(UNREADABLE)
     assert in_own_process((), os.getpid) == child  # the next task, in the same process
+
+
+def test_rl1c_fuzz_says_a_search_its_process_cannot_read_with_status_2(
+        loaded_here: Callable[[], int], monkeypatch: pytest.MonkeyPatch) -> None:
+    # As a campaign's search on a cluster's worker whose rl1 imports other code (a
+    # worker's own search raises it in the same way, named by its worker's address).
+    def campaign(*args: object, **kwargs: object) -> None:
+        in_own_process((), loaded_here)
+
+    monkeypatch.setattr(fuzz, "campaign", campaign)
+    result = rl1c("fuzz", "--count", "1")
+    assert result.exit_code == 2
+    assert result.stderr.startswith(f"error: {UNREADABLE}")
+    assert "Traceback" not in result.stderr
 
 
 def test_an_error_the_parent_cannot_rebuild_is_named_with_its_message() -> None:
