@@ -11,16 +11,19 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
+import reprlib
 from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from importlib.metadata import version
 from pathlib import PurePosixPath
 from typing import Any, ClassVar
 
+from rl1.compiler.campaign import MAX_SEED
 from rl1.compiler.debugger import DebugError, compile_program, parse_call, parse_value
 from rl1.compiler.files import SourceError
 from rl1.compiler.frontend.source import decode
 from rl1.vm import ilc
+from rl1.vm.config import excerpt
 from rl1.vm.defaults import DEFAULT_BUDGET, DEFAULT_LEVEL
 from rl1.vm.sensor_script import Script, ScriptError, decode_script
 from rl1.vm.sim.world import World, WorldError, decode_world
@@ -50,7 +53,6 @@ MAX_BREAKPOINTS = 10_000
 event loop, a search of the program's lines and a condition parsed (once) each."""
 MAX_EXPRESSION = 1000
 """Characters of a condition or an evaluated value."""
-MAX_SEED = 2**32 - 1
 FRAME_BACKLOG = 2**20
 """Bytes the page has not read yet past which frames are dropped (the next one shows
 where the vehicle is): a page that falls behind is not sent more to fall behind on."""
@@ -132,8 +134,8 @@ class Connection:
         handler = self.METHODS.get(method)
         try:
             if handler is None:
-                raise RpcError(NO_SUCH_METHOD, f"`{method}` is no method of the studio: the "
-                               f"methods are {', '.join(self.METHODS)} (spec/studio.md)")
+                raise RpcError(NO_SUCH_METHOD, f"`{excerpt(method)}` is no method of the studio: "
+                               f"the methods are {', '.join(self.METHODS)} (spec/studio.md)")
             if not isinstance(params, dict):
                 raise RpcError(INVALID_PARAMS, "`params` is not an object: send an object, "
                                "{} when there is nothing to give")
@@ -201,8 +203,8 @@ class Connection:
         over = _string(params, "version") if params.get("version") is not None else None
         encoding = params.get("encoding", "utf-8")
         if encoding not in ("utf-8", "cp932"):
-            raise RpcError(INVALID_PARAMS, f"`encoding` is {encoding!r}: give \"utf-8\" or "
-                           "\"cp932\"")
+            raise RpcError(INVALID_PARAMS, f"`encoding` is {reprlib.repr(encoding)}: give "
+                           "\"utf-8\" or \"cp932\"")
         try:
             data = text.encode(encoding)
         except UnicodeEncodeError as error:
@@ -241,16 +243,17 @@ class Connection:
                            "sensor script), not both")
         level = params.get("level")
         if level is not None and not (_whole(level) and level in LEVELS):
-            raise RpcError(INVALID_PARAMS, f"`level` is {level!r}: give 0, 1, 2 or null")
+            raise RpcError(INVALID_PARAMS, f"`level` is {reprlib.repr(level)}: give 0, 1, 2 "
+                           "or null")
         seed = params.get("seed", 0)
         if not _whole(seed) or not 0 <= seed <= MAX_SEED:
-            raise RpcError(INVALID_PARAMS, f"`seed` is {seed!r}: give a whole number from 0 "
-                           f"to {MAX_SEED}")
+            raise RpcError(INVALID_PARAMS, f"`seed` is {reprlib.repr(seed)}: give a whole "
+                           f"number from 0 to {MAX_SEED}")
         speed = _speed(params) if "speed" in params else DEFAULT_SPEED
         stop_on_entry = params.get("stopOnEntry", False)
         if not isinstance(stop_on_entry, bool):
-            raise RpcError(INVALID_PARAMS, f"`stopOnEntry` is {stop_on_entry!r}: give true "
-                           "or false")
+            raise RpcError(INVALID_PARAMS, f"`stopOnEntry` is {reprlib.repr(stop_on_entry)}: "
+                           "give true or false")
         launch = await asyncio.to_thread(self._prepare, program, world, sensors, level, seed,
                                          stop_on_entry)
         self.close()
@@ -472,8 +475,9 @@ def _speed(params: dict[str, Any]) -> float | None:
         return None
     if isinstance(speed, bool) or not isinstance(speed, int | float) or not (
             MIN_SPEED <= speed <= MAX_SPEED):
-        raise RpcError(INVALID_PARAMS, f"`speed` is {speed!r}: give a number of times real "
-                       f"time, {MIN_SPEED:g} to {MAX_SPEED:g}, or null for the fastest")
+        raise RpcError(INVALID_PARAMS, f"`speed` is {reprlib.repr(speed)}: give a number of "
+                       f"times real time, {MIN_SPEED:g} to {MAX_SPEED:g}, or null for the "
+                       "fastest")
     return float(speed)
 
 
@@ -495,7 +499,7 @@ def _source(params: dict[str, Any], key: str, default_name: str) -> Source | Non
                                f"{ilc.MAX_NAME_SIZE} bytes, the most a program records: give "
                                "a file's name, such as `sample.rob`")
             return Source(name, text=_unicode(text, f"`{key}.text`"))
-    raise RpcError(INVALID_PARAMS, f"`{key}` is {json.dumps(given)[:80]}: give {{\"path\": "
+    raise RpcError(INVALID_PARAMS, f"`{key}` is {reprlib.repr(given)}: give {{\"path\": "
                    "\"a file in the folder\"} or {\"text\": \"...\", \"name\": \"...\"}")
 
 

@@ -17,6 +17,7 @@ from pathlib import Path, PurePosixPath
 from typing import Literal
 
 from rl1.compiler.files import write_atomically
+from rl1.vm.config import excerpt
 
 Kind = Literal["program", "world", "sensors"]
 KINDS: dict[str, Kind] = {".rob": "program", ".world.toml": "world",
@@ -24,6 +25,7 @@ KINDS: dict[str, Kind] = {".rob": "program", ".world.toml": "world",
 """The files the studio lists and writes, by how their names end."""
 
 MAX_FILE_BYTES = 8 * 2**20
+MAX_PATH = 4096  # Linux's PATH_MAX: no longer path names a file
 MAX_LISTED = 1000
 MAX_VISITED = 100_000
 """Directory entries a listing looks at, at most: a folder holding a huge tree (a home
@@ -74,6 +76,10 @@ class Folder:
     def resolve(self, path: str) -> Path:
         """Where `path` (relative to the folder, or absolute inside it) leads; Refused
         when it leaves the folder or spells `..`."""
+        if len(path) > MAX_PATH:  # quoted whole, a page's 64 MiB would be six times that
+            raise Refused(f"`{excerpt(path)}` is longer than {MAX_PATH:,} characters, "
+                          "longer than any file's path: give one relative to the folder, "
+                          "such as `sample.rob`")
         if not path or "\x00" in path or not _nameable(path):
             raise Refused(f"`{path!r}` is no file's path: give one relative to the folder, "
                           "such as `sample.rob`")

@@ -121,3 +121,30 @@ def test_a_program_deep_in_the_folder_runs(served: Served) -> None:
         path = (deep / "deep.rob").relative_to(served.server.studio.folder.root).as_posix()
         assert len(path) > 255
         assert client.request("run/launch", {"program": {"path": path}})["lines"] == [1]
+
+
+LONG = "\u00e9" * 2**20  # 6 MiB of JSON escapes once quoted whole
+
+
+@pytest.mark.parametrize("method, params, said", [
+    (LONG, {}, "is no method of the studio"),
+    ("files/read", {"path": LONG}, "is longer than"),
+    ("files/save", {"path": LONG, "text": ""}, "is longer than"),
+    ("files/save", {"path": "a.rob", "text": "", "encoding": LONG}, "`encoding` is"),
+    ("run/launch", {"program": {"path": LONG}}, "is longer than"),
+    ("run/launch", {"program": LONG}, "`program` is"),
+    ("run/launch", {"program": {"path": "sample.rob"}, "level": [LONG]}, "`level` is"),
+    ("run/launch", {"program": {"path": "sample.rob"}, "seed": LONG}, "`seed` is"),
+    ("run/launch", {"program": {"path": "sample.rob"}, "stopOnEntry": LONG}, "`stopOnEntry`"),
+    ("debug/setSpeed", {"speed": LONG}, "`speed` is"),
+])
+def test_an_error_quotes_an_excerpt_of_what_the_page_sent(client: Page, method: str,
+                                                           params: dict[str, Any],
+                                                           said: str) -> None:
+    """Found by the hostile pass: each error quoted the page's value whole, and JSON's
+    escapes made 54 MiB of it (9 Mi characters) an answer of 54 MiB, written at a peak
+    of 262 to 370 MiB more for one page, past the bound of what pages hold."""
+    with pytest.raises(Failed) as failed:
+        client.request(method, params)
+    assert said in str(failed.value)
+    assert len(str(failed.value)) < 400, str(failed.value)[:200]
