@@ -95,11 +95,13 @@ def _to_fixpoint(passes: tuple[Pass, ...], program: ir.Program, check: bool,
         due = [flag and other is not run for flag, other in zip(due, passes, strict=True)]
         program, after = _run_one(run, program, shape, check, fired)
         if after != shape:
-            spared = GIVES_NO_WORK_TO.get(run, frozenset()) \
-                | ({run} if run in IDEMPOTENT else set())
+            spared = (GIVES_NO_WORK_TO.get(run, frozenset())
+                      | ({run} if run in IDEMPOTENT else set()))
             due = [flag or other not in spared for flag, other in zip(due, passes, strict=True)]
             shape = after
-        del after  # equal to `shape` or it: one shape is held while the next pass runs
+        # Unchanged, `after` is a second list equal to `shape`: let it go before the next
+        # pass runs, so that the rounds hold one shape at a time (a program's size).
+        del after
         if not any(due):
             break
     return program
@@ -125,8 +127,8 @@ def _shape(program: ir.Program) -> Shape:
     """The whole program as comparable values (instructions are frozen dataclasses): each
     block's id, then its instructions and terminator, in one list. A block's id, the one
     string among them, tells where each block starts, so two programs are alike when
-    their shapes are equal; a tuple a block cost 9 bytes a source byte of a branch a
-    line."""
+    their shapes are equal. One flat list, since a tuple for each block cost 9 bytes of
+    memory a source byte (a program of a branch a line)."""
     shape: Shape = []
     for block in program:
         shape.append(block.id)
