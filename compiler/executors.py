@@ -445,7 +445,9 @@ def _checked(digest: str, isolated: bool, fn: Callable[P, T], /, *args: P.args,
         raise _OtherRl1(get_worker().address)
     if not isolated:
         return fn(*args, **kwargs)
-    # Those given as modules (not files), which a process finds on the worker's path.
+    # Those given as modules (not files), which a process finds on the worker's path;
+    # their `dask_setup` is not called there: Dask calls it with a worker, which that
+    # process is not (spec/optimization.md).
     preloaded = tuple(preload.name for preload in get_worker().preloads
                       if getattr(getattr(preload, "module", None), "__name__", None)
                       == preload.name)
@@ -509,8 +511,9 @@ def _adopt_orphans(adopt: bool) -> bool:
             f"/proc/self/task/{threading.get_native_id()}/children"):
         return False
     libc = ctypes.CDLL(None, use_errno=True)
-    return libc.prctl(ctypes.c_int(PR_SET_CHILD_SUBREAPER), ctypes.c_ulong(adopt),
-                      ctypes.c_ulong(0), ctypes.c_ulong(0), ctypes.c_ulong(0)) == 0
+    status: int = libc.prctl(ctypes.c_int(PR_SET_CHILD_SUBREAPER), ctypes.c_ulong(adopt),
+                             ctypes.c_ulong(0), ctypes.c_ulong(0), ctypes.c_ulong(0))
+    return status == 0
 
 
 def _children() -> set[int]:
