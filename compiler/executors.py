@@ -483,7 +483,9 @@ def spawn(target: Callable[..., object], *args: object, keep: tuple[int, ...] = 
     return process
 
 
-PR_SET_CHILD_SUBREAPER = 36  # Linux's prctl option (linux/prctl.h)
+# Linux's prctl options (linux/prctl.h)
+PR_SET_PDEATHSIG = 1
+PR_SET_CHILD_SUBREAPER = 36
 
 
 @contextmanager
@@ -507,12 +509,17 @@ def orphans_ended() -> Iterator[None]:
 
 def _adopt_orphans(adopt: bool) -> bool:
     """Whether this process now adopts (or no longer adopts) its descendants' orphans."""
-    if not sys.platform.startswith("linux") or not os.path.exists(
-            f"/proc/self/task/{threading.get_native_id()}/children"):
+    return os.path.exists(f"/proc/self/task/{threading.get_native_id()}/children") \
+        and _prctl(PR_SET_CHILD_SUBREAPER, adopt)
+
+
+def _prctl(option: int, value: int) -> bool:
+    """Whether Linux's prctl set `option` of this process to `value` (False elsewhere)."""
+    if not sys.platform.startswith("linux"):
         return False
     libc = ctypes.CDLL(None, use_errno=True)
-    status: int = libc.prctl(ctypes.c_int(PR_SET_CHILD_SUBREAPER), ctypes.c_ulong(adopt),
-                             ctypes.c_ulong(0), ctypes.c_ulong(0), ctypes.c_ulong(0))
+    status: int = libc.prctl(ctypes.c_int(option), ctypes.c_ulong(value), ctypes.c_ulong(0),
+                             ctypes.c_ulong(0), ctypes.c_ulong(0))
     return status == 0
 
 
@@ -608,21 +615,18 @@ _Answer = tuple[str, bytes, str]
 @dataclass(frozen=True, slots=True)
 class _OwnProcess:
     """A process that makes a thread's tasks one after the other (`_serve`), the modules
-    `preloaded` imported; the ends of its pipes of tasks and answers, and of the pipe
-    whose end, closed, tells it that this process ended (`_end_with_parent`)."""
+    `preloaded` imported; the ends of its pipes of tasks and answers."""
 
     process: subprocess.Popen[bytes]
     preloaded: tuple[str, ...]
     tasks: IO[bytes]
     answers: IO[bytes]
-    alive: IO[bytes]
 
     def close(self) -> None:
         with contextlib.suppress(OSError):  # a task left unsent to a process that ended
             self.tasks.close()  # which ends it, when it lives
         self.answers.close()
         self.process.wait()
-        self.alive.close()
 
 
 _own = threading.local()  # each thread's _OwnProcess
@@ -636,7 +640,8 @@ def in_own_process(preloaded: tuple[str, ...], fn: Callable[P, T], /, *args: P.a
     TaskProcessEnded when that process ends before it answers (the next task has a new
     one); TaskUnreadable when it cannot unpickle the task (it imports other code than
     this process); what the task raised, or a RuntimeError naming it where this process
-    cannot rebuild it. The process ends when this one does, even amid a task."""
+    cannot rebuild it. The process ends when this one does (on Linux even amid a
+    task)."""
     own: _OwnProcess | None = getattr(_own, "process", None)
     if own is None or own.preloaded != preloaded:
         if own is not None:
@@ -679,30 +684,26 @@ def in_own_process(preloaded: tuple[str, ...], fn: Callable[P, T], /, *args: P.a
 def _start_own(preloaded: tuple[str, ...]) -> _OwnProcess:
     tasks_read, tasks = os.pipe()
     answers, answers_written = os.pipe()
-    alive_read, alive = os.pipe()
     try:
-        process = spawn(_serve, tasks_read, answers_written, alive_read, preloaded,
-                        keep=(tasks_read, answers_written, alive_read))
+        process = spawn(_serve, tasks_read, answers_written, os.getpid(), preloaded,
+                        keep=(tasks_read, answers_written))
     except BaseException:  # such as no process to be had (EAGAIN, ENOMEM)
         os.close(tasks)
         os.close(answers)
-        os.close(alive)
         raise
     finally:
         os.close(tasks_read)
         os.close(answers_written)
-        os.close(alive_read)
-    return _OwnProcess(process, preloaded, open(tasks, "wb"), open(answers, "rb"),
-                       open(alive, "wb"))
+    return _OwnProcess(process, preloaded, open(tasks, "wb"), open(answers, "rb"))
 
 
-def _serve(tasks: int, answers: int, alive: int, preloaded: tuple[str, ...]) -> None:
+def _serve(tasks: int, answers: int, parent: int, preloaded: tuple[str, ...]) -> None:
     """`in_own_process`'s child: for each task read from the pipe `tasks`, its answer
     (`_answer`) on the pipe `answers`, until `tasks` ends; it ends amid a task when the
-    pipe `alive` ends."""
+    process `parent` does (`_end_with_parent`)."""
     import importlib
 
-    threading.Thread(target=_end_with_parent, args=(alive,), daemon=True).start()
+    _end_with_parent(parent)
     for module in preloaded:
         importlib.import_module(module)
     # A pipe broken: the parent ended while a task ran (its answer unwritten, this one
@@ -730,12 +731,14 @@ def _answer(task: bytes) -> _Answer:
         return _RAISED, *pickled_error(error)
 
 
-def _end_with_parent(alive: int) -> None:
-    """Ends this process once the pipe `alive` ends: its one writer, the parent, has
-    ended (a Dask worker killed amid a task), and the task's result has no reader."""
-    while os.read(alive, 1):  # nothing is written: it returns at the end
-        pass
-    os._exit(128 + signal.SIGHUP)
+def _end_with_parent(parent: int) -> None:
+    """Has this process killed when the thread of `parent` that started it ends (Linux),
+    as a Dask worker killed amid a task: the task's result would have no reader. A
+    thread watching a pipe would do it anywhere, but a process of several threads
+    judges apart by spawning, not forking (differential.forks_safely), ten times as
+    slow. Elsewhere, this process ends at its next look for a task."""
+    if _prctl(PR_SET_PDEATHSIG, signal.SIGKILL) and os.getppid() != parent:
+        os._exit(128 + signal.SIGKILL)  # it ended before this process asked
 
 
 def _threads(client: Client, address: str) -> int:

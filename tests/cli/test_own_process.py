@@ -18,7 +18,7 @@ import pytest
 from support.cli import rl1c
 from support.processes import ends_within
 
-from rl1.compiler import fuzz
+from rl1.compiler import differential, fuzz
 from rl1.compiler.differential import EngineUnavailable, Observation, VmEngine, judge_apart
 from rl1.compiler.executors import TaskUnreadable, in_own_process
 from rl1.compiler.strategies import Run
@@ -100,6 +100,12 @@ def test_judged_apart_an_error_the_parent_cannot_rebuild_is_named_with_its_messa
     with pytest.raises(RuntimeError, match=r"^_Refused: refused at 3 \(raised in a child "
                        r"process, and not rebuilt here: TypeError: "):
         judge_apart(Run("A=1\n", {}), [VmEngine(0), _RefusingEngine()], 100)
+
+
+def test_a_process_of_its_own_runs_one_thread_so_it_judges_apart_by_forking() -> None:
+    # A thread of its own (one watching its parent, say) would have it spawn a process
+    # for each case judged apart, some ten times as slow (bench/own_process.py).
+    assert in_own_process((), differential.forks_safely)
 
 
 def test_a_process_of_its_own_ends_amid_a_task_when_its_parent_is_killed() -> None:
