@@ -58,8 +58,14 @@ def compile_program(text: str, source_name: str, level: int | None = None
 
 # Values and conditions ----------------------------------------------------------------------------
 
-_CONDITION = re.compile(r"^(?P<value>.*?)\s*(?P<relation>[=<>])\s*0\s*$", re.DOTALL)
-_AGAINST_NUMBER = re.compile(r"^(.+?)\s*([=<>])\s*(-?[0-9]+)\s*$", re.DOTALL)
+MAX_EXPRESSION = 1000
+"""Characters of a condition, a call breakpoint's name or an evaluated value a client
+may give (rl1-dap, the studio): refused whole, a longer one is not quoted in full."""
+
+# Searched for, the value being what comes before: a pattern for the value too
+# backtracked over a run of spaces in time quadratic in its length.
+_CONDITION = re.compile(r"(?P<relation>[=<>])\s*0\s*$")
+_AGAINST_NUMBER = re.compile(r"([=<>])\s*(-?[0-9]+)\s*$")
 _RELATIONS: dict[str, ast.Relation] = {"=": "=", ">": ">", "<": "<"}
 _CONDITION_HELP = ("write a value of the language compared with 0, as a conditional jump "
                    "tests it: `A<0`, `U-L>0`, `d=0`")
@@ -143,18 +149,19 @@ def _as_read(operand: ast.Operand) -> Read:
 def parse_condition(text: str) -> Condition:
     """A breakpoint's condition: a value compared with 0; DebugError saying what is
     wrong."""
-    match = _CONDITION.match(text.strip())
-    other = _AGAINST_NUMBER.match(text.strip())
-    if match is None and other is not None:
-        shown, compared, number = other.groups()
+    stripped = text.strip()
+    match = _CONDITION.search(stripped)
+    other = _AGAINST_NUMBER.search(stripped)
+    if match is None and other is not None and other.start() > 0:
+        shown, (compared, number) = stripped[:other.start()].rstrip(), other.groups()
         sign = "+" if number.startswith("-") else "-"
         raise DebugError(f"the condition `{text.strip()}` compares with {number}, and a "
                          f"condition compares with 0 (`<` after a value is a shift): "
                          f"write `{shown}{sign}{number.lstrip('-')}{compared}0`")
-    if match is None or not match["value"]:
+    if match is None or not (value_text := stripped[:match.start()].rstrip()):
         raise DebugError(f"the condition `{text.strip()}` compares nothing with 0: "
                          f"{_CONDITION_HELP}")
-    value = parse_value(match["value"], _CONDITION_HELP)
+    value = parse_value(value_text, _CONDITION_HELP)
     return Condition(text.strip(), value, _RELATIONS[match["relation"]])
 
 

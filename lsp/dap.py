@@ -31,6 +31,7 @@ import click
 
 from rl1.compiler.campaign import MAX_SEED
 from rl1.compiler.debugger import (
+    MAX_EXPRESSION,
     DebugError,
     Session,
     Stop,
@@ -209,15 +210,15 @@ class Adapter:
     def _on_setBreakpoints(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
         session = self._session()
         wanted = _listed(arguments, "breakpoints")
-        if not all(isinstance(b, dict) and _whole(b.get("line")) for b in wanted):
-            raise Refused("`breakpoints` is a list of objects, each with a `line`")
+        if not all(isinstance(b, dict) and _whole(b.get("line"))
+                   and len(_condition(b) or "") <= MAX_EXPRESSION for b in wanted):
+            raise Refused("`breakpoints` is a list of objects, each with a `line` and maybe "
+                          f"a `condition` of {MAX_EXPRESSION:,} characters at most")
         if (elsewhere := self._elsewhere(arguments.get("source"))) is not None:
             self._respond(request, {"breakpoints": [
                 {"verified": False, "line": b["line"], "message": elsewhere} for b in wanted]})
             return
-        bindings = session.set_line_breakpoints(
-            (b["line"], b.get("condition") if isinstance(b.get("condition"), str) else None)
-            for b in wanted)
+        bindings = session.set_line_breakpoints((b["line"], _condition(b)) for b in wanted)
         self._respond(request, {"breakpoints": [
             {"verified": True, "line": binding.line} if binding.verified else
             {"verified": False, "line": binding.requested, "message": binding.message}
@@ -249,11 +250,15 @@ class Adapter:
         for wanted in _listed(arguments, "breakpoints"):
             name = wanted.get("name") if isinstance(wanted, dict) else None
             try:
-                parse_call(str(name))
+                if not isinstance(name, str) or len(name) > MAX_EXPRESSION:
+                    raise DebugError("a function breakpoint's `name` is a built-in's: give "
+                                     "a mnemonic of Table 2 or 3, as `IMG`, or a form, as "
+                                     "`CAM P`")
+                parse_call(name)
             except DebugError as error:
                 answers.append({"verified": False, "message": str(error)})
                 continue
-            names.append(str(name))
+            names.append(name)
             answers.append({"verified": True})
         session.set_call_breakpoints(names)
         self._respond(request, {"breakpoints": answers})
@@ -342,6 +347,9 @@ class Adapter:
         expression = arguments.get("expression")
         if not isinstance(expression, str):
             raise Refused("evaluate needs `expression`: a value, as `U-L`")
+        if len(expression) > MAX_EXPRESSION:
+            raise Refused(f"`expression` is longer than {MAX_EXPRESSION:,} characters: give a "
+                          "value such as `U-L`")
         session = self._session()
         try:
             value = parse_value(expression).of(session.machine.variables)
@@ -420,6 +428,11 @@ def _refuse_unknown_ids(arguments: dict[str, Any]) -> None:
     for key, (what, ours, given) in _IDS.items():
         if key in arguments and not (_whole(arguments[key]) and arguments[key] == given):
             raise Refused(f"no {what} has the id {arguments[key]!r}: {ours}")
+
+
+def _condition(breakpoint: dict[str, Any]) -> str | None:
+    condition = breakpoint.get("condition")
+    return condition if isinstance(condition, str) else None
 
 
 def _listed(arguments: dict[str, Any], key: str) -> list[Any]:

@@ -19,7 +19,13 @@ from pathlib import PurePosixPath
 from typing import Any, ClassVar
 
 from rl1.compiler.campaign import MAX_SEED
-from rl1.compiler.debugger import DebugError, compile_program, parse_call, parse_value
+from rl1.compiler.debugger import (
+    MAX_EXPRESSION,
+    DebugError,
+    compile_program,
+    parse_call,
+    parse_value,
+)
 from rl1.compiler.files import SourceError
 from rl1.compiler.frontend.source import decode
 from rl1.vm import ilc
@@ -51,8 +57,6 @@ LEVELS = (0, 1, 2)
 MAX_BREAKPOINTS = 10_000
 """Line breakpoints, and call breakpoints, a page may set: binding them costs, on the
 event loop, a search of the program's lines and a condition parsed (once) each."""
-MAX_EXPRESSION = 1000
-"""Characters of a condition or an evaluated value."""
 FRAME_BACKLOG = 2**20
 """Bytes the page has not read yet past which frames are dropped (the next one shows
 where the vehicle is): a page that falls behind is not sent more to fall behind on."""

@@ -501,3 +501,47 @@ def test_a_thread_or_frame_never_given_out_is_refused(command: str, arguments: d
     response = client.request(command, arguments)
     assert (response["success"], response["message"]) == (False, said)
     assert client.request(command, {**arguments, "threadId": 1, "frameId": 1})["success"]
+
+
+def test_conditions_are_read_without_holding_the_adapter() -> None:
+    """Found by the hostile pass: a condition's two patterns backtracked over a run of
+    spaces in time quadratic in its length, and the adapter, which reads requests in
+    the thread that parses conditions, stopped answering: 2,000 conditions of 1,000
+    characters some 50 s (a message's 64 MiB of one, hours)."""
+    client = InProcess()
+    client.request("launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)})
+    wanted = [{"line": 20, "condition": f"A{' ' * 990}x{number}"} for number in range(2000)]
+    answers: list[dict[str, Any]] = []
+    setting = threading.Thread(target=lambda: answers.append(client.request(
+        "setBreakpoints", {"breakpoints": wanted})), daemon=True)
+    setting.start()
+    setting.join(10)
+    assert not setting.is_alive(), "the adapter hangs on the conditions"
+    bindings = answers[0]["body"]["breakpoints"]
+    assert [binding["verified"] for binding in bindings] == [False] * len(wanted)
+    assert bindings[0]["message"].startswith("the condition `A ")
+
+
+@pytest.mark.parametrize(("command", "arguments", "said"), [
+    ("evaluate", {"expression": "A" * 1001},
+     "`expression` is longer than 1,000 characters: give a value such as `U-L`"),
+    ("setBreakpoints", {"breakpoints": [{"line": 20, "condition": "A" * 1001}]},
+     "`breakpoints` is a list of objects, each with a `line` and maybe a `condition` of "
+     "1,000 characters at most"),
+    ("setFunctionBreakpoints", {"breakpoints": [{"name": "IMG" + " " * 1000}]},
+     "a function breakpoint's `name` is a built-in's: give a mnemonic of Table 2 or 3, as "
+     "`IMG`, or a form, as `CAM P`"),
+    ("setFunctionBreakpoints", {"breakpoints": [{"name": ["IMG"] * 1000}]},
+     "a function breakpoint's `name` is a built-in's: give a mnemonic of Table 2 or 3, as "
+     "`IMG`, or a form, as `CAM P`"),
+])
+def test_a_value_or_name_past_the_bound_is_refused_not_quoted(
+        command: str, arguments: dict[str, Any], said: str) -> None:
+    """Found by the hostile pass: each was quoted whole in its refusal, so that 64 MiB
+    of it made an answer of up to six times that (JSON's escapes)."""
+    client = InProcess()
+    client.request("launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)})
+    response = client.request(command, arguments)
+    assert response.get("message", said) == said
+    assert [b["message"] for b in response.get("body", {}).get("breakpoints", [])] in (
+        [], [said])
