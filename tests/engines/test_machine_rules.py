@@ -1,0 +1,73 @@
+"""Rules of the reference VM that no test held until mutation testing (tests/mutation/)
+changed them and every test still passed: each test here fails on such a mutant of
+vm/machine.py, and says which rule of spec/ilc.md it holds."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from support.semantics import int16
+from test_machine import To, assemble, call, execute, int16s, op, v
+from test_stepping import Fake
+
+from rl1.vm.faults import ABORTED_MESSAGE, Fault, FaultKind
+from rl1.vm.language import VARIABLES
+from rl1.vm.machine import Machine, State
+
+# Each conditional jump: whether it jumps on the value its variable holds when tested.
+CONDITIONAL_JUMPS: dict[str, Callable[[int], bool]] = {
+    "JZ": lambda value: value == 0,
+    "JGT": lambda value: value > 0,
+    "JLT": lambda value: value < 0,
+    "DJGT": lambda value: value > 0,  # tested once decremented
+    "SJZ": lambda value: value == 0,  # tested once the accumulator is stored in it
+    "SJGT": lambda value: value > 0,
+    "SJLT": lambda value: value < 0,
+}
+
+
+# Aborts (section 12.7): the fault is placed at the instruction at hand ---------------
+
+def test_an_abort_before_the_first_step_faults_at_the_first_line() -> None:
+    machine = Machine(assemble(op("INC", v("A")), op("INC", v("B"))), Fake())
+    machine.abort()
+    assert machine.step(10) is State.FAULTED
+    assert machine.executed == 0
+    assert machine.result is not None
+    assert machine.result.fault == Fault(FaultKind.ABORTED, ABORTED_MESSAGE, 1)
+
+
+def test_an_abort_while_a_call_waits_faults_at_the_call_and_stops_first() -> None:
+    fake = Fake(busy=5)
+    machine = Machine(assemble(op("INC", v("A")), call("TIM", 3), op("INC", v("B"))), fake)
+    assert machine.step(10) is State.WAITING
+    machine.abort()
+    assert machine.step(10) is State.FAULTED
+    assert machine.result is not None
+    assert machine.result.fault == Fault(FaultKind.ABORTED, ABORTED_MESSAGE, 2)
+    assert machine.result.named()["B"] == 0
+    assert fake.log[-2:] == ["stop", "end"]
+
+
+# Conditional jumps test their own variable (section 8.3) ----------------------------
+
+@settings(max_examples=100, deadline=None)
+@given(st.sampled_from(sorted(CONDITIONAL_JUMPS)), int16s)
+def test_a_conditional_jump_tests_its_variable_whatever_the_others_hold(
+        name: str, value: int) -> None:
+    """The tested variable is `a`; every other variable, among them those whose index is
+    the jump's target offset, holds a value that decides the jump the other way."""
+    jumps = CONDITIONAL_JUMPS[name]
+    tested = int16(value - 1) if name == "DJGT" else value
+    decoy = next(other for other in (-1, 0, 1) if jumps(other) != jumps(tested))
+    setup = [op("MOVI", index, decoy) for index in range(len(VARIABLES)) if index != v("a")]
+    setup.append(op("LDI", value) if name.startswith("S") else op("MOVI", v("a"), value))
+    end = len(setup) + 2
+    # No line map: MOVI is of format 1.2, whose line map needs a source digest.
+    program = assemble(*setup, op(name, v("a"), To(end)), op("MOVI", v("@"), 7),
+                       op("END"), debug=False)
+    variables = execute(program)[0].named()
+    assert variables["@"] == (decoy if jumps(tested) else 7)
+    assert variables["a"] == tested
