@@ -600,14 +600,15 @@ def _received(stream: IO[bytes]) -> bytes | None:
         return None
     if len(head) < _LENGTH.size:
         raise EOFError
-    message = stream.read(_LENGTH.unpack(head)[0])
-    if len(message) < _LENGTH.unpack(head)[0]:
+    (length,) = _LENGTH.unpack(head)
+    message = stream.read(length)
+    if len(message) < length:
         raise EOFError
     return message
 
 
 # What `in_own_process`'s child answers of a task: how it ended, the result or the error
-# pickled, and the error's type and message (`pickled_error`).
+# pickled, and the result's type, or the error's type and message (`pickled_error`).
 _RETURNED, _RAISED, _UNREADABLE = "returned", "raised", "unreadable"
 _Answer = tuple[str, bytes, str]
 
@@ -676,8 +677,8 @@ def in_own_process(preloaded: tuple[str, ...], fn: Callable[P, T], /, *args: P.a
     try:
         result: T = pickle.loads(data)
     except Exception as error:
-        raise RuntimeError(f"the task's result cannot be rebuilt here ({type(error).__name__}: "
-                           f"{error})") from None
+        raise RuntimeError(f"the task's result, a {text}, cannot be rebuilt in this process "
+                           f"({type(error).__name__}: {error})") from None
     return result
 
 
@@ -726,7 +727,7 @@ def _answer(task: bytes) -> _Answer:
     except Exception as error:  # raised again where the task was called
         return _RAISED, *pickled_error(error)
     try:
-        return _RETURNED, pickle.dumps(result), ""
+        return _RETURNED, pickle.dumps(result), type(result).__name__
     except Exception as error:  # such as a result holding a lock
         return _RAISED, *pickled_error(error)
 

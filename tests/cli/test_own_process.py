@@ -87,6 +87,12 @@ def test_an_error_the_parent_cannot_rebuild_is_named_with_its_message() -> None:
     assert in_own_process((), pow, 2, 10) == 1024
 
 
+def test_a_result_the_parent_cannot_rebuild_is_named_by_its_type() -> None:
+    with pytest.raises(RuntimeError, match=r"^the task's result, a _Refused, cannot be rebuilt "
+                       r"in this process \(TypeError: "):
+        in_own_process((), _Refused, "refused", 3)
+
+
 class _RefusingEngine:
     name = "refusing"
     level = 0
