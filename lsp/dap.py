@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import json
 import os
+import reprlib
 import stat
 import sys
 import threading
@@ -42,6 +43,7 @@ from rl1.compiler.debugger import (
 from rl1.compiler.files import SourceError, read_bounded
 from rl1.compiler.frontend.source import read_source
 from rl1.compiler.runner import load_script
+from rl1.vm.config import excerpt
 from rl1.vm.defaults import DEFAULT_BUDGET
 from rl1.vm.device import Device
 from rl1.vm.language import VARIABLES
@@ -52,6 +54,7 @@ from rl1.vm.verifier import VerifyError
 
 from .framing import CHUNK, Framer, frame, standard_streams
 from .json_reading import read_json
+from .studio.files import MAX_PATH
 
 THREAD = 1
 FRAME = 1
@@ -141,7 +144,7 @@ class Adapter:
         handler = getattr(self, "_on_" + message["command"], None)
         if handler is None:
             self._refuse(message, f"rl1-dap does not support the request "
-                                  f"'{message['command']}'")
+                                  f"'{excerpt(message['command'])}'")
             return
         arguments = message.get("arguments", {})
         try:
@@ -165,15 +168,15 @@ class Adapter:
     def _on_launch(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
         if self.session is not None:
             self._idle()  # a program running would go on, unseen, beside the new one
-        program = _text(arguments, "program")
+        program = _path(arguments.get("program"), "program")
         if program is None:
             raise Refused("launch needs `program`: the .rob or .ilc file to debug")
         image = self._image(program, arguments)
         make_device = _device_maker(arguments)
         budget = arguments.get("budget", DEFAULT_BUDGET)
         if not _whole(budget) or budget < 1:
-            raise Refused(f"`budget` is {budget!r}: give a whole number of instructions, 1 "
-                          "or more")
+            raise Refused(f"`budget` is {reprlib.repr(budget)}: give a whole number of "
+                          "instructions, 1 or more")
         try:
             self.session = Session(image, make_device, budget)
         except VerifyError as error:
@@ -187,7 +190,7 @@ class Adapter:
     def _image(self, program: str, arguments: dict[str, Any]) -> bytes:
         level = arguments.get("level")
         if level is not None and not (_whole(level) and level in (0, 1, 2)):
-            raise Refused(f"`level` is {level!r}: give 0, 1 or 2, as rl1c -O0..-O2")
+            raise Refused(f"`level` is {reprlib.repr(level)}: give 0, 1 or 2, as rl1c -O0..-O2")
         try:
             if _regular(program).lower().endswith(".ilc"):
                 return read_bounded(program, MAX_ILC_BYTES, "an .ilc file")
@@ -232,6 +235,7 @@ class Adapter:
             case None | {"path": None}:
                 return None
             case {"path": str(path)}:
+                _path(path, "source.path")
                 try:
                     if os.path.realpath(path) == self.program_path:
                         return None
@@ -241,7 +245,7 @@ class Adapter:
                         "rl1-dap debugs one program")
             case dict() if "path" not in source:
                 return None
-        raise Refused(f"`source` is {source!r}: give an object with the file's `path`")
+        raise Refused(f"`source` is {reprlib.repr(source)}: give an object with the file's `path`")
 
     def _on_setFunctionBreakpoints(self, request: dict[str, Any], arguments: dict[str, Any]
                                    ) -> None:
@@ -339,7 +343,7 @@ class Adapter:
             shown = [{"name": name, "value": _shown(value), "variablesReference": 0}
                      for name, value in session.device_state().items()]
         else:
-            raise Refused(f"no variables have the reference {reference!r}")
+            raise Refused(f"no variables have the reference {reprlib.repr(reference)}")
         self._respond(request, {"variables": shown})
 
     def _on_evaluate(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
@@ -427,7 +431,7 @@ def _refuse_unknown_ids(arguments: dict[str, Any]) -> None:
     """Refuse a thread or a frame the adapter never gave out, in any request."""
     for key, (what, ours, given) in _IDS.items():
         if key in arguments and not (_whole(arguments[key]) and arguments[key] == given):
-            raise Refused(f"no {what} has the id {arguments[key]!r}: {ours}")
+            raise Refused(f"no {what} has the id {reprlib.repr(arguments[key])}: {ours}")
 
 
 def _condition(breakpoint: dict[str, Any]) -> str | None:
@@ -438,19 +442,22 @@ def _condition(breakpoint: dict[str, Any]) -> str | None:
 def _listed(arguments: dict[str, Any], key: str) -> list[Any]:
     value = arguments.get(key, [])
     if not isinstance(value, list):
-        raise Refused(f"`{key}` is {value!r}: give a list")
+        raise Refused(f"`{key}` is {reprlib.repr(value)}: give a list")
     return value
 
 
-def _text(arguments: dict[str, Any], key: str) -> str | None:
-    value = arguments.get(key)
+def _path(value: object, key: str) -> str | None:
+    """A file's path the client gave as `key`, or None when it gave none."""
     if value is not None and not isinstance(value, str):
-        raise Refused(f"`{key}` is {value!r}: give a file's path as a string")
+        raise Refused(f"`{key}` is {reprlib.repr(value)}: give a file's path as a string")
+    if value is not None and len(value) > MAX_PATH:  # not quoted whole in a refusal
+        raise Refused(f"`{key}` is longer than {MAX_PATH:,} characters, longer than any "
+                      "file's path: name a file")
     return value
 
 
 def _device_maker(arguments: dict[str, Any]) -> Callable[[], Device]:
-    sensors, world = _text(arguments, "sensors"), _text(arguments, "world")
+    sensors, world = (_path(arguments.get(key), key) for key in ("sensors", "world"))
     if sensors is not None and world is not None:
         raise Refused("give `sensors` (a sensor script) or `world` (the simulator's world), "
                       "not both")
@@ -460,8 +467,8 @@ def _device_maker(arguments: dict[str, Any]) -> Callable[[], Device]:
 
         seed = arguments.get("seed", 0)
         if not (_whole(seed) and 0 <= seed <= MAX_SEED):
-            raise Refused(f"`seed` is {seed!r}: give a whole number from 0 to {MAX_SEED}, "
-                          "as rl1c sim --seed")
+            raise Refused(f"`seed` is {reprlib.repr(seed)}: give a whole number from 0 to "
+                          f"{MAX_SEED}, as rl1c sim --seed")
         try:
             the_world = decode_world(read_bounded(_regular(world), MAX_WORLD_BYTES,
                                                   "a world file"), world)

@@ -545,3 +545,32 @@ def test_a_value_or_name_past_the_bound_is_refused_not_quoted(
     assert response.get("message", said) == said
     assert [b["message"] for b in response.get("body", {}).get("breakpoints", [])] in (
         [], [said])
+
+
+LONG = "\u00e9" * 2**20  # 6 MiB of JSON escapes once quoted whole
+
+
+@pytest.mark.parametrize(("command", "arguments"), [
+    (LONG, {}),
+    ("launch", {"program": LONG}),
+    ("launch", {"program": str(SAMPLE), "sensors": LONG}),
+    ("launch", {"program": str(SAMPLE), "world": LONG}),
+    ("launch", {"program": [LONG]}),
+    ("launch", {"program": str(SAMPLE), "budget": LONG}),
+    ("launch", {"program": str(SAMPLE), "level": LONG}),
+    ("launch", {"program": str(SAMPLE), "world": str(WORLD), "seed": LONG}),
+    ("setBreakpoints", {"breakpoints": LONG}),
+    ("setBreakpoints", {"source": {"path": LONG}, "breakpoints": [{"line": 1}]}),
+    ("setBreakpoints", {"source": LONG, "breakpoints": []}),
+    ("variables", {"variablesReference": LONG}),
+    ("stackTrace", {"threadId": LONG}),
+])
+def test_a_refusal_quotes_an_excerpt_of_what_the_client_sent(command: str,
+                                                             arguments: dict[str, Any]) -> None:
+    """Found by the hostile pass: each refusal quoted the client's value whole, and
+    JSON's escapes made 9 Mi characters of it an answer of 54 MiB."""
+    client = InProcess()
+    client.request("launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)})
+    response = client.request(command, arguments)
+    said = response.get("message") or response["body"]["breakpoints"][0]["message"]
+    assert len(said) < 400, said[:200]
