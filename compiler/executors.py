@@ -705,14 +705,20 @@ def _serve(tasks: int, answers: int, parent: int, preloaded: tuple[str, ...]) ->
     import importlib
 
     _end_with_parent(parent)
+    unreadable: _Answer | None = None  # every task's answer, when a preload fails
     for module in preloaded:
-        importlib.import_module(module)
+        try:
+            importlib.import_module(module)
+        except Exception as error:
+            unreadable = (_UNREADABLE, b"", f"the module `{module}` the worker preloaded: "
+                          f"{type(error).__name__}: {error}")
+            break
     # A pipe broken: the parent ended while a task ran (its answer unwritten, this one
     # ends as the parent did).
     with contextlib.suppress(BrokenPipeError), open(tasks, "rb") as calls, \
             open(answers, "wb") as replies:
         while (task := _received(calls)) is not None:
-            _send(replies, pickle.dumps(_answer(task)))
+            _send(replies, pickle.dumps(unreadable or _answer(task)))
 
 
 def _answer(task: bytes) -> _Answer:

@@ -65,6 +65,13 @@ def test_a_task_its_process_cannot_read_is_said_so_and_the_process_lives_on(
     assert in_own_process((), os.getpid) == child  # the next task, in the same process
 
 
+def test_a_preloaded_module_its_process_cannot_import_makes_each_task_unreadable() -> None:
+    with pytest.raises(TaskUnreadable, match=r"^the process spawned for a task could not "
+                       r"read it \(the module `rl1_nowhere` the worker preloaded: "
+                       r"ModuleNotFoundError: No module named 'rl1_nowhere'\)\n"):
+        in_own_process(("rl1_nowhere",), pow, 2, 10)
+
+
 def test_rl1c_fuzz_says_a_search_its_process_cannot_read_with_status_2(
         loaded_here: Callable[[], int], monkeypatch: pytest.MonkeyPatch) -> None:
     # As a campaign's search on a cluster's worker whose rl1 imports other code (a
