@@ -58,16 +58,18 @@ def format_lines(text: str, first_line: int, last_line: int) -> list[Edit]:
 
 
 def _statement(statement: ast.Statement) -> str:
-    if isinstance(statement, ast.Assign):
-        steps = "".join(step.op + _operand(step.operand) for step in statement.rest)
-        return f"{statement.target.name}={_operand(statement.first)}{steps}"
-    if isinstance(statement, ast.IncDec):
-        return statement.target.name + statement.step
-    if isinstance(statement, ast.Goto):
-        return statement.target.text
-    if isinstance(statement, ast.CondJump):
-        return f"?{statement.var.name}{statement.relation}{statement.target.text}"
-    return _call(statement.call)
+    match statement:
+        case ast.Assign():
+            steps = "".join(step.op + _operand(step.operand) for step in statement.rest)
+            return f"{statement.target.name}={_operand(statement.first)}{steps}"
+        case ast.IncDec():
+            return statement.target.name + statement.step
+        case ast.Goto():
+            return statement.target.text
+        case ast.CondJump():
+            return f"?{statement.var.name}{statement.relation}{statement.target.text}"
+        case ast.CallStmt():
+            return _call(statement.call)
 
 
 def _operand(operand: ast.Operand) -> str:
@@ -77,11 +79,13 @@ def _operand(operand: ast.Operand) -> str:
 
 
 def _arg(arg: ast.Arg) -> str:
-    if isinstance(arg, ast.Var):
-        return arg.name
-    if isinstance(arg, ast.Const):
-        return arg.text
-    return arg.letter
+    match arg:
+        case ast.Var():
+            return arg.name
+        case ast.Const():
+            return arg.text
+        case ast.Selector():
+            return arg.letter
 
 
 def _call(call: ast.Call) -> str:
