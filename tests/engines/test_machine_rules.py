@@ -5,6 +5,7 @@ vm/machine.py, and says which rule of spec/ilc.md it holds."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass, field
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -12,7 +13,9 @@ from support.semantics import int16
 from test_machine import To, assemble, call, execute, int16s, op, v
 from test_stepping import Fake
 
+from rl1.vm.device import FormKey
 from rl1.vm.faults import ABORTED_MESSAGE, Fault, FaultKind
+from rl1.vm.hardware import Answer
 from rl1.vm.language import VARIABLES
 from rl1.vm.machine import Machine, State
 
@@ -50,6 +53,49 @@ def test_an_abort_while_a_call_waits_faults_at_the_call_and_stops_first() -> Non
     assert machine.result.named()["B"] == 0
     assert fake.log[-2:] == ["stop", "end"]
 
+
+
+def test_an_abort_past_the_last_instruction_faults_at_the_last_one_run() -> None:
+    machine = Machine(assemble(op("INC", v("A")), op("INC", v("B"))), Fake())
+    assert machine.step(2) is State.RUNNING  # both run; the end is the next step's
+    machine.abort()
+    assert machine.step(10) is State.FAULTED
+    assert machine.result is not None
+    assert machine.result.fault == Fault(FaultKind.ABORTED, ABORTED_MESSAGE, 2)
+
+
+@dataclass
+class AbortingInCall(Fake):
+    """Hardware whose calls that take no device time abort the machine they serve, as an
+    interrupt handler may while the VM waits for the callback."""
+
+    machine: list[Machine] = field(default_factory=list)
+
+    def call(self, form: FormKey, args: tuple[int, ...]) -> Answer:
+        self.machine[0].abort()
+        return super().call(form, args)
+
+
+def test_an_abort_during_a_call_is_taken_at_its_event_point() -> None:
+    hardware = AbortingInCall()
+    machine = Machine(assemble(op("INC", v("A")), call("MOV", 1, 1), op("INC", v("B"))),
+                      hardware)
+    hardware.machine.append(machine)
+    assert machine.step(10) is State.FAULTED
+    assert machine.result is not None
+    assert machine.result.fault == Fault(FaultKind.ABORTED, ABORTED_MESSAGE, 2)
+    assert machine.result.named()["B"] == 0
+    assert hardware.log == ["begin", "call MOV", "stop", "end"]
+
+
+def test_an_abort_after_the_end_changes_nothing() -> None:
+    fake = Fake()
+    machine = Machine(assemble(op("INC", v("A"))), fake)
+    ended = machine.run()
+    machine.abort()
+    assert machine.step(10) is State.ENDED
+    assert machine.result == ended and ended.fault is None
+    assert fake.log == ["begin", "end"]
 
 # Conditional jumps test their own variable (section 8.3) ----------------------------
 
