@@ -30,7 +30,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, get_args
 
 import msgspec
 from msgspec import UNSET, Meta, Struct, UnsetType
@@ -54,7 +54,7 @@ from .device import FuzzyReading, ImageReading, MotionCommand, Odometry, form_na
 from .language import BUILTINS
 
 AfterLast = Literal["stop", "repeat"]
-AFTER_LAST: tuple[AfterLast, ...] = ("stop", "repeat")
+AFTER_LAST: tuple[AfterLast, ...] = get_args(AfterLast)
 
 
 class ScriptError(Exception):
