@@ -171,23 +171,22 @@ class Machine:
 
     def _line_at_hand(self) -> int | None:
         """Between steps: the source line of the call in progress, or else of the next
-        instruction (None past the last one, or without a line map)."""
-        debug = self.program.image.debug
-        if self.waiting is not None:
-            return self.current_line()
-        if debug is None or self.pc == len(self.program.instructions):
-            return None
-        return debug.line_at(self.program.instructions[self.pc].offset)
+        instruction."""
+        return self.current_line() if self.waiting is not None else self._line_of(self.pc)
 
     def current_line(self) -> int | None:
         """The source line of the instruction before pc: while an instruction runs, the
-        one at hand (the call under way, the one that faulted); None at index 0, or
+        one at hand (the call under way, the one that faulted); None at index 0."""
+        return self._line_of(self.pc - 1) if self.pc > 0 else None
+
+    def _line_of(self, index: int) -> int | None:
+        """The source line of the instruction at `index`: None past the last one, or
         without a line map."""
         debug = self.program.image.debug
         instructions = self.program.instructions
-        if debug is None or self.pc == 0:
+        if debug is None or index == len(instructions):
             return None
-        return debug.line_at(instructions[self.pc - 1].offset)
+        return debug.line_at(instructions[index].offset)
 
     # One instruction
 
