@@ -25,11 +25,14 @@ from pygls.exceptions import (
     JsonRpcException,
     JsonRpcInvalidParams,
     JsonRpcInvalidRequest,
+    JsonRpcMethodNotFound,
     JsonRpcParseError,
     JsonRpcServerNotInitialized,
 )
 from pygls.lsp.server import LanguageServer
 from pygls.protocol import LanguageServerProtocol, default_converter
+
+from rl1.vm.config import excerpt
 
 from . import (
     actions,
@@ -184,7 +187,7 @@ class Rl1Protocol(LanguageServerProtocol):
         if method is not None and hasattr(message, "id"):  # a request
             if self.shutdown_received:
                 self._refuse(message.id, JsonRpcInvalidRequest(
-                    f"{method} after shutdown: the server only accepts exit now"))
+                    f"{excerpt(method)} after shutdown: the server only accepts exit now"))
                 return
             if method == types.INITIALIZE and self.initialize_received:
                 self._refuse(message.id, JsonRpcInvalidRequest(
@@ -192,14 +195,25 @@ class Rl1Protocol(LanguageServerProtocol):
                 return
             if method != types.INITIALIZE and not self.initialize_received:
                 self._refuse(message.id, JsonRpcServerNotInitialized(
-                    f"{method} before initialize: send initialize first"))
+                    f"{excerpt(method)} before initialize: send initialize first"))
+                return
+            if self._unknown(method):  # pygls would quote it whole, in its answer and log
+                self._refuse(message.id, JsonRpcMethodNotFound(
+                    f"`{excerpt(method)}` is no method rl1-lsp answers"))
                 return
             self.initialize_received = True
             if method == types.SHUTDOWN:
                 self.shutdown_received = True
         super().handle_message(message)
 
+    def _unknown(self, method: object) -> bool:
+        """Whether `method` is a string naming no method of LSP's or of this server's."""
+        return isinstance(method, str) and self.get_message_type(method) is None \
+            and method not in self.fm.features
+
     def structure_message(self, data: dict[str, Any]) -> Any:
+        if self._unknown(data.get("method")):  # pygls' type needs params; LSP lets them go
+            data = {"params": None, **data}
         try:
             return super().structure_message(data)
         except JsonRpcException as error:

@@ -138,6 +138,25 @@ def test_whatever_a_client_sends_the_next_one_is_served(ws: Listening,
         assert ws_reply(client, 2)["result"] is None
 
 
+@pytest.mark.parametrize("message", [
+    {"jsonrpc": "2.0", "id": 2, "method": "rl1/nothing"},  # no params, which LSP allows
+    {"jsonrpc": "2.0", "id": 2, "method": "\u00e9" * 2**20, "params": {}},
+])
+def test_websocket_an_unknown_method_is_method_not_found(ws: Listening,
+                                                         message: dict[str, object]) -> None:
+    """Found by the hostile pass: a request of an unknown method without params was
+    answered "Internal Error" (-32603), and a method of 1 Mi characters was quoted whole
+    in its answer (6 MiB of JSON escapes) and in the server's log."""
+    with ws_session(ws) as client:
+        client.send(json.dumps(message))
+        error = ws_reply(client, 2)["error"]
+        assert error["code"] == -32601, error  # type: ignore[index]
+        assert len(error["message"]) < 200  # type: ignore[index]
+        client.send(json.dumps({"jsonrpc": "2.0", "method": "rl1/nothing"}))  # said nothing
+        client.send(hover(3, "file:///nowhere.rob"))
+        assert ws_reply(client, 3)["result"] is None
+
+
 def test_the_server_still_runs_and_wrote_no_traceback(ws: Listening) -> None:
     """Run last in this module: everything above left it running, and no traceback."""
     assert ws.process.poll() is None
