@@ -51,6 +51,7 @@ from c_speed import (
     callgrind_cost,
     device_calls,
     program_vectors,
+    tools_missing,
     write_vectors,
 )
 
@@ -257,11 +258,7 @@ def measure(binary: Path, vectors_file: Path, executed: int, calls: int, folder:
 
 def main() -> int:
     argparse.ArgumentParser(description=__doc__.split("\n\n")[0]).parse_args()
-    missing = [tool for tool in ("valgrind", "addr2line", "callgrind_annotate", "make")
-               if shutil.which(tool) is None]
-    if missing:
-        print(f"bench/c_host_cost.py needs {', '.join(missing)} (vm/c/install-tools "
-              "installs them on Debian)", file=sys.stderr)
+    if tools_missing("c_host_cost.py", ("valgrind", "addr2line", "callgrind_annotate", "make")):
         return 2
     regions = Regions.of(VM_SOURCE.read_text(encoding="utf-8"))
     host_cc = shutil.which("gcc") or "cc"

@@ -247,15 +247,21 @@ def verification(library: ctypes.CDLL, repeat: int) -> None:
           "(bench/c_size.py); nothing else")
 
 
+def tools_missing(script: str, tools: Sequence[str]) -> bool:
+    """Whether this machine lacks any of the tools bench/`script` runs; if so, say
+    which, and how to install them."""
+    missing = [tool for tool in tools if shutil.which(tool) is None]
+    if missing:
+        print(f"bench/{script} needs {', '.join(missing)} (vm/c/install-tools installs "
+              "them on Debian)", file=sys.stderr)
+    return bool(missing)
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5, help="runs of each; the best counts")
     options = parser.parse_args()
-    missing = [tool for tool in ("lua5.4", "valgrind", "callgrind_annotate", "make")
-               if shutil.which(tool) is None]
-    if missing:
-        print(f"bench/c_speed.py needs {', '.join(missing)} (vm/c/install-tools installs "
-              "them on Debian)", file=sys.stderr)
+    if tools_missing("c_speed.py", ("lua5.4", "valgrind", "callgrind_annotate", "make")):
         return 2
     with tempfile.TemporaryDirectory(prefix="rl1-c-speed-") as scratch:
         folder = Path(scratch)
