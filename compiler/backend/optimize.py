@@ -67,13 +67,13 @@ def optimize(program: ir.Program, level: int, *, check: bool = False,
     if not passes:
         return program
     program = _to_fixpoint(passes, program, check, fired)
-    for run in FINAL_PASSES[level]:
+    for pass_ in FINAL_PASSES[level]:
         before = _shape(program) if fired is not None else None  # else no one asks
-        program = run(program)
+        program = pass_(program)
         if check:
-            _validate(program, run.__name__)
+            _validate(program, pass_.__name__)
         if fired is not None and _shape(program) != before:
-            fired(run.__name__)
+            fired(pass_.__name__)
     _validate(program, "the optimizer")
     return program
 
@@ -89,14 +89,14 @@ def _to_fixpoint(passes: tuple[Pass, ...], program: ir.Program, check: bool,
     due = [True] * len(passes)
     for count in range(MAX_ROUNDS * len(passes)):
         index = count % len(passes)
-        run = passes[index]
+        pass_ = passes[index]
         if not due[index]:
             continue
-        due = [flag and other is not run for flag, other in zip(due, passes, strict=True)]
-        program, after = _run_one(run, program, shape, check, fired)
+        due = [flag and other is not pass_ for flag, other in zip(due, passes, strict=True)]
+        program, after = _run_one(pass_, program, shape, check, fired)
         if after != shape:
-            spared = (GIVES_NO_WORK_TO.get(run, frozenset())
-                      | ({run} if run in IDEMPOTENT else set()))
+            spared = (GIVES_NO_WORK_TO.get(pass_, frozenset())
+                      | ({pass_} if pass_ in IDEMPOTENT else set()))
             due = [flag or other not in spared for flag, other in zip(due, passes, strict=True)]
             shape = after
         # Unchanged, `after` is a second list equal to `shape`: let it go before the next
@@ -110,16 +110,16 @@ def _to_fixpoint(passes: tuple[Pass, ...], program: ir.Program, check: bool,
 Shape = list[object]
 
 
-def _run_one(run: Pass, program: ir.Program, before: Shape, check: bool,
+def _run_one(pass_: Pass, program: ir.Program, before: Shape, check: bool,
              fired: Callable[[str], None] | None) -> tuple[ir.Program, Shape]:
     """The program after one pass, and its shape (`before`: its shape before, which
     the caller keeps, as a pass may edit the program in place)."""
-    program = run(program)
+    program = pass_(program)
     if check:
-        _validate(program, run.__name__)
+        _validate(program, pass_.__name__)
     after = _shape(program)
     if fired is not None and after != before:
-        fired(run.__name__)
+        fired(pass_.__name__)
     return program, after
 
 
