@@ -574,3 +574,35 @@ def test_a_refusal_quotes_an_excerpt_of_what_the_client_sent(command: str,
     response = client.request(command, arguments)
     said = response.get("message") or response["body"]["breakpoints"][0]["message"]
     assert len(said) < 400, said[:200]
+
+
+def test_a_second_configuration_done_is_refused(tmp_path: Path) -> None:
+    """Found by the hostile pass: each configurationDone started the run again, in a
+    worker of its own, beside the one running: two threads stepped one machine."""
+    looping = tmp_path / "loop.rob"
+    looping.write_text(":01 A=A+1; #01\n")
+    client = InProcess()
+    client.request("launch", {"program": str(looping), "budget": 10**12})
+    assert client.request("configurationDone")["success"]
+    running = client.adapter._worker
+    again = client.request("configurationDone")
+    assert (again["success"], again["message"]) == (
+        False, "the run has started: configurationDone comes once, after launch")
+    assert client.adapter._worker is running
+    client.request("pause")
+    assert client.stopped_on()[0] == "pause"
+
+
+def test_a_second_launch_tells_its_own_run_whole() -> None:
+    """Found by the hostile pass: a launch after a run kept the run's count of the calls
+    told, and its last stop, so that the new run's first calls were never told (as many
+    as the run before had made) and exceptionInfo spoke of the old run's fault."""
+    told: list[list[str]] = []
+    client = InProcess()
+    for _ in range(2):
+        client.request("launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)})
+        client.request("configurationDone")
+        client.adapter._worker.join(TIMEOUT)  # type: ignore[union-attr]
+        told.append([m["body"]["output"] for m in client.sent if m.get("event") == "output"])
+        client.sent.clear()
+    assert told[0] and told[1] == told[0]
