@@ -101,7 +101,7 @@ class Adapter:
         self._worker: threading.Thread | None = None
         self._told = 0  # the trace entries already sent as output
         self._last_stop: Stop | None = None
-        self._configured = False  # configurationDone came: the run has started
+        self._started = False  # by configurationDone, or a command before it
 
     # Writing
 
@@ -185,7 +185,7 @@ class Adapter:
                           "program again") from None
         self.program_path = str(Path(program).resolve())
         self.stop_on_entry = arguments.get("stopOnEntry") is True
-        self._told, self._last_stop, self._configured = 0, None, False  # a run of its own
+        self._told, self._last_stop, self._started = 0, None, False  # a run of its own
         self._respond(request)
         self.event("initialized")
 
@@ -277,14 +277,14 @@ class Adapter:
     def _on_configurationDone(self, request: dict[str, Any], arguments: dict[str, Any]
                               ) -> None:
         session = self._session()
-        if self._configured:  # a second run would step the machine beside the first
+        if self._started:  # a second run would step the machine beside the first
             raise Refused("the run has started: configurationDone comes once, after launch")
-        self._configured = True
         self._respond(request)
         self._start(session)
 
     def _start(self, session: Session) -> None:
         """The run from its start: stopped on entry, or continued to its first stop."""
+        self._started = True
         if self.stop_on_entry:
             self._stopped(Stop("entry", session.line))
         else:
@@ -393,6 +393,7 @@ class Adapter:
         return session
 
     def _go(self, command: Callable[[], Stop]) -> None:
+        self._started = True
         self.event("continued", {"threadId": THREAD, "allThreadsContinued": True})
         self._worker = threading.Thread(target=lambda: self._stopped(command()), daemon=True)
         self._worker.start()

@@ -576,14 +576,17 @@ def test_a_refusal_quotes_an_excerpt_of_what_the_client_sent(command: str,
     assert len(said) < 400, said[:200]
 
 
-def test_a_second_configuration_done_is_refused(tmp_path: Path) -> None:
+@pytest.mark.parametrize("first", ["configurationDone", "continue", "restart"])
+def test_a_configuration_done_after_the_run_started_is_refused(tmp_path: Path,
+                                                               first: str) -> None:
     """Found by the hostile pass: each configurationDone started the run again, in a
-    worker of its own, beside the one running: two threads stepped one machine."""
+    worker of its own, beside the one a configurationDone, continue or restart had
+    started: two threads stepped one machine."""
     looping = tmp_path / "loop.rob"
     looping.write_text(":01 A=A+1; #01\n")
     client = InProcess()
     client.request("launch", {"program": str(looping), "budget": 10**12})
-    assert client.request("configurationDone")["success"]
+    assert client.request(first)["success"]
     running = client.adapter._worker
     again = client.request("configurationDone")
     assert (again["success"], again["message"]) == (
