@@ -395,8 +395,20 @@ class Adapter:
     def _go(self, command: Callable[[], Stop]) -> None:
         self._started = True
         self.event("continued", {"threadId": THREAD, "allThreadsContinued": True})
-        self._worker = threading.Thread(target=lambda: self._stopped(command()), daemon=True)
+        self._worker = threading.Thread(target=self._run, args=(command,), daemon=True)
         self._worker.start()
+
+    def _run(self, command: Callable[[], Stop]) -> None:
+        """The worker: where `command` stops, told; a bug of ours ends the session, said
+        (in its thread, it would print a traceback and leave the client waiting)."""
+        try:
+            self._stopped(command())
+        except Exception as error:
+            print(f"rl1-dap: internal error in the run: {error!r}; please report it",
+                  file=sys.stderr)
+            self.event("output", {"category": "stderr", "output": "rl1-dap failed running "
+                                  f"the program ({error!r}): please report it\n"})
+            self.event("terminated")
 
     def _stopped(self, stop: Stop) -> None:
         session = self._session()

@@ -18,6 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from support import SAMPLE, SAMPLE_SENSORS
 
+from rl1.compiler.debugger import Session, Stop
 from rl1.lsp.dap import CAPABILITIES, Adapter
 
 WORLD = SAMPLE.parent / "sample.world.toml"
@@ -609,3 +610,24 @@ def test_a_second_launch_tells_its_own_run_whole() -> None:
         told.append([m["body"]["output"] for m in client.sent if m.get("event") == "output"])
         client.sent.clear()
     assert told[0] and told[1] == told[0]
+
+
+def test_a_run_that_fails_ends_the_session_saying_so(monkeypatch: pytest.MonkeyPatch,
+                                                     capsys: pytest.CaptureFixture[str]
+                                                     ) -> None:
+    """A bug of ours in a run (here one planted) printed a traceback from its worker
+    thread and told the client nothing, which waited for a stop for good."""
+    def failing(session: Session) -> Stop:
+        raise RuntimeError("planted")
+
+    monkeypatch.setattr(Session, "continue_", failing)
+    client = InProcess()
+    client.request("launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)})
+    client.request("configurationDone")
+    client.adapter._worker.join(TIMEOUT)  # type: ignore[union-attr]
+    events = [m for m in client.sent if m["type"] == "event"]
+    assert [m["event"] for m in events][-2:] == ["output", "terminated"]
+    assert events[-2]["body"] == {"category": "stderr", "output": (
+        "rl1-dap failed running the program (RuntimeError('planted')): please report it\n")}
+    assert capsys.readouterr().err == ("rl1-dap: internal error in the run: "
+                                       "RuntimeError('planted'); please report it\n")
