@@ -407,15 +407,11 @@ class NativeMachine:
         if self._stepping:
             self._message = ("a callback stepped the VM that called it, which the C VM "
                              "refuses (spec/rl1_hardware.h, rl1_step)")
-            return State(self.lib.rl1_step(ctypes.byref(self._vm),
-                                           ctypes.byref(self._program),
-                                           ctypes.byref(self._callbacks), limit))
+            return self._rl1_step(limit)
         self._sync()
         self._stepping = True
         try:
-            state = State(self.lib.rl1_step(ctypes.byref(self._vm),
-                                            ctypes.byref(self._program),
-                                            ctypes.byref(self._callbacks), limit))
+            state = self._rl1_step(limit)
         finally:
             self._stepping = False
         if self._error is not None:
@@ -425,6 +421,10 @@ class NativeMachine:
         if state in (State.ENDED, State.FAULTED) and self.result is None:
             self.result = RunResult(tuple(self._vm.V), self._fault())
         return state
+
+    def _rl1_step(self, limit: int) -> State:
+        return State(self.lib.rl1_step(ctypes.byref(self._vm), ctypes.byref(self._program),
+                                       ctypes.byref(self._callbacks), limit))
 
     def abort(self) -> None:
         """The emergency stop, as Machine.abort: rl1_abort on the VM's mailbox (from a
