@@ -215,10 +215,11 @@ class Adapter:
     def _on_setBreakpoints(self, request: dict[str, Any], arguments: dict[str, Any]) -> None:
         session = self._session()
         wanted = _listed(arguments, "breakpoints")
-        if not all(isinstance(b, dict) and _whole(b.get("line"))
+        if not all(isinstance(b, dict) and _whole(b.get("line")) and b["line"] >= 1
                    and len(_condition(b) or "") <= MAX_EXPRESSION for b in wanted):
-            raise Refused("`breakpoints` is a list of objects, each with a `line` and maybe "
-                          f"a `condition` of {MAX_EXPRESSION:,} characters at most")
+            raise Refused("`breakpoints` is a list of objects, each with a `line` (1 or "
+                          f"more) and maybe a `condition` of {MAX_EXPRESSION:,} characters "
+                          "at most")
         if (elsewhere := self._elsewhere(arguments.get("source"))) is not None:
             self._respond(request, {"breakpoints": [
                 {"verified": False, "line": b["line"], "message": elsewhere} for b in wanted]})

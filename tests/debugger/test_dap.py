@@ -527,8 +527,8 @@ def test_conditions_are_read_without_holding_the_adapter() -> None:
     ("evaluate", {"expression": "A" * 1001},
      "`expression` is longer than 1,000 characters: give a value such as `U-L`"),
     ("setBreakpoints", {"breakpoints": [{"line": 20, "condition": "A" * 1001}]},
-     "`breakpoints` is a list of objects, each with a `line` and maybe a `condition` of "
-     "1,000 characters at most"),
+     "`breakpoints` is a list of objects, each with a `line` (1 or more) and maybe a "
+     "`condition` of 1,000 characters at most"),
     ("setFunctionBreakpoints", {"breakpoints": [{"name": "IMG" + " " * 1000}]},
      "a function breakpoint's `name` is a built-in's: give a mnemonic of Table 2 or 3, as "
      "`IMG`, or a form, as `CAM P`"),
@@ -631,3 +631,15 @@ def test_a_run_that_fails_ends_the_session_saying_so(monkeypatch: pytest.MonkeyP
         "rl1-dap failed running the program (RuntimeError('planted')): please report it\n")}
     assert capsys.readouterr().err == ("rl1-dap: internal error in the run: "
                                        "RuntimeError('planted'); please report it\n")
+
+
+@pytest.mark.parametrize("line", [0, -5])
+def test_a_breakpoint_on_no_line_is_refused(line: int) -> None:
+    """Found by the hostile pass: a line before the first (lines start at 1) was bound
+    to the program's first line with code, and answered verified there."""
+    client = InProcess()
+    client.request("launch", {"program": str(SAMPLE), "sensors": str(SAMPLE_SENSORS)})
+    response = client.request("setBreakpoints", {"breakpoints": [{"line": line}]})
+    assert (response["success"], response["message"]) == (
+        False, "`breakpoints` is a list of objects, each with a `line` (1 or more) and "
+               "maybe a `condition` of 1,000 characters at most")
