@@ -314,13 +314,13 @@ class Connection:
         if "lines" in params:
             wanted = params["lines"]
             if not isinstance(wanted, list) or len(wanted) > MAX_BREAKPOINTS or not all(
-                    isinstance(item, dict) and _whole(item.get("line"))
+                    isinstance(item, dict) and _whole(item.get("line")) and item["line"] >= 1
                     and isinstance(item.get("condition"), str | None)
                     and len(item.get("condition") or "") <= MAX_EXPRESSION for item in wanted):
                 raise RpcError(INVALID_PARAMS, "`lines` is a list of objects, each with a "
-                               "`line` (a whole number) and maybe a `condition` (a string of "
-                               f"{MAX_EXPRESSION:,} characters at most), {MAX_BREAKPOINTS:,} "
-                               "at most")
+                               "`line` (a whole number, 1 or more) and maybe a `condition` (a "
+                               f"string of {MAX_EXPRESSION:,} characters at most), "
+                               f"{MAX_BREAKPOINTS:,} at most")
             self._lines = [(item["line"], item.get("condition") or None) for item in wanted]
         if "calls" in params:
             calls = params["calls"]

@@ -148,3 +148,13 @@ def test_an_error_quotes_an_excerpt_of_what_the_page_sent(client: Page, method: 
         client.request(method, params)
     assert said in str(failed.value)
     assert len(str(failed.value)) < 400, str(failed.value)[:200]
+
+
+@pytest.mark.parametrize("line", [0, -5])
+def test_a_breakpoint_on_no_line_is_refused(client: Page, line: int) -> None:
+    """Found by the hostile pass: a line before the first (lines start at 1) was bound
+    to the program's first line with code."""
+    with pytest.raises(Failed) as failed:
+        client.request("debug/setBreakpoints", {"lines": [{"line": line}]})
+    assert failed.value.code == -32602
+    assert "`line` (a whole number, 1 or more)" in str(failed.value)
