@@ -4,11 +4,13 @@ vm/machine.py, and says which rule of spec/ilc.md it holds."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import ROOT
 from support.semantics import int16
 from test_machine import To, assemble, call, execute, int16s, op, v
 from test_stepping import Fake
@@ -30,6 +32,18 @@ CONDITIONAL_JUMPS: dict[str, Callable[[int], bool]] = {
     "SJLT": lambda value: value < 0,
 }
 
+
+# The states a step answers (section 12) ------------------------------------------------
+
+def test_the_states_are_the_c_headers_each_apart() -> None:
+    """vm/native.py reads the C VM's state as `State(number)`, so each state has the
+    number of its RL1_ name in spec/rl1_hardware.h (RL1_IN_STEP, which a step never
+    returns, aside), and no two states are one."""
+    header = (ROOT / "spec" / "rl1_hardware.h").read_text(encoding="utf-8")
+    states = header[header.index("typedef enum {\n    RL1_RUNNING"):header.index("} rl1_state;")]
+    numbers = {name: int(number) for name, number in re.findall(r"RL1_(\w+) = (\d+)", states)}
+    assert {state.name: state.value for state in State} == \
+        {name: number for name, number in numbers.items() if name != "IN_STEP"}
 
 # Aborts (section 12.7): the fault is placed at the instruction at hand ---------------
 

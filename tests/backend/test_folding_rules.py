@@ -1,0 +1,52 @@
+"""Constant folding (compiler/backend/constants.py) where a known value meets one the
+compiler cannot know (a reading): rules that no test held until mutation testing
+(tests/mutation/) changed them and every test still passed."""
+
+from __future__ import annotations
+
+import itertools
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from support.semantics import operate
+from test_passes import after, run_program
+
+from rl1.compiler.backend.constants import fold_constants
+from rl1.vm import isa
+from rl1.vm.language import VARIABLES
+
+INT16 = st.integers(-32768, 32767)
+# The values that an operator's identity and absorbing rules are about, their
+# neighbours, and the shift counts around 16.
+EDGES = (-32768, -17, -16, -2, -1, 0, 1, 2, 3, 15, 16, 17, 32767)
+
+
+def folded_runs(operator: str, known: int, known_first: bool, readings: list[int]
+                ) -> list[int]:
+    """A of `A=B op C` (`C op B` unless `known_first`), B known, C a reading (KYO's
+    centre), folded, then run once on each reading."""
+    expression = f"B{operator}C" if known_first else f"C{operator}B"
+    program = after(fold_constants, f"B={known}\nC=(KYO)\nA={expression}\n")
+    return [run_program(program, {"KYO": [{"centre": reading, "right": 0, "left": 0}]})
+            [0][VARIABLES.index("A")] for reading in readings]
+
+
+@pytest.mark.parametrize(("operator", "known_first"),
+                         list(itertools.product(isa.ALU_OPERATORS, (True, False))))
+def test_a_known_edge_value_with_a_reading_folds_to_what_the_vm_computes(
+        operator: str, known_first: bool) -> None:
+    for known in EDGES:
+        expected = [operate(operator, known, reading) if known_first
+                    else operate(operator, reading, known) for reading in EDGES]
+        assert folded_runs(operator, known, known_first, list(EDGES)) == expected, known
+
+
+@settings(max_examples=100, deadline=None)
+@given(operator=st.sampled_from(isa.ALU_OPERATORS), known=INT16, reading=INT16,
+       known_first=st.booleans())
+def test_any_known_value_with_a_reading_folds_to_what_the_vm_computes(
+        operator: str, known: int, reading: int, known_first: bool) -> None:
+    expected = operate(operator, known, reading) if known_first \
+        else operate(operator, reading, known)
+    assert folded_runs(operator, known, known_first, [reading]) == [expected]
