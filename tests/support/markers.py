@@ -24,6 +24,8 @@ MARKS: dict[str, tuple[str, ...]] = {
         ("needs_cc",),
     # The replay page in Debian's chromium, through Playwright.
     "tests/browser/": ("needs_browser", "slow"),
+    # Emacs (and its language server) started on a terminal, as a user starts it.
+    "tests/editors/": ("slow",),
     # Slow, besides every Hypothesis property (below): fuzzing campaigns, hostile inputs
     # in subprocesses, compilations under many hash seeds, searches through generated
     # programs for each form of the syntax.
