@@ -17,7 +17,6 @@ import shutil
 import signal
 import struct
 import subprocess
-import sys
 import termios
 import time
 from pathlib import Path
@@ -25,14 +24,12 @@ from typing import Any
 
 import pytest
 from support import ROOT
-
-from rl1.compiler.analysis import analyze
+from support.editors import BAD_PROGRAM, SECONDS, editor_environment, the_error
 
 EMACS_MODE = ROOT / "editors" / "emacs"
 README = EMACS_MODE / "README.md"
 FLYMAKE_DIAGNOSTICS = Path(__file__).with_name("flymake_diagnostics.el")
 EMACS = shutil.which("emacs")
-SECONDS = 60  # how long Emacs has to show the diagnostic (rl1-lsp starts in about one)
 
 pytestmark = pytest.mark.skipif(
     EMACS is None,
@@ -90,24 +87,15 @@ def _run_on_a_terminal(command: list[str], cwd: Path, env: dict[str, str]) -> st
 
 def test_eglot_shows_rl1_lsps_diagnostic_of_a_file_set_up_as_the_readme_says(
         tmp_path: Path) -> None:
-    source = "A=1\n(FOO 1)\n(END)\n"
-    [expected] = analyze(source).diagnostics
+    expected = the_error()
     home = tmp_path / "home"
     (home / ".emacs.d").mkdir(parents=True)
     (home / ".emacs.d" / "init.el").write_text(_readme_init_file(), encoding="utf-8")
     project = tmp_path / "robot"
     project.mkdir()
-    (project / "bad.rob").write_text(source, encoding="ascii")
+    (project / "bad.rob").write_text(BAD_PROGRAM, encoding="ascii")
     out = tmp_path / "diagnostics.json"
-    env = {
-        "HOME": str(home),
-        # The README's step 1 with the project's .venv: rl1-lsp beside this Python.
-        "PATH": os.pathsep.join([str(Path(sys.executable).parent), os.environ["PATH"]]),
-        "TERM": "xterm",
-        "LANG": "C.UTF-8",
-        "RL1_DIAGNOSTICS_OUT": str(out),
-        "RL1_DIAGNOSTICS_SECONDS": str(SECONDS - 10),
-    }
+    env = editor_environment(home, out) | {"TERM": "xterm"}
     assert EMACS is not None
     screen = _run_on_a_terminal(
         [EMACS, "-nw", "bad.rob", "-l", str(FLYMAKE_DIAGNOSTICS)], project, env)

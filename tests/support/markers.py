@@ -24,7 +24,7 @@ MARKS: dict[str, tuple[str, ...]] = {
         ("needs_cc",),
     # The replay page in Debian's chromium, through Playwright.
     "tests/browser/": ("needs_browser", "slow"),
-    # Emacs (and its language server) started on a terminal, as a user starts it.
+    # Emacs on a terminal and Neovim headless, each with rl1-lsp, as a user sets them up.
     "tests/editors/": ("slow",),
     # Slow, besides every Hypothesis property (below): fuzzing campaigns, hostile inputs
     # in subprocesses, compilations under many hash seeds, searches through generated

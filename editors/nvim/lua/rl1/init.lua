@@ -9,21 +9,31 @@ M.defaults = {
   root_markers = { 'rl1.toml', 'pyproject.toml', '.git' },
 }
 
+-- The nearest folder, from the buffer's file's up, that holds one of the markers, else the
+-- working directory. (vim.fs.find, which would do, comes with 0.8.)
 local function root_dir(markers, buffer)
-  local found = vim.fs.find(markers, {
-    upward = true,
-    path = vim.fs.dirname(vim.api.nvim_buf_get_name(buffer)),
-  })[1]
-  return found and vim.fs.dirname(found) or vim.fn.getcwd()
+  local folder = vim.fn.fnamemodify(vim.api.nvim_buf_get_name(buffer), ':p:h')
+  while true do
+    for _, marker in ipairs(markers) do
+      if vim.loop.fs_stat(folder .. '/' .. marker) then
+        return folder
+      end
+    end
+    local parent = vim.fn.fnamemodify(folder, ':h')
+    if parent == folder then
+      return vim.fn.getcwd()
+    end
+    folder = parent
+  end
 end
 
 --- Register the server for the `rl1` filetype. Options override M.defaults, e.g.
 --- require('rl1').setup({ cmd = { '/path/to/rl1/.venv/bin/rl1-lsp' } })
 function M.setup(opts)
   local config = vim.tbl_deep_extend('force', M.defaults, opts or {})
-  if vim.fn.has('nvim-0.8') == 0 then
+  if vim.fn.has('nvim-0.7') == 0 then
     vim.notify(
-      'rl1: the language server needs Neovim 0.8 or newer; until then, highlighting works '
+      'rl1: the language server needs Neovim 0.7 or newer; until then, highlighting works '
         .. 'and :compiler rl1c, then :make, checks the current file',
       vim.log.levels.WARN
     )
@@ -43,14 +53,21 @@ function M.setup(opts)
     vim.lsp.enable('rl1')
     return
   end
+  -- Before 0.11, one client for each workspace root, attached to each of its buffers: what
+  -- vim.lsp.start does from 0.8 on, written with what 0.7 has.
+  local clients = {}
   vim.api.nvim_create_autocmd('FileType', {
     group = vim.api.nvim_create_augroup('rl1_lsp', { clear = true }),
     pattern = 'rl1',
     callback = function(event)
-      vim.lsp.start(
-        { name = 'rl1', cmd = config.cmd, root_dir = root_dir(config.root_markers, event.buf) },
-        { bufnr = event.buf }
-      )
+      local root = root_dir(config.root_markers, event.buf)
+      local client = clients[root] and vim.lsp.get_client_by_id(clients[root])
+      if not client or client.is_stopped() then
+        clients[root] = vim.lsp.start_client({ name = 'rl1', cmd = config.cmd, root_dir = root })
+      end
+      if clients[root] then
+        vim.lsp.buf_attach_client(event.buf, clients[root])
+      end
     end,
   })
 end
