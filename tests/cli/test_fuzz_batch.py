@@ -114,8 +114,7 @@ def quick_timeout(monkeypatch: pytest.MonkeyPatch) -> None:
     ("exit 3", "no-run", "(exit status 3)"),  # before reading the job, or answering
     ("echo oops >&2; exit 1", "no-run", "its standard error ends: oops"),
     ("cat > /dev/null", "timeout", "it answered no job in 1 seconds"),
-    # Alive, they were said to have ended.
-    ("exec 0<&-; sleep 30", "no-run", "it closed its standard input before reading the job"),
+    # Alive, it was said to have ended.
     ("read job; exec >&-; sleep 30", "no-run", "it closed its standard output before "
                                                "answering"),
     ("yes", "no-run", "it printed more than one line for one job"),
@@ -135,6 +134,16 @@ def test_a_dead_lying_or_hanging_engine_is_a_run_that_disagrees_never_a_hang(
         assert said in status["message"]
     verdict = judge(CASE, [VmEngine(0), engine], 20_000)
     assert verdict.problems  # never agrees: it ran nothing of the program
+
+
+@pytest.mark.usefixtures("quick_timeout")
+def test_an_engine_that_closes_its_input_alive_says_so() -> None:
+    """It was said to have ended. The job (its sensor script) is longer than a pipe
+    holds, so that the engine closes its input while the job is being written."""
+    engine = _batch("head -c 100 > /dev/null; exec 0<&-; sleep 30")
+    case = Run(CASE.source, {"ULT A": list(range(30_000))})
+    status = engine.run(case, 20_000).document["status"]
+    assert status["message"] == "it closed its standard input before reading the job"
 
 
 def test_an_engine_that_dies_is_started_again_at_the_next_job() -> None:
