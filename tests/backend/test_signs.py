@@ -91,6 +91,19 @@ def test_paths_join_to_the_signs_either_allows() -> None:
         agree(source, {"INP": {"1": [port]}})
 
 
+@pytest.mark.parametrize("value", ["(IMG)&255", "255&(IMG)"])
+def test_a_mask_with_the_sign_bit_clear_either_side_proves_not_negative(value: str) -> None:
+    source = f"A={value}\n?A<#20\n(OUT 1,1); (END)\n:20 (OUT 2,2); (END)\n"
+    assert not kept("if A<0", optimized(source, decide_branches))
+    for area in (-1, 300):
+        agree(source, {"IMG": [{"area": area, "x": 0, "y": 0, "z": 0}]})
+
+
+def test_a_mask_with_the_sign_bit_set_proves_nothing() -> None:
+    source = "A=(IMG)&-256\n?A<#20\n(OUT 1,1); (END)\n:20 (OUT 2,2); (END)\n"
+    assert kept("if A<0", optimized(source, decide_branches))
+
+
 def test_a_step_that_can_wrap_forgets_the_sign() -> None:
     # 32767 + 1 is -32768: a positive variable stepped up may be negative.
     source = "A=(INP 1)\n?A=#20\nA++\n?A<#30\n(END)\n:20 (END)\n:30 (OUT 1,1); (END)\n"
