@@ -71,9 +71,11 @@ typecheck: $(STAMP)
 	MYPYPATH=.typecheck:spec/vectors:tests $(BIN)/mypy tests $(wildcard bench/*.py) spec/vectors \
 	    $(wildcard vm/c/test/*.py)
 
-# Debian's chromium for the browser tests, when missing (CI runs as root).
+# Debian's chromium for the browser tests, and Emacs, eglot and Neovim for the editor
+# tests, when missing (CI runs as root).
 pytest: $(STAMP)
 	tests/browser/install-chromium
+	tests/editors/install-editors
 	$(BIN)/pytest -n 2
 
 # The VS Code extension (editors/vscode): its exact dependencies from the npm lock file
