@@ -237,3 +237,23 @@ def test_polls_and_branch_chains_run_alike_at_every_level(
         "INP": {"1": ports}, "CAM R": pulses,
         "IMG": [{"area": area, "x": 0, "y": 0, "z": 0} for area in areas]}
     assert judge(Run(source, script), ENGINES, BUDGET).problems == []
+
+
+@pytest.mark.parametrize("fused", [
+    ir.StoreBranch(ir.Var("A"), "=", "B1", "B1", 2),  # A = acc, then a branch on it
+    ir.DecrementBranch(ir.Var("A"), "B1", "B1", 2),  # A--, then a branch on it
+])
+def test_a_fused_branch_forgets_what_was_known_of_the_variable_it_writes(
+        fused: ir.StoreBranch | ir.DecrementBranch) -> None:
+    """A is 1 before the fused branch, which writes it (x, an image's reading, or A - 1,
+    0), so a branch on A after it stays: on IR as -O2's fuse leaves it."""
+    program = ir.Program({
+        "B0": ir.Block("B0", [ir.Load(ir.Imm(1), 1), ir.Store(ir.Var("A"), 1),
+                              ir.Call("IMG", None, (), 1), ir.Load(ir.Var("x"), 2)],
+                       fused),
+        "B1": ir.Block("B1", [], ir.Branch(ir.Var("A"), ">", "B2", "B3", 3)),
+        "B2": ir.Block("B2", [], ir.End(4)),
+        "B3": ir.Block("B3", [], ir.End(5)),
+    }, "B0")
+    assert ir.validate(program) == []
+    assert kept("if A>0", decide_branches(program))
