@@ -45,6 +45,15 @@ def test_the_states_are_the_c_headers_each_apart() -> None:
     assert {state.name: state.value for state in State} == \
         {name: number for name, number in numbers.items() if name != "IN_STEP"}
 
+# What the optimizer's budget invariant bounds (spec/optimization.md, section 3) ------
+
+def test_each_call_counts_the_instructions_run_up_to_it_itself_included() -> None:
+    machine = Machine(assemble(op("INC", v("A")), op("INC", v("B")), call("MOV", 1, 1),
+                               op("INC", v("C")), call("TIM", 1), op("JMP", To(6)),
+                               call("TRC", 2)), Fake(busy=1))
+    assert machine.run().fault is None
+    assert machine.call_counts == [3, 5, 7]
+
 # Aborts (section 12.7): the fault is placed at the instruction at hand ---------------
 
 def test_an_abort_before_the_first_step_faults_at_the_first_line() -> None:
