@@ -589,6 +589,8 @@ class _Probe:
             if self.server.transport == "tcp":
                 return self._over_tcp(uri, opened)
             return self._over_websocket(uri, opened)
+        except ConnectionResetError:  # closed at once: as many refused as it may refuse
+            return BUSY
         except (OSError, TimeoutError, ValueError) as error:
             return f"the next client was not served: {type(error).__name__}: {error}"
 
@@ -624,8 +626,9 @@ class _Probe:
                         return said or None
                     continue
                 chunk = client.recv(65536)
-                if not chunk:
-                    return f"the server closed the next client's connection: {self.heard}"
+                if not chunk:  # closed at once, as above, or closed after something said
+                    return BUSY if not self.heard else (
+                        f"the server closed the next client's connection: {self.heard}")
                 buffer += chunk
         return f"the next client got no diagnostics in {PROBE_SECONDS:.0f} s: {self.heard}"
 
