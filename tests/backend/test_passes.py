@@ -114,8 +114,11 @@ def test_handlers_and_reserved_variables_start_unknown() -> None:
     assert code(program, "L96") == ["load A", "store C", "end"]
 
 
-def test_a_known_argument_becomes_a_constant_only_within_its_range() -> None:
-    assert code(after(fold_constants, "A=12; B=13; (MOV A,B)"))[-2] == "call MOV 12, B"
+@pytest.mark.parametrize(("inside", "outside"), [(12, 13), (-12, -13)])  # MOV's -12..12
+def test_a_known_argument_becomes_a_constant_only_within_its_range(inside: int, outside: int
+                                                                   ) -> None:
+    assert code(after(fold_constants, f"A={inside}; B={outside}; (MOV A,B)"))[-2] == \
+        f"call MOV {inside}, B"
 
 
 # Copy propagation -------------------------------------------------------------------------
