@@ -1,6 +1,7 @@
 """Constant folding (compiler/backend/constants.py) where a known value meets one the
-compiler cannot know (a reading): rules that no test held until mutation testing
-(tests/mutation/) changed them and every test still passed."""
+compiler cannot know (a reading), and where it decides a branch: rules that no test
+held until mutation testing (tests/mutation/) changed them and every test still
+passed."""
 
 from __future__ import annotations
 
@@ -50,3 +51,12 @@ def test_any_known_value_with_a_reading_folds_to_what_the_vm_computes(
     expected = operate(operator, known, reading) if known_first \
         else operate(operator, reading, known)
     assert folded_runs(operator, known, known_first, [reading]) == [expected]
+
+
+@pytest.mark.parametrize("relation", ["=", ">", "<"])
+def test_a_branch_on_a_known_value_is_decided_as_it_would_go(relation: str) -> None:
+    for known in EDGES:
+        program = after(fold_constants, f"A={known}\n?A{relation}#20\nB=1\n:20 (END)\n")
+        taken = {"=": known == 0, ">": known > 0, "<": known < 0}[relation]
+        variables, _ = run_program(program, {})
+        assert variables[VARIABLES.index("B")] == (0 if taken else 1), known
