@@ -114,6 +114,13 @@ def test_handlers_and_reserved_variables_start_unknown() -> None:
     assert code(program, "L96") == ["load A", "store C", "end"]
 
 
+def test_a_folded_zero_is_loaded_from_the_first_variable_nothing_writes() -> None:
+    # A holds 0 wherever the program goes (nothing names it), and LDV is a byte shorter
+    # than LDI; B, which the source loaded, holds 5.
+    assert code(after(fold_constants, "C=(KYO)\nB=5\nC=B-5\n"))[-3:] == [
+        "load A", "store C", "end"]
+
+
 @pytest.mark.parametrize(("inside", "outside"), [(12, 13), (-12, -13)])  # MOV's -12..12
 def test_a_known_argument_becomes_a_constant_only_within_its_range(inside: int, outside: int
                                                                    ) -> None:
