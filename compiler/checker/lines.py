@@ -57,7 +57,8 @@ def _malformed_label(text: str, span: ast.Span, what: str, sigil: str) -> Diagno
         help_text = f"write `{fixed}`"
         fixes = (Fix(f"write `{fixed}`", (Edit(span, fixed),), safe=True),)
     else:
-        help_text = f"labels run from `{sigil}00` to `{sigil}99`"
+        named = "labels" if sigil == ":" else "jump targets"
+        help_text = f"{named} run from `{sigil}00` to `{sigil}99`"
     code = "E0201" if sigil == ":" else "E0202"
     return Diagnostic(code, E, f"`{text}` is not {what}: it needs exactly two digits after "
                       f"`{sigil}`", span, help=help_text, fixes=fixes)
@@ -164,7 +165,8 @@ def _arity(call: ast.Call, builtin: Builtin, form: Form, values: tuple[ast.Arg, 
     counted = {0: "no arguments", 1: "1 argument"}.get(expected, f"{expected} arguments")
     after = " after the selector" if form.selector is not None else ""
     message = f"`{signature(builtin, form)}` takes {counted}{after}, found {len(values)}"
-    help_text = f"`{signature(builtin, form)}`: {_describe(form)}" if expected else None
+    help_text = (f"`{signature(builtin, form)}`: {_describe(form)}" if expected
+                 else f"write `{signature(builtin, form)}`")
     if len(values) < expected:
         return Diagnostic("E0503", E, message, call.span, help=help_text)
     extra = values[expected].span.cover(values[-1].span)
