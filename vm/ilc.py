@@ -279,7 +279,7 @@ def read(data: bytes) -> Container:
     if crc_of(data) != header.crc:
         raise IlcFormatError(CRC_OFFSET, f"CRC-32 mismatch: the header says "
                              f"0x{header.crc:08X}, the file's is 0x{crc_of(data):08X}; "
-                             "the file is damaged, compile it again",
+                             "the file is damaged",  # what to do is the reporter's help
                              Refusal.BAD_CRC)
     unknown_required = header.flags & REQUIRED_FLAGS & ~KNOWN_FLAGS
     if unknown_required:
@@ -301,8 +301,9 @@ def read_header(data: bytes) -> Header:
                              f"for an .ilc header ({HEADER.size} bytes)",
                              Refusal.TRUNCATED)
     if data[:4] != MAGIC:
-        raise IlcFormatError(0, f"not an .ilc file: it starts with {data[:4]!r}, "
-                             f"not {MAGIC!r}",
+        raise IlcFormatError(0, f"not an .ilc file: it does not start with "
+                             f"`{MAGIC.decode()}` (its first bytes are "
+                             f"{data[:len(MAGIC)].hex(' ').upper()})",
                              Refusal.BAD_MAGIC)
     if data[4] != VERSION_MAJOR:
         raise IlcFormatError(4, f"format version {data[4]}.{data[5]} is not supported: "

@@ -19,7 +19,7 @@ from rl1.vm.defaults import Engine
 from rl1.vm.device import Device
 
 from .command import Failure
-from .streams import ILC_ROLE, STDIN_NAME, emit, invalid_file, read_ilc, read_input
+from .streams import ILC_ROLE, STDIN_NAME, emit, invalid_file, read_ilc, read_input, refused_ilc
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,13 +43,13 @@ def run_file(file: str, device: Device, engine: Engine, budget: int, color: Colo
             raise click.UsageError("--engine ast interprets RL/I source; an .ilc file runs "
                                    "on the VM: leave out --engine, or run the .rob file")
         data = read_ilc(file)
-        with _refusals(file):
+        with _refusals(file, data):
             finished = run(data, device, engine=engine, budget=budget)
         return Ran(finished, *_recorded_source(data, file))
     source = read_input(file)
     if not isinstance(source, Source):
         return emit([source], "human", color, command, err=True)
-    with _refusals(file):
+    with _refusals(file, None):
         outcome = run(source.text, device, engine=engine, budget=budget,
                       source_name=os.path.basename(source.name))
     if isinstance(outcome, list):  # errors: it cannot run
@@ -62,8 +62,10 @@ def run_file(file: str, device: Device, engine: Engine, budget: int, color: Colo
 
 
 @contextmanager
-def _refusals(file: str) -> Iterator[None]:
-    """What keeps `file` from running, as the command reports it."""
+def _refusals(file: str, data: bytes | None) -> Iterator[None]:
+    """What keeps `file` from running, as the command reports it; `data`: the bytes of
+    an .ilc file, None for a source compiled here (which the verifier refuses only
+    through a bug of the compiler's)."""
     from rl1.vm.native import BuildError
     from rl1.vm.scripted import ScriptError
     from rl1.vm.verifier import VerifyError
@@ -71,6 +73,8 @@ def _refusals(file: str) -> Iterator[None]:
     try:
         yield
     except VerifyError as error:
+        if data is not None:  # as `rl1c dis` says it: text or another file named as such
+            raise refused_ilc(file, data, error, "compile the program again") from None
         raise invalid_file(ILC_ROLE, STDIN_NAME if file == "-" else file,
                            f"byte {error.offset}: {error.message}",
                            "compile the program again", EXIT_ERRORS) from None

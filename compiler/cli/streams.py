@@ -246,12 +246,18 @@ def refused_ilc(file: str, data: bytes, error: IlcFormatError, help: str) -> Fai
         except SourceError:
             detail = (f"it does not start with `{MAGIC.decode()}` as an .ilc file does (its "
                       f"first bytes are {data[:len(MAGIC)].hex(' ').upper()})")
+            help = "check that this is the .ilc file you meant (`rl1c compile` writes one)"
         else:
             source = file.lower().endswith(SOURCE_SUFFIX)
             detail = f"it is {'RL/I source ' if source else ''}text, not compiled code"
             output = with_suffix(file, ".ilc") if file != "-" else "FILE.ilc"
-            help = (f"{'' if source else 'if it is an RL/I program, '}compile it first, "
-                    f"`rl1c compile {file} -o {output}`, then give {output}")
+            if output == file:  # compiling it to its own name is refused: name it as source
+                renamed = with_suffix(file, SOURCE_SUFFIX)
+                help = (f"if it is an RL/I program, name it {renamed} and compile that, "
+                        f"`rl1c compile {renamed} -o {output}`, then give {output}")
+            else:
+                help = (f"{'' if source else 'if it is an RL/I program, '}compile it first, "
+                        f"`rl1c compile {file} -o {output}`, then give {output}")
     return invalid_file(ILC_ROLE, name, detail, help, EXIT_ERRORS)
 
 
