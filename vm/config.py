@@ -15,13 +15,14 @@ positions: `config_lines.py` finds the line from the key path in one linear pass
 
 from __future__ import annotations
 
+import difflib
 import json
 import math
 import re
 import sys
 import tomllib
 import types
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Annotated, Any, Literal, TypeVar, Union, get_args, get_origin
 
@@ -29,7 +30,7 @@ import msgspec
 import msgspec.inspect as mi
 from msgspec import Meta
 
-from .config_lines import KeyPath, first_long_number, line_of
+from .config_lines import BARE_KEY, KeyPath, first_long_number, line_of
 from .language import BUILTINS
 
 T = TypeVar("T")
@@ -75,6 +76,23 @@ def error_at(name: str, text: str, path: KeyPath, detail: str,
 def excerpt(text: str) -> str:
     """`text`, cut to a short excerpt for a message."""
     return text if len(text) <= _EXCERPT else text[:_EXCERPT] + "..."
+
+
+def written_key(key: str, syntax: Syntax) -> str:
+    """`key` as a file of `syntax` writes it: in quotes, unless TOML takes it bare."""
+    return key if syntax == "toml" and BARE_KEY.fullmatch(key) else json.dumps(key)
+
+
+def unknown_key(key: str, known: Sequence[str], quote: Callable[[str], str] = str) -> str:
+    """What a table of the keys `known` says of the key `key` it does not have: the keys
+    it has, each written by `quote`, and the one `key` is likely a misspelling of (its
+    case aside), when one is close."""
+    listed = ", ".join(quote(name) for name in known)
+    by_case = {name.lower(): name for name in reversed(known)}  # the first of equal ones
+    close = difflib.get_close_matches(key.lower(), by_case, n=1) \
+        if len(key) <= _EXCERPT else []  # a long key is no misspelling, and costly to match
+    guess = f"; did you mean {quote(by_case[close[0]])}?" if close else ""
+    return f"unknown key; expected one of {listed}{guess}"
 
 
 def describe_path(path: KeyPath) -> str:
@@ -234,9 +252,9 @@ def convert(document: object, schema: type[T], name: str, text: str,
         known = _keys(kind)
         unknown = (next((key for key in value if key not in known), None)
                    if isinstance(value, Mapping) else None)
-        path = (*path, what[len(_UNKNOWN):-1] if unknown is None else unknown)
-        detail = "unknown key; expected one of " + ", ".join(
-            json.dumps(key) if syntax == "json" else key for key in known)
+        key = what[len(_UNKNOWN):-1] if unknown is None else unknown
+        path = (*path, key)
+        detail = unknown_key(key, known, lambda name: written_key(name, syntax))
     elif at is not None and at.group(1) == "key" and isinstance(value, Mapping):
         path = (*path, _first_failing(value, kind))
         key_kind = get_args(_strip(kind))[0]
@@ -365,7 +383,8 @@ def _missing(kind: Any, path: KeyPath, value: object, syntax: Syntax) -> str:
     keys = [field.encode_name for field in msgspec.structs.fields(_strip(kind))
             if field.required and not (isinstance(value, Mapping) and field.encode_name in value)]
     if syntax == "json":
-        return "missing " + ", ".join(f'"{key}"' for key in keys)
+        named = [json.dumps(key) for key in keys]
+        return f"missing {', '.join(named)}; write {named[0]}: ..."
     if _is_table(_child(kind, keys[0])):
         return f"missing the [{describe_path((*path, keys[0]))}] table; add one"
     return "missing " + ", ".join(f"`{key}`" for key in keys) + f"; write `{keys[0]} = ...`"

@@ -21,7 +21,8 @@ from typing import Literal
 KeyPath = tuple[str | int, ...]
 Entry = tuple[KeyPath, int, str]  # a path, its line (1-based), a scalar's text or ""
 
-_BARE = re.compile(r"[A-Za-z0-9_-]+")
+BARE_KEY = re.compile(r"[A-Za-z0-9_-]+")
+"""A TOML key written without quotes; any other is written in them."""
 _QUOTE_OR_ESCAPE = re.compile(r'["\\]')
 _SCALAR = re.compile(r"[^,\]}#\r\n]*")
 _SPACE = " \t"
@@ -174,7 +175,7 @@ class _Scanner:
             if char in ('"', "'"):
                 token = self.string()
                 keys.append(tomllib.loads(f"k = {token}")["k"] if "\\" in token else token[1:-1])
-            elif (bare := _BARE.match(text, self.at)) is not None:
+            elif (bare := BARE_KEY.match(text, self.at)) is not None:
                 keys.append(bare.group())
                 self.at = bare.end()
             else:

@@ -33,6 +33,7 @@ from ..config import (
     convert,
     error_at,
     read_document,
+    unknown_key,
 )
 from ..config_lines import KeyPath
 from .geometry import Point, rectangle
@@ -265,7 +266,7 @@ class World:
         fields = {"start": _START_FIELDS, "stands": _STAND_FIELDS}.get(
             table, tuple(name for name in settings.__struct_fields__
                          if isinstance(getattr(settings, name), float)))
-        raise ValueError(f"unknown key; expected one of {', '.join(fields)}")
+        raise ValueError(unknown_key(field, fields))
 
     def moved(self, offsets: Mapping[str, float]) -> World:
         """This world with the parameters of `offsets` moved by them (cm, degrees, or the

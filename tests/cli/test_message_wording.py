@@ -1,0 +1,165 @@
+"""Messages read side by side, as a user meets them through `rl1c check`, `rl1c run` and
+`rl1c sim`: each says what is wrong, where, and what to do, in the terms of the file at
+hand, and says the same kind of thing the same way wherever it is said."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from hypothesis import given
+from hypothesis import strategies as st
+from support.cli import rl1c
+
+from rl1.vm import ilc
+from rl1.vm.config import unknown_key
+
+PROGRAM = "(MOV 3,3)\n(TIM 5)\nA=(IMG)\n(MOV 0,0)\n(END)\n"
+
+
+def checked(tmp_path: Path, text: str) -> str:
+    (tmp_path / "p.rob").write_text(text)
+    return rl1c("check", tmp_path / "p.rob", "--color", "never").stdout
+
+
+def test_a_jump_target_of_three_digits_is_told_the_range_of_jump_targets(
+    tmp_path: Path,
+) -> None:
+    out = checked(tmp_path, ":100 (MOV 0,0)\n#100\n(END)\n")
+    assert "help: labels run from `:00` to `:99`" in out
+    assert "help: jump targets run from `#00` to `#99`" in out
+    assert "labels run from `#" not in out  # a label is never written with `#`
+
+
+def test_an_argument_to_a_call_that_takes_none_is_told_how_to_write_the_call(
+    tmp_path: Path,
+) -> None:
+    out = checked(tmp_path, "(MOV 0,0)\n(FRE 1)\n(CAM Z 4)\n(END)\n")
+    assert "`(FRE)` takes no arguments, found 1" in out
+    assert "help: write `(FRE)`" in out
+    assert "help: write `(CAM Z)`" in out
+
+
+def run_ilc(path: Path) -> str:
+    result = rl1c("run", path, "--color", "never")
+    assert result.exit_code == 1, result.output
+    return result.stderr
+
+
+def test_rl1c_run_names_a_file_that_is_no_ilc_file_as_rl1c_dis_does(tmp_path: Path) -> None:
+    other = tmp_path / "photo.ilc"
+    other.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(40))
+    out = run_ilc(other)
+    assert "it does not start with `RLIC` as an .ilc file does (its first bytes are " \
+           "89 50 4E 47)" in out
+    assert "b'" not in out  # no Python bytes repr
+    assert "help: check that this is the .ilc file you meant" in out
+    assert out == rl1c("dis", other).stderr
+
+
+def test_source_named_ilc_is_told_a_compile_command_that_works(tmp_path: Path) -> None:
+    misnamed = tmp_path / "p.ilc"
+    misnamed.write_text(PROGRAM)
+    out = run_ilc(misnamed)
+    assert "is not valid: it is text, not compiled code" in out
+    source, compiled = tmp_path / "p.rob", tmp_path / "p.ilc"
+    assert f"`rl1c compile {source} -o {compiled}`, then give {compiled}" in out
+    # The advice, followed, works (compiling p.ilc onto itself is refused).
+    misnamed.rename(source)
+    assert rl1c("compile", source, "-o", compiled).exit_code == 0
+    assert rl1c("run", compiled).exit_code == 13  # (IMG) without a script: it ran
+
+
+def test_a_damaged_ilc_file_says_what_to_do_once(tmp_path: Path) -> None:
+    (tmp_path / "p.rob").write_text(PROGRAM)
+    compiled = tmp_path / "p.ilc"
+    assert rl1c("compile", tmp_path / "p.rob", "-o", compiled).exit_code == 0
+    data = bytearray(compiled.read_bytes())
+    data[-1] ^= 0xFF
+    compiled.write_bytes(data)
+    out = run_ilc(compiled)
+    assert "byte 8: CRC-32 mismatch: the header says 0x" in out
+    assert out.count("compile") == 1 and "help: compile the program again" in out
+
+
+def test_the_container_reader_shows_a_wrong_start_in_hex() -> None:
+    try:
+        ilc.decode(b"\x00\x01ab" + bytes(40))
+    except ilc.IlcFormatError as error:
+        assert error.message == ("not an .ilc file: it does not start with `RLIC` (its "
+                                 "first bytes are 00 01 61 62)")
+    else:
+        raise AssertionError("decoded a file that does not start with RLIC")
+
+
+def script_says(tmp_path: Path, name: str, text: str) -> str:
+    (tmp_path / "p.rob").write_text(PROGRAM)
+    (tmp_path / name).write_text(text)
+    result = rl1c("run", tmp_path / "p.rob", "--sensors", tmp_path / name, "--color", "never")
+    assert result.exit_code == 2, result.output
+    return result.stderr.splitlines()[0]
+
+
+def test_a_misspelt_key_of_a_sensor_script_is_told_the_key_it_is_close_to(
+    tmp_path: Path,
+) -> None:
+    assert script_says(tmp_path, "s.json", '{"IMGG": [{"area": 1}]}').endswith(
+        '"line_lost", "fail", "stop_fails", "after_last", "comment"; did you mean "IMG"?')
+    assert script_says(tmp_path, "s.json", '{"line_lost": [{"durin": "MOV"}]}').endswith(
+        '"during", "nth", "after"; did you mean "during"?')
+    assert "did you mean" not in script_says(tmp_path, "s.json", '{"zzzz": 1}')
+
+
+def test_toml_keys_are_quoted_as_toml_needs_them(tmp_path: Path) -> None:
+    says = script_says(tmp_path, "s.toml", "ult_a = [1]\n")
+    assert ': ult_a: unknown key; expected one of IMG, KYO, "CAM R", "ULT A",' in says
+    assert says.endswith('; did you mean "ULT A"?')
+
+
+def test_a_json_script_missing_a_key_is_told_what_to_write(tmp_path: Path) -> None:
+    says = script_says(tmp_path, "s.json", '{"IMG": [{"area": 1, "x": 2}]}')
+    assert says.endswith(f'{tmp_path / "s.json"}:1: IMG[0]: missing "y", "z"; write "y": ...')
+
+
+WORLD = """[floor]
+size = [600, 400]
+
+[start]
+x = 60
+y = 200
+
+[[stands]]
+name = "bench"
+x = 400
+y = 330
+facng = -135
+"""
+
+
+def test_a_misspelt_key_of_a_world_file_and_of_a_sweep_are_told_the_close_key(
+    tmp_path: Path,
+) -> None:
+    (tmp_path / "p.rob").write_text(PROGRAM)
+    (tmp_path / "w.toml").write_text(WORLD)
+    says = rl1c("sim", tmp_path / "p.rob", "--world", tmp_path / "w.toml").stderr
+    assert f"{tmp_path / 'w.toml'}:12: stands[0].facng: unknown key; expected one of name, " \
+           "x, y, width, depth, facing, height, marker_height; did you mean facing?" in says
+    (tmp_path / "w.toml").write_text(WORLD.replace("facng", "facing"))
+    swept = rl1c("sim", tmp_path / "p.rob", "--world", tmp_path / "w.toml", "--runs", "2",
+                 "--sweep", "stands.bench.facng=0:40:3")
+    assert swept.exit_code == 2
+    assert "--sweep: stands.bench.facng: unknown key; expected one of x, y, facing; " \
+           "did you mean facing?" in swept.stderr
+
+
+KEYS = ["IMG", "KYO", "CAM R", "ULT A", "line_lost", "after_last", "comment"]
+
+
+@given(st.text(max_size=60))
+def test_a_guess_is_always_one_of_the_keys_and_a_known_key_guesses_itself(key: str) -> None:
+    said = unknown_key(key, KEYS, json.dumps)
+    assert said.startswith("unknown key; expected one of " + ", ".join(map(json.dumps, KEYS)))
+    _, guessed, guess = said.partition("; did you mean ")
+    assert not guessed or guess.removesuffix("?") in map(json.dumps, KEYS)
+    for known in KEYS:
+        assert unknown_key(known.lower(), KEYS, str).endswith(f"did you mean {known}?")
