@@ -171,6 +171,15 @@ _NO_READING_HELP = ("add readings to the sensor script (spec/sensors.md), or giv
 _NO_SCRIPT_HELP = ("give the readings the program needs in a sensor script: "
                    "--sensors FILE (spec/sensors.md)")
 _FORM = re.compile(r"\(([A-Z]{3})\b")
+_NO_HANDLER = re.compile(r"has no label :(\d\d)")  # as faults.missing_handler_message says
+
+
+def _handler_help(label: str) -> str:
+    """What to do about a lost line that jumps to the missing handler `:label`, in the
+    words of the checker's W0301."""
+    return (f"add the handler label: a line that starts with `:{label}` and says what the "
+            f"vehicle does when it loses the line, e.g. `:{label} (MOV 0,0); (END)` "
+            "(`rl1c explain W0301`)")
 
 
 def fault_help(fault: Fault) -> str:
@@ -182,6 +191,9 @@ def fault_help(fault: Fault) -> str:
             return _NO_SCRIPT_HELP
         if "has no reading" in fault.message:
             return _NO_READING_HELP
+    if fault.kind is FaultKind.MISSING_HANDLER and (
+            label := _NO_HANDLER.search(fault.message)) is not None:
+        return _handler_help(label.group(1))
     return _HELP[fault.kind]
 
 

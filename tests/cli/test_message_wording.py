@@ -163,3 +163,19 @@ def test_a_guess_is_always_one_of_the_keys_and_a_known_key_guesses_itself(key: s
     assert not guessed or guess.removesuffix("?") in map(json.dumps, KEYS)
     for known in KEYS:
         assert unknown_key(known.lower(), KEYS, str).endswith(f"did you mean {known}?")
+
+
+def test_a_missing_handler_fault_names_the_label_to_add_as_the_checker_does(
+    tmp_path: Path,
+) -> None:
+    (tmp_path / "p.rob").write_text("(TRC 3)\n(MVI 1,1,50)\n(MOV 0,0)\n(END)\n")
+    (tmp_path / "s.json").write_text('{"line_lost": [{"during": "MVI", "nth": 1}]}')
+    for engine in ("vm", "ast"):
+        result = rl1c("run", tmp_path / "p.rob", "--sensors", tmp_path / "s.json",
+                      "--engine", engine, "--color", "never")
+        assert result.exit_code == 11
+        assert "error[E1011]: the line was lost during MVI in tracing mode 3, which jumps " \
+               "to :97, but the program has no label :97" in result.stdout
+        assert "help: add the handler label: a line that starts with `:97` and says what " \
+               "the vehicle does when it loses the line, e.g. `:97 (MOV 0,0); (END)`" \
+               in result.stdout
