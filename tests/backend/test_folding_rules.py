@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 from support.semantics import operate
 from test_passes import after, run_program
 
+from rl1.compiler.backend import ir
 from rl1.compiler.backend.constants import fold_constants
 from rl1.vm import isa
 from rl1.vm.language import VARIABLES
@@ -60,3 +61,15 @@ def test_a_branch_on_a_known_value_is_decided_as_it_would_go(relation: str) -> N
         taken = {"=": known == 0, ">": known > 0, "<": known < 0}[relation]
         variables, _ = run_program(program, {})
         assert variables[VARIABLES.index("B")] == (0 if taken else 1), known
+
+
+def test_a_computed_value_is_unknown_and_stored_as_it_is() -> None:
+    """-O2's Compute (fuse makes it after this pass) leaves the accumulator unknown: a
+    store after it stays, and so does what it stores, on IR as fuse leaves it."""
+    compute = ir.Compute(ir.Var("B"), "+", ir.Imm(1), 1)
+    program = ir.Program({"B0": ir.Block("B0", [ir.Load(ir.Imm(5), 1), ir.Store(ir.Var("B"), 1),
+                                                compute, ir.Store(ir.Var("A"), 2)],
+                                         ir.End(3))}, "B0")
+    assert ir.validate(program) == []
+    assert fold_constants(program).blocks["B0"].instructions[-2:] == [
+        compute, ir.Store(ir.Var("A"), 2)]
