@@ -190,7 +190,11 @@ def _syntax_help(row: ast.Row, kinds: Kinds, lexemes: list[Lexeme],
                      (_between(row, lexemes, index, "; "),), safe=True),))
     if expected == {"RPAR"} or ("RPAR" in expected and "_COMMA" in expected):
         return "close the call with `)`", ()
-    if "LABELREF" in expected:
+    if found == "=" and "VAR" in expected:  # where a statement or an operand starts
+        return ("an assignment starts with the variable it sets, as in `A=3`"
+                if "LABELREF" in expected else
+                "`=` is written once, as in `A=3`; a comparison is a jump, as in `?A=#10`"), ()
+    if expected == {"LABELREF"}:  # not only among a statement's starts
         return "a jump target is `#` and two digits, e.g. `#10`", ()
     return None, ()
 

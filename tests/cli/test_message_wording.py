@@ -179,3 +179,14 @@ def test_a_missing_handler_fault_names_the_label_to_add_as_the_checker_does(
         assert "help: add the handler label: a line that starts with `:97` and says what " \
                "the vehicle does when it loses the line, e.g. `:97 (MOV 0,0); (END)`" \
                in result.stdout
+
+
+def test_a_stray_equals_sign_is_told_how_an_assignment_is_written(tmp_path: Path) -> None:
+    out = checked(tmp_path, "=3\nA==3\n?A<10\n(END)\n")
+    assert "expected `(`, `;`, `?`, a jump target `#NN`, a label, a variable or the end of " \
+           "the line, found `=`\n" in out
+    assert "help: an assignment starts with the variable it sets, as in `A=3`" in out
+    assert "help: `=` is written once, as in `A=3`; a comparison is a jump, as in `?A=#10`" \
+           in out
+    # Only where a jump target is what the line needs is the help about one.
+    assert out.count("help: a jump target is `#` and two digits, e.g. `#10`") == 1
