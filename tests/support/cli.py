@@ -45,3 +45,10 @@ def rl1c(*args: str | Path, stdin: bytes = b"", encoding: str = "utf-8",
     result = runner.invoke(command, [str(arg) for arg in args], input=stdin, env=env)
     return Result(result.exit_code, result.stdout_bytes, result.stderr_bytes,
                   result.output_bytes, encoding)
+
+
+def without_progress(stderr: str) -> list[str]:
+    """The lines of a campaign's standard error but its progress lines (`fuzz: ...`,
+    every 10 s, so that a loaded machine prints more of them), which a test that
+    compares the warnings exactly leaves out."""
+    return [line for line in stderr.splitlines() if not line.startswith("fuzz: ")]
