@@ -55,8 +55,8 @@ MARKS: dict[str, tuple[str, ...]] = {
         ("slow",),
     "tests/checker/test_fixing.py::test_fixing_takes_at_most_64_bytes_a_source_byte": ("slow",),
     "tests/backend/test_compile_memory.py": ("slow",),
-    # Campaigns of simulated runs on pools of processes, and on a Dask cluster of a
-    # scheduler and two workers started for each test.
+    # Campaigns of simulated runs on pools of processes, and on Dask clusters of a
+    # scheduler and workers, each process started apart.
     "tests/sim/test_campaign.py": ("slow",),
     "tests/sim/test_cluster.py": ("slow",),
     # Forty seeded simulations of the robust Fig. 4 example.
