@@ -190,3 +190,18 @@ def test_a_stray_equals_sign_is_told_how_an_assignment_is_written(tmp_path: Path
            in out
     # Only where a jump target is what the line needs is the help about one.
     assert out.count("help: a jump target is `#` and two digits, e.g. `#10`") == 1
+
+
+def test_an_unexpected_character_that_cannot_be_seen_is_named_by_its_code_point(
+    tmp_path: Path,
+) -> None:
+    (tmp_path / "p.rob").write_bytes(
+        "A=1\u00a0\nB=\u200b2\nC=\x01\nD=\ue000\nE=\u00e9\n(END)\n".encode())
+    out = rl1c("check", tmp_path / "p.rob", "--format", "concise").stdout
+    assert [line.partition(" error[E0102]: ")[2] for line in out.splitlines()[:-1]] == [
+        "unexpected character U+00A0 (NO-BREAK SPACE)",
+        "unexpected character U+200B (ZERO WIDTH SPACE)",
+        "unexpected character U+0001",
+        "unexpected character U+E000",  # private use: no name, nothing a terminal shows
+        "unexpected character `\u00e9` (LATIN SMALL LETTER E WITH ACUTE)",
+    ]
