@@ -205,3 +205,15 @@ def test_an_unexpected_character_that_cannot_be_seen_is_named_by_its_code_point(
         "unexpected character U+E000",  # private use: no name, nothing a terminal shows
         "unexpected character `\u00e9` (LATIN SMALL LETTER E WITH ACUTE)",
     ]
+
+
+def test_a_scene_s_window_turned_round_is_shown_with_how_to_write_one(tmp_path: Path) -> None:
+    (tmp_path / "p.rob").write_text(PROGRAM)
+    world = WORLD.replace("facng", "facing") + (
+        '\n[[scenes]]\nnumber = 2\nsees = ["markers"]\nwindow = [100, 0, 50, 240]\n')
+    (tmp_path / "w.toml").write_text(world)
+    result = rl1c("sim", tmp_path / "p.rob", "--world", tmp_path / "w.toml")
+    assert result.exit_code == 2
+    assert f"{tmp_path / 'w.toml'}:17: scenes[0].window: [100, 0, 50, 240] is no window: " \
+           "write [x0, y0, x1, y1], its left, top, right and bottom edges in pixels, with " \
+           "x0 < x1 and y0 < y1\n" in result.stderr

@@ -655,7 +655,9 @@ class _World:
                                 "twice; give each [[scenes]] its own number")
             x0, y0, x1, y1 = scene.window
             if x1 <= x0 or y1 <= y0:
-                raise self.fail(("scenes", i, "window"), "expected x0 < x1 and y0 < y1")
+                raise self.fail(("scenes", i, "window"), f"[{x0}, {y0}, {x1}, {y1}] is no "
+                                "window: write [x0, y0, x1, y1], its left, top, right and "
+                                "bottom edges in pixels, with x0 < x1 and y0 < y1")
             for j, seen in enumerate(scene.sees):
                 if seen not in known:
                     raise self.fail(("scenes", i, "sees", j), f'"{seen}" is not a kind '
