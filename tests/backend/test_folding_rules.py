@@ -73,3 +73,10 @@ def test_a_computed_value_is_unknown_and_stored_as_it_is() -> None:
     assert ir.validate(program) == []
     assert fold_constants(program).blocks["B0"].instructions[-2:] == [
         compute, ir.Store(ir.Var("A"), 2)]
+
+
+def test_a_call_forgets_the_reserved_variables_it_writes() -> None:
+    """x is 1 before (IMG), which writes the image's x there: `x+1` after it is not 2."""
+    program = after(fold_constants, "x=1\n(IMG)\nB=x+1\n")
+    variables, _ = run_program(program, {"IMG": [{"area": 9, "x": 7, "y": 0, "z": 0}]})
+    assert variables[VARIABLES.index("B")] == 8
