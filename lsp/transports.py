@@ -24,6 +24,11 @@ first of them to need more than its free share is read whatever the others send.
 connection that has not
 sent `initialize` within INITIALIZE_SECONDS is closed, so that a local process cannot
 hold every place by connecting and saying nothing.
+
+On a WebSocket, messages are text, as RFC 6455 has a server refuse what it cannot
+accept: a binary message fails its connection with close code 1003, text not in UTF-8
+with 1007, and an HTTP request the library cannot read is answered 400 (it answers a
+line too long with 414 or 431 itself), where it closed the connection without a word.
 """
 
 from __future__ import annotations
@@ -43,6 +48,7 @@ from concurrent.futures import CancelledError
 from typing import Any, BinaryIO, Protocol
 
 from rl1.compiler.frontend.collector import FullCollections
+from rl1.vm.config import excerpt
 
 from .framing import CHUNK, MAX_MESSAGE, Admission, Framer, frame
 from .json_reading import read_json
@@ -70,8 +76,8 @@ tests/lsp/test_hostile_transports.py (eight clients each sending MAX_MESSAGE byt
 REFUSAL_SECONDS = 10.0
 """How long a client beyond MAX_SESSIONS has to send the request that is refused."""
 INITIALIZE_SECONDS = 10.0
-"""How long a connection has to send `initialize`: past this, it is closed, so that
-connections that send nothing cannot hold every place."""
+"""How long a connection has to send `initialize` (a studio page, its first message):
+past this, it is closed, so that connections that send nothing cannot hold every place."""
 REQUEST_FAILED = -32803  # LSP's code for a valid request that failed
 
 LOCAL_ORIGIN = re.compile(r"https?://(localhost|127\.0\.0\.1|\[::1\])(:\d+)?")
@@ -205,23 +211,33 @@ def _receive(session: Session, framer: Framer, chunk: bytes, tell: Writer | None
     return True
 
 
-async def _close_unless_initialized(session: Session, close: Callable[[], object]) -> None:
-    """Call `close` if `session` has not received `initialize` in INITIALIZE_SECONDS."""
+async def _close_unless(opened: Callable[[], bool], close: Callable[[], object],
+                        silent: str) -> None:
+    """Call `close` if `opened()` is still false INITIALIZE_SECONDS from now."""
     await asyncio.sleep(INITIALIZE_SECONDS)
-    if not session.initialized:
-        log.warning("a client sent no initialize in %.0f s: disconnected", INITIALIZE_SECONDS)
+    if not opened():
+        log.warning("%s in %.0f s: disconnected", silent, INITIALIZE_SECONDS)
         close()
 
 
 @contextlib.asynccontextmanager
-async def _initialize_deadline(session: Session, close: Callable[[], object]
-                               ) -> AsyncIterator[None]:
-    """While inside, `close` is called if `session` is not initialized in time."""
-    watch = asyncio.create_task(_close_unless_initialized(session, close))
+async def opening_deadline(opened: Callable[[], bool], close: Callable[[], object],
+                           silent: str) -> AsyncIterator[None]:
+    """While inside, `close` is called if `opened()` (a session's `initialized`, a studio
+    page's first message) is not true within INITIALIZE_SECONDS; `silent` says in the
+    log what did not come ("a client sent no initialize")."""
+    watch = asyncio.create_task(_close_unless(opened, close, silent))
     try:
         yield
     finally:
         watch.cancel()
+
+
+def _initialize_deadline(session: Session, close: Callable[[], object]
+                         ) -> contextlib.AbstractAsyncContextManager[None]:
+    """While inside, `close` is called if `session` is not initialized in time."""
+    return opening_deadline(lambda: session.initialized, close,
+                            "a client sent no initialize")
 
 
 M_MMAP_THRESHOLD = -3  # mallopt's parameter, from glibc's malloc.h
@@ -432,25 +448,54 @@ async def serve_tcp(new_session: Callable[[], Session], host: str, port: int) ->
 
 # WebSocket ------------------------------------------------------------------------------
 
-def refuse_websocket(connection: Any, reason: str) -> None:
+def fail_websocket(connection: Any, code: int, reason: str) -> None:
     """Close a WebSocket `connection` (websockets' asyncio ServerConnection) at once with
-    code 1013 (try again later) and `reason`: failed, not closed, because while close()
-    waits for the client's answer the library reads its messages, up to max_size a frame,
-    counted nowhere."""
-    from websockets.frames import CloseCode
-
-    connection.protocol.fail(CloseCode.TRY_AGAIN_LATER, reason[:123])
+    close `code` and `reason` (cut to the 123 bytes a close frame holds): failed, not
+    closed, because while close() waits for the client's answer the library reads its
+    messages, up to max_size a frame, counted nowhere."""
+    connection.protocol.fail(code, reason[:123])
     connection.send_data()
     connection.transport.close()
 
 
+async def read_text(connection: Any) -> bytes:
+    """The next message of `connection` (of WebSocketSessions' `connection_class`, which
+    refuses a binary one), a text message's bytes: checked to be UTF-8, not decoded (the
+    JSON reader decodes them; one copy fewer is 64 MiB less at the peak). One that is
+    not UTF-8 fails the connection with code 1007 (RFC 6455 8.1), which the library does
+    only when it decodes. ConnectionClosed once the connection has ended or failed."""
+    from websockets.frames import CloseCode
+
+    body: bytes = await connection.recv(decode=False)
+    if body.isascii():  # JSON as editors and the page write it: no copy to check it
+        return body
+    try:
+        body.decode()  # checked only: the decoded text is let go at once
+    except UnicodeDecodeError as error:
+        where = f"{error.reason} at byte {error.start}"
+        log.warning("closed a WebSocket connection (1007): a text message not in UTF-8 "
+                    "(%s)", where)
+        fail_websocket(connection, CloseCode.INVALID_DATA,
+                       f"a text message not in UTF-8 ({where}): send text in UTF-8")
+        await connection.wait_closed()
+        raise connection.close_exc from None
+    return body
+
+
 def _hand_over(session: Session, body: bytes) -> int:
-    """Hand `session` a WebSocket message's bytes (not decoded to text first: the
-    session's JSON reader checks UTF-8, and one copy fewer is 64 MiB less at the peak);
-    returns the bytes it leaves in flight: the websockets library keeps the last frame
-    it read (in a variable of its parser) until it has read the next."""
+    """Hand `session` a WebSocket message's bytes; returns the bytes it leaves in flight:
+    the websockets library keeps the last frame it read (in a variable of its parser)
+    until it has read the next."""
     session.receive(body)
     return len(body)
+
+
+def _unreadable(cause: BaseException | None) -> str:
+    """What is wrong with an HTTP request that the websockets library could not read
+    (`cause`, its parser's error), and what to do."""
+    if isinstance(cause, UnicodeDecodeError):  # its text says only "'ascii' codec..."
+        return "the request line is not ASCII: percent-encode its path (RFC 3986)"
+    return f"{excerpt(str(cause))}: send an HTTP/1.1 GET without a body"
 
 
 class WebSocketOutbox:
@@ -532,8 +577,11 @@ class WebSocketSessions:
     (only those served here)."""
 
     def __init__(self) -> None:
+        from http import HTTPStatus
+
         from websockets.asyncio.server import ServerConnection
-        from websockets.frames import CloseCode
+        from websockets.exceptions import InvalidMessage
+        from websockets.frames import DATA_OPCODES, CloseCode, Frame, Opcode
         from websockets.protocol import State
 
         return_large_buffers()
@@ -546,9 +594,42 @@ class WebSocketSessions:
             handled, and is closed when they would pass what InFlight allows: the library
             reads a whole message before handing it over. It reads nothing while its
             client has not read what was written to it (the library's answers to pings
-            too, which nothing else bounds)."""
+            too, which nothing else bounds). It takes text messages only, and answers a
+            request it cannot read as HTTP."""
 
             received = 0
+            answered_unreadable = False
+
+            def process_event(self, event: Any) -> None:
+                if isinstance(event, Frame) and event.opcode in DATA_OPCODES:
+                    if self.protocol.state is not State.OPEN:
+                        return  # failed: nothing more is processed (RFC 6455 7.1.7)
+                    if event.opcode is Opcode.BINARY:
+                        # RFC 6455 7.4.1: data of a type the server cannot accept. Refused
+                        # at its first frame, before the message is read.
+                        log.warning("closed a WebSocket connection (1003): it sent a binary "
+                                    "message, where JSON-RPC comes in text messages")
+                        fail_websocket(self, CloseCode.UNSUPPORTED_DATA, "binary messages "
+                                       "are not read: send each message as a text message")
+                        return
+                super().process_event(event)
+
+            def send_data(self) -> None:
+                # The library answers a request it cannot read only when a line is too
+                # long (414, 431); any other (a body, a request line not in ASCII, a line
+                # it cannot split) it closes without a word: it is answered 400 here,
+                # before the end of the stream the library writes. A client that closed
+                # before its request's end is not answered.
+                failed = self.protocol.handshake_exc
+                if (isinstance(failed, InvalidMessage) and not self.answered_unreadable
+                        and not isinstance(failed.__cause__, EOFError)):
+                    self.answered_unreadable = True
+                    what = _unreadable(failed.__cause__)
+                    log.warning("answered 400 Bad Request to an HTTP request it cannot "
+                                "read: %s", what)
+                    self.transport.write(self.protocol.reject(
+                        HTTPStatus.BAD_REQUEST, f"Bad request: {what}.\n").serialize())
+                super().send_data()
 
             def data_received(self, data: bytes) -> None:
                 self._count_and_receive(data)
@@ -597,12 +678,13 @@ class WebSocketSessions:
         """Serve `connection` (of `connection_class`) as a session of its own, one LSP
         message a WebSocket message, until it closes or the session exits."""
         from websockets.exceptions import ConnectionClosed
+        from websockets.frames import CloseCode
 
         assert isinstance(connection, self.connection_class)
         sessions, in_flight = self.sessions, self.in_flight
         if len(sessions) >= MAX_SESSIONS:
             log.warning("a client beyond the %d served at once: refused", MAX_SESSIONS)
-            refuse_websocket(connection, BUSY)
+            fail_websocket(connection, CloseCode.TRY_AGAIN_LATER, BUSY)
             return
         session = new_session()
         sessions.add(session)
@@ -613,8 +695,8 @@ class WebSocketSessions:
                 async with _initialize_deadline(session, connection.transport.abort):
                     while session.exit_status is None:
                         # Not bound to a variable, which would keep it until the next.
-                        connection.received = _hand_over(
-                            session, await connection.recv(decode=False))
+                        connection.received = _hand_over(session,
+                                                         await read_text(connection))
         except ConnectionClosed as closed:  # such as a message over MAX_MESSAGE
             log.info("a WebSocket connection ended: %s", closed)
         finally:

@@ -25,6 +25,7 @@ from urllib.parse import parse_qs, unquote, urlsplit
 from websockets.asyncio.server import ServerConnection, serve
 from websockets.datastructures import Headers
 from websockets.exceptions import ConnectionClosed
+from websockets.frames import CloseCode
 from websockets.http11 import Request, Response
 
 from .. import transports
@@ -154,25 +155,30 @@ class Server:
     async def _studio(self, connection: ServerConnection) -> None:
         if self.pages >= transports.MAX_SESSIONS:
             log.warning("a page beyond the %d served at once: refused", transports.MAX_SESSIONS)
-            transports.refuse_websocket(
-                connection, f"rl1c studio serves {transports.MAX_SESSIONS} pages at once: "
-                "close one")
+            transports.fail_websocket(
+                connection, CloseCode.TRY_AGAIN_LATER,
+                f"rl1c studio serves {transports.MAX_SESSIONS} pages at once: close one")
             return
         assert isinstance(connection, self.lsp.connection_class)
         self.pages += 1
         outbox = transports.WebSocketOutbox(
             connection, functools.partial(self.lsp.in_flight.refusal, connection), "a page")
         page = Connection(self.studio, outbox.send, lambda: outbox.unsent)
+        heard = False  # a page that says nothing holds a place only so long
         try:
             # Its bytes in flight are bounded together with the language server's
             # sessions' (transports.InFlight), as each of them counts its own.
             with self.lsp.in_flight.counting(connection,
                                              lambda: connection.received + outbox.unsent):
-                while True:
-                    message = await connection.recv(decode=False)
-                    await page.receive(message)
-                    # The library keeps the last frame it read until the next.
-                    connection.received, message = len(message), b""
+                async with transports.opening_deadline(lambda: heard,
+                                                       connection.transport.abort,
+                                                       "a page sent no message"):
+                    while True:
+                        message = await transports.read_text(connection)
+                        heard = True
+                        await page.receive(message)
+                        # The library keeps the last frame it read until the next.
+                        connection.received, message = len(message), b""
         except ConnectionClosed as closed:
             log.info("a page's connection ended: %s", closed)
         finally:

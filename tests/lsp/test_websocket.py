@@ -13,6 +13,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from raw import INITIALIZE, INITIALIZED, notification, request
 from sockets import Listening, listening
+from support.hostile import UNREADABLE_REQUESTS, http_answer
 
 websockets = pytest.importorskip("websockets")
 from websockets.sync.client import ClientConnection, connect  # noqa: E402
@@ -114,6 +115,40 @@ def test_websocket_from_a_web_page_elsewhere_is_refused(ws: Listening) -> None:
                  open_timeout=30) as local:
         local.send(json.dumps(INITIALIZE))
         assert "result" in ws_reply(local, 1)
+
+
+def test_a_binary_message_closes_its_connection_with_1003(ws: Listening) -> None:
+    """RFC 6455 7.4.1: LSP over WebSocket is text; a binary message was read as JSON."""
+    with ws_session(ws) as client, ws_session(ws) as kept:
+        client.send(json.dumps(request(2, "shutdown")).encode(), text=False)
+        with pytest.raises(websockets.ConnectionClosed) as closed:
+            client.recv(timeout=30)
+        assert closed.value.rcvd is not None and closed.value.rcvd.code == 1003
+        assert "text message" in closed.value.rcvd.reason
+        kept.send(hover(3, "file:///nowhere.rob"))
+        assert ws_reply(kept, 3)["result"] is None
+
+
+def test_a_text_message_not_in_utf8_closes_its_connection_with_1007(ws: Listening) -> None:
+    """RFC 6455 8.1: it was answered as a JSON-RPC parse error, the connection kept."""
+    sent = b'{"jsonrpc": "2.0", "id": 2, "method": "\xff"}'
+    with ws_session(ws) as client:
+        client.send(sent, text=True)
+        with pytest.raises(websockets.ConnectionClosed) as closed:
+            client.recv(timeout=30)
+        assert closed.value.rcvd is not None and closed.value.rcvd.code == 1007
+        assert f"UTF-8 (invalid start byte at byte {sent.index(0xff)})" in \
+            closed.value.rcvd.reason
+
+
+@pytest.mark.parametrize("sent", UNREADABLE_REQUESTS)
+def test_a_request_it_cannot_read_is_answered(ws: Listening, sent: str) -> None:
+    """A body, a request line not in ASCII, a line it cannot split: the connection was
+    closed without an answer, which an HTTP client reports as a server's failure."""
+    request, status = UNREADABLE_REQUESTS[sent]
+    answered, text = http_answer(ws.port, request)
+    assert answered == status, text
+    assert text.endswith(".\n") and len(text) < 200, text
 
 
 messages = st.one_of(

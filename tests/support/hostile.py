@@ -544,6 +544,37 @@ def ws_handshake(port: int, origin: str | None) -> bytes:
     return b"\r\n".join(lines) + b"\r\n\r\n"
 
 
+UNREADABLE_REQUESTS: dict[str, tuple[bytes, int]] = {
+    "a body": (b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 5\r\n\r\nhello", 400),
+    "a chunked body": (b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nTransfer-Encoding: chunked"
+                       b"\r\n\r\n0\r\n\r\n", 400),
+    "not ASCII": ("GET /\u00e9 HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n".encode(), 400),
+    "no request line": (b"hello\r\n\r\n", 400),
+    "HTTP/2.0": (b"GET / HTTP/2.0\r\nHost: 127.0.0.1\r\n\r\n", 400),
+    "a header line without a colon": (b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\nno colon"
+                                      b"\r\n\r\n", 400),
+    "a header line too long": (b"GET / HTTP/1.1\r\nX: " + b"y" * 9000 + b"\r\n\r\n", 431),
+    "too many headers": (b"GET / HTTP/1.1\r\n" + b"X: y\r\n" * 200 + b"\r\n", 431),
+    "a request line too long": (b"GET /" + b"a" * 9000 + b" HTTP/1.1\r\n\r\n", 414),
+}
+"""Requests that a WebSocket server here (its library) cannot read as HTTP, and the
+status each is answered with."""
+
+
+def http_answer(port: int, request: bytes) -> tuple[int, str]:
+    """The status and body with which the server on `port` answers `request`, sent as it
+    is; (0, "") when it closes the connection without an answer."""
+    with socket.create_connection(("127.0.0.1", port), timeout=30) as client:
+        client.sendall(request)
+        received = b""
+        while chunk := client.recv(65536):
+            received += chunk
+    if not received:
+        return 0, ""
+    head, _, body = received.partition(b"\r\n\r\n")
+    return int(head.split(b" ", 2)[1]), body.decode()
+
+
 def _send_hostile(server: ServedLsp, attack: HostileConnection) -> socket.socket | None:
     """Open one hostile connection and send what it sends; None when the server closed
     it or it timed out on the way (the server may refuse anything)."""
