@@ -2,9 +2,10 @@
 bench/hostile_fuzz.py runs the same attacks for as long as asked): whatever a client
 sends (broken framing, Content-Length bombs and lies, nested or malformed JSON, hostile
 parameters and documents, WebSocket frames of the wrong type, oversize or fragmented, a
-wrong Origin, half-closed sockets, many connections at once), the next client is served,
-hears nothing of the other sessions, and the server stays alive in bounded memory. And
-connections that send nothing cannot hold every place."""
+wrong Origin, an opening request it cannot read, half-closed sockets, many connections
+at once), the next client is served, hears nothing of the other sessions, and the server
+stays alive in bounded memory. And connections that send nothing cannot hold every
+place."""
 
 from __future__ import annotations
 

@@ -396,6 +396,7 @@ class HostileConnection:
     half_close: bool = False
     copies: int = 1
     origin: str | None = None
+    handshake: bytes | None = None  # on a WebSocket, sent for the opening handshake
 
 
 def _json_values() -> st.SearchStrategy[object]:
@@ -526,12 +527,23 @@ def _hostile_frames(draw: st.DrawFn) -> tuple[bytes, ...]:
 def hostile_connections(draw: st.DrawFn, transport: str) -> HostileConnection:
     """Hostile clients of `rl1-lsp --tcp` (transport "tcp") or `--ws` ("ws")."""
     chunks = draw(_hostile_stream() if transport == "tcp" else _hostile_frames())
-    origin = None
+    origin, handshake = None, None
     if transport == "ws":
         origin = draw(st.sampled_from([None, None, "http://localhost:8000",
                                        "https://evil.example", "null", "http://127.0.0.1.evil"]))
+        handshake = draw(st.none() | st.none() | st.none() | _hostile_requests())
     return HostileConnection(chunks=chunks, half_close=draw(st.booleans()),
-                             copies=draw(st.sampled_from([1, 1, 1, 2, 7, 12])), origin=origin)
+                             copies=draw(st.sampled_from([1, 1, 1, 2, 7, 12])), origin=origin,
+                             handshake=handshake)
+
+
+@st.composite
+def _hostile_requests(draw: st.DrawFn) -> bytes:
+    """An opening request a WebSocket server cannot read, or one mutated byte by byte."""
+    if draw(st.booleans()):
+        request, _ = draw(st.sampled_from(list(UNREADABLE_REQUESTS.values())))
+        return request
+    return _mutated(ws_handshake(0, None), draw)
 
 
 def ws_handshake(port: int, origin: str | None) -> bytes:
@@ -584,7 +596,7 @@ def _send_hostile(server: ServedLsp, attack: HostileConnection) -> socket.socket
         return None
     try:
         if server.transport == "ws":
-            connection.sendall(ws_handshake(server.port, attack.origin))
+            connection.sendall(attack.handshake or ws_handshake(server.port, attack.origin))
         for chunk in attack.chunks:
             connection.sendall(chunk)
         if attack.half_close:
