@@ -80,3 +80,12 @@ def test_a_call_forgets_the_reserved_variables_it_writes() -> None:
     program = after(fold_constants, "x=1\n(IMG)\nB=x+1\n")
     variables, _ = run_program(program, {"IMG": [{"area": 9, "x": 7, "y": 0, "z": 0}]})
     assert variables[VARIABLES.index("B")] == 8
+
+
+@pytest.mark.parametrize(("known", "operator"), [(0, "&"), (-1, "|"), (0, "<"), (0, ">")])
+def test_a_known_value_no_reading_changes_is_stored_without_the_operation(
+        known: int, operator: str) -> None:
+    """`0&C`, `-1|C` and 0 shifted are known whatever C is: no operation is left."""
+    program = after(fold_constants, f"A=(KYO)\nC=(KYO)\nB={known}\nA=B{operator}C\n")
+    assert [str(instruction) for instruction in program.blocks[program.entry].instructions
+            ][-2:] == ["load B", "store A"]
