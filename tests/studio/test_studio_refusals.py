@@ -6,6 +6,7 @@ sends no initialize), and an HTTP request it cannot read (400, or the library's 
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import time
 from collections.abc import Iterator
@@ -68,22 +69,26 @@ def test_a_text_message_not_in_utf8_closes_its_connection_with_1007(
 
 
 @pytest.mark.parametrize("path", SOCKETS)
-def test_a_connection_that_says_nothing_is_closed_after_the_deadline(
+def test_connections_that_say_nothing_are_closed_after_the_deadline(
         served: Served, path: str, monkeypatch: pytest.MonkeyPatch,
         caplog: pytest.LogCaptureFixture) -> None:
     """Eight pages that opened /studio and said nothing held every place for as long as
     they stayed; /lsp's connections had INITIALIZE_SECONDS to send initialize. A page
     that has spoken stays past the deadline."""
     monkeypatch.setattr(transports, "INITIALIZE_SECONDS", 0.2)
-    with connect(served.url(path, scheme="ws"), open_timeout=TIMEOUT) as silent, \
-            page(served) as speaking:
+    with contextlib.ExitStack() as stack:
+        silent = [stack.enter_context(connect(served.url(path, scheme="ws"),
+                                              open_timeout=TIMEOUT))
+                  for _ in range(transports.MAX_SESSIONS)]
+        for connection in silent:
+            with pytest.raises(ConnectionClosed):
+                connection.recv(timeout=TIMEOUT)
+    with page(served) as speaking:
         speaking.request("initialize")
-        with pytest.raises(ConnectionClosed):
-            silent.recv(timeout=TIMEOUT)
-        time.sleep(0.4)  # past the deadline of the page that spoke, opened after
+        time.sleep(0.4)  # past its deadline
         assert speaking.request("initialize")["program"] is None
-    silent_said = "a page sent no message" if path == "/studio" else "a client sent no initialize"
-    assert _warnings(caplog) == [f"{silent_said} in 0 s: disconnected"]
+    said = "a page sent no message" if path == "/studio" else "a client sent no initialize"
+    assert _warnings(caplog) == [f"{said} in 0 s: disconnected"] * transports.MAX_SESSIONS
 
 
 @pytest.mark.parametrize("sent", UNREADABLE_REQUESTS)
