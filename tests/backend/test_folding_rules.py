@@ -89,3 +89,12 @@ def test_a_known_value_no_reading_changes_is_stored_without_the_operation(
     program = after(fold_constants, f"A=(KYO)\nC=(KYO)\nB={known}\nA=B{operator}C\n")
     assert [str(instruction) for instruction in program.blocks[program.entry].instructions
             ][-2:] == ["load B", "store A"]
+
+
+@pytest.mark.parametrize("step", ["++", "--"])
+def test_a_step_of_a_known_value_folds_to_what_the_vm_computes(step: str) -> None:
+    for known in EDGES:
+        program = after(fold_constants, f"A={known}\nA{step}\nB=A\n")
+        variables, _ = run_program(program, {})
+        assert variables[VARIABLES.index("B")] == \
+            operate("+" if step == "++" else "-", known, 1), known
