@@ -84,15 +84,33 @@ def written_key(key: str, syntax: Syntax) -> str:
 
 
 def unknown_key(key: str, known: Sequence[str], quote: Callable[[str], str] = str) -> str:
-    """What a table of the keys `known` says of the key `key` it does not have: the keys
-    it has, each written by `quote`, and the one `key` is likely a misspelling of (its
-    case aside), when one is close."""
-    listed = ", ".join(quote(name) for name in known)
-    by_case = {name.lower(): name for name in reversed(known)}  # the first of equal ones
-    close = difflib.get_close_matches(key.lower(), by_case, n=1) \
-        if len(key) <= _EXCERPT else []  # a long key is no misspelling, and costly to match
-    guess = f"; did you mean {quote(by_case[close[0]])}?" if close else ""
-    return f"unknown key; expected one of {listed}{guess}"
+    """What a table of the keys `known` says of the key `key` it does not have."""
+    return "unknown key; " + one_of(key, known, quote)
+
+
+def one_of(word: str, choices: Sequence[str], quote: Callable[[str], str] = str) -> str:
+    """What to write instead of `word`, which is none of `choices`: the choices, each
+    written by `quote`, and the one `word` is likely a misspelling of (its case aside),
+    when one is closer than any other."""
+    listed = ", ".join(quote(choice) for choice in choices)
+    likely = _closest(word.lower(), {choice.lower(): choice for choice in reversed(choices)})
+    if likely is None:
+        return f"expected one of {listed}"
+    # The guess first: a long message is cut at its end when shown.
+    return f"did you mean {quote(likely)}? (expected one of {listed})"
+
+
+def _closest(word: str, choices: Mapping[str, str]) -> str | None:
+    """The value of the key of `choices` closest to `word`; None when none is close, or
+    two are as close (`CAM X` is as near to `CAM A` as to `CAM Z`: a guess would mislead)."""
+    if len(word) > _EXCERPT:  # a long word is no misspelling, and costly to compare
+        return None
+    close = difflib.get_close_matches(word, choices, n=2)
+    # Rated as get_close_matches rates them: the choice first.
+    ratios = [difflib.SequenceMatcher(None, choice, word).ratio() for choice in close]
+    if not close or (len(close) == 2 and ratios[0] == ratios[1]):
+        return None
+    return choices[close[0]]
 
 
 def describe_path(path: KeyPath) -> str:

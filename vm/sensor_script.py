@@ -47,6 +47,7 @@ from .config import (
     convert,
     error_at,
     found,
+    one_of,
     read_document,
 )
 from .config_lines import KeyPath
@@ -263,8 +264,8 @@ class _Script:
     def failures(self) -> dict[str, int]:
         for call in self.file.fail:
             if call not in FORMS:
-                raise self.fail(("fail", call), "not a built-in form; expected one of "
-                                                + ", ".join(sorted(FORMS)))
+                raise self.fail(("fail", call), "not a built-in form; "
+                                                + one_of(call, sorted(FORMS)))
         return dict(self.file.fail)
 
     def loss(self, loss: LossFields, index: int) -> LossAt | LossDuring | LossAfter:

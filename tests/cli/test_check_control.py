@@ -341,7 +341,8 @@ def test_standard_input_takes_the_working_directorys_project_file(
 @pytest.mark.parametrize("content, says", [
     ("[check\n", "line 1: invalid TOML: "),
     ('[check]\nselct = ["W06"]\n',
-     "line 2: check.selct: unknown key; expected one of select, ignore, warnings-as-errors"),
+     "line 2: check.selct: unknown key; did you mean select? (expected one of select, ignore, "
+     "warnings-as-errors)"),
     ('[lint]\nselect = ["W06"]\n', "line 1: lint: unknown key; expected one of check"),
     ("check = 3\n", "line 1: check: expected a table, found 3"),
     ('[check]\nselect = "W06"\n', 'line 2: check.select: expected a list of codes, such as ["W06'),

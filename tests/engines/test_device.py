@@ -71,7 +71,7 @@ def test_the_sample_sensor_script_is_valid() -> None:
 
 @pytest.mark.parametrize(("document", "message"), [
     ([1, 2], "s.json: the script must be an object"),
-    ({"IMAGE": []}, 's.json:1: IMAGE: unknown key; expected one of "IMG"'),
+    ({"IMAGE": []}, 's.json:1: IMAGE: unknown key; did you mean "IMG"? (expected one of "IMG"'),
     ({"IMG": {}}, "s.json:1: IMG: expected a list of at least one reading (leave the key out for "
      "none), found an object"),
     ({"IMG": []}, "s.json:1: IMG: expected a list of at least one reading (leave the key out for "

@@ -91,7 +91,8 @@ def test_noise_is_off_unless_the_world_turns_it_on() -> None:
 @pytest.mark.parametrize(("text", "says"), [
     (b"noise = 3\n", "w.toml:1: noise: expected a table or true or false, found 3"),
     (FLOOR + b"\n[noise]\nslip = 50\n", "w.toml:9: noise.slip: 50 is outside 0..10"),
-    (FLOOR + b"\n[noise]\nsilp = 1\n", "w.toml:9: noise.silp: unknown key; expected one of "),
+    (FLOOR + b"\n[noise]\nsilp = 1\n",
+     "w.toml:9: noise.silp: unknown key; did you mean slip? (expected one of "),
 ])
 def test_a_bad_noise_setting_says_where_and_what(text: bytes, says: str) -> None:
     with pytest.raises(WorldError) as refused:

@@ -69,8 +69,8 @@ def test_a_good_world_loads_with_defaults_filled_in() -> None:
     (GOOD.replace(b"x = 400", b'x = "far"'),
      'w.toml:14: stands[0].x: expected a number in -1e+06..1e+06, found the string "far"'),
     (GOOD.replace(b"facing", b"facingg"),
-     "w.toml:16: stands[0].facingg: unknown key; expected one of name, x, y, width, depth, "
-     "facing"),
+     "w.toml:16: stands[0].facingg: unknown key; did you mean facing? (expected one of name, "
+     "x, y, width, depth, facing"),
     (GOOD.replace(b'["markers"]', b'["nothing"]'),
      'w.toml:20: scenes[0].sees[0]: "nothing" is not a kind'),
     (GOOD.replace(b"[[0, 200], [600, 200]]", b"[[0, 200]]"),

@@ -220,7 +220,8 @@ def test_normal_draws_have_the_truncated_closed_form_s_mean_and_variance(
     ("vehicle.rotate_speed = { uniform = [0, 1] }",
      r"w\.toml:{line}: vary\.vehicle\.rotate_speed: a whole number, which is never drawn"),
     ("vehicle.tred = { uniform = [0, 1] }",
-     r"w\.toml:{line}: vary\.vehicle\.tred: unknown key; expected one of length, width, "
+     r"w\.toml:{line}: vary\.vehicle\.tred: unknown key; did you mean tread\? \(expected one "
+     r"of length, width, "
      "tread,"),
     ("noise.odometry = { uniform = [0, 0.5] }",
      r"w\.toml:{line}: vary\.noise\.odometry: offsets 0\.\.0\.5 would leave the value's "
