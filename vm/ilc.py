@@ -294,6 +294,13 @@ def read(data: bytes) -> Container:
                      entry_offsets)
 
 
+def wrong_start(data: bytes) -> str:
+    """What a file `data` that does not start with MAGIC starts with instead, its bytes
+    in hex (a Python bytes repr, b'...', is no user's notation)."""
+    return (f"it does not start with `{MAGIC.decode()}` (its first bytes are "
+            f"{data[:len(MAGIC)].hex(' ').upper()})")
+
+
 def read_header(data: bytes) -> Header:
     """The header, with its section lengths checked against the file's size."""
     if len(data) < 6:
@@ -301,10 +308,7 @@ def read_header(data: bytes) -> Header:
                              f"for an .ilc header ({HEADER.size} bytes)",
                              Refusal.TRUNCATED)
     if data[:4] != MAGIC:
-        raise IlcFormatError(0, f"not an .ilc file: it does not start with "
-                             f"`{MAGIC.decode()}` (its first bytes are "
-                             f"{data[:len(MAGIC)].hex(' ').upper()})",
-                             Refusal.BAD_MAGIC)
+        raise IlcFormatError(0, f"not an .ilc file: {wrong_start(data)}", Refusal.BAD_MAGIC)
     if data[4] != VERSION_MAJOR:
         raise IlcFormatError(4, f"format version {data[4]}.{data[5]} is not supported: "
                              f"this reader reads version {VERSION_MAJOR}.x",

@@ -234,7 +234,7 @@ def refused_ilc(file: str, data: bytes, error: IlcFormatError, help: str) -> Fai
     verifier refused with `error`; `help` says what to do. A file that does not start
     as an .ilc file does is said to be text (RL/I source, when named so) when it is,
     with what to compile, else its first bytes are shown in hex."""
-    from rl1.vm.ilc import MAGIC
+    from rl1.vm.ilc import MAGIC, wrong_start
 
     name = STDIN_NAME if file == "-" else file
     detail = f"byte {error.offset}: {error.message}"
@@ -244,8 +244,7 @@ def refused_ilc(file: str, data: bytes, error: IlcFormatError, help: str) -> Fai
         try:
             decode(data, name)
         except SourceError:
-            detail = (f"it does not start with `{MAGIC.decode()}` as an .ilc file does (its "
-                      f"first bytes are {data[:len(MAGIC)].hex(' ').upper()})")
+            detail = wrong_start(data)
             help = "check that this is the .ilc file you meant (`rl1c compile` writes one)"
         else:
             source = file.lower().endswith(SOURCE_SUFFIX)

@@ -50,8 +50,8 @@ def test_rl1c_run_names_a_file_that_is_no_ilc_file_as_rl1c_dis_does(tmp_path: Pa
     other = tmp_path / "photo.ilc"
     other.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(40))
     out = run_ilc(other)
-    assert "it does not start with `RLIC` as an .ilc file does (its first bytes are " \
-           "89 50 4E 47)" in out
+    assert "is not valid: it does not start with `RLIC` (its first bytes are 89 50 4E 47)" \
+           in out
     assert "b'" not in out  # no Python bytes repr
     assert "help: check that this is the .ilc file you meant" in out
     assert out == rl1c("dis", other).stderr

@@ -203,8 +203,8 @@ def test_dis_refuses_an_invalid_file_with_its_offset(tmp_path: Path) -> None:
     (tmp_path / "x.ilc").write_bytes(b"RLIX" + assemble("END")[4:])
     result = rl1c("dis", tmp_path / "x.ilc")
     assert result.exit_code == 1
-    assert "it does not start with `RLIC` as an .ilc file does (its first bytes are " \
-        "52 4C 49 58)" in result.output
+    assert "is not valid: it does not start with `RLIC` (its first bytes are 52 4C 49 58)" \
+        in result.output
     (tmp_path / "y.ilc").write_bytes(assemble("END")[:-1])
     cut = rl1c("dis", tmp_path / "y.ilc")
     assert cut.exit_code == 1 and "is not valid: byte " in cut.output
