@@ -166,8 +166,8 @@ _HELP = {
 }
 _TIME_LIMIT_HELP = ("if the program should run longer, raise --time-limit; if not, it waits "
                     "in a loop for something that does not come")
-_NO_READING_HELP = ("add readings to the sensor script (spec/sensors.md), or give "
-                    "\"after_last\": \"repeat\" to repeat the last one")
+_NO_READING_HELP = ("add readings to the sensor script (spec/sensors.md), or set its "
+                    "after_last to \"repeat\" to repeat the last one")  # in JSON or TOML
 _NO_SCRIPT_HELP = ("give the readings the program needs in a sensor script: "
                    "--sensors FILE (spec/sensors.md)")
 _FORM = re.compile(r"\(([A-Z]{3})\b")

@@ -224,3 +224,18 @@ def test_a_scene_s_window_turned_round_is_shown_with_how_to_write_one(tmp_path: 
     assert f"{tmp_path / 'w.toml'}:17: scenes[0].window: [100, 0, 50, 240] is no window: " \
            "write [x0, y0, x1, y1], its left, top, right and bottom edges in pixels, with " \
            "x0 < x1 and y0 < y1\n" in result.stderr
+
+
+def test_readings_used_up_are_told_what_to_write_in_the_script_s_own_syntax(
+    tmp_path: Path,
+) -> None:
+    (tmp_path / "p.rob").write_text(":10 A=(IMG)\n#10\n")
+    (tmp_path / "s.toml").write_text("IMG = [{ area = 1, x = 1, y = 1, z = 1 }]\n")
+    result = rl1c("run", tmp_path / "p.rob", "--sensors", tmp_path / "s.toml",
+                  "--color", "never")
+    assert result.exit_code == 13
+    assert "error[E1013]: (IMG) at 100 ms has no reading: it is call 2, and the sensor script " \
+           f"{tmp_path / 's.toml'} gives 1 IMG reading" in result.stdout
+    assert 'help: add readings to the sensor script (spec/sensors.md), or set its after_last ' \
+           'to "repeat" to repeat the last one' in result.stdout
+    assert '"after_last":' not in result.stdout  # JSON's syntax, in a TOML script's help
