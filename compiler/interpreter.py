@@ -15,7 +15,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from rl1.vm.device import Device, DeviceError, form_name, perform
-from rl1.vm.faults import DEFAULT_BUDGET, Fault, FaultKind, RunResult, missing_handler_message
+from rl1.vm.faults import (
+    DEFAULT_BUDGET,
+    Fault,
+    FaultKind,
+    RunResult,
+    budget_message,
+    missing_handler_message,
+)
 from rl1.vm.language import BUILTINS, VARIABLE_INDEX, VARIABLES, Form, lost_line_handler
 
 from .frontend import ast
@@ -231,9 +238,7 @@ class Interpreter:
         """At each jump taken and before each device call, as the VM does: every loop
         takes a jump, so a runaway program always meets it."""
         if self.steps > self.budget:
-            raise _Faulted(FaultKind.BUDGET, f"the program ran more than {self.budget} "
-                           "statements without ending (raise the budget if it should "
-                           "run longer)")
+            raise _Faulted(FaultKind.BUDGET, budget_message(self.budget, "statements"))
 
     def _operand(self, operand: ast.Operand) -> int:
         if isinstance(operand, ast.Var):

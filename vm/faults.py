@@ -72,10 +72,10 @@ def missing_handler_message(mode: int, command: str, label: int) -> str:
             f":{label}, but the program has no label :{label}")
 
 
-def budget_message(budget: int) -> str:
-    """What a BUDGET fault of the VM says."""
-    return (f"the program ran more than {budget} instructions without ending (raise the "
-            "budget if it should run longer)")
+def budget_message(budget: int, steps: str = "instructions") -> str:
+    """What a BUDGET fault says, whichever engine meets it: `steps` names what it counts
+    (the VMs' instructions, the interpreter's statements). What to do is its help's."""
+    return f"the program ran more than {budget} {steps} without ending"
 
 
 def argument_range_message(param: str, form: str, value: int, variable: int, low: int,
