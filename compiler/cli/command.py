@@ -4,8 +4,10 @@ options of the commands that report diagnostics.
 
 A command is a function returning its exit status, decorated `@click.command(cls=Command)`
 with its parameters; its docstring is its help, the first line its summary in
-`rl1c --help`. It ends early by raising `Failure` (a message for standard error and a
-status) or `click.UsageError` (shown with the command's usage, status 2).
+`rl1c --help`. It ends early by raising `CommandError` (what is wrong and a status,
+said as `rl1c run: error: ...`), `Failure` (a message for standard error, such as a
+file's E0100 diagnostic, and a status) or `click.UsageError` (shown with the command's
+usage, status 2).
 """
 
 from __future__ import annotations
@@ -41,6 +43,17 @@ class Failure(Exception):
     def __init__(self, message: str, status: int = EXIT_USAGE) -> None:
         super().__init__(message)
         self.status = status
+
+
+class CommandError(Failure):
+    """A Failure that is no diagnostic of a file (those are `error[E0100]`, a Failure's
+    whole message): `message` is said as every command's errors are, its usage errors
+    too, `rl1c reduce: error: MESSAGE` (`error_line`)."""
+
+
+def error_line(command_path: str, message: str) -> str:
+    """An error of the command `command_path` (`rl1c run`): `rl1c run: error: message`."""
+    return f"{command_path}: error: {message}"
 
 
 class Context(click.Context):
@@ -82,6 +95,9 @@ class Command(click.Command):
             return status
         except (click.ClickException, click.exceptions.Exit):
             raise  # usage errors are shown by the group, with the usage
+        except CommandError as failure:
+            print(error_line(ctx.command_path, str(failure)), file=sys.stderr)
+            return failure.status
         except Failure as failure:
             print(failure, file=sys.stderr)
             return failure.status
@@ -110,7 +126,7 @@ def output_failed(error: OSError) -> int:
     else:
         problem = f"{error.strerror or error}; free some space or write elsewhere"
     with contextlib.suppress(OSError):  # standard error may be just as full
-        print(f"rl1c: error: cannot write the output: {problem}", file=sys.stderr)
+        print(error_line("rl1c", f"cannot write the output: {problem}"), file=sys.stderr)
     return EXIT_USAGE
 
 

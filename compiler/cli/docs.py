@@ -15,7 +15,7 @@ from pathlib import Path
 
 import click
 
-from .command import Command, Failure
+from .command import Command, CommandError
 
 SECTION = "Documents"
 
@@ -70,8 +70,8 @@ def docs(name: str | None) -> int:
 
         close = difflib.get_close_matches(topic_name(name), list(known), n=1)
         hint = f"did you mean `rl1c docs {close[0]}`? " if close else ""
-        raise Failure(f"error: `{name}` is no document of rl1c\n"
-                      f"  = help: {hint}`rl1c docs` lists every document")
+        raise CommandError(f"`{name}` is no document of rl1c\n"
+                           f"  = help: {hint}`rl1c docs` lists every document")
     sys.stdout.write(wanted.read_text(encoding="utf-8"))
     return 0
 

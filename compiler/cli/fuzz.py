@@ -25,7 +25,7 @@ from .command import (
     EXIT_INTERNAL,
     PATH,
     Command,
-    Failure,
+    CommandError,
     a_budget,
     at_least_one,
     choice_option,
@@ -56,9 +56,9 @@ def needing_hypothesis(purpose: str, otherwise: str) -> Iterator[None]:
     except ModuleNotFoundError as error:
         if (error.name or "").partition(".")[0] != "hypothesis":
             raise
-        raise Failure(f"error: {purpose} with Hypothesis, an optional part of rl1 that is "
-                      f"not installed here; install it with `pip install 'rl1[fuzz]'`"
-                      f"{otherwise}") from None
+        raise CommandError(f"{purpose} with Hypothesis, an optional part of rl1 that is "
+                           f"not installed here; install it with `pip install 'rl1[fuzz]'`"
+                           f"{otherwise}") from None
 
 
 @click.command(cls=Command)
@@ -217,13 +217,13 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
                                lost=held.lost)
     # Such as no C compiler for c-ON, or a cluster that cannot be had or was lost.
     except (BuildError, EngineUnavailable, Unavailable, ClusterLost) as error:
-        raise Failure(f"error: {error}") from None
+        raise CommandError(str(error)) from None
     except SearchLost:  # though no program ended its process
-        raise Failure(f"error: a worker process ended abruptly {LOSSES + 1} times running "
-                      "one search, though none of its programs ended the process that ran "
-                      "it (something killed the workers, or the memory ran out); the "
-                      f"campaign runs again with --seed {seed_value}", EXIT_INTERNAL
-                      ) from None
+        raise CommandError(f"a worker process ended abruptly {LOSSES + 1} times running "
+                           "one search, though none of its programs ended the process that ran "
+                           "it (something killed the workers, or the memory ran out); the "
+                           f"campaign runs again with --seed {seed_value}", EXIT_INTERNAL
+                           ) from None
     finally:
         bar.close()
         channel.close()
@@ -259,9 +259,9 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         click.echo(json.dumps(_statistics(outcome, seed_value, engines, budget, len(corpus),
                                           written), indent=2))
     if unwritten is not None:  # such as a full disk: the finding is printed above
-        raise Failure(f"error: cannot write the reproducer under {out_dir} "
-                      f"({unwritten.strerror or unwritten}); the program is above, and the "
-                      "campaign runs again with the same --seed", EXIT_ERRORS)
+        raise CommandError(f"cannot write the reproducer under {out_dir} "
+                           f"({unwritten.strerror or unwritten}); the program is above, and the "
+                           "campaign runs again with the same --seed", EXIT_ERRORS)
     return stopped or (EXIT_ERRORS if outcome.finding is not None else 0)
 
 
@@ -359,7 +359,7 @@ def _replay(folder: str) -> int:
     try:
         verdict = judge_apart(replay.case, replay.engines, replay.budget)
     except (BuildError, EngineUnavailable) as error:
-        raise Failure(f"error: {error}") from None
+        raise CommandError(str(error)) from None
     names = ", ".join(engine.name for engine in replay.engines)
     program = _numbered(replay.case.source)
     if not verdict.problems:

@@ -35,6 +35,7 @@ from .command import (
     CONTEXT_SETTINGS,
     Context,
     completable,
+    error_line,
     internal_error,
     interrupted,
     output_failed,
@@ -188,7 +189,7 @@ def show_usage_error(error: click.UsageError) -> int:
     if ctx is not None:
         click.echo(ctx.get_usage(), err=True)
     prog = ctx.command_path if ctx is not None else "rl1c"
-    click.echo(f"{prog}: error: {describe(error)}", err=True)
+    click.echo(error_line(prog, describe(error)), err=True)
     return EXIT_USAGE
 
 

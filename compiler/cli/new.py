@@ -10,7 +10,7 @@ import os
 
 import click
 
-from .command import PATH, Command, Failure
+from .command import PATH, Command, CommandError, Failure
 from .project_template import FILES, PROGRAM
 from .streams import cannot, file_problem, os_reason, problem_text, write_help
 
@@ -95,8 +95,8 @@ def _refuse_unless_empty(folder: str, target: str) -> None:
     if not os.path.lexists(target):
         return
     if not os.path.isdir(target):
-        raise Failure(f"rl1c new: error: `{folder}` exists and is no folder; give the "
-                      "path of a new folder")
+        raise CommandError(f"`{folder}` exists and is no folder; give the "
+                           "path of a new folder")
     try:
         entries = sorted(os.listdir(target))
     except OSError as error:
@@ -104,9 +104,9 @@ def _refuse_unless_empty(folder: str, target: str) -> None:
     if entries:
         shown = ", ".join(f"`{entry}`" for entry in entries[:3]) + (
             ", ..." if len(entries) > 3 else "")
-        raise Failure(f"rl1c new: error: `{folder}` is not empty (it holds {shown}); "
-                      "rl1c new writes only into a new or empty folder, so that it "
-                      "replaces nothing: give another path")
+        raise CommandError(f"`{folder}` is not empty (it holds {shown}); "
+                           "rl1c new writes only into a new or empty folder, so that it "
+                           "replaces nothing: give another path")
 
 
 def _cannot_create(folder: str, error: OSError) -> Failure:

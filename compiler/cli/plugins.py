@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import click
 
-from .command import Command, Failure
+from .command import Command, CommandError
 
 if TYPE_CHECKING:  # importlib.metadata takes tens of milliseconds to load: when asked
     from importlib.metadata import Distribution, EntryPoint
@@ -100,14 +100,14 @@ def _unloaded(entry: EntryPoint, why: str) -> Plugin:
     """A command, in the place of the plugin `entry`, that fails with `why`, whatever its
     arguments (`--help` too)."""
     package = entry.dist.name if entry.dist is not None else "the package that adds it"
-    message = (f"rl1c {entry.name}: error: the command cannot be loaded: {why}\n"
+    message = (f"the command cannot be loaded: {why}\n"
                f"  = help: `rl1c {entry.name}` comes from {package} (its entry point "
                f"`{entry.name} = {entry.value}` in the group `{GROUP}`); install it again, "
                f"such as with `pip install --force-reinstall {package}`, or `pip install "
                "-e .` in its checkout")
 
     def fail() -> int:
-        raise Failure(message)
+        raise CommandError(message)
 
     command = Command(entry.name, callback=fail, add_help_option=False,
                       help=f"Cannot be loaded: {why}.",

@@ -30,7 +30,7 @@ from .command import (
     EXIT_INTERRUPTED,
     PATH,
     Command,
-    Failure,
+    CommandError,
     a_budget,
     at_least_one,
     or_none,
@@ -154,7 +154,7 @@ def reduce(file: str, sensors: str | None, command: str | None,
                else f"the original is not interesting: {interesting.said()}; the command "
                "must exit 0 on the original (it runs in a new temporary folder holding "
                + " and ".join(files.names()) + ")")
-        raise Failure(f"rl1c reduce: error: {why}", EXIT_ERRORS) from None
+        raise CommandError(why, EXIT_ERRORS) from None
     except KeyboardInterrupt:  # Ctrl-C: what was found is kept
         if not latest:
             raise
@@ -367,9 +367,9 @@ def _engines_test(names: tuple[str, ...], budget: int | None, original: Case, fi
     if len({engine.name for engine in engines}) < 2:
         raise click.UsageError("argument --engine: give at least two different engines")
     if analyze(original.source).has_errors:
-        raise Failure(f"rl1c reduce: error: the checker finds errors in {file} (`rl1c check "
-                      f"{shlex.quote(file)}` says which); the engines compare only "
-                      "programs it accepts", EXIT_ERRORS)
+        raise CommandError(f"the checker finds errors in {file} (`rl1c check "
+                           f"{shlex.quote(file)}` says which); the engines compare only "
+                           "programs it accepts", EXIT_ERRORS)
     if sensors is not None:
         try:
             parse_script(_script_data(original.script), sensors)
@@ -407,7 +407,7 @@ class _EnginesTest:
             try:
                 load(library())
             except BuildError as error:  # such as no C compiler
-                raise Failure(f"rl1c reduce: error: {error}") from None
+                raise CommandError(str(error)) from None
 
     def __call__(self, case: Case) -> bool:
         from rl1.compiler.differential import (
@@ -424,7 +424,7 @@ class _EnginesTest:
             verdict = judging(Run(case.source, _script_data(case.script)), self.engines,
                               self.budget)
         except (BuildError, EngineUnavailable) as error:  # such as no C compiler
-            raise Failure(f"rl1c reduce: error: {error}") from None
+            raise CommandError(str(error)) from None
         if not verdict.problems:
             return False
         found = signature(verdict)

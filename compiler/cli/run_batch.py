@@ -19,7 +19,7 @@ from rl1.vm.faults import MAX_BUDGET
 from rl1.vm.scripted import ScriptedDevice, ScriptError, parse_script, run_document
 from rl1.vm.verifier import VerifyError
 
-from .command import Failure
+from .command import CommandError
 from .streams import MAX_ILC_BYTES, stdin_problem
 
 # A job's line: the .ilc file in base64 (4 bytes for 3) and the script, with room to spare.
@@ -45,8 +45,8 @@ def _read_line(jobs: IO[bytes], limit: int) -> bytes:
     try:
         return jobs.readline(limit)
     except OSError as error:
-        raise Failure(f"rl1c run: error: cannot read the jobs: {stdin_problem(error)}; "
-                      "send them through a pipe") from None
+        raise CommandError(f"cannot read the jobs: {stdin_problem(error)}; "
+                           "send them through a pipe") from None
 
 
 def _answer(line: bytes, engine: Engine, time_limit: int) -> dict[str, Any]:

@@ -18,7 +18,7 @@ from rl1.compiler.runner import Finished, run
 from rl1.vm.defaults import Engine
 from rl1.vm.device import Device
 
-from .command import Failure
+from .command import CommandError
 from .streams import ILC_ROLE, STDIN_NAME, emit, invalid_file, read_ilc, read_input, refused_ilc
 
 
@@ -81,7 +81,7 @@ def _refusals(file: str, data: bytes | None) -> Iterator[None]:
     except ScriptError as error:
         raise click.UsageError(str(error)) from None
     except BuildError as error:
-        raise Failure(f"error: {error}") from None
+        raise CommandError(str(error)) from None
 
 
 def _recorded_source(data: bytes, file: str) -> tuple[str, str | None]:

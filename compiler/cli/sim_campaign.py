@@ -41,7 +41,7 @@ from rl1.vm.defaults import DEFAULT_BUDGET, Engine
 from rl1.vm.sim.campaign_render import Overlay, Run, heat_map_svg, html, svg
 from rl1.vm.sim.world import World
 
-from .command import EXIT_INTERNAL, Failure, stop_signals_handled
+from .command import EXIT_INTERNAL, CommandError, Failure, stop_signals_handled
 from .running import run_file
 from .streams import (
     PATH_ESCAPES,
@@ -162,7 +162,7 @@ def _workers(setting: Setting, progress: Progress) -> Iterator[Workers]:
                       file=sys.stderr)
             yield held
     except Unavailable as error:
-        raise Failure(f"error: {error}") from None
+        raise CommandError(str(error)) from None
 
 
 def task_of(file: str, world: bytes, world_name: str, setting: Setting,

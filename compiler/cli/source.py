@@ -24,7 +24,7 @@ from rl1.compiler.reporting.render import (
     summary,
 )
 
-from .command import PATH, Command, Failure, color_option, force_option, format_option
+from .command import PATH, Command, CommandError, color_option, force_option, format_option
 from .streams import (
     cannot,
     cannot_write,
@@ -269,8 +269,8 @@ def explain(code: str | None, list_codes: bool) -> int:
         return 0
     info = CODES.get(code.strip().upper())
     if info is None:
-        raise Failure(f"error: `{code}` is not a diagnostic code of rl1c\n"
-                      "  = help: `rl1c explain --list` lists every code with its title")
+        raise CommandError(f"`{code}` is not a diagnostic code of rl1c\n"
+                           "  = help: `rl1c explain --list` lists every code with its title")
     sys.stdout.write(info.explanation())
     return 0
 

@@ -18,6 +18,7 @@ from rl1.compiler.reporting.render import EXIT_ERRORS, EXIT_USAGE, ColorChoice, 
 from .command import (
     PATH,
     Command,
+    CommandError,
     Failure,
     at_least_one,
     color_option,
@@ -159,9 +160,9 @@ def _test_files(paths: Sequence[str]) -> list[str]:
                 "list", "folder", folder, str(error.strerror or error)),
                 "check its permissions")), EXIT_USAGE)
         if not found:
-            raise Failure(f"rl1c test: error: no test file (*{TEST_FILE_SUFFIX}) in "
-                          f"`{path}` or below it; write one as spec/tests.md describes, "
-                          "or start a project with one: `rl1c new DIR`", EXIT_USAGE)
+            raise CommandError(f"no test file (*{TEST_FILE_SUFFIX}) in "
+                               f"`{path}` or below it; write one as spec/tests.md describes, "
+                               "or start a project with one: `rl1c new DIR`", EXIT_USAGE)
         files += found
     return files
 

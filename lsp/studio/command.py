@@ -11,7 +11,7 @@ import os
 
 import click
 
-from rl1.compiler.cli.command import PATH, Command, Failure
+from rl1.compiler.cli.command import PATH, Command, CommandError
 
 SECTION = "Studio"
 
@@ -35,14 +35,14 @@ def studio(file: str | None, world: str | None, port: int, no_browser: bool) -> 
     try:
         import websockets  # noqa: F401
     except ImportError:
-        raise Failure("rl1c studio: error: the studio needs the websockets package: "
-                      "pip install 'rl1[ws]'") from None
+        raise CommandError("the studio needs the websockets package: "
+                           "pip install 'rl1[ws]'") from None
     from .start import CannotStart, serve, studio_for
 
     try:
         serve(studio_for(os.getcwd(), file, world), port, open_browser=not no_browser)
     except CannotStart as error:
-        raise Failure(f"rl1c studio: error: {error}") from None
+        raise CommandError(str(error)) from None
     return 0
 
 

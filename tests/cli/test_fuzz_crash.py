@@ -471,7 +471,7 @@ def test_a_worker_killed_each_time_whatever_program_it_judges_is_said_as_such(
                   "4", "--seed", "3", "--jobs", "1")
     assert result.exit_code == 3, result.output
     assert result.stderr.endswith(
-        "\nerror: a worker process ended abruptly 3 times running one search, though "
+        "\nrl1c fuzz: error: a worker process ended abruptly 3 times running one search, though "
         "none of its programs ended the process that ran it (something killed the "
         "workers, or the memory ran out); the campaign runs again with --seed 3\n")
     assert "Traceback" not in result.output

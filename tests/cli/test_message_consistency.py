@@ -23,3 +23,20 @@ def test_a_used_up_budget_says_what_to_do_once_whichever_engine_runs(
            in result.stdout
     assert result.stdout.count("raise") == 1  # the help alone says to raise the budget
     assert "= help: if the program should run longer, raise --budget;" in result.stdout
+
+
+@pytest.mark.parametrize("args", [["explain", "E9999"], ["docs", "nothing-such"]])
+def test_a_command_that_fails_names_itself_as_its_usage_errors_do(args: list[str]) -> None:
+    failed = rl1c(*args)
+    misused = rl1c(args[0], "--bogus")
+    assert failed.exit_code == misused.exit_code == 2
+    # Both say `rl1c explain: error: ...`, the command that failed named first.
+    assert misused.stderr.splitlines()[-1].startswith(f"rl1c {args[0]}: error: ")
+    assert failed.stderr.startswith(f"rl1c {args[0]}: error: `")
+
+
+def test_rl1c_new_says_its_errors_once_named(tmp_path: Path) -> None:
+    (tmp_path / "taken").write_text("")
+    failed = rl1c("new", tmp_path / "taken")
+    assert failed.stderr == (f"rl1c new: error: `{tmp_path / 'taken'}` exists and is no "
+                             "folder; give the path of a new folder\n")

@@ -14,7 +14,7 @@ def test_hypothesis_missing_is_said_with_how_to_install_it(missing: str) -> None
     with pytest.raises(Failure) as said, needing_hypothesis("rl1c x compares", ", or not"):
         raise ModuleNotFoundError(f"No module named {missing!r}", name=missing)
     assert str(said.value) == (
-        "error: rl1c x compares with Hypothesis, an optional part of rl1 that is not "
+        "rl1c x compares with Hypothesis, an optional part of rl1 that is not "
         "installed here; install it with `pip install 'rl1[fuzz]'`, or not")
     assert said.value.status == 2
 

@@ -82,7 +82,7 @@ def test_rl1c_fuzz_says_a_search_its_process_cannot_read_with_status_2(
     monkeypatch.setattr(fuzz, "campaign", campaign)
     result = rl1c("fuzz", "--count", "1")
     assert result.exit_code == 2
-    assert result.stderr.startswith(f"error: {UNREADABLE}")
+    assert result.stderr.startswith(f"rl1c fuzz: error: {UNREADABLE}")
     assert "Traceback" not in result.stderr
 
 

@@ -295,7 +295,7 @@ def test_without_distributed_the_extra_to_install_is_named(
     result = rl1c("sim", program, "--world", world, "--runs", "5", "--scheduler",
                   "tcp://127.0.0.1:8786", "--out", out)
     assert result.exit_code == 2
-    assert "\nerror: --scheduler needs Dask's `distributed`, which is not installed" in (
+    assert "\nrl1c sim: error: --scheduler needs Dask's `distributed`, which is not installed" in (
         "\n" + result.stderr)
     assert "pip install 'rl1[cluster]'" in result.stderr
     assert "Traceback" not in result.output
@@ -320,7 +320,7 @@ def test_an_unreachable_scheduler_is_said_with_its_address_within_seconds(
                              "--runs", "5", "--scheduler", address, "--out", str(out)],
                             capture_output=True, text=True, timeout=60, check=False)
     assert result.returncode == 2
-    assert f"\nerror: cannot reach a Dask scheduler at {address}" in "\n" + result.stderr
+    assert f"\nrl1c sim: error: cannot reach a Dask scheduler at {address}" in "\n" + result.stderr
     assert f"`dask worker {address}`" in result.stderr
     assert "Traceback" not in result.stderr and "Exception ignored" not in result.stderr
     assert out.read_text() == "kept\n"
@@ -389,8 +389,8 @@ def test_a_scheduler_without_this_rl1_is_refused_before_any_run(
         result = rl1c("sim", program, "--world", world, "--runs", "5", "--scheduler",
                       scheduler.address, "--out", out)
     assert result.exit_code == 2, result.output + scheduler.log()
-    assert result.stderr.startswith(f"error: the Dask scheduler at {scheduler.address} "
-                                    + said), result.stderr
+    assert result.stderr.startswith(
+        f"rl1c sim: error: the Dask scheduler at {scheduler.address} " + said), result.stderr
     assert "restart the scheduler" in result.stderr and not out.exists()
     assert "Traceback" not in result.output
 
@@ -517,7 +517,8 @@ def test_fuzzing_with_an_unreachable_scheduler_says_so(tmp_path: Path) -> None:
     result = rl1c("fuzz", "--count", "10", "--scheduler", address, "--out",
                   tmp_path / "out")
     assert result.exit_code == 2
-    assert result.stderr.startswith(f"error: cannot reach a Dask scheduler at {address}")
+    assert result.stderr.startswith(
+        f"rl1c fuzz: error: cannot reach a Dask scheduler at {address}")
     result = rl1c("fuzz", "--count", "10", "--jobs", "2", "--scheduler", address)
     assert result.exit_code == 2
     assert "--jobs counts local processes, and --scheduler gives" in result.stderr
@@ -738,7 +739,7 @@ def test_a_worker_killed_each_time_on_a_cluster_is_said_as_such(
                       "--count", "4", "--seed", "3", "--scheduler", cluster.address)
     assert result.exit_code == 3, result.output + cluster.log()
     assert without_progress(result.stderr) == [f"rl1c: warning: {WORKER_LOST}"] * 3 + [
-        "error: a worker process ended abruptly 3 times running one search, though "
+        "rl1c fuzz: error: a worker process ended abruptly 3 times running one search, though "
         "none of its programs ended the process that ran it (something killed the "
         "workers, or the memory ran out); the campaign runs again with --seed 3"]
 
