@@ -110,7 +110,7 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
             raise file_failure(file_problem(error.path, cannot("read", role, error.path,
                                                                error.detail),
                                             error.help)) from None
-        raise invalid_file(role, error.path, error.detail,
+        raise invalid_file(role, error.path, str(error),
                            "correct the file (`rl1c docs commands`, \"Controlling `rl1c check`\", "
                            "shows its form), or move it aside") from None
     if diff:

@@ -25,12 +25,14 @@ TABLE = "check"
 
 
 class ProjectFileError(Exception):
-    """An rl1.toml that cannot be read (`unreadable`) or used: its `path`, and where in
-    it and why (`detail`); str() is "PATH: DETAIL"."""
+    """An rl1.toml that cannot be read (`unreadable`) or used: its `path`, and why
+    (`detail`); str() is "PATH: DETAIL", or `placed`, the place and why of a file read
+    but not valid in the form of every configuration file's (vm.config.ConfigError's:
+    "PATH:3: check.ignore: ...")."""
 
     def __init__(self, path: str, detail: str, *, unreadable: bool = False,
-                 help: str = "") -> None:
-        super().__init__(f"{path}: {detail}")
+                 help: str = "", placed: str | None = None) -> None:
+        super().__init__(placed or f"{path}: {detail}")
         self.path = path
         self.detail = detail
         self.unreadable = unreadable
@@ -74,9 +76,7 @@ def load_project_file(path: str) -> Selection:
             except SelectionError as error:
                 raise error_at(path, text, (TABLE, key), str(error)) from None
     except ConfigError as error:
-        at = f"line {error.line}: " if error.line is not None else ""
-        where = f"{error.where}: " if error.where else ""
-        raise ProjectFileError(path, at + where + error.detail) from None
+        raise ProjectFileError(path, error.detail, placed=str(error)) from None
     strict = None if isinstance(check.warnings_as_errors, UnsetType) else check.warnings_as_errors
     return Selection(codes["select"], codes["ignore"], strict)
 

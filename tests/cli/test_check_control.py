@@ -309,7 +309,7 @@ def test_a_project_files_hexadecimal_integer_of_any_length_is_an_error_with_its_
     write(tmp_path, "rl1.toml", "[check]\nignore = 0x" + "f" * 5000 + "\n")
     result = check(write(tmp_path, "a.rob", MOVING))
     assert result.exit_code == 2
-    assert "line 2: check.ignore: a number of more than 4300 digits" in result.stderr
+    assert "rl1.toml:2: check.ignore: a number of more than 4300 digits" in result.stderr
 
 
 def test_options_given_win_over_the_project_file(tmp_path: Path) -> None:
@@ -339,19 +339,20 @@ def test_standard_input_takes_the_working_directorys_project_file(
 
 
 @pytest.mark.parametrize("content, says", [
-    ("[check\n", "line 1: invalid TOML: "),
+    ("[check\n", "rl1.toml:1: invalid TOML: "),
     ('[check]\nselct = ["W06"]\n',
-     "line 2: check.selct: unknown key; did you mean select? (expected one of select, ignore, "
+     "rl1.toml:2: check.selct: unknown key; did you mean select? (expected one of select, ignore, "
      "warnings-as-errors)"),
-    ('[lint]\nselect = ["W06"]\n', "line 1: lint: unknown key; expected one of check"),
-    ("check = 3\n", "line 1: check: expected a table, found 3"),
-    ('[check]\nselect = "W06"\n', 'line 2: check.select: expected a list of codes, such as ["W06'),
-    ('[check]\nignore = ["E0101"]\n', "line 2: check.ignore: `E0101` names only errors"),
+    ('[lint]\nselect = ["W06"]\n', "rl1.toml:1: lint: unknown key; expected one of check"),
+    ("check = 3\n", "rl1.toml:1: check: expected a table, found 3"),
+    ('[check]\nselect = "W06"\n',
+     'rl1.toml:2: check.select: expected a list of codes, such as ["W06'),
+    ('[check]\nignore = ["E0101"]\n', "rl1.toml:2: check.ignore: `E0101` names only errors"),
     ("[check]\nwarnings-as-errors = 1\n",
-     "line 2: check.warnings-as-errors: expected true or false"),
+     "rl1.toml:2: check.warnings-as-errors: expected true or false"),
     # Every number goes through the one bounded reader: an internal error before.
     ("[check]\nwarnings-as-errors = " + "9" * 5000 + "\n",
-     "line 2: check.warnings-as-errors: a number of more than 4300 digits"),
+     "rl1.toml:2: check.warnings-as-errors: a number of more than 4300 digits"),
     ("[check]\nselect = [" + "1" * 4000 + "]\n", "found a number of 4000 digits"),
     (b"[check]\n# \xff\n", "not UTF-8 text"),
     ("x = " + "[" * 100_000 + "]" * 100_000 + "\n", "nested too deeply"),

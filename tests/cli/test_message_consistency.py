@@ -40,3 +40,15 @@ def test_rl1c_new_says_its_errors_once_named(tmp_path: Path) -> None:
     failed = rl1c("new", tmp_path / "taken")
     assert failed.stderr == (f"rl1c new: error: `{tmp_path / 'taken'}` exists and is no "
                              "folder; give the path of a new folder\n")
+
+
+def test_every_configuration_file_places_its_error_as_file_colon_line(tmp_path: Path) -> None:
+    (tmp_path / "p.rob").write_text("(MOV 3,3)\nA=(IMG)\n(END)\n")
+    script = tmp_path / "s.json"
+    script.write_text('{\n  "comment": "",\n  "readings": 1\n}\n')
+    project = tmp_path / "rl1.toml"
+    project.write_text('[check]\nselect = ["W"]\nignre = ["W0603"]\n')
+    ran = rl1c("run", tmp_path / "p.rob", "--sensors", script).stderr
+    checked = rl1c("check", tmp_path / "p.rob").stderr
+    assert f"{script}:3: readings: unknown key;" in ran
+    assert f"{project}:3: check.ignre: unknown key;" in checked  # not `line 3:`

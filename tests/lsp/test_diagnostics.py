@@ -116,7 +116,7 @@ async def test_an_rl1_toml_with_a_huge_number_is_said_and_checking_goes_on(
     (tmp_path / "rl1.toml").write_text("[check]\nwarnings-as-errors = " + "9" * 5000 + "\n",
                                        encoding="utf-8")
     _, shown = await client.opened("(MOV 3,3)\n", (tmp_path / "prog.rob").as_uri())
-    assert "line 2: check.warnings-as-errors: a number of more than 4300 digits" in \
+    assert "rl1.toml:2: check.warnings-as-errors: a number of more than 4300 digits" in \
         shown[0].message
     assert [d.code for d in shown[1:]] == ["W0603", "W0701"]  # checked as without it
 
