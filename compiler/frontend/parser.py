@@ -23,6 +23,7 @@ from rl1.vm.language import BUILTINS
 
 from . import ast
 from .builders import ACTIONS, Builder, Child, ParsedLine, label_def
+from .characters import UNSEEN_ALONE, code_point
 from .collector import collector_paused
 from .diagnostics import Diagnostic, Edit, Fix, Severity
 from .lalr_tables import ACTIONS as TABLE
@@ -222,18 +223,13 @@ def _bad_character(span: ast.Span, character: str) -> Diagnostic:
         help_text = "a control character has no place in RL/I code: delete it"
     else:
         help_text = "RL/I code is ASCII; text in any script may follow `'` as a comment"
-    code, name = f"U+{ord(character):04X}", unicodedata.name(character, "")
-    if unicodedata.category(character) in _UNSEEN:  # quoted, it would read as `` or ` `
+    code, name = code_point(character), unicodedata.name(character, "")
+    if unicodedata.category(character) in UNSEEN_ALONE:  # quoted: `` or ` `
         shown = f"{code} ({name})" if name else code
     else:
         shown = f"`{character}` ({name or code})"
     return Diagnostic("E0102", Severity.ERROR, f"unexpected character {shown}", span,
                       help=help_text)
-
-
-# Characters a terminal shows as nothing or as a space: controls, format characters,
-# private-use and unassigned code points, spaces and separators, combining marks.
-_UNSEEN = frozenset({"Cc", "Cf", "Co", "Cn", "Cs", "Zs", "Zl", "Zp", "Mn", "Me"})
 
 
 def _excerpt(text: str, limit: int = 24) -> str:

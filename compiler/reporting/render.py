@@ -16,6 +16,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from typing import IO, Any, Literal, NamedTuple, Protocol, runtime_checkable
 
 from rl1.compiler.frontend.ast import Span
+from rl1.compiler.frontend.characters import code_point, shows_nothing
 from rl1.compiler.frontend.diagnostics import Diagnostic, Fix, Severity, sort_by_place
 from rl1.compiler.frontend.source import LineIndex, split_lines
 
@@ -217,8 +218,8 @@ def _glyph(character: str, cell: int) -> str:
         return chr(0x2400 + code)  # the Control Pictures block: ␀ to ␟
     if code == 0x7F:
         return "\u2421"  # ␡
-    if unicodedata.category(character) in ("Cc", "Cf", "Zl", "Zp", "Cs"):
-        return f"<U+{code:04X}>"  # C1 controls, bidi overrides, line separators...
+    if shows_nothing(character):  # C1 controls, bidi overrides, private use...
+        return f"<{code_point(character)}>"
     return character
 
 

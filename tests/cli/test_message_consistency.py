@@ -52,3 +52,15 @@ def test_every_configuration_file_places_its_error_as_file_colon_line(tmp_path: 
     checked = rl1c("check", tmp_path / "p.rob").stderr
     assert f"{script}:3: readings: unknown key;" in ran
     assert f"{project}:3: check.ignre: unknown key;" in checked  # not `line 3:`
+
+
+@pytest.mark.parametrize("character", ["\ue000", "\U000f8f3f", "\u0378"])  # private, unassigned
+def test_a_character_a_terminal_shows_as_nothing_is_shown_by_its_code_point_in_the_snippet(
+    tmp_path: Path, character: str
+) -> None:
+    (tmp_path / "p.rob").write_text(f"A=1\nB={character}\n(END)\n")
+    out = rl1c("check", tmp_path / "p.rob", "--color", "never").stdout
+    code = f"U+{ord(character):04X}"
+    # Named as E0102 names it, and underlined whole: the caret line counts its cells.
+    assert f"error[E0102]: unexpected character {code}\n" in out
+    assert f"2 | B=<{code}>\n  |   {'^' * len(f'<{code}>')}\n" in out
