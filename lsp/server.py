@@ -32,7 +32,7 @@ from pygls.exceptions import (
 from pygls.lsp.server import LanguageServer
 from pygls.protocol import LanguageServerProtocol, default_converter
 
-from rl1.vm.config import excerpt
+from rl1.vm.config import excerpt, found
 
 from . import (
     actions,
@@ -156,6 +156,14 @@ class Rl1Protocol(LanguageServerProtocol):
             msg_id = data.get("id") if isinstance(data, dict) else None
             self._refuse(msg_id if isinstance(msg_id, int | str) else None, JsonRpcInvalidRequest(
                 "not a JSON-RPC 2.0 message: send an object with \"jsonrpc\": \"2.0\""))
+            return
+        if "method" in data and not isinstance(method := data["method"], str):
+            # pygls's structuring fails on it as an Internal Error, saying nothing
+            msg_id = data.get("id")
+            self._refuse(msg_id if isinstance(msg_id, int | str) else None,
+                         JsonRpcInvalidRequest(f"`method` is {found(method, 'json')}: name "
+                                               "the method with a string, as "
+                                               "\"textDocument/hover\""))
             return
         try:
             message = self.structure_message(data)

@@ -117,6 +117,25 @@ def test_json_that_is_no_message_is_an_invalid_request(server: RawServer, body: 
     answered(server, 3)
 
 
+@pytest.mark.parametrize("method", [[1], {"name": "x" * 10_000}, 42, None, True])
+@pytest.mark.parametrize("msg_id", [2, None])
+def test_a_method_that_is_no_string_is_an_invalid_request(
+        server: RawServer, method: object, msg_id: int | None) -> None:
+    """JSON-RPC's method is a string: another was answered Internal Error (-32603), a
+    message saying neither what was wrong nor what to send (1da3154 answered only an
+    unknown string)."""
+    server.start()
+    message: dict[str, object] = {"jsonrpc": "2.0", "method": method, "params": {}}
+    if msg_id is not None:
+        message["id"] = msg_id
+    server.send(frame(json.dumps(message).encode()))
+    error = server.reply(msg_id)["error"]
+    assert error["code"] == INVALID_REQUEST, error
+    assert error["message"].startswith("`method` is "), error
+    assert len(error["message"]) < 200, error
+    answered(server, 3)
+
+
 def test_params_that_do_not_fit_are_answered_with_where_and_no_traceback(
         server: RawServer) -> None:
     server.start()
