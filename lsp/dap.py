@@ -119,8 +119,9 @@ class Adapter:
                      "command": request["command"], **({} if body is None else {"body": body})})
 
     def _refuse(self, request: dict[str, Any], message: str) -> None:
+        # An excerpt of the command: one rl1-dap does not know may be megabytes long.
         self._write({"type": "response", "request_seq": request.get("seq", 0),
-                     "success": False, "command": request.get("command", ""),
+                     "success": False, "command": excerpt(request.get("command", "")),
                      "message": message,
                      "body": {"error": {"id": 1, "format": message, "showUser": True}}})
 

@@ -575,6 +575,8 @@ def test_a_refusal_quotes_an_excerpt_of_what_the_client_sent(command: str,
     response = client.request(command, arguments)
     said = response.get("message") or response["body"]["breakpoints"][0]["message"]
     assert len(said) < 400, said[:200]
+    # the whole answer too: a response names its request's command (an excerpt of it)
+    assert len(json.dumps(response)) < 2000, json.dumps(response)[:200]
 
 
 @pytest.mark.parametrize("first", ["configurationDone", "continue", "restart"])
