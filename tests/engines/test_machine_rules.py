@@ -8,6 +8,7 @@ import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from support import ROOT
@@ -122,10 +123,7 @@ def test_an_abort_after_the_end_changes_nothing() -> None:
 
 # Conditional jumps test their own variable (section 8.3) ----------------------------
 
-@settings(max_examples=100, deadline=None)
-@given(st.sampled_from(sorted(CONDITIONAL_JUMPS)), int16s)
-def test_a_conditional_jump_tests_its_variable_whatever_the_others_hold(
-        name: str, value: int) -> None:
+def jumps_on_its_variable_alone(name: str, value: int) -> None:
     """The tested variable is `a`; every other variable, among them those whose index is
     the jump's target offset, holds a value that decides the jump the other way."""
     jumps = CONDITIONAL_JUMPS[name]
@@ -138,5 +136,18 @@ def test_a_conditional_jump_tests_its_variable_whatever_the_others_hold(
     program = assemble(*setup, op(name, v("a"), To(end)), op("MOVI", v("@"), 7),
                        op("END"), debug=False)
     variables = execute(program)[0].named()
-    assert variables["@"] == (decoy if jumps(tested) else 7)
+    assert variables["@"] == (decoy if jumps(tested) else 7), value
     assert variables["a"] == tested
+
+
+@pytest.mark.parametrize("name", sorted(CONDITIONAL_JUMPS))
+def test_a_conditional_jump_tests_its_variable_at_the_edges(name: str) -> None:
+    for value in (-32768, -2, -1, 0, 1, 2, 32767):
+        jumps_on_its_variable_alone(name, value)
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.sampled_from(sorted(CONDITIONAL_JUMPS)), int16s)
+def test_a_conditional_jump_tests_its_variable_whatever_the_others_hold(
+        name: str, value: int) -> None:
+    jumps_on_its_variable_alone(name, value)
