@@ -55,11 +55,13 @@ PortName = Annotated[str, Meta(pattern=r"^[0-9]{1,6}$", extra={
 
 class ConfigError(Exception):
     """A configuration file that cannot be used: `file:line: where: what`, the line
-    (1-based) when it is known and `where` the key path."""
+    (1-based) when it is known and `where` the key path; `problem` is what follows the
+    place, `where: what`."""
 
     def __init__(self, file: str, line: int | None, where: str, detail: str) -> None:
         at = f"{file}:{line}" if line is not None else file
-        super().__init__(f"{at}: {where}: {detail}" if where else f"{at}: {detail}")
+        self.problem = f"{where}: {detail}" if where else detail
+        super().__init__(f"{at}: {self.problem}")
         self.file = file
         self.line = line
         self.where = where

@@ -204,7 +204,7 @@ def decode_script(data: bytes, name: str) -> Script:
     try:
         document, text = read_document(data, name, syntax)
     except ConfigError as error:
-        raise ScriptError(str(error)) from None
+        raise ScriptError(str(error)) from error  # which rl1c places
     return _load(document, name, text, syntax)
 
 
@@ -222,7 +222,7 @@ def _load(document: object, name: str, text: str, syntax: Syntax) -> Script:
         file = convert(document, ScriptFile, name, text, syntax)
         return _Script(file, name, text, syntax).build()
     except ConfigError as error:
-        raise ScriptError(str(error)) from None
+        raise ScriptError(str(error)) from error  # which rl1c places
 
 
 class _Script:

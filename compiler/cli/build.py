@@ -45,7 +45,7 @@ from .streams import (
     PATH_ESCAPES,
     emit,
     file_failure,
-    invalid_file,
+    invalid_config,
     read_failure,
     read_ilc,
     read_input,
@@ -287,8 +287,8 @@ def run(file: str | None, sensors: str | None, run_format: str,
         except SourceError as error:
             raise read_failure(error, SCRIPT_ROLE) from None
         except ScriptError as error:
-            raise invalid_file(SCRIPT_ROLE, sensors, str(error),
-                               "correct it as spec/sensors.md describes") from None
+            raise invalid_config(SCRIPT_ROLE, sensors, error,
+                                 "correct it as spec/sensors.md describes") from None
     device = ScriptedDevice(script, time_limit)
     ran = run_file(file, device, engine, budget, color, "run")
     if isinstance(ran, int):

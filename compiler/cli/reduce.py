@@ -37,6 +37,7 @@ from .command import (
 )
 from .streams import (
     encode_like,
+    invalid_config,
     invalid_file,
     read_failure,
     same_file,
@@ -374,8 +375,8 @@ def _engines_test(names: tuple[str, ...], budget: int | None, original: Case, fi
         try:
             parse_script(_script_data(original.script), sensors)
         except (ValueError, RecursionError, ScriptError) as error:
-            raise invalid_file(SCRIPT_ROLE, sensors, str(error), "with --engine the script "
-                               "is JSON, as rl1c fuzz writes it") from None
+            raise invalid_config(SCRIPT_ROLE, sensors, error, "with --engine the script "
+                                 "is JSON, as rl1c fuzz writes it") from None
     return _EnginesTest(engines, budget or DEFAULT_BUDGET)
 
 

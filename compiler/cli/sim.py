@@ -24,7 +24,7 @@ from .command import (
     force_option,
     or_none,
 )
-from .streams import PATH_ESCAPES, invalid_file, read_failure, same_file, write_file
+from .streams import PATH_ESCAPES, invalid_config, read_failure, same_file, write_file
 
 if TYPE_CHECKING:
     from rl1.compiler.sweep import Axis
@@ -135,8 +135,8 @@ def sim(file: str, world: str | None, svg_file: str | None, html_file: str | Non
     except SourceError as error:
         raise read_failure(error, WORLD_ROLE) from None
     except WorldError as error:
-        raise invalid_file(WORLD_ROLE, world, str(error),
-                           "correct it as spec/simulator.md describes") from None
+        raise invalid_config(WORLD_ROLE, world, error,
+                             "correct it as spec/simulator.md describes") from None
     axes = sweep_axes(sweeps, the_world, runs is not None)
     if runs is not None:
         from .sim_campaign import Pictures, Setting, run_campaign

@@ -32,7 +32,7 @@ from .streams import (
     encode_like,
     file_failure,
     file_problem,
-    invalid_file,
+    invalid_config,
     problem_text,
     read_input,
     source_files,
@@ -110,9 +110,9 @@ def check(files: tuple[str, ...], output_format: Format, color: ColorChoice,
             raise file_failure(file_problem(error.path, cannot("read", role, error.path,
                                                                error.detail),
                                             error.help)) from None
-        raise invalid_file(role, error.path, str(error),
-                           "correct the file (`rl1c docs commands`, \"Controlling `rl1c check`\", "
-                           "shows its form), or move it aside") from None
+        raise invalid_config(role, error.path, error,
+                             "correct the file (`rl1c docs commands`, \"Controlling `rl1c "
+                             "check`\", shows its form), or move it aside") from None
     if diff:
         return _fix_diff(inputs, unsafe_fixes)
     checked: list[FileDiagnostics] = []

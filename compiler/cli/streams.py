@@ -123,9 +123,12 @@ def os_reason(error: OSError) -> str:
     return reason[:1].lower() + reason[1:]
 
 
-def file_problem(name: str, message: str, help: str = "") -> FileDiagnostics:
-    """The E0100 report of a file or folder that cannot be read, written or used."""
-    problem = Diagnostic("E0100", Severity.ERROR, message, Span(1, 1, 1, 1), help=help or None)
+def file_problem(name: str, message: str, help: str = "",
+                 line: int | None = None) -> FileDiagnostics:
+    """The E0100 report of a file or folder that cannot be read, written or used: of the
+    file as a whole, or of its `line` (`--> s.json:3`; render.FileDiagnostics)."""
+    place = Span(1, 1, 1, 1) if line is None else Span(line, 0, line, 0)
+    problem = Diagnostic("E0100", Severity.ERROR, message, place, help=help or None)
     return FileDiagnostics(name, None, [problem])
 
 
@@ -148,6 +151,24 @@ def file_failure(problem: FileDiagnostics, status: int = EXIT_USAGE) -> Failure:
 def read_failure(error: SourceError, role: str) -> Failure:
     """The Failure of the `role` file that `error` could not read (exit status 2)."""
     return file_failure(unreadable(error.path, error, role))
+
+
+def config_problem(role: str, name: str, error: Exception, help: str) -> FileDiagnostics:
+    """The E0100 report of the configuration file `name` (a sensor script, a world file,
+    rl1.toml, a test file) that `error` refuses: a vm.config.ConfigError, or an error it
+    caused, which says where, on the `--> s.json:3` line that names the file, and what."""
+    from rl1.vm.config import ConfigError
+
+    cause = error if isinstance(error, ConfigError) else error.__cause__
+    if not isinstance(cause, ConfigError) or cause.file != name:
+        return file_problem(name, f"the {role} `{name}` is not valid: {error}", help)
+    return file_problem(name, f"the {role} is not valid: {cause.problem}", help, cause.line)
+
+
+def invalid_config(role: str, name: str, error: Exception, help: str) -> Failure:
+    """The Failure (exit status 2) of the configuration file `name` that `error`
+    refuses, as `config_problem` says it."""
+    return file_failure(config_problem(role, name, error, help))
 
 
 def invalid_file(role: str, name: str, detail: str, help: str = "",

@@ -25,7 +25,15 @@ from .command import (
     force_option,
     or_none,
 )
-from .streams import cannot, file_problem, problem_text, same_file, unreadable, write_file
+from .streams import (
+    cannot,
+    config_problem,
+    file_problem,
+    problem_text,
+    same_file,
+    unreadable,
+    write_file,
+)
 
 if TYPE_CHECKING:  # the test file's schema loads when the command runs
     from rl1.compiler.program_tests import Case
@@ -108,9 +116,8 @@ def _load(paths: Sequence[str]) -> list[tuple[str, list[Test]]]:
         except SourceError as error:
             problems.append(unreadable(file, error, TEST_FILE_ROLE))
         except ConfigError as error:
-            problems.append(file_problem(file, f"the {TEST_FILE_ROLE} `{file}` is not "
-                                               f"valid: {error}",
-                                         "correct it as spec/tests.md describes"))
+            problems.append(config_problem(TEST_FILE_ROLE, file, error,
+                                           "correct it as spec/tests.md describes"))
     if problems:
         raise Failure("\n".join(problem_text(problem) for problem in problems), EXIT_USAGE)
     return loaded

@@ -76,7 +76,7 @@ def load_project_file(path: str) -> Selection:
             except SelectionError as error:
                 raise error_at(path, text, (TABLE, key), str(error)) from None
     except ConfigError as error:
-        raise ProjectFileError(path, error.detail, placed=str(error)) from None
+        raise ProjectFileError(path, error.detail, placed=str(error)) from error
     strict = None if isinstance(check.warnings_as_errors, UnsetType) else check.warnings_as_errors
     return Selection(codes["select"], codes["ignore"], strict)
 

@@ -56,7 +56,8 @@ class Ordered(Protocol):
 
 class FileDiagnostics(NamedTuple):
     """The diagnostics of one source file. `text` is None when the file could not be
-    read; its diagnostics then say why (E0100) and have no place in the text."""
+    read or used (a configuration file); its diagnostics then say why (E0100) and have
+    no place in the text, but a line whose column is 0: the line of a key."""
 
     name: str
     text: str | None
@@ -331,7 +332,8 @@ class _HumanRenderer:
         """The ` --> file:line:col` line and the underlined source lines of `span`."""
         pad = " " * gutter
         if self.file.text is None:
-            return [self.paint(f"{pad}--> ", "gutter") + _visible(self.file.name)]
+            line = f":{span.line}" if span.column == 0 else ""
+            return [self.paint(f"{pad}--> ", "gutter") + _visible(self.file.name) + line]
         where = f"{_visible(self.file.name)}:{span.line}:{max(span.column, 1)}"
         out = [self.paint(f"{pad}--> ", "gutter") + where]
         if not 1 <= span.line <= len(self.lines):

@@ -306,10 +306,11 @@ def test_a_project_file_may_start_with_a_byte_order_mark(tmp_path: Path) -> None
 def test_a_project_files_hexadecimal_integer_of_any_length_is_an_error_with_its_line(
         tmp_path: Path) -> None:
     # tomllib reads 0x integers without Python's 4300-digit bound: it was an internal error.
-    write(tmp_path, "rl1.toml", "[check]\nignore = 0x" + "f" * 5000 + "\n")
+    project = write(tmp_path, "rl1.toml", "[check]\nignore = 0x" + "f" * 5000 + "\n")
     result = check(write(tmp_path, "a.rob", MOVING))
     assert result.exit_code == 2
-    assert "rl1.toml:2: check.ignore: a number of more than 4300 digits" in result.stderr
+    assert (": check.ignore: a number of more than 4300 digits; no value here is near that "
+            f"long\n --> {project}:2\n") in result.stderr
 
 
 def test_options_given_win_over_the_project_file(tmp_path: Path) -> None:
@@ -338,33 +339,35 @@ def test_standard_input_takes_the_working_directorys_project_file(
     assert check("-", stdin=MOVING.encode()).stdout == "1 file checked: 0 errors, 0 warnings\n"
 
 
-@pytest.mark.parametrize("content, says", [
-    ("[check\n", "rl1.toml:1: invalid TOML: "),
+# What follows "is not valid: ", and the line of ` --> rl1.toml:LINE` (None: the file).
+@pytest.mark.parametrize("content, line, says", [
+    ("[check\n", 1, "invalid TOML: "),
     ('[check]\nselct = ["W06"]\n',
-     "rl1.toml:2: check.selct: unknown key; did you mean select? (expected one of select, ignore, "
+     2, "check.selct: unknown key; did you mean select? (expected one of select, ignore, "
      "warnings-as-errors)"),
-    ('[lint]\nselect = ["W06"]\n', "rl1.toml:1: lint: unknown key; expected one of check"),
-    ("check = 3\n", "rl1.toml:1: check: expected a table, found 3"),
+    ('[lint]\nselect = ["W06"]\n', 1, "lint: unknown key; expected one of check"),
+    ("check = 3\n", 1, "check: expected a table, found 3"),
     ('[check]\nselect = "W06"\n',
-     'rl1.toml:2: check.select: expected a list of codes, such as ["W06'),
-    ('[check]\nignore = ["E0101"]\n', "rl1.toml:2: check.ignore: `E0101` names only errors"),
+     2, 'check.select: expected a list of codes, such as ["W06'),
+    ('[check]\nignore = ["E0101"]\n', 2, "check.ignore: `E0101` names only errors"),
     ("[check]\nwarnings-as-errors = 1\n",
-     "rl1.toml:2: check.warnings-as-errors: expected true or false"),
+     2, "check.warnings-as-errors: expected true or false"),
     # Every number goes through the one bounded reader: an internal error before.
     ("[check]\nwarnings-as-errors = " + "9" * 5000 + "\n",
-     "rl1.toml:2: check.warnings-as-errors: a number of more than 4300 digits"),
-    ("[check]\nselect = [" + "1" * 4000 + "]\n", "found a number of 4000 digits"),
-    (b"[check]\n# \xff\n", "not UTF-8 text"),
-    ("x = " + "[" * 100_000 + "]" * 100_000 + "\n", "nested too deeply"),
+     2, "check.warnings-as-errors: a number of more than 4300 digits"),
+    ("[check]\nselect = [" + "1" * 4000 + "]\n", 2, "found a number of 4000 digits"),
+    (b"[check]\n# \xff\n", None, "not UTF-8 text"),
+    ("x = " + "[" * 100_000 + "]" * 100_000 + "\n", None, "nested too deeply"),
 ])
 def test_a_bad_project_file_stops_the_check_with_where_and_why(
-    tmp_path: Path, content: str | bytes, says: str,
+    tmp_path: Path, content: str | bytes, line: int | None, says: str,
 ) -> None:
     project = write(tmp_path, "rl1.toml", content)
     result = check(write(tmp_path, "a.rob", MOVING))
     assert (result.exit_code, result.stdout) == (2, "")
-    assert result.stderr.startswith(f"error[E0100]: the project file `{project}` is not valid: ")
+    assert result.stderr.startswith("error[E0100]: the project file is not valid: ")
     assert says in result.stderr
+    assert f"\n --> {project}{'' if line is None else f':{line}'}\n" in result.stderr
     assert "= help: correct the file" in result.stderr
     assert "Traceback" not in result.stderr
 

@@ -44,18 +44,18 @@ def cases(tmp: Path) -> list[tuple[list[str | Path], int, str]]:
         (["run", SAMPLE, "--sensors", gone / "s.json"], 2,
          f"cannot read the sensor script `{gone / 's.json'}`"),
         (["run", SAMPLE, "--sensors", bad / "s.json"], 2,
-         f"the sensor script `{bad / 's.json'}` is not valid: "),
+         "the sensor script is not valid: "),
         (["sim", gone / "p.rob", "--world", WORLD], 2,
          f"cannot read the source file `{gone / 'p.rob'}`"),
         (["sim", SAMPLE, "--world", gone / "w.toml"], 2,
          f"cannot read the world file `{gone / 'w.toml'}`"),
         (["sim", SAMPLE, "--world", bad / "w.toml"], 2,
-         f"the world file `{bad / 'w.toml'}` is not valid: "),
+         "the world file is not valid: "),
         (["sim", SAMPLE, "--world", WORLD, "--svg", folder], 2,
          f"cannot write the SVG file `{folder}`"),
         (["sim", SAMPLE, "--world", WORLD, "--html", folder], 2,
          f"cannot write the HTML file `{folder}`"),
-        (["check", bad / "p.rob"], 2, f"the project file `{bad / 'rl1.toml'}` is not valid: "),
+        (["check", bad / "p.rob"], 2, "the project file is not valid: "),
     ]
 
 

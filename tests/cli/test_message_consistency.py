@@ -42,16 +42,31 @@ def test_rl1c_new_says_its_errors_once_named(tmp_path: Path) -> None:
                              "folder; give the path of a new folder\n")
 
 
-def test_every_configuration_file_places_its_error_as_file_colon_line(tmp_path: Path) -> None:
+def test_every_configuration_file_is_named_once_and_placed_at_its_line(
+    tmp_path: Path,
+) -> None:
     (tmp_path / "p.rob").write_text("(MOV 3,3)\nA=(IMG)\n(END)\n")
     script = tmp_path / "s.json"
     script.write_text('{\n  "comment": "",\n  "readings": 1\n}\n')
+    world = tmp_path / "w.toml"
+    world.write_text("[floor]\nwidht = 3\n")
     project = tmp_path / "rl1.toml"
     project.write_text('[check]\nselect = ["W"]\nignre = ["W0603"]\n')
-    ran = rl1c("run", tmp_path / "p.rob", "--sensors", script).stderr
-    checked = rl1c("check", tmp_path / "p.rob").stderr
-    assert f"{script}:3: readings: unknown key;" in ran
-    assert f"{project}:3: check.ignre: unknown key;" in checked  # not `line 3:`
+    said = [rl1c("run", tmp_path / "p.rob", "--sensors", script).stderr,
+            rl1c("sim", tmp_path / "p.rob", "--world", world).stderr,
+            rl1c("check", tmp_path / "p.rob").stderr]
+    assert [text.splitlines()[:2] for text in said] == [
+        ["error[E0100]: the sensor script is not valid: readings: unknown key; expected one "
+         'of "IMG", "KYO", "CAM R", "ULT A", "ULT B", "ULT C", "ULT D", "INP", "FZI", '
+         '"line_lost", "fail", "stop_fails", "after_last", "comment"', f" --> {script}:3"],
+        ["error[E0100]: the world file is not valid: floor.widht: unknown key; expected one "
+         "of size", f" --> {world}:2"],
+        ["error[E0100]: the project file is not valid: check.ignre: unknown key; did you "
+         "mean ignore? (expected one of select, ignore, warnings-as-errors)",
+         f" --> {project}:3"],  # where rl1.toml said `line 3:`
+    ]
+    for text, file in zip(said, (script, world, project), strict=True):
+        assert text.count(str(file)) == 1
 
 
 @pytest.mark.parametrize("character", ["\ue000", "\U000f8f3f", "\u0378"])  # private, unassigned

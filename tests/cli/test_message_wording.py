@@ -123,7 +123,7 @@ def test_toml_keys_are_quoted_as_toml_needs_them(tmp_path: Path) -> None:
 
 def test_a_json_script_missing_a_key_is_told_what_to_write(tmp_path: Path) -> None:
     says = script_says(tmp_path, "s.json", '{"IMG": [{"area": 1, "x": 2}]}')
-    assert says.endswith(f'{tmp_path / "s.json"}:1: IMG[0]: missing "y", "z"; write "y": ...')
+    assert says.endswith('is not valid: IMG[0]: missing "y", "z"; write "y": ...')
 
 
 WORLD = """[floor]
@@ -147,8 +147,9 @@ def test_a_misspelt_key_of_a_world_file_and_of_a_sweep_are_told_the_close_key(
     (tmp_path / "p.rob").write_text(PROGRAM)
     (tmp_path / "w.toml").write_text(WORLD)
     says = rl1c("sim", tmp_path / "p.rob", "--world", tmp_path / "w.toml").stderr
-    assert f"{tmp_path / 'w.toml'}:12: stands[0].facng: unknown key; did you mean facing? " \
-           "(expected one of name, x, y, width, depth, facing, height, marker_height)" in says
+    assert "the world file is not valid: stands[0].facng: unknown key; did you mean facing? " \
+           "(expected one of name, x, y, width, depth, facing, height, marker_height)\n" \
+           f"  --> {tmp_path / 'w.toml'}:12\n" in says  # the gutter as wide as 12
     (tmp_path / "w.toml").write_text(WORLD.replace("facng", "facing"))
     swept = rl1c("sim", tmp_path / "p.rob", "--world", tmp_path / "w.toml", "--runs", "2",
                  "--sweep", "stands.bench.facng=0:40:3")
@@ -221,9 +222,9 @@ def test_a_scene_s_window_turned_round_is_shown_with_how_to_write_one(tmp_path: 
     (tmp_path / "w.toml").write_text(world)
     result = rl1c("sim", tmp_path / "p.rob", "--world", tmp_path / "w.toml")
     assert result.exit_code == 2
-    assert f"{tmp_path / 'w.toml'}:17: scenes[0].window: [100, 0, 50, 240] is no window: " \
+    assert "is not valid: scenes[0].window: [100, 0, 50, 240] is no window: " \
            "write [x0, y0, x1, y1], its left, top, right and bottom edges in pixels, with " \
-           "x0 < x1 and y0 < y1\n" in result.stderr
+           f"x0 < x1 and y0 < y1\n  --> {tmp_path / 'w.toml'}:17\n" in result.stderr
 
 
 def test_readings_used_up_are_told_what_to_write_in_the_script_s_own_syntax(

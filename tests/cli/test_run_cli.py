@@ -290,8 +290,8 @@ def test_bad_inputs_are_reported_naming_the_file_s_role(tmp_path: Path) -> None:
     (tmp_path / "cut.ilc").write_bytes(compiled.read_bytes()[:30])
     bad, none = tmp_path / "bad.json", tmp_path / "none.json"
     cases = [
-        (("run", SAMPLE, "--sensors", bad), 2, f"error[E0100]: the sensor script `{bad}` is "
-         f'not valid: {bad}:1: IMG[0]: missing "x", "y", "z"'),
+        (("run", SAMPLE, "--sensors", bad), 2, "error[E0100]: the sensor script is not "
+         f'valid: IMG[0]: missing "x", "y", "z"; write "x": ...\n --> {bad}:1\n'),
         (("run", SAMPLE, "--sensors", none), 2,
          f"error[E0100]: cannot read the sensor script `{none}`: no such file"),
         (("run", tmp_path / "errors.rob"), 1, "returns no value"),

@@ -147,8 +147,9 @@ def test_an_invalid_test_file_is_refused_with_its_line_before_any_test_runs(
     result = rl1c("test", good, bad)
     assert result.exit_code == 2
     assert result.stdout == ""
-    assert f"the test file `{bad}` is not valid: {bad}:4: test[0].expect.goal: a goal is " \
-           "judged on a world" in result.stderr
+    assert "the test file is not valid: test[0].expect.goal: a goal is judged on a world" \
+           in result.stderr
+    assert f"\n --> {bad}:4\n" in result.stderr
     assert "Traceback" not in result.output
 
 
@@ -230,7 +231,8 @@ def test_a_hostile_test_file_is_exit_status_2_without_a_traceback(
     file.write_bytes(data)
     result = rl1c("test", file)
     assert result.exit_code == 2
-    assert f"the test file `{file}` is not valid" in result.stderr
+    assert "the test file is not valid: " in result.stderr
+    assert f"\n --> {file}" in result.stderr
     assert "Traceback" not in result.output and "internal error" not in result.output
 
 

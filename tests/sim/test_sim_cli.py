@@ -93,7 +93,8 @@ def test_a_bad_world_file_is_a_message_and_status_2(tmp_path: Path) -> None:
     bad.write_text(WORLD.read_text().replace("facing = -137.0663", 'facing = "north"'))
     result = rl1c("sim", SAMPLE, "--world", bad)
     assert result.exit_code == 2
-    assert f"{bad}:41: stands[0].facing: expected a number" in result.stderr
+    assert "is not valid: stands[0].facing: expected a number" in result.stderr
+    assert f"  --> {bad}:41\n" in result.stderr
     assert "Traceback" not in result.output
     missing = rl1c("sim", SAMPLE, "--world", tmp_path / "none.toml")
     assert missing.exit_code == 2 and "Traceback" not in missing.output

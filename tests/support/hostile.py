@@ -231,7 +231,7 @@ def world_attack(data: bytes, folder: Path) -> list[str]:
     try:
         decode_world(data, str(world))
     except WorldError:
-        said = f"error[E0100]: the world file `{world}` is not valid: {world}"
+        said = "error[E0100]: the world file is not valid: "
         if result.exit_code != 2 or not result.stderr.startswith(said):
             found.append(f"sim: a bad world gave status {result.exit_code}: "
                          f"{result.output_bytes[-300:]!r}")
@@ -863,7 +863,7 @@ def attack_with_test_file(data: bytes, folder: Path) -> list[str]:
     result = rl1c("test", tests, "--jobs", "1", "--junit", junit)
     found = _problems("test", result, junit if result.exit_code == 2 else None)
     if loaded is None and (result.exit_code != 2 or result.stdout or not result.stderr
-                           .startswith(f"error[E0100]: the test file `{tests}` is not valid")):
+                           .startswith("error[E0100]: the test file is not valid: ")):
         found.append(f"test: a bad test file gave status {result.exit_code}: "
                      f"{result.output_bytes[-300:]!r}")
     if loaded is not None and result.exit_code in (0, 1) and not junit.exists():
@@ -960,7 +960,7 @@ def vary_attack(world_data: bytes, sweeps: tuple[str, ...], folder: Path) -> lis
     try:
         decode_world(world_data, str(world))
     except WorldError:
-        said = f"error[E0100]: the world file `{world}` is not valid: {world}"
+        said = "error[E0100]: the world file is not valid: "
         for result in (campaign, one_run):
             if result.exit_code != 2 or not result.stderr.startswith(said):
                 found.append(f"sim: a bad world gave status {result.exit_code}: "

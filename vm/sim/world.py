@@ -488,8 +488,9 @@ def decode_world(data: bytes, name: str) -> World:
         document, text = read_document(data, name, "toml")
     except ConfigError as error:
         if data.lstrip().startswith(b"{"):
-            raise WorldError(f"{name}: {WORLD.mistaken_for(SENSOR_SCRIPT)}") from None
-        raise WorldError(str(error)) from None
+            mistaken = ConfigError(name, None, "", WORLD.mistaken_for(SENSOR_SCRIPT))
+            raise WorldError(str(mistaken)) from mistaken
+        raise WorldError(str(error)) from error  # which rl1c places
     return parse_world(document, text, name)
 
 
@@ -499,7 +500,7 @@ def parse_world(document: dict[str, Any], text: str = "", name: str = "<world>")
         WORLD.refuse_other(document, name, SENSOR_SCRIPT)
         return _World(convert(document, WorldFile, name, text), text, name).build()
     except ConfigError as error:
-        raise WorldError(str(error)) from None
+        raise WorldError(str(error)) from error  # which rl1c places
 
 
 def place(points: list[Point]) -> str:
