@@ -397,8 +397,10 @@ class _Ran:
 
 def _run_shell(command: str) -> _Ran:
     """Run `command` through the shell for at most EXEC_TIMEOUT seconds, reading at most
-    EXEC_OUTPUT_LIMIT bytes of its output; then every process it started is killed (the
-    command runs in a process group of its own)."""
+    EXEC_OUTPUT_LIMIT bytes of its output, which is what it printed by the shell's end (on
+    Linux; elsewhere, by the end of its pipes, which a process it left running holds
+    open); then every process it started is killed (the command runs in a process group
+    of its own)."""
     process = subprocess.Popen(command, shell=True, stdin=subprocess.DEVNULL,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                start_new_session=True)
@@ -406,15 +408,28 @@ def _run_shell(command: str) -> _Ran:
     stdout, stderr = bytearray(), bytearray()
     ending = "done"
     deadline = time.monotonic() + EXEC_TIMEOUT
+    shell = _end_seen(process.pid)
+    shell_ended = False  # then what it wrote is in the pipes, which a process it left
+    # running (`sleep 300 &`) may hold open for ever: what is there is read, no more
     try:
         with selectors.DefaultSelector() as selector:
             selector.register(process.stdout, selectors.EVENT_READ, stdout)
             selector.register(process.stderr, selectors.EVENT_READ, stderr)
-            while selector.get_map() and ending == "done":
+            if shell is not None:
+                selector.register(shell, selectors.EVENT_READ)
+            while ending == "done" and any(key.data is not None
+                                           for key in selector.get_map().values()):
                 left = deadline - time.monotonic()
                 if left <= 0:
                     ending = "timeout"
-                for key, _ in selector.select(max(left, 0)):
+                ready = selector.select(0 if shell_ended else max(left, 0))
+                if shell_ended and not ready:
+                    break
+                for key, _ in ready:
+                    if key.data is None:  # the shell's end
+                        selector.unregister(key.fileobj)
+                        shell_ended = True
+                        continue
                     chunk = os.read(key.fd, 1 << 16)
                     if not chunk:
                         selector.unregister(key.fileobj)
@@ -435,7 +450,18 @@ def _run_shell(command: str) -> _Ran:
         process.wait()
         process.stdout.close()
         process.stderr.close()
+        if shell is not None:
+            os.close(shell)
     return _Ran(ending, bytes(stdout), bytes(stderr))
+
+
+def _end_seen(pid: int) -> int | None:
+    """A file descriptor readable once the process `pid` (a child not yet waited for)
+    has ended: a Linux pidfd; None where there is none."""
+    try:
+        return os.pidfd_open(pid)
+    except (AttributeError, OSError):  # not Linux, or a kernel before 5.3
+        return None
 
 
 def _no_run(code: str, message: str) -> Observation:

@@ -319,6 +319,19 @@ def test_an_engines_process_in_a_session_of_its_own_is_killed_too(
             os.kill(pid, signal.SIGKILL)
 
 
+@pytest.mark.skipif(not hasattr(os, "pidfd_open"), reason="the shell's end is seen by a pidfd")
+@pytest.mark.parametrize("left", ["sleep 300 &", "setsid sleep 300 &"])
+def test_an_engine_that_ended_is_its_run_though_a_process_it_left_holds_its_output(
+        monkeypatch: pytest.MonkeyPatch, left: str) -> None:
+    """Its output was read until its end of file, which a process it left running holds
+    open: a command that had printed its run and ended was told to have run longer than
+    the timeout."""
+    monkeypatch.setattr(differential, "EXEC_TIMEOUT", 5.0)
+    run = json.dumps({"status": "ok", "variables": {"A": 1}, "trace": []})
+    observation = exec_run(f"{left} echo {shlex.quote(run)}")
+    assert observation.document == json.loads(run)
+
+
 def test_a_quoted_placeholder_never_runs_the_folder_name(tmp_path: Path) -> None:
     # shlex-quoted paths are literal bare, but inside double quotes the quote is a
     # character and a `$(...)` in the temporary folder's name ran.
