@@ -49,6 +49,7 @@ from .config import (
     found,
     one_of,
     read_document,
+    written_key,
 )
 from .config_lines import KeyPath
 from .device import FuzzyReading, ImageReading, MotionCommand, Odometry, form_name
@@ -264,8 +265,8 @@ class _Script:
     def failures(self) -> dict[str, int]:
         for call in self.file.fail:
             if call not in FORMS:
-                raise self.fail(("fail", call), "not a built-in form; "
-                                                + one_of(call, sorted(FORMS)))
+                raise self.fail(("fail", call), "not a built-in form; " + one_of(
+                    call, sorted(FORMS), lambda form: written_key(form, self.syntax)))
         return dict(self.file.fail)
 
     def loss(self, loss: LossFields, index: int) -> LossAt | LossDuring | LossAfter:

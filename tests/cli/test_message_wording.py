@@ -109,8 +109,11 @@ def test_a_misspelt_key_of_a_sensor_script_is_told_the_key_it_is_close_to(
         ': line_lost[0].durin: unknown key; did you mean "during"? (expected one of "time", '
         '"instruction", "during", "nth", "after")')
     assert "did you mean" not in script_says(tmp_path, "s.json", '{"zzzz": 1}')
-    assert ": fail.tim: not a built-in form; did you mean TIM? (expected one of CAM A, " \
+    # A form is a key of `fail`: written as each format writes that key.
+    assert ': fail.tim: not a built-in form; did you mean "TIM"? (expected one of "CAM A", ' \
            in script_says(tmp_path, "s.json", '{"fail": {"tim": 1}}')
+    assert ': fail.tim: not a built-in form; did you mean TIM? (expected one of "CAM A", ' \
+           in script_says(tmp_path, "s.toml", '[fail]\ntim = 1\n')
     # As near to CAM A as to CAM Z: no guess.
     assert "did you mean" not in script_says(tmp_path, "s.json", '{"fail": {"CAM X": 1}}')
 
