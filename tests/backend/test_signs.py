@@ -91,12 +91,13 @@ def test_paths_join_to_the_signs_either_allows() -> None:
         agree(source, {"INP": {"1": [port]}})
 
 
-@pytest.mark.parametrize("value", ["(IMG)&255", "255&(IMG)"])
+# M, a port's data, is 0..255 (B=M has the flow follow its sign).
+@pytest.mark.parametrize("value", ["(IMG)&255", "255&(IMG)", "(IMG)&M"])
 def test_a_mask_with_the_sign_bit_clear_either_side_proves_not_negative(value: str) -> None:
-    source = f"A={value}\n?A<#20\n(OUT 1,1); (END)\n:20 (OUT 2,2); (END)\n"
+    source = f"M=(INP 1)\nB=M\nA={value}\n?A<#20\n(OUT 1,1); (END)\n:20 (OUT 2,2); (END)\n"
     assert not kept("if A<0", optimized(source, decide_branches))
     for area in (-1, 300):
-        agree(source, {"IMG": [{"area": area, "x": 0, "y": 0, "z": 0}]})
+        agree(source, {"INP": {"1": [255]}, "IMG": [{"area": area, "x": 0, "y": 0, "z": 0}]})
 
 
 def test_a_mask_with_the_sign_bit_set_proves_nothing() -> None:
@@ -190,6 +191,15 @@ def test_a_jump_that_decides_the_branch_it_enters_goes_past_it() -> None:
     program = optimized(CLAMP, decide_branches)
     assert terminators(program)["L20"] == "jump L12"
     assert terminators(program)["L11"] == "if V>0 then L12 else B2"
+
+
+def test_a_branch_whose_way_decides_the_branch_it_enters_goes_past_it() -> None:
+    # On `?A=#20`'s taken edge A is 0, so `:20 ?A>#40` there falls through to B2.
+    source = ("A=(INP 1)\n?A=#20\n(OUT 1,1)\n#30\n:20 ?A>#40\n(OUT 2,2); (END)\n"
+              ":40 (OUT 3,3); (END)\n:30 (END)\n")
+    assert terminators(optimized(source, decide_branches))["B0"] == "if A=0 then B2 else B1"
+    for port in (0, 5):
+        agree(source, {"INP": {"1": [port]}})
 
 
 def test_a_way_that_falls_through_into_a_branch_it_decides_is_left_alone() -> None:
