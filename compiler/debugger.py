@@ -466,7 +466,15 @@ class Session:
         fault = self.result.fault
         if fault is None:
             return Stop("end", None, "the program ended")
-        return Stop("fault", fault.line, f"{fault.kind.diagnostic_code}: {fault.message}")
+        advice = _BUDGET_ADVICE if fault.kind is FaultKind.BUDGET else ""
+        return Stop("fault", fault.line,
+                    f"{fault.kind.diagnostic_code}: {fault.message}{advice}")
+
+
+# What a used-up budget's stop says to do, as rl1c run's help does: the fault's message
+# leaves it to the help, which a debugger's stop has no place for.
+_BUDGET_ADVICE = ("; if the program should run longer, give it a larger budget; if not, a "
+                  "loop that nothing ends is running")
 
 
 def _parsed_condition(text: str) -> Condition | DebugError:

@@ -212,6 +212,19 @@ def test_a_fault_is_an_exception_on_its_line_then_the_end(client: Client,
     assert client.close() == (0, "")
 
 
+def test_a_used_up_budget_stops_saying_what_to_do(client: Client, tmp_path: Path) -> None:
+    program = tmp_path / "loop.rob"
+    program.write_text(":10 A=A+1\n#10\n")
+    _launched(client, program=str(program), budget=50)
+    client.request("configurationDone")
+    description = client.event("stopped")["body"]["description"]
+    assert description.startswith(
+        "E1012: the program ran more than 50 instructions without ending; if the program "
+        "should run longer, give it a larger budget")
+    client.request("continue", {"threadId": 1})
+    assert client.event("exited")["body"] == {"exitCode": 12}
+
+
 def test_a_call_breakpoint_on_the_simulator_shows_the_vehicle(client: Client) -> None:
     _launched(client, program=str(SAMPLE), world=str(WORLD))
     response = client.request("setFunctionBreakpoints", {
