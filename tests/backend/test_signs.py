@@ -105,6 +105,12 @@ def test_a_mask_with_the_sign_bit_set_proves_nothing() -> None:
     assert kept("if A<0", optimized(source, decide_branches))
 
 
+def test_a_call_forgets_the_signs_of_the_reserved_variables_it_writes() -> None:
+    # x is positive before (IMG), which writes the image's x there.
+    source = "x=1\n(IMG)\n?x>#20\n(OUT 1,1); (END)\n:20 (OUT 2,2); (END)\n"
+    assert kept("if x>0", optimized(source, decide_branches))
+
+
 def test_a_step_that_can_wrap_forgets_the_sign() -> None:
     # 32767 + 1 is -32768: a positive variable stepped up may be negative.
     source = "A=(INP 1)\n?A=#20\nA++\n?A<#30\n(END)\n:20 (END)\n:30 (OUT 1,1); (END)\n"
