@@ -208,6 +208,15 @@ def test_a_branch_whose_way_decides_the_branch_it_enters_goes_past_it() -> None:
         agree(source, {"INP": {"1": [port]}})
 
 
+def test_a_jump_goes_past_the_branch_it_decides_to_a_block_laid_out_before() -> None:
+    # From B1 A is not 0, so `:10 ?A=#30` falls through to B2, whatever the blocks' names.
+    source = ("A=(INP 1)\n?A=#20\n#10\n:20 (OUT 2,2)\n#10\n:10 ?A=#30\n(OUT 1,1); (END)\n"
+              ":30 (END)\n")
+    assert terminators(optimized(source, decide_branches))["B1"] == "jump B2"
+    for port in (0, 5):
+        agree(source, {"INP": {"1": [port]}})
+
+
 def test_a_way_that_falls_through_into_a_branch_it_decides_is_left_alone() -> None:
     # A jump to :12 in place of falling into `?V>#12` costs as much and 3 bytes more.
     source = "V=(IMG); E=V-6; ?E<#11\nV=6\n:11 ?V>#12\nV=1\n:12 (MOV V,V); (MOV 0,0); (END)\n"
