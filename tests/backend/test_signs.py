@@ -129,9 +129,11 @@ def test_nothing_is_known_where_a_handler_starts() -> None:
 POLL_LOOP = ":10 N=(INP 2)\n?N>#20\n#10\n:20 (OUT 1,N); (END)\n"
 
 
-def test_a_branch_around_a_jump_is_negated_when_the_signs_allow_it() -> None:
-    program = optimize.optimize(lower(analyze(POLL_LOOP).program), 1, check=True)
-    assert terminators(program)["L10"] == "if N=0 then L10 else L20"
+@pytest.mark.parametrize("loop", ["10", "30"])  # before and after :20, the block next
+def test_a_branch_around_a_jump_is_negated_when_the_signs_allow_it(loop: str) -> None:
+    source = POLL_LOOP.replace("10", loop)
+    program = optimize.optimize(lower(analyze(source).program), 1, check=True)
+    assert terminators(program)[f"L{loop}"] == f"if N=0 then L{loop} else L20"
 
 
 def test_a_branch_around_a_jump_is_kept_when_the_variable_may_have_any_sign() -> None:
