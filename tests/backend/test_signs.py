@@ -111,6 +111,13 @@ def test_a_call_forgets_the_signs_of_the_reserved_variables_it_writes() -> None:
     assert kept("if x>0", optimized(source, decide_branches))
 
 
+@pytest.mark.parametrize(("value", "taken"), [(-1, True), (0, False), (1, False)])
+def test_a_loaded_constant_has_its_own_sign(value: int, taken: bool) -> None:
+    source = f"A=(INP 1)\nA={value}\n?A<#20\n(OUT 1,1); (END)\n:20 (OUT 2,2); (END)\n"
+    assert terminators(optimized(source, decide_branches))["B0"] == \
+        ("jump L20" if taken else "jump B1")
+
+
 def test_a_step_that_can_wrap_forgets_the_sign() -> None:
     # 32767 + 1 is -32768: a positive variable stepped up may be negative.
     source = "A=(INP 1)\n?A=#20\nA++\n?A<#30\n(END)\n:20 (END)\n:30 (OUT 1,1); (END)\n"
