@@ -6,7 +6,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: demo test quick lint typecheck pytest clean vscode-test vscode-package c-test studio-check studio-page
+.PHONY: demo test quick lint typecheck pytest clean vscode-test vscode-package c-test studio-check studio-page mutation
 
 # pip byte-compiles what it installs, but an editable install leaves rl1 to its first
 # run, which cannot write bytecode where PYTHONDONTWRITEBYTECODE is set: compileall.
@@ -48,6 +48,11 @@ QUICK := not slow and not needs_cc and not needs_node and not needs_browser
 
 quick: $(STAMP)
 	$(BIN)/pytest -n 2 -m '$(QUICK)'
+
+# Mutation testing (tests/mutation/README.md): cosmic-ray's session M (machine, constants
+# or signs) in a clone of its own. Slow (an hour or more), never part of `make test`.
+mutation:
+	tests/mutation/run $(or $(M),machine)
 
 # The C VM (vm/c/): the Debian packages it needs when missing (CI runs as root),
 # then its builds, the conformance vectors under sanitizers and on emulated targets,
