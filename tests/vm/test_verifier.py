@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import pytest
 from hypothesis import given, settings
+from hypothesis import strategies as st
 from support.ilc import damaged, images, with_crc
 
 from rl1.vm import ilc, isa, machine
@@ -98,6 +99,52 @@ def test_bad_code_is_refused_at_the_offending_byte(code: bytes, offset: int, mes
     error = refusal(file_of(code))
     assert (error.offset, error.refusal) == (offset, kind)
     assert message in error.message
+
+
+# Whole instructions of each length (1, 2, 3 and 6 bytes) to put anything after.
+WHOLE = [op("END"), op("STV", 0), op("LDI", -2), op("MOV", args=(var(0), const(-3)))]
+UNKNOWN_OPCODE = 0x0B
+
+
+@pytest.mark.parametrize("before", [4, 8, 9, 40])
+def test_a_refusal_points_at_code_start_plus_its_code_offset(before: int) -> None:
+    # 24 + 8 is 32, not 24 | 8: a refusal past code offset 7 says where it is too.
+    error = refusal(file_of(op("END") * before + bytes([UNKNOWN_OPCODE])))
+    assert (error.offset, error.refusal) == (CODE + before, Refusal.UNKNOWN_OPCODE)
+    assert error.message.startswith(f"code offset {before}: unknown opcode 0x0B")
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.sampled_from(WHOLE), max_size=30))
+def test_an_unknown_opcode_after_any_code_is_refused_at_its_byte(
+    prefix: list[bytes],
+) -> None:
+    at = len(b"".join(prefix))
+    error = refusal(file_of(b"".join(prefix) + bytes([UNKNOWN_OPCODE])))
+    assert (error.offset, error.refusal) == (CODE + at, Refusal.UNKNOWN_OPCODE)
+    assert error.message.startswith(f"code offset {at}: unknown opcode 0x0B")
+
+
+def test_an_instruction_cut_off_after_another_is_refused() -> None:
+    # At code offset 3, 3 bytes of LDI with 2 left: 3 + 3 > 5, though 3 | 3 is not.
+    error = refusal(file_of(op("LDI", 0) + op("LDI", 0)[:2]))
+    assert (error.offset, error.refusal) == (CODE + 3, Refusal.CUT_OFF)
+    assert "code offset 3: LDI needs 3 bytes, only 2 remain in the code" in error.message
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.sampled_from(WHOLE), max_size=30), st.sampled_from(WHOLE[1:]),
+       st.data())
+def test_any_code_whose_last_instruction_is_cut_off_is_refused_at_it(
+    prefix: list[bytes], last: bytes, data: st.DataObject,
+) -> None:
+    kept = data.draw(st.integers(1, len(last) - 1), label="bytes kept")
+    at = len(b"".join(prefix))
+    error = refusal(file_of(b"".join(prefix) + last[:kept]))
+    assert (error.offset, error.refusal) == (CODE + at, Refusal.CUT_OFF)
+    name = isa.OPCODES[last[0]].name
+    assert (f"code offset {at}: {name} needs {len(last)} bytes, only {kept} remain in the "
+            "code") in error.message
 
 
 @pytest.mark.parametrize("minor", [0, ilc.DIGEST_MINOR])
