@@ -217,6 +217,16 @@ def test_a_branch_whose_way_decides_the_branch_it_enters_goes_past_it() -> None:
         agree(source, {"INP": {"1": [port]}})
 
 
+def test_a_branch_whose_way_decides_the_branch_it_enters_goes_past_it_to_any_block() -> None:
+    # On `?A=#20`'s taken edge A is 0, so `:20 ?A=#40` there goes to :40, whose block's
+    # name sorts after :20's (the ways are threaded whatever order their names sort in).
+    source = ("A=(INP 1)\n?A=#20\n(OUT 1,1)\n#30\n:20 ?A=#40\n(OUT 2,2); (END)\n"
+              ":40 (OUT 3,3); (END)\n:30 (END)\n")
+    assert terminators(optimized(source, decide_branches))["B0"] == "if A=0 then L40 else B1"
+    for port in (0, 5):
+        agree(source, {"INP": {"1": [port]}})
+
+
 def test_a_jump_goes_past_the_branch_it_decides_to_a_block_laid_out_before() -> None:
     # From B1 A is not 0, so `:10 ?A=#30` falls through to B2, whatever the blocks' names.
     source = ("A=(INP 1)\n?A=#20\n#10\n:20 (OUT 2,2)\n#10\n:10 ?A=#30\n(OUT 1,1); (END)\n"
