@@ -3,6 +3,8 @@ points at, and that no damage to a valid file makes it fail in any other way."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -49,6 +51,15 @@ def test_a_valid_file_gives_its_instructions_and_their_index() -> None:
     assert program.index_of == {0: 0, 3: 1, 5: 2, 11: 3}
     assert program.instructions[2].args == (var(0), const(-3))
     assert program.image.handlers == {96: 5}
+
+
+def test_a_verified_program_cannot_be_pointed_at_other_code() -> None:
+    # The VM checks nothing the verifier checked: what it was given stays what passed.
+    program = verify(file_of(op("LDI", 5)))
+    unverified = isa.decode_at(op("JMP", 9), 0)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        program.instructions = (unverified,)  # type: ignore[misc]
+    assert program.instructions == (isa.decode_at(op("LDI", 5), 0),)
 
 
 @settings(max_examples=100, deadline=None)
