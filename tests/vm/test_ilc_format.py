@@ -8,9 +8,10 @@ import struct
 
 import pytest
 from hypothesis import given, settings
+from hypothesis import strategies as st
 from support.ilc import images, with_crc
 
-from rl1.vm import ilc
+from rl1.vm import ilc, isa
 from rl1.vm.language import Feature
 
 LDI_5_END = bytes([0x02, 0x05, 0x00, 0x00])  # LDI 5; END
@@ -105,7 +106,25 @@ def test_the_same_minor_version_with_extra_bytes_is_refused() -> None:
     data = ilc.encode(SAMPLE)
     error = refusal(with_crc(data + b"x"))
     assert error.offset == len(data)
-    assert "unexpected bytes" in error.message
+    assert error.message == "1 unexpected bytes after the last section"
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.binary(min_size=1, max_size=40))
+def test_extra_bytes_are_counted_from_the_last_sections_end(extra: bytes) -> None:
+    data = ilc.encode(SAMPLE)
+    error = refusal(with_crc(data + extra))
+    assert (error.offset, error.refusal) == (len(data), ilc.Refusal.EXTRA_BYTES)
+    assert error.message == f"{len(extra)} unexpected bytes after the last section"
+
+
+@pytest.mark.parametrize("extra", [2, 3, 10])
+def test_extra_bytes_are_counted(extra: int) -> None:
+    # past a 38-byte file: 40 ^ 38 is 14, 41 ^ 38 is 15, 48 ^ 38 is 22; 40 - 38 is 2
+    data = ilc.encode(dataclasses.replace(SAMPLE, debug=None))
+    assert len(data) == 38
+    error = refusal(with_crc(data + bytes(extra)))
+    assert error.message == f"{extra} unexpected bytes after the last section"
 
 
 def test_a_newer_major_version_is_refused() -> None:
@@ -214,15 +233,35 @@ def test_a_malformed_debug_section_is_refused(section: bytes, offset: int,
 
 # --- the writer's limits -------------------------------------------------------------
 
-@pytest.mark.parametrize("image", [
-    ilc.Image(bytes(0x10000), {}, frozenset()),
-    ilc.Image(LDI_5_END, {95: 0}, frozenset()),
-    ilc.Image(LDI_5_END, {96: 4}, frozenset()),
-    ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x" * 256, ())),
-    ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", ((0, 5), (3, 4)))),
-    ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", ((3, 5), (3, 6)))),
-    ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", ((0, 0),))),
+FUSED = bytes([isa.BY_NAME["MOVV"].opcode, 0, 1])  # MOVV, an instruction of 1.2
+
+
+@pytest.mark.parametrize(("image", "message"), [
+    (ilc.Image(bytes(0x10000), {}, frozenset()),
+     "code is 65536 bytes; the format allows 65535"),
+    (ilc.Image(LDI_5_END, {95: 0}, frozenset()), "handler labels must be 96..99, not [95]"),
+    (ilc.Image(LDI_5_END, {96: 4}, frozenset()), "handler :96 at 4 is outside the code"),
+    (ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x" * 256, ())),
+     "source name is 256 bytes; the format allows 255"),
+    (ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", ((0, 5), (3, 4)))),
+     "line entry (3, 4): lines must not decrease"),
+    (ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", ((3, 5), (3, 6)))),
+     "line entry (3, 6): offsets must increase"),
+    (ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", ((0, 0),))),
+     "line entry (0, 0): offsets are u16, lines 1..65535"),
+    # Past 1.0 (here for its code, not a digest) a debug section needs the digest after it.
+    (ilc.Image(FUSED, {}, frozenset(), ilc.DebugInfo("x", ((0, 1),))),
+     "a version 1.2 file's debug section is followed by the source digest, and this image "
+     "has none"),
 ])
-def test_encode_refuses_an_image_the_format_cannot_hold(image: ilc.Image) -> None:
-    with pytest.raises(ValueError):
+def test_encode_refuses_an_image_the_format_cannot_hold(image: ilc.Image,
+                                                        message: str) -> None:
+    with pytest.raises(ValueError) as caught:
         ilc.encode(image)
+    assert str(caught.value) == message
+
+
+def test_a_source_name_of_the_longest_length_is_written_and_read() -> None:
+    name = "\u00e9" * 127 + "x"  # 255 bytes of UTF-8
+    image = ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo(name, ()))
+    assert ilc.decode(ilc.encode(image)) == image
