@@ -127,10 +127,11 @@ def test_extra_bytes_are_counted(extra: int) -> None:
     assert error.message == f"{extra} unexpected bytes after the last section"
 
 
-def test_a_newer_major_version_is_refused() -> None:
-    error = refusal(patched(ilc.encode(SAMPLE), 4, "<B", 2))
-    assert error.offset == 4
-    assert "version 2.0 is not supported" in error.message
+@pytest.mark.parametrize("major", [0, 2, 255])
+def test_a_major_version_other_than_1_is_refused(major: int) -> None:
+    error = refusal(patched(ilc.encode(SAMPLE), 4, "<B", major))
+    assert (error.offset, error.refusal) == (4, ilc.Refusal.BAD_MAJOR)
+    assert f"version {major}.0 is not supported" in error.message
 
 
 def test_an_unknown_required_flag_is_refused_an_optional_one_kept() -> None:
@@ -249,6 +250,8 @@ FUSED = bytes([isa.BY_NAME["MOVV"].opcode, 0, 1])  # MOVV, an instruction of 1.2
      "line entry (3, 6): offsets must increase"),
     (ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", ((0, 0),))),
      "line entry (0, 0): offsets are u16, lines 1..65535"),
+    (ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", ((-1, 1),))),
+     "line entry (-1, 1): offsets are u16, lines 1..65535"),
     # Past 1.0 (here for its code, not a digest) a debug section needs the digest after it.
     (ilc.Image(FUSED, {}, frozenset(), ilc.DebugInfo("x", ((0, 1),))),
      "a version 1.2 file's debug section is followed by the source digest, and this image "
@@ -259,6 +262,11 @@ def test_encode_refuses_an_image_the_format_cannot_hold(image: ilc.Image,
     with pytest.raises(ValueError) as caught:
         ilc.encode(image)
     assert str(caught.value) == message
+
+
+def test_the_last_line_is_written_and_read() -> None:
+    image = ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", ((0, ilc.MAX_LINE),)))
+    assert ilc.decode(ilc.encode(image)) == image
 
 
 def test_a_source_name_of_the_longest_length_is_written_and_read() -> None:
