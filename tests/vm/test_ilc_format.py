@@ -215,9 +215,10 @@ def with_debug(section: bytes) -> bytes:
 
 
 @pytest.mark.parametrize(("section", "offset", "message"), [
-    (bytes([9]) + b"a.rob", DEBUG + 1, "ends in the middle of a field"),
+    (bytes([9]) + b"a.rob", DEBUG + 1,
+     "the debug section ends in the middle of a field (9 bytes needed, 5 left)"),
     (bytes([2]) + b"\xff\xfe" + bytes(2), DEBUG + 1, "not UTF-8"),
-    (bytes([0, 1]), DEBUG + 1, "ends in the middle of a field"),
+    (bytes([0, 1]), DEBUG + 1, "ends in the middle of a field (2 bytes needed, 1 left)"),
     (bytes([0, 2, 0, 0, 1, 0, 1]), DEBUG + 5, "repeats the previous entry's code offset"),
     (bytes([0, 1, 0, 0, 0]), DEBUG + 3, "line 0"),
     (bytes([0, 1, 0, 0, 0x80, 0x80, 0x04]), DEBUG + 3, "line 65536) is out of range"),
