@@ -153,6 +153,20 @@ def test_a_short_file_is_refused_as_truncated() -> None:
         assert "truncated" in error.message
 
 
+def test_a_header_without_its_sections_is_refused_as_truncated_where_they_end() -> None:
+    data = ilc.encode(SAMPLE)
+    error = refusal(data[:24])  # the whole header, which the shortest file passes
+    assert (error.offset, error.refusal) == (24, ilc.Refusal.TRUNCATED)
+    assert error.message == (f"truncated: the header's section sizes add up to {len(data)} "
+                             "bytes, the file has 24")
+
+
+def test_a_source_name_keeps_every_character_but_the_surrogates() -> None:
+    # A name that is not UTF-8 holds each of its bytes as a surrogate, U+D800..U+DFFF.
+    name = "a\ud7ff\ud800\udc80\udfff\ue000.rob"
+    assert ilc.debug_source_name(name) == "a\ud7ff\ufffd\ufffd\ufffd\ue000.rob"
+
+
 def test_bad_magic_is_refused_at_offset_0() -> None:
     error = refusal(b"RLIX" + ilc.encode(SAMPLE)[4:])
     assert error.offset == 0
