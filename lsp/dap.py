@@ -31,6 +31,7 @@ from typing import Any, BinaryIO
 import click
 
 from rl1.compiler.campaign import MAX_SEED
+from rl1.compiler.cli.command import ToolCommand, command_line_status
 from rl1.compiler.debugger import (
     MAX_EXPRESSION,
     DebugError,
@@ -99,6 +100,7 @@ class Adapter:
         self.stop_on_entry = False
         self.done = False  # after disconnect
         self._worker: threading.Thread | None = None
+        self._running = False  # till the worker says where it stopped (it ends just after)
         self._told = 0  # the trace entries already sent as output
         self._last_stop: Stop | None = None
         self._started = False  # by configurationDone, or a command before it
@@ -390,12 +392,13 @@ class Adapter:
 
     def _idle(self) -> Session:
         session = self._session()
-        if self._worker is not None and self._worker.is_alive():
+        if self._running:
             raise Refused("the program is running: pause it first")
         return session
 
     def _go(self, command: Callable[[], Stop]) -> None:
         self._started = True
+        self._running = True
         self.event("continued", {"threadId": THREAD, "allThreadsContinued": True})
         self._worker = threading.Thread(target=self._run, args=(command,), daemon=True)
         self._worker.start()
@@ -406,6 +409,7 @@ class Adapter:
         try:
             self._stopped(command())
         except Exception as error:
+            self._running = False
             print(f"rl1-dap: internal error in the run: {error!r}; please report it",
                   file=sys.stderr)
             self.event("output", {"category": "stderr", "output": "rl1-dap failed running "
@@ -416,6 +420,9 @@ class Adapter:
         session = self._session()
         previous, self._last_stop = self._last_stop, stop
         self._tell_trace(session)
+        # Idle before the client hears of the stop: its next request may come at once,
+        # while this thread is still ending (it was refused as running).
+        self._running = False
         # A fault is shown as an exception where it happened; the command after it ends.
         if stop.reason == "end" or (stop.reason == "fault" and previous == stop):
             self.event("exited", {"exitCode": 0 if stop.reason == "end" else
@@ -566,8 +573,11 @@ def serve(input_: BinaryIO, output: BinaryIO) -> None:
         framer.problems.clear()
 
 
-@click.command("rl1-dap", context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(package_name="rl1", prog_name="rl1-dap")
+NAME = "rl1-dap"
+
+
+@click.command(NAME, cls=ToolCommand)
+@click.version_option(package_name="rl1", prog_name=NAME)
 def command() -> None:
     """The RL/I debug adapter: the Debug Adapter Protocol over standard input and output,
     for VS Code, nvim-dap and any DAP client. Launch a .rob (compiled in memory, `level`
@@ -578,8 +588,10 @@ def command() -> None:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """The `rl1-dap` command line (default: the process's arguments)."""
-    command.main(argv, prog_name="rl1-dap")
+    """The `rl1-dap` command line (default: the process's arguments); a malformed one is
+    said as rl1c's are: `rl1-dap: error: ...`, status 2."""
+    sys.exit(command_line_status(
+        lambda: command.main(argv, prog_name=NAME, standalone_mode=False), NAME))
 
 
 if __name__ == "__main__":

@@ -32,6 +32,7 @@ from pygls.exceptions import (
 from pygls.lsp.server import LanguageServer
 from pygls.protocol import LanguageServerProtocol, default_converter
 
+from rl1.compiler.cli.command import ToolCommand, command_line_status
 from rl1.vm.config import excerpt, found
 
 from . import (
@@ -485,7 +486,7 @@ def create_server() -> Rl1Server:
     return server
 
 
-@click.command(NAME, context_settings={"help_option_names": ["-h", "--help"]})
+@click.command(NAME, cls=ToolCommand)
 @click.version_option(package_name="rl1", prog_name=NAME)
 @click.option("--stdio", is_flag=True,
               help="talk LSP over standard input and output (the default)")
@@ -528,8 +529,10 @@ def command(stdio: bool, tcp: tuple[str, int] | None, ws: tuple[str, int] | None
 
 def main(argv: list[str] | None = None) -> None:
     """The `rl1-lsp` command line (default: the process's arguments); serves until the
-    client leaves, then exits. Help, the version and a malformed command line exit too."""
-    command.main(argv, prog_name=NAME)  # the name, also under `python -m rl1.lsp`
+    client leaves, then exits. Help, the version and a malformed command line exit too,
+    the last as rl1c's do: `rl1-lsp: error: ...`, status 2."""
+    sys.exit(command_line_status(  # the name, also under `python -m rl1.lsp`
+        lambda: command.main(argv, prog_name=NAME, standalone_mode=False), NAME))
 
 
 def _host_port(text: str | None) -> tuple[str, int] | None:

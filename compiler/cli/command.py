@@ -19,7 +19,7 @@ import signal
 import sys
 from collections.abc import Callable, Iterator, Sequence
 from types import FrameType
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any, Literal, TypeVar
 
 import click
 
@@ -48,12 +48,18 @@ class Failure(Exception):
 class CommandError(Failure):
     """A Failure that is no diagnostic of a file (those are `error[E0100]`, a Failure's
     whole message): `message` is said as every command's errors are, its usage errors
-    too, `rl1c reduce: error: MESSAGE` (`error_line`)."""
+    too, `rl1c reduce: error: MESSAGE` (`message_line`)."""
 
 
-def error_line(command_path: str, message: str) -> str:
-    """An error of the command `command_path` (`rl1c run`): `rl1c run: error: message`."""
-    return f"{command_path}: error: {message}"
+MessageKind = Literal["error", "warning", "note"]
+
+
+def message_line(command_path: str, kind: MessageKind, message: str) -> str:
+    """A message of the command `command_path` (`rl1c sim`) that is no file's diagnostic:
+    `rl1c sim: warning: message`. Errors, warnings and notes alike name the command that
+    says them, as its usage errors do; `rl1c` alone when no command runs (the plugins'
+    entry points), and `rl1-lsp` or `rl1-dap` for those programs' command lines."""
+    return f"{command_path}: {kind}: {message}"
 
 
 class Context(click.Context):
@@ -74,10 +80,9 @@ def write_usage(command: click.Command, ctx: click.Context,
                           prefix="usage: ")
 
 
-class Command(click.Command):
-    """An `rl1c` command: its callback returns the exit status. Failures, a closed
-    output pipe, Ctrl-C and bugs become a message on standard error and a status here,
-    before click's own handling (which would print a blank line on Ctrl-C)."""
+class ToolCommand(click.Command):
+    """A click command whose help and usage read as rl1c's (`-h`, `usage: ...`, as wide
+    as the terminal): rl1c's commands, and the command lines of rl1-lsp and rl1-dap."""
 
     context_class = Context
 
@@ -88,6 +93,12 @@ class Command(click.Command):
     def format_usage(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         write_usage(self, ctx, formatter)
 
+
+class Command(ToolCommand):
+    """An `rl1c` command: its callback returns the exit status. Failures, a closed
+    output pipe, Ctrl-C and bugs become a message on standard error and a status here,
+    before click's own handling (which would print a blank line on Ctrl-C)."""
+
     def invoke(self, ctx: click.Context) -> int:
         try:
             status: int = super().invoke(ctx)
@@ -96,7 +107,7 @@ class Command(click.Command):
         except (click.ClickException, click.exceptions.Exit):
             raise  # usage errors are shown by the group, with the usage
         except CommandError as failure:
-            print(error_line(ctx.command_path, str(failure)), file=sys.stderr)
+            print(message_line(ctx.command_path, "error", str(failure)), file=sys.stderr)
             return failure.status
         except Failure as failure:
             print(failure, file=sys.stderr)
@@ -109,6 +120,48 @@ class Command(click.Command):
             return interrupted()
         except Exception as error:
             return internal_error(error)
+
+
+def command_line_status(run: Callable[[], object], prog: str) -> int:
+    """The exit status of `run`, a click command line run not standalone (its `main`
+    with `standalone_mode=False`), saying what ends it early as rl1c says it: a usage
+    error as `usage: ...` then `rl1c check: error: what is wrong` (status 2), another of
+    click's errors as `PROG: error: ...` with its status (`prog`: the program's name),
+    Ctrl-C that click turned into Abort as `PROG: interrupted` (130)."""
+    try:
+        status = run()
+    except click.UsageError as error:
+        return show_usage_error(error, prog)
+    except click.ClickException as error:
+        print(message_line(prog, "error", error.format_message()), file=sys.stderr)
+        return error.exit_code
+    except click.Abort:
+        return interrupted(prog)
+    return status if isinstance(status, int) else 0  # a callback that returns nothing
+
+
+def show_usage_error(error: click.UsageError, prog: str) -> int:
+    """Prints the usage and what is wrong, as `rl1c check: error: ...` (`prog` when the
+    error names no command); exit status 2."""
+    ctx = error.ctx
+    if ctx is not None:
+        click.echo(ctx.get_usage(), err=True)
+    said = message_line(ctx.command_path if ctx is not None else prog, "error",
+                        describe(error))
+    click.echo(said, err=True)
+    return EXIT_USAGE
+
+
+def describe(error: click.UsageError) -> str:
+    """What is wrong, in the words rl1c has always used."""
+    if isinstance(error, click.MissingParameter) and isinstance(error.param, click.Argument):
+        return f"the following arguments are required: {error.param.human_readable_name}"
+    if isinstance(error, click.BadParameter) and error.param is not None:
+        return f"argument {'/'.join(error.param.opts)}: {error.message}"
+    if isinstance(error, click.NoSuchOption):
+        close = f" (did you mean {error.possibilities[0]}?)" if error.possibilities else ""
+        return f"unrecognized arguments: {error.option_name}{close}"
+    return error.format_message()
 
 
 def output_failed(error: OSError) -> int:
@@ -126,12 +179,13 @@ def output_failed(error: OSError) -> int:
     else:
         problem = f"{error.strerror or error}; free some space or write elsewhere"
     with contextlib.suppress(OSError):  # standard error may be just as full
-        print(error_line("rl1c", f"cannot write the output: {problem}"), file=sys.stderr)
+        print(message_line("rl1c", "error", f"cannot write the output: {problem}"),
+              file=sys.stderr)
     return EXIT_USAGE
 
 
-def interrupted() -> int:
-    print("rl1c: interrupted", file=sys.stderr)
+def interrupted(prog: str = "rl1c") -> int:
+    print(f"{prog}: interrupted", file=sys.stderr)
     return EXIT_INTERRUPTED
 
 

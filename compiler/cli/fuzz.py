@@ -29,6 +29,7 @@ from .command import (
     a_budget,
     at_least_one,
     choice_option,
+    message_line,
     or_none,
     stop_signals_handled,
 )
@@ -38,6 +39,7 @@ if TYPE_CHECKING:
     from rl1.compiler.fuzz import Channel, Finding, Outcome, Reproducer
 
 SECTION = "Testing"
+COMMAND_PATH = "rl1c fuzz"  # what its warnings begin with
 
 DEFAULT_COUNT = 1000
 DEFAULT_BUDGET = 20_000  # generated programs are short; a runaway is found quickly
@@ -187,7 +189,7 @@ def fuzz(engine_names: tuple[str, ...], count: int | None, seconds: int | None,
         raise click.UsageError(f"argument --corpus: {missing[0]}: no such file or folder")
     corpus, warnings = read_corpus(corpus_paths)
     for warning in warnings:
-        print(f"rl1c: warning: {warning}", file=sys.stderr)
+        print(message_line(COMMAND_PATH, "warning", warning), file=sys.stderr)
     limit = None if seconds is not None else count or DEFAULT_COUNT
     bar = _Bar(limit, seconds)
     channel = Channel()
@@ -424,7 +426,7 @@ class _Bar:
     def warn(self, warning: str) -> None:
         """Say `warning` on a line of its own (a bar is drawn again after it)."""
         erase = "\r\033[K" if self.terminal and self.shown else ""  # the bar drawn so far
-        self.stream.write(f"{erase}rl1c: warning: {warning}\n")
+        self.stream.write(erase + message_line(COMMAND_PATH, "warning", warning) + "\n")
         self.stream.flush()
 
     def close(self) -> None:

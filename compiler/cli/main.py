@@ -34,10 +34,9 @@ from . import plugins
 from .command import (
     CONTEXT_SETTINGS,
     Context,
+    command_line_status,
     completable,
-    error_line,
     internal_error,
-    interrupted,
     output_failed,
     write_usage,
 )
@@ -152,17 +151,11 @@ class Toolchain(click.Group):
         exit status, or exits with it in standalone mode (the default)."""
         _hold_closed_standard_streams()
         _escape_unprintable_output()
+        name = prog_name or self.name or "rl1c"  # not "-c" or "__main__.py", however started
         try:
-            # The name is rl1c however Python was started (not "-c" or "__main__.py").
-            status = super().main(args, prog_name or self.name, complete_var,
-                                  standalone_mode=False, **extra)
-        except click.UsageError as error:
-            status = show_usage_error(error)
-        except click.ClickException as error:
-            error.show()
-            status = error.exit_code
-        except click.Abort:  # Ctrl-C while click reads the command line
-            status = interrupted()
+            status = command_line_status(
+                lambda: super(Toolchain, self).main(args, name, complete_var,
+                                                    standalone_mode=False, **extra), name)
         except OSError as error:  # writing --help or --version failed
             status = output_failed(error) if error.filename is None else internal_error(error)
         except Exception as error:
@@ -181,28 +174,6 @@ def names_a_file(word: str) -> bool:
         return word == "-"
     return (os.sep in word or "/" in word or os.path.splitext(word)[1] != ""
             or (os.path.exists(word) and word not in plugin_names()))
-
-
-def show_usage_error(error: click.UsageError) -> int:
-    """Prints the usage and what is wrong, as `rl1c check: error: ...`; exit status 2."""
-    ctx = error.ctx
-    if ctx is not None:
-        click.echo(ctx.get_usage(), err=True)
-    prog = ctx.command_path if ctx is not None else "rl1c"
-    click.echo(error_line(prog, describe(error)), err=True)
-    return EXIT_USAGE
-
-
-def describe(error: click.UsageError) -> str:
-    """What is wrong, in the words rl1c has always used."""
-    if isinstance(error, click.MissingParameter) and isinstance(error.param, click.Argument):
-        return f"the following arguments are required: {error.param.human_readable_name}"
-    if isinstance(error, click.BadParameter) and error.param is not None:
-        return f"argument {'/'.join(error.param.opts)}: {error.message}"
-    if isinstance(error, click.NoSuchOption):
-        close = f" (did you mean {error.possibilities[0]}?)" if error.possibilities else ""
-        return f"unrecognized arguments: {error.option_name}{close}"
-    return error.format_message()
 
 
 def _hold_closed_standard_streams() -> None:

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import click
 
-from .command import Command, CommandError
+from .command import Command, CommandError, message_line
 
 if TYPE_CHECKING:  # importlib.metadata takes tens of milliseconds to load: when asked
     from importlib.metadata import Distribution, EntryPoint
@@ -47,10 +47,10 @@ def installed() -> dict[str, EntryPoint]:
         try:
             entries = distribution.entry_points.select(group=GROUP)
         except Exception as error:  # a file of its metadata that is no entry point list
-            click.echo(f"rl1c: warning: cannot read the entry points (entry_points.txt) "
-                       f"of {_named(distribution)} ({type(error).__name__}: {error}), "
-                       "which may add commands to rl1c; they are left out: install that "
-                       "package again", err=True)
+            click.echo(message_line(
+                "rl1c", "warning", "cannot read the entry points (entry_points.txt) of "
+                f"{_named(distribution)} ({type(error).__name__}: {error}), which may add "
+                "commands to rl1c; they are left out: install that package again"), err=True)
             continue
         for entry in entries:
             found.setdefault(entry.name, entry)

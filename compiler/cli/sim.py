@@ -22,6 +22,7 @@ from .command import (
     color_option,
     engine_option,
     force_option,
+    message_line,
     or_none,
 )
 from .streams import PATH_ESCAPES, invalid_config, read_failure, same_file, write_file
@@ -31,6 +32,7 @@ if TYPE_CHECKING:
     from rl1.vm.sim.world import World
 
 SECTION = "Simulation"
+COMMAND_PATH = "rl1c sim"  # what its errors, warnings and notes (a campaign's too) begin with
 MAX_WORLD_BYTES = 4 * 2**20
 WORLD_ROLE = "world file"
 EXAMPLE_WORLD = "examples/sample.world.toml"
@@ -237,8 +239,9 @@ def single_run_world(world: World, axes: tuple[Axis, ...], seed: int | None) -> 
         return world.moved(dict(offsets))
     world, values = drawn_world(world, offsets, seed)
     if values:
-        print("rl1c: note: the world of seed " + str(seed) + ": " + ", ".join(
-            f"{key} = {value:.6g}" for key, value in values.items()), file=sys.stderr)
+        drawn = ", ".join(f"{key} = {value:.6g}" for key, value in values.items())
+        print(message_line(COMMAND_PATH, "note", f"the world of seed {seed}: {drawn}"),
+              file=sys.stderr)
     return world
 
 

@@ -41,8 +41,15 @@ from rl1.vm.defaults import DEFAULT_BUDGET, Engine
 from rl1.vm.sim.campaign_render import Overlay, Run, heat_map_svg, html, svg
 from rl1.vm.sim.world import World
 
-from .command import EXIT_INTERNAL, CommandError, Failure, stop_signals_handled
+from .command import (
+    EXIT_INTERNAL,
+    CommandError,
+    Failure,
+    message_line,
+    stop_signals_handled,
+)
 from .running import run_file
+from .sim import COMMAND_PATH
 from .streams import (
     PATH_ESCAPES,
     cannot_write,
@@ -157,9 +164,10 @@ def _workers(setting: Setting, progress: Progress) -> Iterator[Workers]:
                      unmanned=lambda: progress.warn(no_workers_left(setting.scheduler or ""))
                      ) as held:
             if setting.scheduler is not None and held.slots == 0:
-                print(f"rl1c: note: the scheduler at {setting.scheduler} has no workers yet; "
-                      f"the runs wait for one (`dask worker {setting.scheduler}`)",
-                      file=sys.stderr)
+                print(message_line(
+                    COMMAND_PATH, "note", f"the scheduler at {setting.scheduler} has no "
+                    f"workers yet; the runs wait for one (`dask worker {setting.scheduler}`)"),
+                    file=sys.stderr)
             yield held
     except Unavailable as error:
         raise CommandError(str(error)) from None
@@ -218,7 +226,7 @@ class Progress:
     def warn(self, warning: str) -> None:
         """Say `warning` on a line of its own (the progress line is drawn again later)."""
         self.finish()
-        self.stream.write(f"rl1c: warning: {warning}\n")
+        self.stream.write(message_line(COMMAND_PATH, "warning", warning) + "\n")
         self.stream.flush()
 
 
@@ -379,18 +387,19 @@ def run_campaign(file: str, world: bytes, world_name: str, setting: Setting, out
     next_seed = setting.seed + tally.runs
     rest = setting.rest(next_seed, setting.runs - tally.runs)
     if status == EXIT_INTERNAL:
-        print(f"rl1c: error: the run of seed {next_seed} ended its worker each time it "
-              f"was made: replay it alone ({setting.replay(next_seed, keeper.point)}), and "
-              f"if rl1c crashed, report it; the runs before it are kept"
-              + ("" if setting.sweep else "; to go on after it: "
-                 + setting.rest(next_seed + 1, setting.runs - tally.runs - 1)),
-              file=sys.stderr)
+        print(message_line(
+            COMMAND_PATH, "error", f"the run of seed {next_seed} ended its worker each "
+            f"time it was made: replay it alone ({setting.replay(next_seed, keeper.point)}), "
+            "and if rl1c crashed, report it; the runs before it are kept"
+            + ("" if setting.sweep else "; to go on after it: "
+               + setting.rest(next_seed + 1, setting.runs - tally.runs - 1))),
+            file=sys.stderr)
     elif status:
-        print(("rl1c: interrupted" if lost is None else f"rl1c: error: {lost}")
-              + ": the runs finished are kept" + ("" if out is None else f" in {out}") + (
-                  "; to go on, run the sweep again (each point makes the same runs)"
-                  if setting.sweep else "; to go on, run the seeds left: " + rest),
-              file=sys.stderr)
+        kept = ("the runs finished are kept" + ("" if out is None else f" in {out}") + (
+            "; to go on, run the sweep again (each point makes the same runs)"
+            if setting.sweep else "; to go on, run the seeds left: " + rest))
+        print("rl1c: interrupted: " + kept if lost is None
+              else message_line(COMMAND_PATH, "error", f"{lost}: {kept}"), file=sys.stderr)
     return status
 
 def _make_runs(task: Task, seeds: range, held: Workers, keeper: Keeper,

@@ -33,7 +33,7 @@ from rl1.compiler.reporting.render import (
     write_report,
 )
 
-from .command import Failure
+from .command import Failure, message_line
 
 if TYPE_CHECKING:  # the .ilc module loads only when an .ilc file is read
     from rl1.vm.ilc import IlcFormatError
@@ -102,8 +102,8 @@ def source_files(names: Sequence[str], command: str) -> list[str | FileDiagnosti
                                                      os_reason(error)),
                                       "check its permissions"))
         if len(found) == before:
-            print(f"rl1c {command}: warning: no {SOURCE_SUFFIX} file under `{name}`",
-                  file=sys.stderr)
+            print(message_line(f"rl1c {command}", "warning",
+                               f"no {SOURCE_SUFFIX} file under `{name}`"), file=sys.stderr)
     return found
 
 

@@ -348,7 +348,7 @@ def test_rl1c_fuzz_says_each_worker_an_engine_ends(tmp_path: Path,
                   tmp_path / "out")
     assert result.exit_code == 1, result.output
     assert f"      2  {SIGSEGV}\n" in result.stdout
-    assert without_progress(result.stderr) == [f"rl1c: warning: {WORKER_LOST}"] * 2
+    assert without_progress(result.stderr) == [f"rl1c fuzz: warning: {WORKER_LOST}"] * 2
 
 
 @pytest.mark.parametrize("jobs", ["1", "2"])
@@ -359,7 +359,7 @@ def test_rl1c_fuzz_names_the_program_writes_its_reproducer_and_replays_it(
                   "--seed", str(SEED), "--jobs", jobs, "--out", out)
     assert result.exit_code == 1, result.output
     assert "Traceback" not in result.output
-    assert "rl1c: warning: a worker process ended abruptly" in result.stderr
+    assert "rl1c fuzz: warning: a worker process ended abruptly" in result.stderr
     # The killer is the eighth program; on 2 processes the third search may run a while.
     programs = int(result.stdout.split()[1])
     assert programs == 8 if jobs == "1" else 8 <= programs <= COUNT

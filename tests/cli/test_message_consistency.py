@@ -3,10 +3,14 @@ through `rl1c`: a fault's help said once, whichever engine meets it."""
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import pytest
 from support.cli import rl1c
+
+from rl1.compiler.cli import fuzz
+from rl1.compiler.cli.sim_campaign import Progress
 
 LOOP = ":10 A=A+1\n#10\n(END)\n"
 
@@ -40,6 +44,25 @@ def test_rl1c_new_says_its_errors_once_named(tmp_path: Path) -> None:
     failed = rl1c("new", tmp_path / "taken")
     assert failed.stderr == (f"rl1c new: error: `{tmp_path / 'taken'}` exists and is no "
                              "folder; give the path of a new folder\n")
+
+
+def test_a_note_names_the_command_as_its_errors_do(tmp_path: Path) -> None:
+    (tmp_path / "p.rob").write_text("(END)\n")
+    (tmp_path / "w.toml").write_text("[floor]\nsize = [600, 400]\n[start]\nx = 100.0\n"
+                                     "y = 200.0\n[vary]\nstart.heading = { uniform = [5, 5] }\n")
+    ran = rl1c("sim", tmp_path / "p.rob", "--world", tmp_path / "w.toml", "--seed", "3")
+    assert ran.exit_code == 0, ran.output
+    # Where it said `rl1c: note:` beside `rl1c sim: error: ...`.
+    assert ran.stderr == "rl1c sim: note: the world of seed 3: start.heading = 5\n"
+
+
+def test_a_campaigns_warning_names_its_command_as_its_errors_do() -> None:
+    warned = {"rl1c sim": io.StringIO(), "rl1c fuzz": io.StringIO()}
+    Progress(10, warned["rl1c sim"]).warn("a worker was lost")
+    fuzz._Bar(10, None, warned["rl1c fuzz"]).warn("a worker was lost")
+    # Where both said `rl1c: warning:` and their errors `rl1c fuzz: error:`.
+    for command, stream in warned.items():
+        assert stream.getvalue() == f"{command}: warning: a worker was lost\n"
 
 
 def test_every_configuration_file_is_named_once_and_placed_at_its_line(

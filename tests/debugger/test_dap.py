@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from support import SAMPLE, SAMPLE_SENSORS
 
 from rl1.compiler.debugger import Session, Stop
-from rl1.lsp.dap import CAPABILITIES, Adapter
+from rl1.lsp.dap import CAPABILITIES, Adapter, Refused
 
 WORLD = SAMPLE.parent / "sample.world.toml"
 TIMEOUT = 60
@@ -341,6 +341,32 @@ def test_any_arguments_get_one_answer_and_never_break_the_adapter(
     responses = [m for m in sent if m["type"] == "response"]
     assert [m["request_seq"] for m in responses] == list(range(1, len(requests) + 2))
     assert not [m for m in responses if "please report it" in m.get("message", "")]
+
+
+def test_a_request_sent_as_soon_as_the_run_stops_is_answered(tmp_path: Path) -> None:
+    # The client hears of the stop from the worker, which is still ending: a continue
+    # sent at once was refused as `the program is running` (at random, as threads ran).
+    program = tmp_path / "loop.rob"
+    program.write_text(":10 A=A+1\n#10\n")
+    idle_when_told: list[bool] = []
+
+    def send(message: dict[str, Any]) -> None:
+        if message.get("event") in ("stopped", "exited"):  # in the worker, still alive
+            try:
+                adapter._idle()
+                idle_when_told.append(True)
+            except Refused:
+                idle_when_told.append(False)
+
+    adapter = Adapter(send)
+    for seq, (command, arguments) in enumerate(
+            [("launch", {"program": str(program), "budget": 50}), ("configurationDone", {})],
+            start=1):
+        adapter.receive(json.dumps({"seq": seq, "type": "request", "command": command,
+                                    "arguments": arguments}).encode())
+    assert adapter._worker is not None
+    adapter._worker.join(TIMEOUT)
+    assert idle_when_told == [True]
 
 
 def test_the_command_line_answers_help_and_version_without_serving() -> None:

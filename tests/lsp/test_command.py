@@ -10,6 +10,7 @@ import socket
 import subprocess
 import sys
 from importlib.metadata import version
+from pathlib import Path
 
 import pytest
 from sockets import free_port
@@ -42,8 +43,30 @@ def test_a_closed_standard_stream_is_a_usage_error(module: str, closed: int,
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                             timeout=60, check=False, preexec_fn=lambda: os.close(closed))
     assert failed.returncode == 2, failed.stderr
-    assert failed.stderr.endswith(f"Error: standard {stream} is closed: a client starts this "
-                                  "server with its standard input and output as pipes\n")
+    name = "rl1-dap" if module.endswith("dap") else "rl1-lsp"
+    assert failed.stderr.endswith(f"{name}: error: standard {stream} is closed: a client "
+                                  "starts this server with its standard input and output "
+                                  "as pipes\n")
+
+
+@pytest.mark.parametrize(("program", "args", "said"), [
+    ("rl1-lsp", ["--bogus"], "unrecognized arguments: --bogus"),
+    ("rl1-lsp", ["--tcp", "2087"],
+     "argument --tcp: expected HOST:PORT such as 127.0.0.1:2087, got '2087'"),
+    ("rl1-dap", ["--bogus"], "unrecognized arguments: --bogus"),
+])
+def test_a_malformed_command_line_is_said_as_rl1cs_are(program: str, args: list[str],
+                                                        said: str) -> None:
+    # The installed programs, as an editor starts them; click said `Usage: ...` then
+    # `Error: No such option: --bogus` before, unlike every rl1c command.
+    script = Path(sys.executable).with_name(program)
+    failed = subprocess.run([script, *args], capture_output=True, text=True, timeout=60,
+                            stdin=subprocess.DEVNULL, check=False)
+    rl1c = subprocess.run([script.with_name("rl1c"), "check", *args], capture_output=True,
+                          text=True, timeout=60, check=False)
+    assert failed.returncode == rl1c.returncode == 2
+    assert failed.stderr == f"usage: {program} [OPTIONS]\n{program}: error: {said}\n"
+    assert rl1c.stderr.splitlines()[0].startswith("usage: rl1c check ")
 
 
 @pytest.mark.parametrize("option", ["--tcp", "--ws"])

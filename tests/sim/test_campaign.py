@@ -495,7 +495,7 @@ def test_a_run_that_ends_its_worker_each_time_is_named_and_those_before_it_kept(
     killed = with_a_killer(True)
     result = killed.two
     assert result.exit_code == 3, result.output
-    assert (f"rl1c: error: the run of seed {KILLER} ended its worker each time it was "
+    assert (f"rl1c sim: error: the run of seed {KILLER} ended its worker each time it was "
             f"made: replay it alone (rl1c sim ") in result.stderr
     assert f"--runs {RUNS - KILLER - 1} --seed {KILLER + 1} --jobs 2" in result.stderr
     assert killed.lines.splitlines() == killed.alone_lines.splitlines()[:KILLER]

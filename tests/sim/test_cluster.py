@@ -229,8 +229,8 @@ def test_a_worker_killed_in_a_campaign_on_a_cluster_loses_no_run(
     assert process.returncode == 0, stderr + cluster.log()
     assert "Traceback" not in stderr
     # Said once, though each of the tasks it had failed (KilledWorker, allowed failures 0).
-    assert stderr.count("rl1c: warning: ") == 1  # beside the progress lines
-    assert f"rl1c: warning: {SIM_WORKER_LOST}\n" in stderr
+    assert stderr.count("rl1c sim: warning: ") == 1  # beside the progress lines
+    assert f"rl1c sim: warning: {SIM_WORKER_LOST}\n" in stderr
     local = _local(program, world, runs, tmp_path / "local.jsonl")
     assert stdout == local  # every run counted once: the summary is exact
     assert out.read_bytes() == (tmp_path / "local.jsonl").read_bytes()
@@ -250,7 +250,7 @@ def test_a_campaign_whose_workers_are_all_lost_says_so_and_waits_for_one(
         stdout = _lose_the_workers(
             cluster, process, said, lambda: out.exists() and out.read_text().count("\n") >= 100)
     assert process.returncode == 0, said.read_text() + cluster.log()
-    assert f"rl1c: warning: {no_workers_left(cluster.address)}\n" in said.read_text()
+    assert f"rl1c sim: warning: {no_workers_left(cluster.address)}\n" in said.read_text()
     assert "Traceback" not in said.read_text()
     assert stdout == _local(program, world, runs, tmp_path / "local.jsonl")
 
@@ -280,7 +280,7 @@ def test_a_campaign_started_before_any_worker_says_so_and_waits_for_one(
         scheduler.start_worker()
         stdout, _ = process.communicate(timeout=STARTED_WITHIN)
     assert process.returncode == 0, said.read_text() + scheduler.log()
-    assert (f"rl1c: note: the scheduler at {scheduler.address} has no workers yet; the runs "
+    assert (f"rl1c sim: note: the scheduler at {scheduler.address} has no workers yet; the runs "
             f"wait for one (`dask worker {scheduler.address}`)") in said.read_text()
     assert stdout == _local(program, world, 50, tmp_path / "local.jsonl")
     assert out.read_bytes() == (tmp_path / "local.jsonl").read_bytes()
@@ -405,7 +405,7 @@ def test_a_worker_running_another_rl1_that_joins_later_stops_the_campaign(
         scheduler.start_worker(python_path=_other_rl1(tmp_path))
         stdout, _ = process.communicate(timeout=STARTED_WITHIN)
     assert process.returncode == 2, said.read_text() + scheduler.log()
-    assert re.search(r"rl1c: error: the Dask worker tcp://127\.0\.0\.1:\d+, which joined the "
+    assert re.search(r"rl1c sim: error: the Dask worker tcp://127\.0\.0\.1:\d+, which joined the "
                      f"scheduler at {re.escape(scheduler.address)} after the start, runs "
                      r"another rl1 than this one \(its sources differ; install the same rl1 "
                      r"there, and restart that worker\): the runs finished are kept",
@@ -536,7 +536,7 @@ def test_a_scheduler_lost_in_a_campaign_keeps_its_runs_and_says_how_to_go_on(
     assert "Traceback" not in stderr
     kept = out.read_text().count("\n")
     assert f"{kept} runs of" in stdout and f"(stopped after {kept} of {runs})" in stdout
-    assert (f"rl1c: error: the connection to the Dask scheduler at {cluster.address} was "
+    assert (f"rl1c sim: error: the connection to the Dask scheduler at {cluster.address} was "
             f"lost: the runs finished are kept in {out}; to go on, run the seeds left: "
             f"rl1c sim {program} --world {world} --runs {runs - kept} --seed {kept} "
             f"--scheduler {cluster.address} --budget 10000") in stderr
@@ -575,7 +575,7 @@ def test_fuzzing_on_a_cluster_whose_workers_are_all_lost_says_so_and_waits_for_o
                 cluster, process, said,
                 lambda: cluster.log().count("Receive client connection") > connections)
     assert process.returncode == 0, said.read_text() + cluster.log()
-    assert (f"rl1c: warning: the Dask scheduler at {cluster.address} has no workers left "
+    assert (f"rl1c fuzz: warning: the Dask scheduler at {cluster.address} has no workers left "
             "(killed, or out of memory: one is started again only under a nanny, `dask "
             "worker` without --no-nanny); the searches wait for one (`dask worker "
             f"{cluster.address}`)\n") in said.read_text()
@@ -708,7 +708,7 @@ def test_a_program_that_crashes_a_workers_c_vm_is_the_finding(
     # crash ended the worker, and Dask tried the search on 3 more, each ended alike,
     # before it failed it and the campaign judged its programs apart.
     assert _workers_lost(crashing) == lost, crashing.log()
-    assert without_progress(result.stderr) == [f"rl1c: warning: {WORKER_LOST}"]
+    assert without_progress(result.stderr) == [f"rl1c fuzz: warning: {WORKER_LOST}"]
     assert ("an engine ends the process it runs in\n\nthe smallest program found that "
             f"does it:\n   1 | A=1234\n\n{CRASH}\n\nreproducer: ") in result.stdout
     folder = _the_crash(tmp_path / "out")
@@ -738,7 +738,7 @@ def test_a_worker_killed_each_time_on_a_cluster_is_said_as_such(
         result = rl1c("fuzz", "--engine", "vm-O0", "--engine", "ends-its-worker",
                       "--count", "4", "--seed", "3", "--scheduler", cluster.address)
     assert result.exit_code == 3, result.output + cluster.log()
-    assert without_progress(result.stderr) == [f"rl1c: warning: {WORKER_LOST}"] * 3 + [
+    assert without_progress(result.stderr) == [f"rl1c fuzz: warning: {WORKER_LOST}"] * 3 + [
         "rl1c fuzz: error: a worker process ended abruptly 3 times running one search, though "
         "none of its programs ended the process that ran it (something killed the "
         "workers, or the memory ran out); the campaign runs again with --seed 3"]
@@ -759,7 +759,7 @@ def test_a_crash_on_workers_without_a_nanny_ends_none_of_them(
         result = _fuzz_crashing(cluster, tmp_path)
         assert all(worker.poll() is None for worker in cluster.workers), cluster.log()
     assert result.returncode == 1, result.stderr + cluster.log()
-    assert without_progress(result.stderr) == [f"rl1c: warning: {WORKER_LOST}"]
+    assert without_progress(result.stderr) == [f"rl1c fuzz: warning: {WORKER_LOST}"]
     assert f"that does it:\n   1 | A=1234\n\n{CRASH}\n\nreproducer: " in result.stdout
     assert _workers_lost(cluster) == 0, cluster.log()
     _the_crash(tmp_path / "out")
