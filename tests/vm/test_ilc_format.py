@@ -279,9 +279,21 @@ def test_encode_refuses_an_image_the_format_cannot_hold(image: ilc.Image,
     assert str(caught.value) == message
 
 
-def test_the_last_line_is_written_and_read() -> None:
-    image = ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", ((0, ilc.MAX_LINE),)))
+def test_the_last_line_and_code_offset_are_written_and_read() -> None:
+    # The container holds any u16 offset; that it starts an instruction is the verifier's.
+    lines = ((0, ilc.MAX_LINE), (ilc.MAX_CODE_SIZE, ilc.MAX_LINE))
+    image = ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", lines))
     assert ilc.decode(ilc.encode(image)) == image
+
+
+def test_as_many_line_entries_as_the_count_holds_are_written_and_read() -> None:
+    lines = tuple((offset, 1) for offset in range(ilc.MAX_LINE_ENTRIES))
+    image = ilc.Image(LDI_5_END, {}, frozenset(), ilc.DebugInfo("x", lines))
+    assert ilc.decode(ilc.encode(image)) == image
+    with pytest.raises(ValueError) as caught:
+        ilc.encode(dataclasses.replace(
+            image, debug=ilc.DebugInfo("x", (*lines, (ilc.MAX_CODE_SIZE, 1)))))
+    assert str(caught.value) == "65536 line entries; the format allows 65535"
 
 
 def test_a_source_name_of_the_longest_length_is_written_and_read() -> None:
