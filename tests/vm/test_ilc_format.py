@@ -54,6 +54,14 @@ def test_decode_inverts_encode(image: ilc.Image) -> None:
     assert stripped == ilc.Image(image.code, image.handlers, image.features, None, image.flags)
 
 
+def test_a_decoded_debug_section_cannot_be_changed() -> None:
+    # The verifier checks the line map it was given: it must stay the one it checked.
+    debug = ilc.decode(ilc.encode(SAMPLE)).debug
+    assert debug == SAMPLE_DEBUG
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        debug.lines = ((1, 1),)  # type: ignore[misc]
+
+
 def test_strip_debug_leaves_an_empty_debug_section() -> None:
     data = ilc.encode(ilc.strip_debug(SAMPLE))
     assert ilc.read_header(data).debug_size == 0
