@@ -49,8 +49,8 @@ QUICK := not slow and not needs_cc and not needs_node and not needs_browser
 quick: $(STAMP)
 	$(BIN)/pytest -n 2 -m '$(QUICK)'
 
-# Mutation testing (tests/mutation/README.md): cosmic-ray's session M (machine, constants
-# or signs) in a clone of its own. Slow (an hour or more), never part of `make test`.
+# Mutation testing (tests/mutation/README.md): cosmic-ray's session M (machine, constants,
+# signs, verifier or ilc) in a clone of its own. Slow (an hour or more), never in `make test`.
 mutation:
 	tests/mutation/run $(or $(M),machine)
 
