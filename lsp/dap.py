@@ -100,7 +100,11 @@ class Adapter:
         self.stop_on_entry = False
         self.done = False  # after disconnect
         self._worker: threading.Thread | None = None
-        self._running = False  # till the worker says where it stopped (it ends just after)
+        self._running = False  # till the worker has told where it stopped
+        # Held while the worker tells a stop, so that a request waits until it is told
+        # whole: never refused as running after the client heard of the stop, and never
+        # let in before, to start a run whose events would come amid this one's.
+        self._telling = threading.Lock()
         self._told = 0  # the trace entries already sent as output
         self._last_stop: Stop | None = None
         self._started = False  # by configurationDone, or a command before it
@@ -392,7 +396,9 @@ class Adapter:
 
     def _idle(self) -> Session:
         session = self._session()
-        if self._running:
+        with self._telling:
+            running = self._running
+        if running:
             raise Refused("the program is running: pause it first")
         return session
 
@@ -407,7 +413,10 @@ class Adapter:
         """The worker: where `command` stops, told; a bug of ours ends the session, said
         (in its thread, it would print a traceback and leave the client waiting)."""
         try:
-            self._stopped(command())
+            stop = command()
+            with self._telling:
+                self._stopped(stop)
+                self._running = False
         except Exception as error:
             self._running = False
             print(f"rl1-dap: internal error in the run: {error!r}; please report it",
@@ -420,9 +429,6 @@ class Adapter:
         session = self._session()
         previous, self._last_stop = self._last_stop, stop
         self._tell_trace(session)
-        # Idle before the client hears of the stop: its next request may come at once,
-        # while this thread is still ending (it was refused as running).
-        self._running = False
         # A fault is shown as an exception where it happened; the command after it ends.
         if stop.reason == "end" or (stop.reason == "fault" and previous == stop):
             self.event("exited", {"exitCode": 0 if stop.reason == "end" else

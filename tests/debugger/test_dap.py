@@ -344,19 +344,29 @@ def test_any_arguments_get_one_answer_and_never_break_the_adapter(
 
 
 def test_a_request_sent_as_soon_as_the_run_stops_is_answered(tmp_path: Path) -> None:
-    # The client hears of the stop from the worker, which is still ending: a continue
-    # sent at once was refused as `the program is running` (at random, as threads ran).
+    # The client hears of the stop from the worker, which is still ending: a request sent
+    # at once, from the adapter's reading thread, was refused as `the program is running`
+    # (at random, as threads ran). It waits until the stop is told whole, then is let in.
     program = tmp_path / "loop.rob"
     program.write_text(":10 A=A+1\n#10\n")
-    idle_when_told: list[bool] = []
+    idle: list[bool] = []
+    asking = threading.Event()
+
+    def ask() -> None:  # the reading thread's next request, as the client sends it
+        asking.set()
+        try:
+            adapter._idle()
+            idle.append(True)
+        except Refused:
+            idle.append(False)
+
+    requests: list[threading.Thread] = []
 
     def send(message: dict[str, Any]) -> None:
-        if message.get("event") in ("stopped", "exited"):  # in the worker, still alive
-            try:
-                adapter._idle()
-                idle_when_told.append(True)
-            except Refused:
-                idle_when_told.append(False)
+        if message.get("event") == "stopped" and not requests:  # in the worker
+            requests.append(threading.Thread(target=ask))
+            requests[0].start()
+            asking.wait(TIMEOUT)
 
     adapter = Adapter(send)
     for seq, (command, arguments) in enumerate(
@@ -366,7 +376,8 @@ def test_a_request_sent_as_soon_as_the_run_stops_is_answered(tmp_path: Path) -> 
                                     "arguments": arguments}).encode())
     assert adapter._worker is not None
     adapter._worker.join(TIMEOUT)
-    assert idle_when_told == [True]
+    requests[0].join(TIMEOUT)
+    assert idle == [True]
 
 
 def test_the_command_line_answers_help_and_version_without_serving() -> None:
