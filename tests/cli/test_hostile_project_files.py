@@ -54,8 +54,9 @@ def test_a_path_with_a_nul_character_is_refused_with_its_line(tmp_path: Path,
     result = rl1c("test", tests)
     assert result.exit_code == 2, result.output
     line = 3 if key == "program" else 4
-    assert (f"t.tests.toml:{line}: test[0].{key}: holds the control character U+0000"
-            in result.stderr)
+    assert f"is not valid: test[0].{key}: holds the control character U+0000" \
+        in result.stderr
+    assert f" --> {tests}:{line}\n" in result.stderr  # the place, on the arrow's line
 
 
 def test_a_name_with_an_escape_sequence_never_reaches_the_terminal(tmp_path: Path) -> None:
