@@ -32,7 +32,6 @@ if TYPE_CHECKING:
     from rl1.vm.sim.world import World
 
 SECTION = "Simulation"
-COMMAND_PATH = "rl1c sim"  # what its errors, warnings and notes (a campaign's too) begin with
 MAX_WORLD_BYTES = 4 * 2**20
 WORLD_ROLE = "world file"
 EXAMPLE_WORLD = "examples/sample.world.toml"
@@ -240,8 +239,8 @@ def single_run_world(world: World, axes: tuple[Axis, ...], seed: int | None) -> 
     world, values = drawn_world(world, offsets, seed)
     if values:
         drawn = ", ".join(f"{key} = {value:.6g}" for key, value in values.items())
-        print(message_line(COMMAND_PATH, "note", f"the world of seed {seed}: {drawn}"),
-              file=sys.stderr)
+        print(message_line(click.get_current_context().command_path, "note",
+                           f"the world of seed {seed}: {drawn}"), file=sys.stderr)
     return world
 
 

@@ -49,7 +49,6 @@ from .command import (
     stop_signals_handled,
 )
 from .running import run_file
-from .sim import COMMAND_PATH
 from .streams import (
     PATH_ESCAPES,
     cannot_write,
@@ -59,6 +58,9 @@ from .streams import (
     write_file,
 )
 
+# What the campaign's errors, warnings and notes begin with: some are said from the
+# executors' threads, where click's context (rl1c sim's own messages) is not at hand.
+COMMAND_PATH = "rl1c sim"
 PROGRESS_EVERY = 5.0  # s between progress lines when standard error is no terminal
 REDRAW_EVERY = 0.2  # s between redraws of the progress line on a terminal
 WINDOW_PER_JOB = 8  # tasks in flight per worker (a cluster: per thread), each of a few
