@@ -155,14 +155,14 @@ def parse_condition(text: str) -> Condition:
     if match is None and other is not None and other.start() > 0:
         shown, (compared, number) = stripped[:other.start()].rstrip(), other.groups()
         sign = "+" if number.startswith("-") else "-"
-        raise DebugError(f"the condition `{text.strip()}` compares with {number}, and a "
+        raise DebugError(f"the condition `{stripped}` compares with {number}, and a "
                          f"condition compares with 0 (`<` after a value is a shift): "
                          f"write `{shown}{sign}{number.lstrip('-')}{compared}0`")
     if match is None or not (value_text := stripped[:match.start()].rstrip()):
-        raise DebugError(f"the condition `{text.strip()}` compares nothing with 0: "
+        raise DebugError(f"the condition `{stripped}` compares nothing with 0: "
                          f"{_CONDITION_HELP}")
     value = parse_value(value_text, _CONDITION_HELP)
-    return Condition(text.strip(), value, _RELATIONS[match["relation"]])
+    return Condition(stripped, value, _RELATIONS[match["relation"]])
 
 
 def parse_call(name: str) -> FormKey:
